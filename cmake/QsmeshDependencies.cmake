@@ -1,0 +1,81 @@
+# Finds every dependency; each failure names the Debian package that provides it
+# (scripts/setup.sh installs them all).
+
+macro(qsmesh_require found what package)
+  if(NOT ${found})
+    message(FATAL_ERROR "qsmesh: ${what} not found. Install the Debian package '${package}' "
+                        "(or run scripts/setup.sh, which installs every dependency).")
+  endif()
+endmacro()
+
+find_package(PkgConfig QUIET)
+qsmesh_require(PkgConfig_FOUND "pkg-config" "pkg-config")
+
+# OpenCASCADE 7.6
+# (OpenCASCADE's version file accepts exact versions only, so the minimum is checked here.)
+find_package(OpenCASCADE QUIET)
+if(OpenCASCADE_FOUND AND OpenCASCADE_VERSION VERSION_LESS 7.6)
+  set(OpenCASCADE_FOUND FALSE)
+endif()
+qsmesh_require(OpenCASCADE_FOUND "OpenCASCADE >= 7.6" "libocct-data-exchange-dev")
+add_library(qsmesh_occt INTERFACE)
+target_include_directories(qsmesh_occt SYSTEM INTERFACE ${OpenCASCADE_INCLUDE_DIR})
+target_link_libraries(qsmesh_occt INTERFACE
+  TKernel TKMath TKG2d TKG3d TKGeomBase TKBRep TKGeomAlgo TKTopAlgo TKPrim TKBO TKBool
+  TKShHealing TKOffset TKFillet TKMesh TKSTEP TKSTEPBase TKSTEPAttr TKSTEP209 TKIGES TKXSBase)
+
+# MPI
+find_package(MPI QUIET COMPONENTS C)
+qsmesh_require(MPI_C_FOUND "MPI (C bindings)" "libopenmpi-dev")
+
+# TBB
+find_package(TBB QUIET CONFIG)
+qsmesh_require(TBB_FOUND "oneTBB" "libtbb-dev")
+
+# Eigen
+find_package(Eigen3 3.3 QUIET NO_MODULE)
+qsmesh_require(Eigen3_FOUND "Eigen3" "libeigen3-dev")
+
+# PETSc (with MUMPS), through pkg-config
+pkg_check_modules(PETSC QUIET IMPORTED_TARGET petsc)
+qsmesh_require(PETSC_FOUND "PETSc" "petsc-dev")
+find_library(MUMPS_D_LIBRARY dmumps)
+qsmesh_require(MUMPS_D_LIBRARY "MUMPS" "libmumps-dev")
+
+# METIS
+find_path(METIS_INCLUDE_DIR metis.h)
+find_library(METIS_LIBRARY metis)
+if(METIS_INCLUDE_DIR AND METIS_LIBRARY)
+  set(METIS_FOUND TRUE)
+endif()
+qsmesh_require(METIS_FOUND "METIS" "libmetis-dev")
+add_library(qsmesh_metis INTERFACE)
+target_include_directories(qsmesh_metis SYSTEM INTERFACE ${METIS_INCLUDE_DIR})
+target_link_libraries(qsmesh_metis INTERFACE ${METIS_LIBRARY})
+
+# HDF5 (serial: Debian's libcgns is built against it)
+pkg_check_modules(HDF5S QUIET IMPORTED_TARGET hdf5-serial)
+qsmesh_require(HDF5S_FOUND "HDF5 (serial)" "libhdf5-dev")
+
+# CGNS: Debian ships neither CMake nor pkg-config files for it
+find_path(CGNS_INCLUDE_DIR cgnslib.h)
+find_library(CGNS_LIBRARY cgns)
+if(CGNS_INCLUDE_DIR AND CGNS_LIBRARY)
+  set(CGNS_FOUND TRUE)
+endif()
+qsmesh_require(CGNS_FOUND "CGNS" "libcgns-dev")
+add_library(qsmesh_cgns INTERFACE)
+target_include_directories(qsmesh_cgns SYSTEM INTERFACE ${CGNS_INCLUDE_DIR})
+target_link_libraries(qsmesh_cgns INTERFACE ${CGNS_LIBRARY} PkgConfig::HDF5S)
+
+find_program(CGNSCHECK_EXECUTABLE cgnscheck)
+if(NOT CGNSCHECK_EXECUTABLE)
+  message(WARNING "qsmesh: cgnscheck not found (Debian package 'cgns-convert'); CGNS validation tests are skipped.")
+endif()
+
+# GoogleTest
+if(QSMESH_BUILD_TESTS)
+  find_package(GTest QUIET)
+  qsmesh_require(GTest_FOUND "GoogleTest" "libgtest-dev")
+  find_program(MPIEXEC_EXECUTABLE_FOUND NAMES mpiexec)
+endif()

@@ -1,0 +1,16 @@
+# qsmesh_add_module(NAME SOURCES ... DEPENDS ...)
+# One static library per module, named qsmesh_<NAME>, with the project's warnings and C++20.
+function(qsmesh_apply_settings target)
+  target_compile_features(${target} PUBLIC cxx_std_20)
+  set_target_properties(${target} PROPERTIES CXX_EXTENSIONS OFF POSITION_INDEPENDENT_CODE ON)
+  target_compile_options(${target} PRIVATE -Wall -Wextra -Wpedantic -Wshadow -Wno-unused-parameter)
+endfunction()
+
+function(qsmesh_add_module name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPENDS;PRIVATE_DEPENDS" ${ARGN})
+  add_library(qsmesh_${name} STATIC ${ARG_SOURCES})
+  add_library(qsmesh::${name} ALIAS qsmesh_${name})
+  target_include_directories(qsmesh_${name} PUBLIC ${PROJECT_SOURCE_DIR}/include)
+  target_link_libraries(qsmesh_${name} PUBLIC ${ARG_DEPENDS} PRIVATE ${ARG_PRIVATE_DEPENDS})
+  qsmesh_apply_settings(qsmesh_${name})
+endfunction()

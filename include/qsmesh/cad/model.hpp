@@ -1,0 +1,128 @@
+// The CAD model: topology (corners, curves, faces with oriented loops) and geometry access.
+// Immutable after load; every const member is safe to call from many threads at once.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "qsmesh/cad/geometry.hpp"
+#include "qsmesh/core/adjacency.hpp"
+#include "qsmesh/core/types.hpp"
+
+namespace qsmesh::cad {
+
+enum class SurfaceType : std::uint8_t {
+  Plane, Cylinder, Cone, Sphere, Torus, Bezier, BSpline, Revolution, Extrusion, Offset, Other
+};
+enum class CurveType : std::uint8_t {
+  Line, Circle, Ellipse, Hyperbola, Parabola, Bezier, BSpline, Offset, Other, Degenerate
+};
+[[nodiscard]] const char* to_string(SurfaceType t);
+[[nodiscard]] const char* to_string(CurveType t);
+
+/// A CAD vertex.
+struct Corner {
+  Vec3 point;
+  double tolerance = 0;  ///< OpenCASCADE tolerance of the vertex (model units)
+};
+
+/// A CAD edge.
+struct Curve {
+  std::array<LO, 2> corners{kNoIndex, kNoIndex};  ///< corner at t0, corner at t1 (equal when closed)
+  double t0 = 0, t1 = 0;                           ///< parameter range, t0 < t1
+  double length = 0;                               ///< 3D arc length (0 when degenerate)
+  bool degenerate = false;  ///< collapses to one point (pole of a sphere or cone)
+  CurveType type = CurveType::Other;
+};
+
+/// One use of a curve in a face loop. reversed: traversed from t1 to t0.
+struct CurveUse {
+  LO curve = kNoIndex;
+  bool reversed = false;
+};
+
+/// A closed chain of curve uses bounding a face. Consecutive uses share a corner.
+struct Loop {
+  std::vector<CurveUse> uses;
+  bool outer = false;
+};
+
+/// A CAD face.
+struct Face {
+  std::vector<Loop> loops;   ///< loops[0] is the outer loop; the others bound holes
+  std::vector<LO> seams;     ///< curves used twice in this face's loops (seams of periodic surfaces)
+  SurfaceType type = SurfaceType::Other;
+  bool reversed = false;     ///< face normal opposite to the surface's natural normal du x dv
+  double area = 0;           ///< model units squared
+  Box3 box;                  ///< 3D bounding box
+  Box2 uv_box;               ///< parameter-plane bounds of the trimmed face
+  bool u_periodic = false, v_periodic = false;
+  double u_period = 0, v_period = 0;
+};
+
+/// Options of load_cad.
+struct LoadOptions {
+  bool sew = false;          ///< sew disconnected faces before building the topology
+  double sew_tolerance = 0;  ///< 0: 1e-6 of the bounding-box diagonal
+};
+
+class CadModel {
+ public:
+  CadModel();
+  ~CadModel();
+  CadModel(CadModel&&) noexcept;
+  CadModel& operator=(CadModel&&) noexcept;
+
+  [[nodiscard]] std::span<const Corner> corners() const { return corners_; }
+  [[nodiscard]] std::span<const Curve> curves() const { return curves_; }
+  [[nodiscard]] std::span<const Face> faces() const { return faces_; }
+  [[nodiscard]] LO num_corners() const { return static_cast<LO>(corners_.size()); }
+  [[nodiscard]] LO num_curves() const { return static_cast<LO>(curves_.size()); }
+  [[nodiscard]] LO num_faces() const { return static_cast<LO>(faces_.size()); }
+
+  /// curve -> faces using it (each face once, increasing ids). A free curve of an open shell has 1.
+  [[nodiscard]] const Adjacency& curve2faces() const { return curve2faces_; }
+  /// corner -> curves ending at it (increasing ids).
+  [[nodiscard]] const Adjacency& corner2curves() const { return corner2curves_; }
+  /// face -> faces sharing at least one curve (increasing ids, no self).
+  [[nodiscard]] const Adjacency& face2faces() const { return face2faces_; }
+
+  [[nodiscard]] const Box3& box() const { return box_; }
+  [[nodiscard]] double diagonal() const { return box_.diagonal(); }
+  [[nodiscard]] const std::string& source() const { return source_; }
+
+  /// New evaluator of curve c (the caller owns it and uses it from one thread).
+  [[nodiscard]] std::unique_ptr<CurveGeometry> curve_geometry(LO c) const;
+  /// New evaluator of face f (the caller owns it and uses it from one thread).
+  [[nodiscard]] std::unique_ptr<FaceGeometry> face_geometry(LO f) const;
+
+  /// Implementation data (OpenCASCADE shapes), opaque outside src/cad.
+  struct Impl;
+  [[nodiscard]] const Impl& impl() const { return *impl_; }
+
+ private:
+  friend class ModelBuilder;
+  std::vector<Corner> corners_;
+  std::vector<Curve> curves_;
+  std::vector<Face> faces_;
+  Adjacency curve2faces_, corner2curves_, face2faces_;
+  Box3 box_;
+  std::string source_;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Reads a STEP (.step, .stp), IGES (.iges, .igs) or BREP (.brep) file and builds the topology.
+/// Entity ids follow OpenCASCADE's unique-shape maps (TopExp::MapShapes order), so they are the
+/// same on every rank and every run. Throws InputError for a missing, empty, unreadable or
+/// unsupported file, naming the file and the reason.
+[[nodiscard]] CadModel load_cad(const std::string& path, const LoadOptions& options = {});
+
+/// Writes the built-in wing-body example (fuselage of revolution fused with a wing lofted from
+/// NACA 4-digit sections) as STEP to `path`. Throws InputError when the file cannot be written.
+void write_wing_body_example(const std::string& path);
+
+}  // namespace qsmesh::cad

@@ -1,0 +1,68 @@
+// Mesh data: per-curve and per-face meshes in local numbering, and the assembled surface mesh in
+// global numbering. Flat arrays, explicit index types; every vertex carries its CAD classification.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "qsmesh/core/adjacency.hpp"
+#include "qsmesh/core/types.hpp"
+
+namespace qsmesh::mesh {
+
+/// CAD classification of a vertex.
+///  dim 0: on corner `entity`;
+///  dim 1: on curve `entity`, at parameter param[0], vertex `index` of that curve's mesh;
+///  dim 2: inside face `entity`, at (u, v) = (param[0], param[1]).
+struct VertexClass {
+  std::int8_t dim = 2;
+  LO entity = kNoIndex;
+  LO index = kNoIndex;
+  std::array<double, 2> param{0, 0};
+};
+
+/// Mesh of one CAD curve: vertices ordered from t0 to t1, both ends included (they are the curve's
+/// corners; a closed curve repeats its corner). A degenerate curve has exactly its two end vertices.
+struct CurveMesh {
+  LO curve = kNoIndex;
+  std::vector<double> t;      ///< curve parameters, increasing
+  std::vector<Vec3> points;   ///< C(t) (corner points at both ends)
+  [[nodiscard]] LO num_edges() const { return static_cast<LO>(t.size()) - 1; }
+};
+
+/// Mesh of one CAD face in face-local numbering. Elements are oriented along the face normal.
+struct FaceMesh {
+  LO face = kNoIndex;
+  std::vector<Vec3> points;
+  std::vector<Vec2> uv;                      ///< parameter-plane position (boundary: the pcurve image)
+  std::vector<VertexClass> vclass;
+  std::vector<std::array<LO, 3>> triangles;
+  std::vector<std::array<LO, 4>> quads;
+  [[nodiscard]] LO num_vertices() const { return static_cast<LO>(points.size()); }
+};
+
+/// The assembled surface mesh of a model, global numbering: corners first (vertex id = corner id),
+/// then interior vertices of the curves by curve id, then interior vertices of the faces by face id.
+/// Elements are grouped by face, faces in increasing id; bars are grouped by curve.
+struct SurfaceMesh {
+  std::vector<Vec3> points;
+  std::vector<VertexClass> vclass;
+  std::vector<std::array<GO, 3>> triangles;
+  std::vector<std::array<GO, 4>> quads;
+  std::vector<LO> triangle_face;              ///< CAD face of each triangle
+  std::vector<LO> quad_face;                  ///< CAD face of each quad
+  std::vector<std::array<GO, 2>> bars;        ///< curve edges
+  std::vector<LO> bar_curve;                  ///< CAD curve of each bar
+  LO num_cad_faces = 0;
+  LO num_cad_curves = 0;
+  LO num_cad_corners = 0;
+  /// CAD topology, for writers that record entities (MSH $Entities, CGNS families):
+  std::vector<std::array<LO, 2>> curve_corners;  ///< end corners of each curve
+  Adjacency face2curves;                         ///< curves bounding each face (each once)
+  std::string length_unit = "mm";                ///< unit of the coordinates
+  [[nodiscard]] GO num_vertices() const { return static_cast<GO>(points.size()); }
+};
+
+}  // namespace qsmesh::mesh

@@ -1,0 +1,41 @@
+#include "qsmesh/core/tasks.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/global_control.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+
+namespace qsmesh {
+
+struct TaskArena::Impl {
+  explicit Impl(int n) : arena(n) {}
+  tbb::task_arena arena;
+};
+
+TaskArena::TaskArena(int threads)
+    : impl_(std::make_unique<Impl>(threads > 0 ? threads : tbb::this_task_arena::max_concurrency())) {}
+
+TaskArena::~TaskArena() = default;
+
+int TaskArena::threads() const { return impl_->arena.max_concurrency(); }
+
+void TaskArena::parallel_for(std::int64_t n, const std::function<void(std::int64_t)>& body) const {
+  if (n <= 0) return;
+  if (threads() == 1) {
+    for (std::int64_t i = 0; i < n; ++i) body(i);
+    return;
+  }
+  // Grain 1 with the simple partitioner: items are coarse and of very uneven cost.
+  impl_->arena.execute([&] {
+    tbb::parallel_for(
+        tbb::blocked_range<std::int64_t>(0, n, 1),
+        [&](const tbb::blocked_range<std::int64_t>& r) {
+          for (std::int64_t i = r.begin(); i < r.end(); ++i) body(i);
+        },
+        tbb::simple_partitioner());
+  });
+}
+
+}  // namespace qsmesh

@@ -1,0 +1,27 @@
+#include "qsmesh/core/timer.hpp"
+
+namespace qsmesh {
+
+void StageTimes::add(const std::string& stage, double seconds) {
+  for (auto& [name, s] : entries_) {
+    if (name == stage) {
+      s += seconds;
+      return;
+    }
+  }
+  entries_.emplace_back(stage, seconds);
+}
+
+double StageTimes::get(const std::string& stage) const {
+  for (const auto& [name, s] : entries_)
+    if (name == stage) return s;
+  return 0.0;
+}
+
+double StageTimes::total() const {
+  double t = 0;
+  for (const auto& e : entries_) t += e.second;
+  return t;
+}
+
+}  // namespace qsmesh
