@@ -27,6 +27,10 @@ target_link_libraries(qsmesh_occt INTERFACE
 # MPI
 find_package(MPI QUIET COMPONENTS C)
 qsmesh_require(MPI_C_FOUND "MPI (C bindings)" "libopenmpi-dev")
+# The C API only: OpenMPI's and MPICH's mpi.h otherwise pull in the deprecated C++ bindings.
+add_library(qsmesh_mpi INTERFACE)
+target_link_libraries(qsmesh_mpi INTERFACE MPI::MPI_C)
+target_compile_definitions(qsmesh_mpi INTERFACE OMPI_SKIP_MPICXX=1 MPICH_SKIP_MPICXX=1)
 
 # TBB
 find_package(TBB QUIET CONFIG)

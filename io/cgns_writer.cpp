@@ -1,1 +1,295 @@
-// (being written)
+// CGNS output through the cgnslib mid-level API (Debian: 32-bit cgsize_t, HDF5 serial backend).
+// cgnslib keeps its own file table and the HDF5 library state; no HDF5 call is made here.
+#include <cgns_io.h>
+#include <cgnslib.h>
+
+#include <array>
+#include <bit>
+#include <cerrno>
+#include <cstdio>
+#include <cstdint>
+#include <cstring>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "detail.hpp"
+#include "qsmesh/core/error.hpp"
+#include "qsmesh/io/atomic_file.hpp"
+#include "qsmesh/io/writer.hpp"
+
+namespace qsmesh::io {
+
+namespace {
+
+// Every cgnslib call goes through here: a nonzero return becomes an Error naming the call and file.
+void cg_check(int rc, const char* call, const std::string& path) {
+  if (rc != CG_OK) {
+    throw Error("CGNS " + std::string(call) + " failed for " + path + ": " + cg_get_error());
+  }
+}
+#define QSMESH_CG(call) cg_check((call), #call, path)
+
+void cgio_check(int rc, const char* call, const std::string& path) {
+  if (rc != CGIO_ERR_NONE) {
+    char msg[CGIO_MAX_ERROR_LENGTH + 1] = {};
+    cgio_error_message(msg);
+    throw Error("CGNS " + std::string(call) + " failed for " + path + ": " + msg);
+  }
+}
+#define QSMESH_CGIO(call) cgio_check((call), #call, path)
+
+// Closes the file on the error path; the success path closes explicitly to check the result.
+struct CgFile {
+  int fn = -1;
+  CgFile() = default;
+  CgFile(const CgFile&) = delete;
+  CgFile& operator=(const CgFile&) = delete;
+  ~CgFile() {
+    if (fn >= 0) cg_close(fn);
+  }
+};
+
+CGNS_ENUMT(LengthUnits_t) length_unit(const std::string& unit) {
+  if (unit == "mm") return CGNS_ENUMV(Millimeter);
+  if (unit == "cm") return CGNS_ENUMV(Centimeter);
+  if (unit == "m") return CGNS_ENUMV(Meter);
+  if (unit == "in") return CGNS_ENUMV(Inch);
+  if (unit == "ft") return CGNS_ENUMV(Foot);
+  throw Error("CGNS output: length unit '" + unit + "' is not one of mm, cm, m, in, ft");
+}
+
+cgsize_t to_cg(GO value, const std::string& path) {
+  QSMESH_CHECK(value <= static_cast<GO>(std::numeric_limits<cgsize_t>::max()),
+               "CGNS output " << path << ": id " << value
+                              << " exceeds the 32-bit ids of this cgnslib build");
+  return static_cast<cgsize_t>(value);
+}
+
+
+// Bob Jenkins' lookup3 hashlittle with initval 0: the checksum HDF5 stores in its metadata.
+std::uint32_t lookup3(const unsigned char* k, std::size_t length) {
+  auto rot = [](std::uint32_t x, int r) { return (x << r) | (x >> (32 - r)); };
+  std::uint32_t a = 0xdeadbeef + static_cast<std::uint32_t>(length);
+  std::uint32_t b = a;
+  std::uint32_t c = a;
+  auto word = [&](std::size_t i) {
+    return std::uint32_t{k[i]} | (std::uint32_t{k[i + 1]} << 8) | (std::uint32_t{k[i + 2]} << 16) |
+           (std::uint32_t{k[i + 3]} << 24);
+  };
+  while (length > 12) {
+    a += word(0);
+    b += word(4);
+    c += word(8);
+    a -= c; a ^= rot(c, 4);  c += b;
+    b -= a; b ^= rot(a, 6);  a += c;
+    c -= b; c ^= rot(b, 8);  b += a;
+    a -= c; a ^= rot(c, 16); c += b;
+    b -= a; b ^= rot(a, 19); a += c;
+    c -= b; c ^= rot(b, 4);  b += a;
+    length -= 12;
+    k += 12;
+  }
+  if (length == 0) return c;
+  unsigned char tail[12] = {};
+  std::memcpy(tail, k, length);
+  a += std::uint32_t{tail[0]} | (std::uint32_t{tail[1]} << 8) | (std::uint32_t{tail[2]} << 16) |
+       (std::uint32_t{tail[3]} << 24);
+  b += std::uint32_t{tail[4]} | (std::uint32_t{tail[5]} << 8) | (std::uint32_t{tail[6]} << 16) |
+       (std::uint32_t{tail[7]} << 24);
+  c += std::uint32_t{tail[8]} | (std::uint32_t{tail[9]} << 8) | (std::uint32_t{tail[10]} << 16) |
+       (std::uint32_t{tail[11]} << 24);
+  c ^= b; c -= rot(b, 14);
+  a ^= c; a -= rot(c, 11);
+  b ^= a; b -= rot(a, 25);
+  c ^= b; c -= rot(b, 16);
+  a ^= c; a -= rot(c, 4);
+  b ^= a; b -= rot(a, 14);
+  c ^= b; c -= rot(b, 24);
+  return c;
+}
+
+// HDF5 (through cgnslib, which offers no switch) stores access/modification/change/birth times in
+// every version-2 object header, so two writes of the same mesh differ. This zeroes those times and
+// rewrites the header checksums. A candidate "OHDR" is only patched when its stored checksum
+// verifies, so bytes in raw data that happen to read "OHDR" are left alone.
+void strip_hdf5_times(const std::string& file) {
+  std::FILE* f = std::fopen(file.c_str(), "r+b");
+  if (f == nullptr) throw Error("cannot reopen " + file + ": " + std::strerror(errno));
+  std::string data;
+  char buf[1 << 16];
+  for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, f)) > 0;) data.append(buf, n);
+  bool ok = std::ferror(f) == 0;
+  auto* bytes = reinterpret_cast<unsigned char*>(data.data());
+  std::size_t pos = 0;
+  while (ok && (pos = data.find("OHDR", pos)) != std::string::npos) {
+    const std::size_t start = pos;
+    pos += 4;
+    if (start + 6 > data.size() || bytes[start + 4] != 2 || (bytes[start + 5] & 0x20) == 0) continue;
+    const unsigned flags = bytes[start + 5];
+    std::size_t p = start + 6 + 16 + ((flags & 0x10) != 0 ? 4 : 0);
+    const std::size_t width = std::size_t{1} << (flags & 3);
+    if (p + width > data.size()) continue;
+    std::uint64_t chunk = 0;
+    for (std::size_t i = 0; i < width; ++i) chunk |= std::uint64_t{bytes[p + i]} << (8 * i);
+    p += width;
+    if (chunk > data.size() - p || p + chunk + 4 > data.size()) continue;
+    const std::size_t sum_at = p + chunk;
+    std::uint32_t stored = 0;
+    std::memcpy(&stored, bytes + sum_at, 4);  // little-endian file, little-endian host
+    if (lookup3(bytes + start, sum_at - start) != stored) continue;
+    std::memset(bytes + start + 6, 0, 16);
+    const std::uint32_t sum = lookup3(bytes + start, sum_at - start);
+    ok = std::fseek(f, static_cast<long>(start + 6), SEEK_SET) == 0 &&
+         std::fwrite(bytes + start + 6, 1, 16, f) == 16 &&
+         std::fseek(f, static_cast<long>(sum_at), SEEK_SET) == 0 && std::fwrite(&sum, 1, 4, f) == 4;
+    pos = sum_at + 4;
+  }
+  if (std::fclose(f) != 0 || !ok) throw Error("cannot rewrite " + file + ": " + std::strerror(errno));
+}
+static_assert(std::endian::native == std::endian::little, "strip_hdf5_times assumes little endian");
+
+}  // namespace
+
+void write_cgns(const mesh::SurfaceMesh& mesh, const std::string& path, const WriteOptions& options) {
+  detail::check_output_folder(path);
+  check_mesh_for_output(mesh);
+  const auto unit = length_unit(mesh.length_unit);
+  const GO nv = mesh.num_vertices();
+  const GO ncells = static_cast<GO>(mesh.triangles.size() + mesh.quads.size());
+  (void)to_cg(nv, path);
+  (void)to_cg(ncells + static_cast<GO>(mesh.bars.size()), path);
+  const detail::ElementGroups groups = detail::group_elements(mesh);
+
+  AtomicFile out(path);
+  CgFile file;
+  QSMESH_CG(cg_set_file_type(CG_FILE_HDF5));
+  QSMESH_CG(cg_open(out.temp_path().c_str(), CG_MODE_WRITE, &file.fn));
+  const int fn = file.fn;
+
+  int base = 0;
+  QSMESH_CG(cg_base_write(fn, options.cgns_base_name.c_str(), 2, 3, &base));
+  QSMESH_CG(cg_goto(fn, base, "end"));
+  QSMESH_CG(cg_dataclass_write(CGNS_ENUMV(Dimensional)));
+  QSMESH_CG(cg_units_write(CGNS_ENUMV(Kilogram), unit, CGNS_ENUMV(Second), CGNS_ENUMV(Kelvin),
+                           CGNS_ENUMV(Degree)));
+
+  // Zone size for an unstructured zone: vertices, cells (the 2D elements), boundary vertices (0:
+  // unsorted).
+  cgsize_t size[3] = {to_cg(nv, path), to_cg(ncells, path), 0};
+  int zone = 0;
+  QSMESH_CG(cg_zone_write(fn, base, options.cgns_zone_name.c_str(), size,
+                          CGNS_ENUMV(Unstructured), &zone));
+
+  {
+    std::vector<double> coord(static_cast<std::size_t>(nv));
+    const char* names[3] = {"CoordinateX", "CoordinateY", "CoordinateZ"};
+    for (int d = 0; d < 3; ++d) {
+      for (std::size_t v = 0; v < coord.size(); ++v) coord[v] = mesh.points[v][d];
+      int c = 0;
+      QSMESH_CG(cg_coord_write(fn, base, zone, CGNS_ENUMV(RealDouble), names[d], coord.data(), &c));
+      // Coordinates are lengths: exponents (mass, length, time, temperature, angle) = (0,1,0,0,0).
+      QSMESH_CG(cg_goto(fn, base, "Zone_t", zone, "GridCoordinates_t", 1, "DataArray_t", c, "end"));
+      const float exponents[5] = {0, 1, 0, 0, 0};
+      QSMESH_CG(cg_exponents_write(CGNS_ENUMV(RealSingle), exponents));
+    }
+  }
+
+  // cgnslib 3.4 refuses FamilyName_t under Elements_t, so a section is tied to its family by the
+  // shared name only ("Face_<f>", "Curve_<c>").
+  cgsize_t next = 1;  // next element id
+  std::vector<cgsize_t> conn;
+  std::vector<cgsize_t> offsets;
+  for (LO f = 0; f < mesh.num_cad_faces; ++f) {
+    const auto& tris = groups.face2tris[static_cast<std::size_t>(f)];
+    const auto& quads = groups.face2quads[static_cast<std::size_t>(f)];
+    const auto n = static_cast<cgsize_t>(tris.size() + quads.size());
+    if (n == 0) continue;
+    const std::string name = "Face_" + std::to_string(f);
+    const bool mixed = !tris.empty() && !quads.empty();
+    conn.clear();
+    offsets.assign(1, 0);
+    // MIXED connectivity: each element's type code, then its vertices; offsets into it.
+    for (GO t : tris) {
+      if (mixed) conn.push_back(CGNS_ENUMV(TRI_3));
+      for (GO v : mesh.triangles[static_cast<std::size_t>(t)]) conn.push_back(static_cast<cgsize_t>(v + 1));
+      offsets.push_back(static_cast<cgsize_t>(conn.size()));
+    }
+    for (GO q : quads) {
+      if (mixed) conn.push_back(CGNS_ENUMV(QUAD_4));
+      for (GO v : mesh.quads[static_cast<std::size_t>(q)]) conn.push_back(static_cast<cgsize_t>(v + 1));
+      offsets.push_back(static_cast<cgsize_t>(conn.size()));
+    }
+    int section = 0;
+    if (mixed) {
+      QSMESH_CG(cg_poly_section_write(fn, base, zone, name.c_str(), CGNS_ENUMV(MIXED), next,
+                                      next + n - 1, 0, conn.data(), offsets.data(), &section));
+    } else {
+      QSMESH_CG(cg_section_write(fn, base, zone, name.c_str(),
+                                 tris.empty() ? CGNS_ENUMV(QUAD_4) : CGNS_ENUMV(TRI_3), next,
+                                 next + n - 1, 0, conn.data(), &section));
+    }
+    int family = 0;
+    QSMESH_CG(cg_family_write(fn, base, name.c_str(), &family));
+    next += n;
+  }
+
+  struct CurveRange {
+    std::string name;
+    cgsize_t first, last;
+  };
+  std::vector<CurveRange> curve_ranges;
+  for (LO c = 0; c < mesh.num_cad_curves; ++c) {
+    const auto& bars = groups.curve2bars[static_cast<std::size_t>(c)];
+    if (bars.empty()) continue;
+    const std::string name = "Curve_" + std::to_string(c);
+    const auto n = static_cast<cgsize_t>(bars.size());
+    conn.clear();
+    for (GO b : bars) {
+      for (GO v : mesh.bars[static_cast<std::size_t>(b)]) conn.push_back(static_cast<cgsize_t>(v + 1));
+    }
+    int section = 0;
+    QSMESH_CG(cg_section_write(fn, base, zone, name.c_str(), CGNS_ENUMV(BAR_2), next, next + n - 1,
+                               0, conn.data(), &section));
+    int family = 0;
+    QSMESH_CG(cg_family_write(fn, base, name.c_str(), &family));
+    int fambc = 0;
+    QSMESH_CG(cg_fambc_write(fn, base, family, "FamBC", CGNS_ENUMV(BCWall), &fambc));
+    curve_ranges.push_back({name, next, next + n - 1});
+    next += n;
+  }
+
+  int cgio = 0;
+  double root = 0;
+  QSMESH_CG(cg_get_cgio(fn, &cgio));
+  QSMESH_CG(cg_root_id(fn, &root));
+  // One BC per meshed curve over its bar elements (contiguous ids, hence a PointRange).
+  for (const CurveRange& r : curve_ranges) {
+    const cgsize_t range[2] = {r.first, r.last};
+    int bc = 0;
+    QSMESH_CG(cg_boco_write(fn, base, zone, r.name.c_str(), CGNS_ENUMV(FamilySpecified),
+                            CGNS_ENUMV(PointRange), 2, range, &bc));
+    QSMESH_CG(cg_boco_gridlocation_write(fn, base, zone, bc, CGNS_ENUMV(EdgeCenter)));
+    // cgnslib 3.4 writes the 33-byte label of the point set node from an uninitialized stack
+    // buffer (bytes after "IndexRange_t" are garbage), so files would differ between runs;
+    // rewrite the label from a zero-padded buffer.
+    {
+      const std::string node = "/" + options.cgns_base_name + "/" + options.cgns_zone_name +
+                               "/ZoneBC/" + r.name + "/PointRange";
+      double id = 0;
+      QSMESH_CGIO(cgio_get_node_id(cgio, root, node.c_str(), &id));
+      char label[CGIO_MAX_LABEL_LENGTH + 1] = {};
+      std::strncpy(label, "IndexRange_t", CGIO_MAX_LABEL_LENGTH);
+      QSMESH_CGIO(cgio_set_label(cgio, id, label));
+    }
+    QSMESH_CG(cg_goto(fn, base, "Zone_t", zone, "ZoneBC_t", 1, "BC_t", bc, "end"));
+    QSMESH_CG(cg_famname_write(r.name.c_str()));
+  }
+
+  file.fn = -1;
+  QSMESH_CG(cg_close(fn));
+  strip_hdf5_times(out.temp_path());
+  out.commit();
+}
+
+}  // namespace qsmesh::io

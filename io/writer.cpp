@@ -1,1 +1,154 @@
-// (being written)
+#include "qsmesh/io/writer.hpp"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cctype>
+#include <filesystem>
+#include <system_error>
+
+#include "detail.hpp"
+#include "qsmesh/core/error.hpp"
+
+namespace qsmesh::io {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+enum class Format { kNone, kCgns, kVtu, kMsh };
+
+Format format_of(const std::string& path) {
+  std::string ext = fs::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (ext == ".cgns") return Format::kCgns;
+  if (ext == ".vtu") return Format::kVtu;
+  if (ext == ".msh") return Format::kMsh;
+  return Format::kNone;
+}
+
+}  // namespace
+
+bool is_supported_output(const std::string& path) {
+  return !fs::path(path).stem().empty() && format_of(path) != Format::kNone;
+}
+
+void check_output_path(const std::string& path) {
+  if (!is_supported_output(path)) {
+    throw InputError("output '" + path +
+                     "': unsupported format (the extension must be .cgns, .vtu or .msh)");
+  }
+  detail::check_output_folder(path);
+}
+
+namespace detail {
+
+void check_output_folder(const std::string& path) {
+  const fs::path p(path);
+  std::error_code ec;
+  if (p.filename().empty()) {
+    throw InputError("output '" + path + "' names no file");
+  }
+  if (fs::is_directory(p, ec)) {
+    throw InputError("output '" + path + "' is a folder");
+  }
+  const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
+  if (!fs::is_directory(dir, ec)) {
+    throw InputError("output '" + path + "': folder '" + dir.string() + "' does not exist");
+  }
+  // access() also reports read-only file systems, which the permission bits do not show.
+  if (::access(dir.c_str(), W_OK | X_OK) != 0) {
+    throw InputError("output '" + path + "': folder '" + dir.string() + "' is not writable");
+  }
+}
+
+}  // namespace detail
+
+void check_mesh_for_output(const mesh::SurfaceMesh& m) {
+  const GO nv = m.num_vertices();
+  QSMESH_CHECK(m.vclass.size() == m.points.size(),
+               "output: " << m.vclass.size() << " classifications for " << nv << " vertices");
+  QSMESH_CHECK(m.triangle_face.size() == m.triangles.size(),
+               "output: triangle_face has " << m.triangle_face.size() << " entries for "
+                                            << m.triangles.size() << " triangles");
+  QSMESH_CHECK(m.quad_face.size() == m.quads.size(),
+               "output: quad_face has " << m.quad_face.size() << " entries for " << m.quads.size()
+                                        << " quads");
+  QSMESH_CHECK(m.bar_curve.size() == m.bars.size(),
+               "output: bar_curve has " << m.bar_curve.size() << " entries for " << m.bars.size()
+                                        << " bars");
+  QSMESH_CHECK(m.num_cad_faces >= 0 && m.num_cad_curves >= 0 && m.num_cad_corners >= 0,
+               "output: negative CAD entity count");
+  QSMESH_CHECK(m.curve_corners.empty() ||
+                   static_cast<LO>(m.curve_corners.size()) == m.num_cad_curves,
+               "output: curve_corners has " << m.curve_corners.size() << " entries for "
+                                            << m.num_cad_curves << " curves");
+  QSMESH_CHECK(m.face2curves.size() == 0 || m.face2curves.size() == m.num_cad_faces,
+               "output: face2curves has " << m.face2curves.size() << " faces, mesh has "
+                                          << m.num_cad_faces);
+  for (const auto& cc : m.curve_corners) {
+    for (LO k : cc) {
+      QSMESH_CHECK(k == kNoIndex || (k >= 0 && k < m.num_cad_corners),
+                   "output: curve corner " << k << " out of range");
+    }
+  }
+  for (LO c : m.face2curves.targets) {
+    QSMESH_CHECK(c >= 0 && c < m.num_cad_curves, "output: face2curves curve " << c << " out of range");
+  }
+  auto check_vertices = [&](const auto& elements, const char* what) {
+    for (std::size_t e = 0; e < elements.size(); ++e) {
+      for (GO v : elements[e]) {
+        QSMESH_CHECK(v >= 0 && v < nv, "output: " << what << ' ' << e << " has vertex " << v
+                                                  << " out of [0, " << nv << ")");
+      }
+    }
+  };
+  check_vertices(m.triangles, "triangle");
+  check_vertices(m.quads, "quad");
+  check_vertices(m.bars, "bar");
+  auto check_ids = [](const std::vector<LO>& ids, LO n, const char* what) {
+    for (std::size_t e = 0; e < ids.size(); ++e) {
+      QSMESH_CHECK(ids[e] >= 0 && ids[e] < n,
+                   "output: " << what << ' ' << e << " on CAD entity " << ids[e] << " out of [0, "
+                              << n << ")");
+    }
+  };
+  check_ids(m.triangle_face, m.num_cad_faces, "triangle");
+  check_ids(m.quad_face, m.num_cad_faces, "quad");
+  check_ids(m.bar_curve, m.num_cad_curves, "bar");
+}
+
+void write_mesh(const mesh::SurfaceMesh& mesh, const std::string& path, const WriteOptions& options) {
+  check_output_path(path);
+  switch (format_of(path)) {
+    case Format::kCgns: write_cgns(mesh, path, options); return;
+    case Format::kVtu: write_vtu(mesh, path, options); return;
+    case Format::kMsh: write_msh(mesh, path, options); return;
+    case Format::kNone: break;
+  }
+  QSMESH_CHECK(false, "unreachable: unsupported output " << path);
+}
+
+namespace detail {
+
+ElementGroups group_elements(const mesh::SurfaceMesh& m) {
+  ElementGroups g;
+  g.face2tris.resize(static_cast<std::size_t>(m.num_cad_faces));
+  g.face2quads.resize(static_cast<std::size_t>(m.num_cad_faces));
+  g.curve2bars.resize(static_cast<std::size_t>(m.num_cad_curves));
+  for (std::size_t e = 0; e < m.triangles.size(); ++e) {
+    g.face2tris[static_cast<std::size_t>(m.triangle_face[e])].push_back(static_cast<GO>(e));
+  }
+  for (std::size_t e = 0; e < m.quads.size(); ++e) {
+    g.face2quads[static_cast<std::size_t>(m.quad_face[e])].push_back(static_cast<GO>(e));
+  }
+  for (std::size_t e = 0; e < m.bars.size(); ++e) {
+    g.curve2bars[static_cast<std::size_t>(m.bar_curve[e])].push_back(static_cast<GO>(e));
+  }
+  return g;
+}
+
+}  // namespace detail
+
+}  // namespace qsmesh::io

@@ -62,6 +62,10 @@ struct Face {
   Box2 uv_box;               ///< parameter-plane bounds of the trimmed face
   bool u_periodic = false, v_periodic = false;
   double u_period = 0, v_period = 0;
+  /// True when every loop is a closed chain (consecutive uses share a corner, last meets first).
+  /// False on broken input (e.g. a wire whose edges could not be ordered); the loops are still
+  /// recorded, in the best order found.
+  bool loops_closed = true;
 };
 
 /// Options of load_cad.

@@ -53,6 +53,10 @@ struct TriangulateStats {
 /// degenerate segments are merged with their corner. Interior vertices are classified on the face
 /// (dim 2) with their (u, v). Triangles are counterclockwise in (u, v) when face_reversed is false
 /// and clockwise when it is true, so that in 3D they are oriented along the face normal. Deterministic: same input, same output, whatever the thread count.
+/// Degenerate segments: every point of a chain of degenerate segments (both ends and the extra
+/// points) becomes one output vertex, the chain's first input point (the other end is omitted
+/// from the output); triangles with two vertices there are dropped. Triangles of the pole fan use
+/// that vertex's (u, v), so they are valid in 3D but may be inverted in (u, v).
 /// Throws qsmesh::Error when the boundary cannot be recovered or a loop is invalid.
 [[nodiscard]] FaceMesh triangulate_face(const cad::FaceGeometry& surface, bool face_reversed,
                                         std::span<const BoundaryLoop> loops,

@@ -1,0 +1,39 @@
+// Command-line parsing of the qsmesh driver. Parsing is pure (no MPI, no files touched), so every
+// rank parses the same arguments to the same result and tests can call it directly.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace qsmesh::cli {
+
+enum class Command { Help, Version, Info, Mesh, Example };
+
+struct Arguments {
+  Command command = Command::Help;
+  std::string help_topic;          ///< command whose --help was asked ("" = general)
+  std::string model;               ///< input CAD file (info, mesh)
+  std::string output;              ///< -o
+  std::optional<double> size;      ///< --size (model units)
+  std::optional<double> size_factor;  ///< --size-factor (fraction of the bounding-box diagonal)
+  std::string until = "background";
+  int threads = 0;                 ///< 0: automatic
+  std::string stats;               ///< --stats FILE.json
+  bool json = false;               ///< info --json
+  bool sew = false;
+  bool quiet = false;
+  bool verbose = false;
+  std::string example_name;        ///< example NAME
+};
+
+/// Default --size-factor when neither --size nor --size-factor is given: a medium mesh.
+inline constexpr double kDefaultSizeFactor = 0.02;
+
+/// Parses argv[1..]. Throws InputError (one line naming the option and the reason) on bad input.
+[[nodiscard]] Arguments parse(const std::vector<std::string>& args);
+
+/// Help text of a command ("" for the general help).
+[[nodiscard]] std::string help(const std::string& topic);
+
+}  // namespace qsmesh::cli

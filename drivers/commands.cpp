@@ -1,0 +1,260 @@
+#include "commands.hpp"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <thread>
+
+#include "json.hpp"
+#include "qsmesh/cad/model.hpp"
+#include "qsmesh/core/error.hpp"
+#include "qsmesh/core/log.hpp"
+#include "qsmesh/core/tasks.hpp"
+#include "qsmesh/core/timer.hpp"
+#include "qsmesh/io/writer.hpp"
+#include "qsmesh/mesh/quality.hpp"
+#include "qsmesh/parallel/comm.hpp"
+#include "qsmesh/parallel/pipeline.hpp"
+
+namespace qsmesh::cli {
+
+namespace fs = std::filesystem;
+
+void check_writable(const std::string& option, const std::string& path) {
+  const fs::path p(path);
+  const fs::path dir = p.parent_path().empty() ? fs::path(".") : p.parent_path();
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec))
+    throw InputError(option + ": cannot write '" + path + "': directory '" + dir.string() + "' does not exist");
+  if (::access(dir.c_str(), W_OK) != 0)
+    throw InputError(option + ": cannot write '" + path + "': directory '" + dir.string() + "' is not writable");
+  if (fs::is_directory(p, ec)) throw InputError(option + ": '" + path + "' is a directory");
+}
+
+void write_text_file_atomically(const std::string& path, const std::string& text) {
+  const fs::path p(path);
+  const fs::path tmp = p.parent_path() / ("." + p.filename().string() + ".tmp." + std::to_string(::getpid()));
+  {
+    std::ofstream out(tmp, std::ios::binary);
+    out << text;
+    out.flush();
+    if (!out) {
+      std::error_code ec;
+      fs::remove(tmp, ec);
+      throw Error("cannot write '" + path + "'");
+    }
+  }
+  std::error_code ec;
+  fs::rename(tmp, p, ec);
+  if (ec) {
+    fs::remove(tmp, ec);
+    throw Error("cannot rename temporary file to '" + path + "': " + ec.message());
+  }
+}
+
+int run_info(const Arguments& args) {
+  const cad::CadModel model = cad::load_cad(args.model, cad::LoadOptions{args.sew, 0});
+  if (args.json) {
+    JsonWriter j;
+    j.begin_object();
+    j.value("file", args.model);
+    j.value("corners", static_cast<std::int64_t>(model.num_corners()));
+    j.value("curves", static_cast<std::int64_t>(model.num_curves()));
+    j.value("faces", static_cast<std::int64_t>(model.num_faces()));
+    std::int64_t degenerate = 0;
+    for (const auto& c : model.curves()) degenerate += c.degenerate ? 1 : 0;
+    j.value("degenerate_curves", degenerate);
+    j.value("diagonal", model.diagonal());
+    j.begin_array("box").begin_object().value("x", model.box().lo.x).value("y", model.box().lo.y)
+        .value("z", model.box().lo.z).end_object();
+    j.begin_object().value("x", model.box().hi.x).value("y", model.box().hi.y).value("z", model.box().hi.z)
+        .end_object().end_array();
+    j.begin_array("face_list");
+    for (LO f = 0; f < model.num_faces(); ++f) {
+      const cad::Face& face = model.faces()[f];
+      std::int64_t uses = 0;
+      for (const auto& l : face.loops) uses += static_cast<std::int64_t>(l.uses.size());
+      j.begin_object().value("id", static_cast<std::int64_t>(f)).value("type", cad::to_string(face.type))
+          .value("loops", static_cast<std::int64_t>(face.loops.size())).value("curve_uses", uses)
+          .value("seams", static_cast<std::int64_t>(face.seams.size())).value("area", face.area)
+          .value("reversed", face.reversed).end_object();
+    }
+    j.end_array();
+    j.end_object();
+    std::cout << j.str();
+    return 0;
+  }
+  std::cout << "model:     " << args.model << "\n"
+            << "corners:   " << model.num_corners() << "\n"
+            << "curves:    " << model.num_curves() << "\n"
+            << "faces:     " << model.num_faces() << "\n";
+  std::int64_t degenerate = 0;
+  for (const auto& c : model.curves()) degenerate += c.degenerate ? 1 : 0;
+  std::cout << "degenerate curves: " << degenerate << "\n"
+            << "bounding box: (" << model.box().lo.x << ", " << model.box().lo.y << ", " << model.box().lo.z
+            << ") - (" << model.box().hi.x << ", " << model.box().hi.y << ", " << model.box().hi.z
+            << "), diagonal " << model.diagonal() << "\n\n";
+  std::cout << std::setw(6) << "face" << std::setw(12) << "surface" << std::setw(7) << "loops"
+            << std::setw(7) << "uses" << std::setw(7) << "seams" << std::setw(15) << "area" << "\n";
+  for (LO f = 0; f < model.num_faces(); ++f) {
+    const cad::Face& face = model.faces()[f];
+    std::size_t uses = 0;
+    for (const auto& l : face.loops) uses += l.uses.size();
+    std::cout << std::setw(6) << f << std::setw(12) << cad::to_string(face.type) << std::setw(7)
+              << face.loops.size() << std::setw(7) << uses << std::setw(7) << face.seams.size()
+              << std::setw(15) << std::setprecision(6) << face.area << (face.reversed ? "  reversed" : "")
+              << "\n";
+  }
+  return 0;
+}
+
+int run_example(const Arguments& args) {
+  check_writable("-o", args.output);
+  cad::write_wing_body_example(args.output);
+  std::cout << "wrote " << args.output << " (example " << args.example_name << ")\n";
+  return 0;
+}
+
+namespace {
+
+std::string stats_json(const Arguments& args, const cad::CadModel& model, double size, int ranks,
+                       int threads, const parallel::PipelineResult& r, const mesh::MeshStats& s,
+                       const StageTimes& times) {
+  JsonWriter j;
+  j.begin_object();
+  j.value("model", args.model);
+  j.value("output", args.output);
+  j.value("stage", args.until);
+  j.value("ranks", ranks);
+  j.value("threads", threads);
+  j.value("size", size);
+  j.value("corners", static_cast<std::int64_t>(model.num_corners()));
+  j.value("curves", static_cast<std::int64_t>(model.num_curves()));
+  j.value("faces", static_cast<std::int64_t>(model.num_faces()));
+  std::int64_t failed = 0, fell_back = 0;
+  for (const auto& rep : r.reports) {
+    failed += rep.ok ? 0 : 1;
+    fell_back += rep.fell_back ? 1 : 0;
+  }
+  j.value("faces_failed", failed);
+  j.value("faces_fell_back", fell_back);
+  j.value("vertices", s.vertices);
+  j.value("triangles", s.triangles);
+  j.value("quads", s.quads);
+  j.value("curve_edges", s.bars);
+  j.value("interior_vertices", s.interior_vertices);
+  j.value("irregular_interior", s.irregular_interior);
+  j.value("sicn_min", s.sicn_min);
+  j.value("sicn_avg", s.sicn_avg);
+  j.value("triangle_quality_min", s.tri_quality_min);
+  j.value("triangle_quality_avg", s.tri_quality_avg);
+  j.value("min_angle_deg", s.min_angle_deg);
+  j.begin_object("min_angle_histogram");
+  static const char* kBins[] = {"0-5", "5-10", "10-20", "20-30", "30-60"};
+  for (int b = 0; b < 5; ++b) j.value(kBins[b], s.min_angle_histogram[b]);
+  j.end_object();
+  j.value("small_angle_at_sharp_corner", s.small_angle_at_sharp_corner);
+  j.begin_object("seconds");
+  for (const auto& [stage, sec] : times.entries()) j.value(stage, sec);
+  j.value("total", times.total());
+  j.end_object();
+  j.begin_array("face_reports");
+  for (const auto& rep : r.reports) {
+    if (rep.ok && !rep.fell_back) continue;
+    j.begin_object().value("face", static_cast<std::int64_t>(rep.face)).value("ok", rep.ok)
+        .value("fell_back", rep.fell_back).value("error", rep.error).end_object();
+  }
+  j.end_array();
+  j.end_object();
+  return j.str();
+}
+
+void print_summary(std::ostream& os, const cad::CadModel& model, const parallel::PipelineResult& r,
+                   const mesh::MeshStats& s, const StageTimes& times) {
+  std::int64_t failed = 0, fell_back = 0;
+  for (const auto& rep : r.reports) {
+    failed += rep.ok ? 0 : 1;
+    fell_back += rep.fell_back ? 1 : 0;
+  }
+  os << "\nsummary\n"
+     << "  faces:      " << model.num_faces() << " (" << failed << " failed, " << fell_back
+     << " kept their boundary-only triangulation)\n"
+     << "  vertices:   " << s.vertices << "\n"
+     << "  triangles:  " << s.triangles << "\n"
+     << "  quads:      " << s.quads << "\n"
+     << "  irregular interior vertices: " << s.irregular_interior << " of " << s.interior_vertices << "\n";
+  if (s.quads > 0) os << "  SICN min/avg: " << s.sicn_min << " / " << s.sicn_avg << "\n";
+  if (s.triangles > 0) {
+    os << "  triangle quality min/avg: " << s.tri_quality_min << " / " << s.tri_quality_avg << "\n"
+       << "  smallest angle: " << s.min_angle_deg << " deg; triangles by smallest angle: "
+       << "<5: " << s.min_angle_histogram[0] << ", 5-10: " << s.min_angle_histogram[1]
+       << ", 10-20: " << s.min_angle_histogram[2] << ", 20-30: " << s.min_angle_histogram[3]
+       << ", >=30: " << s.min_angle_histogram[4] << " (" << s.small_angle_at_sharp_corner
+       << " below 10 at CAD corners sharper than 10)\n";
+  }
+  os << "  time (s):";
+  for (const auto& [stage, sec] : times.entries()) os << " " << stage << " " << std::setprecision(3) << sec << ";";
+  os << " total " << times.total() << "\n";
+  for (const auto& rep : r.reports)
+    if (!rep.ok || rep.fell_back) os << "  face " << rep.face << ": " << rep.error << "\n";
+}
+
+}  // namespace
+
+int run_mesh(const Arguments& args) {
+  const Stopwatch total;
+  const parallel::Comm comm = parallel::Comm::world();
+  const int rank = comm.rank();
+  const int ranks = comm.size();
+  const LogLevel level = args.quiet ? LogLevel::Warning : (args.verbose ? LogLevel::Debug : LogLevel::Info);
+  Logger log(std::cerr, rank == 0 ? level : LogLevel::Warning, ranks > 1 ? cat("[rank ", rank, "] ") : "");
+
+  // Everything the user could get wrong is checked before any work.
+  const parallel::Stage until = parallel::parse_stage(args.until);
+  io::check_output_path(args.output);
+  if (!args.stats.empty()) check_writable("--stats", args.stats);
+
+  StageTimes times;
+  Stopwatch clock;
+  const cad::CadModel model = cad::load_cad(args.model, cad::LoadOptions{args.sew, 0});
+  times.add("load", comm.allreduce_max(clock.seconds()));
+  const double size = args.size ? *args.size : model.diagonal() * args.size_factor.value_or(kDefaultSizeFactor);
+  if (!(size > 0)) throw InputError("size: the model '" + args.model + "' has an empty bounding box");
+
+  int threads = args.threads;
+  if (threads <= 0) threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()) / comm.local_size());
+  const TaskArena tasks(threads);
+  log.info(cat("qsmesh mesh ", args.model, ": ", model.num_corners(), " corners, ", model.num_curves(),
+               " curves, ", model.num_faces(), " faces; size ", size, "; ", ranks, " rank(s) x ", threads,
+               " thread(s)"));
+
+  parallel::PipelineOptions options;
+  options.background.sizes.size = size;
+  options.until = until;
+  parallel::PipelineResult result = parallel::run_pipeline(comm, model, options, tasks, log);
+  for (const auto& [stage, sec] : result.times.entries()) times.add(stage, sec);
+
+  int code = 0;
+  if (rank == 0) {
+    clock.reset();
+    const mesh::MeshStats stats = mesh::compute_stats(result.mesh);
+    times.add("statistics", clock.seconds());
+    clock.reset();
+    io::write_mesh(result.mesh, args.output);
+    times.add("write", clock.seconds());
+    log.info(cat("wrote ", args.output));
+    if (!args.quiet) print_summary(std::cout, model, result, stats, times);
+    if (!args.stats.empty()) {
+      write_text_file_atomically(args.stats, stats_json(args, model, size, ranks, threads, result, stats, times));
+    }
+    for (const auto& rep : result.reports)
+      if (!rep.ok) log.warn(rep.error);
+  }
+  return code;
+}
+
+}  // namespace qsmesh::cli

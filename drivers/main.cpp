@@ -1,0 +1,57 @@
+// qsmesh: the command-line driver.
+#include <exception>
+#include <iostream>
+#include <string>
+#include <vector>
+
+#include "cli.hpp"
+#include "commands.hpp"
+#include "qsmesh/core/error.hpp"
+#include "qsmesh/parallel/comm.hpp"
+
+int main(int argc, char** argv) {
+  using namespace qsmesh;
+  std::vector<std::string> args(argv + 1, argv + argc);
+  cli::Arguments parsed;
+  try {
+    parsed = cli::parse(args);
+  } catch (const InputError& e) {
+    std::cerr << "qsmesh: " << e.what() << "\n";
+    return 2;
+  }
+  if (parsed.command == cli::Command::Help) {
+    std::cout << cli::help(parsed.help_topic);
+    return 0;
+  }
+  if (parsed.command == cli::Command::Version) {
+    std::cout << "qsmesh 0.1.0\n";
+    return 0;
+  }
+
+  // Only the mesh command runs distributed; the others need no MPI.
+  if (parsed.command != cli::Command::Mesh) {
+    try {
+      return parsed.command == cli::Command::Info ? cli::run_info(parsed) : cli::run_example(parsed);
+    } catch (const InputError& e) {
+      std::cerr << "qsmesh: " << e.what() << "\n";
+      return 2;
+    } catch (const std::exception& e) {
+      std::cerr << "qsmesh: internal error: " << e.what() << "\n";
+      return 1;
+    }
+  }
+
+  parallel::MpiSession mpi(&argc, &argv);
+  const bool root = parallel::Comm::world().rank() == 0;
+  try {
+    return cli::run_mesh(parsed);
+  } catch (const InputError& e) {
+    // Every rank reads the same input and fails the same way: one line, from rank 0.
+    if (root) std::cerr << "qsmesh: " << e.what() << "\n";
+    return 2;
+  } catch (const std::exception& e) {
+    std::cerr << "qsmesh: internal error: " << e.what() << "\n";
+    if (parallel::Comm::world().size() > 1) parallel::MpiSession::abort(1);
+    return 1;
+  }
+}

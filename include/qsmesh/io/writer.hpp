@@ -1,0 +1,80 @@
+// Mesh output: CGNS (cgnslib), VTK XML UnstructuredGrid (.vtu) and Gmsh MSH 4.1 ASCII (.msh).
+//
+// Every writer writes to a temporary file in the destination folder and renames it to the requested
+// name only once the file is complete (io/atomic_file.hpp): a failed write leaves nothing under the
+// requested name and no temporary behind. Files carry no timestamps, so the same mesh and options
+// give byte-identical files.
+//
+// Numbering shared by the writers (SurfaceMesh documents the mesh itself):
+//  - vertex v of the mesh is vertex v+1 in CGNS and node v+1 in MSH, point v in VTU;
+//  - CAD face f / curve c / corner k is CGNS section and family "Face_<f>" / "Curve_<c>", MSH entity
+//    tag f+1 / c+1 / k+1 of dimension 2 / 1 / 0;
+//  - CGNS elements: one section per non-empty CAD face in increasing face id (the face's triangles in
+//    mesh order, then its quads), then one BAR_2 section per non-empty CAD curve; ids 1..n contiguous.
+//  - VTU cells: the triangles in mesh order, then the quads, then (optionally) the bars.
+// CAD faces and curves without elements get no section, family, BC nor element block.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "qsmesh/mesh/surface_mesh.hpp"
+
+namespace qsmesh::io {
+
+/// An extra named field for the VTU writer (cross fields, size maps, quality, ...).
+/// values.size() == components * (number of points or cells written); components is 1 or 3.
+/// Written as Float64.
+struct Field {
+  std::string name;
+  int components = 1;
+  std::vector<double> values;
+};
+
+struct WriteOptions {
+  // CGNS
+  std::string cgns_base_name = "qsmesh";   ///< CGNS names are at most 32 characters
+  std::string cgns_zone_name = "Surface";
+  // VTU
+  bool vtu_binary = true;                  ///< inline base64 (true) or ASCII (false) data arrays
+  bool vtu_include_bars = false;           ///< also write the curve bars as VTK_LINE cells
+  std::vector<Field> point_fields;         ///< one value (or 3) per mesh vertex
+  std::vector<Field> cell_fields;          ///< one value (or 3) per VTU cell (see above)
+  // MSH
+  bool msh_corner_elements = true;         ///< write one point element (type 15) per meshed corner
+};
+
+/// Writes `mesh` to `path`, the format chosen from the extension (.cgns, .vtu, .msh; any case).
+/// Throws InputError (one line naming the path) when the extension is not supported or the folder
+/// does not exist or is not writable, before any work; qsmesh::Error when the mesh is inconsistent
+/// (check_mesh_for_output) or writing fails.
+void write_mesh(const mesh::SurfaceMesh& mesh, const std::string& path, const WriteOptions& options = {});
+
+/// True when the extension of `path` names a format write_mesh writes (case-insensitive).
+[[nodiscard]] bool is_supported_output(const std::string& path);
+
+/// For the CLI at start-up, before meshing: throws InputError (one line naming the path) unless the
+/// extension is supported, the path is not a folder, and its folder exists and is writable.
+void check_output_path(const std::string& path);
+
+/// Throws qsmesh::Error unless the arrays of `mesh` agree: per-element CAD ids sized like the
+/// elements and in range, vertex ids in range, one classification per vertex, curve_corners sized
+/// num_cad_curves, face2curves empty or sized num_cad_faces.
+void check_mesh_for_output(const mesh::SurfaceMesh& mesh);
+
+/// CGNS/HDF5: one base (CellDimension 2, PhysicalDimension 3, SI-like units with the mesh's length
+/// unit "mm" or "m"), one unstructured zone, a TRI_3/QUAD_4/MIXED section and a family per CAD face,
+/// a BAR_2 section, a family and an EdgeCenter BC (FamilySpecified) per CAD curve.
+/// Limit: Debian's cgnslib uses 32-bit ids; larger meshes throw Error.
+void write_cgns(const mesh::SurfaceMesh& mesh, const std::string& path, const WriteOptions& options = {});
+
+/// VTK XML UnstructuredGrid: triangles (VTK type 5), quads (9), optionally bars (3); cell data Int32
+/// "cad_face" (and "cad_curve" with bars; -1 where not applicable), point data Int32 "cad_dim" and
+/// "cad_entity" (the vertex classification), plus options.point_fields / cell_fields.
+void write_vtu(const mesh::SurfaceMesh& mesh, const std::string& path, const WriteOptions& options = {});
+
+/// Gmsh MSH 4.1 ASCII: $Entities (corners, curves with their end corners, faces with their bounding
+/// curves), $Nodes and $Elements grouped by CAD entity (parametric 0).
+void write_msh(const mesh::SurfaceMesh& mesh, const std::string& path, const WriteOptions& options = {});
+
+}  // namespace qsmesh::io

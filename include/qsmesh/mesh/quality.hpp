@@ -1,0 +1,43 @@
+// Element quality measures and mesh statistics (paper 000 Eq. 12 for SICN).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "qsmesh/mesh/surface_mesh.hpp"
+
+namespace qsmesh::mesh {
+
+/// Signed inverse condition number of a quad (paper 000 Eq. 12): the minimum over the four corners
+/// of 2 (L_{i-1} x L_i).N / (|L_{i-1}|^2 + |L_i|^2), with N the normalised sum of the four corner
+/// cross products. 1 for a square, <= 0 for a folded or non-convex quad.
+[[nodiscard]] double quad_sicn(const std::array<Vec3, 4>& q);
+
+/// Shape quality of a triangle, 4 sqrt(3) area / (sum of squared edge lengths): 1 equilateral,
+/// 0 degenerate.
+[[nodiscard]] double triangle_quality(const Vec3& a, const Vec3& b, const Vec3& c);
+
+/// The three angles of a triangle, in degrees, at a, b, c.
+[[nodiscard]] std::array<double, 3> triangle_angles(const Vec3& a, const Vec3& b, const Vec3& c);
+
+struct MeshStats {
+  std::int64_t vertices = 0, triangles = 0, quads = 0, bars = 0;
+  /// Vertices not on a CAD curve or corner whose valence differs from the regular one
+  /// (4 for a quad mesh, 6 for a triangle mesh).
+  std::int64_t irregular_interior = 0;
+  std::int64_t interior_vertices = 0;
+  double sicn_min = 0, sicn_avg = 0;          ///< over quads (0 when none)
+  double tri_quality_min = 0, tri_quality_avg = 0;  ///< over triangles (0 when none)
+  /// Triangles by their smallest 3D angle: [0,5), [5,10), [10,20), [20,30), [30,60] degrees.
+  std::array<std::int64_t, 5> min_angle_histogram{};
+  double min_angle_deg = 0;                   ///< smallest triangle angle (degrees)
+  /// Triangles with an angle below 10 degrees at a CAD corner whose angle in that face is itself
+  /// below 10 degrees (unavoidable), among those below 10 degrees.
+  std::int64_t small_angle_at_sharp_corner = 0;
+};
+
+/// Statistics of an assembled mesh.
+[[nodiscard]] MeshStats compute_stats(const SurfaceMesh& mesh);
+
+}  // namespace qsmesh::mesh

@@ -1,0 +1,36 @@
+// Validation of an assembled mesh against its CAD model: conformity and classification.
+// Used by the end-to-end tests and the benchmark scripts (paper 000 Sec. 2: "strict respect of
+// the CAD features").
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "qsmesh/cad/model.hpp"
+#include "qsmesh/mesh/surface_mesh.hpp"
+
+namespace qsmesh::mesh {
+
+struct ConformityReport {
+  std::int64_t edges = 0;                 ///< distinct element edges
+  std::int64_t interior_edges_bad = 0;    ///< edges off the curves not shared by exactly 2 elements of one face
+  std::int64_t curve_edges_bad = 0;       ///< curve edges not used once per use of the curve by a face
+  std::int64_t orientation_bad = 0;       ///< interior edges traversed the same way by both elements
+  std::int64_t degenerate_elements = 0;   ///< elements repeating a vertex
+  std::int64_t faces_without_elements = 0;
+  [[nodiscard]] bool ok() const {
+    return interior_edges_bad == 0 && curve_edges_bad == 0 && orientation_bad == 0 &&
+           degenerate_elements == 0 && faces_without_elements == 0;
+  }
+  [[nodiscard]] std::string summary() const;
+};
+
+/// Checks that elements of a face meet edge to edge, that faces meet along the curve meshes and
+/// nowhere else, and that each face is consistently oriented.
+[[nodiscard]] ConformityReport check_conformity(const SurfaceMesh& mesh, const cad::CadModel& model);
+
+/// Largest distance (model units) between a vertex and its CAD entity evaluated at the vertex's
+/// parameters (corner point, C(t), S(u, v)).
+[[nodiscard]] double max_distance_to_cad(const SurfaceMesh& mesh, const cad::CadModel& model);
+
+}  // namespace qsmesh::mesh

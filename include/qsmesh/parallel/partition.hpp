@@ -1,0 +1,18 @@
+// Partition of CAD faces across MPI ranks (the unit of distributed work is the CAD face).
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include "qsmesh/core/adjacency.hpp"
+
+namespace qsmesh::parallel {
+
+/// Assigns each face to one of `parts` ranks with METIS (k-way, fixed seed) on the face-adjacency
+/// graph `face2faces`, balancing `weights` (estimated cost per face, >= 0). Deterministic: every
+/// rank computes the same answer from the same input. With parts == 1 every face goes to 0; with
+/// more parts than faces, face i goes to part i.
+[[nodiscard]] std::vector<int> partition_faces(const Adjacency& face2faces,
+                                               std::span<const double> weights, int parts);
+
+}  // namespace qsmesh::parallel

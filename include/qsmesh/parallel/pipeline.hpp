@@ -1,0 +1,51 @@
+// The distributed pipeline: curves meshed on every rank, faces partitioned with METIS and meshed
+// as TBB tasks on their rank, per-face results gathered on rank 0 and assembled with global
+// numbering. The assembled mesh does not depend on the number of ranks or threads.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "qsmesh/background/face_mesh.hpp"
+#include "qsmesh/cad/model.hpp"
+#include "qsmesh/core/log.hpp"
+#include "qsmesh/core/tasks.hpp"
+#include "qsmesh/core/timer.hpp"
+#include "qsmesh/mesh/surface_mesh.hpp"
+#include "qsmesh/parallel/comm.hpp"
+
+namespace qsmesh::parallel {
+
+/// Pipeline stages, in order. Later issues add unstructured and quasi-structured quads.
+enum class Stage { Background };
+[[nodiscard]] const char* to_string(Stage s);
+/// Parses a stage name; throws InputError listing the valid names.
+[[nodiscard]] Stage parse_stage(const std::string& name);
+
+struct PipelineOptions {
+  background::BackgroundOptions background;
+  Stage until = Stage::Background;
+};
+
+struct PipelineResult {
+  mesh::SurfaceMesh mesh;                       ///< assembled mesh (rank 0 only)
+  std::vector<background::FaceReport> reports;  ///< one per face, by face id (rank 0 only)
+  std::vector<int> face_rank;                   ///< rank that meshed each face (every rank)
+  StageTimes times;                             ///< wall time per stage (max over ranks)
+};
+
+/// Runs the pipeline up to options.until on all ranks of `comm` (collective).
+[[nodiscard]] PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
+                                          const PipelineOptions& options, const TaskArena& tasks,
+                                          Logger& log);
+
+/// Estimated cost of meshing each face (area / size^2), the METIS vertex weights.
+[[nodiscard]] std::vector<double> estimate_face_costs(const cad::CadModel& model, double size);
+
+/// Byte serialisation of face meshes and reports, for the gather.
+void pack(const mesh::FaceMesh& m, const background::FaceReport& r, std::vector<char>& out);
+/// Reads one record written by pack starting at `pos`; advances `pos`.
+void unpack(const std::vector<char>& in, std::size_t& pos, mesh::FaceMesh& m,
+            background::FaceReport& r);
+
+}  // namespace qsmesh::parallel

@@ -1,0 +1,19 @@
+#!/usr/bin/env bash
+# Sets up a fresh Debian machine, builds qsmesh, writes the built-in wing-body CAD model and meshes
+# it on 2 MPI ranks. Results land in example_output/.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/setup.sh
+bash scripts/build.sh
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+mkdir -p example_output
+./build/drivers/qsmesh example wing-body -o example_output/wing_body.step
+./build/drivers/qsmesh info example_output/wing_body.step
+ranks=2
+mpiexec --oversubscribe -n "$ranks" ./build/drivers/qsmesh mesh example_output/wing_body.step \
+  -o example_output/wing_body.cgns --stats example_output/wing_body_stats.json
+./build/drivers/qsmesh mesh example_output/wing_body.step -o example_output/wing_body.vtu -q
+if command -v cgnscheck >/dev/null; then
+  cgnscheck example_output/wing_body.cgns | tail -n 3
+fi
+echo "outputs: example_output/wing_body.cgns (CGNS), example_output/wing_body.vtu (ParaView), example_output/wing_body_stats.json"

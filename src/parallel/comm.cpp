@@ -1,0 +1,146 @@
+#include "qsmesh/parallel/comm.hpp"
+
+#include <mpi.h>
+
+#include <limits>
+
+#include "qsmesh/core/error.hpp"
+
+namespace qsmesh::parallel {
+
+namespace {
+void check_mpi(int code, const char* what) {
+  if (code == MPI_SUCCESS) return;
+  char text[MPI_MAX_ERROR_STRING];
+  int len = 0;
+  MPI_Error_string(code, text, &len);
+  throw Error(std::string("MPI error in ") + what + ": " + std::string(text, static_cast<std::size_t>(len)));
+}
+}  // namespace
+
+MpiSession::MpiSession(int* argc, char*** argv) {
+  int provided = 0;
+  check_mpi(MPI_Init_thread(argc, argv, MPI_THREAD_FUNNELED, &provided), "MPI_Init_thread");
+  // Errors come back as codes so that they are checked and reported, not aborted on silently.
+  check_mpi(MPI_Comm_set_errhandler(MPI_COMM_WORLD, MPI_ERRORS_RETURN), "MPI_Comm_set_errhandler");
+}
+
+MpiSession::~MpiSession() {
+  int finalized = 0;
+  MPI_Finalized(&finalized);
+  if (finalized == 0) MPI_Finalize();
+}
+
+void MpiSession::abort(int code) {
+  MPI_Abort(MPI_COMM_WORLD, code);
+  std::abort();
+}
+
+struct Comm::Impl {
+  MPI_Comm comm = MPI_COMM_WORLD;
+};
+
+Comm::Comm(std::shared_ptr<Impl> impl) : impl_(std::move(impl)) {}
+Comm::Comm(const Comm&) = default;
+Comm& Comm::operator=(const Comm&) = default;
+Comm::~Comm() = default;
+
+Comm Comm::world() { return Comm(std::make_shared<Impl>()); }
+
+int Comm::rank() const {
+  int r = 0;
+  check_mpi(MPI_Comm_rank(impl_->comm, &r), "MPI_Comm_rank");
+  return r;
+}
+
+int Comm::size() const {
+  int s = 0;
+  check_mpi(MPI_Comm_size(impl_->comm, &s), "MPI_Comm_size");
+  return s;
+}
+
+int Comm::local_size() const {
+  MPI_Comm node = MPI_COMM_NULL;
+  check_mpi(MPI_Comm_split_type(impl_->comm, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &node),
+            "MPI_Comm_split_type");
+  int s = 1;
+  const int code = MPI_Comm_size(node, &s);
+  MPI_Comm_free(&node);
+  check_mpi(code, "MPI_Comm_size");
+  return s;
+}
+
+void Comm::barrier() const { check_mpi(MPI_Barrier(impl_->comm), "MPI_Barrier"); }
+
+void Comm::allreduce_sum(std::vector<double>& values) const {
+  QSMESH_CHECK(values.size() <= static_cast<std::size_t>(std::numeric_limits<int>::max()), "reduction too large");
+  check_mpi(MPI_Allreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()), MPI_DOUBLE,
+                          MPI_SUM, impl_->comm),
+            "MPI_Allreduce");
+}
+
+void Comm::allreduce_sum(std::vector<std::int64_t>& values) const {
+  QSMESH_CHECK(values.size() <= static_cast<std::size_t>(std::numeric_limits<int>::max()), "reduction too large");
+  check_mpi(MPI_Allreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()), MPI_INT64_T,
+                          MPI_SUM, impl_->comm),
+            "MPI_Allreduce");
+}
+
+double Comm::allreduce_max(double value) const {
+  double out = value;
+  check_mpi(MPI_Allreduce(&value, &out, 1, MPI_DOUBLE, MPI_MAX, impl_->comm), "MPI_Allreduce");
+  return out;
+}
+
+bool Comm::allreduce_and(bool value) const {
+  int in = value ? 1 : 0, out = 0;
+  check_mpi(MPI_Allreduce(&in, &out, 1, MPI_INT, MPI_LAND, impl_->comm), "MPI_Allreduce");
+  return out != 0;
+}
+
+std::vector<std::vector<char>> Comm::gather_bytes(const std::vector<char>& mine, int root) const {
+  // Sizes first (64-bit), then the payload rank by rank with point-to-point messages, so that no
+  // single MPI count exceeds the int range even when the assembled mesh is large.
+  const int n = size();
+  const int me = rank();
+  std::int64_t my_size = static_cast<std::int64_t>(mine.size());
+  std::vector<std::int64_t> sizes(static_cast<std::size_t>(n), 0);
+  check_mpi(MPI_Gather(&my_size, 1, MPI_INT64_T, sizes.data(), 1, MPI_INT64_T, root, impl_->comm),
+            "MPI_Gather");
+  constexpr std::int64_t kChunk = std::int64_t{1} << 30;
+  std::vector<std::vector<char>> out;
+  if (me == root) {
+    out.resize(static_cast<std::size_t>(n));
+    for (int r = 0; r < n; ++r) {
+      out[r].resize(static_cast<std::size_t>(sizes[r]));
+      if (r == root) {
+        out[r] = mine;
+        continue;
+      }
+      for (std::int64_t off = 0; off < sizes[r]; off += kChunk) {
+        const int count = static_cast<int>(std::min(kChunk, sizes[r] - off));
+        check_mpi(MPI_Recv(out[r].data() + off, count, MPI_CHAR, r, 7, impl_->comm, MPI_STATUS_IGNORE),
+                  "MPI_Recv");
+      }
+    }
+  } else {
+    for (std::int64_t off = 0; off < my_size; off += kChunk) {
+      const int count = static_cast<int>(std::min(kChunk, my_size - off));
+      check_mpi(MPI_Send(mine.data() + off, count, MPI_CHAR, root, 7, impl_->comm), "MPI_Send");
+    }
+  }
+  return out;
+}
+
+void Comm::broadcast_bytes(std::vector<char>& bytes, int root) const {
+  std::int64_t n = static_cast<std::int64_t>(bytes.size());
+  check_mpi(MPI_Bcast(&n, 1, MPI_INT64_T, root, impl_->comm), "MPI_Bcast");
+  bytes.resize(static_cast<std::size_t>(n));
+  constexpr std::int64_t kChunk = std::int64_t{1} << 30;
+  for (std::int64_t off = 0; off < n; off += kChunk) {
+    const int count = static_cast<int>(std::min(kChunk, n - off));
+    check_mpi(MPI_Bcast(bytes.data() + off, count, MPI_CHAR, root, impl_->comm), "MPI_Bcast");
+  }
+}
+
+}  // namespace qsmesh::parallel

@@ -1,0 +1,173 @@
+#include "qsmesh/parallel/pipeline.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cstring>
+
+#include "qsmesh/background/curve_mesh.hpp"
+#include "qsmesh/core/error.hpp"
+#include "qsmesh/mesh/assemble.hpp"
+#include "qsmesh/parallel/partition.hpp"
+
+namespace qsmesh::parallel {
+
+const char* to_string(Stage s) {
+  switch (s) {
+    case Stage::Background: return "background";
+  }
+  return "?";
+}
+
+Stage parse_stage(const std::string& name) {
+  if (name == "background") return Stage::Background;
+  throw InputError("--until: unknown stage '" + name + "' (valid: background)");
+}
+
+std::vector<double> estimate_face_costs(const cad::CadModel& model, double size) {
+  std::vector<double> cost;
+  cost.reserve(static_cast<std::size_t>(model.num_faces()));
+  for (const cad::Face& f : model.faces()) cost.push_back(std::max(1.0, f.area / (size * size)));
+  return cost;
+}
+
+namespace {
+
+template <class T>
+void put(std::vector<char>& out, const T& v) {
+  const auto* p = reinterpret_cast<const char*>(&v);
+  out.insert(out.end(), p, p + sizeof(T));
+}
+template <class T>
+void put_vec(std::vector<char>& out, const std::vector<T>& v) {
+  put<std::int64_t>(out, static_cast<std::int64_t>(v.size()));
+  const auto* p = reinterpret_cast<const char*>(v.data());
+  out.insert(out.end(), p, p + v.size() * sizeof(T));
+}
+template <class T>
+T get(const std::vector<char>& in, std::size_t& pos) {
+  QSMESH_CHECK(pos + sizeof(T) <= in.size(), "truncated face record");
+  T v;
+  std::memcpy(&v, in.data() + pos, sizeof(T));
+  pos += sizeof(T);
+  return v;
+}
+template <class T>
+void get_vec(const std::vector<char>& in, std::size_t& pos, std::vector<T>& v) {
+  const auto n = static_cast<std::size_t>(get<std::int64_t>(in, pos));
+  QSMESH_CHECK(pos + n * sizeof(T) <= in.size(), "truncated face record");
+  v.resize(n);
+  std::memcpy(v.data(), in.data() + pos, n * sizeof(T));
+  pos += n * sizeof(T);
+}
+
+}  // namespace
+
+void pack(const mesh::FaceMesh& m, const background::FaceReport& r, std::vector<char>& out) {
+  put<LO>(out, m.face);
+  put_vec(out, m.points);
+  put_vec(out, m.uv);
+  put_vec(out, m.vclass);
+  put_vec(out, m.triangles);
+  put_vec(out, m.quads);
+  put<LO>(out, r.face);
+  put<std::uint8_t>(out, r.ok ? 1 : 0);
+  put<std::uint8_t>(out, r.fell_back ? 1 : 0);
+  put<double>(out, r.seconds);
+  put_vec(out, std::vector<char>(r.error.begin(), r.error.end()));
+}
+
+void unpack(const std::vector<char>& in, std::size_t& pos, mesh::FaceMesh& m,
+            background::FaceReport& r) {
+  m.face = get<LO>(in, pos);
+  get_vec(in, pos, m.points);
+  get_vec(in, pos, m.uv);
+  get_vec(in, pos, m.vclass);
+  get_vec(in, pos, m.triangles);
+  get_vec(in, pos, m.quads);
+  r.face = get<LO>(in, pos);
+  r.ok = get<std::uint8_t>(in, pos) != 0;
+  r.fell_back = get<std::uint8_t>(in, pos) != 0;
+  r.seconds = get<double>(in, pos);
+  std::vector<char> err;
+  get_vec(in, pos, err);
+  r.error.assign(err.begin(), err.end());
+}
+
+PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
+                            const PipelineOptions& options, const TaskArena& tasks, Logger& log) {
+  PipelineResult result;
+  const int rank = comm.rank();
+  const int nranks = comm.size();
+  const LO nfaces = model.num_faces();
+
+  // Curves: every rank computes the same meshes (cheap next to the faces, and no communication).
+  Stopwatch clock;
+  const std::vector<mesh::CurveMesh> curves =
+      background::mesh_curves(model, options.background.sizes, tasks);
+  std::int64_t curve_edges = 0;
+  for (const auto& c : curves) curve_edges += c.num_edges();
+  result.times.add("curves", comm.allreduce_max(clock.seconds()));
+  log.info(cat("curves: ", model.num_curves(), " curves meshed, ", curve_edges, " edges (",
+               result.times.get("curves"), " s)"));
+
+  // Faces: METIS partition weighted by the estimated cost.
+  clock.reset();
+  result.face_rank = partition_faces(model.face2faces(),
+                                     estimate_face_costs(model, options.background.sizes.size), nranks);
+  std::vector<LO> mine;
+  for (LO f = 0; f < nfaces; ++f)
+    if (result.face_rank[f] == rank) mine.push_back(f);
+  result.times.add("partition", comm.allreduce_max(clock.seconds()));
+  if (nranks > 1) {
+    std::vector<std::int64_t> per_rank(static_cast<std::size_t>(nranks), 0);
+    per_rank[rank] = static_cast<std::int64_t>(mine.size());
+    comm.allreduce_sum(per_rank);
+    std::string line = "partition: faces per rank";
+    for (auto n : per_rank) line += cat(" ", n);
+    log.info(line);
+  }
+
+  // Background triangulation of this rank's faces, one task per face. Progress is counted on this
+  // rank; rank 0's logger prints it (the other ranks' loggers are quiet by default).
+  clock.reset();
+  std::vector<mesh::FaceMesh> meshes(mine.size());
+  std::vector<background::FaceReport> reports(mine.size());
+  std::atomic<std::int64_t> done{0};
+  const std::int64_t step = std::max<std::int64_t>(1, static_cast<std::int64_t>(mine.size()) / 10);
+  tasks.parallel_for(static_cast<std::int64_t>(mine.size()), [&](std::int64_t i) {
+    meshes[i] = background::mesh_face_background(model, mine[i], curves, options.background, &reports[i]);
+    const std::int64_t n = ++done;
+    if (n % step == 0 || n == static_cast<std::int64_t>(mine.size()))
+      log.info(cat("background: ", n, "/", mine.size(), " faces on rank ", rank));
+  });
+  result.times.add("background", comm.allreduce_max(clock.seconds()));
+
+  // Gather on rank 0 and assemble in face order.
+  clock.reset();
+  std::vector<char> buffer;
+  for (std::size_t i = 0; i < mine.size(); ++i) pack(meshes[i], reports[i], buffer);
+  meshes.clear();
+  const auto gathered = comm.gather_bytes(buffer, 0);
+  if (rank == 0) {
+    std::vector<mesh::FaceMesh> all(static_cast<std::size_t>(nfaces));
+    result.reports.resize(static_cast<std::size_t>(nfaces));
+    for (const auto& bytes : gathered) {
+      std::size_t pos = 0;
+      while (pos < bytes.size()) {
+        mesh::FaceMesh m;
+        background::FaceReport r;
+        unpack(bytes, pos, m, r);
+        const LO f = r.face;
+        QSMESH_CHECK(f >= 0 && f < nfaces, "gathered report for unknown face " << f);
+        result.reports[f] = std::move(r);
+        all[f] = std::move(m);
+      }
+    }
+    for (LO f = 0; f < nfaces; ++f) all[f].face = f;
+    result.mesh = mesh::assemble(model, curves, all);
+  }
+  result.times.add("assemble", comm.allreduce_max(clock.seconds()));
+  return result;
+}
+
+}  // namespace qsmesh::parallel

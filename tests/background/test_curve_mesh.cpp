@@ -1,0 +1,93 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "qsmesh/background/curve_mesh.hpp"
+#include "qsmesh/core/error.hpp"
+#include "shapes.hpp"
+
+namespace qsmesh::background {
+namespace {
+
+std::string tmp(const std::string& name) { return std::string(QSMESH_TEST_TMP_DIR) + "/" + name; }
+
+TEST(CurveMesh, StraightEdgesFollowTheSize) {
+  const cad::CadModel model = cad::load_cad(test::write_box_with_hole(tmp("cm_box.brep")));
+  SizeOptions sizes;
+  sizes.size = 0.5;
+  const TaskArena tasks(1);
+  const auto meshes = mesh_curves(model, sizes, tasks);
+  ASSERT_EQ(static_cast<LO>(meshes.size()), model.num_curves());
+  for (LO c = 0; c < model.num_curves(); ++c) {
+    const auto& curve = model.curves()[c];
+    const auto& m = meshes[c];
+    ASSERT_GE(m.num_edges(), 1);
+    EXPECT_EQ(m.points.front(), model.corners()[curve.corners[0]].point);
+    EXPECT_EQ(m.points.back(), model.corners()[curve.corners[1]].point);
+    for (std::size_t i = 1; i < m.t.size(); ++i) ASSERT_GT(m.t[i], m.t[i - 1]);
+    if (curve.type == cad::CurveType::Line) {
+      // A straight edge of length L gets round(L / h) edges of equal length.
+      EXPECT_EQ(m.num_edges(), std::lround(curve.length / sizes.size)) << "curve " << c;
+      for (LO i = 0; i < m.num_edges(); ++i)
+        EXPECT_NEAR(distance(m.points[i], m.points[i + 1]), curve.length / m.num_edges(), 1e-9);
+    }
+  }
+}
+
+TEST(CurveMesh, CirclesGetEdgesPerTurnFromCurvature) {
+  const cad::CadModel model = cad::load_cad(test::write_cylinder(tmp("cm_cyl.brep")));
+  SizeOptions sizes;
+  sizes.size = 100.0;  // the cap does not bind: curvature decides
+  sizes.min_size = 1e-3;
+  sizes.edges_per_turn = 16;
+  const TaskArena tasks(2);
+  const auto meshes = mesh_curves(model, sizes, tasks);
+  int circles = 0;
+  for (LO c = 0; c < model.num_curves(); ++c) {
+    if (model.curves()[c].type != cad::CurveType::Circle) continue;
+    ++circles;
+    EXPECT_EQ(meshes[c].num_edges(), 16) << "curve " << c;
+  }
+  EXPECT_EQ(circles, 2);
+}
+
+TEST(CurveMesh, ClosedCurveHasAtLeastThreeEdgesAndDegenerateOne) {
+  const cad::CadModel model = cad::load_cad(test::write_sphere(tmp("cm_sphere.brep")));
+  SizeOptions sizes;
+  sizes.size = 1e3;
+  sizes.edges_per_turn = 2;  // asks for fewer than allowed
+  const TaskArena tasks(1);
+  const auto meshes = mesh_curves(model, sizes, tasks);
+  for (LO c = 0; c < model.num_curves(); ++c) {
+    if (model.curves()[c].degenerate) {
+      EXPECT_EQ(meshes[c].num_edges(), 1);
+    } else if (model.curves()[c].corners[0] == model.curves()[c].corners[1]) {
+      EXPECT_GE(meshes[c].num_edges(), 3);
+    }
+  }
+}
+
+TEST(CurveMesh, SameResultWhateverTheThreads) {
+  const cad::CadModel model = cad::load_cad(test::write_filleted_box(tmp("cm_fillet.step")));
+  SizeOptions sizes;
+  sizes.size = 0.4;
+  const auto a = mesh_curves(model, sizes, TaskArena(1));
+  const auto b = mesh_curves(model, sizes, TaskArena(2));
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t c = 0; c < a.size(); ++c) {
+    EXPECT_EQ(a[c].t, b[c].t);
+    ASSERT_EQ(a[c].points.size(), b[c].points.size());
+    for (std::size_t i = 0; i < a[c].points.size(); ++i) EXPECT_EQ(a[c].points[i], b[c].points[i]);
+  }
+}
+
+TEST(CurveMesh, RejectsNonPositiveSize) {
+  const cad::CadModel model = cad::load_cad(test::write_cylinder(tmp("cm_cyl2.brep")));
+  SizeOptions sizes;
+  sizes.size = 0;
+  EXPECT_THROW((void)mesh_curves(model, sizes, TaskArena(1)), Error);
+}
+
+}  // namespace
+}  // namespace qsmesh::background

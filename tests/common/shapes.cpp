@@ -1,0 +1,57 @@
+#include "shapes.hpp"
+
+#include <BRepAlgoAPI_Cut.hxx>
+#include <BRepFilletAPI_MakeFillet.hxx>
+#include <BRepPrimAPI_MakeBox.hxx>
+#include <BRepPrimAPI_MakeCylinder.hxx>
+#include <BRepPrimAPI_MakeSphere.hxx>
+#include <BRepTools.hxx>
+#include <IFSelect_ReturnStatus.hxx>
+#include <STEPControl_Writer.hxx>
+#include <TopExp_Explorer.hxx>
+#include <TopoDS.hxx>
+#include <gp_Ax2.hxx>
+
+#include <stdexcept>
+
+namespace qsmesh::test {
+
+namespace {
+std::string write(const TopoDS_Shape& s, const std::string& path) {
+  if (!BRepTools::Write(s, path.c_str())) throw std::runtime_error("cannot write " + path);
+  return path;
+}
+}  // namespace
+
+std::string write_box_with_hole(const std::string& path) {
+  const TopoDS_Shape box = BRepPrimAPI_MakeBox(10.0, 6.0, 4.0).Shape();
+  const gp_Ax2 axis(gp_Pnt(5.0, 3.0, -1.0), gp_Dir(0, 0, 1));
+  const TopoDS_Shape hole = BRepPrimAPI_MakeCylinder(axis, 1.5, 6.0).Shape();
+  BRepAlgoAPI_Cut cut(box, hole);
+  cut.Build();
+  if (!cut.IsDone()) throw std::runtime_error("boolean cut failed");
+  return write(cut.Shape(), path);
+}
+
+std::string write_cylinder(const std::string& path) {
+  return write(BRepPrimAPI_MakeCylinder(2.0, 5.0).Shape(), path);
+}
+
+std::string write_sphere(const std::string& path) {
+  return write(BRepPrimAPI_MakeSphere(3.0).Shape(), path);
+}
+
+std::string write_filleted_box(const std::string& path) {
+  const TopoDS_Shape box = BRepPrimAPI_MakeBox(8.0, 6.0, 4.0).Shape();
+  BRepFilletAPI_MakeFillet fillet(box);
+  for (TopExp_Explorer e(box, TopAbs_EDGE); e.More(); e.Next()) fillet.Add(1.0, TopoDS::Edge(e.Current()));
+  fillet.Build();
+  if (!fillet.IsDone()) throw std::runtime_error("fillet failed");
+  STEPControl_Writer w;
+  if (w.Transfer(fillet.Shape(), STEPControl_AsIs) != IFSelect_RetDone ||
+      w.Write(path.c_str()) != IFSelect_RetDone)
+    throw std::runtime_error("cannot write " + path);
+  return path;
+}
+
+}  // namespace qsmesh::test

@@ -1,0 +1,17 @@
+// OpenCASCADE-built test models shared by the background, parallel and driver tests.
+#pragma once
+
+#include <string>
+
+namespace qsmesh::test {
+
+/// Writes a 10 x 6 x 4 box with a cylindrical hole (radius 1.5) through it, as BREP; returns path.
+std::string write_box_with_hole(const std::string& path);
+/// Writes a cylinder (radius 2, height 5): side face with a seam, two disks.
+std::string write_cylinder(const std::string& path);
+/// Writes a sphere of radius 3: one face, a seam and two degenerate pole curves.
+std::string write_sphere(const std::string& path);
+/// Writes a box with filleted edges (radius 1), as STEP.
+std::string write_filleted_box(const std::string& path);
+
+}  // namespace qsmesh::test

@@ -1,0 +1,155 @@
+// End-to-end tests of the qsmesh executable: help, info, example, mesh, and bad input.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <array>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "shapes.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct ExeResult {
+  int code = -1;
+  std::string out, err;
+};
+
+std::string tmp(const std::string& name) { return std::string(QSMESH_TEST_TMP_DIR) + "/" + name; }
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+/// Runs qsmesh with the given argument string (shell-quoted by the caller).
+ExeResult run(const std::string& args) {
+  static int counter = 0;
+  const std::string out = tmp("run_out_" + std::to_string(counter));
+  const std::string err = tmp("run_err_" + std::to_string(counter++));
+  const std::string cmd = std::string(QSMESH_EXE) + " " + args + " >" + out + " 2>" + err;
+  const int status = std::system(cmd.c_str());
+  ExeResult r;
+  r.code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  r.out = slurp(out);
+  r.err = slurp(err);
+  return r;
+}
+
+int lines(const std::string& s) {
+  int n = 0;
+  for (char c : s) n += c == '\n' ? 1 : 0;
+  return n;
+}
+
+/// No file of the folder starts with `stem` (neither the output nor a temporary of it).
+bool nothing_written(const std::string& dir, const std::string& stem) {
+  for (const auto& e : fs::directory_iterator(dir)) {
+    const std::string name = e.path().filename().string();
+    if (name.rfind(stem, 0) == 0 || name.rfind("." + stem, 0) == 0) return false;
+  }
+  return true;
+}
+
+class Qsmesh : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    model_ = tmp("e2e_fillet.step");
+    qsmesh::test::write_filleted_box(model_);
+  }
+  static std::string model_;
+};
+std::string Qsmesh::model_;
+
+TEST_F(Qsmesh, HelpAnswers) {
+  for (const std::string a : {"--help", "mesh --help", "info --help", "example --help"}) {
+    const ExeResult r = run(a);
+    EXPECT_EQ(r.code, 0) << a;
+    EXPECT_NE(r.out.find("usage"), std::string::npos) << a;
+  }
+}
+
+TEST_F(Qsmesh, InfoAndJson) {
+  const ExeResult r = run("info " + model_);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.out.find("faces:     26"), std::string::npos) << r.out;
+  const ExeResult j = run("info --json " + model_);
+  ASSERT_EQ(j.code, 0) << j.err;
+  EXPECT_NE(j.out.find("\"faces\": 26"), std::string::npos) << j.out;
+  EXPECT_NE(j.out.find("\"corners\": "), std::string::npos);
+  EXPECT_NE(j.out.find("\"curves\": "), std::string::npos);
+}
+
+TEST_F(Qsmesh, MeshWritesEveryFormatAndStats) {
+  for (const std::string ext : {"cgns", "vtu", "msh"}) {
+    const std::string out = tmp("e2e_mesh." + ext);
+    const std::string stats = tmp("e2e_stats_" + ext + ".json");
+    fs::remove(out);
+    const ExeResult r = run("mesh " + model_ + " -o " + out + " --size 0.8 --threads 2 --stats " + stats);
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(fs::exists(out));
+    EXPECT_GT(fs::file_size(out), 1000u);
+    EXPECT_NE(r.out.find("summary"), std::string::npos);
+    const std::string json = slurp(stats);
+    for (const char* key : {"\"vertices\"", "\"quads\"", "\"triangles\"", "\"irregular_interior\"", "\"sicn_min\"",
+                            "\"sicn_avg\"", "\"seconds\"", "\"background\""})
+      EXPECT_NE(json.find(key), std::string::npos) << key;
+    EXPECT_NE(json.find("\"faces_failed\": 0"), std::string::npos) << json;
+  }
+}
+
+TEST_F(Qsmesh, SameFileWhateverTheThreads) {
+  const std::string a = tmp("e2e_t1.msh"), b = tmp("e2e_t2.msh");
+  ASSERT_EQ(run("mesh " + model_ + " -o " + a + " --size 0.7 --threads 1 -q").code, 0);
+  ASSERT_EQ(run("mesh " + model_ + " -o " + b + " --size 0.7 --threads 2 -q").code, 0);
+  EXPECT_EQ(slurp(a), slurp(b));
+}
+
+TEST_F(Qsmesh, ExampleWingBody) {
+  const std::string step = tmp("e2e_wing_body.step");
+  const ExeResult r = run("example wing-body -o " + step);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const ExeResult info = run("info --json " + step);
+  ASSERT_EQ(info.code, 0) << info.err;
+  EXPECT_NE(info.out.find("\"faces\": "), std::string::npos);
+}
+
+// Bad input: one line on stderr naming the file or option, exit code 2, nothing written.
+struct BadCase {
+  std::string name, args, expect_in_error;
+};
+
+TEST_F(Qsmesh, BadInputIsOneLineAndExitTwo) {
+  const std::string dir = QSMESH_TEST_TMP_DIR;
+  std::ofstream(tmp("empty.step")).close();
+  std::ofstream(tmp("garbage.step")) << "this is not a STEP file\n\x01\x02\x03 garbage\n";
+  std::ofstream(tmp("model.xyz")) << "solid\n";
+  const std::vector<BadCase> cases = {
+      {"missing file", "mesh " + tmp("no_such.step") + " -o " + tmp("bad1.vtu"), "no_such.step"},
+      {"empty file", "mesh " + tmp("empty.step") + " -o " + tmp("bad2.vtu"), "empty.step"},
+      {"garbage file", "mesh " + tmp("garbage.step") + " -o " + tmp("bad3.vtu"), "garbage.step"},
+      {"unsupported input", "mesh " + tmp("model.xyz") + " -o " + tmp("bad4.vtu"), "model.xyz"},
+      {"unsupported output", "mesh " + model_ + " -o " + tmp("bad5.stl"), "bad5.stl"},
+      {"unwritable output dir", "mesh " + model_ + " -o /nonexistent_dir/bad6.vtu", "/nonexistent_dir"},
+      {"negative size", "mesh " + model_ + " -o " + tmp("bad7.vtu") + " --size -3", "--size"},
+      {"non-numeric size", "mesh " + model_ + " -o " + tmp("bad8.vtu") + " --size big", "--size"},
+      {"zero size factor", "mesh " + model_ + " -o " + tmp("bad9.vtu") + " --size-factor 0", "--size-factor"},
+      {"unknown stage", "mesh " + model_ + " -o " + tmp("bad10.vtu") + " --until everything", "--until"},
+      {"info missing file", "info " + tmp("no_such.brep"), "no_such.brep"},
+  };
+  for (const auto& c : cases) {
+    const ExeResult r = run(c.args);
+    EXPECT_EQ(r.code, 2) << c.name << ": " << r.err;
+    EXPECT_EQ(lines(r.err), 1) << c.name << ": " << r.err;
+    EXPECT_NE(r.err.find(c.expect_in_error), std::string::npos) << c.name << ": " << r.err;
+  }
+  for (int i = 1; i <= 10; ++i) EXPECT_TRUE(nothing_written(dir, "bad" + std::to_string(i) + ".")) << i;
+}
+
+}  // namespace

@@ -1,0 +1,58 @@
+#include <gtest/gtest.h>
+
+#include "qsmesh/core/error.hpp"
+#include "qsmesh/parallel/pipeline.hpp"
+
+namespace qsmesh::parallel {
+namespace {
+
+TEST(Pack, RoundTripOfFaceMeshesAndReports) {
+  mesh::FaceMesh a;
+  a.face = 3;
+  a.points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0.5}};
+  a.uv = {{0, 0}, {1, 0}, {0, 1}};
+  a.vclass.resize(3);
+  a.vclass[0] = {0, 7, kNoIndex, {0, 0}};
+  a.vclass[1] = {1, 2, 4, {0.25, 0}};
+  a.vclass[2] = {2, 3, kNoIndex, {0, 1}};
+  a.triangles = {{0, 1, 2}};
+  background::FaceReport ra;
+  ra.face = 3;
+  ra.ok = true;
+  ra.fell_back = true;
+  ra.error = "[background] face 3: refinement failed";
+  ra.seconds = 0.5;
+  mesh::FaceMesh b;
+  b.face = 9;
+  background::FaceReport rb;
+  rb.face = 9;
+
+  std::vector<char> buf;
+  pack(a, ra, buf);
+  pack(b, rb, buf);
+  std::size_t pos = 0;
+  mesh::FaceMesh a2, b2;
+  background::FaceReport ra2, rb2;
+  unpack(buf, pos, a2, ra2);
+  unpack(buf, pos, b2, rb2);
+  EXPECT_EQ(pos, buf.size());
+  EXPECT_EQ(a2.face, 3);
+  EXPECT_EQ(a2.points, a.points);
+  EXPECT_EQ(a2.uv, a.uv);
+  EXPECT_EQ(a2.triangles, a.triangles);
+  EXPECT_EQ(a2.vclass[1].entity, 2);
+  EXPECT_EQ(a2.vclass[1].index, 4);
+  EXPECT_EQ(ra2.error, ra.error);
+  EXPECT_TRUE(ra2.fell_back);
+  EXPECT_EQ(b2.face, 9);
+  EXPECT_TRUE(b2.points.empty());
+  EXPECT_FALSE(rb2.ok);
+  // A truncated buffer is an error, not a crash.
+  buf.resize(buf.size() - 3);
+  pos = 0;
+  unpack(buf, pos, a2, ra2);
+  EXPECT_THROW(unpack(buf, pos, b2, rb2), Error);
+}
+
+}  // namespace
+}  // namespace qsmesh::parallel

@@ -1,0 +1,57 @@
+#include <gtest/gtest.h>
+
+#include <numeric>
+
+#include "qsmesh/parallel/partition.hpp"
+
+namespace qsmesh::parallel {
+namespace {
+
+/// A grid graph of nx x ny faces, each adjacent to its 4 neighbours.
+Adjacency grid(LO nx, LO ny) {
+  std::vector<std::pair<LO, LO>> pairs;
+  for (LO j = 0; j < ny; ++j)
+    for (LO i = 0; i < nx; ++i) {
+      const LO f = j * nx + i;
+      if (i > 0) pairs.emplace_back(f, f - 1);
+      if (i + 1 < nx) pairs.emplace_back(f, f + 1);
+      if (j > 0) pairs.emplace_back(f, f - nx);
+      if (j + 1 < ny) pairs.emplace_back(f, f + nx);
+    }
+  return Adjacency::from_pairs(nx * ny, std::move(pairs));
+}
+
+TEST(Partition, OnePartTakesEverything) {
+  const auto g = grid(4, 4);
+  const std::vector<double> w(16, 1.0);
+  const auto p = partition_faces(g, w, 1);
+  for (int x : p) EXPECT_EQ(x, 0);
+}
+
+TEST(Partition, BalancedAndDeterministic) {
+  const auto g = grid(20, 10);
+  std::vector<double> w(200);
+  for (LO i = 0; i < 200; ++i) w[i] = 1.0 + (i % 7);  // uneven costs
+  const double total = std::accumulate(w.begin(), w.end(), 0.0);
+  for (int parts : {2, 3, 4}) {
+    const auto p = partition_faces(g, w, parts);
+    EXPECT_EQ(p, partition_faces(g, w, parts)) << "METIS must be deterministic";
+    std::vector<double> load(static_cast<std::size_t>(parts), 0.0);
+    for (LO i = 0; i < 200; ++i) {
+      ASSERT_GE(p[i], 0);
+      ASSERT_LT(p[i], parts);
+      load[p[i]] += w[i];
+    }
+    for (double l : load) EXPECT_LT(l, 1.1 * total / parts) << parts << " parts";
+  }
+}
+
+TEST(Partition, MorePartsThanFaces) {
+  const auto g = grid(2, 1);
+  const std::vector<double> w(2, 1.0);
+  const auto p = partition_faces(g, w, 4);
+  EXPECT_EQ(p, (std::vector<int>{0, 1}));
+}
+
+}  // namespace
+}  // namespace qsmesh::parallel
