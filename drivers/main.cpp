@@ -6,6 +6,7 @@
 
 #include "cli.hpp"
 #include "commands.hpp"
+#include "qsmesh/cad/model.hpp"
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/parallel/comm.hpp"
 
@@ -27,6 +28,8 @@ int main(int argc, char** argv) {
     std::cout << "qsmesh 0.1.0\n";
     return 0;
   }
+
+  cad::set_kernel_messages(!parsed.verbose);
 
   // Only the mesh command runs distributed; the others need no MPI.
   if (parsed.command != cli::Command::Mesh) {

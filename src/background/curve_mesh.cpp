@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <array>
 #include <map>
+#include <unordered_map>
 #include <memory>
 
 #include "qsmesh/core/error.hpp"
@@ -52,68 +54,144 @@ class CurveSizer {
   const SizeOptions& sizes_;
 };
 
-/// Cumulative integral of |C'(t)| / h(t) on `samples + 1` equally spaced parameters.
-struct DensityTable {
-  std::vector<double> t, cumulative;
-  [[nodiscard]] double total() const { return cumulative.back(); }
+/// A curve sampled finely enough to resolve its size field: parameters, points, arc length, and
+/// the size at each sample (reduced by the feature and gradation passes).
+struct CurveSamples {
+  std::vector<double> t, s, h;
+  std::vector<Vec3> p;
+  [[nodiscard]] double length() const { return s.empty() ? 0.0 : s.back(); }
 };
 
-DensityTable integrate_density(const CurveSizer& sizer, double t0, double t1, int samples) {
-  DensityTable table;
-  table.t.resize(static_cast<std::size_t>(samples) + 1);
-  table.cumulative.assign(table.t.size(), 0.0);
-  double prev = 0;
-  for (int i = 0; i <= samples; ++i) {
-    const double t = t0 + (t1 - t0) * i / samples;
-    const double rho = norm(sizer.geometry().derivative(t)) / sizer.size_at(t);
-    table.t[i] = t;
-    if (i > 0) table.cumulative[i] = table.cumulative[i - 1] + 0.5 * (rho + prev) * (t1 - t0) / samples;
-    prev = rho;
+CurveSamples sample_curve(const CurveSizer& sizer, const cad::Curve& curve, double cap) {
+  // A coarse pass estimates the edge count from the curvature sizes; the samples then resolve the
+  // size field at ~8 per edge and are never further apart than cap / 4 (for the feature search).
+  const int coarse_n = 32;
+  double estimate = 0, length = 0;
+  Vec3 prev = sizer.geometry().point(curve.t0);
+  for (int i = 1; i <= coarse_n; ++i) {
+    const double t = curve.t0 + (curve.t1 - curve.t0) * i / coarse_n;
+    const Vec3 q = sizer.geometry().point(t);
+    const double ds = distance(prev, q);
+    estimate += ds / sizer.size_at(t);
+    length += ds;
+    prev = q;
   }
-  return table;
+  const int n = std::clamp(static_cast<int>(std::ceil(std::max(8 * estimate, 4 * length / cap))), 64, 16384);
+  CurveSamples cs;
+  cs.t.resize(static_cast<std::size_t>(n) + 1);
+  cs.s.assign(cs.t.size(), 0.0);
+  cs.h.resize(cs.t.size());
+  cs.p.resize(cs.t.size());
+  for (int i = 0; i <= n; ++i) {
+    cs.t[i] = curve.t0 + (curve.t1 - curve.t0) * i / n;
+    cs.p[i] = sizer.geometry().point(cs.t[i]);
+    cs.h[i] = sizer.size_at(cs.t[i]);
+    if (i > 0) cs.s[i] = cs.s[i - 1] + distance(cs.p[i - 1], cs.p[i]);
+  }
+  return cs;
 }
 
-/// Parameter where the cumulative density reaches `target` (linear inside a sample interval).
-double invert(const DensityTable& table, double target) {
-  const auto it = std::lower_bound(table.cumulative.begin(), table.cumulative.end(), target);
-  if (it == table.cumulative.begin()) return table.t.front();
-  if (it == table.cumulative.end()) return table.t.back();
-  const auto i = static_cast<std::size_t>(it - table.cumulative.begin());
-  const double c0 = table.cumulative[i - 1], c1 = table.cumulative[i];
-  const double w = c1 > c0 ? (target - c0) / (c1 - c0) : 0.0;
-  return table.t[i - 1] + w * (table.t[i] - table.t[i - 1]);
+/// Lowers the sizes so that they grow by at most `g` per unit arc length from either end value
+/// and along the curve (one forward and one backward sweep: the exact one-way gradation in 1D).
+void grade_along(CurveSamples& cs, double h_start, double h_end, double g) {
+  const std::size_t n = cs.h.size();
+  cs.h.front() = std::min(cs.h.front(), h_start);
+  cs.h.back() = std::min(cs.h.back(), h_end);
+  for (std::size_t i = 1; i < n; ++i) cs.h[i] = std::min(cs.h[i], cs.h[i - 1] + g * (cs.s[i] - cs.s[i - 1]));
+  for (std::size_t i = n - 1; i-- > 0;) cs.h[i] = std::min(cs.h[i], cs.h[i + 1] + g * (cs.s[i + 1] - cs.s[i]));
 }
 
-mesh::CurveMesh mesh_one_curve(const cad::CadModel& model, LO c, std::span<const CurveUseRef> uses,
-                               const SizeOptions& sizes, int min_edges) {
-  const cad::Curve& curve = model.curves()[c];
+/// Places round(integral of ds / h) edges (at least min_edges) at equal steps of that integral.
+mesh::CurveMesh place_vertices(const CurveSamples& cs, const CurveSizer& sizer, LO c,
+                               const Vec3& p0, const Vec3& p1, int min_edges) {
+  const std::size_t n = cs.t.size();
+  std::vector<double> cumulative(n, 0.0);
+  for (std::size_t i = 1; i < n; ++i)
+    cumulative[i] = cumulative[i - 1] + 0.5 * (1 / cs.h[i - 1] + 1 / cs.h[i]) * (cs.s[i] - cs.s[i - 1]);
+  const double total = cumulative.back();
+  QSMESH_CHECK(std::isfinite(total) && total > 0, "size integral is not finite (" << total << ")");
+  const int edges = std::max(min_edges, static_cast<int>(std::lround(total)));
   mesh::CurveMesh out;
   out.curve = c;
-  const Vec3 p0 = model.corners()[curve.corners[0]].point;
-  const Vec3 p1 = model.corners()[curve.corners[1]].point;
-  if (curve.degenerate) {
-    out.t = {curve.t0, curve.t1};
-    out.points = {p0, p1};
-    return out;
-  }
-  const CurveSizer sizer(model, c, uses, sizes);
-  // A coarse pass estimates the edge count; the fine pass resolves the density at ~8 samples/edge.
-  const DensityTable coarse = integrate_density(sizer, curve.t0, curve.t1, 32);
-  const int samples = std::clamp(static_cast<int>(std::ceil(8 * coarse.total())), 64, 8192);
-  const DensityTable table = integrate_density(sizer, curve.t0, curve.t1, samples);
-  QSMESH_CHECK(std::isfinite(table.total()), "curve " << c << ": size integral is not finite");
-  const int n = std::max(min_edges, static_cast<int>(std::lround(table.total())));
-  out.t.resize(static_cast<std::size_t>(n) + 1);
+  out.t.resize(static_cast<std::size_t>(edges) + 1);
   out.points.resize(out.t.size());
-  out.t.front() = curve.t0;
-  out.t.back() = curve.t1;
-  for (int i = 1; i < n; ++i) out.t[i] = invert(table, table.total() * i / n);
-  for (int i = 1; i < n; ++i) out.points[i] = sizer.geometry().point(out.t[i]);
+  out.t.front() = cs.t.front();
+  out.t.back() = cs.t.back();
+  for (int k = 1; k < edges; ++k) {
+    const double target = total * k / edges;
+    const auto it = std::lower_bound(cumulative.begin(), cumulative.end(), target);
+    const auto i = std::clamp<std::size_t>(static_cast<std::size_t>(it - cumulative.begin()), 1, n - 1);
+    const double c0 = cumulative[i - 1], c1 = cumulative[i];
+    const double w = c1 > c0 ? std::clamp((target - c0) / (c1 - c0), 0.0, 1.0) : 0.0;
+    out.t[k] = cs.t[i - 1] + w * (cs.t[i] - cs.t[i - 1]);
+    out.points[k] = sizer.geometry().point(out.t[k]);
+  }
   // End points are the corners themselves, so that every curve ending there shares them exactly.
   out.points.front() = p0;
   out.points.back() = p1;
   return out;
 }
+
+/// Uniform hash grid over the samples of all curves, for the nearest non-adjacent sample.
+class SampleGrid {
+ public:
+  SampleGrid(const std::vector<CurveSamples>& samples, double cell) : cell_(cell) {
+    for (LO c = 0; c < static_cast<LO>(samples.size()); ++c)
+      for (LO i = 0; i < static_cast<LO>(samples[c].p.size()); ++i)
+        cells_[key(samples[c].p[i])].push_back({c, i});
+  }
+
+  /// For each curve with `eligible(curve)` that has a sample within `radius` of p: its nearest
+  /// sample's (curve, sample index), in increasing curve id.
+  template <class Eligible>
+  [[nodiscard]] std::vector<std::pair<LO, LO>> candidates(const std::vector<CurveSamples>& samples,
+                                                          const Vec3& p, double radius,
+                                                          const Eligible& eligible) const {
+    std::vector<std::pair<LO, LO>> best;  // (curve, sample)
+    std::vector<double> best_d2;
+    const double r2 = radius * radius;
+    const auto r = static_cast<std::int64_t>(std::ceil(radius / cell_));
+    const auto [cx, cy, cz] = coords(p);
+    for (std::int64_t x = cx - r; x <= cx + r; ++x)
+      for (std::int64_t y = cy - r; y <= cy + r; ++y)
+        for (std::int64_t z = cz - r; z <= cz + r; ++z) {
+          const auto it = cells_.find(pack(x, y, z));
+          if (it == cells_.end()) continue;
+          for (const auto& [c, i] : it->second) {
+            const double d2 = norm2(samples[c].p[i] - p);
+            if (d2 >= r2 || !eligible(c)) continue;
+            std::size_t k = 0;
+            while (k < best.size() && best[k].first != c) ++k;
+            if (k == best.size()) {
+              best.emplace_back(c, i);
+              best_d2.push_back(d2);
+            } else if (d2 < best_d2[k] || (d2 == best_d2[k] && i < best[k].second)) {
+              best[k].second = i;
+              best_d2[k] = d2;
+            }
+          }
+        }
+    std::sort(best.begin(), best.end());
+    return best;
+  }
+
+ private:
+  [[nodiscard]] std::array<std::int64_t, 3> coords(const Vec3& p) const {
+    return {static_cast<std::int64_t>(std::floor(p.x / cell_)), static_cast<std::int64_t>(std::floor(p.y / cell_)),
+            static_cast<std::int64_t>(std::floor(p.z / cell_))};
+  }
+  static std::uint64_t pack(std::int64_t x, std::int64_t y, std::int64_t z) {
+    constexpr std::int64_t kBias = 1 << 20;
+    return (static_cast<std::uint64_t>(x + kBias) << 42) ^ (static_cast<std::uint64_t>(y + kBias) << 21) ^
+           static_cast<std::uint64_t>(z + kBias);
+  }
+  [[nodiscard]] std::uint64_t key(const Vec3& p) const {
+    const auto [x, y, z] = coords(p);
+    return pack(x, y, z);
+  }
+  double cell_;
+  std::unordered_map<std::uint64_t, std::vector<std::pair<LO, LO>>> cells_;
+};
 
 }  // namespace
 
@@ -122,6 +200,65 @@ std::vector<mesh::CurveMesh> mesh_curves(const cad::CadModel& model, const SizeO
   QSMESH_CHECK(sizes.size > 0, "mesh size must be positive, got " << sizes.size);
   const LO n = model.num_curves();
   const auto uses = curve_uses(model);
+  auto with_context = [](LO c, auto&& body) {
+    try {
+      body();
+    } catch (const Error& e) {
+      throw e.with_context({"curves", 1, c});
+    }
+  };
+
+  // 1. Sample every curve with its curvature sizes.
+  std::vector<std::unique_ptr<CurveSizer>> sizers(static_cast<std::size_t>(n));
+  std::vector<CurveSamples> samples(static_cast<std::size_t>(n));
+  tasks.parallel_for(n, [&](std::int64_t i) {
+    const auto c = static_cast<LO>(i);
+    if (model.curves()[c].degenerate) return;
+    with_context(c, [&] {
+      sizers[c] = std::make_unique<CurveSizer>(model, c, uses[c], sizes);
+      samples[c] = sample_curve(*sizers[c], model.curves()[c], sizes.size);
+    });
+  });
+
+  // 2. Small features: no size larger than the distance to a curve sharing no corner with this one.
+  if (sizes.feature_size) {
+    const SampleGrid grid(samples, sizes.size);
+    tasks.parallel_for(n, [&](std::int64_t i) {
+      const auto c = static_cast<LO>(i);
+      const auto& cc = model.curves()[c];
+      const auto adjacent = [&](LO other) {
+        const auto& oc = model.curves()[other];
+        return other == c || oc.corners[0] == cc.corners[0] || oc.corners[0] == cc.corners[1] ||
+               oc.corners[1] == cc.corners[0] || oc.corners[1] == cc.corners[1];
+      };
+      // Gaps narrower than a tenth of the smallest size are curves touching or lying on top of each
+      // other (unsewn volumes, sloppy models), not features the mesh could resolve.
+      const double touching = 0.1 * sizes.effective_min_size();
+      std::map<LO, std::unique_ptr<cad::CurveGeometry>> others;
+      CurveSamples& cs = samples[c];
+      for (std::size_t k = 0; k < cs.p.size(); ++k) {
+        for (const auto& [o, j] : grid.candidates(samples, cs.p[k], cs.h[k], [&](LO x) { return !adjacent(x); })) {
+          auto& g = others[o];
+          if (!g) g = model.curve_geometry(o);
+          Vec3 foot;
+          (void)g->project(cs.p[k], samples[o].t[j], &foot);
+          const double d = distance(foot, cs.p[k]);
+          if (d > touching) cs.h[k] = std::max(sizes.effective_min_size(), std::min(cs.h[k], d));
+        }
+      }
+    });
+  }
+
+  // 3. Corners take the smallest size of the curves ending there (a curve never asks for more than
+  //    its length); then sizes grade along each curve from its two corners.
+  std::vector<double> corner_size(static_cast<std::size_t>(model.num_corners()), sizes.size);
+  for (LO c = 0; c < n; ++c) {
+    const auto& cc = model.curves()[c];
+    if (cc.degenerate || samples[c].p.empty()) continue;
+    const double len = samples[c].length();
+    corner_size[cc.corners[0]] = std::min({corner_size[cc.corners[0]], samples[c].h.front(), len});
+    corner_size[cc.corners[1]] = std::min({corner_size[cc.corners[1]], samples[c].h.back(), len});
+  }
 
   // Curves joining the same corner pair would coincide if both were single straight edges.
   std::map<std::pair<LO, LO>, int> pair_count;
@@ -130,18 +267,26 @@ std::vector<mesh::CurveMesh> mesh_curves(const cad::CadModel& model, const SizeO
     ++pair_count[std::minmax(c.corners[0], c.corners[1])];
   }
 
+  // 4. Vertices at equal steps of the integral of 1/h.
   std::vector<mesh::CurveMesh> meshes(static_cast<std::size_t>(n));
   tasks.parallel_for(n, [&](std::int64_t i) {
     const auto c = static_cast<LO>(i);
     const cad::Curve& curve = model.curves()[c];
+    const Vec3 p0 = model.corners()[curve.corners[0]].point;
+    const Vec3 p1 = model.corners()[curve.corners[1]].point;
+    if (curve.degenerate) {
+      meshes[c].curve = c;
+      meshes[c].t = {curve.t0, curve.t1};
+      meshes[c].points = {p0, p1};
+      return;
+    }
     int min_edges = 1;
     if (curve.corners[0] == curve.corners[1]) min_edges = 3;
     else if (pair_count.at(std::minmax(curve.corners[0], curve.corners[1])) > 1) min_edges = 2;
-    try {
-      meshes[c] = mesh_one_curve(model, c, uses[c], sizes, min_edges);
-    } catch (const Error& e) {
-      throw e.with_context({"curves", 1, c});
-    }
+    with_context(c, [&] {
+      grade_along(samples[c], corner_size[curve.corners[0]], corner_size[curve.corners[1]], sizes.gradation);
+      meshes[c] = place_vertices(samples[c], *sizers[c], c, p0, p1, min_edges);
+    });
   });
   return meshes;
 }

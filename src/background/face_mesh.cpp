@@ -59,10 +59,22 @@ mesh::FaceMesh mesh_face_background(const cad::CadModel& model, LO f,
   try {
     const auto surface = model.face_geometry(f);
     const auto loops = face_boundary(model, f, *surface, curves);
-    const SizeOptions& sizes = options.sizes;
-    const mesh::SizeFunction size = [&](const Vec2& uv, const Vec3&) {
-      return sizes.from_curvature(max_principal_curvature(*surface, uv));
-    };
+    std::vector<Vec3> bpoints;
+    std::vector<double> bsizes;
+    for (const auto& loop : loops) {
+      const std::size_t n = loop.points.size();
+      for (std::size_t i = 0; i < n; ++i) {
+        const Vec3& p = loop.points[i].xyz;
+        const double prev = distance(loop.points[(i + n - 1) % n].xyz, p);
+        const double next = distance(p, loop.points[(i + 1) % n].xyz);
+        // Pole points (degenerate curves) have zero-length edges and tell nothing about sizes.
+        if (prev <= 0 && next <= 0) continue;
+        bpoints.push_back(p);
+        bsizes.push_back(prev <= 0 ? next : next <= 0 ? prev : 0.5 * (prev + next));
+      }
+    }
+    const FaceSizeField field(*surface, options.sizes, std::move(bpoints), std::move(bsizes));
+    const mesh::SizeFunction size = [&](const Vec2& uv, const Vec3& xyz) { return field(uv, xyz); };
     const bool reversed = model.faces()[f].reversed;
     try {
       out = mesh::triangulate_face(*surface, reversed, loops, size, options.triangulate);

@@ -13,6 +13,28 @@ double SizeOptions::from_curvature(double kappa) const {
   return std::clamp(h, lo, size);
 }
 
+FaceSizeField::FaceSizeField(const cad::FaceGeometry& surface, const SizeOptions& sizes,
+                             std::vector<Vec3> boundary_points, std::vector<double> boundary_sizes)
+    : surface_(surface),
+      sizes_(sizes),
+      points_(std::move(boundary_points)),
+      sizes_at_(std::move(boundary_sizes)) {}
+
+double FaceSizeField::operator()(const Vec2& uv, const Vec3& xyz) const {
+  double h = sizes_.from_curvature(max_principal_curvature(surface_, uv));
+  for (std::size_t i = 0; i < points_.size(); ++i) {
+    // Compare squared distances first: most boundary vertices are too far to bind.
+    const double reach = (h - sizes_at_[i]) / sizes_.gradation;
+    if (reach <= 0) {
+      h = std::min(h, sizes_at_[i]);
+      continue;
+    }
+    const double d2 = norm2(xyz - points_[i]);
+    if (d2 < reach * reach) h = sizes_at_[i] + sizes_.gradation * std::sqrt(d2);
+  }
+  return std::max(h, sizes_.effective_min_size());
+}
+
 double max_principal_curvature(const cad::FaceGeometry& surface, const Vec2& uv) {
   const cad::SurfaceEval2 e = surface.eval2(uv);
   const Vec3 n_raw = cross(e.du, e.dv);

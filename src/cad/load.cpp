@@ -5,6 +5,9 @@
 #include <BRep_Builder.hxx>
 #include <Bnd_Box.hxx>
 #include <IFSelect_ReturnStatus.hxx>
+#include <Message.hxx>
+#include <Message_Messenger.hxx>
+#include <Message_PrinterOStream.hxx>
 #include <IGESControl_Reader.hxx>
 #include <STEPControl_Reader.hxx>
 #include <Standard_Failure.hxx>
@@ -103,6 +106,21 @@ CadModel load_cad(const std::string& path, const LoadOptions& options) {
     }
   }
   return ModelBuilder::build(shape, path);
+}
+
+}  // namespace qsmesh::cad
+
+namespace qsmesh::cad {
+
+void set_kernel_messages(bool quiet) {
+  const Handle(Message_Messenger)& messenger = Message::DefaultMessenger();
+  messenger->RemovePrinters(STANDARD_TYPE(Message_PrinterOStream));
+  // Quiet: the program reports load failures itself, in one line; the kernel's own parser messages
+  // would only repeat them. Verbose: the kernel's warnings go to stderr, never to stdout.
+  if (quiet) return;
+  Handle(Message_PrinterOStream) printer = new Message_PrinterOStream("cerr", Standard_False, Message_Warning);
+  printer->SetToColorize(Standard_False);
+  messenger->AddPrinter(printer);
 }
 
 }  // namespace qsmesh::cad

@@ -147,6 +147,7 @@ TEST_F(Qsmesh, BadInputIsOneLineAndExitTwo) {
     const ExeResult r = run(c.args);
     EXPECT_EQ(r.code, 2) << c.name << ": " << r.err;
     EXPECT_EQ(lines(r.err), 1) << c.name << ": " << r.err;
+    EXPECT_TRUE(r.out.empty()) << c.name << ": " << r.out;
     EXPECT_NE(r.err.find(c.expect_in_error), std::string::npos) << c.name << ": " << r.err;
   }
   for (int i = 1; i <= 10; ++i) EXPECT_TRUE(nothing_written(dir, "bad" + std::to_string(i) + ".")) << i;

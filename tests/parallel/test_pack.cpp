@@ -11,10 +11,8 @@ TEST(Pack, RoundTripOfFaceMeshesAndReports) {
   a.face = 3;
   a.points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0.5}};
   a.uv = {{0, 0}, {1, 0}, {0, 1}};
-  a.vclass.resize(3);
-  a.vclass[0] = {0, 7, kNoIndex, {0, 0}};
-  a.vclass[1] = {1, 2, 4, {0.25, 0}};
-  a.vclass[2] = {2, 3, kNoIndex, {0, 1}};
+  a.vclass = {mesh::VertexClass{0, 7, kNoIndex, {0, 0}}, mesh::VertexClass{1, 2, 4, {0.25, 0}},
+              mesh::VertexClass{2, 3, kNoIndex, {0, 1}}};
   a.triangles = {{0, 1, 2}};
   background::FaceReport ra;
   ra.face = 3;

@@ -4,6 +4,8 @@
 // size map of the final mesh; the background mesh keeps this one.
 #pragma once
 
+#include <vector>
+
 #include "qsmesh/cad/geometry.hpp"
 #include "qsmesh/core/types.hpp"
 
@@ -16,10 +18,35 @@ struct SizeOptions {
   double min_size = 0;
   /// Edges per full turn on curved geometry: a radius of curvature R gives edges of 2 pi R / n.
   double edges_per_turn = 16;
+  /// Largest growth of the size per unit distance (paper 000 Eq. 10: 0.25 is a progression ratio
+  /// of 1.25 between neighbouring edges).
+  double gradation = 0.25;
+  /// Cap the size on curves by the distance to the nearest non-adjacent curve (small CAD features,
+  /// paper 000 Sec. 4.1), so that narrow faces get edges as short as they are wide.
+  bool feature_size = true;
 
   [[nodiscard]] double effective_min_size() const { return min_size > 0 ? min_size : size / 20; }
   /// The size for a radius of curvature 1/kappa (kappa >= 0, 1/model units), within the bounds.
   [[nodiscard]] double from_curvature(double kappa) const;
+};
+
+/// Size field of one face: the curvature size of the face, graded from the boundary: at a point x it
+/// is at most h_b + gradation * |x - b| for every boundary vertex b with local edge length h_b.
+/// Without the grading, a curve meshed finely (for the curvature of a neighbouring face, say) next
+/// to a face of large size forces long thin triangles along it.
+class FaceSizeField {
+ public:
+  /// boundary: the face's boundary vertices (3D) and the mean length of their two boundary edges.
+  FaceSizeField(const cad::FaceGeometry& surface, const SizeOptions& sizes,
+                std::vector<Vec3> boundary_points, std::vector<double> boundary_sizes);
+  /// Target edge length at (uv, xyz) of the face (model units).
+  [[nodiscard]] double operator()(const Vec2& uv, const Vec3& xyz) const;
+
+ private:
+  const cad::FaceGeometry& surface_;
+  const SizeOptions& sizes_;
+  std::vector<Vec3> points_;
+  std::vector<double> sizes_at_;
 };
 
 /// Largest absolute principal curvature of `surface` at uv (1/model units), 0 where it cannot

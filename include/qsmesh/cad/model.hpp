@@ -125,6 +125,12 @@ class CadModel {
 /// unsupported file, naming the file and the reason.
 [[nodiscard]] CadModel load_cad(const std::string& path, const LoadOptions& options = {});
 
+/// Sets how much the CAD kernel (OpenCASCADE) itself prints: by default its readers print progress
+/// and statistics on stdout, which would mix with the program's own output (e.g. `info --json`).
+/// quiet: nothing; otherwise its warnings and errors, on stderr. Process-wide:
+/// the driver calls it once at start-up, before any thread exists.
+void set_kernel_messages(bool quiet);
+
 /// Writes the built-in wing-body example (fuselage of revolution fused with a wing lofted from
 /// NACA 4-digit sections) as STEP to `path`. Throws InputError when the file cannot be written.
 void write_wing_body_example(const std::string& path);
