@@ -17,6 +17,7 @@
 #include "qsmesh/core/timer.hpp"
 #include "qsmesh/io/writer.hpp"
 #include "qsmesh/mesh/quality.hpp"
+#include "qsmesh/mesh/validate.hpp"
 #include "qsmesh/parallel/comm.hpp"
 #include "qsmesh/parallel/pipeline.hpp"
 
@@ -121,9 +122,15 @@ int run_example(const Arguments& args) {
 
 namespace {
 
+/// Self-checks of the written mesh against the CAD model.
+struct Checks {
+  mesh::ConformityReport conformity;
+  double max_distance_to_cad = 0;  ///< relative to the model diagonal
+};
+
 std::string stats_json(const Arguments& args, const cad::CadModel& model, double size, int ranks,
                        int threads, const parallel::PipelineResult& r, const mesh::MeshStats& s,
-                       const StageTimes& times) {
+                       const Checks& checks, const StageTimes& times) {
   JsonWriter j;
   j.begin_object();
   j.value("model", args.model);
@@ -158,6 +165,8 @@ std::string stats_json(const Arguments& args, const cad::CadModel& model, double
   for (int b = 0; b < 5; ++b) j.value(kBins[b], s.min_angle_histogram[b]);
   j.end_object();
   j.value("small_angle_at_sharp_corner", s.small_angle_at_sharp_corner);
+  j.value("conforming", checks.conformity.ok());
+  j.value("max_distance_to_cad", checks.max_distance_to_cad);
   j.begin_object("seconds");
   for (const auto& [stage, sec] : times.entries()) j.value(stage, sec);
   j.value("total", times.total());
@@ -174,7 +183,7 @@ std::string stats_json(const Arguments& args, const cad::CadModel& model, double
 }
 
 void print_summary(std::ostream& os, const cad::CadModel& model, const parallel::PipelineResult& r,
-                   const mesh::MeshStats& s, const StageTimes& times) {
+                   const mesh::MeshStats& s, const Checks& checks, const StageTimes& times) {
   std::int64_t failed = 0, fell_back = 0;
   for (const auto& rep : r.reports) {
     failed += rep.ok ? 0 : 1;
@@ -196,6 +205,8 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
        << ", >=30: " << s.min_angle_histogram[4] << " (" << s.small_angle_at_sharp_corner
        << " below 10 at CAD corners sharper than 10)\n";
   }
+  os << "  conforming: " << (checks.conformity.ok() ? "yes" : "NO (" + checks.conformity.summary() + ")")
+     << "; largest vertex distance to its CAD entity: " << checks.max_distance_to_cad << " of the diagonal\n";
   os << "  time (s):";
   for (const auto& [stage, sec] : times.entries()) os << " " << stage << " " << std::setprecision(3) << sec << ";";
   os << " total " << times.total() << "\n";
@@ -242,14 +253,17 @@ int run_mesh(const Arguments& args) {
   if (rank == 0) {
     clock.reset();
     const mesh::MeshStats stats = mesh::compute_stats(result.mesh);
+    Checks checks;
+    checks.conformity = mesh::check_conformity(result.mesh, model);
+    checks.max_distance_to_cad = mesh::max_distance_to_cad(result.mesh, model) / model.diagonal();
     times.add("statistics", clock.seconds());
     clock.reset();
     io::write_mesh(result.mesh, args.output);
     times.add("write", clock.seconds());
     log.info(cat("wrote ", args.output));
-    if (!args.quiet) print_summary(std::cout, model, result, stats, times);
+    if (!args.quiet) print_summary(std::cout, model, result, stats, checks, times);
     if (!args.stats.empty()) {
-      write_text_file_atomically(args.stats, stats_json(args, model, size, ranks, threads, result, stats, times));
+      write_text_file_atomically(args.stats, stats_json(args, model, size, ranks, threads, result, stats, checks, times));
     }
     for (const auto& rep : result.reports)
       if (!rep.ok) log.warn(rep.error);

@@ -226,6 +226,9 @@ std::vector<mesh::CurveMesh> mesh_curves(const cad::CadModel& model, const SizeO
     tasks.parallel_for(n, [&](std::int64_t i) {
       const auto c = static_cast<LO>(i);
       const auto& cc = model.curves()[c];
+      // Curves sharing a corner are not features of each other (paper 000 Sec. 4.1: the nearest
+      // non-adjacent curve). Counting them inside sharp wedges was tried and made things worse:
+      // the boundary sizes then vary too fast near the corner.
       const auto adjacent = [&](LO other) {
         const auto& oc = model.curves()[other];
         return other == c || oc.corners[0] == cc.corners[0] || oc.corners[0] == cc.corners[1] ||

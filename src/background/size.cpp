@@ -32,7 +32,9 @@ double FaceSizeField::operator()(const Vec2& uv, const Vec3& xyz) const {
     const double d2 = norm2(xyz - points_[i]);
     if (d2 < reach * reach) h = sizes_at_[i] + sizes_.gradation * std::sqrt(d2);
   }
-  return std::max(h, sizes_.effective_min_size());
+  // No lower clamp here: the curvature part is already bounded, and boundary edges shorter than
+  // the smallest size (a curve shorter than it) must be matched inside the face.
+  return h;
 }
 
 double max_principal_curvature(const cad::FaceGeometry& surface, const Vec2& uv) {

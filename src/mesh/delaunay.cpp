@@ -657,6 +657,84 @@ class FaceMesher {
   }
 
   void optimize() {
+    flip_for_angles();
+    // Vertices the front placed badly (where fronts met, next to much finer boundary edges)
+    // leave thin triangles that no flip removes; moving them helps, and new flips may follow.
+    for (int round = 0; round < 3; ++round) {
+      if (smooth_bad_vertices() == 0) break;
+      flip_for_angles();
+    }
+  }
+
+  /// Moves each interior vertex whose star has an angle below 25 degrees to the uv centroid of its
+  /// neighbours (or halfway there) when every star triangle stays counterclockwise in uv (exact
+  /// test) and the star's smallest 3D angle grows. Returns the number of vertices moved.
+  std::int64_t smooth_bad_vertices() {
+    constexpr double kBad = 25.0 * kPi / 180.0;
+    constexpr double kGain = 1e-3;  // radians
+    std::int64_t moved = 0;
+    std::vector<LO> star;
+    const LO nv = static_cast<LO>(tr_.pts.size());
+    for (LO v = first_real_; v < nv; ++v) {
+      if (out_[v] != kNoIndex || tr_.v2t[v] == kNoIndex) continue;  // boundary or removed
+      tr_.star(v, star);
+      if (star.size() < 3) continue;
+      auto star_min = [&]() {
+        double m = kPi;
+        for (LO t : star) {
+          const Tri& T = tr_.tris[t];
+          m = std::min(m, tri_min_angle(T.v[0], T.v[1], T.v[2]));
+        }
+        return m;
+      };
+      const double before = star_min();
+      if (before >= kBad) continue;
+      Vec2 centroid{0, 0};
+      int count = 0;
+      bool closed = true;
+      for (LO t : star) {
+        const Tri& T = tr_.tris[t];
+        for (int k = 0; k < 3; ++k) {
+          if (T.v[k] == v) continue;
+          if (T.v[k] < first_real_) closed = false;
+          centroid += tr_.pts[T.v[k]];
+          ++count;
+        }
+      }
+      if (!closed || count == 0) continue;
+      centroid = centroid / count;
+      const Vec2 old_uv = tr_.pts[v];
+      const Vec3 old_xyz = xyz_[v];
+      bool accepted = false;
+      for (const double w : {1.0, 0.5}) {
+        const Vec2 x = old_uv + (centroid - old_uv) * w;
+        bool valid = true;
+        for (LO t : star) {
+          const Tri& T = tr_.tris[t];
+          std::array<Vec2, 3> q{tr_.pts[T.v[0]], tr_.pts[T.v[1]], tr_.pts[T.v[2]]};
+          for (int k = 0; k < 3; ++k)
+            if (T.v[k] == v) q[k] = x;
+          if (orient2d(q[0], q[1], q[2]) <= 0) {
+            valid = false;
+            break;
+          }
+        }
+        if (!valid) continue;
+        tr_.pts[v] = x;
+        xyz_[v] = surf_.eval(x).p;
+        if (star_min() > before + kGain) {
+          accepted = true;
+          break;
+        }
+        tr_.pts[v] = old_uv;
+        xyz_[v] = old_xyz;
+      }
+      moved += accepted ? 1 : 0;
+    }
+    return moved;
+  }
+
+  void flip_for_angles() {
     constexpr double kGain = 1e-3;  // radians
     for (int sweep = 0; sweep < 6; ++sweep) {
       std::int64_t flips = 0;

@@ -133,11 +133,11 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
   std::vector<mesh::FaceMesh> meshes(mine.size());
   std::vector<background::FaceReport> reports(mine.size());
   std::atomic<std::int64_t> done{0};
-  const std::int64_t step = std::max<std::int64_t>(1, static_cast<std::int64_t>(mine.size()) / 10);
+  const auto total = static_cast<std::int64_t>(mine.size());
   tasks.parallel_for(static_cast<std::int64_t>(mine.size()), [&](std::int64_t i) {
     meshes[i] = background::mesh_face_background(model, mine[i], curves, options.background, &reports[i]);
     const std::int64_t n = ++done;
-    if (n % step == 0 || n == static_cast<std::int64_t>(mine.size()))
+    if (n * 10 / total != (n - 1) * 10 / total)  // every tenth of the faces
       log.info(cat("background: ", n, "/", mine.size(), " faces on rank ", rank));
   });
   result.times.add("background", comm.allreduce_max(clock.seconds()));
