@@ -1,6 +1,7 @@
 // End-to-end tests of the qsmesh executable: help, info, example, mesh, and bad input.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
+#include <unistd.h>
 
 #include <array>
 #include <cstdio>
@@ -19,7 +20,10 @@ struct ExeResult {
   std::string out, err;
 };
 
-std::string tmp(const std::string& name) { return std::string(QSMESH_TEST_TMP_DIR) + "/" + name; }
+// ctest runs each test in its own process, several at once: every name carries the process id.
+std::string tmp(const std::string& name) {
+  return std::string(QSMESH_TEST_TMP_DIR) + "/p" + std::to_string(::getpid()) + "_" + name;
+}
 
 std::string slurp(const std::string& path) {
   std::ifstream in(path, std::ios::binary);
@@ -150,7 +154,8 @@ TEST_F(Qsmesh, BadInputIsOneLineAndExitTwo) {
     EXPECT_TRUE(r.out.empty()) << c.name << ": " << r.out;
     EXPECT_NE(r.err.find(c.expect_in_error), std::string::npos) << c.name << ": " << r.err;
   }
-  for (int i = 1; i <= 10; ++i) EXPECT_TRUE(nothing_written(dir, "bad" + std::to_string(i) + ".")) << i;
+  const std::string prefix = "p" + std::to_string(::getpid()) + "_bad";
+  for (int i = 1; i <= 10; ++i) EXPECT_TRUE(nothing_written(dir, prefix + std::to_string(i) + ".")) << i;
 }
 
 }  // namespace
