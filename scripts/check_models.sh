@@ -44,7 +44,7 @@ for model in "${models[@]}"; do
   same=yes
   for ext in cgns vtu msh; do
     for np in 1 2 4; do
-      mpiexec --oversubscribe -n $np $exe mesh "$model" -o "$out/m_$np.$ext" --size-factor "$factor" \
+      mpiexec --oversubscribe --bind-to none -n $np $exe mesh "$model" -o "$out/m_$np.$ext" --size-factor "$factor" \
         --threads "$threads" -q --stats "$out/s_$np.json" >/dev/null 2>"$out/err_$np" || { same="FAILED (np $np)"; status=1; }
     done
     cmp -s "$out/m_1.$ext" "$out/m_2.$ext" && cmp -s "$out/m_1.$ext" "$out/m_4.$ext" || { same="no ($ext)"; status=1; }

@@ -10,7 +10,7 @@ mkdir -p example_output
 ./build/drivers/qsmesh example wing-body -o example_output/wing_body.step
 ./build/drivers/qsmesh info example_output/wing_body.step
 ranks=2
-mpiexec --oversubscribe -n "$ranks" ./build/drivers/qsmesh mesh example_output/wing_body.step \
+mpiexec --oversubscribe --bind-to none -n "$ranks" ./build/drivers/qsmesh mesh example_output/wing_body.step \
   -o example_output/wing_body.cgns --stats example_output/wing_body_stats.json
 ./build/drivers/qsmesh mesh example_output/wing_body.step -o example_output/wing_body.vtu -q
 if command -v cgnscheck >/dev/null; then

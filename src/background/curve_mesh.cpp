@@ -65,7 +65,9 @@ struct CurveSamples {
 CurveSamples sample_curve(const CurveSizer& sizer, const cad::Curve& curve, double cap) {
   // A coarse pass estimates the edge count from the curvature sizes; the samples then resolve the
   // size field at ~8 per edge and are never further apart than cap / 4 (for the feature search).
-  const int coarse_n = 32;
+  // Size evaluations (second derivatives of the curve and of every adjacent surface) dominate the
+  // cost of curve meshing, hence no more samples than that.
+  const int coarse_n = 16;
   double estimate = 0, length = 0;
   Vec3 prev = sizer.geometry().point(curve.t0);
   for (int i = 1; i <= coarse_n; ++i) {
@@ -76,7 +78,7 @@ CurveSamples sample_curve(const CurveSizer& sizer, const cad::Curve& curve, doub
     length += ds;
     prev = q;
   }
-  const int n = std::clamp(static_cast<int>(std::ceil(std::max(8 * estimate, 4 * length / cap))), 64, 16384);
+  const int n = std::clamp(static_cast<int>(std::ceil(std::max(8 * estimate, 4 * length / cap))), 32, 16384);
   CurveSamples cs;
   cs.t.resize(static_cast<std::size_t>(n) + 1);
   cs.s.assign(cs.t.size(), 0.0);
@@ -130,6 +132,21 @@ mesh::CurveMesh place_vertices(const CurveSamples& cs, const CurveSizer& sizer, 
   out.points.front() = p0;
   out.points.back() = p1;
   return out;
+}
+
+/// Distance from p to the two sample segments around sample j of a curve.
+double distance_to_polyline(const CurveSamples& cs, LO j, const Vec3& p) {
+  auto segment = [&](std::size_t a, std::size_t b) {
+    const Vec3 ab = cs.p[b] - cs.p[a];
+    const double l2 = norm2(ab);
+    const double s = l2 > 0 ? std::clamp(dot(p - cs.p[a], ab) / l2, 0.0, 1.0) : 0.0;
+    return distance(p, cs.p[a] + ab * s);
+  };
+  const auto i = static_cast<std::size_t>(j);
+  double d = distance(p, cs.p[i]);
+  if (i > 0) d = std::min(d, segment(i - 1, i));
+  if (i + 1 < cs.p.size()) d = std::min(d, segment(i, i + 1));
+  return d;
 }
 
 /// Uniform hash grid over the samples of all curves, for the nearest non-adjacent sample.
@@ -237,15 +254,12 @@ std::vector<mesh::CurveMesh> mesh_curves(const cad::CadModel& model, const SizeO
       // Gaps narrower than a tenth of the smallest size are curves touching or lying on top of each
       // other (unsewn volumes, sloppy models), not features the mesh could resolve.
       const double touching = 0.1 * sizes.effective_min_size();
-      std::map<LO, std::unique_ptr<cad::CurveGeometry>> others;
       CurveSamples& cs = samples[c];
       for (std::size_t k = 0; k < cs.p.size(); ++k) {
         for (const auto& [o, j] : grid.candidates(samples, cs.p[k], cs.h[k], [&](LO x) { return !adjacent(x); })) {
-          auto& g = others[o];
-          if (!g) g = model.curve_geometry(o);
-          Vec3 foot;
-          (void)g->project(cs.p[k], samples[o].t[j], &foot);
-          const double d = distance(foot, cs.p[k]);
+          // The other curve near its nearest sample is the polyline through the samples around it
+          // (at most cap/4 and h/8 apart): exact enough, and far cheaper than a CAD projection.
+          const double d = distance_to_polyline(samples[o], j, cs.p[k]);
           if (d > touching) cs.h[k] = std::max(sizes.effective_min_size(), std::min(cs.h[k], d));
         }
       }

@@ -90,9 +90,9 @@ std::unique_ptr<CurveGeometry> CadModel::curve_geometry(LO c) const {
   return make_curve_geometry(*impl_, cu, p, c);
 }
 
-std::unique_ptr<FaceGeometry> CadModel::face_geometry(LO f) const {
+std::unique_ptr<FaceGeometry> CadModel::face_geometry(LO f, bool with_classifier) const {
   QSMESH_CHECK(f >= 0 && f < num_faces(), "face id " << f << " out of range");
-  return make_face_geometry(*impl_, faces_[f], f);
+  return make_face_geometry(*impl_, faces_[f], f, with_classifier);
 }
 
 namespace {

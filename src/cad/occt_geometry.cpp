@@ -126,7 +126,7 @@ class OcctCurve final : public CurveGeometry {
 
 class OcctFace final : public FaceGeometry {
  public:
-  OcctFace(const CadModel::Impl& impl, const Face& face, LO id)
+  OcctFace(const CadModel::Impl& impl, const Face& face, LO id, bool with_classifier)
       : reversed_(face.reversed),
         uv_box_(face.uv_box),
         u_periodic_(face.u_periodic),
@@ -140,7 +140,7 @@ class OcctFace final : public FaceGeometry {
       vmin_ = surface_.FirstVParameter();
       vmax_ = surface_.LastVParameter();
       geom_ = BRep_Tool::Surface(ff);
-      classifier_ = std::make_unique<BRepTopAdaptor_FClass2d>(ff, Precision::PConfusion());
+      if (with_classifier) classifier_ = std::make_unique<BRepTopAdaptor_FClass2d>(ff, Precision::PConfusion());
       for (const auto& loop : impl.loop_edges[id]) {
         std::vector<Geom2dAdaptor_Curve> pl;
         for (const TopoDS_Edge& e : loop) {
@@ -257,7 +257,7 @@ class OcctFace final : public FaceGeometry {
   }
 
   bool contains(const Vec2& uv) const override {
-    if (!classifier_) return false;
+    QSMESH_CHECK(classifier_ != nullptr, "face " << id_ << ": contains() needs an evaluator made with a classifier");
     const TopAbs_State s = classifier_->Perform(gp_Pnt2d(uv.u, uv.v));
     return s == TopAbs_IN || s == TopAbs_ON;
   }
@@ -291,8 +291,8 @@ std::unique_ptr<CurveGeometry> make_curve_geometry(const CadModel::Impl& impl, c
 }
 
 std::unique_ptr<FaceGeometry> make_face_geometry(const CadModel::Impl& impl, const Face& face,
-                                                 LO f) {
-  return std::make_unique<OcctFace>(impl, face, f);
+                                                 LO f, bool with_classifier) {
+  return std::make_unique<OcctFace>(impl, face, f, with_classifier);
 }
 
 }  // namespace qsmesh::cad

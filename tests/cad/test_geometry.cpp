@@ -1,8 +1,11 @@
 // Evaluation and projection on curves and faces.
 #include <gtest/gtest.h>
 
+#include "qsmesh/core/error.hpp"
+
 #include <BRepBuilderAPI_MakeEdge.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
+#include <BRepPrimAPI_MakeBox.hxx>
 #include <BRepPrimAPI_MakeCylinder.hxx>
 #include <BRepPrimAPI_MakeTorus.hxx>
 #include <GeomAPI_PointsToBSplineSurface.hxx>
@@ -168,6 +171,21 @@ TEST(CadGeometry, ConcurrentEvaluators) {
   for (auto& r : res) threads.emplace_back(work, &r);
   for (auto& t : threads) t.join();
   for (const auto& r : res) EXPECT_EQ(r, ref);
+}
+
+}  // namespace
+}  // namespace qsmesh::cad
+
+namespace qsmesh::cad {
+namespace {
+
+TEST(FaceGeometry, ContainsNeedsAClassifier) {
+  const CadModel m = test::round_trip(BRepPrimAPI_MakeBox(1.0, 2.0, 3.0).Shape(), "classifier_box");
+  const auto plain = m.face_geometry(0);
+  EXPECT_THROW((void)plain->contains({0, 0}), Error);
+  const auto classified = m.face_geometry(0, true);
+  const Face& face = m.faces()[0];
+  EXPECT_TRUE(classified->contains((face.uv_box.lo + face.uv_box.hi) * 0.5));
 }
 
 }  // namespace

@@ -211,7 +211,7 @@ TEST(CadLoad, PlateWithHoleLoopsAndOrientation) {
   int holed = 0, reversed_holed = 0;
   for (LO f = 0; f < m.num_faces(); ++f) {
     const Face& face = m.faces()[f];
-    const auto g = m.face_geometry(f);
+    const auto g = m.face_geometry(f, true);
     // Normals point out of the solid (centre at (5, 5, 0.5)).
     const Vec2 mid = (face.uv_box.lo + face.uv_box.hi) * 0.5;
     if (face.type == SurfaceType::Plane) {

@@ -78,7 +78,7 @@ TEST_P(SharedModel, CountsAndConsistency) {
   for (LO f = 0; f < m.num_faces(); ++f) {
     const Face& face = m.faces()[f];
     if (face.loops.empty() || face.loops[0].uses.empty()) continue;
-    const auto g = m.face_geometry(f);
+    const auto g = m.face_geometry(f, true);
     const Curve& c = m.curves()[face.loops[0].uses[0].curve];
     const Vec2 uv = g->boundary_uv(0, 0, 0.5 * (c.t0 + c.t1));
     const Vec3 p = g->eval(uv).p;

@@ -52,6 +52,7 @@ class FaceGeometry {
   /// parameter t (the face's pcurve). For a seam curve, its two uses give its two images.
   [[nodiscard]] virtual Vec2 boundary_uv(LO loop, LO use, double t) const = 0;
   /// True when uv lies inside the face's trimmed domain (on the boundary counts as inside).
+  /// Throws qsmesh::Error when the evaluator was made without a classifier.
   [[nodiscard]] virtual bool contains(const Vec2& uv) const = 0;
 };
 

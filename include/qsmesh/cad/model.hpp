@@ -101,8 +101,10 @@ class CadModel {
 
   /// New evaluator of curve c (the caller owns it and uses it from one thread).
   [[nodiscard]] std::unique_ptr<CurveGeometry> curve_geometry(LO c) const;
-  /// New evaluator of face f (the caller owns it and uses it from one thread).
-  [[nodiscard]] std::unique_ptr<FaceGeometry> face_geometry(LO f) const;
+  /// New evaluator of face f (the caller owns it and uses it from one thread). FaceGeometry::contains
+  /// needs `with_classifier`: building the point classifier costs more than the evaluator itself,
+  /// so only the stages that classify points ask for it.
+  [[nodiscard]] std::unique_ptr<FaceGeometry> face_geometry(LO f, bool with_classifier = false) const;
 
   /// Implementation data (OpenCASCADE shapes), opaque outside src/cad.
   struct Impl;
