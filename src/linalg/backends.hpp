@@ -1,0 +1,42 @@
+// Private to src/linalg: the concrete backends behind make_solver.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "qsmesh/core/error.hpp"
+#include "qsmesh/linalg/solver.hpp"
+
+namespace qsmesh::linalg::detail {
+
+/// The pattern a solver analysed, kept to reject a factorize() on another pattern (a silent
+/// mismatch would give a wrong factorization, not an error).
+class Pattern {
+ public:
+  Pattern() = default;
+  explicit Pattern(const SparseMatrix& A)
+      : n_(A.size()), offsets_(A.row_offsets()), cols_(A.columns()) {}
+  [[nodiscard]] LO size() const { return n_; }
+  [[nodiscard]] bool empty() const { return offsets_.empty(); }
+  void check(const SparseMatrix& A, const char* backend) const {
+    QSMESH_CHECK(!offsets_.empty(), backend << ": factorize() before analyze()");
+    QSMESH_CHECK(A.size() == n_ && A.row_offsets() == offsets_ && A.columns() == cols_,
+                 backend << ": factorize() on a matrix whose pattern differs from the analysed one ("
+                         << A.size() << " unknowns, " << A.nonzeros() << " nonzeros; analysed "
+                         << n_ << ", " << cols_.size() << ")");
+  }
+
+ private:
+  LO n_ = 0;
+  std::vector<std::int64_t> offsets_;
+  std::vector<LO> cols_;
+};
+
+/// Eigen::SimplicialLDLT (AMD ordering) on a copy of the matrix in Eigen's storage.
+std::unique_ptr<LinearSolver> make_eigen_solver();
+
+/// PETSc SeqAIJ on PETSC_COMM_SELF factorized by MUMPS (Cholesky; LU, then PETSc's own factorization,
+/// as fallbacks). Every PETSc call is made while holding lane.mutex().
+std::unique_ptr<LinearSolver> make_petsc_solver(PetscLane& lane);
+
+}  // namespace qsmesh::linalg::detail

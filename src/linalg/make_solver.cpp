@@ -1,0 +1,22 @@
+#include "backends.hpp"
+
+namespace qsmesh::linalg {
+
+std::unique_ptr<LinearSolver> make_solver(LO n, const SolverOptions& options, PetscLane* lane) {
+  QSMESH_CHECK(n >= 0, "make_solver: negative system size " << n);
+  switch (options.backend) {
+    case Backend::Eigen:
+      return detail::make_eigen_solver();
+    case Backend::Petsc:
+      QSMESH_CHECK(lane != nullptr,
+                   "make_solver: Backend::Petsc needs a PetscLane, and none was given");
+      return detail::make_petsc_solver(*lane);
+    case Backend::Automatic:
+      if (lane != nullptr && n >= options.petsc_threshold) return detail::make_petsc_solver(*lane);
+      return detail::make_eigen_solver();
+  }
+  QSMESH_CHECK(false, "make_solver: unknown backend " << static_cast<int>(options.backend));
+  return nullptr;
+}
+
+}  // namespace qsmesh::linalg
