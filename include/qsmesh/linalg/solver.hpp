@@ -53,6 +53,17 @@ class SparseMatrix {
 /// PETSc in Debian is not thread-safe: every PETSc call of a rank goes through its one lane, which
 /// serialises them. Created once per process by the driver, after MPI and before any solve, and
 /// passed down; it initialises PETSc on construction and finalises it on destruction.
+///
+/// - At most one lane exists at a time in a process (the constructor throws qsmesh::Error when
+///   PETSc is already initialised). Every solver made with a lane must be destroyed before it.
+/// - MPI: when MPI is already initialised (by the driver), PETSc uses it and the lane leaves it
+///   running; the driver should ask for MPI_THREAD_SERIALIZED, since solver calls come from worker
+///   threads (one at a time). When MPI is not initialised, PETSc initialises it (asking for
+///   MPI_THREAD_SERIALIZED) and finalises it with the lane; MPI cannot be initialised twice, so
+///   such a process (a test, a benchmark) can create only one lane in its lifetime.
+/// - No options file is read (~/.petscrc, ./.petscrc); the PETSC_OPTIONS environment variable
+///   still applies (debugging aid). PETSc's signal handler is removed so crashes are not hijacked,
+///   and PETSc's error printing is replaced by qsmesh::Error exceptions carrying its message.
 class PetscLane {
  public:
   PetscLane();
@@ -60,9 +71,13 @@ class PetscLane {
   PetscLane(const PetscLane&) = delete;
   PetscLane& operator=(const PetscLane&) = delete;
   [[nodiscard]] std::mutex& mutex() { return mutex_; }
+  /// Message of the last PETSc error raised under this lane (for src/linalg's error reports).
+  /// Read and written only while holding mutex().
+  [[nodiscard]] std::string& last_error() { return last_error_; }
 
  private:
   std::mutex mutex_;
+  std::string last_error_;
 };
 
 enum class Backend { Automatic, Eigen, Petsc };
