@@ -46,31 +46,30 @@ qsmesh_require(PETSC_FOUND "PETSc" "petsc-dev")
 find_library(MUMPS_D_LIBRARY dmumps)
 qsmesh_require(MUMPS_D_LIBRARY "MUMPS" "libmumps-dev")
 
+# qsmesh_find_plain(TARGET HEADER LIBRARY WHAT PACKAGE): a library without CMake or pkg-config
+# files, found by header and library name, as the interface target TARGET.
+function(qsmesh_find_plain target header library what package)
+  find_path(${target}_INCLUDE_DIR ${header})
+  find_library(${target}_LIBRARY ${library})
+  if(${target}_INCLUDE_DIR AND ${target}_LIBRARY)
+    set(found TRUE)
+  endif()
+  qsmesh_require(found "${what}" "${package}")
+  add_library(${target} INTERFACE)
+  target_include_directories(${target} SYSTEM INTERFACE ${${target}_INCLUDE_DIR})
+  target_link_libraries(${target} INTERFACE ${${target}_LIBRARY})
+endfunction()
+
 # METIS
-find_path(METIS_INCLUDE_DIR metis.h)
-find_library(METIS_LIBRARY metis)
-if(METIS_INCLUDE_DIR AND METIS_LIBRARY)
-  set(METIS_FOUND TRUE)
-endif()
-qsmesh_require(METIS_FOUND "METIS" "libmetis-dev")
-add_library(qsmesh_metis INTERFACE)
-target_include_directories(qsmesh_metis SYSTEM INTERFACE ${METIS_INCLUDE_DIR})
-target_link_libraries(qsmesh_metis INTERFACE ${METIS_LIBRARY})
+qsmesh_find_plain(qsmesh_metis metis.h metis "METIS" "libmetis-dev")
 
 # HDF5 (serial: Debian's libcgns is built against it)
 pkg_check_modules(HDF5S QUIET IMPORTED_TARGET hdf5-serial)
 qsmesh_require(HDF5S_FOUND "HDF5 (serial)" "libhdf5-dev")
 
 # CGNS: Debian ships neither CMake nor pkg-config files for it
-find_path(CGNS_INCLUDE_DIR cgnslib.h)
-find_library(CGNS_LIBRARY cgns)
-if(CGNS_INCLUDE_DIR AND CGNS_LIBRARY)
-  set(CGNS_FOUND TRUE)
-endif()
-qsmesh_require(CGNS_FOUND "CGNS" "libcgns-dev")
-add_library(qsmesh_cgns INTERFACE)
-target_include_directories(qsmesh_cgns SYSTEM INTERFACE ${CGNS_INCLUDE_DIR})
-target_link_libraries(qsmesh_cgns INTERFACE ${CGNS_LIBRARY} PkgConfig::HDF5S)
+qsmesh_find_plain(qsmesh_cgns cgnslib.h cgns "CGNS" "libcgns-dev")
+target_link_libraries(qsmesh_cgns INTERFACE PkgConfig::HDF5S)
 
 find_program(CGNSCHECK_EXECUTABLE cgnscheck)
 if(NOT CGNSCHECK_EXECUTABLE)

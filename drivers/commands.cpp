@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <string_view>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -15,6 +16,7 @@
 #include "qsmesh/core/log.hpp"
 #include "qsmesh/core/tasks.hpp"
 #include "qsmesh/core/timer.hpp"
+#include "qsmesh/io/atomic_file.hpp"
 #include "qsmesh/io/writer.hpp"
 #include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/mesh/validate.hpp"
@@ -37,24 +39,11 @@ void check_writable(const std::string& option, const std::string& path) {
 }
 
 void write_text_file_atomically(const std::string& path, const std::string& text) {
-  const fs::path p(path);
-  const fs::path tmp = p.parent_path() / ("." + p.filename().string() + ".tmp." + std::to_string(::getpid()));
-  {
-    std::ofstream out(tmp, std::ios::binary);
-    out << text;
-    out.flush();
-    if (!out) {
-      std::error_code ec;
-      fs::remove(tmp, ec);
-      throw Error("cannot write '" + path + "'");
-    }
-  }
-  std::error_code ec;
-  fs::rename(tmp, p, ec);
-  if (ec) {
-    fs::remove(tmp, ec);
-    throw Error("cannot rename temporary file to '" + path + "': " + ec.message());
-  }
+  io::AtomicFile file(path);
+  io::OutputFile out(file.temp_path());
+  out << std::string_view(text);
+  out.close();
+  file.commit();
 }
 
 int run_info(const Arguments& args) {

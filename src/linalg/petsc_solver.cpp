@@ -1,0 +1,308 @@
+// PETSc backend: MUMPS sparse Cholesky on a SeqAIJ matrix (PETSC_COMM_SELF), for the large
+// per-face systems where a multifrontal factorization (BLAS-3 on supernodes) beats Eigen's
+// simplicial one. Also home of PetscLane.
+//
+// The factor matrix is driven directly (MatGetFactor / MatCholeskyFactorSymbolic / ...Numeric /
+// MatSolve) rather than through KSPPREONLY + PCCHOLESKY: that is exactly what the PC does
+// internally, and the direct calls map one to one onto analyze / factorize / solve, so the
+// symbolic analysis runs once per pattern and never depends on the values of the pattern matrix.
+#include <mpi.h>
+#include <petscmat.h>
+#include <petscsys.h>
+
+#include <algorithm>
+#include <array>
+#include <limits>
+#include <mutex>
+#include <sstream>
+
+#include "backends.hpp"
+
+namespace qsmesh::linalg {
+namespace {
+
+// Error handler pushed by the lane: records PETSc's message (the initial one and the call chain
+// it travels up) instead of printing it, so that the throwing site can put it into qsmesh::Error.
+// Only ever runs inside a PETSc call, hence under the lane's mutex.
+PetscErrorCode record_petsc_error(MPI_Comm /*comm*/, int line, const char* fun, const char* file,
+                                  PetscErrorCode code, PetscErrorType type, const char* message,
+                                  void* context) {
+  auto& text = *static_cast<std::string*>(context);
+  std::ostringstream os;
+  if (type == PETSC_ERROR_INITIAL) {
+    const char* generic = nullptr;
+    PetscErrorMessage(code, &generic, nullptr);
+    os << (generic != nullptr ? generic : "PETSc error");
+    if (message != nullptr && message[0] != '\0') os << ": " << message;
+    os << " (in " << (fun != nullptr ? fun : "?") << " at " << (file != nullptr ? file : "?")
+       << ":" << line << ")";
+    text = os.str();
+  } else {
+    os << text << " <- " << (fun != nullptr ? fun : "?");
+    text = os.str();
+  }
+  // Newlines would break the one-line contract of qsmesh::Error.
+  std::replace(text.begin(), text.end(), '\n', ' ');
+  return code;
+}
+
+}  // namespace
+
+PetscLane::PetscLane() {
+  std::lock_guard lock(mutex_);
+  PetscBool petsc_up = PETSC_FALSE;
+  QSMESH_CHECK(PetscInitialized(&petsc_up) == 0 && petsc_up == PETSC_FALSE,
+               "PetscLane: PETSc is already initialised in this process (only one lane at a time)");
+  int mpi_up = 0;
+  QSMESH_CHECK(MPI_Initialized(&mpi_up) == MPI_SUCCESS, "PetscLane: MPI_Initialized failed");
+  if (mpi_up == 0) PETSC_MPI_THREAD_REQUIRED = MPI_THREAD_SERIALIZED;
+  // No options files: results must not depend on a user's ~/.petscrc. No signal handler either.
+  static char arg0[] = "qsmesh";
+  static char arg1[] = "-skip_petscrc";
+  static char arg2[] = "-no_signal_handler";
+  std::array<char*, 4> argv{arg0, arg1, arg2, nullptr};
+  const PetscErrorCode init = PetscInitializeNoPointers(3, argv.data(), nullptr, nullptr);
+  QSMESH_CHECK(init == 0, "PetscLane: PetscInitialize failed with PETSc error code " << init);
+  const PetscErrorCode pop = PetscPopSignalHandler();
+  const PetscErrorCode push = PetscPushErrorHandler(record_petsc_error, &last_error_);
+  if (pop != 0 || push != 0) {
+    PetscFinalize();
+    QSMESH_CHECK(false, "PetscLane: could not set PETSc's signal/error handlers (error codes "
+                            << pop << ", " << push << ")");
+  }
+}
+
+PetscLane::~PetscLane() {
+  std::lock_guard lock(mutex_);
+  // Destructors cannot throw; a failing finalisation at exit has nothing left to protect.
+  PetscPopErrorHandler();
+  PetscFinalize();
+}
+
+namespace detail {
+namespace {
+
+[[noreturn]] void petsc_failed(PetscLane& lane, PetscErrorCode code, const char* call,
+                               const char* file, int line) {
+  std::ostringstream os;
+  os << "petsc: " << call << " failed with error " << code;
+  if (!lane.last_error().empty()) os << ": " << lane.last_error();
+  os << " (at " << file << ":" << line << ")";
+  lane.last_error().clear();
+  throw Error(os.str());
+}
+
+// Checks the return code of a PETSc call; must be used while holding lane_->mutex().
+#define QSMESH_PETSC_CALL(call)                                                            \
+  do {                                                                                     \
+    const PetscErrorCode qsmesh_petsc_code_ = (call);                                      \
+    if (qsmesh_petsc_code_ != 0) [[unlikely]]                                              \
+      petsc_failed(*lane_, qsmesh_petsc_code_, #call, __FILE__, __LINE__);                 \
+  } while (false)
+
+PetscInt to_petsc_int(std::int64_t value, const char* what) {
+  QSMESH_CHECK(value >= 0 && value <= std::numeric_limits<PetscInt>::max(),
+               "petsc: " << what << " " << value << " does not fit PETSc's "
+                         << 8 * sizeof(PetscInt) << "-bit indices");
+  return static_cast<PetscInt>(value);
+}
+
+class PetscSolver final : public LinearSolver {
+ public:
+  explicit PetscSolver(PetscLane& lane) : lane_(&lane) {}
+  ~PetscSolver() override {
+    std::lock_guard lock(lane_->mutex());
+    destroy_all();
+  }
+  PetscSolver(const PetscSolver&) = delete;
+  PetscSolver& operator=(const PetscSolver&) = delete;
+
+  void analyze(const SparseMatrix& A) override {
+    std::lock_guard lock(lane_->mutex());
+    destroy_all();
+    pattern_ = Pattern();
+    factorized_ = false;
+    try {
+      build(A);
+    } catch (const Error&) {
+      destroy_all();  // a half-built solver must not be factorized
+      throw;
+    }
+    pattern_ = Pattern(A);
+  }
+
+  void factorize(const SparseMatrix& A) override {
+    pattern_.check(A, "petsc");
+    std::lock_guard lock(lane_->mutex());
+    factorized_ = false;
+    if (A.size() == 0) {
+      factorized_ = true;
+      return;
+    }
+    // A failed MUMPS factorization leaves MUMPS in an error state that PETSc does not reset:
+    // redo the symbolic phase on a fresh factor before trying new values.
+    if (factor_ == nullptr) symbolic();
+    PetscScalar* values = nullptr;
+    QSMESH_PETSC_CALL(MatSeqAIJGetArray(matrix_, &values));
+    // Same pattern, sorted columns: SeqAIJ stores the values in exactly our CSR order.
+    std::copy(A.values().begin(), A.values().end(), values);
+    QSMESH_PETSC_CALL(MatSeqAIJRestoreArray(matrix_, &values));
+    try {
+      if (type_ == MAT_FACTOR_CHOLESKY)
+        QSMESH_PETSC_CALL(MatCholeskyFactorNumeric(factor_, matrix_, &info_));
+      else
+        QSMESH_PETSC_CALL(MatLUFactorNumeric(factor_, matrix_, &info_));
+      check_factor(A.size());
+    } catch (const Error&) {
+      MatDestroy(&factor_);  // rebuilt by the next factorize(); its own error would add nothing
+      throw;
+    }
+    factorized_ = true;
+  }
+  }
+
+  // Under the lock: matrix, vectors and symbolic factorization for the pattern of A.
+  void build(const SparseMatrix& A) {
+    const LO n = A.size();
+    if (n == 0) return;
+    std::vector<PetscInt> ia(static_cast<std::size_t>(n) + 1);
+    for (std::size_t i = 0; i < ia.size(); ++i)
+      ia[i] = to_petsc_int(A.row_offsets()[i], "nonzero count");
+    const std::vector<PetscInt> ja(A.columns().begin(), A.columns().end());
+
+    QSMESH_PETSC_CALL(MatCreate(PETSC_COMM_SELF, &matrix_));
+    QSMESH_PETSC_CALL(MatSetSizes(matrix_, n, n, n, n));
+    QSMESH_PETSC_CALL(MatSetType(matrix_, MATSEQAIJ));
+    // Preallocates exactly and assembles: the values are replaced in place by factorize().
+    QSMESH_PETSC_CALL(MatSeqAIJSetPreallocationCSR(matrix_, ia.data(), ja.data(), A.values().data()));
+    QSMESH_PETSC_CALL(MatSetOption(matrix_, MAT_NEW_NONZERO_LOCATION_ERR, PETSC_TRUE));
+    // SPD makes MUMPS run its SPD variant (SYM=1, no pivoting); only the upper triangle is read.
+    QSMESH_PETSC_CALL(MatSetOption(matrix_, MAT_SYMMETRIC, PETSC_TRUE));
+    QSMESH_PETSC_CALL(MatSetOption(matrix_, MAT_SYMMETRY_ETERNAL, PETSC_TRUE));
+    QSMESH_PETSC_CALL(MatSetOption(matrix_, MAT_SPD, PETSC_TRUE));
+    QSMESH_PETSC_CALL(MatSetOption(matrix_, MAT_SPD_ETERNAL, PETSC_TRUE));
+    QSMESH_PETSC_CALL(MatCreateVecs(matrix_, &x_, &b_));
+
+    // MUMPS Cholesky; MUMPS LU when a PETSc build lacks the Cholesky path; PETSc's own
+    // factorizations when MUMPS is missing altogether.
+    static constexpr std::array<std::pair<const char*, MatFactorType>, 4> kChoices{{
+        {MATSOLVERMUMPS, MAT_FACTOR_CHOLESKY},
+        {MATSOLVERMUMPS, MAT_FACTOR_LU},
+        {MATSOLVERPETSC, MAT_FACTOR_CHOLESKY},
+        {MATSOLVERPETSC, MAT_FACTOR_LU},
+    }};
+    bool found = false;
+    for (const auto& [package, type] : kChoices) {
+      PetscBool available = PETSC_FALSE;
+      QSMESH_PETSC_CALL(MatGetFactorAvailable(matrix_, package, type, &available));
+      if (available == PETSC_TRUE) {
+        package_ = package;
+        type_ = type;
+        found = true;
+        break;
+      }
+    }
+    QSMESH_CHECK(found, "petsc: no direct factorization (MUMPS or PETSc) is available for SeqAIJ");
+    name_ = std::string("petsc/") + package_ + (type_ == MAT_FACTOR_CHOLESKY ? "-cholesky" : "-lu");
+    // MUMPS orders the matrix itself; PETSc's own factorization needs a fill-reducing ordering.
+    QSMESH_PETSC_CALL(MatGetOrdering(
+        matrix_, package_ == std::string(MATSOLVERMUMPS) ? MATORDERINGNATURAL : MATORDERINGND,
+        &row_order_, &col_order_));
+    symbolic();
+  }
+
+  void solve(std::span<const double> b, std::span<double> x) override {
+    QSMESH_CHECK(factorized_, "petsc: solve() without a successful factorize()");
+    const auto n = static_cast<std::size_t>(pattern_.size());
+    QSMESH_CHECK(b.size() == n && x.size() == n, "petsc: solve() with vectors of "
+                                                     << b.size() << " and " << x.size()
+                                                     << " entries for a system of size " << n);
+    if (n == 0) return;
+    std::lock_guard lock(lane_->mutex());
+    PetscScalar* bp = nullptr;
+    QSMESH_PETSC_CALL(VecGetArrayWrite(b_, &bp));
+    std::copy(b.begin(), b.end(), bp);
+    QSMESH_PETSC_CALL(VecRestoreArrayWrite(b_, &bp));
+    QSMESH_PETSC_CALL(MatSolve(factor_, b_, x_));
+    const PetscScalar* xp = nullptr;
+    QSMESH_PETSC_CALL(VecGetArrayRead(x_, &xp));
+    std::copy(xp, xp + n, x.begin());
+    QSMESH_PETSC_CALL(VecRestoreArrayRead(x_, &xp));
+  }
+
+  [[nodiscard]] const char* name() const override { return name_.c_str(); }
+
+ private:
+  // Under the lock: a fresh factor matrix and its symbolic analysis of matrix_'s pattern.
+  void symbolic() {
+    QSMESH_PETSC_CALL(MatGetFactor(matrix_, package_, type_, &factor_));
+    if (package_ == std::string(MATSOLVERMUMPS)) {
+      // Quiet: no MUMPS diagnostics on stdout (ICNTL 1-4), whatever PETSC_OPTIONS says.
+      QSMESH_PETSC_CALL(MatMumpsSetIcntl(factor_, 4, 0));
+    }
+    QSMESH_PETSC_CALL(MatFactorInfoInitialize(&info_));
+    if (type_ == MAT_FACTOR_CHOLESKY)
+      QSMESH_PETSC_CALL(MatCholeskyFactorSymbolic(factor_, matrix_, row_order_, &info_));
+    else
+      QSMESH_PETSC_CALL(MatLUFactorSymbolic(factor_, matrix_, row_order_, col_order_, &info_));
+  }
+
+  // Under the lock: PETSc reports a failed numeric factorization through the factor, not the
+  // return code (MatSetErrorIfFailure is off), and MUMPS's SPD path accepts negative pivots.
+  void check_factor(LO n) {
+    MatFactorError error = MAT_FACTOR_NOERROR;
+    QSMESH_PETSC_CALL(MatFactorGetError(factor_, &error));
+    PetscInt infog1 = 0;
+    PetscInt negative_pivots = 0;
+    const bool mumps = package_ == std::string(MATSOLVERMUMPS);
+    if (mumps) {
+      QSMESH_PETSC_CALL(MatMumpsGetInfog(factor_, 1, &infog1));
+      QSMESH_PETSC_CALL(MatMumpsGetInfog(factor_, 12, &negative_pivots));
+    }
+    QSMESH_CHECK(error == MAT_FACTOR_NOERROR && infog1 >= 0,
+                 "petsc: numeric factorization (" << name_ << ") failed for a matrix of size " << n
+                     << ": the matrix is singular or not positive definite (PETSc factor error "
+                     << static_cast<int>(error) << (mumps ? ", MUMPS INFOG(1) " : "")
+                     << (mumps ? std::to_string(infog1) : std::string()) << ")");
+    QSMESH_CHECK(type_ != MAT_FACTOR_CHOLESKY || negative_pivots == 0,
+                 "petsc: the matrix of size " << n << " is not positive definite ("
+                                              << negative_pivots << " negative pivots in "
+                                              << name_ << ")");
+  }
+
+  // Under the lock. Never throws (runs in the destructor); a failing destroy leaks at worst.
+  void destroy_all() noexcept {
+    MatDestroy(&factor_);
+    ISDestroy(&row_order_);
+    ISDestroy(&col_order_);
+    VecDestroy(&b_);
+    VecDestroy(&x_);
+    MatDestroy(&matrix_);
+    lane_->last_error().clear();
+  }
+
+  PetscLane* lane_;
+  Pattern pattern_;
+  bool factorized_ = false;
+  std::string name_ = "petsc";
+  const char* package_ = MATSOLVERMUMPS;
+  MatFactorType type_ = MAT_FACTOR_CHOLESKY;
+  Mat matrix_ = nullptr;
+  Mat factor_ = nullptr;
+  IS row_order_ = nullptr;
+  IS col_order_ = nullptr;
+  Vec b_ = nullptr;
+  Vec x_ = nullptr;
+  MatFactorInfo info_{};
+};
+
+#undef QSMESH_PETSC_CALL
+
+}  // namespace
+
+std::unique_ptr<LinearSolver> make_petsc_solver(PetscLane& lane) {
+  return std::make_unique<PetscSolver>(lane);
+}
+
+}  // namespace detail
+}  // namespace qsmesh::linalg

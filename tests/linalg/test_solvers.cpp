@@ -1,0 +1,220 @@
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "qsmesh/core/error.hpp"
+#include "qsmesh/linalg/solver.hpp"
+
+namespace qsmesh::linalg {
+namespace {
+
+// One lane for the whole test process: PETSc initialises MPI here and finalises it with the lane,
+// and MPI cannot be initialised twice in a process.
+class LaneEnvironment : public ::testing::Environment {
+ public:
+  void SetUp() override { lane_ = std::make_unique<PetscLane>(); }
+  void TearDown() override { lane_.reset(); }
+  static PetscLane* lane() { return lane_.get(); }
+
+ private:
+  static inline std::unique_ptr<PetscLane> lane_;
+};
+[[maybe_unused]] auto* const kLaneEnvironment =
+    ::testing::AddGlobalTestEnvironment(new LaneEnvironment);
+
+PetscLane& lane() {
+  PetscLane* l = LaneEnvironment::lane();
+  if (l == nullptr) throw Error("test: no PetscLane");
+  return *l;
+}
+
+// 5-point Laplacian on an m x m grid (Dirichlet boundary folded in) plus shift * identity.
+SparseMatrix poisson(LO m, double shift) {
+  std::vector<SparseMatrix::Triplet> t;
+  const auto id = [m](LO i, LO j) { return i * m + j; };
+  for (LO i = 0; i < m; ++i)
+    for (LO j = 0; j < m; ++j) {
+      const LO r = id(i, j);
+      t.push_back({r, r, 4.0 + shift});
+      if (i > 0) t.push_back({r, id(i - 1, j), -1.0});
+      if (i + 1 < m) t.push_back({r, id(i + 1, j), -1.0});
+      if (j > 0) t.push_back({r, id(i, j - 1), -1.0});
+      if (j + 1 < m) t.push_back({r, id(i, j + 1), -1.0});
+    }
+  return SparseMatrix(m * m, t);
+}
+
+std::vector<double> rhs(LO n, int seed) {
+  std::vector<double> b(static_cast<std::size_t>(n));
+  for (LO i = 0; i < n; ++i) b[static_cast<std::size_t>(i)] = std::sin(0.37 * i + seed) + 0.1 * seed;
+  return b;
+}
+
+double norm(const std::vector<double>& v) {
+  double s = 0;
+  for (double x : v) s += x * x;
+  return std::sqrt(s);
+}
+
+double relative_residual(const SparseMatrix& A, const std::vector<double>& x,
+                         const std::vector<double>& b) {
+  std::vector<double> r(b.size());
+  A.multiply(x, r);
+  for (std::size_t i = 0; i < r.size(); ++i) r[i] -= b[i];
+  return norm(r) / norm(b);
+}
+
+std::unique_ptr<LinearSolver> make(Backend backend) {
+  SolverOptions options;
+  options.backend = backend;
+  return make_solver(100, options, backend == Backend::Petsc ? &lane() : nullptr);
+}
+
+class BothBackends : public ::testing::TestWithParam<Backend> {};
+
+TEST_P(BothBackends, SolvesPoisson) {
+  const SparseMatrix A = poisson(30, 0.5);
+  auto solver = make(GetParam());
+  solver->analyze(A);
+  solver->factorize(A);
+  const auto b = rhs(A.size(), 1);
+  std::vector<double> x(b.size());
+  solver->solve(b, x);
+  EXPECT_LT(relative_residual(A, x, b), 1e-10) << solver->name();
+}
+
+TEST_P(BothBackends, AnalyzeOnceFactorizeTwiceSolveThreeTimes) {
+  SparseMatrix A = poisson(25, 0.0);
+  auto solver = make(GetParam());
+  solver->analyze(A);  // values of the pattern matrix (singular-ish Laplacian) do not matter
+  for (double shift : {0.01, 10.0}) {
+    for (LO i = 0; i < A.size(); ++i)
+      A.values()[static_cast<std::size_t>(A.find(i, i))] = 4.0 + shift;
+    solver->factorize(A);
+    for (int k = 0; k < 3; ++k) {
+      const auto b = rhs(A.size(), k);
+      std::vector<double> x(b.size());
+      solver->solve(b, x);
+      EXPECT_LT(relative_residual(A, x, b), 1e-10) << solver->name() << " shift " << shift;
+    }
+  }
+}
+
+TEST_P(BothBackends, RejectsNonSpdAndRecovers) {
+  const SparseMatrix good = poisson(10, 0.1);
+  const SparseMatrix indefinite = poisson(10, -3.0);  // eigenvalues in (-3, 5)
+  auto solver = make(GetParam());
+  solver->analyze(good);
+  EXPECT_THROW(solver->factorize(indefinite), Error) << solver->name();
+  std::vector<double> x(static_cast<std::size_t>(good.size()));
+  const auto b = rhs(good.size(), 2);
+  EXPECT_THROW(solver->solve(b, x), Error);  // no valid factorization
+  solver->factorize(good);
+  solver->solve(b, x);
+  EXPECT_LT(relative_residual(good, x, b), 1e-10) << solver->name();
+}
+
+TEST_P(BothBackends, RejectsMisuse) {
+  const SparseMatrix A = poisson(5, 1.0);
+  auto solver = make(GetParam());
+  EXPECT_THROW(solver->factorize(A), Error);  // before analyze
+  solver->analyze(A);
+  std::vector<double> x(static_cast<std::size_t>(A.size()));
+  EXPECT_THROW(solver->solve(rhs(A.size(), 0), x), Error);  // before factorize
+  EXPECT_THROW(solver->factorize(poisson(6, 1.0)), Error);  // another pattern
+  solver->factorize(A);
+  std::vector<double> short_x(3);
+  EXPECT_THROW(solver->solve(rhs(A.size(), 0), short_x), Error);
+}
+
+TEST_P(BothBackends, FourThreadsEachWithItsOwnSolver) {
+  constexpr int kThreads = 4;
+  std::vector<double> residual(kThreads, 1.0);
+  std::vector<std::string> failure(kThreads);
+  std::vector<std::thread> threads;
+  for (int t = 0; t < kThreads; ++t)
+    threads.emplace_back([&, t] {
+      try {
+        for (int round = 0; round < 3; ++round) {
+          const SparseMatrix A = poisson(20 + 3 * t, 0.1 * (t + 1) + round);
+          auto solver = make(GetParam());
+          solver->analyze(A);
+          solver->factorize(A);
+          double worst = 0;
+          for (int k = 0; k < 3; ++k) {
+            const auto b = rhs(A.size(), t + k);
+            std::vector<double> x(b.size());
+            solver->solve(b, x);
+            worst = std::max(worst, relative_residual(A, x, b));
+          }
+          residual[static_cast<std::size_t>(t)] = worst;
+        }
+      } catch (const std::exception& e) {
+        failure[static_cast<std::size_t>(t)] = e.what();
+      }
+    });
+  for (auto& th : threads) th.join();
+  for (int t = 0; t < kThreads; ++t) {
+    EXPECT_EQ(failure[static_cast<std::size_t>(t)], "") << "thread " << t;
+    EXPECT_LT(residual[static_cast<std::size_t>(t)], 1e-10) << "thread " << t;
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Linalg, BothBackends, ::testing::Values(Backend::Eigen, Backend::Petsc),
+                         [](const auto& info) {
+                           return std::string(info.param == Backend::Eigen ? "Eigen" : "Petsc");
+                         });
+
+TEST(Solvers, BackendsAgree) {
+  const SparseMatrix A = poisson(40, 0.2);
+  const auto b = rhs(A.size(), 3);
+  std::vector<double> xe(b.size()), xp(b.size());
+  auto eigen = make(Backend::Eigen);
+  auto petsc = make(Backend::Petsc);
+  for (auto* s : {eigen.get(), petsc.get()}) {
+    s->analyze(A);
+    s->factorize(A);
+  }
+  eigen->solve(b, xe);
+  petsc->solve(b, xp);
+  std::vector<double> diff(b.size());
+  for (std::size_t i = 0; i < b.size(); ++i) diff[i] = xe[i] - xp[i];
+  EXPECT_LT(norm(diff) / norm(xe), 1e-12);
+}
+
+TEST(Solvers, PetscWithoutLaneThrows) {
+  SolverOptions options;
+  options.backend = Backend::Petsc;
+  EXPECT_THROW((void)make_solver(10, options, nullptr), Error);
+}
+
+TEST(Solvers, AutomaticPicksBySize) {
+  SolverOptions options;
+  options.petsc_threshold = 100;
+  EXPECT_EQ(std::string(make_solver(99, options, &lane())->name()).rfind("eigen", 0), 0u);
+  auto big = make_solver(100, options, &lane());
+  big->analyze(poisson(10, 1.0));
+  EXPECT_EQ(std::string(big->name()).rfind("petsc/mumps-cholesky", 0), 0u) << big->name();
+  EXPECT_EQ(std::string(make_solver(1000, options, nullptr)->name()).rfind("eigen", 0), 0u);
+}
+
+TEST(Solvers, SecondLaneIsRejected) { EXPECT_THROW(PetscLane second, Error); }
+
+TEST(Solvers, EmptySystem) {
+  const SparseMatrix A(0, std::span<const SparseMatrix::Triplet>{});
+  for (Backend backend : {Backend::Eigen, Backend::Petsc}) {
+    auto solver = make(backend);
+    solver->analyze(A);
+    solver->factorize(A);
+    std::vector<double> b, x;
+    solver->solve(b, x);
+  }
+}
+
+}  // namespace
+}  // namespace qsmesh::linalg
