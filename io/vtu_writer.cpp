@@ -107,11 +107,13 @@ void check_fields(const std::vector<Field>& fields, std::size_t n, const char* w
 void write_vtu(const mesh::SurfaceMesh& mesh, const std::string& path, const WriteOptions& options) {
   detail::check_output_folder(path);
   check_mesh_for_output(mesh);
-  const std::size_t nv = mesh.points.size();
+  const std::size_t nm = options.vtu_markers.size();
+  const std::size_t nmesh = mesh.points.size();
+  const std::size_t nv = nmesh + nm;
   const std::size_t nt = mesh.triangles.size();
   const std::size_t nq = mesh.quads.size();
   const std::size_t nb = options.vtu_include_bars ? mesh.bars.size() : 0;
-  const std::size_t ncells = nt + nq + nb;
+  const std::size_t ncells = nt + nq + nb + nm;
   check_fields(options.point_fields, nv, "point", path);
   check_fields(options.cell_fields, ncells, "cell", path);
   const bool bin = options.vtu_binary;
@@ -126,11 +128,12 @@ void write_vtu(const mesh::SurfaceMesh& mesh, const std::string& path, const Wri
 
   out << "      <PointData>\n";
   {
-    std::vector<std::int32_t> dim(nv), entity(nv);
-    for (std::size_t v = 0; v < nv; ++v) {
+    std::vector<std::int32_t> dim(nv, -1), entity(nv, -1);
+    for (std::size_t v = 0; v < nmesh; ++v) {
       dim[v] = mesh.vclass[v].dim;
       entity[v] = mesh.vclass[v].entity;
     }
+    for (std::size_t m = 0; m < nm; ++m) entity[nmesh + m] = options.vtu_markers[m].face;
     write_array(out, "cad_dim", 1, dim, bin);
     write_array(out, "cad_entity", 1, entity, bin);
   }
@@ -142,6 +145,7 @@ void write_vtu(const mesh::SurfaceMesh& mesh, const std::string& path, const Wri
     std::vector<std::int32_t> face(ncells, -1);
     for (std::size_t e = 0; e < nt; ++e) face[e] = mesh.triangle_face[e];
     for (std::size_t e = 0; e < nq; ++e) face[nt + e] = mesh.quad_face[e];
+    for (std::size_t m = 0; m < nm; ++m) face[nt + nq + nb + m] = options.vtu_markers[m].face;
     write_array(out, "cad_face", 1, face, bin);
     if (nb > 0) {
       std::vector<std::int32_t> curve(ncells, -1);
@@ -156,9 +160,10 @@ void write_vtu(const mesh::SurfaceMesh& mesh, const std::string& path, const Wri
   {
     std::vector<double> xyz(3 * nv);
     for (std::size_t v = 0; v < nv; ++v) {
-      xyz[3 * v] = mesh.points[v].x;
-      xyz[3 * v + 1] = mesh.points[v].y;
-      xyz[3 * v + 2] = mesh.points[v].z;
+      const Vec3& p = v < nmesh ? mesh.points[v] : options.vtu_markers[v - nmesh].position;
+      xyz[3 * v] = p.x;
+      xyz[3 * v + 1] = p.y;
+      xyz[3 * v + 2] = p.z;
     }
     write_array(out, "Points", 3, xyz, bin);
   }
@@ -186,6 +191,11 @@ void write_vtu(const mesh::SurfaceMesh& mesh, const std::string& path, const Wri
       conn.insert(conn.end(), mesh.bars[e].begin(), mesh.bars[e].end());
       offsets.push_back(static_cast<std::int64_t>(conn.size()));
       types.push_back(3);  // VTK_LINE
+    }
+    for (std::size_t m = 0; m < nm; ++m) {
+      conn.push_back(static_cast<std::int64_t>(nmesh + m));
+      offsets.push_back(static_cast<std::int64_t>(conn.size()));
+      types.push_back(1);  // VTK_VERTEX
     }
     write_array(out, "connectivity", 1, conn, bin);
     write_array(out, "offsets", 1, offsets, bin);

@@ -186,5 +186,29 @@ TEST(Vtu, ExtraFieldsAndBars) {
   EXPECT_FALSE(fs::exists(dir / "bad.vtu"));
 }
 
+TEST(Vtu, MarkersAreExtraPointsAndVertexCells) {
+  const fs::path dir = fresh_dir("vtu_markers");
+  const mesh::SurfaceMesh m = make_test_mesh();
+  WriteOptions opt;
+  opt.vtu_binary = false;
+  opt.vtu_markers = {Marker{{0.5, 0.25, 0}, 3}, Marker{{1, 2, 3}, 0}};
+  Field index{"singularity_index", 1, {}};
+  for (int e = 0; e < 9; ++e) index.values.push_back(0);
+  index.values.insert(index.values.end(), {1.0, -1.0});
+  opt.cell_fields.push_back(index);
+  const std::string path = (dir / "markers.vtu").string();
+  write_vtu(m, path, opt);
+  const std::string xml = read_all(path);
+  EXPECT_NE(xml.find("NumberOfPoints=\"14\" NumberOfCells=\"11\""), std::string::npos);
+  auto arrays = parse_arrays(xml);
+  EXPECT_EQ(arrays["types"].values[9], 1);
+  EXPECT_EQ(arrays["types"].values[10], 1);
+  EXPECT_EQ(arrays["connectivity"].values.back(), 13);
+  EXPECT_EQ(arrays["cad_face"].values[9], 3);
+  EXPECT_EQ(arrays["cad_dim"].values[12], -1);
+  EXPECT_EQ(arrays["Points"].values[3 * 13 + 2], 3.0);
+  EXPECT_EQ(arrays["singularity_index"].values[10], -1.0);
+}
+
 }  // namespace
 }  // namespace qsmesh::io

@@ -11,7 +11,8 @@
 //    tag f+1 / c+1 / k+1 of dimension 2 / 1 / 0;
 //  - CGNS elements: one section per non-empty CAD face in increasing face id (the face's triangles in
 //    mesh order, then its quads), then one BAR_2 section per non-empty CAD curve; ids 1..n contiguous.
-//  - VTU cells: the triangles in mesh order, then the quads, then (optionally) the bars.
+//  - VTU cells: the triangles in mesh order, then the quads, then (optionally) the bars, then one
+//    VTK_VERTEX per marker (WriteOptions::vtu_markers; their points follow the mesh vertices).
 // CAD faces and curves without elements get no section, family, BC nor element block.
 #pragma once
 
@@ -31,6 +32,13 @@ struct Field {
   std::vector<double> values;
 };
 
+/// A point of interest drawn with the mesh in VTU output (a cross-field singularity, say), as an
+/// extra point and a VTK_VERTEX cell after every other point and cell.
+struct Marker {
+  Vec3 position;
+  LO face = kNoIndex;  ///< CAD face it belongs to (cell data cad_face)
+};
+
 struct WriteOptions {
   // CGNS
   std::string cgns_base_name = "qsmesh";   ///< CGNS names are at most 32 characters
@@ -38,8 +46,9 @@ struct WriteOptions {
   // VTU
   bool vtu_binary = true;                  ///< inline base64 (true) or ASCII (false) data arrays
   bool vtu_include_bars = false;           ///< also write the curve bars as VTK_LINE cells
-  std::vector<Field> point_fields;         ///< one value (or 3) per mesh vertex
-  std::vector<Field> cell_fields;          ///< one value (or 3) per VTU cell (see above)
+  std::vector<Marker> vtu_markers;         ///< extra points with a vertex cell each
+  std::vector<Field> point_fields;         ///< one value (or 3) per mesh vertex, then per marker
+  std::vector<Field> cell_fields;          ///< one value (or 3) per VTU cell (see above), markers last
   // MSH
   bool msh_corner_elements = true;         ///< write one point element (type 15) per meshed corner
 };
