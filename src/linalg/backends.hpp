@@ -20,10 +20,11 @@ class Pattern {
   [[nodiscard]] bool empty() const { return offsets_.empty(); }
   void check(const SparseMatrix& A, const char* backend) const {
     QSMESH_CHECK(!offsets_.empty(), backend << ": factorize() before analyze()");
-    QSMESH_CHECK(A.size() == n_ && A.row_offsets() == offsets_ && A.columns() == cols_,
-                 backend << ": factorize() on a matrix whose pattern differs from the analysed one ("
-                         << A.size() << " unknowns, " << A.nonzeros() << " nonzeros; analysed "
-                         << n_ << ", " << cols_.size() << ")");
+    QSMESH_CHECK(
+        A.size() == n_ && A.row_offsets() == offsets_ && A.columns() == cols_,
+        backend << ": factorize() on a matrix whose pattern differs from the analysed one ("
+                << A.size() << " unknowns, " << A.nonzeros() << " nonzeros; analysed " << n_ << ", "
+                << cols_.size() << ")");
   }
 
  private:
@@ -35,8 +36,8 @@ class Pattern {
 /// Eigen::SimplicialLDLT (AMD ordering) on a copy of the matrix in Eigen's storage.
 std::unique_ptr<LinearSolver> make_eigen_solver();
 
-/// PETSc SeqAIJ on PETSC_COMM_SELF factorized by MUMPS (Cholesky; LU, then PETSc's own factorization,
-/// as fallbacks). Every PETSc call is made while holding lane.mutex().
+/// PETSc SeqAIJ on PETSC_COMM_SELF factorized by MUMPS (Cholesky; LU, then PETSc's own
+/// factorization, as fallbacks). Every PETSc call is made while holding lane.mutex().
 std::unique_ptr<LinearSolver> make_petsc_solver(PetscLane& lane);
 
 }  // namespace qsmesh::linalg::detail

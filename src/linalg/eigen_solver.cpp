@@ -45,9 +45,8 @@ class EigenSolver final : public LinearSolver {
     const auto& d = ldlt_.vectorD();
     for (Eigen::Index i = 0; i < d.size(); ++i)
       QSMESH_CHECK(d[i] > 0 && std::isfinite(d[i]),
-                   "eigen: the matrix of size " << A.size()
-                                                << " is not positive definite (pivot " << d[i]
-                                                << " at elimination step " << i << ")");
+                   "eigen: the matrix of size " << A.size() << " is not positive definite (pivot "
+                                                << d[i] << " at elimination step " << i << ")");
     factorized_ = true;
   }
 

@@ -34,8 +34,8 @@ PetscErrorCode record_petsc_error(MPI_Comm /*comm*/, int line, const char* fun, 
     PetscErrorMessage(code, &generic, nullptr);
     os << (generic != nullptr ? generic : "PETSc error");
     if (message != nullptr && message[0] != '\0') os << ": " << message;
-    os << " (in " << (fun != nullptr ? fun : "?") << " at " << (file != nullptr ? file : "?")
-       << ":" << line << ")";
+    os << " (in " << (fun != nullptr ? fun : "?") << " at " << (file != nullptr ? file : "?") << ":"
+       << line << ")";
     text = os.str();
   } else {
     os << text << " <- " << (fun != nullptr ? fun : "?");
@@ -93,17 +93,17 @@ namespace {
 }
 
 // Checks the return code of a PETSc call; must be used while holding lane_->mutex().
-#define QSMESH_PETSC_CALL(call)                                                            \
-  do {                                                                                     \
-    const PetscErrorCode qsmesh_petsc_code_ = (call);                                      \
-    if (qsmesh_petsc_code_ != 0) [[unlikely]]                                              \
-      petsc_failed(*lane_, qsmesh_petsc_code_, #call, __FILE__, __LINE__);                 \
+#define QSMESH_PETSC_CALL(call)                                            \
+  do {                                                                     \
+    const PetscErrorCode qsmesh_petsc_code_ = (call);                      \
+    if (qsmesh_petsc_code_ != 0) [[unlikely]]                              \
+      petsc_failed(*lane_, qsmesh_petsc_code_, #call, __FILE__, __LINE__); \
   } while (false)
 
 PetscInt to_petsc_int(std::int64_t value, const char* what) {
   QSMESH_CHECK(value >= 0 && value <= std::numeric_limits<PetscInt>::max(),
-               "petsc: " << what << " " << value << " does not fit PETSc's "
-                         << 8 * sizeof(PetscInt) << "-bit indices");
+               "petsc: " << what << " " << value << " does not fit PETSc's " << 8 * sizeof(PetscInt)
+                         << "-bit indices");
   return static_cast<PetscInt>(value);
 }
 
@@ -159,7 +159,6 @@ class PetscSolver final : public LinearSolver {
     }
     factorized_ = true;
   }
-  }
 
   // Under the lock: matrix, vectors and symbolic factorization for the pattern of A.
   void build(const SparseMatrix& A) {
@@ -174,7 +173,8 @@ class PetscSolver final : public LinearSolver {
     QSMESH_PETSC_CALL(MatSetSizes(matrix_, n, n, n, n));
     QSMESH_PETSC_CALL(MatSetType(matrix_, MATSEQAIJ));
     // Preallocates exactly and assembles: the values are replaced in place by factorize().
-    QSMESH_PETSC_CALL(MatSeqAIJSetPreallocationCSR(matrix_, ia.data(), ja.data(), A.values().data()));
+    QSMESH_PETSC_CALL(
+        MatSeqAIJSetPreallocationCSR(matrix_, ia.data(), ja.data(), A.values().data()));
     QSMESH_PETSC_CALL(MatSetOption(matrix_, MAT_NEW_NONZERO_LOCATION_ERR, PETSC_TRUE));
     // SPD makes MUMPS run its SPD variant (SYM=1, no pivoting); only the upper triangle is read.
     QSMESH_PETSC_CALL(MatSetOption(matrix_, MAT_SYMMETRIC, PETSC_TRUE));
@@ -260,14 +260,15 @@ class PetscSolver final : public LinearSolver {
       QSMESH_PETSC_CALL(MatMumpsGetInfog(factor_, 12, &negative_pivots));
     }
     QSMESH_CHECK(error == MAT_FACTOR_NOERROR && infog1 >= 0,
-                 "petsc: numeric factorization (" << name_ << ") failed for a matrix of size " << n
+                 "petsc: numeric factorization ("
+                     << name_ << ") failed for a matrix of size " << n
                      << ": the matrix is singular or not positive definite (PETSc factor error "
                      << static_cast<int>(error) << (mumps ? ", MUMPS INFOG(1) " : "")
                      << (mumps ? std::to_string(infog1) : std::string()) << ")");
     QSMESH_CHECK(type_ != MAT_FACTOR_CHOLESKY || negative_pivots == 0,
                  "petsc: the matrix of size " << n << " is not positive definite ("
-                                              << negative_pivots << " negative pivots in "
-                                              << name_ << ")");
+                                              << negative_pivots << " negative pivots in " << name_
+                                              << ")");
   }
 
   // Under the lock. Never throws (runs in the destructor); a failing destroy leaks at worst.

@@ -68,9 +68,10 @@ void SparseMatrix::multiply(std::span<const double> x, std::span<double> y) cons
   QSMESH_CHECK(x.data() != y.data() || n_ == 0, "SparseMatrix::multiply: x and y must not alias");
   for (LO r = 0; r < n_; ++r) {
     double sum = 0;
-    for (auto k = offsets_[static_cast<std::size_t>(r)]; k < offsets_[static_cast<std::size_t>(r) + 1];
-         ++k)
-      sum += values_[static_cast<std::size_t>(k)] * x[static_cast<std::size_t>(cols_[static_cast<std::size_t>(k)])];
+    for (auto k = offsets_[static_cast<std::size_t>(r)];
+         k < offsets_[static_cast<std::size_t>(r) + 1]; ++k)
+      sum += values_[static_cast<std::size_t>(k)] *
+             x[static_cast<std::size_t>(cols_[static_cast<std::size_t>(k)])];
     y[static_cast<std::size_t>(r)] = sum;
   }
 }

@@ -11,7 +11,7 @@ namespace {
 using T = SparseMatrix::Triplet;
 
 TEST(SparseMatrix, SumsDuplicatesAndSortsColumns) {
-  const std::vector<T> t{{0, 2, 1.0}, {0, 0, 2.0}, {1, 1, 3.0}, {0, 2, 0.5},
+  const std::vector<T> t{{0, 2, 1.0},  {0, 0, 2.0}, {1, 1, 3.0}, {0, 2, 0.5},
                          {2, 0, -1.0}, {1, 1, 1.0}, {2, 2, 4.0}};
   const SparseMatrix A(3, t);
   EXPECT_EQ(A.size(), 3);

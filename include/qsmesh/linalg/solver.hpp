@@ -85,8 +85,10 @@ enum class Backend { Automatic, Eigen, Petsc };
 struct SolverOptions {
   Backend backend = Backend::Automatic;
   /// Automatic: systems with at least this many unknowns go to PETSc (when a lane is given),
-  /// smaller ones to Eigen. Chosen by measurement (docs/benchmarks.md).
-  LO petsc_threshold = 200000;
+  /// smaller ones to Eigen. Chosen by measurement (docs/benchmarks.md, "Linear solvers"): on one
+  /// thread, analyze + 2 factorizations + 10 solves cost the same in both at about 5e5-6.5e5
+  /// unknowns (Eigen's solves are 2x faster; MUMPS factorizes faster from 2e5-3e5 unknowns).
+  LO petsc_threshold = 500000;
 };
 
 /// A direct solver for symmetric positive definite systems.

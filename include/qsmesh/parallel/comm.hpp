@@ -9,7 +9,8 @@
 
 namespace qsmesh::parallel {
 
-/// Initialises MPI (thread level FUNNELED: only the main thread calls MPI) and finalises it on
+/// Initialises MPI (thread level SERIALIZED: MPI itself is called from the main thread only, but
+/// PETSc solves run on worker threads, one at a time through linalg::PetscLane) and finalises it on
 /// destruction. Exactly one per process, created by the driver's main().
 class MpiSession {
  public:

@@ -1,0 +1,163 @@
+// Benchmark of the linear-solver backends (scripts/bench_solvers.sh): analyze, factorize and
+// solve times of Eigen vs PETSc/MUMPS on SPD matrices of the kinds the cross-field stage builds.
+// One rank, one thread (the script pins OMP/BLAS threads to 1). Prints markdown table rows.
+//
+// Usage: qsmesh_bench_solvers [N ...]   (default: 1000 10000 100000 500000)
+//   poisson: 5-point Laplacian on a sqrt(N) x sqrt(N) grid + 0.01 * identity;
+//   cr:      Crouzeix-Raviart-like: 2 unknowns per edge of a triangulated grid (N/2 edges), the
+//            P1-nonconforming Laplacian coupled by a 2x2 block [1 .5; .5 1] + 0.01 * identity.
+#include <mpi.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <exception>
+#include <string>
+#include <vector>
+
+#include "qsmesh/core/timer.hpp"
+#include "qsmesh/linalg/solver.hpp"
+
+namespace {
+
+using qsmesh::LO;
+using qsmesh::Stopwatch;
+using qsmesh::linalg::Backend;
+using qsmesh::linalg::SparseMatrix;
+using Triplet = SparseMatrix::Triplet;
+
+SparseMatrix poisson(LO target) {
+  const LO m =
+      std::max<LO>(2, static_cast<LO>(std::lround(std::sqrt(static_cast<double>(target)))));
+  std::vector<Triplet> t;
+  t.reserve(static_cast<std::size_t>(m) * m * 5);
+  const auto id = [m](LO i, LO j) { return i * m + j; };
+  for (LO i = 0; i < m; ++i)
+    for (LO j = 0; j < m; ++j) {
+      const LO r = id(i, j);
+      t.push_back({r, r, 4.01});
+      if (i > 0) t.push_back({r, id(i - 1, j), -1.0});
+      if (i + 1 < m) t.push_back({r, id(i + 1, j), -1.0});
+      if (j > 0) t.push_back({r, id(i, j - 1), -1.0});
+      if (j + 1 < m) t.push_back({r, id(i, j + 1), -1.0});
+    }
+  return SparseMatrix(m * m, t);
+}
+
+SparseMatrix crouzeix_raviart(LO target) {
+  // m x m grid vertices, each cell cut by its anti-diagonal: ~3 m^2 edges, 2 unknowns each.
+  const LO m = std::max<LO>(2, static_cast<LO>(std::lround(std::sqrt(target / 6.0))) + 1);
+  const LO nh = m * (m - 1), nv = (m - 1) * m;
+  const auto h = [m](LO i, LO j) { return i * (m - 1) + j; };                    // (i,j)-(i,j+1)
+  const auto v = [m, nh](LO i, LO j) { return nh + i * m + j; };                 // (i,j)-(i+1,j)
+  const auto d = [m, nh, nv](LO i, LO j) { return nh + nv + i * (m - 1) + j; };  // (i,j+1)-(i+1,j)
+  const LO edges = nh + nv + (m - 1) * (m - 1);
+  // CR stiffness of a right isosceles triangle, edges ordered as the opposite vertices (right
+  // angle first): 4 x the P1 stiffness.
+  static constexpr double K[3][3] = {{4, -2, -2}, {-2, 2, 0}, {-2, 0, 2}};
+  static constexpr double R[2][2] = {{1, 0.5}, {0.5, 1}};
+  std::vector<Triplet> t;
+  t.reserve(static_cast<std::size_t>(m - 1) * (m - 1) * 2 * 36 +
+            2 * static_cast<std::size_t>(edges));
+  const auto element = [&](const LO(&e)[3]) {
+    for (int a = 0; a < 3; ++a)
+      for (int b = 0; b < 3; ++b)
+        for (int c = 0; c < 2; ++c)
+          for (int k = 0; k < 2; ++k) t.push_back({2 * e[a] + c, 2 * e[b] + k, R[c][k] * K[a][b]});
+  };
+  for (LO i = 0; i + 1 < m; ++i)
+    for (LO j = 0; j + 1 < m; ++j) {
+      element({d(i, j), v(i, j), h(i, j)});
+      element({d(i, j), v(i, j + 1), h(i + 1, j)});
+    }
+  for (LO r = 0; r < 2 * edges; ++r) t.push_back({r, r, 0.01});
+  return SparseMatrix(2 * edges, t);
+}
+
+struct Times {
+  double analyze = 0, factorize = 0, refactorize = 0, solve = 0, residual = 0;
+  std::string name;
+};
+
+Times run(const SparseMatrix& A, Backend backend, qsmesh::linalg::PetscLane* lane) {
+  qsmesh::linalg::SolverOptions options;
+  options.backend = backend;
+  auto solver = qsmesh::linalg::make_solver(A.size(), options, lane);
+  Times t;
+  Stopwatch w;
+  solver->analyze(A);
+  t.analyze = w.seconds();
+  w.reset();
+  solver->factorize(A);
+  t.factorize = w.seconds();
+  SparseMatrix B = A;  // a second level: same pattern, other values
+  for (double& x : B.values()) x *= 1.5;
+  w.reset();
+  solver->factorize(B);
+  t.refactorize = w.seconds();
+  const auto n = static_cast<std::size_t>(A.size());
+  std::vector<double> b(n), x(n), r(n);
+  constexpr int kSolves = 5;
+  for (int k = 0; k < kSolves; ++k) {
+    for (std::size_t i = 0; i < n; ++i) b[i] = std::sin(0.1 * static_cast<double>(i) + k);
+    w.reset();
+    solver->solve(b, x);
+    t.solve += w.seconds() / kSolves;
+    B.multiply(x, r);
+    double rr = 0, bb = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+      rr += (r[i] - b[i]) * (r[i] - b[i]);
+      bb += b[i] * b[i];
+    }
+    t.residual = std::max(t.residual, std::sqrt(rr / bb));
+  }
+  t.name = solver->name();
+  return t;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  // As a driver would: MPI first (serialised threads), then the lane, which leaves MPI running.
+  int provided = 0;
+  if (MPI_Init_thread(&argc, &argv, MPI_THREAD_SERIALIZED, &provided) != MPI_SUCCESS) return 1;
+  int status = 0;
+  try {
+    std::vector<LO> sizes;
+    for (int i = 1; i < argc; ++i) sizes.push_back(static_cast<LO>(std::atof(argv[i])));
+    if (sizes.empty()) sizes = {1000, 10000, 100000, 500000};
+    qsmesh::linalg::PetscLane lane;
+    std::printf(
+        "| matrix | n | nonzeros | backend | analyze (s) | factorize (s) | refactorize (s) "
+        "| solve (s) | rel. residual | Eigen/PETSc: factorize | refactorize | solve | "
+        "analyze+2 fact.+10 solves |\n");
+    std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+    for (const char* kind : {"poisson", "cr"}) {
+      for (LO target : sizes) {
+        const SparseMatrix A =
+            std::string(kind) == "poisson" ? poisson(target) : crouzeix_raviart(target);
+        const Times e = run(A, Backend::Eigen, &lane);
+        const Times p = run(A, Backend::Petsc, &lane);
+        const auto total = [](const Times& t) {
+          return t.analyze + t.factorize + t.refactorize + 10 * t.solve;
+        };
+        for (const Times* t : {&e, &p}) {
+          std::printf("| %s | %d | %lld | %s | %.4f | %.4f | %.4f | %.5f | %.1e |", kind, A.size(),
+                      static_cast<long long>(A.nonzeros()), t->name.c_str(), t->analyze,
+                      t->factorize, t->refactorize, t->solve, t->residual);
+          if (t == &e)
+            std::printf(" %.2f | %.2f | %.2f | %.2f |\n", e.factorize / p.factorize,
+                        e.refactorize / p.refactorize, e.solve / p.solve, total(e) / total(p));
+          else
+            std::printf("  |  |  |  |\n");
+        }
+        std::fflush(stdout);
+      }
+    }
+  } catch (const std::exception& ex) {
+    std::fprintf(stderr, "bench_solvers: %s\n", ex.what());
+    status = 1;
+  }
+  MPI_Finalize();
+  return status;
+}

@@ -1,0 +1,107 @@
+// Cross field of one CAD face (paper 000 Sec. 3): boundary-aligned cross field by multilevel heat
+// diffusion on Crouzeix-Raviart edges (Sec. 3.1, Algorithm 1, boundary-condition extension), its
+// singularities and the check against the Euler relation (Sec. 3.2, Sec. 1.3 Eq. 2), and its
+// conformal scaling (Sec. 3.3, Eq. 8-9).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "qsmesh/core/types.hpp"
+#include "qsmesh/linalg/solver.hpp"
+#include "qsmesh/mesh/surface_mesh.hpp"
+
+namespace qsmesh::crossfield {
+
+struct CrossFieldOptions {
+  int levels = 4;           ///< N diffusion levels (Algorithm 1), >= 1
+  double tolerance = 1e-3;  ///< a level ends when ||U(i+1)-U(i)||_inf < tolerance
+  int max_iterations_per_level = 50;
+  bool extend_boundary = true;   ///< Sec. 3.1 boundary-condition extension
+  double acute_corner_deg = 45;  ///< artificial +1 singularity at CAD corners sharper than this
+  linalg::SolverOptions solver;
+};
+
+struct Singularity {
+  Vec3 position;
+  int index = 0;  ///< +1 (valence 3) or -1 (valence 5)
+  enum class Where { Vertex, Edge, Triangle, AcuteCorner } where = Where::Vertex;
+  LO element =
+      kNoIndex;  ///< glued vertex (Vertex, AcuteCorner), edge (Edge) or triangle (Triangle)
+};
+
+/// Eq. 2 of paper 000 with the corner contributions.
+struct EulerCheck {
+  int chi = 0;  ///< V - E + F of the glued triangulation
+  int corner_term =
+      0;  ///< sum over boundary CAD corners of k_c = 2 - round(angle / 90 deg) (acute: 1)
+  int expected =
+      0;          ///< 4 chi - corner_term: the sum of interior singularity indices Eq. 2 asks for
+  int found = 0;  ///< sum of the indices in the singularity list (acute-corner ones included)
+  bool consistent = false;  ///< found == expected
+  /// Diagnostic: the boundary indices the computed field really has (sum over every boundary vertex
+  /// of 2 + (rotation of the cross around it - 4 * angle) / 2 pi). The discrete index theorem makes
+  /// (sum of interior cell indices) + field_boundary_term == 4 chi exactly; a mismatch between
+  /// field_boundary_term and corner_term shows where the field disagrees with the CAD corners.
+  int field_boundary_term = 0;
+};
+
+struct CrossFieldStats {
+  int levels = 0;          ///< diffusion levels run
+  int factorizations = 0;  ///< heat-system factorizations (one per level)
+  int solves = 0;          ///< heat-system solves
+  std::vector<int> iterations_per_level;
+  double seconds = 0;        ///< wall time of compute_face_cross_field
+  int extension_solves = 0;  ///< Laplace solves of the boundary-condition extension (0 or 1)
+  int dropped_pairs = 0;     ///< clusters of singular cells whose indices cancel (not listed)
+  int high_index_cells = 0;  ///< cells of |index| >= 2 (listed as |index| singularities of +-1)
+  std::string solver;        ///< name of the linear solver backend used
+};
+
+struct FaceCrossField {
+  LO face = kNoIndex;
+  // Glued triangulation: FaceMesh vertices with the same corner (dim 0) or the same curve vertex
+  // (dim 1: curve id and index) are one vertex, so seams of periodic surfaces are interior.
+  std::vector<Vec3> points;
+  std::vector<std::array<LO, 3>> triangles;  ///< oriented along the face normal
+  std::vector<LO> input2glued;               ///< FaceMesh vertex -> glued vertex
+  std::vector<std::int8_t> vertex_dim;       ///< CAD dimension of each glued vertex (0, 1, 2)
+  std::vector<std::array<LO, 2>> edges;      ///< (a, b) with a < b
+  /// tri2edges[t][k]: edge joining triangles[t][k] and triangles[t][(k+1)%3].
+  std::vector<std::array<LO, 3>> tri2edges;
+  std::vector<std::uint8_t> boundary_edge;  ///< 1 when the edge has one triangle after gluing
+  std::vector<std::uint8_t> fixed_edge;     ///< 1 when Dirichlet in the heat solves
+  /// Per edge: (cos 4θ, sin 4θ) after projection, θ measured from the edge direction
+  /// edges[e][0] -> edges[e][1], positive around the face normal.
+  std::vector<Vec2> u;
+  std::vector<double> u_norm;                   ///< per edge: |U| of the last unprojected solve
+  std::vector<std::array<Vec3, 2>> directions;  ///< per triangle: two orthogonal unit branches
+  std::vector<double> H, h;                     ///< per glued vertex: conformal scaling, h = exp(H)
+  std::vector<Singularity> singularities;
+  EulerCheck euler;
+  CrossFieldStats stats;
+};
+
+/// Whole step 1 for one face: glue, Algorithm 1 (+BC extension), singularities (+acute corners),
+/// Euler check, scaling. `background` is the face's background triangulation (FaceMesh of
+/// background::mesh_face_background, triangles oriented along the face normal); `lane` may be null
+/// (Eigen). A face without boundary (closed surface, e.g. a full sphere) has no Dirichlet data and
+/// starts from a fixed direction projected on the surface. Throws qsmesh::Error on an empty mesh
+/// or a solver failure; the caller logs the face and falls back.
+[[nodiscard]] FaceCrossField compute_face_cross_field(const mesh::FaceMesh& background,
+                                                      const CrossFieldOptions& options,
+                                                      linalg::PetscLane* lane);
+
+/// The constant C of Sec. 3.3 giving about n_quads quads: C = -1/2 ln(N / ∫ e^{-2H}), the integral
+/// over the glued triangulation (per triangle, the mean of e^{-2H} at its vertices times its area).
+/// The size map is then h(x) = exp(H(x) + C) (model units).
+[[nodiscard]] double scaling_constant(const FaceCrossField& cf, double n_quads);
+
+// Stages of compute_face_cross_field, exposed for tests and tools.
+
+/// Fills points, triangles, input2glued, vertex_dim, edges, tri2edges, boundary_edge of `cf`.
+void glue_triangulation(const mesh::FaceMesh& background, FaceCrossField& cf);
+
+}  // namespace qsmesh::crossfield

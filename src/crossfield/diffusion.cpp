@@ -1,0 +1,246 @@
+// Sec. 3.1: Crouzeix-Raviart cross field, boundary-condition extension and Algorithm 1.
+//
+// One unknown pair (cos 4θ, sin 4θ) per edge, θ measured from the edge's own direction. Inside a
+// triangle every edge direction lies in the triangle's plane, so the crosses of two edges of the
+// triangle are compared after rotating by 4 times the angle between their directions: the CR
+// stiffness couples edges i and j of a triangle by K_ij R(4(φ_j - φ_i)). Across an edge the two
+// triangles share the edge direction, which is the discrete parallel transport of the surface; on a
+// curved face the holonomy around a vertex is its angle defect, as it should be.
+#include <algorithm>
+#include <cmath>
+
+#include "internal.hpp"
+#include "qsmesh/core/error.hpp"
+
+namespace qsmesh::crossfield::detail {
+namespace {
+
+using Triplet = linalg::SparseMatrix::Triplet;
+
+/// CR stiffness of the triangles selected by `use`, on the unknowns edge2unk (2 per edge, kNoIndex:
+/// Dirichlet). Returns the free-free triplets and adds -K_fd u_d to `coupling`.
+std::vector<Triplet> assemble_stiffness(const FaceCrossField& cf, const Geometry& g,
+                                        const std::vector<std::uint8_t>& use,
+                                        const std::vector<LO>& edge2unk,
+                                        std::vector<double>& coupling) {
+  std::vector<Triplet> trip;
+  trip.reserve(cf.triangles.size() * 36);
+  for (std::size_t t = 0; t < cf.triangles.size(); ++t) {
+    if (!use[t]) continue;
+    // Edge k of the triangle joins vertices k and k+1: it is opposite vertex k+2. The CR basis
+    // function of the edge opposite vertex m is 1 - 2 λ_m, so K = 4 × (P1 stiffness): off-diagonal
+    // -2 cot(third angle), diagonal 2 (cot + cot) of the two angles at the edge's ends.
+    double K[3][3];
+    for (int i = 0; i < 3; ++i) {
+      const int oi = (i + 2) % 3;  // vertex opposite edge i
+      for (int j = 0; j < 3; ++j) {
+        const int oj = (j + 2) % 3;
+        if (i == j)
+          K[i][j] = 2 * (g.cot[t][(oi + 1) % 3] + g.cot[t][(oi + 2) % 3]);
+        else
+          K[i][j] = -2 * g.cot[t][3 - oi - oj];
+      }
+    }
+    for (int i = 0; i < 3; ++i) {
+      const LO ei = cf.tri2edges[t][i];
+      const LO ui = edge2unk[ei];
+      if (ui == kNoIndex) continue;
+      for (int j = 0; j < 3; ++j) {
+        const LO ej = cf.tri2edges[t][j];
+        const double beta = 4 * (g.phi[t][j] - g.phi[t][i]);
+        const double c = std::cos(beta) * K[i][j], s = std::sin(beta) * K[i][j];
+        const double B[2][2] = {{c, -s}, {s, c}};
+        const LO uj = edge2unk[ej];
+        if (uj != kNoIndex) {
+          for (int a = 0; a < 2; ++a)
+            for (int b = 0; b < 2; ++b) trip.push_back({ui + a, uj + b, B[a][b]});
+        } else {
+          const Vec2& d = cf.u[ej];
+          coupling[ui] -= B[0][0] * d.u + B[0][1] * d.v;
+          coupling[ui + 1] -= B[1][0] * d.u + B[1][1] * d.v;
+        }
+      }
+    }
+  }
+  return trip;
+}
+
+/// Lumped CR mass (|t1| + |t2|) / 3 of each edge.
+std::vector<double> edge_mass(const FaceCrossField& cf, const Geometry& g) {
+  std::vector<double> m(cf.edges.size(), 0.0);
+  for (std::size_t t = 0; t < cf.triangles.size(); ++t)
+    for (int k = 0; k < 3; ++k) m[cf.tri2edges[t][k]] += g.area[t] / 3;
+  return m;
+}
+
+Vec2 project(const Vec2& x, const Vec2& fallback) {
+  const double n = norm(x);
+  return n > 1e-14 ? x / n : fallback;
+}
+
+/// Boundary-condition extension: the crosses of the triangles touching the boundary are fixed to
+/// the solution of the CR Laplace equation on that one-triangle layer with the boundary crosses as
+/// data.
+void extend_boundary_conditions(FaceCrossField& cf, const Geometry& g,
+                                const CrossFieldOptions& options, linalg::PetscLane* lane,
+                                const std::vector<double>& mass) {
+  const std::size_t nt = cf.triangles.size(), ne = cf.edges.size();
+  std::vector<std::uint8_t> layer(nt, 0);
+  for (std::size_t t = 0; t < nt; ++t)
+    for (LO v : cf.triangles[t])
+      if (g.boundary_vertex[v]) layer[t] = 1;
+  std::vector<LO> edge2unk(ne, kNoIndex);
+  LO n = 0;
+  for (std::size_t t = 0; t < nt; ++t) {
+    if (!layer[t]) continue;
+    for (LO e : cf.tri2edges[t])
+      if (!cf.boundary_edge[e] && edge2unk[e] == kNoIndex) {
+        edge2unk[e] = n;
+        n += 2;
+      }
+  }
+  if (n == 0) return;
+  std::vector<double> rhs(static_cast<std::size_t>(n), 0.0);
+  auto trip = assemble_stiffness(cf, g, layer, edge2unk, rhs);
+  // A vanishing mass term keeps the system definite should a layer triangle be degenerate.
+  const double eps = 1e-10 / (g.min_edge * g.min_edge);
+  for (std::size_t e = 0; e < ne; ++e)
+    if (edge2unk[e] != kNoIndex)
+      for (int a = 0; a < 2; ++a) trip.push_back({edge2unk[e] + a, edge2unk[e] + a, eps * mass[e]});
+  const linalg::SparseMatrix A(n, trip);
+  auto solver = linalg::make_solver(n, options.solver, lane);
+  solver->analyze(A);
+  solver->factorize(A);
+  std::vector<double> x(static_cast<std::size_t>(n));
+  solver->solve(rhs, x);
+  ++cf.stats.extension_solves;
+  for (std::size_t e = 0; e < ne; ++e) {
+    const LO i = edge2unk[e];
+    if (i == kNoIndex) continue;
+    const Vec2 raw{x[i], x[i + 1]};
+    cf.u_norm[e] = norm(raw);
+    cf.u[e] = project(raw, Vec2{1, 0});
+    cf.fixed_edge[e] = 1;
+  }
+}
+
+}  // namespace
+
+void diffuse(FaceCrossField& cf, const Geometry& g, const CrossFieldOptions& options,
+             linalg::PetscLane* lane) {
+  QSMESH_CHECK(options.levels >= 1, "crossfield: levels must be >= 1");
+  const std::size_t ne = cf.edges.size(), nt = cf.triangles.size();
+  cf.u.assign(ne, Vec2{1, 0});
+  cf.u_norm.assign(ne, 1.0);
+  cf.fixed_edge.assign(ne, 0);
+  bool has_boundary = false;
+  for (std::size_t e = 0; e < ne; ++e)
+    if (cf.boundary_edge[e]) cf.fixed_edge[e] = 1, has_boundary = true;
+
+  const auto mass = edge_mass(cf, g);
+  if (options.extend_boundary && has_boundary)
+    extend_boundary_conditions(cf, g, options, lane, mass);
+
+  if (!has_boundary) {
+    // Closed surface: no boundary to diffuse, start from one fixed direction seen in each edge
+    // frame.
+    const Vec3 dir = normalized(Vec3{1.0, 0.31, 0.17});
+    for (std::size_t e = 0; e < ne; ++e) {
+      const LO t = g.edge2tris[e][0];
+      const Vec3 d = normalized(cf.points[cf.edges[e][1]] - cf.points[cf.edges[e][0]]);
+      const double b = std::atan2(dot(dir, cross(g.normal[t], d)), dot(dir, d));
+      cf.u[e] = {std::cos(4 * b), std::sin(4 * b)};
+    }
+  }
+
+  std::vector<LO> edge2unk(ne, kNoIndex);
+  LO n = 0;
+  for (std::size_t e = 0; e < ne; ++e)
+    if (!cf.fixed_edge[e]) {
+      edge2unk[e] = n;
+      n += 2;
+    }
+  if (n == 0) return;  // every edge is fixed: nothing to diffuse
+
+  std::vector<double> coupling(static_cast<std::size_t>(n), 0.0);
+  const std::vector<std::uint8_t> all(nt, 1);
+  auto trip = assemble_stiffness(cf, g, all, edge2unk, coupling);
+  for (std::size_t e = 0; e < ne; ++e)
+    if (edge2unk[e] != kNoIndex)
+      for (int a = 0; a < 2; ++a) trip.push_back({edge2unk[e] + a, edge2unk[e] + a, 0.0});
+  const linalg::SparseMatrix K(n, trip);
+  std::vector<double> mfree(static_cast<std::size_t>(n));
+  std::vector<std::int64_t> diag(static_cast<std::size_t>(n));
+  for (std::size_t e = 0; e < ne; ++e)
+    if (const LO i = edge2unk[e]; i != kNoIndex)
+      for (int a = 0; a < 2; ++a) {
+        mfree[i + a] = mass[e];
+        diag[i + a] = K.find(i + a, i + a);
+      }
+
+  // α from (0.1 d)^2 down to (3 h_min)^2, linearly (Algorithm 1).
+  const double a0 = std::pow(0.1 * g.diagonal, 2);
+  const double a1 = std::min(a0, std::pow(3 * g.min_edge, 2));
+  auto solver = linalg::make_solver(n, options.solver, lane);
+  cf.stats.solver = solver->name();
+  solver->analyze(K);
+
+  std::vector<double> U(static_cast<std::size_t>(n)), X(U.size()), rhs(U.size());
+  for (std::size_t e = 0; e < ne; ++e)
+    if (const LO i = edge2unk[e]; i != kNoIndex) {
+      // Surfaces with a boundary start from zero: the first solve diffuses the boundary crosses.
+      U[i] = has_boundary ? 0.0 : cf.u[e].u;
+      U[i + 1] = has_boundary ? 0.0 : cf.u[e].v;
+    }
+  linalg::SparseMatrix A = K;
+  for (int level = 0; level < options.levels; ++level) {
+    const double alpha =
+        options.levels == 1 ? a1 : a0 + (a1 - a0) * double(level) / double(options.levels - 1);
+    A.values() = K.values();
+    for (LO i = 0; i < n; ++i) A.values()[diag[i]] += mfree[i] / alpha;
+    solver->factorize(A);
+    ++cf.stats.factorizations;
+    int it = 0;
+    double change = 1e300;
+    while (change >= options.tolerance && it < options.max_iterations_per_level) {
+      for (LO i = 0; i < n; ++i) rhs[i] = mfree[i] / alpha * U[i] + coupling[i];
+      solver->solve(rhs, X);
+      ++cf.stats.solves;
+      ++it;
+      change = 0;
+      for (LO i = 0; i < n; i += 2) {
+        const Vec2 p = project({X[i], X[i + 1]}, Vec2{U[i], U[i + 1]});
+        change = std::max({change, std::abs(p.u - U[i]), std::abs(p.v - U[i + 1])});
+        U[i] = p.u;
+        U[i + 1] = p.v;
+      }
+    }
+    cf.stats.iterations_per_level.push_back(it);
+    ++cf.stats.levels;
+  }
+  for (std::size_t e = 0; e < ne; ++e)
+    if (const LO i = edge2unk[e]; i != kNoIndex) {
+      cf.u[e] = {U[i], U[i + 1]};
+      cf.u_norm[e] = std::hypot(X[i], X[i + 1]);
+      QSMESH_CHECK(std::isfinite(cf.u[e].u) && std::isfinite(cf.u[e].v),
+                   "crossfield: face " << cf.face << ": non-finite cross at edge " << e);
+    }
+}
+
+void compute_directions(FaceCrossField& cf, const Geometry& g) {
+  cf.directions.resize(cf.triangles.size());
+  for (std::size_t t = 0; t < cf.triangles.size(); ++t) {
+    // CR basis functions are 1/3 each at the barycentre.
+    Vec2 s{0, 0};
+    for (int k = 0; k < 3; ++k) {
+      const double a = angle_in_triangle(cf, g, static_cast<LO>(t), k);
+      s += Vec2{std::cos(a), std::sin(a)};
+    }
+    const double theta = std::atan2(s.v, s.u) / 4;
+    const Vec3 y = cross(g.normal[t], g.xaxis[t]);
+    const Vec3 d0 = g.xaxis[t] * std::cos(theta) + y * std::sin(theta);
+    cf.directions[t] = {d0, cross(g.normal[t], d0)};
+  }
+}
+
+}  // namespace qsmesh::crossfield::detail

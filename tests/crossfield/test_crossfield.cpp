@@ -1,0 +1,326 @@
+// Cross field of single faces built with OpenCASCADE (paper 000 Sec. 3.1-3.3).
+#include <gtest/gtest.h>
+
+#include <BRepBuilderAPI_MakeEdge.hxx>
+#include <BRepBuilderAPI_MakeFace.hxx>
+#include <BRepBuilderAPI_MakePolygon.hxx>
+#include <BRepBuilderAPI_MakeWire.hxx>
+#include <BRepPrimAPI_MakeSphere.hxx>
+#include <BRepTools.hxx>
+#include <TopoDS.hxx>
+#include <algorithm>
+#include <cstdio>
+#include <gp_Circ.hxx>
+#include <gp_Pln.hxx>
+#include <numbers>
+#include <stdexcept>
+
+#include "qsmesh/background/curve_mesh.hpp"
+#include "qsmesh/background/face_mesh.hpp"
+#include "qsmesh/crossfield/cross_field.hpp"
+#include "shapes.hpp"
+
+namespace qsmesh::crossfield {
+namespace {
+
+constexpr double kPi = std::numbers::pi;
+
+std::string tmp(const std::string& name) { return std::string(QSMESH_TEST_TMP_DIR) + "/" + name; }
+
+cad::CadModel load_shape(const TopoDS_Shape& s, const std::string& name) {
+  const std::string path = tmp(name);
+  if (!BRepTools::Write(s, path.c_str())) throw std::runtime_error("cannot write " + path);
+  return cad::load_cad(path);
+}
+
+TopoDS_Wire circle_wire(double r) {
+  const gp_Circ c(gp_Ax2(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), r);
+  return BRepBuilderAPI_MakeWire(BRepBuilderAPI_MakeEdge(c).Edge()).Wire();
+}
+
+/// Background mesh of face f and its cross field; prints the time per face.
+struct Result {
+  mesh::FaceMesh background;
+  FaceCrossField cf;
+};
+Result run(const cad::CadModel& model, LO f, double size, const char* label,
+           const CrossFieldOptions& cf_options = {}) {
+  background::BackgroundOptions options;
+  options.sizes.size = size;
+  const TaskArena tasks(1);
+  const auto curves = background::mesh_curves(model, options.sizes, tasks);
+  background::FaceReport report;
+  Result r;
+  r.background = background::mesh_face_background(model, f, curves, options, &report);
+  EXPECT_TRUE(report.ok) << report.error;
+  EXPECT_FALSE(report.fell_back) << report.error;
+  r.cf = compute_face_cross_field(r.background, cf_options, nullptr);
+  const auto& s = r.cf.stats;
+  std::printf("[crossfield] %-10s %6zu triangles  %.3f s  levels %d  solves %d  iterations", label,
+              r.cf.triangles.size(), s.seconds, s.levels, s.solves);
+  for (int it : s.iterations_per_level) std::printf(" %d", it);
+  std::printf(
+      "  singularities %zu  euler chi %d corners %d expected %d found %d (field boundary %d)\n",
+      r.cf.singularities.size(), r.cf.euler.chi, r.cf.euler.corner_term, r.cf.euler.expected,
+      r.cf.euler.found, r.cf.euler.field_boundary_term);
+  return r;
+}
+
+LO face_of_type(const cad::CadModel& model, cad::SurfaceType type) {
+  for (LO f = 0; f < model.num_faces(); ++f)
+    if (model.faces()[f].type == type) return f;
+  throw std::runtime_error("no face of the requested type");
+}
+
+void expect_stats(const FaceCrossField& cf) {
+  const CrossFieldOptions defaults;
+  EXPECT_EQ(cf.stats.levels, defaults.levels);
+  EXPECT_EQ(cf.stats.factorizations, cf.stats.levels);
+  EXPECT_GE(cf.stats.solves, cf.stats.levels);
+  EXPECT_EQ(static_cast<int>(cf.stats.iterations_per_level.size()), cf.stats.levels);
+  for (const auto& u : cf.u) EXPECT_NEAR(std::hypot(u.u, u.v), 1.0, 1e-9);
+  for (double h : cf.h) EXPECT_TRUE(std::isfinite(h) && h > 0);
+}
+
+/// Largest angle (degrees) between the cross of a triangle and the cross of the given frame.
+double cross_deviation_deg(const std::array<Vec3, 2>& d, const Vec3& a, const Vec3& b) {
+  const double t = std::atan2(dot(d[0], b), dot(d[0], a));  // angle of the branch in (a, b)
+  return std::abs(std::remainder(t, kPi / 2)) * 180 / kPi;
+}
+
+TEST(CrossField, UnitSquareIsAlignedWithItsSides) {
+  const TopoDS_Face face = BRepBuilderAPI_MakeFace(gp_Pln(gp::XOY()), 0.0, 1.0, 0.0, 1.0).Face();
+  const auto model = load_shape(face, "cf_square.brep");
+  const auto r = run(model, 0, 0.03, "square");
+  const auto& cf = r.cf;
+  EXPECT_GT(cf.triangles.size(), 1000u);
+  expect_stats(cf);
+  EXPECT_TRUE(cf.singularities.empty());
+  EXPECT_TRUE(cf.euler.consistent);
+  EXPECT_EQ(cf.euler.chi, 1);
+  EXPECT_EQ(cf.euler.corner_term, 4);
+  double worst = 0;
+  for (const auto& d : cf.directions) {
+    EXPECT_NEAR(dot(d[0], d[1]), 0.0, 1e-12);
+    worst = std::max(worst, cross_deviation_deg(d, {1, 0, 0}, {0, 1, 0}));
+  }
+  std::printf("[crossfield] square: worst deviation from the sides %.2e deg\n", worst);
+  EXPECT_LT(worst, 1.0);
+  // The plane has no rotation of the cross: the scaling is constant.
+  for (double H : cf.H) EXPECT_NEAR(H, 0.0, 1e-6);
+}
+
+TEST(CrossField, DiskHasFourSymmetricSingularities) {
+  const TopoDS_Face face = BRepBuilderAPI_MakeFace(circle_wire(1.0)).Face();
+  const auto model = load_shape(face, "cf_disk.brep");
+  const auto r = run(model, 0, 0.05, "disk");
+  const auto& cf = r.cf;
+  expect_stats(cf);
+  EXPECT_TRUE(cf.euler.consistent);
+  EXPECT_EQ(cf.euler.expected, 4);
+  ASSERT_EQ(cf.singularities.size(), 4u);
+  std::vector<double> angle, radius;
+  for (const auto& s : cf.singularities) {
+    EXPECT_EQ(s.index, 1);
+    angle.push_back(std::atan2(s.position.y, s.position.x) * 180 / kPi);
+    radius.push_back(std::hypot(s.position.x, s.position.y));
+  }
+  std::sort(angle.begin(), angle.end());
+  const double mean_r = (radius[0] + radius[1] + radius[2] + radius[3]) / 4;
+  for (int i = 0; i < 4; ++i) {
+    const double gap = i < 3 ? angle[i + 1] - angle[i] : angle[0] + 360 - angle[3];
+    std::printf("[crossfield] disk singularity at %.2f deg, r %.4f; gap to next %.2f deg\n",
+                angle[i], radius[i], gap);
+    EXPECT_NEAR(gap, 90.0, 5.0);
+    EXPECT_NEAR(radius[i], mean_r, 0.1 * mean_r);
+  }
+  EXPECT_GT(mean_r, 0.2);
+  EXPECT_LT(mean_r, 0.9);
+}
+
+TEST(CrossField, AnnulusIsRegularAndScalesLikeR) {
+  BRepBuilderAPI_MakeFace mk(circle_wire(2.0));
+  mk.Add(TopoDS::Wire(circle_wire(1.0).Reversed()));
+  const auto model = load_shape(mk.Face(), "cf_annulus.brep");
+  const auto r = run(model, 0, 0.09, "annulus");
+  const auto& cf = r.cf;
+  expect_stats(cf);
+  EXPECT_TRUE(cf.singularities.empty());
+  EXPECT_EQ(cf.euler.chi, 0);
+  EXPECT_TRUE(cf.euler.consistent);
+  // Crosses follow the polar frame.
+  double worst_dir = 0;
+  for (std::size_t t = 0; t < cf.triangles.size(); ++t) {
+    const auto& tri = cf.triangles[t];
+    const Vec3 c = (cf.points[tri[0]] + cf.points[tri[1]] + cf.points[tri[2]]) / 3.0;
+    const Vec3 er = normalized(Vec3{c.x, c.y, 0});
+    worst_dir = std::max(worst_dir, cross_deviation_deg(cf.directions[t], er, {-er.y, er.x, 0}));
+  }
+  // h = c r: least-squares c, then the largest relative misfit.
+  double num = 0, den = 0;
+  for (std::size_t v = 0; v < cf.points.size(); ++v) {
+    const double rr = std::hypot(cf.points[v].x, cf.points[v].y);
+    num += cf.h[v] * rr;
+    den += rr * rr;
+  }
+  const double c = num / den;
+  double worst = 0;
+  for (std::size_t v = 0; v < cf.points.size(); ++v) {
+    const double rr = std::hypot(cf.points[v].x, cf.points[v].y);
+    worst = std::max(worst, std::abs(cf.h[v] / (c * rr) - 1));
+  }
+  std::printf(
+      "[crossfield] annulus: worst cross deviation from polar %.3f deg; h = %.4f r, worst misfit "
+      "%.2f%%\n",
+      worst_dir, c, 100 * worst);
+  EXPECT_LT(worst_dir, 2.0);
+  EXPECT_LT(worst, 0.05);
+}
+
+TEST(CrossField, LShapeWithReflexCorner) {
+  BRepBuilderAPI_MakePolygon poly;
+  for (const auto& p : {gp_Pnt(0, 0, 0), gp_Pnt(2, 0, 0), gp_Pnt(2, 1, 0), gp_Pnt(1, 1, 0),
+                        gp_Pnt(1, 2, 0), gp_Pnt(0, 2, 0)})
+    poly.Add(p);
+  poly.Close();
+  const auto model = load_shape(BRepBuilderAPI_MakeFace(poly.Wire()).Face(), "cf_lshape.brep");
+  const auto r = run(model, 0, 0.06, "L-shape");
+  const auto& cf = r.cf;
+  expect_stats(cf);
+  EXPECT_EQ(cf.euler.corner_term,
+            4);  // five 90 degree corners (+1 each), one 270 degree corner (-1)
+  EXPECT_EQ(cf.euler.expected, 0);
+  EXPECT_TRUE(cf.euler.consistent);
+  EXPECT_TRUE(cf.singularities.empty());
+  double worst = 0;
+  for (const auto& d : cf.directions)
+    worst = std::max(worst, cross_deviation_deg(d, {1, 0, 0}, {0, 1, 0}));
+  EXPECT_LT(worst, 1.0);
+}
+
+TEST(CrossField, CylinderSeamIsNotABoundary) {
+  const auto model = cad::load_cad(test::write_cylinder(tmp("cf_cylinder.brep")));
+  const LO f = face_of_type(model, cad::SurfaceType::Cylinder);
+  const auto r = run(model, f, 0.25, "cylinder");
+  const auto& cf = r.cf;
+  expect_stats(cf);
+  EXPECT_LT(cf.points.size(), r.background.points.size());  // the seam copies were glued
+  for (std::size_t e = 0; e < cf.edges.size(); ++e) {
+    if (!cf.boundary_edge[e]) continue;
+    for (LO v : cf.edges[e]) {
+      const double z = cf.points[v].z;
+      EXPECT_TRUE(std::abs(z) < 1e-9 || std::abs(z - 5) < 1e-9) << "boundary edge off the circles";
+    }
+  }
+  EXPECT_EQ(cf.euler.chi, 0);
+  EXPECT_TRUE(cf.euler.consistent);
+  EXPECT_TRUE(cf.singularities.empty());
+  double worst = 0;
+  for (const auto& d : cf.directions)
+    worst =
+        std::max(worst, cross_deviation_deg(d, {0, 0, 1}, normalized(cross(Vec3{0, 0, 1}, d[0]))));
+  std::printf("[crossfield] cylinder: worst deviation from the axis %.3f deg\n", worst);
+  EXPECT_LT(worst, 1.0);
+}
+
+TEST(CrossField, HemisphereHasFourSingularitiesAwayFromThePole) {
+  const auto model =
+      load_shape(BRepPrimAPI_MakeSphere(3.0, 0.0, kPi / 2).Shape(), "cf_hemisphere.brep");
+  const LO f = face_of_type(model, cad::SurfaceType::Sphere);
+  const auto r = run(model, f, 0.35, "hemisphere");
+  const auto& cf = r.cf;
+  expect_stats(cf);
+  EXPECT_EQ(cf.euler.chi, 1);
+  EXPECT_TRUE(cf.euler.consistent);
+  ASSERT_EQ(cf.singularities.size(), 4u);
+  for (const auto& s : cf.singularities) {
+    EXPECT_EQ(s.index, 1);
+    const double from_pole = distance(s.position, Vec3{0, 0, 3});
+    std::printf("[crossfield] hemisphere singularity at (%.3f %.3f %.3f), %.3f from the pole\n",
+                s.position.x, s.position.y, s.position.z, from_pole);
+    EXPECT_GT(from_pole, 0.5);
+  }
+}
+
+TEST(CrossField, FullSphereHasEightSingularities) {
+  const auto model = cad::load_cad(test::write_sphere(tmp("cf_sphere.brep")));
+  const auto r = run(model, 0, 0.35, "sphere");
+  const auto& cf = r.cf;
+  expect_stats(cf);
+  EXPECT_EQ(cf.euler.chi, 2);
+  for (std::uint8_t b : cf.boundary_edge) EXPECT_EQ(b, 0);  // seam and poles glued: closed surface
+  EXPECT_EQ(cf.euler.expected, 8);
+  EXPECT_TRUE(cf.euler.consistent);
+  int plus = 0;
+  for (const auto& s : cf.singularities) plus += s.index == 1;
+  EXPECT_EQ(plus, 8);
+}
+
+TEST(CrossField, AcuteCornerGetsAnArtificialSingularity) {
+  // Right triangle with angles 90, 60 and 30 degrees.
+  BRepBuilderAPI_MakePolygon poly(gp_Pnt(0, 0, 0), gp_Pnt(2, 0, 0),
+                                  gp_Pnt(2, 2 * std::tan(kPi / 6), 0), true);
+  const auto model = load_shape(BRepBuilderAPI_MakeFace(poly.Wire()).Face(), "cf_triangle.brep");
+  const auto r = run(model, 0, 0.04, "triangle");
+  const auto& cf = r.cf;
+  expect_stats(cf);
+  EXPECT_EQ(cf.euler.corner_term, 3);  // 90 and 60 degrees: valence 1; 30 degrees: acute, valence 1
+  EXPECT_EQ(cf.euler.expected, 1);
+  int acute = 0;
+  for (const auto& s : cf.singularities)
+    if (s.where == Singularity::Where::AcuteCorner) {
+      ++acute;
+      EXPECT_LT(distance(s.position, Vec3{0, 0, 0}), 1e-9);
+    }
+  EXPECT_EQ(acute, 1);
+  EXPECT_TRUE(cf.euler.consistent);
+}
+
+TEST(CrossField, BoundaryExtensionPushesSingularitiesInwards) {
+  const TopoDS_Face face = BRepBuilderAPI_MakeFace(circle_wire(1.0)).Face();
+  const auto model = load_shape(face, "cf_disk3.brep");
+  CrossFieldOptions plain;
+  plain.extend_boundary = false;
+  const auto with = run(model, 0, 0.05, "disk-ext");
+  const auto without = run(model, 0, 0.05, "disk-noext", plain);
+  const auto mean_radius = [](const FaceCrossField& cf) {
+    double s = 0;
+    for (const auto& x : cf.singularities) s += std::hypot(x.position.x, x.position.y);
+    return s / double(cf.singularities.size());
+  };
+  ASSERT_EQ(without.cf.singularities.size(), 4u);
+  ASSERT_EQ(with.cf.singularities.size(), 4u);
+  EXPECT_EQ(without.cf.stats.extension_solves, 0);
+  EXPECT_EQ(with.cf.stats.extension_solves, 1);
+  std::printf("[crossfield] disk: mean singularity radius %.4f with the extension, %.4f without\n",
+              mean_radius(with.cf), mean_radius(without.cf));
+  EXPECT_LE(mean_radius(with.cf), mean_radius(without.cf));
+}
+
+TEST(CrossField, Deterministic) {
+  const TopoDS_Face face = BRepBuilderAPI_MakeFace(circle_wire(1.0)).Face();
+  const auto model = load_shape(face, "cf_disk2.brep");
+  const auto a = run(model, 0, 0.08, "disk-a");
+  const auto b = run(model, 0, 0.08, "disk-b");
+  ASSERT_EQ(a.cf.u.size(), b.cf.u.size());
+  for (std::size_t e = 0; e < a.cf.u.size(); ++e) {
+    EXPECT_EQ(a.cf.u[e].u, b.cf.u[e].u);
+    EXPECT_EQ(a.cf.u[e].v, b.cf.u[e].v);
+  }
+  EXPECT_EQ(a.cf.H, b.cf.H);
+  ASSERT_EQ(a.cf.singularities.size(), b.cf.singularities.size());
+  for (std::size_t i = 0; i < a.cf.singularities.size(); ++i)
+    EXPECT_EQ(a.cf.singularities[i].position, b.cf.singularities[i].position);
+}
+
+TEST(CrossField, ScalingConstantGivesTheQuadCount) {
+  const TopoDS_Face face = BRepBuilderAPI_MakeFace(gp_Pln(gp::XOY()), 0.0, 2.0, 0.0, 1.0).Face();
+  const auto model = load_shape(face, "cf_rect.brep");
+  const auto r = run(model, 0, 0.1, "rectangle");
+  // Constant H = 0 on a plane with aligned crosses: h = e^C, and area / h^2 = N.
+  const double C = scaling_constant(r.cf, 200);
+  EXPECT_NEAR(2.0 / std::exp(2 * C), 200, 1e-6 * 200);
+}
+
+}  // namespace
+}  // namespace qsmesh::crossfield
