@@ -53,8 +53,10 @@ Arguments parse(const std::vector<std::string>& args) {
   }
   if (cmd == "info") a.command = Command::Info;
   else if (cmd == "mesh") a.command = Command::Mesh;
+  else if (cmd == "crossfield") a.command = Command::CrossField;
   else if (cmd == "example") a.command = Command::Example;
-  else throw InputError("unknown command '" + cmd + "' (commands: info, mesh, example; see qsmesh --help)");
+  else throw InputError("unknown command '" + cmd + "' (commands: info, mesh, crossfield, example; see qsmesh --help)");
+  const bool meshing = a.command == Command::Mesh || a.command == Command::CrossField;
 
   std::vector<std::string> positional;
   for (std::size_t i = 1; i < args.size(); ++i) {
@@ -69,11 +71,12 @@ Arguments parse(const std::vector<std::string>& args) {
       return a;
     }
     if (opt == "-o" || opt == "--output") a.output = value();
-    else if (opt == "--size" && a.command == Command::Mesh) a.size = parse_positive(opt, value());
-    else if (opt == "--size-factor" && a.command == Command::Mesh) a.size_factor = parse_positive(opt, value());
+    else if (opt == "--size" && meshing) a.size = parse_positive(opt, value());
+    else if (opt == "--size-factor" && meshing) a.size_factor = parse_positive(opt, value());
     else if (opt == "--until" && a.command == Command::Mesh) a.until = value();
     else if (opt == "--threads") a.threads = parse_threads(value());
-    else if (opt == "--stats" && a.command == Command::Mesh) a.stats = value();
+    else if (opt == "--stats" && meshing) a.stats = value();
+    else if (opt == "--check" && a.command == Command::CrossField) a.check = true;
     else if (opt == "--json" && a.command == Command::Info) a.json = true;
     else if (opt == "--sew") a.sew = true;
     else if (opt == "--quiet" || opt == "-q") a.quiet = true;
@@ -97,6 +100,8 @@ Arguments parse(const std::vector<std::string>& args) {
     a.model = positional[0];
     if (a.command == Command::Mesh && a.output.empty())
       throw InputError("mesh: missing -o OUT (.cgns, .vtu or .msh)");
+    if (a.command == Command::CrossField && a.output.empty() && !a.check)
+      throw InputError("crossfield: missing -o OUT.vtu (or --check)");
   }
   return a;
 }
@@ -130,6 +135,19 @@ std::string help(const std::string& topic) {
           "  -q, --quiet           print only warnings and errors\n"
           "  -v, --verbose         print per-face details\n\n"
           "Exit codes: 0 success, 2 bad input (one line on stderr says what to fix), 1 internal error.\n";
+  } else if (topic == "crossfield") {
+    os << "usage: [mpirun -np P] qsmesh crossfield MODEL [-o OUT.vtu] [--check] [options]\n\n"
+          "Computes, on the background triangulation of every CAD face, the boundary-aligned cross\n"
+          "field (multilevel heat diffusion, paper 000 Sec. 3.1), its singularities (Sec. 3.2) and\n"
+          "its conformal scaling H, h = exp(H) (Sec. 3.3). OUT.vtu holds the triangulation with cell\n"
+          "data cross_u and cross_v (the two cross directions), u_norm (|U| before projection), H, h,\n"
+          "and the singularities as vertex cells with cell data singularity_index (+1: valence 3,\n"
+          "-1: valence 5). The summary lists, per face, its singularities and whether they satisfy\n"
+          "the Euler relation of the face (paper 000 Eq. 2).\n\n"
+          "  -o, --output OUT.vtu  output file (VTK XML, opens in ParaView)\n"
+          "  --check               list the faces whose singularities break the Euler relation and end\n"
+          "                        with the line 'euler-consistent: K/N'\n"
+          "  --size H, --size-factor F, --threads T, --stats FILE.json, --sew, -q, -v: as for mesh\n";
   } else if (topic == "example") {
     os << "usage: qsmesh example wing-body -o FILE.step\n\n"
           "Writes a built-in CAD model built with OpenCASCADE:\n"
@@ -140,6 +158,8 @@ std::string help(const std::string& topic) {
           "commands:\n"
           "  info MODEL            print the CAD topology (corners, curves, faces)\n"
           "  mesh MODEL -o OUT     mesh the model and write OUT (.cgns, .vtu, .msh)\n"
+          "  crossfield MODEL -o OUT.vtu\n"
+          "                        cross fields, singularities and scaling of every face\n"
           "  example NAME -o FILE  write a built-in CAD model (wing-body)\n\n"
           "Run 'qsmesh COMMAND --help' for the options of a command.\n"
           "Quick start:\n"

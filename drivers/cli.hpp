@@ -8,7 +8,7 @@
 
 namespace qsmesh::cli {
 
-enum class Command { Help, Version, Info, Mesh, Example };
+enum class Command { Help, Version, Info, Mesh, CrossField, Example };
 
 struct Arguments {
   Command command = Command::Help;
@@ -21,6 +21,7 @@ struct Arguments {
   int threads = 0;                 ///< 0: automatic
   std::string stats;               ///< --stats FILE.json
   bool json = false;               ///< info --json
+  bool check = false;              ///< crossfield --check
   bool sew = false;
   bool quiet = false;
   bool verbose = false;

@@ -205,59 +205,59 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
 
 }  // namespace
 
-int run_mesh(const Arguments& args) {
-  const Stopwatch total;
-  const parallel::Comm comm = parallel::Comm::world();
-  const int rank = comm.rank();
-  const int ranks = comm.size();
-  const LogLevel level = args.quiet ? LogLevel::Warning : (args.verbose ? LogLevel::Debug : LogLevel::Info);
-  Logger log(std::cerr, rank == 0 ? level : LogLevel::Warning, ranks > 1 ? cat("[rank ", rank, "] ") : "");
+Session::Session(const Arguments& args, const char* command)
+    : comm(parallel::Comm::world()),
+      rank(comm.rank()),
+      ranks(comm.size()),
+      log(std::cerr,
+          rank == 0 ? (args.quiet ? LogLevel::Warning : (args.verbose ? LogLevel::Debug : LogLevel::Info))
+                    : LogLevel::Warning,
+          ranks > 1 ? cat("[rank ", rank, "] ") : "") {
+  Stopwatch clock;
+  model = cad::load_cad(args.model, cad::LoadOptions{args.sew, 0});
+  times.add("load", comm.allreduce_max(clock.seconds()));
+  size = args.size ? *args.size : model.diagonal() * args.size_factor.value_or(kDefaultSizeFactor);
+  if (!(size > 0)) throw InputError("size: the model '" + args.model + "' has an empty bounding box");
+  threads = args.threads;
+  if (threads <= 0) threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()) / comm.local_size());
+  tasks = std::make_unique<TaskArena>(threads);
+  log.info(cat("qsmesh ", command, " ", args.model, ": ", model.num_corners(), " corners, ", model.num_curves(),
+               " curves, ", model.num_faces(), " faces; size ", size, "; ", ranks, " rank(s) x ", threads,
+               " thread(s)"));
+}
 
+int run_mesh(const Arguments& args) {
   // Everything the user could get wrong is checked before any work.
   const parallel::Stage until = parallel::parse_stage(args.until);
   io::check_output_path(args.output);
   if (!args.stats.empty()) check_writable("--stats", args.stats);
 
-  StageTimes times;
-  Stopwatch clock;
-  const cad::CadModel model = cad::load_cad(args.model, cad::LoadOptions{args.sew, 0});
-  times.add("load", comm.allreduce_max(clock.seconds()));
-  const double size = args.size ? *args.size : model.diagonal() * args.size_factor.value_or(kDefaultSizeFactor);
-  if (!(size > 0)) throw InputError("size: the model '" + args.model + "' has an empty bounding box");
-
-  int threads = args.threads;
-  if (threads <= 0) threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()) / comm.local_size());
-  const TaskArena tasks(threads);
-  log.info(cat("qsmesh mesh ", args.model, ": ", model.num_corners(), " corners, ", model.num_curves(),
-               " curves, ", model.num_faces(), " faces; size ", size, "; ", ranks, " rank(s) x ", threads,
-               " thread(s)"));
-
+  Session s(args, "mesh");
   parallel::PipelineOptions options;
-  options.background.sizes.size = size;
+  options.background.sizes.size = s.size;
   options.until = until;
-  parallel::PipelineResult result = parallel::run_pipeline(comm, model, options, tasks, log);
-  for (const auto& [stage, sec] : result.times.entries()) times.add(stage, sec);
+  parallel::PipelineResult result = parallel::run_pipeline(s.comm, s.model, options, *s.tasks, s.log);
+  for (const auto& [stage, sec] : result.times.entries()) s.times.add(stage, sec);
 
-  int code = 0;
-  if (rank == 0) {
-    clock.reset();
+  if (s.rank == 0) {
+    Stopwatch clock;
     const mesh::MeshStats stats = mesh::compute_stats(result.mesh);
     Checks checks;
-    checks.conformity = mesh::check_conformity(result.mesh, model);
-    checks.max_distance_to_cad = mesh::max_distance_to_cad(result.mesh, model) / model.diagonal();
-    times.add("statistics", clock.seconds());
+    checks.conformity = mesh::check_conformity(result.mesh, s.model);
+    checks.max_distance_to_cad = mesh::max_distance_to_cad(result.mesh, s.model) / s.model.diagonal();
+    s.times.add("statistics", clock.seconds());
     clock.reset();
     io::write_mesh(result.mesh, args.output);
-    times.add("write", clock.seconds());
-    log.info(cat("wrote ", args.output));
-    if (!args.quiet) print_summary(std::cout, model, result, stats, checks, times);
-    if (!args.stats.empty()) {
-      write_text_file_atomically(args.stats, stats_json(args, model, size, ranks, threads, result, stats, checks, times));
-    }
+    s.times.add("write", clock.seconds());
+    s.log.info(cat("wrote ", args.output));
+    if (!args.quiet) print_summary(std::cout, s.model, result, stats, checks, s.times);
+    if (!args.stats.empty())
+      write_text_file_atomically(args.stats, stats_json(args, s.model, s.size, s.ranks, s.threads, result, stats,
+                                                        checks, s.times));
     for (const auto& rep : result.reports)
-      if (!rep.ok) log.warn(rep.error);
+      if (!rep.ok) s.log.warn(rep.error);
   }
-  return code;
+  return 0;
 }
 
 }  // namespace qsmesh::cli

@@ -1,14 +1,39 @@
 // The driver's commands. Each returns the process exit code.
 #pragma once
 
+#include <memory>
+
 #include "cli.hpp"
+#include "qsmesh/cad/model.hpp"
+#include "qsmesh/core/log.hpp"
+#include "qsmesh/core/tasks.hpp"
+#include "qsmesh/core/timer.hpp"
+#include "qsmesh/parallel/comm.hpp"
 
 namespace qsmesh::cli {
+
+/// What the distributed commands (mesh, crossfield) share: the communicator, a logger that prints
+/// on rank 0, the model read by every rank, the size, the thread arena and the stage times.
+/// Collective: MPI must be initialised. Throws InputError for a bad model file.
+struct Session {
+  Session(const Arguments& args, const char* command);
+  parallel::Comm comm;
+  int rank = 0, ranks = 1;
+  Logger log;
+  cad::CadModel model;
+  double size = 0;
+  int threads = 1;
+  std::unique_ptr<TaskArena> tasks;
+  StageTimes times;
+};
 
 int run_info(const Arguments& args);
 int run_example(const Arguments& args);
 /// Collective over MPI_COMM_WORLD; MPI must be initialised.
 int run_mesh(const Arguments& args);
+/// `qsmesh crossfield`: background meshes and cross fields of every face (paper 000 Sec. 3),
+/// written as VTU with the fields, and the Euler check per face. Collective.
+int run_crossfield(const Arguments& args);
 
 /// Writes `text` to `path` through a temporary file renamed at the end.
 void write_text_file_atomically(const std::string& path, const std::string& text);

@@ -31,8 +31,9 @@ int main(int argc, char** argv) {
 
   cad::set_kernel_messages(!parsed.verbose);
 
-  // Only the mesh command runs distributed; the others need no MPI.
-  if (parsed.command != cli::Command::Mesh) {
+  // Only the mesh and crossfield commands run distributed; the others need no MPI.
+  const bool distributed = parsed.command == cli::Command::Mesh || parsed.command == cli::Command::CrossField;
+  if (!distributed) {
     try {
       return parsed.command == cli::Command::Info ? cli::run_info(parsed) : cli::run_example(parsed);
     } catch (const InputError& e) {
@@ -47,7 +48,7 @@ int main(int argc, char** argv) {
   parallel::MpiSession mpi(&argc, &argv);
   const bool root = parallel::Comm::world().rank() == 0;
   try {
-    return cli::run_mesh(parsed);
+    return parsed.command == cli::Command::Mesh ? cli::run_mesh(parsed) : cli::run_crossfield(parsed);
   } catch (const InputError& e) {
     // Every rank reads the same input and fails the same way: one line, from rank 0.
     if (root) std::cerr << "qsmesh: " << e.what() << "\n";

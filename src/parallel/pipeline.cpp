@@ -93,8 +93,64 @@ void unpack(const std::vector<char>& in, std::size_t& pos, mesh::FaceMesh& m,
   r.error.assign(err.begin(), err.end());
 }
 
+CrossFieldOutput summarize(const crossfield::FaceCrossField& cf) {
+  CrossFieldOutput out;
+  out.ok = true;
+  const std::size_t nt = cf.triangles.size();
+  out.directions = cf.directions;
+  out.u_norm.resize(nt);
+  out.H.resize(nt);
+  for (std::size_t t = 0; t < nt; ++t) {
+    double un = 0, h = 0;
+    for (int k = 0; k < 3; ++k) {
+      un += cf.u_norm[cf.tri2edges[t][k]];
+      h += cf.H[cf.triangles[t][k]];
+    }
+    out.u_norm[t] = un / 3;
+    out.H[t] = h / 3;
+  }
+  out.singularities = cf.singularities;
+  out.euler = cf.euler;
+  out.levels = cf.stats.levels;
+  out.factorizations = cf.stats.factorizations;
+  out.solves = cf.stats.solves;
+  out.seconds = cf.stats.seconds;
+  return out;
+}
+
+void pack(const CrossFieldOutput& c, std::vector<char>& out) {
+  put<std::uint8_t>(out, c.ok ? 1 : 0);
+  put_vec(out, std::vector<char>(c.error.begin(), c.error.end()));
+  put_vec(out, c.directions);
+  put_vec(out, c.u_norm);
+  put_vec(out, c.H);
+  put_vec(out, c.singularities);
+  put(out, c.euler);
+  put<int>(out, c.levels);
+  put<int>(out, c.factorizations);
+  put<int>(out, c.solves);
+  put<double>(out, c.seconds);
+}
+
+void unpack(const std::vector<char>& in, std::size_t& pos, CrossFieldOutput& c) {
+  c.ok = get<std::uint8_t>(in, pos) != 0;
+  std::vector<char> err;
+  get_vec(in, pos, err);
+  c.error.assign(err.begin(), err.end());
+  get_vec(in, pos, c.directions);
+  get_vec(in, pos, c.u_norm);
+  get_vec(in, pos, c.H);
+  get_vec(in, pos, c.singularities);
+  c.euler = get<crossfield::EulerCheck>(in, pos);
+  c.levels = get<int>(in, pos);
+  c.factorizations = get<int>(in, pos);
+  c.solves = get<int>(in, pos);
+  c.seconds = get<double>(in, pos);
+}
+
 PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
-                            const PipelineOptions& options, const TaskArena& tasks, Logger& log) {
+                            const PipelineOptions& options, const TaskArena& tasks, Logger& log,
+                            linalg::PetscLane* lane) {
   PipelineResult result;
   const int rank = comm.rank();
   const int nranks = comm.size();
@@ -142,15 +198,41 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
   });
   result.times.add("background", comm.allreduce_max(clock.seconds()));
 
+  // Cross fields (paper 000 Sec. 3) on the same faces, one task per face.
+  std::vector<CrossFieldOutput> fields;
+  if (options.cross_fields) {
+    clock.reset();
+    fields.resize(mine.size());
+    std::atomic<std::int64_t> cf_done{0};
+    tasks.parallel_for(total, [&](std::int64_t i) {
+      try {
+        fields[i] = summarize(crossfield::compute_face_cross_field(meshes[i], options.crossfield, lane));
+      } catch (const std::exception& e) {
+        // A face without a cross field keeps its background mesh; later stages fall back to
+        // methods that need no field.
+        fields[i] = CrossFieldOutput{};
+        fields[i].error = Error(e.what(), ErrorContext{"crossfield", 2, mine[i]}).what();
+      }
+      const std::int64_t n = ++cf_done;
+      if (n * 10 / total != (n - 1) * 10 / total)
+        log.info(cat("crossfield: ", n, "/", mine.size(), " faces on rank ", rank));
+    });
+    result.times.add("crossfield", comm.allreduce_max(clock.seconds()));
+  }
+
   // Gather on rank 0 and assemble in face order.
   clock.reset();
   std::vector<char> buffer;
-  for (std::size_t i = 0; i < mine.size(); ++i) pack(meshes[i], reports[i], buffer);
+  for (std::size_t i = 0; i < mine.size(); ++i) {
+    pack(meshes[i], reports[i], buffer);
+    if (options.cross_fields) pack(fields[i], buffer);
+  }
   meshes.clear();
   const auto gathered = comm.gather_bytes(buffer, 0);
   if (rank == 0) {
     std::vector<mesh::FaceMesh> all(static_cast<std::size_t>(nfaces));
     result.reports.resize(static_cast<std::size_t>(nfaces));
+    if (options.cross_fields) result.cross_fields.resize(static_cast<std::size_t>(nfaces));
     for (const auto& bytes : gathered) {
       std::size_t pos = 0;
       while (pos < bytes.size()) {
@@ -161,6 +243,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
         QSMESH_CHECK(f >= 0 && f < nfaces, "gathered report for unknown face " << f);
         result.reports[f] = std::move(r);
         all[f] = std::move(m);
+        if (options.cross_fields) unpack(bytes, pos, result.cross_fields[f]);
       }
     }
     for (LO f = 0; f < nfaces; ++f) all[f].face = f;

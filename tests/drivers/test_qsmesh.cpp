@@ -115,6 +115,25 @@ TEST_F(Qsmesh, SameFileWhateverTheThreads) {
   EXPECT_EQ(slurp(a), slurp(b));
 }
 
+TEST_F(Qsmesh, CrossFieldCheckAndVtu) {
+  const std::string out = tmp("e2e_cf.vtu");
+  const std::string stats = tmp("e2e_cf.json");
+  const ExeResult r = run("crossfield " + model_ + " -o " + out + " --size 0.8 --stats " + stats);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string vtu = slurp(out);
+  for (const char* name : {"cross_u", "cross_v", "u_norm", "\"H\"", "\"h\"", "singularity_index"})
+    EXPECT_NE(vtu.find(name), std::string::npos) << name;
+  EXPECT_NE(r.out.find("euler-consistent: 26/26"), std::string::npos) << r.out;
+  EXPECT_NE(slurp(stats).find("\"factorizations\""), std::string::npos);
+  const ExeResult check = run("crossfield --check " + model_ + " --size 0.8");
+  ASSERT_EQ(check.code, 0) << check.err;
+  // Every face consistent: the listing is the closing line alone.
+  EXPECT_EQ(check.out, "euler-consistent: 26/26\n");
+  const ExeResult bad = run("crossfield " + model_ + " -o " + tmp("cf.msh"));
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_NE(bad.err.find("VTU"), std::string::npos) << bad.err;
+}
+
 TEST_F(Qsmesh, ExampleWingBody) {
   const std::string step = tmp("e2e_wing_body.step");
   const ExeResult r = run("example wing-body -o " + step);

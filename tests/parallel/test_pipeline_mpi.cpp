@@ -4,6 +4,7 @@
 #include <mpi.h>
 
 #include "qsmesh/background/curve_mesh.hpp"
+#include "qsmesh/crossfield/cross_field.hpp"
 #include "qsmesh/mesh/assemble.hpp"
 #include "qsmesh/mesh/validate.hpp"
 #include "qsmesh/parallel/comm.hpp"
@@ -81,6 +82,42 @@ TEST(Pipeline, DistributedEqualsSerial) {
   for (const auto& r : result.reports) EXPECT_TRUE(r.ok) << r.error;
   const auto conformity = mesh::check_conformity(dist, model);
   EXPECT_TRUE(conformity.ok()) << conformity.summary();
+}
+
+TEST(Pipeline, CrossFieldsDoNotDependOnRanks) {
+  const Comm comm = Comm::world();
+  const cad::CadModel model = shared_model(comm, "pipe_cf");
+  PipelineOptions options;
+  options.background.sizes.size = 0.8;
+  options.cross_fields = true;
+  std::ostringstream sink;
+  Logger log(sink, LogLevel::Quiet);
+  const PipelineResult result = run_pipeline(comm, model, options, TaskArena(2), log);
+  if (comm.rank() != 0) return;
+  ASSERT_EQ(static_cast<LO>(result.cross_fields.size()), model.num_faces());
+  const auto curves = background::mesh_curves(model, options.background.sizes, TaskArena(1));
+  int consistent = 0;
+  for (LO f = 0; f < model.num_faces(); ++f) {
+    const auto face = background::mesh_face_background(model, f, curves, options.background, nullptr);
+    const CrossFieldOutput serial = summarize(crossfield::compute_face_cross_field(face, options.crossfield, nullptr));
+    const CrossFieldOutput& dist = result.cross_fields[f];
+    ASSERT_TRUE(dist.ok) << dist.error;
+    ASSERT_EQ(dist.directions.size(), serial.directions.size());
+    for (std::size_t t = 0; t < serial.directions.size(); ++t) {
+      ASSERT_EQ(dist.directions[t][0], serial.directions[t][0]);
+      ASSERT_EQ(dist.directions[t][1], serial.directions[t][1]);
+    }
+    EXPECT_EQ(dist.H, serial.H);
+    ASSERT_EQ(dist.singularities.size(), serial.singularities.size());
+    for (std::size_t k = 0; k < serial.singularities.size(); ++k) {
+      EXPECT_EQ(dist.singularities[k].position, serial.singularities[k].position);
+      EXPECT_EQ(dist.singularities[k].index, serial.singularities[k].index);
+    }
+    consistent += dist.euler.consistent ? 1 : 0;
+  }
+  // A box with filleted edges: flat faces, cylinders and sphere corners, all simple enough for the
+  // Euler relation to hold everywhere.
+  EXPECT_EQ(consistent, model.num_faces());
 }
 
 }  // namespace

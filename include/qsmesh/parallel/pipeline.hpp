@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "qsmesh/background/face_mesh.hpp"
+#include "qsmesh/crossfield/cross_field.hpp"
 #include "qsmesh/cad/model.hpp"
 #include "qsmesh/core/log.hpp"
 #include "qsmesh/core/tasks.hpp"
@@ -25,19 +26,41 @@ enum class Stage { Background };
 struct PipelineOptions {
   background::BackgroundOptions background;
   Stage until = Stage::Background;
+  /// Compute the cross field of every face on its background mesh (paper 000 Sec. 3).
+  bool cross_fields = false;
+  crossfield::CrossFieldOptions crossfield;
+};
+
+/// What the drivers need of a face's cross field, per triangle of its background mesh in the
+/// order of the assembled mesh (triangles collapsed at poles excluded, as in assembly).
+struct CrossFieldOutput {
+  bool ok = false;
+  std::string error;
+  std::vector<std::array<Vec3, 2>> directions;  ///< two unit branches per triangle
+  std::vector<double> u_norm;                   ///< per triangle: mean |U| of its edges
+  std::vector<double> H;                        ///< per triangle: mean conformal scaling H
+  std::vector<crossfield::Singularity> singularities;
+  crossfield::EulerCheck euler;
+  int levels = 0, factorizations = 0, solves = 0;
+  double seconds = 0;
 };
 
 struct PipelineResult {
   mesh::SurfaceMesh mesh;                       ///< assembled mesh (rank 0 only)
   std::vector<background::FaceReport> reports;  ///< one per face, by face id (rank 0 only)
+  std::vector<CrossFieldOutput> cross_fields;   ///< one per face when requested (rank 0 only)
   std::vector<int> face_rank;                   ///< rank that meshed each face (every rank)
   StageTimes times;                             ///< wall time per stage (max over ranks)
 };
 
-/// Runs the pipeline up to options.until on all ranks of `comm` (collective).
+/// Runs the pipeline up to options.until on all ranks of `comm` (collective). `lane` serialises
+/// this rank's PETSc solves (null: Eigen only).
 [[nodiscard]] PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
                                           const PipelineOptions& options, const TaskArena& tasks,
-                                          Logger& log);
+                                          Logger& log, linalg::PetscLane* lane = nullptr);
+
+/// The driver's view of a face cross field (see CrossFieldOutput).
+[[nodiscard]] CrossFieldOutput summarize(const crossfield::FaceCrossField& cf);
 
 /// Estimated cost of meshing each face (area / size^2), the METIS vertex weights.
 [[nodiscard]] std::vector<double> estimate_face_costs(const cad::CadModel& model, double size);
@@ -47,5 +70,7 @@ void pack(const mesh::FaceMesh& m, const background::FaceReport& r, std::vector<
 /// Reads one record written by pack starting at `pos`; advances `pos`.
 void unpack(const std::vector<char>& in, std::size_t& pos, mesh::FaceMesh& m,
             background::FaceReport& r);
+void pack(const CrossFieldOutput& c, std::vector<char>& out);
+void unpack(const std::vector<char>& in, std::size_t& pos, CrossFieldOutput& c);
 
 }  // namespace qsmesh::parallel
