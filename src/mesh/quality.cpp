@@ -87,6 +87,27 @@ MeshStats compute_stats(const SurfaceMesh& mesh) {
       for (int k = 0; k < 3; ++k)
         if (mesh.vclass[t[k]].dim == 0) corner_angle[key(mesh.triangle_face[i], t[k])] += angles[i][k];
     }
+    // Curves forming a sharp corner of a face: (face, curve) pairs.
+    std::unordered_map<std::int64_t, std::vector<GO>> sharp_curves;  // face -> corners
+    for (const auto& [k, angle] : corner_angle)
+      if (angle < 10) sharp_curves[k >> 32].push_back(k & 0xffffffff);
+    auto in_sharp_wedge = [&](std::size_t i) {
+      const LO f = mesh.triangle_face[i];
+      const auto it = sharp_curves.find(f);
+      if (it == sharp_curves.end() || mesh.curve_corners.empty()) return false;
+      for (const GO corner : it->second) {
+        bool all = true;
+        for (const GO v : mesh.triangles[i]) {
+          const VertexClass& vc = mesh.vclass[v];
+          const bool on = (vc.dim == 0 && v == corner) ||
+                          (vc.dim == 1 && (mesh.curve_corners[vc.entity][0] == corner ||
+                                           mesh.curve_corners[vc.entity][1] == corner));
+          all = all && on;
+        }
+        if (all) return true;
+      }
+      return false;
+    };
     double qsum = 0;
     s.tri_quality_min = std::numeric_limits<double>::max();
     s.min_angle_deg = 180;
@@ -100,8 +121,7 @@ MeshStats compute_stats(const SurfaceMesh& mesh) {
       s.min_angle_deg = std::min(s.min_angle_deg, a);
       const int bin = a < 5 ? 0 : a < 10 ? 1 : a < 20 ? 2 : a < 30 ? 3 : 4;
       ++s.min_angle_histogram[bin];
-      if (a < 10 && mesh.vclass[t[k]].dim == 0 && corner_angle[key(mesh.triangle_face[i], t[k])] < 10)
-        ++s.small_angle_at_sharp_corner;
+      if (a < 10 && in_sharp_wedge(i)) ++s.small_angle_at_sharp_corner;
     }
     s.tri_quality_avg = qsum / static_cast<double>(s.triangles);
   }

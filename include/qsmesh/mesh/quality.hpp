@@ -32,8 +32,9 @@ struct MeshStats {
   /// Triangles by their smallest 3D angle: [0,5), [5,10), [10,20), [20,30), [30,60] degrees.
   std::array<std::int64_t, 5> min_angle_histogram{};
   double min_angle_deg = 0;                   ///< smallest triangle angle (degrees)
-  /// Triangles with an angle below 10 degrees at a CAD corner whose angle in that face is itself
-  /// below 10 degrees (unavoidable), among those below 10 degrees.
+  /// Among the triangles with an angle below 10 degrees, those inside the wedge of a CAD corner
+  /// whose angle in that face is itself below 10 degrees: every vertex is that corner or lies on one
+  /// of the two curves forming it (no triangle there can do better than the wedge allows).
   std::int64_t small_angle_at_sharp_corner = 0;
 };
 
