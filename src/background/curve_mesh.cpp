@@ -1,4 +1,5 @@
 #include "qsmesh/background/curve_mesh.hpp"
+#include "qsmesh/background/feature_size.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -134,82 +135,6 @@ mesh::CurveMesh place_vertices(const CurveSamples& cs, const CurveSizer& sizer, 
   return out;
 }
 
-/// Distance from p to the two sample segments around sample j of a curve.
-double distance_to_polyline(const CurveSamples& cs, LO j, const Vec3& p) {
-  auto segment = [&](std::size_t a, std::size_t b) {
-    const Vec3 ab = cs.p[b] - cs.p[a];
-    const double l2 = norm2(ab);
-    const double s = l2 > 0 ? std::clamp(dot(p - cs.p[a], ab) / l2, 0.0, 1.0) : 0.0;
-    return distance(p, cs.p[a] + ab * s);
-  };
-  const auto i = static_cast<std::size_t>(j);
-  double d = distance(p, cs.p[i]);
-  if (i > 0) d = std::min(d, segment(i - 1, i));
-  if (i + 1 < cs.p.size()) d = std::min(d, segment(i, i + 1));
-  return d;
-}
-
-/// Uniform hash grid over the samples of all curves, for the nearest non-adjacent sample.
-class SampleGrid {
- public:
-  SampleGrid(const std::vector<CurveSamples>& samples, double cell) : cell_(cell) {
-    for (LO c = 0; c < static_cast<LO>(samples.size()); ++c)
-      for (LO i = 0; i < static_cast<LO>(samples[c].p.size()); ++i)
-        cells_[key(samples[c].p[i])].push_back({c, i});
-  }
-
-  /// For each curve with `eligible(curve)` that has a sample within `radius` of p: its nearest
-  /// sample's (curve, sample index), in increasing curve id.
-  template <class Eligible>
-  [[nodiscard]] std::vector<std::pair<LO, LO>> candidates(const std::vector<CurveSamples>& samples,
-                                                          const Vec3& p, double radius,
-                                                          const Eligible& eligible) const {
-    std::vector<std::pair<LO, LO>> best;  // (curve, sample)
-    std::vector<double> best_d2;
-    const double r2 = radius * radius;
-    const auto r = static_cast<std::int64_t>(std::ceil(radius / cell_));
-    const auto [cx, cy, cz] = coords(p);
-    for (std::int64_t x = cx - r; x <= cx + r; ++x)
-      for (std::int64_t y = cy - r; y <= cy + r; ++y)
-        for (std::int64_t z = cz - r; z <= cz + r; ++z) {
-          const auto it = cells_.find(pack(x, y, z));
-          if (it == cells_.end()) continue;
-          for (const auto& [c, i] : it->second) {
-            const double d2 = norm2(samples[c].p[i] - p);
-            if (d2 >= r2 || !eligible(c)) continue;
-            std::size_t k = 0;
-            while (k < best.size() && best[k].first != c) ++k;
-            if (k == best.size()) {
-              best.emplace_back(c, i);
-              best_d2.push_back(d2);
-            } else if (d2 < best_d2[k] || (d2 == best_d2[k] && i < best[k].second)) {
-              best[k].second = i;
-              best_d2[k] = d2;
-            }
-          }
-        }
-    std::sort(best.begin(), best.end());
-    return best;
-  }
-
- private:
-  [[nodiscard]] std::array<std::int64_t, 3> coords(const Vec3& p) const {
-    return {static_cast<std::int64_t>(std::floor(p.x / cell_)), static_cast<std::int64_t>(std::floor(p.y / cell_)),
-            static_cast<std::int64_t>(std::floor(p.z / cell_))};
-  }
-  static std::uint64_t pack(std::int64_t x, std::int64_t y, std::int64_t z) {
-    constexpr std::int64_t kBias = 1 << 20;
-    return (static_cast<std::uint64_t>(x + kBias) << 42) ^ (static_cast<std::uint64_t>(y + kBias) << 21) ^
-           static_cast<std::uint64_t>(z + kBias);
-  }
-  [[nodiscard]] std::uint64_t key(const Vec3& p) const {
-    const auto [x, y, z] = coords(p);
-    return pack(x, y, z);
-  }
-  double cell_;
-  std::unordered_map<std::uint64_t, std::vector<std::pair<LO, LO>>> cells_;
-};
-
 }  // namespace
 
 std::vector<mesh::CurveMesh> mesh_curves(const cad::CadModel& model, const SizeOptions& sizes,
@@ -239,31 +164,17 @@ std::vector<mesh::CurveMesh> mesh_curves(const cad::CadModel& model, const SizeO
 
   // 2. Small features: no size larger than the distance to a curve sharing no corner with this one.
   if (sizes.feature_size) {
-    const SampleGrid grid(samples, sizes.size);
-    tasks.parallel_for(n, [&](std::int64_t i) {
-      const auto c = static_cast<LO>(i);
-      const auto& cc = model.curves()[c];
-      // Curves sharing a corner are not features of each other (paper 000 Sec. 4.1: the nearest
-      // non-adjacent curve). Counting them inside sharp wedges was tried and made things worse:
-      // the boundary sizes then vary too fast near the corner.
-      const auto adjacent = [&](LO other) {
-        const auto& oc = model.curves()[other];
-        return other == c || oc.corners[0] == cc.corners[0] || oc.corners[0] == cc.corners[1] ||
-               oc.corners[1] == cc.corners[0] || oc.corners[1] == cc.corners[1];
-      };
-      // Gaps narrower than a tenth of the smallest size are curves touching or lying on top of each
-      // other (unsewn volumes, sloppy models), not features the mesh could resolve.
-      const double touching = 0.1 * sizes.effective_min_size();
-      CurveSamples& cs = samples[c];
-      for (std::size_t k = 0; k < cs.p.size(); ++k) {
-        for (const auto& [o, j] : grid.candidates(samples, cs.p[k], cs.h[k], [&](LO x) { return !adjacent(x); })) {
-          // The other curve near its nearest sample is the polyline through the samples around it
-          // (at most cap/4 and h/8 apart): exact enough, and far cheaper than a CAD projection.
-          const double d = distance_to_polyline(samples[o], j, cs.p[k]);
-          if (d > touching) cs.h[k] = std::max(sizes.effective_min_size(), std::min(cs.h[k], d));
-        }
-      }
-    });
+    std::vector<std::vector<Vec3>> polylines(samples.size());
+    std::vector<std::vector<double>> h(samples.size());
+    for (std::size_t c = 0; c < samples.size(); ++c) {
+      polylines[c] = samples[c].p;
+      h[c] = samples[c].h;
+    }
+    // Gaps narrower than a tenth of the smallest size are curves touching or lying on top of each
+    // other (unsewn volumes, sloppy models), not features the mesh could resolve.
+    limit_by_feature_distance(model, polylines, h, 0.1 * sizes.effective_min_size(),
+                              sizes.effective_min_size(), sizes.size, tasks);
+    for (std::size_t c = 0; c < samples.size(); ++c) samples[c].h = std::move(h[c]);
   }
 
   // 3. Corners take the smallest size of the curves ending there (a curve never asks for more than

@@ -1,0 +1,26 @@
+// Small CAD features (paper 000 Sec. 4.1): the distance from a curve to the nearest curve that is
+// not topologically adjacent to it bounds the mesh size there. Used by the background curve
+// meshing and by the small-feature size field s_min of the size map.
+#pragma once
+
+#include <span>
+#include <vector>
+
+#include "qsmesh/cad/model.hpp"
+#include "qsmesh/core/tasks.hpp"
+#include "qsmesh/core/types.hpp"
+
+namespace qsmesh::background {
+
+/// Lowers sizes[c][k] to the distance from polyline vertex k of curve c to the nearest curve that
+/// shares no corner with c (model units), searching only within the current sizes[c][k] (a uniform
+/// hash grid with cells of `cell`, no all-pairs search). polylines[c] are points along curve c,
+/// dense enough that the polyline stands for the curve (its segments are what distances are taken
+/// to); empty polylines (degenerate curves) are skipped. Distances up to `touching` are ignored:
+/// curves that touch or lie on top of each other are not features. Results are at least `floor`.
+/// Deterministic, whatever the thread count of `tasks`.
+void limit_by_feature_distance(const cad::CadModel& model, std::span<const std::vector<Vec3>> polylines,
+                               std::vector<std::vector<double>>& sizes, double touching, double floor,
+                               double cell, const TaskArena& tasks);
+
+}  // namespace qsmesh::background
