@@ -86,6 +86,13 @@ void Comm::allreduce_sum(std::vector<std::int64_t>& values) const {
             "MPI_Allreduce");
 }
 
+void Comm::allreduce_min(std::vector<double>& values) const {
+  QSMESH_CHECK(values.size() <= static_cast<std::size_t>(std::numeric_limits<int>::max()), "reduction too large");
+  check_mpi(MPI_Allreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()), MPI_DOUBLE,
+                          MPI_MIN, impl_->comm),
+            "MPI_Allreduce");
+}
+
 double Comm::allreduce_max(double value) const {
   double out = value;
   check_mpi(MPI_Allreduce(&value, &out, 1, MPI_DOUBLE, MPI_MAX, impl_->comm), "MPI_Allreduce");

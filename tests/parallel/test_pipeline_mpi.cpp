@@ -33,6 +33,9 @@ TEST(Comm, ReductionsAndGather) {
   EXPECT_EQ(v[0], comm.size());
   EXPECT_EQ(v[1], static_cast<std::int64_t>(comm.size()) * (comm.size() - 1) / 2);
   EXPECT_EQ(comm.allreduce_max(comm.rank()), comm.size() - 1);
+  std::vector<double> m{static_cast<double>(comm.rank()), 5.0 - comm.rank()};
+  comm.allreduce_min(m);
+  EXPECT_EQ(m, (std::vector<double>{0.0, 5.0 - (comm.size() - 1)}));
   EXPECT_FALSE(comm.allreduce_and(comm.rank() != 0));
   const std::vector<char> mine(static_cast<std::size_t>(comm.rank()) + 1, static_cast<char>('a' + comm.rank()));
   const auto all = comm.gather_bytes(mine, 0);

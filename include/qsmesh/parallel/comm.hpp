@@ -40,6 +40,8 @@ class Comm {
   /// Element-wise sum over ranks, result on every rank.
   void allreduce_sum(std::vector<double>& values) const;
   void allreduce_sum(std::vector<std::int64_t>& values) const;
+  /// Element-wise minimum over ranks, result on every rank.
+  void allreduce_min(std::vector<double>& values) const;
   /// Maximum over ranks.
   [[nodiscard]] double allreduce_max(double value) const;
   /// Logical and over ranks.
