@@ -36,6 +36,32 @@ int parse_threads(const std::string& text) {
   return v;
 }
 
+/// "ID:VALUE[,ID:VALUE...]" with ids >= 0 and values > 0.
+std::vector<std::pair<int, double>> parse_id_values(const std::string& option, const std::string& text) {
+  std::vector<std::pair<int, double>> out;
+  std::size_t start = 0;
+  while (start <= text.size()) {
+    const std::size_t end = std::min(text.find(',', start), text.size());
+    const std::string item = text.substr(start, end - start);
+    const std::size_t colon = item.find(':');
+    if (colon == std::string::npos)
+      throw InputError(option + ": '" + item + "' is not ID:VALUE (e.g. " + option + " 12:0.5,40:2)");
+    const std::string id_text = item.substr(0, colon);
+    std::size_t used = 0;
+    int id = -1;
+    try {
+      id = std::stoi(id_text, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used == 0 || used != id_text.size() || id < 0)
+      throw InputError(option + ": '" + id_text + "' is not an entity id (a non-negative integer)");
+    out.emplace_back(id, parse_positive(option, item.substr(colon + 1)));
+    start = end + 1;
+  }
+  return out;
+}
+
 }  // namespace
 
 Arguments parse(const std::vector<std::string>& args) {
@@ -54,9 +80,13 @@ Arguments parse(const std::vector<std::string>& args) {
   if (cmd == "info") a.command = Command::Info;
   else if (cmd == "mesh") a.command = Command::Mesh;
   else if (cmd == "crossfield") a.command = Command::CrossField;
+  else if (cmd == "sizemap") a.command = Command::SizeMap;
   else if (cmd == "example") a.command = Command::Example;
-  else throw InputError("unknown command '" + cmd + "' (commands: info, mesh, crossfield, example; see qsmesh --help)");
-  const bool meshing = a.command == Command::Mesh || a.command == Command::CrossField;
+  else throw InputError("unknown command '" + cmd + "' (commands: info, mesh, crossfield, sizemap, example; see qsmesh --help)");
+  const bool meshing = a.command == Command::Mesh || a.command == Command::CrossField || a.command == Command::SizeMap;
+  // Size-map options act from the sizemap command on; the mesh command takes them once its quad
+  // stages exist (until then they would change nothing).
+  const bool sizing = a.command == Command::SizeMap;
 
   std::vector<std::string> positional;
   for (std::size_t i = 1; i < args.size(); ++i) {
@@ -77,6 +107,25 @@ Arguments parse(const std::vector<std::string>& args) {
     else if (opt == "--threads") a.threads = parse_threads(value());
     else if (opt == "--stats" && meshing) a.stats = value();
     else if (opt == "--check" && a.command == Command::CrossField) a.check = true;
+    else if (opt == "--sizemap" && sizing) {
+      a.sizemap = value();
+      if (a.sizemap != "features" && a.sizemap != "crossfield")
+        throw InputError("--sizemap: unknown method '" + a.sizemap + "' (features or crossfield)");
+    } else if (opt == "--quads" && sizing) a.quads = parse_positive(opt, value());
+    else if (opt == "--curve-edges" && sizing) {
+      for (const auto& [id, v] : parse_id_values(opt, value())) {
+        if (v != std::floor(v)) throw InputError(opt + ": curve " + std::to_string(id) + ": edge count must be an integer");
+        // Refused here, before any work, rather than by the quantization after the cross fields.
+        if (static_cast<long>(v) % 2 != 0)
+          throw InputError(opt + ": curve " + std::to_string(id) + ": " + std::to_string(static_cast<long>(v)) +
+                           " edges prescribed, but all-quad meshing by midpoint subdivision needs an even count "
+                           "(odd counts are not supported yet)");
+        a.curve_edges.emplace_back(id, static_cast<int>(v));
+      }
+    } else if (opt == "--face-quads" && sizing) a.face_quads = parse_id_values(opt, value());
+    else if (opt == "--corner-size" && sizing) a.corner_sizes = parse_id_values(opt, value());
+    else if (opt == "--curve-size" && sizing) a.curve_sizes = parse_id_values(opt, value());
+    else if (opt == "--face-size" && sizing) a.face_sizes = parse_id_values(opt, value());
     else if (opt == "--json" && a.command == Command::Info) a.json = true;
     else if (opt == "--sew") a.sew = true;
     else if (opt == "--quiet" || opt == "-q") a.quiet = true;
@@ -102,6 +151,8 @@ Arguments parse(const std::vector<std::string>& args) {
       throw InputError("mesh: missing -o OUT (.cgns, .vtu or .msh)");
     if (a.command == Command::CrossField && a.output.empty() && !a.check)
       throw InputError("crossfield: missing -o OUT.vtu (or --check)");
+    if (a.command == Command::SizeMap && a.output.empty())
+      throw InputError("sizemap: missing -o OUT.vtu");
   }
   return a;
 }
@@ -148,6 +199,21 @@ std::string help(const std::string& topic) {
           "  --check               list the faces whose singularities break the Euler relation and end\n"
           "                        with the line 'euler-consistent: K/N'\n"
           "  --size H, --size-factor F, --threads T, --stats FILE.json, --sew, -q, -v: as for mesh\n";
+  } else if (topic == "sizemap") {
+    os << "usage: [mpirun -np P] qsmesh sizemap MODEL -o OUT.vtu [options]\n\n"
+          "Computes the size map (paper 000 Sec. 4.1-4.2) and the curve quantization (Sec. 4.3):\n"
+          "OUT.vtu holds the background triangulation with point data s (the size map), s_min (small\n"
+          "CAD features) and s_cf (cross-field conformal sizes), the background curve meshes, and the\n"
+          "vertices of the quantized curve meshes as vertex cells. The summary gives the numbers of\n"
+          "curves, chords and edges.\n\n"
+          "  --sizemap METHOD      features (small features and user sizes only) or crossfield\n"
+          "                        (also the conformal scaling of the cross fields; default)\n"
+          "  --quads N             target number of quads of the model (default: area / size^2)\n"
+          "  --curve-edges C:N,..  prescribe the (even) number of edges of curves; kept exactly\n"
+          "  --face-quads F:N,..   prescribe the number of quads of faces\n"
+          "  --corner-size K:H,.., --curve-size C:H,.., --face-size F:H,..\n"
+          "                        size constraints at corners, on curves, on faces (model units)\n"
+          "  --size H, --size-factor F, --threads T, --stats FILE.json, --sew, -q, -v: as for mesh\n";
   } else if (topic == "example") {
     os << "usage: qsmesh example wing-body -o FILE.step\n\n"
           "Writes a built-in CAD model built with OpenCASCADE:\n"
@@ -160,6 +226,8 @@ std::string help(const std::string& topic) {
           "  mesh MODEL -o OUT     mesh the model and write OUT (.cgns, .vtu, .msh)\n"
           "  crossfield MODEL -o OUT.vtu\n"
           "                        cross fields, singularities and scaling of every face\n"
+          "  sizemap MODEL -o OUT.vtu\n"
+          "                        size map and curve quantization\n"
           "  example NAME -o FILE  write a built-in CAD model (wing-body)\n\n"
           "Run 'qsmesh COMMAND --help' for the options of a command.\n"
           "Quick start:\n"

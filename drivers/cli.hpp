@@ -8,7 +8,7 @@
 
 namespace qsmesh::cli {
 
-enum class Command { Help, Version, Info, Mesh, CrossField, Example };
+enum class Command { Help, Version, Info, Mesh, CrossField, SizeMap, Example };
 
 struct Arguments {
   Command command = Command::Help;
@@ -22,6 +22,13 @@ struct Arguments {
   std::string stats;               ///< --stats FILE.json
   bool json = false;               ///< info --json
   bool check = false;              ///< crossfield --check
+  std::string sizemap = "crossfield";  ///< --sizemap features|crossfield
+  double quads = 0;                ///< --quads N: target quad count of the model (0: from the size)
+  std::vector<std::pair<int, int>> curve_edges;       ///< --curve-edges C:N,...
+  std::vector<std::pair<int, double>> face_quads;     ///< --face-quads F:N,...
+  std::vector<std::pair<int, double>> corner_sizes;   ///< --corner-size K:H,...
+  std::vector<std::pair<int, double>> curve_sizes;    ///< --curve-size C:H,...
+  std::vector<std::pair<int, double>> face_sizes;     ///< --face-size F:H,...
   bool sew = false;
   bool quiet = false;
   bool verbose = false;

@@ -32,7 +32,8 @@ int main(int argc, char** argv) {
   cad::set_kernel_messages(!parsed.verbose);
 
   // Only the mesh and crossfield commands run distributed; the others need no MPI.
-  const bool distributed = parsed.command == cli::Command::Mesh || parsed.command == cli::Command::CrossField;
+  const bool distributed = parsed.command == cli::Command::Mesh || parsed.command == cli::Command::CrossField ||
+                           parsed.command == cli::Command::SizeMap;
   if (!distributed) {
     try {
       return parsed.command == cli::Command::Info ? cli::run_info(parsed) : cli::run_example(parsed);
@@ -48,7 +49,11 @@ int main(int argc, char** argv) {
   parallel::MpiSession mpi(&argc, &argv);
   const bool root = parallel::Comm::world().rank() == 0;
   try {
-    return parsed.command == cli::Command::Mesh ? cli::run_mesh(parsed) : cli::run_crossfield(parsed);
+    switch (parsed.command) {
+      case cli::Command::Mesh: return cli::run_mesh(parsed);
+      case cli::Command::CrossField: return cli::run_crossfield(parsed);
+      default: return cli::run_sizemap(parsed);
+    }
   } catch (const InputError& e) {
     // Every rank reads the same input and fails the same way: one line, from rank 0.
     if (root) std::cerr << "qsmesh: " << e.what() << "\n";

@@ -108,7 +108,8 @@ void limit_by_feature_distance(const cad::CadModel& model, std::span<const std::
         // The other curve near its nearest vertex is the polyline through the vertices around it:
         // exact enough for dense polylines, and far cheaper than a CAD projection.
         const double d = distance_to_polyline(polylines[o], j, line[k]);
-        if (d > touching) h[k] = std::max(floor, std::min(h[k], d));
+        // The floor bounds what a feature may ask for, never a size already smaller.
+        if (d > touching) h[k] = std::min(h[k], std::max(floor, d));
       }
     }
   });

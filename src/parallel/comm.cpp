@@ -47,6 +47,12 @@ Comm::~Comm() = default;
 
 Comm Comm::world() { return Comm(std::make_shared<Impl>()); }
 
+Comm Comm::self() {
+  auto impl = std::make_shared<Impl>();
+  impl->comm = MPI_COMM_SELF;
+  return Comm(std::move(impl));
+}
+
 int Comm::rank() const {
   int r = 0;
   check_mpi(MPI_Comm_rank(impl_->comm, &r), "MPI_Comm_rank");

@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <atomic>
 #include <cstring>
+#include <limits>
+#include <memory>
 
 #include "qsmesh/background/curve_mesh.hpp"
 #include "qsmesh/core/error.hpp"
@@ -148,6 +150,18 @@ void unpack(const std::vector<char>& in, std::size_t& pos, CrossFieldOutput& c) 
   c.seconds = get<double>(in, pos);
 }
 
+void pack(const FaceSizeOutput& s, std::vector<char>& out) {
+  put_vec(out, s.s);
+  put_vec(out, s.s_min);
+  put_vec(out, s.s_cf);
+}
+
+void unpack(const std::vector<char>& in, std::size_t& pos, FaceSizeOutput& s) {
+  get_vec(in, pos, s.s);
+  get_vec(in, pos, s.s_min);
+  get_vec(in, pos, s.s_cf);
+}
+
 PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
                             const PipelineOptions& options, const TaskArena& tasks, Logger& log,
                             linalg::PetscLane* lane) {
@@ -198,15 +212,22 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
   });
   result.times.add("background", comm.allreduce_max(clock.seconds()));
 
-  // Cross fields (paper 000 Sec. 3) on the same faces, one task per face.
+  // Cross fields (paper 000 Sec. 3) on the same faces, one task per face. The size map keeps the
+  // whole fields (it needs H at every vertex); the drivers get summaries.
+  const bool keep_fields = options.size_map && options.sizemap.method == sizemap::Method::CrossField;
+  const bool want_fields = options.cross_fields || keep_fields;
   std::vector<CrossFieldOutput> fields;
-  if (options.cross_fields) {
+  std::vector<std::unique_ptr<crossfield::FaceCrossField>> full(mine.size());
+  if (want_fields) {
     clock.reset();
     fields.resize(mine.size());
     std::atomic<std::int64_t> cf_done{0};
     tasks.parallel_for(total, [&](std::int64_t i) {
       try {
-        fields[i] = summarize(crossfield::compute_face_cross_field(meshes[i], options.crossfield, lane));
+        auto cf = std::make_unique<crossfield::FaceCrossField>(
+            crossfield::compute_face_cross_field(meshes[i], options.crossfield, lane));
+        fields[i] = summarize(*cf);
+        if (keep_fields) full[i] = std::move(cf);
       } catch (const std::exception& e) {
         // A face without a cross field keeps its background mesh; later stages fall back to
         // methods that need no field.
@@ -220,12 +241,51 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     result.times.add("crossfield", comm.allreduce_max(clock.seconds()));
   }
 
+  // Size map (paper 000 Sec. 4.1-4.2): curve sizes known to every rank, face fields on the faces'
+  // ranks, their union on shared curves by an MPI min-reduction, then quantization (Sec. 4.3)
+  // computed identically on every rank.
+  std::vector<FaceSizeOutput> sizes(options.size_map ? mine.size() : 0);
+  if (options.size_map) {
+    clock.reset();
+    const sizemap::SizeMapOptions& so = options.sizemap;
+    const sizemap::CurveSizes initial = sizemap::initial_curve_sizes(model, curves, so, tasks);
+    const std::vector<double> targets = sizemap::face_quad_targets(model, so);
+    auto face_pass = [&](const sizemap::CurveSizes& on_curves) {
+      tasks.parallel_for(total, [&](std::int64_t i) {
+        sizemap::FaceSizes fs = sizemap::face_sizes(meshes[i], full[i].get(), curves, on_curves, targets[mine[i]], so);
+        sizes[i] = FaceSizeOutput{std::move(fs.s), std::move(fs.s_min), std::move(fs.s_cf)};
+      });
+    };
+    face_pass(initial);
+    // The union on shared curves and corners starts from the initial sizes on every rank (the
+    // minimum is idempotent), so curves that no face of this rank touches keep their values.
+    sizemap::CurveSizes united = initial;
+    for (std::size_t i = 0; i < mine.size(); ++i) sizemap::fold_boundary_min(meshes[i], sizes[i].s, united);
+    std::vector<double> flat = united.pack();
+    comm.allreduce_min(flat);
+    united.unpack(flat);
+    sizemap::grade_curves(model, curves, so.gradation, united);
+    face_pass(united);  // faces now agree on their shared curves
+    result.curve_sizes = std::move(united);
+    result.times.add("sizemap", comm.allreduce_max(clock.seconds()));
+
+    clock.reset();
+    const std::vector<double> ideal = quantize::ideal_edge_counts(curves, result.curve_sizes.at);
+    result.quantization = quantize::quantize_curves(model, ideal, options.quantize);
+    result.quantized_curves = quantize::place_vertices(model, curves, result.curve_sizes.at, result.quantization,
+                                                       /*halved=*/false, tasks);
+    result.times.add("quantize", comm.allreduce_max(clock.seconds()));
+    log.info(cat("quantize: ", model.num_curves(), " curves, ", result.quantization.num_chords, " chords, ",
+                 result.quantization.total_edges, " edges"));
+  }
+
   // Gather on rank 0 and assemble in face order.
   clock.reset();
   std::vector<char> buffer;
   for (std::size_t i = 0; i < mine.size(); ++i) {
     pack(meshes[i], reports[i], buffer);
     if (options.cross_fields) pack(fields[i], buffer);
+    if (options.size_map) pack(sizes[i], buffer);
   }
   meshes.clear();
   const auto gathered = comm.gather_bytes(buffer, 0);
@@ -233,6 +293,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     std::vector<mesh::FaceMesh> all(static_cast<std::size_t>(nfaces));
     result.reports.resize(static_cast<std::size_t>(nfaces));
     if (options.cross_fields) result.cross_fields.resize(static_cast<std::size_t>(nfaces));
+    if (options.size_map) result.face_sizes.resize(static_cast<std::size_t>(nfaces));
     for (const auto& bytes : gathered) {
       std::size_t pos = 0;
       while (pos < bytes.size()) {
@@ -244,10 +305,12 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
         result.reports[f] = std::move(r);
         all[f] = std::move(m);
         if (options.cross_fields) unpack(bytes, pos, result.cross_fields[f]);
+        if (options.size_map) unpack(bytes, pos, result.face_sizes[f]);
       }
     }
     for (LO f = 0; f < nfaces; ++f) all[f].face = f;
     result.mesh = mesh::assemble(model, curves, all);
+    if (options.size_map) result.background = std::move(all);
   }
   result.times.add("assemble", comm.allreduce_max(clock.seconds()));
   return result;

@@ -134,6 +134,34 @@ TEST_F(Qsmesh, CrossFieldCheckAndVtu) {
   EXPECT_NE(bad.err.find("VTU"), std::string::npos) << bad.err;
 }
 
+TEST_F(Qsmesh, SizeMapWritesFieldsAndHonoursPrescriptions) {
+  const std::string out = tmp("e2e_sm.vtu");
+  const std::string stats = tmp("e2e_sm.json");
+  // Curve 0 of the filleted box asks for about 10 edges at this size; 14 must be kept exactly.
+  const ExeResult r = run("sizemap " + model_ + " -o " + out + " --size 0.8 --curve-edges 0:14 --stats " + stats);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string vtu = slurp(out);
+  for (const char* name : {"\"s\"", "s_min", "s_cf", "quantized_curve"})
+    EXPECT_NE(vtu.find(name), std::string::npos) << name;
+  EXPECT_NE(r.out.find("chords: "), std::string::npos) << r.out;
+  const std::string json = slurp(stats);
+  const auto list = json.find("\"curve_edges\": [");
+  ASSERT_NE(list, std::string::npos) << json;
+  EXPECT_EQ(json.substr(json.find_first_not_of(" \n", list + 16), 2), "14") << json.substr(list, 60);
+  for (const std::string method : {"features", "crossfield"})
+    EXPECT_EQ(run("sizemap " + model_ + " -o " + out + " --size 0.8 -q --sizemap " + method).code, 0) << method;
+  // An odd prescription cannot be honoured yet: refused, nothing written.
+  const std::string odd_out = tmp("e2e_sm_odd.vtu");
+  const ExeResult odd = run("sizemap " + model_ + " -o " + odd_out + " --curve-edges 0:7");
+  EXPECT_EQ(odd.code, 2);
+  EXPECT_EQ(lines(odd.err), 1) << odd.err;
+  EXPECT_NE(odd.err.find("even"), std::string::npos) << odd.err;
+  EXPECT_FALSE(fs::exists(odd_out));
+  const ExeResult bad_id = run("sizemap " + model_ + " -o " + odd_out + " --curve-edges 100000:8");
+  EXPECT_EQ(bad_id.code, 2);
+  EXPECT_NE(bad_id.err.find("curve 100000 does not exist"), std::string::npos) << bad_id.err;
+}
+
 TEST_F(Qsmesh, ExampleWingBody) {
   const std::string step = tmp("e2e_wing_body.step");
   const ExeResult r = run("example wing-body -o " + step);

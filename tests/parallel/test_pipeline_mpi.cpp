@@ -5,12 +5,15 @@
 
 #include "qsmesh/background/curve_mesh.hpp"
 #include "qsmesh/crossfield/cross_field.hpp"
+#include "qsmesh/quantize/quantize.hpp"
+#include "qsmesh/sizemap/size_map.hpp"
 #include "qsmesh/mesh/assemble.hpp"
 #include "qsmesh/mesh/validate.hpp"
 #include "qsmesh/parallel/comm.hpp"
 #include "qsmesh/parallel/pipeline.hpp"
 #include "shapes.hpp"
 
+#include <filesystem>
 #include <sstream>
 
 namespace qsmesh::parallel {
@@ -121,6 +124,98 @@ TEST(Pipeline, CrossFieldsDoNotDependOnRanks) {
   // A box with filleted edges: flat faces, cylinders and sphere corners, all simple enough for the
   // Euler relation to hold everywhere.
   EXPECT_EQ(consistent, model.num_faces());
+}
+
+/// Runs the size map and quantization on `model` and checks, on every rank, that the curve data
+/// equal those of the same stage functions run serially (no MPI), and that ranks agree.
+void check_size_map(const Comm& comm, const cad::CadModel& model, double size) {
+  PipelineOptions options;
+  options.background.sizes.size = size;
+  options.size_map = true;
+  options.sizemap.size_max = size;
+  std::ostringstream sink;
+  Logger log(sink, LogLevel::Quiet);
+  const PipelineResult result = run_pipeline(comm, model, options, TaskArena(2), log);
+
+  // Serial reference: every face on this process, the same flow.
+  const TaskArena one(1);
+  const auto curves = background::mesh_curves(model, options.background.sizes, one);
+  const auto initial = sizemap::initial_curve_sizes(model, curves, options.sizemap, one);
+  const auto targets = sizemap::face_quad_targets(model, options.sizemap);
+  sizemap::CurveSizes united = initial;
+  for (LO f = 0; f < model.num_faces(); ++f) {
+    const auto bg = background::mesh_face_background(model, f, curves, options.background, nullptr);
+    const auto cf = crossfield::compute_face_cross_field(bg, options.crossfield, nullptr);
+    const auto fs = sizemap::face_sizes(bg, &cf, curves, initial, targets[f], options.sizemap);
+    sizemap::fold_boundary_min(bg, fs.s, united);
+  }
+  sizemap::grade_curves(model, curves, options.sizemap.gradation, united);
+  EXPECT_EQ(result.curve_sizes.pack(), united.pack());
+  const auto q = quantize::quantize_curves(model, quantize::ideal_edge_counts(curves, united.at), options.quantize);
+  EXPECT_EQ(result.quantization.edges, q.edges);
+  const auto placed = quantize::place_vertices(model, curves, united.at, q, false, one);
+  ASSERT_EQ(result.quantized_curves.size(), placed.size());
+  for (std::size_t c = 0; c < placed.size(); ++c) {
+    EXPECT_EQ(result.quantized_curves[c].t, placed[c].t) << "curve " << c;
+    ASSERT_EQ(result.quantized_curves[c].points.size(), placed[c].points.size());
+    for (std::size_t i = 0; i < placed[c].points.size(); ++i)
+      ASSERT_EQ(result.quantized_curves[c].points[i], placed[c].points[i]);
+  }
+  // Every rank holds the same counts: the sum of squares differs otherwise.
+  std::int64_t mine = 0;
+  for (int e : result.quantization.edges) mine += static_cast<std::int64_t>(e) * e;
+  std::vector<std::int64_t> all{mine};
+  comm.allreduce_sum(all);
+  EXPECT_EQ(all[0], mine * comm.size());
+}
+
+TEST(Pipeline, SizeMapAndCurveMeshesDoNotDependOnRanks) {
+  const Comm comm = Comm::world();
+  check_size_map(comm, shared_model(comm, "pipe_sm"), 0.6);
+}
+
+TEST(Pipeline, SizeMapOnSharedModels) {
+  const std::string dir = QSMESH_SHARED_CAD_DIR;
+  if (!std::filesystem::exists(dir + "/A319.brep")) GTEST_SKIP() << "no " << dir;
+  const Comm comm = Comm::world();
+  for (const char* name : {"A319.brep", "Block.stp"}) {
+    const cad::CadModel model = cad::load_cad(dir + "/" + name);
+    const double size = 0.02 * model.diagonal();
+    check_size_map(comm, model, size);
+    if (comm.rank() != 0) continue;
+    // The checks on the real size map: opposite sides of the four-sided faces of conformal
+    // chains have equal counts, and the size never exceeds the length of its curve (degenerate
+    // curves, poles, have no length: their vertices carry the pole corner's size).
+    PipelineOptions options;
+    options.background.sizes.size = size;
+    options.size_map = true;
+    options.sizemap.size_max = size;
+    std::ostringstream sink;
+    Logger log(sink, LogLevel::Quiet);
+    const PipelineResult r = run_pipeline(Comm::self(), model, options, TaskArena(2), log);
+    const auto& q = r.quantization;
+    int pairs = 0, unequal = 0, too_large = 0;
+    for (const auto& face : model.faces()) {
+      if (face.loops.size() != 1 || face.loops[0].uses.size() != 4 || !face.loops_closed) continue;
+      const auto& uses = face.loops[0].uses;
+      for (int k = 0; k < 2; ++k) {
+        const LO a = uses[k].curve, b = uses[k + 2].curve;
+        if (q.curve2chord[a] == kNoIndex || q.curve2chord[a] != q.curve2chord[b]) continue;
+        ++pairs;
+        unequal += q.edges[a] != q.edges[b] ? 1 : 0;
+      }
+    }
+    for (LO c = 0; c < model.num_curves(); ++c)
+      for (double s : r.curve_sizes.at[c])
+        if (!model.curves()[c].degenerate && s > model.curves()[c].length * (1 + 1e-12)) {
+          ++too_large;
+          ADD_FAILURE() << name << ": curve " << c << " of length " << model.curves()[c].length << " has size " << s;
+        }
+    EXPECT_GT(pairs, 0) << name;
+    EXPECT_EQ(unequal, 0) << name;
+    EXPECT_EQ(too_large, 0) << name;
+    std::cout << name << ": " << q.num_chords << " chords, " << pairs << " opposite pairs in chords\n";
+  }
 }
 
 }  // namespace

@@ -17,7 +17,8 @@ namespace qsmesh::background {
 /// hash grid with cells of `cell`, no all-pairs search). polylines[c] are points along curve c,
 /// dense enough that the polyline stands for the curve (its segments are what distances are taken
 /// to); empty polylines (degenerate curves) are skipped. Distances up to `touching` are ignored:
-/// curves that touch or lie on top of each other are not features. Results are at least `floor`.
+/// curves that touch or lie on top of each other are not features. A feature never asks for less
+/// than `floor` (sizes already below it stay as they are).
 /// Deterministic, whatever the thread count of `tasks`.
 void limit_by_feature_distance(const cad::CadModel& model, std::span<const std::vector<Vec3>> polylines,
                                std::vector<std::vector<double>>& sizes, double touching, double floor,

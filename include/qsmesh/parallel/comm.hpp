@@ -27,6 +27,8 @@ class Comm {
  public:
   /// The world communicator; MPI must be initialised.
   static Comm world();
+  /// This process alone (MPI_COMM_SELF): serial runs of collective code.
+  static Comm self();
   Comm(const Comm&);
   Comm& operator=(const Comm&);
   ~Comm();

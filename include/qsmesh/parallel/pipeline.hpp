@@ -8,6 +8,8 @@
 
 #include "qsmesh/background/face_mesh.hpp"
 #include "qsmesh/crossfield/cross_field.hpp"
+#include "qsmesh/quantize/quantize.hpp"
+#include "qsmesh/sizemap/size_map.hpp"
 #include "qsmesh/cad/model.hpp"
 #include "qsmesh/core/log.hpp"
 #include "qsmesh/core/tasks.hpp"
@@ -29,6 +31,16 @@ struct PipelineOptions {
   /// Compute the cross field of every face on its background mesh (paper 000 Sec. 3).
   bool cross_fields = false;
   crossfield::CrossFieldOptions crossfield;
+  /// Compute the size map (paper 000 Sec. 4.1-4.2) and quantize the curves (Sec. 4.3). With
+  /// the crossfield method the cross fields are computed too.
+  bool size_map = false;
+  sizemap::SizeMapOptions sizemap;
+  quantize::QuantizeOptions quantize;
+};
+
+/// Size fields of one face at its background mesh vertices (FaceMesh order), for output.
+struct FaceSizeOutput {
+  std::vector<double> s, s_min, s_cf;
 };
 
 /// What the drivers need of a face's cross field, per triangle of its background mesh in the
@@ -49,6 +61,11 @@ struct PipelineResult {
   mesh::SurfaceMesh mesh;                       ///< assembled mesh (rank 0 only)
   std::vector<background::FaceReport> reports;  ///< one per face, by face id (rank 0 only)
   std::vector<CrossFieldOutput> cross_fields;   ///< one per face when requested (rank 0 only)
+  std::vector<mesh::FaceMesh> background;       ///< background meshes by face (rank 0, size map only)
+  std::vector<FaceSizeOutput> face_sizes;       ///< size fields by face (rank 0, size map only)
+  sizemap::CurveSizes curve_sizes;              ///< size map on the background curve meshes (every rank)
+  quantize::Quantization quantization;          ///< curve edge counts (every rank)
+  std::vector<mesh::CurveMesh> quantized_curves;  ///< final curve meshes (every rank)
   std::vector<int> face_rank;                   ///< rank that meshed each face (every rank)
   StageTimes times;                             ///< wall time per stage (max over ranks)
 };
@@ -71,6 +88,8 @@ void pack(const mesh::FaceMesh& m, const background::FaceReport& r, std::vector<
 void unpack(const std::vector<char>& in, std::size_t& pos, mesh::FaceMesh& m,
             background::FaceReport& r);
 void pack(const CrossFieldOutput& c, std::vector<char>& out);
+void pack(const FaceSizeOutput& s, std::vector<char>& out);
+void unpack(const std::vector<char>& in, std::size_t& pos, FaceSizeOutput& s);
 void unpack(const std::vector<char>& in, std::size_t& pos, CrossFieldOutput& c);
 
 }  // namespace qsmesh::parallel

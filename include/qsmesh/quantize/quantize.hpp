@@ -1,0 +1,100 @@
+// Global curve quantization (paper 000 Sec. 4.3): how many edges each CAD curve gets, consistently
+// for the whole model, and where the curve vertices go (Eq. 11).
+//
+// Every function here depends only on the model, the background curve meshes and the sizes along
+// them, which are identical on every rank: every rank computes the same quantization and the same
+// curve meshes, whatever the partition and the thread count.
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <utility>
+#include <vector>
+
+#include "qsmesh/cad/model.hpp"
+#include "qsmesh/core/tasks.hpp"
+#include "qsmesh/core/types.hpp"
+#include "qsmesh/mesh/surface_mesh.hpp"
+
+namespace qsmesh::quantize {
+
+struct QuantizeOptions {
+  /// User edge counts (curve id, count > 0), kept exactly. A prescribed curve fixes the count of
+  /// its whole chord. Several entries for one curve must agree.
+  std::vector<std::pair<LO, int>> prescribed;
+  /// Opposite sides of a four-sided face are forced equal (joined in one chord) unless their ideal
+  /// counts differ by more than this ratio (max / min > chord_ratio_limit). Must be >= 1.
+  double chord_ratio_limit = 2.0;
+  /// Final counts even: all-quad meshing by midpoint subdivision (paper 000 Sec. 5.2) halves them
+  /// before the quad mesher and subdivides afterwards.
+  bool even = true;
+  /// When `even`, also make the halved meshes (place_vertices with halved = true) valid boundaries:
+  /// closed curves at least 6 (3 before subdivision) and curves joining the same two corners at
+  /// least 4 (2 before subdivision, so the two halved curves never coincide). Off by default: the
+  /// minimums then apply to the final counts only (closed 4, parallel 2).
+  bool halved_minimums = false;
+};
+
+struct Quantization {
+  /// Per curve: the floating number of edges, integral of dl / s (from ideal_edge_counts).
+  std::vector<double> ideal;
+  /// Per curve: the final number of edges. Even and >= 2 when options.even (>= 4 on closed curves);
+  /// >= 1 otherwise (>= 3 closed, >= 2 when another curve joins the same two corners).
+  /// Degenerate curves (poles): 0; place_vertices keeps their single background edge.
+  std::vector<int> edges;
+  /// Chord id per curve (0 .. num_chords-1, numbered by increasing smallest curve id), kNoIndex
+  /// when the curve is in no chord. A chord is a set of topologically parallel curves: opposite
+  /// sides of four-sided faces, propagated through shared curves.
+  std::vector<LO> curve2chord;
+  LO num_chords = 0;
+  /// Sum of `edges` over all curves.
+  std::int64_t total_edges = 0;
+};
+
+/// Paper 000 Sec. 4.3, size map integration: for each curve c, the integral of dl / s along the
+/// background polyline curves[c].points, with s linear along each polyline segment between
+/// sizes[c][i] and sizes[c][i+1] (integrated exactly: len * ln(s1/s0) / (s1 - s0)).
+/// Preconditions: sizes.size() == curves.size(), sizes[c].size() == curves[c].points.size(),
+/// every size finite and > 0 (model units). Returns one value per curve (0 for a degenerate curve,
+/// whose polyline has zero length). Throws qsmesh::Error when a precondition fails.
+[[nodiscard]] std::vector<double> ideal_edge_counts(std::span<const mesh::CurveMesh> curves,
+                                                    std::span<const std::vector<double>> sizes);
+
+/// Paper 000 Sec. 4.3, topological constraints on quadrilateral patches, and Sec. 5.2 (even
+/// counts).
+///  - Chords: for every face with one loop of exactly four curve uses (a conformal four-sided
+///  face),
+///    uses 0-2 and 1-3 are opposite; each opposite pair of non-degenerate curves is joined
+///    (union-find over curves) unless max/min of their ideal values > chord_ratio_limit. A curve
+///    is in a chord when it is a side of at least one joined pair (a seam opposite itself, as on a
+///    cylinder, makes a chord of one curve). All curves of a chord get the average of the chord's
+///    ideal values (each curve counted once), then rounded.
+///  - Rounding: to the nearest even number when options.even (at least 2), else to the nearest
+///    integer (at least 1); closed curves at least 4 (even) / 3; curves joining the same two
+///    corners at least 2 each. A chord takes the largest minimum of its curves so it stays equal.
+///  - Prescriptions are kept exactly and fix their whole chord. InputError for: an unknown or
+///    degenerate curve, a count <= 0, an odd count while options.even ("curve C: N edges
+///    prescribed, but all-quad meshing by midpoint subdivision needs an even count (odd counts are
+///    not supported yet)"), two different counts in one chord (naming both curves), a count below
+///    what a closed curve (3) or a pair of curves joining the same corners (2) needs.
+/// `ideal` has one value per curve (model.num_curves()), finite and >= 0.
+/// Sequential and deterministic: the result depends only on the model, `ideal` and `options`.
+[[nodiscard]] Quantization quantize_curves(const cad::CadModel& model,
+                                           std::span<const double> ideal,
+                                           const QuantizeOptions& options);
+
+/// Paper 000 Eq. 11: the final curve meshes, one per curve, indexed by curve id. Curve c gets
+/// n = q.edges[c] edges (n = q.edges[c] / 2 when `halved`: the meshes the quad mesher uses before
+/// midpoint subdivision; q.edges[c] must then be even). Vertex i sits where the integral of dl / s
+/// (s linear along the background polyline curves[c], as in ideal_edge_counts) reaches i/n of the
+/// total; its parameter is interpolated linearly between the two background vertices around it and
+/// its point is evaluated on the CAD curve (model.curve_geometry(c)). The end vertices are the
+/// curve's corners exactly (t = the background's end parameters). Degenerate curves keep their
+/// background mesh (one edge). One task per curve on `tasks`; the result does not depend on the
+/// thread count. Throws qsmesh::Error on size mismatches or non-positive sizes.
+[[nodiscard]] std::vector<mesh::CurveMesh> place_vertices(
+    const cad::CadModel& model, std::span<const mesh::CurveMesh> curves,
+    std::span<const std::vector<double>> sizes, const Quantization& q, bool halved,
+    const TaskArena& tasks);
+
+}  // namespace qsmesh::quantize

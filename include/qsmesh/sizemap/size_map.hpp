@@ -1,0 +1,133 @@
+// Size map of the final quad mesh (paper 000 Sec. 4 intro, 4.1, 4.2): the small-feature size field
+// s_min (Sec. 4.1, Eq. 10), the per-face conformal sizes s_cf = exp(H + C_i) of the cross field
+// (Sec. 3.3, Sec. 4.2) with C_i chosen for the face's share N_i of the target quad count, their
+// union with the minimum on shared curves and corners, the one-way gradation, s = min(s_cf, s_min).
+//
+// Distributed flow (every rank; nothing depends on the partition or the thread count):
+//   initial = initial_curve_sizes(model, curves, options, tasks)      // identical on every rank
+//   union = initial                                                   // (a copy; see
+//   fold_boundary_min) for each local face f: fold_boundary_min(bg[f], face_sizes(bg[f], cf[f],
+//   curves, initial, N[f], options).s, union) MPI min-reduction of union.pack() over all ranks,
+//   union.unpack(...) grade_curves(model, curves, options.gradation, union)            // the curve
+//   sizes of the model for each local face f: face_sizes(bg[f], cf[f], curves, union, N[f],
+//   options)   // final per-face field
+// The curve sizes after grade_curves feed the curve quantization (Sec. 4.3): ideal count = ∫ dl /
+// s.
+#pragma once
+
+#include <span>
+#include <utility>
+#include <vector>
+
+#include "qsmesh/cad/model.hpp"
+#include "qsmesh/core/tasks.hpp"
+#include "qsmesh/core/types.hpp"
+#include "qsmesh/crossfield/cross_field.hpp"
+#include "qsmesh/mesh/surface_mesh.hpp"
+
+namespace qsmesh::sizemap {
+
+/// `Features`: s_min and the user sizes only (Sec. 4.1); `CrossField`: min(union of s_cf, s_min)
+/// (Sec. 4.2).
+enum class Method { Features, CrossField };
+
+struct SizeMapOptions {
+  Method method = Method::CrossField;
+  /// Global cap (model units, > 0): --size, or --size-factor x the model diagonal.
+  double size_max = 0;
+  /// Floor of the automatic sizes (model units); 0: size_max / 100. User sizes below it are
+  /// honoured (the floor is then lowered to the smallest user size, see effective_size_min).
+  double size_min = 0;
+  /// g_max of Eq. 10: largest growth of the size per unit distance (0.2: progression ratio 1.2).
+  double gradation = 0.2;
+  /// N, the target number of quads of the whole model; 0: total area / size_max^2.
+  double target_quads = 0;
+  /// (face id, quad count) fixed by the user: that face gets this N_i instead of its area share.
+  std::vector<std::pair<LO, double>> face_quads;
+  /// User size constraints (entity id, size in model units, > 0). A face size caps the size inside
+  /// the face and on its boundary curves.
+  std::vector<std::pair<LO, double>> corner_sizes, curve_sizes, face_sizes;
+};
+
+/// The floor actually applied: size_min (or size_max / 100) lowered to the smallest user size.
+/// Throws InputError when size_max <= 0, size_min < 0 or size_min > size_max.
+[[nodiscard]] double effective_size_min(const SizeMapOptions& options);
+
+/// Size values (model units) at the vertices of the curve meshes.
+struct CurveSizes {
+  /// at[c][i]: vertex i of curve c's mesh, both ends included (they are corners; a corner's value
+  /// is the same in every curve ending there once grade_curves / initial_curve_sizes ran).
+  std::vector<std::vector<double>> at;
+  /// corner[k]: the value at corner k (what faces read at their dim-0 vertices).
+  std::vector<double> corner;
+
+  /// Every value in one flat array: at[0], at[1], ..., then corner (for an MPI min-reduction).
+  [[nodiscard]] std::vector<double> pack() const;
+  /// Inverse of pack: `flat` must have the size pack() returns.
+  void unpack(std::span<const double> flat);
+};
+
+/// CurveSizes shaped like `curves` (one value per curve-mesh vertex) and `num_corners`, all
+/// `value`.
+[[nodiscard]] CurveSizes make_curve_sizes(std::span<const mesh::CurveMesh> curves, LO num_corners,
+                                          double value);
+
+/// Initial curve sizes, global and the same on every rank (Sec. 4.1): size_max, user curve sizes,
+/// user face sizes on the face's boundary curves; for both methods the small-feature limits: no
+/// larger than (i) the curve's length and (ii) the distance to the nearest curve sharing no corner
+/// (background::limit_by_feature_distance on the curve-mesh polylines, densified so that a segment
+/// is no longer than half the local size); floored by effective_size_min (so (i) and (ii) hold for
+/// features larger than the floor); then user corner sizes, and grade_curves (corners = min over
+/// their curves, Eq. 10 along the curve edges and through corners). `curves` indexed by curve id,
+/// as background::mesh_curves returns them. Deterministic whatever the thread count of `tasks`.
+/// Throws InputError for bad options (sizes <= 0, ids out of range).
+[[nodiscard]] CurveSizes initial_curve_sizes(const cad::CadModel& model,
+                                             std::span<const mesh::CurveMesh> curves,
+                                             const SizeMapOptions& options, const TaskArena& tasks);
+
+/// Face quad targets N_i (Sec. 4.2): area_i / total area x N, or the user's value (face_quads) for
+/// the faces the user fixed (the paper's substitution: the other faces keep their area share).
+/// Indexed by face id. Throws InputError for a bad face id or a negative count.
+[[nodiscard]] std::vector<double> face_quad_targets(const cad::CadModel& model,
+                                                    const SizeMapOptions& options);
+
+/// Per FaceMesh vertex (model units).
+struct FaceSizes {
+  std::vector<double> s;  ///< the size map: min(s_cf, s_min) graded, capped, floored
+  /// Small-feature field (Sec. 4.1): the `curve` values graded over the face, capped and floored
+  /// (the pure s_min when `curve` is initial_curve_sizes; after the union it includes s_cf there).
+  std::vector<double> s_min;
+  std::vector<double> s_cf;  ///< exp(H + C_i), ungraded (empty when no cross field is used)
+};
+
+/// The size field of one face at its FaceMesh vertices. Boundary vertices start from `curve` (dim
+/// 1: at[curve][index], dim 0: corner[corner]), interior vertices from +inf (s_min) or from s_cf =
+/// exp(H + C_i) with C_i = crossfield::scaling_constant(*cf, face_quads) (CrossField method, cf not
+/// null, face_quads > 0); then Eq. 10 by Dijkstra (a heap) over every edge of the glued
+/// triangulation (seams and poles interior), the edges on curves included, so a boundary value may
+/// come out lower than `curve` where a path through the face is shorter than along the curves (the
+/// union, fold + reduction + grade_curves, carries that to the other faces). Then capped by
+/// size_max and the user face size, floored by effective_size_min (both keep the gradation bound).
+/// cf: the face's cross field (its input2glued must match `background`), or null (Features method,
+/// or a face whose cross field failed: s_min only). Throws qsmesh::Error on inconsistent inputs.
+[[nodiscard]] FaceSizes face_sizes(const mesh::FaceMesh& background,
+                                   const crossfield::FaceCrossField* cf,
+                                   std::span<const mesh::CurveMesh> curves, const CurveSizes& curve,
+                                   double face_quads, const SizeMapOptions& options);
+
+/// Folds values at the boundary vertices of `background` (one per FaceMesh vertex) into `into` by
+/// minimum: dim 1 into at[curve][index], dim 0 into corner[corner]. This is one rank's contribution
+/// to the union of Sec. 4.2; start `into` as a copy of initial_curve_sizes (identical on every
+/// rank, so an MPI min over ranks is unchanged by it, and curves that no local face touches keep
+/// their initial values), then min-reduce pack() over ranks.
+void fold_boundary_min(const mesh::FaceMesh& background, std::span<const double> values,
+                       CurveSizes& into);
+
+/// The one-way 1D gradation along the curves (Eq. 10 along curve-mesh edges, through corners):
+/// first corner[k] = min(corner[k], the end values of the curves ending at k), then Dijkstra over
+/// the graph of all curve meshes (exact, no sweeps), and every curve end gets its corner's value.
+/// Degenerate curves take their corner's value. Serial and deterministic.
+void grade_curves(const cad::CadModel& model, std::span<const mesh::CurveMesh> curves,
+                  double gradation, CurveSizes& sizes);
+
+}  // namespace qsmesh::sizemap

@@ -1,0 +1,295 @@
+#include "qsmesh/quantize/quantize.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numeric>
+#include <sstream>
+
+#include "qsmesh/core/error.hpp"
+
+namespace qsmesh::quantize {
+
+namespace {
+
+// ∫ dl / s over a straight segment of length len with s linear from s0 to s1: len/s0 * ln(1+r)/r,
+// r = (s1 - s0)/s0. The series keeps it accurate when s barely varies (r -> 0).
+double segment_integral(double len, double s0, double s1) {
+  const double r = (s1 - s0) / s0;
+  const double phi = std::abs(r) < 1e-4 ? 1 - r / 2 + r * r / 3 - r * r * r / 4 : std::log1p(r) / r;
+  return len / s0 * phi;
+}
+
+// Inverse of the above: the fraction a/len of the segment where ∫_0^a dl / s reaches g.
+double segment_fraction(double len, double s0, double s1, double g) {
+  if (len <= 0) return 0;
+  const double r = (s1 - s0) / s0;
+  const double k = g * s0 / len;
+  const double kr = k * r;
+  const double f = std::abs(kr) < 1e-8 ? k * (1 + kr / 2) : std::expm1(kr) / r;
+  return std::clamp(f, 0.0, 1.0);
+}
+
+void check_sizes(LO c, const mesh::CurveMesh& m, const std::vector<double>& s) {
+  QSMESH_CHECK(s.size() == m.points.size(), "curve " << c << ": " << s.size() << " sizes for "
+                                                     << m.points.size() << " background vertices");
+  QSMESH_CHECK(m.t.size() == m.points.size() && m.points.size() >= 2,
+               "curve " << c << ": background mesh has " << m.points.size() << " points and "
+                        << m.t.size() << " parameters");
+  for (std::size_t i = 0; i < s.size(); ++i)
+    QSMESH_CHECK(std::isfinite(s[i]) && s[i] > 0,
+                 "curve " << c << ": size " << s[i] << " at background vertex " << i);
+}
+
+// Cumulative ∫ dl / s at the background vertices of one curve.
+std::vector<double> cumulative(const mesh::CurveMesh& m, const std::vector<double>& s) {
+  std::vector<double> f(m.points.size(), 0.0);
+  for (std::size_t i = 0; i + 1 < m.points.size(); ++i)
+    f[i + 1] = f[i] + segment_integral(distance(m.points[i], m.points[i + 1]), s[i], s[i + 1]);
+  return f;
+}
+
+struct UnionFind {
+  std::vector<LO> parent;
+  explicit UnionFind(LO n) : parent(static_cast<std::size_t>(n)) {
+    std::iota(parent.begin(), parent.end(), 0);
+  }
+  LO find(LO a) {
+    while (parent[a] != a) {
+      parent[a] = parent[parent[a]];
+      a = parent[a];
+    }
+    return a;
+  }
+  // The smaller id becomes the root: the result does not depend on the order of the unions.
+  void join(LO a, LO b) {
+    a = find(a);
+    b = find(b);
+    if (a == b) return;
+    if (b < a) std::swap(a, b);
+    parent[b] = a;
+  }
+};
+
+}  // namespace
+
+std::vector<double> ideal_edge_counts(std::span<const mesh::CurveMesh> curves,
+                                      std::span<const std::vector<double>> sizes) {
+  QSMESH_CHECK(sizes.size() == curves.size(),
+               sizes.size() << " size lists for " << curves.size() << " curves");
+  std::vector<double> ideal(curves.size(), 0.0);
+  for (std::size_t c = 0; c < curves.size(); ++c) {
+    check_sizes(static_cast<LO>(c), curves[c], sizes[c]);
+    ideal[c] = cumulative(curves[c], sizes[c]).back();
+  }
+  return ideal;
+}
+
+Quantization quantize_curves(const cad::CadModel& model, std::span<const double> ideal,
+                             const QuantizeOptions& options) {
+  const LO nc = model.num_curves();
+  const auto curves = model.curves();
+  QSMESH_CHECK(static_cast<LO>(ideal.size()) == nc,
+               ideal.size() << " ideal edge counts for " << nc << " curves");
+  for (LO c = 0; c < nc; ++c)
+    QSMESH_CHECK(std::isfinite(ideal[c]) && ideal[c] >= 0,
+                 "curve " << c << ": ideal edge count " << ideal[c]);
+  QSMESH_CHECK(options.chord_ratio_limit >= 1,
+               "chord_ratio_limit " << options.chord_ratio_limit << " is below 1");
+
+  Quantization q;
+  q.ideal.assign(ideal.begin(), ideal.end());
+  q.edges.assign(static_cast<std::size_t>(nc), 0);
+  q.curve2chord.assign(static_cast<std::size_t>(nc), kNoIndex);
+
+  // Curves joining the same two corners: each needs 2 edges or the two meshes would coincide.
+  std::vector<bool> parallel(static_cast<std::size_t>(nc), false);
+  {
+    std::map<std::pair<LO, LO>, LO> first;
+    for (LO c = 0; c < nc; ++c) {
+      const auto& cv = curves[c];
+      if (cv.degenerate || cv.corners[0] == cv.corners[1]) continue;
+      const std::pair<LO, LO> key = std::minmax(cv.corners[0], cv.corners[1]);
+      const auto [it, inserted] = first.emplace(key, c);
+      if (!inserted) parallel[c] = parallel[it->second] = true;
+    }
+  }
+  const auto closed = [&](LO c) { return curves[c].corners[0] == curves[c].corners[1]; };
+  // Smallest count the rounding may give.
+  const auto minimum = [&](LO c) {
+    const bool coarse = options.even && options.halved_minimums;
+    if (closed(c)) return options.even ? (coarse ? 6 : 4) : 3;
+    if (parallel[c]) return coarse ? 4 : 2;
+    return options.even ? 2 : 1;
+  };
+  // Smallest count a prescription may ask for: what makes a valid curve mesh.
+  const auto hard_minimum = [&](LO c) { return closed(c) ? 3 : (parallel[c] ? 2 : 1); };
+
+  // Chords of conformal four-sided faces.
+  UnionFind uf(nc);
+  std::vector<bool> in_chord(static_cast<std::size_t>(nc), false);
+  for (const cad::Face& face : model.faces()) {
+    if (face.loops.size() != 1 || face.loops[0].uses.size() != 4 || !face.loops_closed) continue;
+    const auto& uses = face.loops[0].uses;
+    for (int k = 0; k < 2; ++k) {
+      const LO a = uses[k].curve, b = uses[k + 2].curve;
+      if (curves[a].degenerate || curves[b].degenerate) continue;
+      const double lo = std::min(ideal[a], ideal[b]), hi = std::max(ideal[a], ideal[b]);
+      if (hi > options.chord_ratio_limit * lo) continue;
+      uf.join(a, b);
+      in_chord[a] = in_chord[b] = true;
+    }
+  }
+  std::vector<LO> root2chord(static_cast<std::size_t>(nc), kNoIndex);
+  std::vector<std::vector<LO>> chords;
+  for (LO c = 0; c < nc; ++c) {
+    if (!in_chord[c]) continue;
+    LO& id = root2chord[uf.find(c)];
+    if (id == kNoIndex) {
+      id = static_cast<LO>(chords.size());
+      chords.emplace_back();
+    }
+    q.curve2chord[c] = id;
+    chords[id].push_back(c);
+  }
+  q.num_chords = static_cast<LO>(chords.size());
+  const auto members = [&](LO c) -> std::vector<LO> {
+    return q.curve2chord[c] == kNoIndex ? std::vector<LO>{c} : chords[q.curve2chord[c]];
+  };
+
+  // Prescriptions, checked in the order given; the first one of a chord fixes it.
+  std::vector<int> fixed(static_cast<std::size_t>(nc), 0);
+  std::vector<LO> fixed_by(static_cast<std::size_t>(nc), kNoIndex);
+  for (const auto& [c, n] : options.prescribed) {
+    if (c < 0 || c >= nc) {
+      std::ostringstream os;
+      os << "curve " << c
+         << ": edge count prescribed for a curve that does not exist (the model has " << nc
+         << " curves)";
+      throw InputError(os.str());
+    }
+    if (curves[c].degenerate)
+      throw InputError("curve " + std::to_string(c) + ": " + std::to_string(n) +
+                       " edges prescribed on a degenerate curve (a pole), which has no length");
+    if (n <= 0)
+      throw InputError("curve " + std::to_string(c) + ": " + std::to_string(n) +
+                       " edges prescribed, but a curve needs at least 1");
+    if (options.even && n % 2 != 0)
+      throw InputError("curve " + std::to_string(c) + ": " + std::to_string(n) +
+                       " edges prescribed, but all-quad meshing by midpoint subdivision needs an "
+                       "even count (odd counts are not supported yet)");
+    for (const LO m : members(c)) {
+      if (fixed[m] != 0 && fixed[m] != n) {
+        const LO other = fixed_by[m];
+        std::ostringstream os;
+        if (other == c)
+          os << "curve " << c << ": prescribed both " << fixed[m] << " and " << n << " edges";
+        else
+          os << "curves " << other << " and " << c
+             << " are topologically parallel (one chord of four-sided faces) but are prescribed "
+             << "different edge counts (" << fixed[m] << " and " << n << ")";
+        throw InputError(os.str());
+      }
+      if (n < hard_minimum(m)) {
+        std::ostringstream os;
+        os << "curve " << c << ": " << n << " edges prescribed, but ";
+        if (m != c) os << "curve " << m << ", in its chord, ";
+        os << (closed(m) ? "is closed and needs at least 3"
+                         : "shares both end corners with another curve and needs at least 2");
+        throw InputError(os.str());
+      }
+      fixed[m] = n;
+      fixed_by[m] = c;
+    }
+  }
+
+  const auto round = [&](double x, int lo) {
+    const long n = options.even ? 2 * std::lround(x / 2) : std::lround(x);
+    return std::max(static_cast<int>(n), lo);
+  };
+  for (LO c = 0; c < nc; ++c) {
+    if (curves[c].degenerate) continue;
+    if (fixed[c] != 0) {
+      q.edges[c] = fixed[c];
+    } else if (q.curve2chord[c] == kNoIndex) {
+      q.edges[c] = round(ideal[c], minimum(c));
+    } else if (chords[q.curve2chord[c]].front() == c) {
+      // Average the ideal values over the chord, each curve once, in increasing id (deterministic).
+      const auto& chord = chords[q.curve2chord[c]];
+      double sum = 0;
+      int lo = 0;
+      for (const LO m : chord) {
+        sum += ideal[m];
+        lo = std::max(lo, minimum(m));
+      }
+      const int n = round(sum / static_cast<double>(chord.size()), lo);
+      for (const LO m : chord) q.edges[m] = n;
+    }
+  }
+  q.total_edges = std::accumulate(q.edges.begin(), q.edges.end(), std::int64_t{0});
+  return q;
+}
+
+std::vector<mesh::CurveMesh> place_vertices(const cad::CadModel& model,
+                                            std::span<const mesh::CurveMesh> curves,
+                                            std::span<const std::vector<double>> sizes,
+                                            const Quantization& q, bool halved,
+                                            const TaskArena& tasks) {
+  const LO nc = model.num_curves();
+  QSMESH_CHECK(static_cast<LO>(curves.size()) == nc,
+               curves.size() << " background curve meshes for " << nc << " curves");
+  QSMESH_CHECK(static_cast<LO>(sizes.size()) == nc, sizes.size()
+                                                        << " size lists for " << nc << " curves");
+  QSMESH_CHECK(static_cast<LO>(q.edges.size()) == nc,
+               q.edges.size() << " edge counts for " << nc << " curves");
+  std::vector<mesh::CurveMesh> out(static_cast<std::size_t>(nc));
+  tasks.parallel_for(nc, [&](std::int64_t ci) {
+    const LO c = static_cast<LO>(ci);
+    const cad::Curve& curve = model.curves()[c];
+    const mesh::CurveMesh& bg = curves[c];
+    mesh::CurveMesh& m = out[c];
+    if (curve.degenerate) {
+      m = bg;
+      m.curve = c;
+      return;
+    }
+    check_sizes(c, bg, sizes[c]);
+    const int total_edges = q.edges[c];
+    QSMESH_CHECK(!halved || total_edges % 2 == 0,
+                 "curve " << c << ": " << total_edges << " edges cannot be halved");
+    const int n = halved ? total_edges / 2 : total_edges;
+    QSMESH_CHECK(n >= 1, "curve " << c << ": " << n << " edges asked for");
+
+    const std::vector<double> f = cumulative(bg, sizes[c]);
+    const double total = f.back();
+    m.curve = c;
+    m.t.resize(static_cast<std::size_t>(n) + 1);
+    m.t.front() = bg.t.front();
+    m.t.back() = bg.t.back();
+    if (!(total > 0)) {
+      // A background polyline of zero length (a curve shorter than its tolerance): equal steps in
+      // t.
+      for (int i = 1; i < n; ++i) m.t[i] = bg.t.front() + (bg.t.back() - bg.t.front()) * i / n;
+    } else {
+      std::size_t j = 0;
+      const std::size_t last = f.size() - 2;
+      for (int i = 1; i < n; ++i) {
+        const double target = total * i / n;
+        while (j < last && f[j + 1] < target) ++j;
+        const double len = distance(bg.points[j], bg.points[j + 1]);
+        const double frac = segment_fraction(len, sizes[c][j], sizes[c][j + 1], target - f[j]);
+        m.t[i] = bg.t[j] + frac * (bg.t[j + 1] - bg.t[j]);
+      }
+    }
+    m.points.resize(m.t.size());
+    m.points.front() = model.corners()[curve.corners[0]].point;
+    m.points.back() = model.corners()[curve.corners[1]].point;
+    if (n > 1) {
+      const auto geometry = model.curve_geometry(c);
+      for (int i = 1; i < n; ++i) m.points[i] = geometry->point(m.t[i]);
+    }
+  });
+  return out;
+}
+
+}  // namespace qsmesh::quantize

@@ -1,0 +1,410 @@
+#include "qsmesh/sizemap/size_map.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <queue>
+#include <sstream>
+#include <string>
+
+#include "qsmesh/background/feature_size.hpp"
+#include "qsmesh/core/error.hpp"
+
+namespace qsmesh::sizemap {
+
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+[[noreturn]] void input_error(const std::string& what) { throw InputError("sizemap: " + what); }
+
+void check_entities(const std::vector<std::pair<LO, double>>& list, LO count, const char* kind) {
+  for (const auto& [id, value] : list) {
+    if (id < 0 || id >= count) {
+      std::ostringstream os;
+      os << kind << " size constraint on " << kind << " " << id << ", but the model has " << count
+         << " " << kind << "s";
+      input_error(os.str());
+    }
+    if (!(value > 0) || !std::isfinite(value)) {
+      std::ostringstream os;
+      os << kind << " " << id << ": size " << value << " must be a positive number";
+      input_error(os.str());
+    }
+  }
+}
+
+void validate(const cad::CadModel& model, const SizeMapOptions& options) {
+  (void)effective_size_min(options);
+  if (!(options.gradation >= 0) || !std::isfinite(options.gradation))
+    input_error("gradation must be >= 0");
+  check_entities(options.corner_sizes, model.num_corners(), "corner");
+  check_entities(options.curve_sizes, model.num_curves(), "curve");
+  check_entities(options.face_sizes, model.num_faces(), "face");
+}
+
+/// Eq. 10 to its fixed point by Dijkstra: s(v) = min(s0(v), min over edges (u, v) of s(u) + g d(u,
+/// v)). The fixed point is unique, so the result does not depend on the order of equal keys; the
+/// heap orders by (value, vertex) anyway.
+void propagate(std::vector<double>& s, const std::vector<LO>& offsets,
+               const std::vector<LO>& targets, const std::vector<double>& weights) {
+  using Item = std::pair<double, LO>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<>> heap;
+  for (LO v = 0; v < static_cast<LO>(s.size()); ++v)
+    if (std::isfinite(s[v])) heap.emplace(s[v], v);
+  while (!heap.empty()) {
+    const auto [value, u] = heap.top();
+    heap.pop();
+    if (value > s[u]) continue;  // stale entry
+    for (LO k = offsets[u]; k < offsets[u + 1]; ++k) {
+      const LO v = targets[k];
+      const double candidate = value + weights[k];
+      if (candidate < s[v]) {
+        s[v] = candidate;
+        heap.emplace(candidate, v);
+      }
+    }
+  }
+}
+
+/// CSR graph with weights g * |a - b| from an undirected edge list.
+struct Graph {
+  std::vector<LO> offsets, targets;
+  std::vector<double> weights;
+};
+Graph make_graph(LO n, const std::vector<std::array<LO, 2>>& edges,
+                 const std::vector<double>& lengths, double gradation) {
+  Graph g;
+  g.offsets.assign(static_cast<std::size_t>(n) + 1, 0);
+  for (const auto& [a, b] : edges) {
+    ++g.offsets[a + 1];
+    ++g.offsets[b + 1];
+  }
+  for (LO v = 0; v < n; ++v) g.offsets[v + 1] += g.offsets[v];
+  g.targets.resize(g.offsets.back());
+  g.weights.resize(g.offsets.back());
+  std::vector<LO> fill(g.offsets.begin(), g.offsets.end() - 1);
+  for (std::size_t e = 0; e < edges.size(); ++e) {
+    const auto [a, b] = edges[e];
+    const double w = gradation * lengths[e];
+    g.targets[fill[a]] = b;
+    g.weights[fill[a]++] = w;
+    g.targets[fill[b]] = a;
+    g.weights[fill[b]++] = w;
+  }
+  return g;
+}
+
+double user_size(const std::vector<std::pair<LO, double>>& list, LO id) {
+  double s = kInf;
+  for (const auto& [i, v] : list)
+    if (i == id) s = std::min(s, v);
+  return s;
+}
+
+void check_shape(const CurveSizes& sizes, std::span<const mesh::CurveMesh> curves, LO num_corners) {
+  QSMESH_CHECK(sizes.at.size() == curves.size(), "sizemap: curve sizes for "
+                                                     << sizes.at.size() << " curves, "
+                                                     << curves.size() << " curve meshes");
+  for (std::size_t c = 0; c < curves.size(); ++c)
+    QSMESH_CHECK(sizes.at[c].size() == curves[c].t.size(),
+                 "sizemap: curve " << c << " has " << sizes.at[c].size() << " size values for "
+                                   << curves[c].t.size() << " vertices");
+  QSMESH_CHECK(
+      num_corners < 0 || sizes.corner.size() == static_cast<std::size_t>(num_corners),
+      "sizemap: " << sizes.corner.size() << " corner sizes for " << num_corners << " corners");
+}
+
+}  // namespace
+
+double effective_size_min(const SizeMapOptions& options) {
+  if (!(options.size_max > 0) || !std::isfinite(options.size_max))
+    input_error("the size cap (--size / --size-factor) must be > 0");
+  if (!(options.size_min >= 0) || options.size_min > options.size_max)
+    input_error("the smallest size must be >= 0 and no larger than the size cap");
+  double floor = options.size_min > 0 ? options.size_min : options.size_max / 100;
+  for (const auto* list : {&options.corner_sizes, &options.curve_sizes, &options.face_sizes})
+    for (const auto& [id, v] : *list)
+      if (v > 0) floor = std::min(floor, v);
+  return floor;
+}
+
+std::vector<double> CurveSizes::pack() const {
+  std::vector<double> flat;
+  std::size_t n = corner.size();
+  for (const auto& a : at) n += a.size();
+  flat.reserve(n);
+  for (const auto& a : at) flat.insert(flat.end(), a.begin(), a.end());
+  flat.insert(flat.end(), corner.begin(), corner.end());
+  return flat;
+}
+
+void CurveSizes::unpack(std::span<const double> flat) {
+  std::size_t n = corner.size();
+  for (const auto& a : at) n += a.size();
+  QSMESH_CHECK(flat.size() == n, "sizemap: unpack of " << flat.size() << " values into " << n);
+  std::size_t k = 0;
+  for (auto& a : at)
+    for (double& x : a) x = flat[k++];
+  for (double& x : corner) x = flat[k++];
+}
+
+CurveSizes make_curve_sizes(std::span<const mesh::CurveMesh> curves, LO num_corners, double value) {
+  CurveSizes s;
+  s.at.resize(curves.size());
+  for (std::size_t c = 0; c < curves.size(); ++c) s.at[c].assign(curves[c].t.size(), value);
+  s.corner.assign(static_cast<std::size_t>(std::max<LO>(num_corners, 0)), value);
+  return s;
+}
+
+CurveSizes initial_curve_sizes(const cad::CadModel& model, std::span<const mesh::CurveMesh> curves,
+                               const SizeMapOptions& options, const TaskArena& tasks) {
+  validate(model, options);
+  const LO nc = model.num_curves();
+  QSMESH_CHECK(static_cast<LO>(curves.size()) == nc,
+               "sizemap: " << curves.size() << " curve meshes for " << nc << " curves");
+  const double floor = effective_size_min(options);
+  CurveSizes out = make_curve_sizes(curves, model.num_corners(), options.size_max);
+  auto cap_curve = [&](LO c, double v) {
+    for (double& x : out.at[c]) x = std::min(x, v);
+  };
+  for (const auto& [c, v] : options.curve_sizes) cap_curve(c, v);
+  for (const auto& [f, v] : options.face_sizes)
+    for (const auto& loop : model.faces()[f].loops)
+      for (const auto& use : loop.uses) cap_curve(use.curve, v);
+
+  // (i) no larger than the curve's length, even below the floor: a curve gets at least one edge,
+  //     and the faces around a very short curve grade out from it.
+  for (LO c = 0; c < nc; ++c) {
+    const auto& cc = model.curves()[c];
+    if (!cc.degenerate) cap_curve(c, cc.length);
+  }
+
+  // (ii) no larger than the distance to the nearest curve sharing no corner. The search only finds
+  //      polyline vertices within the current size, so the curve meshes are densified: a segment
+  //      much longer than the size could otherwise pass close by with both its ends out of reach.
+  {
+    std::vector<std::vector<Vec3>> dense(nc);
+    std::vector<std::vector<double>> h(nc);
+    std::vector<std::vector<LO>> original(nc);  // dense index of each curve-mesh vertex
+    double cell = 0;
+    for (LO c = 0; c < nc; ++c) {
+      if (model.curves()[c].degenerate) continue;
+      const auto& p = curves[c].points;
+      const auto& s = out.at[c];
+      for (std::size_t i = 0; i < p.size(); ++i) {
+        original[c].push_back(static_cast<LO>(dense[c].size()));
+        dense[c].push_back(p[i]);
+        h[c].push_back(s[i]);
+        cell = std::max(cell, s[i]);
+        if (i + 1 == p.size()) break;
+        const double piece = 0.5 * std::min(s[i], s[i + 1]);
+        const double length = distance(p[i], p[i + 1]);
+        const int pieces = std::clamp(static_cast<int>(std::ceil(length / piece)), 1, 16);
+        for (int k = 1; k < pieces; ++k) {
+          const double a = static_cast<double>(k) / pieces;
+          dense[c].push_back(p[i] * (1 - a) + p[i + 1] * a);
+          h[c].push_back(s[i] * (1 - a) + s[i + 1] * a);
+        }
+      }
+    }
+    if (cell > 0) {
+      // Gaps narrower than a tenth of the floor are curves touching or lying on top of each other
+      // (unsewn or sloppy models), not features a mesh could resolve.
+      background::limit_by_feature_distance(model, dense, h, 0.1 * floor, floor, cell, tasks);
+      for (LO c = 0; c < nc; ++c)
+        for (std::size_t i = 0; i < original[c].size(); ++i)
+          out.at[c][i] = std::min(out.at[c][i], h[c][original[c][i]]);
+    }
+  }
+
+  for (const auto& [k, v] : options.corner_sizes) out.corner[k] = std::min(out.corner[k], v);
+  grade_curves(model, curves, options.gradation, out);
+  return out;
+}
+
+std::vector<double> face_quad_targets(const cad::CadModel& model, const SizeMapOptions& options) {
+  const LO nf = model.num_faces();
+  double total = 0;
+  for (const auto& f : model.faces()) total += f.area;
+  double n = options.target_quads;
+  if (!(n >= 0) || !std::isfinite(n)) input_error("the target number of quads must be >= 0");
+  if (n == 0) {
+    if (!(options.size_max > 0)) input_error("the size cap (--size / --size-factor) must be > 0");
+    n = total / (options.size_max * options.size_max);
+  }
+  std::vector<double> out(static_cast<std::size_t>(nf), 0.0);
+  for (LO f = 0; f < nf; ++f) out[f] = total > 0 ? model.faces()[f].area / total * n : n / nf;
+  for (const auto& [f, q] : options.face_quads) {
+    if (f < 0 || f >= nf) {
+      std::ostringstream os;
+      os << "quad count given for face " << f << ", but the model has " << nf << " faces";
+      input_error(os.str());
+    }
+    if (!(q >= 0) || !std::isfinite(q)) {
+      std::ostringstream os;
+      os << "face " << f << ": quad count " << q << " must be >= 0";
+      input_error(os.str());
+    }
+    out[f] = q;
+  }
+  return out;
+}
+
+FaceSizes face_sizes(const mesh::FaceMesh& background, const crossfield::FaceCrossField* cf,
+                     std::span<const mesh::CurveMesh> curves, const CurveSizes& curve,
+                     double face_quads, const SizeMapOptions& options) {
+  const double floor = effective_size_min(options);
+  check_shape(curve, curves, -1);
+  const LO n = background.num_vertices();
+  FaceSizes out;
+  if (n == 0 || background.triangles.empty()) return out;
+
+  // Seams and poles must be interior for the propagation: work on the glued triangulation.
+  crossfield::FaceCrossField local;
+  const crossfield::FaceCrossField* glued = cf;
+  if (glued == nullptr) {
+    crossfield::glue_triangulation(background, local);
+    glued = &local;
+  }
+  QSMESH_CHECK(glued->input2glued.size() == static_cast<std::size_t>(n),
+               "sizemap: face " << background.face << ": the cross field is of another mesh ("
+                                << glued->input2glued.size() << " vertices, the face has " << n
+                                << ")");
+  const auto ng = static_cast<LO>(glued->points.size());
+
+  std::vector<double> s_min(ng, kInf);
+  for (LO v = 0; v < n; ++v) {
+    const auto& vc = background.vclass[v];
+    double value = kInf;
+    if (vc.dim == 1) {
+      QSMESH_CHECK(vc.entity >= 0 && vc.entity < static_cast<LO>(curve.at.size()) &&
+                       vc.index >= 0 && vc.index < static_cast<LO>(curve.at[vc.entity].size()),
+                   "sizemap: face " << background.face << " vertex " << v << " on curve "
+                                    << vc.entity << " index " << vc.index << " has no curve size");
+      value = curve.at[vc.entity][vc.index];
+    } else if (vc.dim == 0) {
+      QSMESH_CHECK(vc.entity >= 0 && vc.entity < static_cast<LO>(curve.corner.size()),
+                   "sizemap: face " << background.face << " vertex " << v << " on corner "
+                                    << vc.entity << " has no corner size");
+      value = curve.corner[vc.entity];
+    } else {
+      continue;
+    }
+    const LO g = glued->input2glued[v];
+    s_min[g] = std::min(s_min[g], value);
+  }
+
+  std::vector<double> s_cf;
+  if (options.method == Method::CrossField && cf != nullptr && face_quads > 0 &&
+      cf->H.size() == static_cast<std::size_t>(ng)) {
+    const double c = crossfield::scaling_constant(*cf, face_quads);
+    s_cf.resize(ng);
+    // H grows without bound near singularities: the floor keeps s_cf usable there.
+    for (LO g = 0; g < ng; ++g) s_cf[g] = std::max(floor, std::exp(cf->H[g] + c));
+  }
+
+  std::vector<double> lengths(glued->edges.size());
+  for (std::size_t e = 0; e < glued->edges.size(); ++e)
+    lengths[e] = distance(glued->points[glued->edges[e][0]], glued->points[glued->edges[e][1]]);
+  const Graph graph = make_graph(ng, glued->edges, lengths, options.gradation);
+
+  // s = min(s_cf, s_min) graded: Eq. 10 is min-plus linear, so grading the minimum of the two
+  // initial fields gives the minimum of the two graded fields.
+  std::vector<double> s = s_min;
+  if (!s_cf.empty())
+    for (LO g = 0; g < ng; ++g) s[g] = std::min(s[g], s_cf[g]);
+  propagate(s_min, graph.offsets, graph.targets, graph.weights);
+  propagate(s, graph.offsets, graph.targets, graph.weights);
+
+  // A constant cap keeps the gradation bound (|min(a,c) - min(b,c)| <= |a - b|). No floor here:
+  // the sources are already floored, except the sizes of curves shorter than the floor, which the
+  // faces must follow.
+  const double cap = std::min(options.size_max, user_size(options.face_sizes, background.face));
+  auto clamp = [&](double x) { return std::min(cap, x); };
+  out.s.resize(n);
+  out.s_min.resize(n);
+  if (!s_cf.empty()) out.s_cf.resize(n);
+  for (LO v = 0; v < n; ++v) {
+    const LO g = glued->input2glued[v];
+    out.s[v] = clamp(s[g]);
+    out.s_min[v] = clamp(s_min[g]);
+    if (!s_cf.empty()) out.s_cf[v] = s_cf[g];
+  }
+  return out;
+}
+
+void fold_boundary_min(const mesh::FaceMesh& background, std::span<const double> values,
+                       CurveSizes& into) {
+  const LO n = background.num_vertices();
+  QSMESH_CHECK(values.size() == static_cast<std::size_t>(n),
+               "sizemap: face " << background.face << ": " << values.size() << " values for " << n
+                                << " vertices");
+  for (LO v = 0; v < n; ++v) {
+    const auto& vc = background.vclass[v];
+    if (vc.dim == 1) {
+      QSMESH_CHECK(vc.entity >= 0 && vc.entity < static_cast<LO>(into.at.size()) && vc.index >= 0 &&
+                       vc.index < static_cast<LO>(into.at[vc.entity].size()),
+                   "sizemap: face " << background.face << " vertex " << v << " on curve "
+                                    << vc.entity << " index " << vc.index
+                                    << " is outside the curve sizes");
+      double& x = into.at[vc.entity][vc.index];
+      x = std::min(x, values[v]);
+    } else if (vc.dim == 0) {
+      QSMESH_CHECK(vc.entity >= 0 && vc.entity < static_cast<LO>(into.corner.size()),
+                   "sizemap: face " << background.face << " vertex " << v << " on corner "
+                                    << vc.entity << " is outside the corner sizes");
+      double& x = into.corner[vc.entity];
+      x = std::min(x, values[v]);
+    }
+  }
+}
+
+void grade_curves(const cad::CadModel& model, std::span<const mesh::CurveMesh> curves,
+                  double gradation, CurveSizes& sizes) {
+  const LO nc = model.num_curves(), nk = model.num_corners();
+  QSMESH_CHECK(static_cast<LO>(curves.size()) == nc,
+               "sizemap: " << curves.size() << " curve meshes for " << nc << " curves");
+  check_shape(sizes, curves, nk);
+
+  // Graph nodes: corners first, then the interior vertices of every curve mesh.
+  std::vector<LO> base(static_cast<std::size_t>(nc) + 1, nk);
+  for (LO c = 0; c < nc; ++c)
+    base[c + 1] = base[c] + std::max<LO>(static_cast<LO>(curves[c].t.size()) - 2, 0);
+  auto node = [&](LO c, std::size_t i) -> LO {
+    const auto& cc = model.curves()[c];
+    if (i == 0) return cc.corners[0];
+    if (i + 1 == curves[c].t.size()) return cc.corners[1];
+    return base[c] + static_cast<LO>(i) - 1;
+  };
+
+  std::vector<double> s(static_cast<std::size_t>(base[nc]), kInf);
+  for (LO k = 0; k < nk; ++k) s[k] = sizes.corner[k];
+  std::vector<std::array<LO, 2>> edges;
+  std::vector<double> lengths;
+  for (LO c = 0; c < nc; ++c) {
+    const auto& at = sizes.at[c];
+    const auto& p = curves[c].points;
+    for (std::size_t i = 0; i < at.size(); ++i) {
+      const LO v = node(c, i);
+      QSMESH_CHECK(v >= 0, "sizemap: curve " << c << " has no corner at an end");
+      s[v] = std::min(s[v], at[i]);
+    }
+    if (model.curves()[c].degenerate) continue;
+    for (std::size_t i = 0; i + 1 < at.size(); ++i) {
+      const LO a = node(c, i), b = node(c, i + 1);
+      if (a == b) continue;
+      edges.push_back({a, b});
+      lengths.push_back(distance(p[i], p[i + 1]));
+    }
+  }
+  const Graph graph = make_graph(static_cast<LO>(s.size()), edges, lengths, gradation);
+  propagate(s, graph.offsets, graph.targets, graph.weights);
+
+  for (LO k = 0; k < nk; ++k) sizes.corner[k] = s[k];
+  for (LO c = 0; c < nc; ++c)
+    for (std::size_t i = 0; i < sizes.at[c].size(); ++i) sizes.at[c][i] = s[node(c, i)];
+}
+
+}  // namespace qsmesh::sizemap

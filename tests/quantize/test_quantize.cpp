@@ -1,0 +1,492 @@
+#include <gtest/gtest.h>
+
+#include <BRepBuilderAPI_MakeFace.hxx>
+#include <BRepBuilderAPI_MakePolygon.hxx>
+#include <BRepPrimAPI_MakeBox.hxx>
+#include <BRepTools.hxx>
+#include <TopoDS_Shape.hxx>
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <gp_Pnt.hxx>
+#include <iostream>
+#include <map>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "qsmesh/background/curve_mesh.hpp"
+#include "qsmesh/core/error.hpp"
+#include "qsmesh/quantize/quantize.hpp"
+#include "shapes.hpp"
+
+namespace qsmesh::quantize {
+namespace {
+
+std::string tmp(const std::string& name) { return std::string(QSMESH_TEST_TMP_DIR) + "/" + name; }
+
+cad::CadModel load(const TopoDS_Shape& shape, const std::string& name) {
+  const std::string path = tmp(name);
+  if (!BRepTools::Write(shape, path.c_str())) throw std::runtime_error("cannot write " + path);
+  return cad::load_cad(path);
+}
+
+// A planar polygonal face through the given (x, y) points.
+cad::CadModel polygon_face(const std::vector<std::pair<double, double>>& xy,
+                           const std::string& name) {
+  BRepBuilderAPI_MakePolygon poly;
+  for (const auto& [x, y] : xy) poly.Add(gp_Pnt(x, y, 0));
+  poly.Close();
+  BRepBuilderAPI_MakeFace face(poly.Wire(), /*OnlyPlane=*/true);
+  if (!face.IsDone()) throw std::runtime_error("face construction failed");
+  return load(face.Shape(), name);
+}
+
+// Curves of face 0's outer loop, in loop order.
+std::vector<LO> loop_curves(const cad::CadModel& model) {
+  std::vector<LO> out;
+  for (const auto& use : model.faces()[0].loops[0].uses) out.push_back(use.curve);
+  return out;
+}
+
+// Ideal values given per loop use of face 0.
+std::vector<double> ideal_by_use(const cad::CadModel& model, const std::vector<double>& by_use) {
+  std::vector<double> ideal(static_cast<std::size_t>(model.num_curves()), 0.0);
+  const auto loop = loop_curves(model);
+  EXPECT_EQ(loop.size(), by_use.size());
+  for (std::size_t k = 0; k < loop.size(); ++k) ideal[loop[k]] = by_use[k];
+  return ideal;
+}
+
+std::vector<int> edges_by_use(const cad::CadModel& model, const Quantization& q) {
+  std::vector<int> out;
+  for (const LO c : loop_curves(model)) out.push_back(q.edges[c]);
+  return out;
+}
+
+// Background mesh of curve c: m + 1 vertices at equal parameter steps.
+mesh::CurveMesh uniform_background(const cad::CadModel& model, LO c, int m) {
+  const auto& curve = model.curves()[c];
+  const auto geometry = model.curve_geometry(c);
+  mesh::CurveMesh bg;
+  bg.curve = c;
+  for (int i = 0; i <= m; ++i) {
+    const double t = curve.t0 + (curve.t1 - curve.t0) * i / m;
+    bg.t.push_back(t);
+    bg.points.push_back(geometry->point(t));
+  }
+  bg.points.front() = model.corners()[curve.corners[0]].point;
+  bg.points.back() = model.corners()[curve.corners[1]].point;
+  return bg;
+}
+
+// Arc length along a polyline, at each vertex.
+std::vector<double> arc_length(const std::vector<Vec3>& p) {
+  std::vector<double> x(p.size(), 0.0);
+  for (std::size_t i = 1; i < p.size(); ++i) x[i] = x[i - 1] + distance(p[i - 1], p[i]);
+  return x;
+}
+
+const cad::CadModel& rectangle() {
+  static const cad::CadModel model =
+      polygon_face({{0, 0}, {10, 0}, {10, 4}, {0, 4}}, "q_rect.brep");
+  return model;
+}
+
+const cad::CadModel& box() {
+  static const cad::CadModel model =
+      load(BRepPrimAPI_MakeBox(10.0, 6.0, 4.0).Shape(), "q_box.brep");
+  return model;
+}
+
+// Box ideals: curves of length 10, 6, 4 around 14.6, 8.6, 6.4, alternately 0.9 below and above,
+// so that rounding each curve alone would give different counts within a chord.
+std::vector<double> box_ideals(const cad::CadModel& model) {
+  const std::map<long, double> base{{10, 14.6}, {6, 8.6}, {4, 6.4}};
+  std::map<long, int> seen;
+  std::vector<double> ideal;
+  for (const auto& c : model.curves()) {
+    const long len = std::lround(c.length);
+    ideal.push_back(base.at(len) + (seen[len]++ % 2 == 0 ? -0.9 : 0.9));
+  }
+  return ideal;
+}
+
+TEST(Quantize, PaperRectangleGetsEqualOppositeSides) {
+  const auto& model = rectangle();
+  ASSERT_EQ(model.num_faces(), 1);
+  ASSERT_EQ(model.faces()[0].loops[0].uses.size(), 4u);
+  const auto ideal = ideal_by_use(model, {9.4, 4.1, 10.6, 3.9});
+  const Quantization q = quantize_curves(model, ideal, {});
+  EXPECT_EQ(edges_by_use(model, q), (std::vector<int>{10, 4, 10, 4}));
+  EXPECT_EQ(q.num_chords, 2);
+  const auto loop = loop_curves(model);
+  EXPECT_EQ(q.curve2chord[loop[0]], q.curve2chord[loop[2]]);
+  EXPECT_EQ(q.curve2chord[loop[1]], q.curve2chord[loop[3]]);
+  EXPECT_NE(q.curve2chord[loop[0]], q.curve2chord[loop[1]]);
+  EXPECT_EQ(q.total_edges, 28);
+  EXPECT_EQ(q.ideal, ideal);
+
+  QuantizeOptions odd_ok;
+  odd_ok.even = false;  // plain rounding would give [9, 4, 11, 4]
+  EXPECT_EQ(edges_by_use(model, quantize_curves(model, ideal, odd_ok)),
+            (std::vector<int>{10, 4, 10, 4}));
+}
+
+TEST(Quantize, FiveSidedFaceIsRoundedCurveByCurve) {
+  const auto model = polygon_face({{0, 0}, {10, 0}, {12, 3}, {6, 7}, {0, 4}}, "q_penta.brep");
+  ASSERT_EQ(model.faces()[0].loops[0].uses.size(), 5u);
+  const auto ideal = ideal_by_use(model, {9.4, 4.1, 11.2, 3.9, 6.8});
+  const Quantization q = quantize_curves(model, ideal, {});
+  EXPECT_EQ(edges_by_use(model, q), (std::vector<int>{10, 4, 12, 4, 6}));
+  EXPECT_EQ(q.num_chords, 0);
+  for (const LO ch : q.curve2chord) EXPECT_EQ(ch, kNoIndex);
+
+  QuantizeOptions odd_ok;
+  odd_ok.even = false;
+  EXPECT_EQ(edges_by_use(model, quantize_curves(model, ideal, odd_ok)),
+            (std::vector<int>{9, 4, 11, 4, 7}));
+}
+
+TEST(Quantize, BoxChordsGoAroundTheBox) {
+  const auto& model = box();
+  ASSERT_EQ(model.num_curves(), 12);
+  ASSERT_EQ(model.num_faces(), 6);
+  const auto ideal = box_ideals(model);
+  const Quantization q = quantize_curves(model, ideal, {});
+  EXPECT_EQ(q.num_chords, 3);
+  // Each chord holds the 4 curves of one direction (one length), all with the same count: the
+  // even rounding of their average ideal value (14.6, 8.6, 6.4 -> 14, 8, 6).
+  const std::map<long, int> expected{{10, 14}, {6, 8}, {4, 6}};
+  std::map<LO, std::set<long>> chord_lengths;
+  std::map<LO, int> chord_size;
+  std::int64_t total = 0;
+  for (LO c = 0; c < model.num_curves(); ++c) {
+    const long len = std::lround(model.curves()[c].length);
+    ASSERT_NE(q.curve2chord[c], kNoIndex) << "curve " << c;
+    chord_lengths[q.curve2chord[c]].insert(len);
+    ++chord_size[q.curve2chord[c]];
+    EXPECT_EQ(q.edges[c], expected.at(len)) << "curve " << c << " ideal " << ideal[c];
+    total += q.edges[c];
+  }
+  for (const auto& [ch, lengths] : chord_lengths) {
+    EXPECT_EQ(lengths.size(), 1u) << "chord " << ch;
+    EXPECT_EQ(chord_size[ch], 4) << "chord " << ch;
+  }
+  EXPECT_EQ(q.total_edges, total);
+  EXPECT_EQ(total, 4 * (14 + 8 + 6));
+  // Deterministic.
+  const Quantization again = quantize_curves(model, ideal, {});
+  EXPECT_EQ(again.edges, q.edges);
+  EXPECT_EQ(again.curve2chord, q.curve2chord);
+}
+
+TEST(Quantize, PrescribedEvenCountFixesItsChord) {
+  const auto& model = box();
+  const auto ideal = box_ideals(model);
+  const Quantization free = quantize_curves(model, ideal, {});
+  QuantizeOptions options;
+  options.prescribed = {{0, 20}};
+  const Quantization q = quantize_curves(model, ideal, options);
+  EXPECT_EQ(q.edges[0], 20);
+  for (LO c = 0; c < model.num_curves(); ++c) {
+    if (q.curve2chord[c] == q.curve2chord[0])
+      EXPECT_EQ(q.edges[c], 20) << "curve " << c;
+    else
+      EXPECT_EQ(q.edges[c], free.edges[c]) << "curve " << c;
+  }
+  // Two agreeing prescriptions in one chord are fine.
+  LO partner = kNoIndex;
+  for (LO c = 1; c < model.num_curves(); ++c)
+    if (q.curve2chord[c] == q.curve2chord[0]) partner = c;
+  ASSERT_NE(partner, kNoIndex);
+  options.prescribed = {{0, 20}, {partner, 20}};
+  EXPECT_EQ(quantize_curves(model, ideal, options).edges[partner], 20);
+  // An odd prescription is kept when odd counts are allowed.
+  options.prescribed = {{0, 7}};
+  options.even = false;
+  const Quantization odd = quantize_curves(model, ideal, options);
+  EXPECT_EQ(odd.edges[0], 7);
+  EXPECT_EQ(odd.edges[partner], 7);
+}
+
+TEST(Quantize, OddPrescriptionIsRefused) {
+  const auto& model = box();
+  QuantizeOptions options;
+  options.prescribed = {{3, 7}};
+  try {
+    (void)quantize_curves(model, box_ideals(model), options);
+    FAIL() << "odd prescription accepted";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(
+        e.what(),
+        "curve 3: 7 edges prescribed, but all-quad meshing by midpoint subdivision needs an "
+        "even count (odd counts are not supported yet)");
+  }
+}
+
+TEST(Quantize, ConflictingPrescriptionsAreRefused) {
+  const auto& model = box();
+  const auto ideal = box_ideals(model);
+  const Quantization q = quantize_curves(model, ideal, {});
+  LO partner = kNoIndex, other = kNoIndex;
+  for (LO c = 1; c < model.num_curves(); ++c) {
+    if (q.curve2chord[c] == q.curve2chord[0])
+      partner = c;
+    else
+      other = c;
+  }
+  ASSERT_NE(partner, kNoIndex);
+  QuantizeOptions options;
+  options.prescribed = {{0, 14}, {partner, 16}};
+  try {
+    (void)quantize_curves(model, ideal, options);
+    FAIL() << "conflicting prescriptions accepted";
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_EQ(msg.rfind("curves 0 and " + std::to_string(partner) + " ", 0), 0u) << msg;
+    EXPECT_NE(msg.find("14"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("16"), std::string::npos) << msg;
+    std::cout << msg << "\n";
+  }
+  // Different counts on curves of different chords are fine.
+  options.prescribed = {{0, 14}, {other, 16}};
+  const Quantization ok = quantize_curves(model, ideal, options);
+  EXPECT_EQ(ok.edges[0], 14);
+  EXPECT_EQ(ok.edges[other], 16);
+  // Unknown curve, non-positive count.
+  options.prescribed = {{model.num_curves(), 4}};
+  EXPECT_THROW((void)quantize_curves(model, ideal, options), InputError);
+  options.prescribed = {{0, 0}};
+  EXPECT_THROW((void)quantize_curves(model, ideal, options), InputError);
+}
+
+TEST(Quantize, RatioLimitKeepsVeryDifferentSidesApart) {
+  const auto& model = rectangle();
+  const auto ideal = ideal_by_use(model, {10, 4, 40, 4});
+  const auto loop = loop_curves(model);
+  const Quantization q = quantize_curves(model, ideal, {});
+  EXPECT_EQ(edges_by_use(model, q), (std::vector<int>{10, 4, 40, 4}));
+  EXPECT_EQ(q.curve2chord[loop[0]], kNoIndex);
+  EXPECT_EQ(q.curve2chord[loop[2]], kNoIndex);
+  EXPECT_NE(q.curve2chord[loop[1]], kNoIndex);
+  EXPECT_EQ(q.curve2chord[loop[1]], q.curve2chord[loop[3]]);
+  EXPECT_EQ(q.num_chords, 1);
+  // A looser limit joins them: average 25 -> 26.
+  QuantizeOptions loose;
+  loose.chord_ratio_limit = 5;
+  const Quantization j = quantize_curves(model, ideal, loose);
+  EXPECT_EQ(edges_by_use(model, j), (std::vector<int>{26, 4, 26, 4}));
+  EXPECT_EQ(j.num_chords, 2);
+}
+
+TEST(Quantize, ClosedAndDegenerateCurves) {
+  const cad::CadModel cyl = cad::load_cad(test::write_cylinder(tmp("q_cyl.brep")));
+  std::vector<double> ideal(static_cast<std::size_t>(cyl.num_curves()), 1.0);
+  std::vector<LO> circles;
+  for (LO c = 0; c < cyl.num_curves(); ++c)
+    if (cyl.curves()[c].corners[0] == cyl.curves()[c].corners[1]) circles.push_back(c);
+  ASSERT_EQ(circles.size(), 2u);
+  ideal[circles[0]] = 0.5;
+  ideal[circles[1]] = 0.7;
+  // Small circles: at least 4 edges (closed), the two circles in one chord (side face).
+  Quantization q = quantize_curves(cyl, ideal, {});
+  EXPECT_EQ(q.edges[circles[0]], 4);
+  EXPECT_EQ(q.edges[circles[1]], 4);
+  EXPECT_NE(q.curve2chord[circles[0]], kNoIndex);
+  EXPECT_EQ(q.curve2chord[circles[0]], q.curve2chord[circles[1]]);
+  // 4.9 and 7.0 alone would round to 4 and 8; the chord average 5.95 gives 6 to both.
+  ideal[circles[0]] = 4.9;
+  ideal[circles[1]] = 7.0;
+  q = quantize_curves(cyl, ideal, {});
+  EXPECT_EQ(q.edges[circles[0]], 6);
+  EXPECT_EQ(q.edges[circles[1]], 6);
+  QuantizeOptions coarse;
+  coarse.halved_minimums = true;
+  ideal[circles[0]] = ideal[circles[1]] = 0.5;
+  q = quantize_curves(cyl, ideal, coarse);
+  EXPECT_EQ(q.edges[circles[0]], 6);  // 3 before midpoint subdivision
+  QuantizeOptions bad;
+  bad.even = false;
+  bad.prescribed = {{circles[0], 2}};
+  EXPECT_THROW((void)quantize_curves(cyl, ideal, bad), InputError);
+
+  // Sphere: the poles are degenerate: 0 edges, and place_vertices keeps their single edge.
+  const cad::CadModel sphere = cad::load_cad(test::write_sphere(tmp("q_sphere.brep")));
+  background::SizeOptions so;
+  so.size = 0.5;
+  const TaskArena tasks(2);
+  const auto bg = background::mesh_curves(sphere, so, tasks);
+  std::vector<std::vector<double>> sizes;
+  for (const auto& m : bg) sizes.emplace_back(m.points.size(), 0.5);
+  const auto sq = quantize_curves(sphere, ideal_edge_counts(bg, sizes), {});
+  const auto meshes = place_vertices(sphere, bg, sizes, sq, false, tasks);
+  int poles = 0;
+  for (LO c = 0; c < sphere.num_curves(); ++c) {
+    if (!sphere.curves()[c].degenerate) {
+      EXPECT_EQ(meshes[c].num_edges(), sq.edges[c]);
+      continue;
+    }
+    ++poles;
+    EXPECT_EQ(sq.edges[c], 0);
+    EXPECT_EQ(sq.curve2chord[c], kNoIndex);
+    EXPECT_EQ(meshes[c].num_edges(), 1);
+  }
+  EXPECT_EQ(poles, 2);
+}
+
+TEST(IdealEdgeCounts, StraightLine) {
+  const auto& model = rectangle();
+  std::vector<mesh::CurveMesh> bg;
+  for (LO c = 0; c < model.num_curves(); ++c) bg.push_back(uniform_background(model, c, 17));
+  // Constant size: L / s.
+  std::vector<std::vector<double>> sizes;
+  for (const auto& m : bg) sizes.emplace_back(m.points.size(), 0.37);
+  auto ideal = ideal_edge_counts(bg, sizes);
+  for (LO c = 0; c < model.num_curves(); ++c)
+    EXPECT_NEAR(ideal[c], model.curves()[c].length / 0.37, 1e-9) << "curve " << c;
+  // Size linear in arc length, s = a + b x: (1/b) ln((a + b L) / a).
+  sizes.clear();
+  for (const auto& m : bg) {
+    std::vector<double> s;
+    for (const double x : arc_length(m.points)) s.push_back(0.2 + 0.08 * x);
+    sizes.push_back(s);
+  }
+  ideal = ideal_edge_counts(bg, sizes);
+  for (LO c = 0; c < model.num_curves(); ++c) {
+    const double len = model.curves()[c].length;
+    EXPECT_NEAR(ideal[c], std::log((0.2 + 0.08 * len) / 0.2) / 0.08, 1e-9) << "curve " << c;
+  }
+  sizes[0][3] = 0;
+  EXPECT_THROW((void)ideal_edge_counts(bg, sizes), Error);
+}
+
+TEST(PlaceVertices, Eq11SpacingFollowsTheSize) {
+  const auto& model = rectangle();
+  std::vector<mesh::CurveMesh> bg;
+  std::vector<std::vector<double>> sizes;
+  const auto s_at = [](double x) { return 0.2 + 0.08 * x; };
+  for (LO c = 0; c < model.num_curves(); ++c) {
+    bg.push_back(uniform_background(model, c, 40));
+    std::vector<double> s;
+    for (const double x : arc_length(bg.back().points)) s.push_back(s_at(x));
+    sizes.push_back(s);
+  }
+  const auto ideal = ideal_edge_counts(bg, sizes);
+  const Quantization q = quantize_curves(model, ideal, {});
+  const TaskArena tasks(2);
+  for (const bool halved : {false, true}) {
+    const auto meshes = place_vertices(model, bg, sizes, q, halved, tasks);
+    ASSERT_EQ(static_cast<LO>(meshes.size()), model.num_curves());
+    for (LO c = 0; c < model.num_curves(); ++c) {
+      const auto& m = meshes[c];
+      const auto& curve = model.curves()[c];
+      const int n = halved ? q.edges[c] / 2 : q.edges[c];
+      ASSERT_EQ(m.num_edges(), n) << "curve " << c;
+      EXPECT_EQ(m.curve, c);
+      EXPECT_EQ(m.points.front(), model.corners()[curve.corners[0]].point);
+      EXPECT_EQ(m.points.back(), model.corners()[curve.corners[1]].point);
+      EXPECT_EQ(m.t.front(), curve.t0);
+      EXPECT_EQ(m.t.back(), curve.t1);
+      for (LO i = 0; i < n; ++i) ASSERT_GT(m.t[i + 1], m.t[i]);
+      if (std::lround(curve.length) != 10) continue;
+      // The long sides: 20.1 ideal -> 20 edges (10 halved). Each edge holds 1/n of the integral
+      // (Eq. 11, exact here: straight line, s linear), so edges grow with s.
+      EXPECT_EQ(n, halved ? 10 : 20);
+      const auto x = arc_length(m.points);
+      double previous = 0;
+      for (LO i = 0; i < n; ++i) {
+        const double e = x[i + 1] - x[i];
+        const double integral = std::log(s_at(x[i + 1]) / s_at(x[i])) / 0.08;
+        EXPECT_NEAR(integral, ideal[c] / n, 1e-6) << "curve " << c << " edge " << i;
+        const double predicted = s_at((x[i] + x[i + 1]) / 2) * ideal[c] / n;
+        EXPECT_NEAR(e / predicted, 1.0, 0.1) << "curve " << c << " edge " << i;
+        EXPECT_GT(e, previous);
+        previous = e;
+      }
+      EXPECT_GT((x[n] - x[n - 1]) / (x[1] - x[0]), 3.0);
+    }
+  }
+}
+
+TEST(PlaceVertices, BoxCountsAndChords) {
+  const auto& model = box();
+  background::SizeOptions so;
+  so.size = 0.5;
+  const TaskArena tasks(2);
+  const auto bg = background::mesh_curves(model, so, tasks);
+  std::vector<std::vector<double>> sizes;
+  for (const auto& m : bg) {
+    std::vector<double> s;
+    const auto x = arc_length(m.points);
+    for (const double xi : x) s.push_back(0.3 + 0.3 * xi / x.back());
+    sizes.push_back(s);
+  }
+  const Quantization q = quantize_curves(model, ideal_edge_counts(bg, sizes), {});
+  EXPECT_EQ(q.num_chords, 3);
+  const auto full = place_vertices(model, bg, sizes, q, false, tasks);
+  const auto half = place_vertices(model, bg, sizes, q, true, TaskArena(1));
+  for (LO c = 0; c < model.num_curves(); ++c) {
+    EXPECT_EQ(q.edges[c] % 2, 0);
+    EXPECT_EQ(full[c].num_edges(), q.edges[c]);
+    EXPECT_EQ(half[c].num_edges(), q.edges[c] / 2);
+    for (LO d = 0; d < model.num_curves(); ++d)
+      if (q.curve2chord[c] == q.curve2chord[d]) {
+        EXPECT_EQ(q.edges[c], q.edges[d]);
+      }
+    const auto& curve = model.curves()[c];
+    for (const auto* m : {&full[c], &half[c]}) {
+      EXPECT_EQ(m->points.front(), model.corners()[curve.corners[0]].point);
+      EXPECT_EQ(m->points.back(), model.corners()[curve.corners[1]].point);
+    }
+    // The halved mesh is the same Eq. 11 placement with n/2 steps: its vertices are the full
+    // mesh's even vertices, so midpoint subdivision of the halved curve is the full one.
+    for (LO i = 0; i <= half[c].num_edges(); ++i)
+      EXPECT_NEAR(half[c].t[i], full[c].t[2 * i], 1e-9 * (curve.t1 - curve.t0 + 1));
+  }
+}
+
+// Paper 000 Sec. 4.3 on a real model: opposite sides of every conformal four-sided face have the
+// same count unless their ideal values are too different; every count is even.
+TEST(Quantize, BlockModelOppositeSidesAgree) {
+  const std::string path = std::string(QSMESH_SHARED_CAD_DIR) + "/Block.stp";
+  if (!std::ifstream(path)) GTEST_SKIP() << path << " not found";
+  const cad::CadModel model = cad::load_cad(path);
+  background::SizeOptions so;
+  so.size = model.diagonal() / 40;
+  const TaskArena tasks(2);
+  const auto bg = background::mesh_curves(model, so, tasks);
+  std::vector<std::vector<double>> sizes;
+  for (const auto& m : bg) sizes.emplace_back(m.points.size(), so.size);
+  const auto ideal = ideal_edge_counts(bg, sizes);
+  const Quantization q = quantize_curves(model, ideal, {});
+  int pairs = 0;
+  for (const auto& face : model.faces()) {
+    if (face.loops.size() != 1 || face.loops[0].uses.size() != 4 || !face.loops_closed) continue;
+    const auto& uses = face.loops[0].uses;
+    for (int k = 0; k < 2; ++k) {
+      const LO a = uses[k].curve, b = uses[k + 2].curve;
+      if (model.curves()[a].degenerate || model.curves()[b].degenerate) continue;
+      if (std::max(ideal[a], ideal[b]) > 2.0 * std::min(ideal[a], ideal[b])) continue;
+      ++pairs;
+      EXPECT_EQ(q.edges[a], q.edges[b]) << "curves " << a << " and " << b;
+      EXPECT_EQ(q.curve2chord[a], q.curve2chord[b]);
+    }
+  }
+  EXPECT_GT(pairs, 0);
+  for (LO c = 0; c < model.num_curves(); ++c)
+    if (!model.curves()[c].degenerate) {
+      EXPECT_EQ(q.edges[c] % 2, 0) << "curve " << c;
+    }
+  const auto meshes = place_vertices(model, bg, sizes, q, true, tasks);
+  for (LO c = 0; c < model.num_curves(); ++c)
+    if (!model.curves()[c].degenerate) {
+      EXPECT_EQ(meshes[c].num_edges(), q.edges[c] / 2);
+    }
+  std::cout << "Block.stp: " << model.num_curves() << " curves, " << q.num_chords << " chords, "
+            << q.total_edges << " edges, " << pairs << " opposite pairs\n";
+}
+
+}  // namespace
+}  // namespace qsmesh::quantize
