@@ -8,6 +8,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <sstream>
 #include <thread>
 
 #include "json.hpp"
@@ -117,17 +118,14 @@ struct Checks {
   double max_distance_to_cad = 0;  ///< relative to the model diagonal
 };
 
-std::string stats_json(const Arguments& args, const cad::CadModel& model, double size, int ranks,
-                       int threads, const parallel::PipelineResult& r, const mesh::MeshStats& s,
-                       const Checks& checks, const StageTimes& times) {
+std::string stats_json(const Arguments& args, const Session& session, const parallel::PipelineResult& r,
+                       const mesh::MeshStats& s, const Checks& checks) {
+  const cad::CadModel& model = session.model;
   JsonWriter j;
   j.begin_object();
-  j.value("model", args.model);
+  write_run_header(j, args, session);
   j.value("output", args.output);
   j.value("stage", args.until);
-  j.value("ranks", ranks);
-  j.value("threads", threads);
-  j.value("size", size);
   j.value("corners", static_cast<std::int64_t>(model.num_corners()));
   j.value("curves", static_cast<std::int64_t>(model.num_curves()));
   j.value("faces", static_cast<std::int64_t>(model.num_faces()));
@@ -156,10 +154,7 @@ std::string stats_json(const Arguments& args, const cad::CadModel& model, double
   j.value("small_angle_at_sharp_corner", s.small_angle_at_sharp_corner);
   j.value("conforming", checks.conformity.ok());
   j.value("max_distance_to_cad", checks.max_distance_to_cad);
-  j.begin_object("seconds");
-  for (const auto& [stage, sec] : times.entries()) j.value(stage, sec);
-  j.value("total", times.total());
-  j.end_object();
+  write_times(j, session.times);
   j.begin_array("face_reports");
   for (const auto& rep : r.reports) {
     if (rep.ok && !rep.fell_back) continue;
@@ -196,14 +191,34 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
   }
   os << "  conforming: " << (checks.conformity.ok() ? "yes" : "NO (" + checks.conformity.summary() + ")")
      << "; largest vertex distance to its CAD entity: " << checks.max_distance_to_cad << " of the diagonal\n";
-  os << "  time (s):";
-  for (const auto& [stage, sec] : times.entries()) os << " " << stage << " " << std::setprecision(3) << sec << ";";
-  os << " total " << times.total() << "\n";
+  os << "  time (s):" << times_line(times) << "\n";
   for (const auto& rep : r.reports)
     if (!rep.ok || rep.fell_back) os << "  face " << rep.face << ": " << rep.error << "\n";
 }
 
 }  // namespace
+
+void write_run_header(JsonWriter& j, const Arguments& args, const Session& s) {
+  j.value("model", args.model);
+  j.value("ranks", s.ranks);
+  j.value("threads", s.threads);
+  j.value("size", s.size);
+}
+
+void write_times(JsonWriter& j, const StageTimes& times) {
+  j.begin_object("seconds");
+  for (const auto& [stage, sec] : times.entries()) j.value(stage, sec);
+  j.value("total", times.total());
+  j.end_object();
+}
+
+std::string times_line(const StageTimes& times) {
+  std::ostringstream os;
+  os << std::setprecision(3);
+  for (const auto& [stage, sec] : times.entries()) os << " " << stage << " " << sec << ";";
+  os << " total " << times.total();
+  return os.str();
+}
 
 Session::Session(const Arguments& args, const char* command)
     : comm(parallel::Comm::world()),
@@ -252,8 +267,7 @@ int run_mesh(const Arguments& args) {
     s.log.info(cat("wrote ", args.output));
     if (!args.quiet) print_summary(std::cout, s.model, result, stats, checks, s.times);
     if (!args.stats.empty())
-      write_text_file_atomically(args.stats, stats_json(args, s.model, s.size, s.ranks, s.threads, result, stats,
-                                                        checks, s.times));
+      write_text_file_atomically(args.stats, stats_json(args, s, result, stats, checks));
     for (const auto& rep : result.reports)
       if (!rep.ok) s.log.warn(rep.error);
   }

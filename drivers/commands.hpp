@@ -27,6 +27,14 @@ struct Session {
   StageTimes times;
 };
 
+class JsonWriter;
+/// The fields every distributed command's --stats starts with: model, ranks, threads, size.
+void write_run_header(JsonWriter& j, const Arguments& args, const Session& s);
+/// "seconds": {stage: seconds, ..., "total": seconds}.
+void write_times(JsonWriter& j, const StageTimes& times);
+/// " stage seconds; ... total seconds" for the printed summaries.
+std::string times_line(const StageTimes& times);
+
 int run_info(const Arguments& args);
 int run_example(const Arguments& args);
 /// Collective over MPI_COMM_WORLD; MPI must be initialised.

@@ -106,9 +106,8 @@ int run_crossfield(const Arguments& args) {
     }
     std::cout << "\nsummary\n  faces: " << nfaces << " (" << nfaces - with_field << " without cross field)\n"
               << "  singularities: " << plus << " of index +1, " << minus << " of index -1\n"
-              << "  factorizations: " << factorizations << ", solves: " << solves << "\n  time (s):";
-    for (const auto& [stage, sec] : s.times.entries()) std::cout << " " << stage << " " << sec << ";";
-    std::cout << " total " << s.times.total() << "\n";
+              << "  factorizations: " << factorizations << ", solves: " << solves << "\n  time (s):"
+              << times_line(s.times) << "\n";
   }
   if (args.check) {
     for (LO f = 0; f < nfaces; ++f) {
@@ -126,10 +125,7 @@ int run_crossfield(const Arguments& args) {
   if (!args.stats.empty()) {
     JsonWriter j;
     j.begin_object();
-    j.value("model", args.model);
-    j.value("ranks", s.ranks);
-    j.value("threads", s.threads);
-    j.value("size", s.size);
+    write_run_header(j, args, s);
     j.value("faces", static_cast<std::int64_t>(nfaces));
     j.value("faces_with_cross_field", with_field);
     j.value("euler_consistent", consistent);
@@ -138,10 +134,7 @@ int run_crossfield(const Arguments& args) {
     j.value("levels", levels);
     j.value("factorizations", factorizations);
     j.value("solves", solves);
-    j.begin_object("seconds");
-    for (const auto& [stage, sec] : s.times.entries()) j.value(stage, sec);
-    j.value("total", s.times.total());
-    j.end_object();
+    write_times(j, s.times);
     j.begin_array("face_list");
     for (LO f = 0; f < nfaces; ++f) {
       const auto& cf = result.cross_fields[f];

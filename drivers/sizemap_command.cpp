@@ -123,18 +123,13 @@ int run_sizemap(const Arguments& args) {
   if (!args.quiet) {
     std::cout << "\nsummary\n  size map method: " << args.sizemap << "\n  curves: " << s.model.num_curves()
               << ", chords: " << q.num_chords << ", edges: " << q.total_edges << "\n  size on curves: "
-              << smin << " to " << smax << "\n  time (s):";
-    for (const auto& [stage, sec] : s.times.entries()) std::cout << " " << stage << " " << sec << ";";
-    std::cout << " total " << s.times.total() << "\n";
+              << smin << " to " << smax << "\n  time (s):" << times_line(s.times) << "\n";
   }
   if (!args.stats.empty()) {
     JsonWriter j;
     j.begin_object();
-    j.value("model", args.model);
+    write_run_header(j, args, s);
     j.value("method", args.sizemap);
-    j.value("ranks", s.ranks);
-    j.value("threads", s.threads);
-    j.value("size", s.size);
     j.value("curves", static_cast<std::int64_t>(s.model.num_curves()));
     j.value("chords", static_cast<std::int64_t>(q.num_chords));
     j.value("edges", q.total_edges);
@@ -143,10 +138,7 @@ int run_sizemap(const Arguments& args) {
     j.begin_array("curve_edges");
     for (int e : q.edges) j.value("", static_cast<std::int64_t>(e));
     j.end_array();
-    j.begin_object("seconds");
-    for (const auto& [stage, sec] : s.times.entries()) j.value(stage, sec);
-    j.value("total", s.times.total());
-    j.end_object();
+    write_times(j, s.times);
     j.end_object();
     write_text_file_atomically(args.stats, j.str());
   }
