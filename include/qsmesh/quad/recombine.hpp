@@ -1,0 +1,44 @@
+// Triangle combination into a quad-dominant mesh (paper 000 Sec. 5.2).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+
+#include "qsmesh/core/types.hpp"
+#include "qsmesh/mesh/surface_mesh.hpp"
+
+namespace qsmesh::quad {
+
+struct RecombineOptions {
+  /// Quads whose SICN (paper 000 Eq. 12) is not above this are not formed.
+  double min_sicn = 0.1;
+  /// Weight of the cross-field alignment in the score, in [0, 1]: the score of a candidate quad is
+  /// sicn * (1 - w + w * alignment), alignment in [0, 1] (1: every edge along a cross branch,
+  /// 0: every edge at 45 degrees). Ignored when no directions are given.
+  double alignment_weight = 0.5;
+};
+
+struct RecombineStats {
+  std::int64_t quads = 0;             ///< quads in the result (input quads included)
+  std::int64_t triangles_left = 0;    ///< triangles not combined
+  double sicn_min = 0, sicn_avg = 0;  ///< over the quads of the result (0 when none)
+};
+
+/// Paper 000 Sec. 5.2: every pair of triangles of `mesh` sharing an edge (an edge used by exactly
+/// two triangles of the face; seam copies are distinct vertices, so seams and curves are never
+/// crossed) is a candidate quad, scored by its SICN (Eq. 12, mesh::quad_sicn on the 3D points),
+/// weighted by its alignment with the cross field when `directions` is not empty. Candidates are
+/// selected greedily, best score first (ties: smaller triangle ids first), when both triangles are
+/// still free and the SICN is above options.min_sicn.
+/// `directions`: empty, or one entry per triangle of `mesh`: two unit tangent vectors (the two
+/// branches of the cross; the other two are their opposites).
+/// Returns the mesh with the same vertices (points, uv, classification unchanged), the input quads
+/// followed by the new ones (each oriented like its triangles), and the remaining triangles in
+/// their input order. Deterministic. Throws qsmesh::Error when `directions` has the wrong size.
+[[nodiscard]] mesh::FaceMesh recombine(const mesh::FaceMesh& mesh,
+                                       std::span<const std::array<Vec3, 2>> directions,
+                                       const RecombineOptions& options,
+                                       RecombineStats* stats = nullptr);
+
+}  // namespace qsmesh::quad

@@ -1,0 +1,290 @@
+#include "qsmesh/quad/subdivide.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <tuple>
+#include <vector>
+
+#include "qsmesh/core/error.hpp"
+#include "qsmesh/mesh/quality.hpp"
+
+namespace qsmesh::quad {
+namespace {
+
+struct EdgeUse {
+  LO a, b;  // sorted vertex pair
+  LO elem;
+  int local;
+  bool operator<(const EdgeUse& o) const {
+    return std::tie(a, b, elem, local) < std::tie(o.a, o.b, o.elem, o.local);
+  }
+};
+
+// Where a boundary edge lies: curve `curve`, between its halved vertices i and i+1.
+struct CurveSpot {
+  LO curve = kNoIndex;
+  LO i = kNoIndex;
+  bool a_first = true;  // vertex a is halved vertex i
+};
+
+class BoundaryResolver {
+ public:
+  BoundaryResolver(const mesh::FaceMesh& m, std::span<const mesh::CurveMesh> curves)
+      : m_(m), curves_(curves) {}
+
+  // Resolves boundary edge (a, b); returns false for an edge of a degenerate curve (two copies of
+  // one corner at the same point).
+  bool resolve(LO a, LO b, CurveSpot* spot) const {
+    const auto& ca = m_.vclass[a];
+    const auto& cb = m_.vclass[b];
+    const Vec3 mid = 0.5 * (m_.points[a] + m_.points[b]);
+    QSMESH_CHECK(ca.dim <= 1 && cb.dim <= 1, "face " << m_.face << ": boundary edge " << a << "-"
+                                                     << b << " has a vertex inside the face");
+    if (ca.dim == 1 && cb.dim == 1) {
+      QSMESH_CHECK(ca.entity == cb.entity && std::abs(ca.index - cb.index) == 1,
+                   "face " << m_.face << ": boundary edge " << a << "-" << b
+                           << " joins two curves or non-consecutive curve vertices");
+      const LO c = ca.entity;
+      check_curve(c);
+      *spot = {c, std::min(ca.index, cb.index), ca.index < cb.index};
+      return true;
+    }
+    if (ca.dim == 1 || cb.dim == 1) {
+      const bool a_curve = ca.dim == 1;
+      const auto& cv = a_curve ? ca : cb;
+      const LO c = cv.entity;
+      check_curve(c);
+      const LO n = curves_[c].num_edges() / 2;
+      // The corner is halved vertex 0 (edge 0) or n (edge n-1); a curve of 2 halved edges that
+      // closes on one corner allows both: the nearer full midpoint decides.
+      CurveSpot best;
+      double best_d = std::numeric_limits<double>::infinity();
+      if (cv.index == 1) consider(c, 0, /*curve vertex first=*/false, a_curve, mid, &best, &best_d);
+      if (cv.index == n - 1) consider(c, n - 1, true, a_curve, mid, &best, &best_d);
+      QSMESH_CHECK(best.curve != kNoIndex, "face " << m_.face << ": boundary edge " << a << "-" << b
+                                                   << " from a corner to vertex " << cv.index
+                                                   << " of curve " << c << " (" << n
+                                                   << " halved edges)");
+      *spot = best;
+      return true;
+    }
+    // Two corners.
+    const Vec3& pa = m_.points[a];
+    const Vec3& pb = m_.points[b];
+    if (ca.entity == cb.entity) {
+      const double scale = std::max({std::abs(pa.x), std::abs(pa.y), std::abs(pa.z), 1.0});
+      if (distance(pa, pb) <= 1e-12 * scale) return false;
+    }
+    double best_d = std::numeric_limits<double>::infinity();
+    CurveSpot best;
+    for (std::size_t c = 0; c < curves_.size(); ++c) {
+      const auto& cm = curves_[c];
+      if (cm.num_edges() != 2) continue;
+      const Vec3& s = cm.points.front();
+      const Vec3& e = cm.points.back();
+      const double tol = 1e-9 * std::max(distance(s, e), distance(s, cm.points[1]));
+      const bool forward = distance(s, pa) <= tol && distance(e, pb) <= tol;
+      const bool backward = distance(s, pb) <= tol && distance(e, pa) <= tol;
+      if (!forward && !backward) continue;
+      const double d = distance(cm.points[1], mid);
+      if (d < best_d) {
+        best_d = d;
+        best = {static_cast<LO>(c), 0, forward};
+      }
+    }
+    QSMESH_CHECK(best.curve != kNoIndex, "face " << m_.face
+                                                 << ": no curve of one halved edge joins corners "
+                                                 << ca.entity << " and " << cb.entity);
+    *spot = best;
+    return true;
+  }
+
+  void check_curve(LO c) const {
+    QSMESH_CHECK(c >= 0 && static_cast<std::size_t>(c) < curves_.size(),
+                 "face " << m_.face << ": curve " << c << " has no full mesh");
+    QSMESH_CHECK(curves_[c].num_edges() >= 2 && curves_[c].num_edges() % 2 == 0,
+                 "face " << m_.face << ": full mesh of curve " << c << " has "
+                         << curves_[c].num_edges() << " edges (an even count >= 2 is needed)");
+  }
+
+ private:
+  void consider(LO c, LO i, bool curve_vertex_first, bool a_curve, const Vec3& mid, CurveSpot* best,
+                double* best_d) const {
+    const double d = distance(curves_[c].points[2 * i + 1], mid);
+    if (d < *best_d) {
+      *best_d = d;
+      *best = {c, i, curve_vertex_first == a_curve};
+    }
+  }
+
+  const mesh::FaceMesh& m_;
+  std::span<const mesh::CurveMesh> curves_;
+};
+
+}  // namespace
+
+mesh::FaceMesh subdivide(const mesh::FaceMesh& mesh, const cad::FaceGeometry& surface,
+                         std::span<const mesh::CurveMesh> full_curves, SubdivideStats* stats) {
+  // Elements: quads first, then triangles.
+  std::vector<std::array<LO, 4>> elems;
+  std::vector<int> sides;
+  for (const auto& q : mesh.quads) {
+    elems.push_back(q);
+    sides.push_back(4);
+  }
+  for (const auto& t : mesh.triangles) {
+    elems.push_back({t[0], t[1], t[2], kNoIndex});
+    sides.push_back(3);
+  }
+  const auto ne = static_cast<LO>(elems.size());
+
+  std::vector<EdgeUse> uses;
+  for (LO e = 0; e < ne; ++e)
+    for (int k = 0; k < sides[e]; ++k) {
+      const LO a = elems[e][k], b = elems[e][(k + 1) % sides[e]];
+      uses.push_back({std::min(a, b), std::max(a, b), e, k});
+    }
+  std::sort(uses.begin(), uses.end());
+
+  mesh::FaceMesh out;
+  out.face = mesh.face;
+  out.points = mesh.points;
+  out.uv = mesh.uv;
+  out.vclass = mesh.vclass;
+  // Curve vertices: index doubled, and the full mesh's t and point (the same values by
+  // construction, taken from the full mesh so that every face agrees bit for bit).
+  for (LO v = 0; v < mesh.num_vertices(); ++v) {
+    auto& vc = out.vclass[v];
+    if (vc.dim != 1) continue;
+    QSMESH_CHECK(vc.entity >= 0 && static_cast<std::size_t>(vc.entity) < full_curves.size(),
+                 "face " << mesh.face << ": curve " << vc.entity << " has no full mesh");
+    const auto& cm = full_curves[vc.entity];
+    QSMESH_CHECK(2 * vc.index < cm.num_edges(), "face " << mesh.face << ": vertex " << v
+                                                        << " index " << vc.index << " of curve "
+                                                        << vc.entity << " outside the halved mesh");
+    vc.index *= 2;
+    vc.param = {cm.t[vc.index], 0};
+    out.points[v] = cm.points[vc.index];
+  }
+
+  // What each new vertex falls back to when its uv placement folds a quad.
+  struct Snap {
+    LO vertex;
+    Vec3 fallback;  // 3D midpoint / centroid
+    Vec2 guess;
+  };
+  std::vector<Snap> snaps;
+
+  const BoundaryResolver resolver(mesh, full_curves);
+  // elem_mid[e][k]: new vertex at the middle of edge k of element e.
+  std::vector<std::array<LO, 4>> elem_mid(elems.size(), {kNoIndex, kNoIndex, kNoIndex, kNoIndex});
+  for (std::size_t i = 0; i < uses.size();) {
+    std::size_t j = i;
+    while (j < uses.size() && uses[j].a == uses[i].a && uses[j].b == uses[i].b) ++j;
+    const LO a = uses[i].a, b = uses[i].b;
+    const LO v = out.num_vertices();
+    const Vec2 uv_mid = 0.5 * (mesh.uv[a] + mesh.uv[b]);
+    mesh::VertexClass vc;
+    Vec3 p;
+    Vec2 uv = uv_mid;
+    CurveSpot spot;
+    if (j - i == 1 && resolver.resolve(a, b, &spot)) {
+      const auto& cm = full_curves[spot.curve];
+      const LO k = 2 * spot.i + 1;
+      vc.dim = 1;
+      vc.entity = spot.curve;
+      vc.index = k;
+      vc.param = {cm.t[k], 0};
+      p = cm.points[k];
+      // uv along the edge in proportion of t (exact for linear pcurves), then projected.
+      const Vec2 uv0 = spot.a_first ? mesh.uv[a] : mesh.uv[b];
+      const Vec2 uv1 = spot.a_first ? mesh.uv[b] : mesh.uv[a];
+      const double dt = cm.t[k + 1] - cm.t[k - 1];
+      const double s = dt != 0 ? (cm.t[k] - cm.t[k - 1]) / dt : 0.5;
+      uv = uv0 + s * (uv1 - uv0);
+      const Vec2 proj = surface.project(p, uv, nullptr);
+      if (norm(proj - uv) <= 0.25 * norm(uv1 - uv0)) uv = proj;
+    } else if (j - i == 1) {
+      // Edge of a degenerate curve (pole): another copy of the corner.
+      vc = mesh.vclass[a];
+      p = out.points[a];
+    } else {
+      vc.dim = 2;
+      vc.entity = mesh.face;
+      vc.param = {uv.u, uv.v};
+      p = surface.eval(uv).p;
+      snaps.push_back({v, 0.5 * (mesh.points[a] + mesh.points[b]), uv});
+    }
+    out.points.push_back(p);
+    out.uv.push_back(uv);
+    out.vclass.push_back(vc);
+    for (std::size_t k = i; k < j; ++k) elem_mid[uses[k].elem][uses[k].local] = v;
+    i = j;
+  }
+
+  // Centres and the sub-quads: corner, midpoint of its outgoing edge, centre, midpoint of its
+  // incoming edge (same orientation as the element).
+  for (LO e = 0; e < ne; ++e) {
+    const int n = sides[e];
+    Vec2 uv{0, 0};
+    Vec3 g{0, 0, 0};
+    for (int k = 0; k < n; ++k) {
+      uv += mesh.uv[elems[e][k]];
+      g += mesh.points[elems[e][k]];
+    }
+    uv = uv / n;
+    g = g / n;
+    const LO c = out.num_vertices();
+    mesh::VertexClass vc;
+    vc.dim = 2;
+    vc.entity = mesh.face;
+    vc.param = {uv.u, uv.v};
+    out.points.push_back(surface.eval(uv).p);
+    out.uv.push_back(uv);
+    out.vclass.push_back(vc);
+    snaps.push_back({c, g, uv});
+    for (int k = 0; k < n; ++k)
+      out.quads.push_back({elems[e][k], elem_mid[e][k], c, elem_mid[e][(k + n - 1) % n]});
+  }
+
+  // Revert snaps that fold an adjacent quad, in vertex order (deterministic).
+  std::vector<std::vector<LO>> v2q(out.points.size());
+  for (LO q = 0; q < static_cast<LO>(out.quads.size()); ++q)
+    for (const LO v : out.quads[q]) v2q[v].push_back(q);
+  const auto min_sicn = [&](LO v) {
+    double s = std::numeric_limits<double>::infinity();
+    for (const LO q : v2q[v]) {
+      const auto& Q = out.quads[q];
+      s = std::min(s, mesh::quad_sicn({out.points[Q[0]], out.points[Q[1]], out.points[Q[2]],
+                                       out.points[Q[3]]}));
+    }
+    return s;
+  };
+  std::int64_t reverted = 0;
+  for (const Snap& snap : snaps) {
+    const double before = min_sicn(snap.vertex);
+    if (before > 0) continue;
+    const Vec3 p_old = out.points[snap.vertex];
+    const Vec2 uv_old = out.uv[snap.vertex];
+    Vec3 foot;
+    const Vec2 uv = surface.project(snap.fallback, snap.guess, &foot);
+    out.points[snap.vertex] = foot;
+    out.uv[snap.vertex] = uv;
+    if (min_sicn(snap.vertex) > before) {
+      out.vclass[snap.vertex].param = {uv.u, uv.v};
+      ++reverted;
+    } else {
+      out.points[snap.vertex] = p_old;
+      out.uv[snap.vertex] = uv_old;
+    }
+  }
+
+  if (stats) {
+    stats->quads = static_cast<std::int64_t>(out.quads.size());
+    stats->snaps_reverted = reverted;
+  }
+  return out;
+}
+
+}  // namespace qsmesh::quad

@@ -1,0 +1,263 @@
+#include <gtest/gtest.h>
+
+#include <BRepBuilderAPI_MakeFace.hxx>
+#include <BRepBuilderAPI_MakePolygon.hxx>
+#include <BRepPrimAPI_MakeBox.hxx>
+#include <BRepTools.hxx>
+#include <TopoDS_Shape.hxx>
+#include <algorithm>
+#include <cmath>
+#include <gp_Pnt.hxx>
+#include <map>
+#include <set>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "qsmesh/background/curve_mesh.hpp"
+#include "qsmesh/background/face_mesh.hpp"
+#include "qsmesh/mesh/assemble.hpp"
+#include "qsmesh/mesh/quality.hpp"
+#include "qsmesh/mesh/validate.hpp"
+#include "qsmesh/quad/recombine.hpp"
+#include "qsmesh/quad/subdivide.hpp"
+#include "qsmesh/quantize/quantize.hpp"
+#include "shapes.hpp"
+
+namespace qsmesh::quad {
+namespace {
+
+std::string tmp(const std::string& name) { return std::string(QSMESH_TEST_TMP_DIR) + "/" + name; }
+
+cad::CadModel load_shape(const TopoDS_Shape& shape, const std::string& name) {
+  const std::string path = tmp(name);
+  if (!BRepTools::Write(shape, path.c_str())) throw std::runtime_error("cannot write " + path);
+  return cad::load_cad(path);
+}
+
+cad::CadModel plate() {
+  BRepBuilderAPI_MakePolygon poly;
+  for (const auto& [x, y] :
+       std::vector<std::pair<double, double>>{{0, 0}, {10, 0}, {10, 7}, {0, 7}})
+    poly.Add(gp_Pnt(x, y, 0));
+  poly.Close();
+  BRepBuilderAPI_MakeFace face(poly.Wire(), /*OnlyPlane=*/true);
+  if (!face.IsDone()) throw std::runtime_error("face construction failed");
+  return load_shape(face.Shape(), "sd_plate.brep");
+}
+
+// Curve meshes of the final size `size` (full) and of twice that size (halved), and the face
+// triangulations on the halved curves, as the pipeline builds them.
+struct Prepared {
+  std::vector<mesh::CurveMesh> full, halved;
+  std::vector<mesh::FaceMesh> faces;
+};
+
+Prepared prepare(const cad::CadModel& model, double size) {
+  const TaskArena tasks(1);
+  background::BackgroundOptions options;
+  options.sizes.size = size;
+  const auto bg = background::mesh_curves(model, options.sizes, tasks);
+  std::vector<std::vector<double>> sizes;
+  for (const auto& m : bg) sizes.emplace_back(m.points.size(), size);
+  quantize::QuantizeOptions qo;
+  qo.halved_minimums = true;
+  const auto q = quantize::quantize_curves(model, quantize::ideal_edge_counts(bg, sizes), qo);
+  Prepared p;
+  p.full = quantize::place_vertices(model, bg, sizes, q, false, tasks);
+  p.halved = quantize::place_vertices(model, bg, sizes, q, true, tasks);
+  background::BackgroundOptions face_options;
+  face_options.sizes.size = 2 * size;
+  for (LO f = 0; f < model.num_faces(); ++f) {
+    background::FaceReport report;
+    p.faces.push_back(background::mesh_face_background(model, f, p.halved, face_options, &report));
+    EXPECT_TRUE(report.ok) << report.error;
+  }
+  return p;
+}
+
+double sicn(const mesh::FaceMesh& m, const std::array<LO, 4>& q) {
+  return mesh::quad_sicn({m.points[q[0]], m.points[q[1]], m.points[q[2]], m.points[q[3]]});
+}
+
+struct Quality {
+  double min = 1e300, avg = 0;
+};
+Quality quality(const mesh::FaceMesh& m) {
+  Quality q;
+  for (const auto& e : m.quads) {
+    const double s = sicn(m, e);
+    q.min = std::min(q.min, s);
+    q.avg += s;
+  }
+  if (!m.quads.empty()) q.avg /= static_cast<double>(m.quads.size());
+  return q;
+}
+
+// Checks one subdivided face against its input and the full curve meshes; returns its quality.
+Quality check_subdivided(const cad::CadModel& model, const mesh::FaceMesh& in,
+                         const mesh::FaceMesh& out, const std::vector<mesh::CurveMesh>& full,
+                         const SubdivideStats& stats, const char* what) {
+  EXPECT_TRUE(out.triangles.empty());
+  EXPECT_EQ(out.quads.size(), 4 * in.quads.size() + 3 * in.triangles.size());
+  EXPECT_EQ(stats.quads, static_cast<std::int64_t>(out.quads.size()));
+  EXPECT_EQ(out.points.size(), out.uv.size());
+  EXPECT_EQ(out.points.size(), out.vclass.size());
+  const Quality q = quality(out);
+  EXPECT_GT(q.min, 0) << what;
+  const auto surface = model.face_geometry(in.face);
+  const double tol = 1e-9 * model.diagonal();
+  std::map<LO, std::set<LO>> seen;  // curve -> full indices present
+  for (LO v = 0; v < out.num_vertices(); ++v) {
+    const auto& vc = out.vclass[v];
+    if (vc.dim == 1) {
+      const auto& cm = full[vc.entity];
+      if (vc.index < 0 || vc.index >= static_cast<LO>(cm.points.size())) {
+        ADD_FAILURE() << what << " curve " << vc.entity << " index " << vc.index;
+        continue;
+      }
+      // Exactly the full curve mesh's vertex (odd ones are the new midpoints).
+      EXPECT_EQ(out.points[v], cm.points[vc.index])
+          << what << " curve " << vc.entity << " index " << vc.index;
+      EXPECT_EQ(vc.param[0], cm.t[vc.index]);
+      seen[vc.entity].insert(vc.index);
+    }
+    if (v >= in.num_vertices()) {
+      // New point on the surface at its uv.
+      EXPECT_LT(distance(surface->eval(out.uv[v]).p, out.points[v]), 1e-6 * model.diagonal())
+          << what << " vertex " << v;
+      if (vc.dim == 2) {
+        EXPECT_LT(distance(surface->eval({vc.param[0], vc.param[1]}).p, out.points[v]), tol);
+      }
+    }
+  }
+  // Every interior vertex of every curve bounding the face is present.
+  for (const auto& loop : model.faces()[in.face].loops)
+    for (const auto& use : loop.uses) {
+      const auto& cm = full[use.curve];
+      if (model.curves()[use.curve].degenerate) continue;
+      for (LO i = 1; i < cm.num_edges(); ++i)
+        EXPECT_TRUE(seen[use.curve].count(i)) << what << " curve " << use.curve << " vertex " << i;
+    }
+  return q;
+}
+
+TEST(Subdivide, PlateBecomesAllQuadOnTheFullCurves) {
+  const auto model = plate();
+  const auto p = prepare(model, 0.5);
+  const auto& tri = p.faces[0];
+  ASSERT_FALSE(tri.triangles.empty());
+  RecombineStats rs;
+  const auto qd = recombine(tri, {}, {}, &rs);
+  ASSERT_GT(qd.quads.size(), 0u);
+  ASSERT_GT(qd.triangles.size(), 0u);  // both element kinds are subdivided
+  SubdivideStats ss;
+  const auto surface = model.face_geometry(0);
+  const auto out = subdivide(qd, *surface, p.full, &ss);
+  const Quality q = check_subdivided(model, qd, out, p.full, ss, "plate");
+  std::printf(
+      "plate: before subdivision %lld quads %lld triangles, SICN min %.3f avg %.3f; after %lld "
+      "quads, "
+      "SICN min %.3f avg %.3f, %lld snaps reverted\n",
+      static_cast<long long>(rs.quads), static_cast<long long>(rs.triangles_left), rs.sicn_min,
+      rs.sicn_avg, static_cast<long long>(ss.quads), q.min, q.avg,
+      static_cast<long long>(ss.snaps_reverted));
+  // Pure triangles subdivide too (3 quads each).
+  SubdivideStats ts;
+  const auto from_triangles = subdivide(tri, *surface, p.full, &ts);
+  (void)check_subdivided(model, tri, from_triangles, p.full, ts, "plate triangles");
+  // Deterministic.
+  const auto again = subdivide(qd, *surface, p.full);
+  EXPECT_EQ(again.points, out.points);
+  EXPECT_EQ(again.quads, out.quads);
+}
+
+TEST(Subdivide, CylinderSideIsValidAcrossTheSeam) {
+  const auto model = cad::load_cad(test::write_cylinder(tmp("sd_cyl.brep")));
+  const auto p = prepare(model, 0.4);
+  LO f = kNoIndex;
+  for (LO k = 0; k < model.num_faces(); ++k)
+    if (model.faces()[k].type == cad::SurfaceType::Cylinder) f = k;
+  ASSERT_NE(f, kNoIndex);
+  ASSERT_FALSE(model.faces()[f].seams.empty());
+  RecombineStats rs;
+  const auto qd = recombine(p.faces[f], {}, {}, &rs);
+  SubdivideStats ss;
+  const auto surface = model.face_geometry(f);
+  const auto out = subdivide(qd, *surface, p.full, &ss);
+  const Quality q = check_subdivided(model, qd, out, p.full, ss, "cylinder side");
+  std::printf(
+      "cylinder side: before SICN min %.3f avg %.3f; after %lld quads SICN min %.3f avg %.3f\n",
+      rs.sicn_min, rs.sicn_avg, static_cast<long long>(ss.quads), q.min, q.avg);
+  // The seam is used twice: both of its images carry every full seam vertex.
+  const LO seam = model.faces()[f].seams[0];
+  std::map<LO, int> copies;
+  for (const auto& vc : out.vclass)
+    if (vc.dim == 1 && vc.entity == seam) ++copies[vc.index];
+  for (LO i = 1; i < p.full[seam].num_edges(); ++i) EXPECT_EQ(copies[i], 2) << "seam vertex " << i;
+}
+
+// Subdivided faces of a box agree on the vertices of their shared curves, and assembling them
+// with the full curve meshes gives a conforming all-quad mesh.
+void expect_model_all_quad(const cad::CadModel& model, double size, const char* what) {
+  const auto p = prepare(model, size);
+  std::vector<mesh::FaceMesh> faces;
+  std::map<std::pair<LO, LO>, Vec3> curve_points;
+  int disagreements = 0;
+  double before_min = 1e300, after_min = 1e300, before_sum = 0, after_sum = 0;
+  std::int64_t before_n = 0, after_n = 0, tri_in = 0, tri_paired = 0;
+  for (LO f = 0; f < model.num_faces(); ++f) {
+    RecombineStats rs;
+    const auto qd = recombine(p.faces[f], {}, {}, &rs);
+    tri_in += static_cast<std::int64_t>(p.faces[f].triangles.size());
+    tri_paired += 2 * rs.quads;
+    before_min = std::min(before_min, rs.sicn_min);
+    before_sum += rs.sicn_avg * static_cast<double>(rs.quads);
+    before_n += rs.quads;
+    const auto surface = model.face_geometry(f);
+    SubdivideStats ss;
+    faces.push_back(subdivide(qd, *surface, p.full, &ss));
+    const auto& out = faces.back();
+    const Quality q = check_subdivided(model, qd, out, p.full, ss, what);
+    after_min = std::min(after_min, q.min);
+    after_sum += q.avg * static_cast<double>(out.quads.size());
+    after_n += static_cast<std::int64_t>(out.quads.size());
+    for (LO v = 0; v < out.num_vertices(); ++v) {
+      const auto& vc = out.vclass[v];
+      if (vc.dim != 1) continue;
+      const auto [it, inserted] =
+          curve_points.emplace(std::make_pair(vc.entity, vc.index), out.points[v]);
+      if (!inserted && !(it->second == out.points[v])) ++disagreements;
+    }
+  }
+  EXPECT_EQ(disagreements, 0);
+  std::printf(
+      "%s: %.1f%% of %lld triangles paired; SICN before subdivision min %.3f avg %.3f, after min "
+      "%.3f avg "
+      "%.3f (%lld quads)\n",
+      what, 100.0 * static_cast<double>(tri_paired) / static_cast<double>(tri_in),
+      static_cast<long long>(tri_in), before_min, before_sum / static_cast<double>(before_n),
+      after_min, after_sum / static_cast<double>(after_n), static_cast<long long>(after_n));
+  const auto assembled = mesh::assemble(model, p.full, faces);
+  const auto conformity = mesh::check_conformity(assembled, model);
+  EXPECT_TRUE(conformity.ok()) << what << ": " << conformity.summary();
+  const auto stats = mesh::compute_stats(assembled);
+  EXPECT_EQ(stats.triangles, 0);
+  EXPECT_EQ(stats.quads, after_n);
+  EXPECT_GT(stats.sicn_min, 0) << what;
+  EXPECT_LT(mesh::max_distance_to_cad(assembled, model), 1e-6 * model.diagonal());
+}
+
+TEST(Subdivide, BoxFacesAgreeOnSharedCurves) {
+  const auto model = load_shape(BRepPrimAPI_MakeBox(10.0, 6.0, 4.0).Shape(), "sd_box.brep");
+  expect_model_all_quad(model, 0.6, "box");
+}
+
+TEST(Subdivide, BoxWithHoleEndToEnd) {
+  const auto model = cad::load_cad(test::write_box_with_hole(tmp("sd_box_hole.brep")));
+  expect_model_all_quad(model, 0.5, "box with hole");
+}
+
+}  // namespace
+}  // namespace qsmesh::quad
