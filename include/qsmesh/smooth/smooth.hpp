@@ -1,0 +1,64 @@
+// Geometry optimisation of quad meshes of one CAD face (paper 000 Sec. 5.3): SICN quality,
+// Laplacian smoothing in the parameter plane, Winslow / angle-based kernels, measure and roll back.
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "qsmesh/cad/geometry.hpp"
+#include "qsmesh/mesh/surface_mesh.hpp"
+
+namespace qsmesh::smooth {
+
+/// SICN statistics over the quads of a mesh.
+struct QualityReport {
+  double sicn_min = 0, sicn_avg = 0;  ///< 0 when the mesh has no quad
+  std::int64_t invalid = 0;           ///< quads with SICN <= 0
+};
+
+/// SICN (paper 000 Eq. 12, mesh::quad_sicn, on the 3D points) of every quad of the mesh.
+/// Triangles are ignored.
+[[nodiscard]] QualityReport measure(const mesh::FaceMesh& mesh);
+
+struct SmoothOptions {
+  int iterations = 10;       ///< passes of the explicit kernels over all free vertices
+  bool laplacian_uv = true;  ///< step 1: Laplacian in the parameter plane (direct solve)
+  bool winslow = true;       ///< step 2: Winslow (regular) / angle-based (irregular) kernels
+  /// Wall-clock bound on the explicit passes, checked between passes (0: none). When it stops a
+  /// run early the result depends on timing; leave 0 where reproducibility matters.
+  double time_budget_s = 0;
+};
+
+struct SmoothStats {
+  QualityReport before, after;
+  int iterations = 0;        ///< explicit passes done
+  bool rolled_back = false;  ///< the output is the input because the minimum SICN dropped
+  /// Steps applied, e.g. "uv_laplacian+kernels", "uv_laplacian(rejected)+kernels",
+  /// "uv_laplacian(skipped:seam)+kernels".
+  std::string method;
+};
+
+/// Paper 000 Sec. 5.3 on the quads of one face mesh, boundary locked.
+///
+/// Takes a FaceMesh with consistent uv (boundary vertices at their pcurve images) and the face's
+/// geometry. Free vertices: dim-2 vertices that are not used by any triangle; all others (dim 0,
+/// dim 1, triangle vertices) keep bit-identical point and uv.
+///  1) Laplacian in (u, v): arithmetic average of edge neighbours, one sparse direct solve (Eigen)
+///     with the locked uv as Dirichlet values; skipped when the uv images are not continuous (a
+///     boundary vertex whose (dim, entity, index) appears twice with different uv: seam; or a
+///     boundary vertex where the surface normal vanishes: pole). New points S(uv). Kept only when
+///     the minimum SICN does not drop and no quad flips against the face normal.
+///  2) `iterations` Gauss-Seidel passes in vertex order: Winslow kernel (Eq. 13) on vertices with
+///     four incident quads, angle-based kernel (bisectors of the one-ring) on the others, computed
+///     in the tangent plane at the vertex, mapped to uv by Gauss-Newton steps on (du, dv), the new
+///     point S(uv). A move is kept only when the minimum SICN of the incident quads does not drop
+///     and none of them flips against the face normal.
+/// Measures before and after; when the minimum SICN dropped or more quads are invalid, returns the
+/// input (stats->rolled_back). Deterministic: no randomness, fixed order, no threads.
+/// Returns the smoothed mesh (same topology and classification; dim-2 vclass.param = new uv).
+[[nodiscard]] mesh::FaceMesh smooth_face(const mesh::FaceMesh& mesh,
+                                         const cad::FaceGeometry& surface,
+                                         const SmoothOptions& options,
+                                         SmoothStats* stats = nullptr);
+
+}  // namespace qsmesh::smooth

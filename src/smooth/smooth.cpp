@@ -1,0 +1,384 @@
+#include "qsmesh/smooth/smooth.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <numbers>
+#include <tuple>
+#include <utility>
+#include <vector>
+
+#include "qsmesh/core/error.hpp"
+#include "qsmesh/core/timer.hpp"
+#include "qsmesh/linalg/solver.hpp"
+#include "qsmesh/mesh/quality.hpp"
+
+namespace qsmesh::smooth {
+
+QualityReport measure(const mesh::FaceMesh& mesh) {
+  QualityReport r;
+  if (mesh.quads.empty()) return r;
+  double sum = 0;
+  r.sicn_min = std::numeric_limits<double>::max();
+  for (const auto& q : mesh.quads) {
+    const double s = mesh::quad_sicn(
+        {mesh.points[q[0]], mesh.points[q[1]], mesh.points[q[2]], mesh.points[q[3]]});
+    r.sicn_min = std::min(r.sicn_min, s);
+    sum += s;
+    if (s <= 0) ++r.invalid;
+  }
+  r.sicn_avg = sum / static_cast<double>(mesh.quads.size());
+  return r;
+}
+
+namespace {
+
+struct Topology {
+  std::vector<char> free;            // vertex may move
+  std::vector<std::vector<LO>> v2q;  // incident quads, increasing
+  std::vector<std::vector<LO>> v2v;  // edge neighbours, increasing
+  std::vector<std::vector<LO>>
+      ring;  // ordered one-ring (edge, diagonal, edge, ...); empty: not a closed fan
+};
+
+Topology build_topology(const mesh::FaceMesh& m) {
+  const LO n = m.num_vertices();
+  Topology t;
+  t.free.assign(static_cast<std::size_t>(n), 0);
+  t.v2q.resize(n);
+  t.v2v.resize(n);
+  t.ring.resize(n);
+  for (LO v = 0; v < n; ++v) t.free[v] = m.vclass[v].dim == 2 ? 1 : 0;
+  // Triangles are not measured here, so their vertices stay where they are.
+  for (const auto& tri : m.triangles)
+    for (LO v : tri) t.free[v] = 0;
+  for (LO q = 0; q < static_cast<LO>(m.quads.size()); ++q) {
+    const auto& qd = m.quads[q];
+    for (int k = 0; k < 4; ++k) {
+      t.v2q[qd[k]].push_back(q);
+      t.v2v[qd[k]].push_back(qd[(k + 1) % 4]);
+      t.v2v[qd[k]].push_back(qd[(k + 3) % 4]);
+    }
+  }
+  for (LO v = 0; v < n; ++v) {
+    auto& nb = t.v2v[v];
+    std::sort(nb.begin(), nb.end());
+    nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
+  }
+  for (LO v = 0; v < n; ++v) {
+    if (!t.free[v] || t.v2q[v].size() < 3) continue;
+    // Fan segments (a, d, b) of quads (v, a, d, b); chained by b_i == a_{i+1}.
+    std::vector<std::array<LO, 3>> seg;
+    for (LO q : t.v2q[v]) {
+      const auto& qd = m.quads[q];
+      int k = 0;
+      while (qd[k] != v) ++k;
+      seg.push_back({qd[(k + 1) % 4], qd[(k + 2) % 4], qd[(k + 3) % 4]});
+    }
+    std::vector<LO> ring;
+    std::vector<char> used(seg.size(), 0);
+    std::size_t cur = 0;
+    bool ok = true;
+    for (std::size_t step = 0; step < seg.size(); ++step) {
+      used[cur] = 1;
+      ring.push_back(seg[cur][0]);
+      ring.push_back(seg[cur][1]);
+      if (step + 1 == seg.size()) {
+        ok = seg[cur][2] == seg[0][0];
+        break;
+      }
+      std::size_t next = seg.size();
+      for (std::size_t j = 0; j < seg.size(); ++j)
+        if (!used[j] && seg[j][0] == seg[cur][2]) {
+          next = j;
+          break;
+        }
+      if (next == seg.size()) {
+        ok = false;
+        break;
+      }
+      cur = next;
+    }
+    if (ok) t.ring[v] = std::move(ring);
+  }
+  return t;
+}
+
+// Seam: a boundary vertex appearing twice with different uv; pole: the surface normal vanishes at
+// a boundary vertex. Either way the boundary uv is not a continuous image of the boundary.
+const char* uv_discontinuity(const mesh::FaceMesh& m, const cad::FaceGeometry& surface) {
+  std::map<std::tuple<int, LO, LO>, Vec2> seen;
+  for (LO v = 0; v < m.num_vertices(); ++v) {
+    const auto& c = m.vclass[v];
+    if (c.dim == 2) continue;
+    const auto key = std::make_tuple(int(c.dim), c.entity, c.dim == 1 ? c.index : kNoIndex);
+    const auto [it, inserted] = seen.emplace(key, m.uv[v]);
+    if (!inserted && !(it->second == m.uv[v])) return "seam";
+    if (norm2(surface.normal(m.uv[v])) == 0) return "pole";
+  }
+  return nullptr;
+}
+
+// Orientation of the mesh against the face normal: +1 when quads turn counter-clockwise around it.
+double orientation(const mesh::FaceMesh& m, const cad::FaceGeometry& surface) {
+  double votes = 0;
+  for (const auto& q : m.quads) {
+    Vec3 s{};
+    for (int k = 0; k < 4; ++k)
+      s += cross(m.points[q[k]] - m.points[q[(k + 3) % 4]],
+                 m.points[q[(k + 1) % 4]] - m.points[q[k]]);
+    // The centroid uv of a quad along a seam may be meaningless; a vertex uv is not.
+    const Vec3 n = surface.normal(m.uv[q[0]]);
+    const double d = dot(s, n);
+    votes += d > 0 ? 1 : (d < 0 ? -1 : 0);
+  }
+  return votes >= 0 ? 1.0 : -1.0;
+}
+
+class Smoother {
+ public:
+  Smoother(mesh::FaceMesh& m, const cad::FaceGeometry& s, const Topology& t, double sign)
+      : m_(m), s_(s), t_(t), sign_(sign) {}
+
+  // SICN of a quad, -1 when it turns against the face normal (quad_sicn alone cannot see a quad
+  // flipped as a whole, its normal being the average of its own corners).
+  double quality(LO q) const {
+    const auto& qd = m_.quads[q];
+    const std::array<Vec3, 4> p{m_.points[qd[0]], m_.points[qd[1]], m_.points[qd[2]],
+                                m_.points[qd[3]]};
+    Vec3 sum{};
+    for (int k = 0; k < 4; ++k) sum += cross(p[k] - p[(k + 3) % 4], p[(k + 1) % 4] - p[k]);
+    Vec3 n{};
+    for (int k = 0; k < 4 && norm2(n) == 0; ++k) n = s_.normal(m_.uv[qd[k]]);  // skip a pole corner
+    if (sign_ * dot(sum, n) <= 0) return -1.0;
+    return mesh::quad_sicn(p);
+  }
+  // (minimum, sum) of the quality of the quads around v.
+  std::pair<double, double> local_quality(LO v) const {
+    double w = std::numeric_limits<double>::max(), sum = 0;
+    for (LO q : t_.v2q[v]) {
+      const double s = quality(q);
+      w = std::min(w, s);
+      sum += s;
+    }
+    return {w, sum};
+  }
+
+  // One Gauss-Seidel pass; returns the largest accepted displacement.
+  double pass() {
+    double moved = 0;
+    for (LO v = 0; v < m_.num_vertices(); ++v) {
+      if (!t_.free[v] || t_.ring[v].empty()) continue;
+      const Vec2 uv0 = m_.uv[v];
+      const Vec3 x0 = m_.points[v];
+      const Vec3 n = s_.normal(uv0) * sign_;
+      if (norm2(n) == 0) continue;
+      Vec3 target;
+      if (!kernel(v, x0, n, &target)) continue;
+      Vec2 uv;
+      if (!to_uv(uv0, target, &uv)) continue;
+      const auto before = local_quality(v);
+      m_.uv[v] = uv;
+      m_.points[v] = s_.eval(uv).p;
+      const auto after = local_quality(v);
+      // The minimum must not drop; on a tie (a folded quad stuck at -1) the sum decides, so that
+      // a move cannot spoil the other quads for free.
+      const bool keep = after.first > before.first ||
+                        (after.first == before.first && after.second >= before.second);
+      if (!keep) {
+        m_.uv[v] = uv0;
+        m_.points[v] = x0;
+        continue;
+      }
+      moved = std::max(moved, distance(x0, m_.points[v]));
+    }
+    return moved;
+  }
+
+ private:
+  // New position in the tangent plane at x (normal n, unit).
+  bool kernel(LO v, const Vec3& x, const Vec3& n, Vec3* out) const {
+    const auto& ring = t_.ring[v];
+    std::vector<Vec3> p(ring.size());
+    for (std::size_t i = 0; i < ring.size(); ++i) {
+      const Vec3 d = m_.points[ring[i]] - x;
+      p[i] = d - n * dot(d, n);  // relative to x, in the tangent plane
+    }
+    if (ring.size() == 8) {
+      // Winslow (paper 000 Eq. 13), x1..x8 = p[0..7], x at the origin.
+      const Vec3 a = p[0] - p[4], b = p[2] - p[6];
+      const double alpha0 = dot(b, b), alpha1 = dot(a, a), beta = dot(a, b);
+      const double den = 2.0 * (alpha0 + alpha1);
+      if (!(den > 0)) return false;
+      const Vec3 num = (p[0] + p[4]) * alpha0 + (p[2] + p[6]) * alpha1 -
+                       (p[1] + p[5] - p[3] - p[7]) * (0.5 * beta);
+      *out = x + num / den;
+      return true;
+    }
+    // Angle-based kernel: each edge neighbour proposes the point on the bisector of its angle in
+    // the one-ring, at the current distance; the proposals are averaged.
+    const Vec3 e1 = normalized(p[0]);
+    if (norm2(e1) == 0) return false;
+    const Vec3 e2 = cross(n, e1);
+    auto ang = [&](const Vec3& d) { return std::atan2(dot(d, e2), dot(d, e1)); };
+    const std::size_t k = ring.size();
+    Vec3 sum{};
+    int count = 0;
+    for (std::size_t i = 0; i < k; i += 2) {
+      const Vec3& nj = p[i];
+      const Vec3& next = p[(i + 1) % k];
+      const Vec3& prev = p[(i + k - 1) % k];
+      const Vec3 toward = nj * -1.0;
+      const double r = norm(toward);
+      if (!(r > 0) || norm2(next - nj) == 0 || norm2(prev - nj) == 0) return false;
+      const double an = ang(next - nj);
+      double sweep = ang(prev - nj) - an;
+      while (sweep < 0) sweep += 2 * std::numbers::pi;
+      while (sweep >= 2 * std::numbers::pi) sweep -= 2 * std::numbers::pi;
+      const double th = an + 0.5 * sweep;
+      sum += nj + (e1 * std::cos(th) + e2 * std::sin(th)) * r;
+      ++count;
+    }
+    *out = x + sum / count;
+    return true;
+  }
+
+  // uv whose S(uv) is nearest to target, from uv0, by Gauss-Newton steps on (du, dv).
+  bool to_uv(const Vec2& uv0, const Vec3& target, Vec2* out) const {
+    Vec2 uv = uv0;
+    for (int it = 0; it < 3; ++it) {
+      const auto e = s_.eval(uv);
+      const Vec3 r = target - e.p;
+      const double g11 = dot(e.du, e.du), g12 = dot(e.du, e.dv), g22 = dot(e.dv, e.dv);
+      const double det = g11 * g22 - g12 * g12;
+      if (!(det > 1e-14 * g11 * g22) || !std::isfinite(det))
+        return it > 0 ? (*out = uv, true) : false;
+      const double b1 = dot(e.du, r), b2 = dot(e.dv, r);
+      uv += Vec2{(g22 * b1 - g12 * b2) / det, (g11 * b2 - g12 * b1) / det};
+    }
+    if (!std::isfinite(uv.u) || !std::isfinite(uv.v)) return false;
+    *out = uv;
+    return true;
+  }
+
+  mesh::FaceMesh& m_;
+  const cad::FaceGeometry& s_;
+  const Topology& t_;
+  double sign_;
+};
+
+// Minimum quality (with flip detection) over all quads.
+double min_quality_all(const Smoother& sm, LO nquads) {
+  double w = std::numeric_limits<double>::max();
+  for (LO q = 0; q < nquads; ++q) w = std::min(w, sm.quality(q));
+  return w;
+}
+
+// Unweighted Laplacian of u and v over the free vertices, locked ones as Dirichlet values.
+bool laplacian_uv(mesh::FaceMesh& m, const Topology& t) {
+  const LO n = m.num_vertices();
+  std::vector<LO> unknown(static_cast<std::size_t>(n), kNoIndex);
+  LO nu = 0;
+  for (LO v = 0; v < n; ++v)
+    if (t.free[v] && !t.v2v[v].empty()) unknown[v] = nu++;
+  if (nu == 0) return false;
+  std::vector<linalg::SparseMatrix::Triplet> trip;
+  std::vector<double> bu(static_cast<std::size_t>(nu), 0.0), bv(static_cast<std::size_t>(nu), 0.0);
+  for (LO v = 0; v < n; ++v) {
+    const LO i = unknown[v];
+    if (i == kNoIndex) continue;
+    trip.push_back({i, i, static_cast<double>(t.v2v[v].size())});
+    for (LO w : t.v2v[v]) {
+      if (unknown[w] != kNoIndex) {
+        trip.push_back({i, unknown[w], -1.0});
+      } else {
+        bu[i] += m.uv[w].u;
+        bv[i] += m.uv[w].v;
+      }
+    }
+  }
+  const linalg::SparseMatrix A(nu, trip);
+  std::vector<double> xu(static_cast<std::size_t>(nu)), xv(static_cast<std::size_t>(nu));
+  try {
+    auto solver = linalg::make_solver(nu, linalg::SolverOptions{linalg::Backend::Eigen}, nullptr);
+    solver->analyze(A);
+    solver->factorize(A);  // throws when a component of free vertices touches no locked one
+    solver->solve(bu, xu);
+    solver->solve(bv, xv);
+  } catch (const Error&) {
+    return false;
+  }
+  for (LO v = 0; v < n; ++v) {
+    const LO i = unknown[v];
+    if (i == kNoIndex) continue;
+    if (!std::isfinite(xu[i]) || !std::isfinite(xv[i])) return false;
+  }
+  for (LO v = 0; v < n; ++v)
+    if (unknown[v] != kNoIndex) m.uv[v] = {xu[unknown[v]], xv[unknown[v]]};
+  return true;
+}
+
+}  // namespace
+
+mesh::FaceMesh smooth_face(const mesh::FaceMesh& input, const cad::FaceGeometry& surface,
+                           const SmoothOptions& options, SmoothStats* stats) {
+  QSMESH_CHECK(input.uv.size() == input.points.size() && input.vclass.size() == input.points.size(),
+               "face " << input.face << ": points, uv and vclass sizes differ");
+  SmoothStats st;
+  st.before = measure(input);
+  mesh::FaceMesh m = input;
+  const Stopwatch clock;
+  if (!m.quads.empty()) {
+    const Topology topo = build_topology(m);
+    Smoother sm(m, surface, topo, orientation(m, surface));
+    const LO nq = static_cast<LO>(m.quads.size());
+
+    if (options.laplacian_uv) {
+      if (const char* why = uv_discontinuity(m, surface)) {
+        st.method = std::string("uv_laplacian(skipped:") + why + ")";
+      } else {
+        const double q0 = min_quality_all(sm, nq);
+        const std::vector<Vec2> uv0 = m.uv;
+        const std::vector<Vec3> p0 = m.points;
+        bool kept = laplacian_uv(m, topo);
+        if (kept) {
+          for (LO v = 0; v < m.num_vertices(); ++v)
+            if (!(m.uv[v] == uv0[v])) m.points[v] = surface.eval(m.uv[v]).p;
+          kept = min_quality_all(sm, nq) >= q0;
+        }
+        if (!kept) {
+          m.uv = uv0;
+          m.points = p0;
+        }
+        st.method = kept ? "uv_laplacian" : "uv_laplacian(rejected)";
+      }
+    }
+    if (options.winslow && options.iterations > 0) {
+      const double size = [&] {
+        Box3 b;
+        for (const auto& p : m.points) b.add(p);
+        return b.diagonal();
+      }();
+      for (int it = 0; it < options.iterations; ++it) {
+        if (options.time_budget_s > 0 && clock.seconds() > options.time_budget_s) break;
+        const double moved = sm.pass();
+        ++st.iterations;
+        if (moved <= 1e-9 * size) break;
+      }
+      st.method += st.method.empty() ? "kernels" : "+kernels";
+    }
+    for (LO v = 0; v < m.num_vertices(); ++v)
+      if (m.vclass[v].dim == 2) m.vclass[v].param = {m.uv[v].u, m.uv[v].v};
+  }
+  st.after = measure(m);
+  if (st.after.sicn_min < st.before.sicn_min || st.after.invalid > st.before.invalid) {
+    m = input;
+    st.after = st.before;
+    st.rolled_back = true;
+  }
+  if (stats) *stats = st;
+  return m;
+}
+
+}  // namespace qsmesh::smooth

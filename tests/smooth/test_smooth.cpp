@@ -1,0 +1,334 @@
+#include <gtest/gtest.h>
+
+#include <BRepBuilderAPI_MakeFace.hxx>
+#include <BRepTools.hxx>
+#include <TopoDS_Face.hxx>
+#include <cstdint>
+#include <gp_Ax3.hxx>
+#include <gp_Cylinder.hxx>
+#include <gp_Pln.hxx>
+#include <map>
+#include <numbers>
+#include <string>
+
+#include "qsmesh/cad/model.hpp"
+#include "qsmesh/smooth/smooth.hpp"
+#include "shapes.hpp"
+
+namespace qsmesh::smooth {
+namespace {
+
+std::string tmp(const std::string& name) { return std::string(QSMESH_TEST_TMP_DIR) + "/" + name; }
+
+std::string write_face(const TopoDS_Shape& s, const std::string& name) {
+  const std::string path = tmp(name);
+  if (!BRepTools::Write(s, path.c_str())) throw std::runtime_error("cannot write " + path);
+  return path;
+}
+
+// 10 x 6 plate in the z = 0 plane, u = x, v = y.
+std::string write_plate() {
+  return write_face(
+      BRepBuilderAPI_MakeFace(gp_Pln(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), 0.0, 10.0, 0.0, 6.0).Face(),
+      "smooth_plate.brep");
+}
+// Quarter of a cylinder side of radius 2, height 3: no seam inside.
+std::string write_cylinder_patch() {
+  return write_face(
+      BRepBuilderAPI_MakeFace(gp_Cylinder(gp_Ax3(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), 2.0), 0.0,
+                              std::numbers::pi / 2, 0.0, 3.0)
+          .Face(),
+      "smooth_cyl_patch.brep");
+}
+
+// Deterministic pseudo-random numbers in [-1, 1] (no library distribution: portable).
+struct Lcg {
+  std::uint64_t s;
+  double next() {
+    s = s * 6364136223846793005ULL + 1442695040888963407ULL;
+    return static_cast<double>(s >> 11) / static_cast<double>(1ULL << 53) * 2.0 - 1.0;
+  }
+};
+
+struct Case {
+  cad::CadModel model;
+  std::unique_ptr<cad::FaceGeometry> geometry;
+  LO face = 0;
+};
+
+Case load_face(const std::string& path, cad::SurfaceType type) {
+  Case c{cad::load_cad(path), nullptr, kNoIndex};
+  for (LO f = 0; f < c.model.num_faces(); ++f)
+    if (c.model.faces()[f].type == type) c.face = f;
+  if (c.face == kNoIndex) throw std::runtime_error("no face of the wanted type in " + path);
+  c.geometry = c.model.face_geometry(c.face);
+  return c;
+}
+
+// Structured nu x nv grid of quads over the uv box; interior uv perturbed by `amp` cell sizes.
+// seam_u: the sides u = lo and u = hi are the two images of one seam curve.
+mesh::FaceMesh grid(const cad::FaceGeometry& g, Box2 box, int nu, int nv, double amp,
+                    std::uint64_t seed, bool seam_u = false) {
+  mesh::FaceMesh m;
+  m.face = 0;
+  Lcg rng{seed};
+  const double hu = (box.hi.u - box.lo.u) / nu, hv = (box.hi.v - box.lo.v) / nv;
+  auto id = [&](int i, int j) { return static_cast<LO>(j * (nu + 1) + i); };
+  for (int j = 0; j <= nv; ++j)
+    for (int i = 0; i <= nu; ++i) {
+      Vec2 uv{box.lo.u + i * hu, box.lo.v + j * hv};
+      mesh::VertexClass c;
+      const bool bi = i == 0 || i == nu, bj = j == 0 || j == nv;
+      if (bi && bj) {
+        c.dim = 0;
+        c.entity =
+            (seam_u && i == nu) ? LO(j == 0 ? 0 : 2) : LO((j == 0 ? 0 : 2) + (i == 0 ? 0 : 1));
+      } else if (bi || bj) {
+        c.dim = 1;
+        if (bj) {
+          c.entity = j == 0 ? 0 : 2;
+          c.index = i;
+        } else {
+          c.entity = (seam_u || i == 0) ? 3 : 1;
+          c.index = j;
+        }
+      } else {
+        uv.u += amp * hu * rng.next();
+        uv.v += amp * hv * rng.next();
+        c.param = {uv.u, uv.v};
+      }
+      m.uv.push_back(uv);
+      m.points.push_back(g.eval(uv).p);
+      m.vclass.push_back(c);
+    }
+  for (int j = 0; j < nv; ++j)
+    for (int i = 0; i < nu; ++i)
+      m.quads.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)});
+  return m;
+}
+
+// Each grid cell split into two triangles, each triangle into three quads (centroid + edge
+// midpoints): interior vertices of valence 3, 4 and 6. Interior uv perturbed by `amp` cell sizes.
+mesh::FaceMesh split_triangles(const cad::FaceGeometry& g, Box2 box, int nu, int nv, double amp,
+                               std::uint64_t seed) {
+  mesh::FaceMesh m;
+  Lcg rng{seed};
+  const double hu = (box.hi.u - box.lo.u) / nu, hv = (box.hi.v - box.lo.v) / nv;
+  auto on_boundary = [&](const Vec2& uv) {
+    const double e = 1e-9 * (hu + hv);
+    return std::abs(uv.u - box.lo.u) < e || std::abs(uv.u - box.hi.u) < e ||
+           std::abs(uv.v - box.lo.v) < e || std::abs(uv.v - box.hi.v) < e;
+  };
+  std::map<std::pair<long, long>, LO> index;  // key: uv in half-steps
+  auto vertex = [&](long a, long b) {         // at uv = lo + (a hu, b hv) / 6
+    const auto [it, inserted] = index.emplace(std::make_pair(a, b), static_cast<LO>(m.uv.size()));
+    if (inserted) {
+      const Vec2 uv{box.lo.u + a * hu / 6.0, box.lo.v + b * hv / 6.0};
+      mesh::VertexClass c;
+      if (on_boundary(uv)) {
+        c.dim = 1;
+        c.entity = 0;
+        c.index = static_cast<LO>(m.uv.size());
+      }
+      m.uv.push_back(uv);
+      m.vclass.push_back(c);
+    }
+    return it->second;
+  };
+  for (int j = 0; j < nv; ++j)
+    for (int i = 0; i < nu; ++i) {
+      const std::array<std::pair<long, long>, 4> c{
+          {{6L * i, 6L * j}, {6L * i + 6, 6L * j}, {6L * i + 6, 6L * j + 6}, {6L * i, 6L * j + 6}}};
+      for (const auto& t : {std::array<int, 3>{0, 1, 2}, std::array<int, 3>{0, 2, 3}}) {
+        const auto& a = c[t[0]];
+        const auto& b = c[t[1]];
+        const auto& d = c[t[2]];
+        const LO va = vertex(a.first, a.second), vb = vertex(b.first, b.second),
+                 vd = vertex(d.first, d.second);
+        const LO mab = vertex((a.first + b.first) / 2, (a.second + b.second) / 2);
+        const LO mbd = vertex((b.first + d.first) / 2, (b.second + d.second) / 2);
+        const LO mda = vertex((d.first + a.first) / 2, (d.second + a.second) / 2);
+        const LO g0 =
+            vertex((a.first + b.first + d.first) / 3, (a.second + b.second + d.second) / 3);
+        m.quads.push_back({va, mab, g0, mda});
+        m.quads.push_back({vb, mbd, g0, mab});
+        m.quads.push_back({vd, mda, g0, mbd});
+      }
+    }
+  for (std::size_t v = 0; v < m.uv.size(); ++v) {
+    if (m.vclass[v].dim == 2) {
+      m.uv[v].u += amp * hu / 6.0 * rng.next();
+      m.uv[v].v += amp * hv / 6.0 * rng.next();
+      m.vclass[v].param = {m.uv[v].u, m.uv[v].v};
+    }
+    m.points.push_back(g.eval(m.uv[v]).p);
+  }
+  return m;
+}
+
+void expect_boundary_locked_and_on_surface(const mesh::FaceMesh& in, const mesh::FaceMesh& out,
+                                           const cad::FaceGeometry& g, double size) {
+  ASSERT_EQ(in.points.size(), out.points.size());
+  EXPECT_EQ(in.quads, out.quads);
+  for (std::size_t v = 0; v < in.points.size(); ++v) {
+    if (in.vclass[v].dim != 2) {
+      EXPECT_TRUE(in.points[v] == out.points[v]) << "boundary vertex " << v << " moved";
+      EXPECT_TRUE(in.uv[v] == out.uv[v]) << "boundary vertex " << v << " moved in uv";
+    }
+    EXPECT_LT(distance(g.eval(out.uv[v]).p, out.points[v]), 1e-9 * size) << v;
+  }
+}
+
+TEST(Smooth, MeasureOfSquaresIsOne) {
+  const Case c = load_face(write_plate(), cad::SurfaceType::Plane);
+  const auto m = grid(*c.geometry, c.model.faces()[c.face].uv_box, 10, 6, 0.0, 1);
+  const QualityReport r = measure(m);
+  EXPECT_NEAR(r.sicn_min, 1.0, 1e-12);
+  EXPECT_NEAR(r.sicn_avg, 1.0, 1e-12);
+  EXPECT_EQ(r.invalid, 0);
+}
+
+TEST(Smooth, PerturbedPlateGridBecomesRegular) {
+  const Case c = load_face(write_plate(), cad::SurfaceType::Plane);
+  const auto in = grid(*c.geometry, c.model.faces()[c.face].uv_box, 20, 12, 0.35, 7);
+  SmoothStats st;
+  const auto out = smooth_face(in, *c.geometry, SmoothOptions{}, &st);
+  std::printf("plate: before min %.4f avg %.4f, after min %.4f avg %.4f, %s, %d it\n",
+              st.before.sicn_min, st.before.sicn_avg, st.after.sicn_min, st.after.sicn_avg,
+              st.method.c_str(), st.iterations);
+  EXPECT_LT(st.before.sicn_avg, 0.9);
+  EXPECT_GE(st.after.sicn_avg, 0.95);
+  EXPECT_GT(st.after.sicn_min, st.before.sicn_min);
+  EXPECT_FALSE(st.rolled_back);
+  EXPECT_EQ(st.method.rfind("uv_laplacian+", 0), 0u) << st.method;
+  expect_boundary_locked_and_on_surface(in, out, *c.geometry, c.model.diagonal());
+  const auto r = measure(out);
+  EXPECT_EQ(r.sicn_min, st.after.sicn_min);
+}
+
+TEST(Smooth, KernelsAloneImprovePlateGrid) {
+  const Case c = load_face(write_plate(), cad::SurfaceType::Plane);
+  const auto in = grid(*c.geometry, c.model.faces()[c.face].uv_box, 20, 12, 0.35, 11);
+  SmoothOptions o;
+  o.laplacian_uv = false;
+  o.iterations = 30;
+  SmoothStats st;
+  const auto out = smooth_face(in, *c.geometry, o, &st);
+  std::printf("plate kernels only: before min %.4f avg %.4f, after min %.4f avg %.4f, %d it\n",
+              st.before.sicn_min, st.before.sicn_avg, st.after.sicn_min, st.after.sicn_avg,
+              st.iterations);
+  EXPECT_EQ(st.method, "kernels");
+  EXPECT_GE(st.after.sicn_avg, 0.95);
+  EXPECT_GT(st.after.sicn_min, st.before.sicn_min);
+  expect_boundary_locked_and_on_surface(in, out, *c.geometry, c.model.diagonal());
+}
+
+TEST(Smooth, PerturbedCylinderPatchBecomesRegular) {
+  const Case c = load_face(write_cylinder_patch(), cad::SurfaceType::Cylinder);
+  const auto in = grid(*c.geometry, c.model.faces()[c.face].uv_box, 12, 12, 0.35, 3);
+  SmoothStats st;
+  const auto out = smooth_face(in, *c.geometry, SmoothOptions{}, &st);
+  std::printf("cylinder patch: before min %.4f avg %.4f, after min %.4f avg %.4f, %s\n",
+              st.before.sicn_min, st.before.sicn_avg, st.after.sicn_min, st.after.sicn_avg,
+              st.method.c_str());
+  EXPECT_LT(st.before.sicn_avg, 0.9);
+  EXPECT_GE(st.after.sicn_avg, 0.95);
+  EXPECT_GT(st.after.sicn_min, st.before.sicn_min);
+  EXPECT_EQ(st.method.rfind("uv_laplacian+", 0), 0u) << st.method;
+  expect_boundary_locked_and_on_surface(in, out, *c.geometry, c.model.diagonal());
+  for (const auto& p : out.points) EXPECT_NEAR(std::hypot(p.x, p.y), 2.0, 1e-9);
+}
+
+TEST(Smooth, SeamSkipsUvLaplacianButKernelsImprove) {
+  const Case c =
+      load_face(test::write_cylinder(tmp("smooth_cyl.brep")), cad::SurfaceType::Cylinder);
+  Box2 box = c.model.faces()[c.face].uv_box;
+  ASSERT_TRUE(c.model.faces()[c.face].u_periodic);
+  const auto in = grid(*c.geometry, box, 24, 10, 0.35, 5, /*seam_u=*/true);
+  SmoothOptions o;
+  o.iterations = 30;
+  SmoothStats st;
+  const auto out = smooth_face(in, *c.geometry, o, &st);
+  std::printf("cylinder with seam: before min %.4f avg %.4f, after min %.4f avg %.4f, %s, %d it\n",
+              st.before.sicn_min, st.before.sicn_avg, st.after.sicn_min, st.after.sicn_avg,
+              st.method.c_str(), st.iterations);
+  EXPECT_EQ(st.method, "uv_laplacian(skipped:seam)+kernels");
+  EXPECT_GT(st.after.sicn_avg, st.before.sicn_avg + 0.05);
+  EXPECT_GT(st.after.sicn_min, st.before.sicn_min);
+  EXPECT_GE(st.after.sicn_avg, 0.9);
+  expect_boundary_locked_and_on_surface(in, out, *c.geometry, c.model.diagonal());
+}
+
+TEST(Smooth, IrregularVerticesUseAngleKernel) {
+  const Case c = load_face(write_plate(), cad::SurfaceType::Plane);
+  const auto in = split_triangles(*c.geometry, c.model.faces()[c.face].uv_box, 6, 4, 0.8, 13);
+  for (const bool lap : {false, true}) {
+    SmoothOptions o;
+    o.laplacian_uv = lap;
+    o.iterations = 20;
+    SmoothStats st;
+    const auto out = smooth_face(in, *c.geometry, o, &st);
+    std::printf("split triangles (%s): before min %.4f avg %.4f, after min %.4f avg %.4f, %d it\n",
+                st.method.c_str(), st.before.sicn_min, st.before.sicn_avg, st.after.sicn_min,
+                st.after.sicn_avg, st.iterations);
+    EXPECT_GT(st.after.sicn_min, st.before.sicn_min);
+    EXPECT_GT(st.after.sicn_avg, st.before.sicn_avg);
+    EXPECT_EQ(st.after.invalid, 0);
+    expect_boundary_locked_and_on_surface(in, out, *c.geometry, c.model.diagonal());
+  }
+}
+
+TEST(Smooth, OptimalGridIsNotMadeWorse) {
+  const Case c = load_face(write_plate(), cad::SurfaceType::Plane);
+  const auto in = grid(*c.geometry, c.model.faces()[c.face].uv_box, 10, 6, 0.0, 1);
+  SmoothStats st;
+  const auto out = smooth_face(in, *c.geometry, SmoothOptions{}, &st);
+  std::printf("optimal grid: before min %.17g, after min %.17g, %s, rolled back %d\n",
+              st.before.sicn_min, st.after.sicn_min, st.method.c_str(), int(st.rolled_back));
+  EXPECT_GE(st.after.sicn_min, st.before.sicn_min);
+  EXPECT_GE(measure(out).sicn_min, measure(in).sicn_min);
+  for (std::size_t v = 0; v < in.points.size(); ++v)
+    EXPECT_LT(distance(in.points[v], out.points[v]), 1e-12);
+  if (st.rolled_back) {
+    for (std::size_t v = 0; v < in.points.size(); ++v) EXPECT_TRUE(in.points[v] == out.points[v]);
+  }
+}
+
+TEST(Smooth, InvertedInputIsUntangledOrRolledBack) {
+  // One interior vertex thrown outside its cell: quads around it are folded. The result is never
+  // worse than the input, and here it is valid.
+  const Case c = load_face(write_plate(), cad::SurfaceType::Plane);
+  auto in = grid(*c.geometry, c.model.faces()[c.face].uv_box, 10, 6, 0.0, 1);
+  const LO v = 3 * 11 + 5;
+  in.uv[v] = in.uv[v] + Vec2{2.5, 0.3};
+  in.points[v] = c.geometry->eval(in.uv[v]).p;
+  SmoothOptions o;
+  o.laplacian_uv = false;
+  SmoothStats st;
+  const auto out = smooth_face(in, *c.geometry, o, &st);
+  EXPECT_GT(st.before.invalid, 0);
+  EXPECT_GE(st.after.sicn_min, st.before.sicn_min);
+  EXPECT_LE(st.after.invalid, st.before.invalid);
+  o.laplacian_uv = true;
+  const auto out2 = smooth_face(in, *c.geometry, o, &st);
+  EXPECT_EQ(st.after.invalid, 0);
+  EXPECT_GT(st.after.sicn_min, 0.99);
+}
+
+TEST(Smooth, Deterministic) {
+  const Case c = load_face(write_cylinder_patch(), cad::SurfaceType::Cylinder);
+  const auto in = split_triangles(*c.geometry, c.model.faces()[c.face].uv_box, 5, 5, 0.8, 17);
+  for (const bool lap : {false, true}) {
+    SmoothOptions o;
+    o.laplacian_uv = lap;
+    const auto a = smooth_face(in, *c.geometry, o);
+    const auto b = smooth_face(in, *c.geometry, o);
+    for (std::size_t v = 0; v < a.points.size(); ++v) {
+      EXPECT_TRUE(a.points[v] == b.points[v]);
+      EXPECT_TRUE(a.uv[v] == b.uv[v]);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace qsmesh::smooth
