@@ -17,6 +17,8 @@ struct Arguments {
   std::string output;              ///< -o
   std::optional<double> size;      ///< --size (model units)
   std::optional<double> size_factor;  ///< --size-factor (fraction of the bounding-box diagonal)
+  /// Last stage to run. `unstructured` exists but still fails on some faces of the shared models
+  /// (reported per face), so the default stays the furthest stage that is complete.
   std::string until = "background";
   int threads = 0;                 ///< 0: automatic
   std::string stats;               ///< --stats FILE.json

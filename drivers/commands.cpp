@@ -118,6 +118,37 @@ struct Checks {
   double max_distance_to_cad = 0;  ///< relative to the model diagonal
 };
 
+/// How one face ended at the last stage run.
+struct FaceOutcome {
+  LO face;
+  bool ok, fell_back;
+  std::string error;
+};
+
+/// Per face: the quad stage's report when it ran, the background stage's otherwise.
+std::vector<FaceOutcome> outcomes(const parallel::PipelineResult& r) {
+  std::vector<FaceOutcome> out;
+  if (!r.quad_reports.empty()) {
+    for (std::size_t f = 0; f < r.quad_reports.size(); ++f) {
+      const auto& q = r.quad_reports[f];
+      out.push_back({static_cast<LO>(f), q.ok, q.fell_back, q.error});
+    }
+  } else {
+    for (const auto& rep : r.reports) out.push_back({rep.face, rep.ok, rep.fell_back, rep.error});
+  }
+  return out;
+}
+
+/// Faces without a valid mesh at the stage reached, and faces that fell back to a simpler method.
+std::pair<std::int64_t, std::int64_t> count_failures(const parallel::PipelineResult& r) {
+  std::int64_t failed = 0, fell_back = 0;
+  for (const auto& o : outcomes(r)) {
+    failed += o.ok ? 0 : 1;
+    fell_back += o.fell_back ? 1 : 0;
+  }
+  return {failed, fell_back};
+}
+
 std::string stats_json(const Arguments& args, const Session& session, const parallel::PipelineResult& r,
                        const mesh::MeshStats& s, const Checks& checks) {
   const cad::CadModel& model = session.model;
@@ -129,11 +160,7 @@ std::string stats_json(const Arguments& args, const Session& session, const para
   j.value("corners", static_cast<std::int64_t>(model.num_corners()));
   j.value("curves", static_cast<std::int64_t>(model.num_curves()));
   j.value("faces", static_cast<std::int64_t>(model.num_faces()));
-  std::int64_t failed = 0, fell_back = 0;
-  for (const auto& rep : r.reports) {
-    failed += rep.ok ? 0 : 1;
-    fell_back += rep.fell_back ? 1 : 0;
-  }
+  const auto [failed, fell_back] = count_failures(r);
   j.value("faces_failed", failed);
   j.value("faces_fell_back", fell_back);
   j.value("vertices", s.vertices);
@@ -156,10 +183,10 @@ std::string stats_json(const Arguments& args, const Session& session, const para
   j.value("max_distance_to_cad", checks.max_distance_to_cad);
   write_times(j, session.times);
   j.begin_array("face_reports");
-  for (const auto& rep : r.reports) {
-    if (rep.ok && !rep.fell_back) continue;
-    j.begin_object().value("face", static_cast<std::int64_t>(rep.face)).value("ok", rep.ok)
-        .value("fell_back", rep.fell_back).value("error", rep.error).end_object();
+  for (const auto& o : outcomes(r)) {
+    if (o.ok && !o.fell_back) continue;
+    j.begin_object().value("face", static_cast<std::int64_t>(o.face)).value("ok", o.ok)
+        .value("fell_back", o.fell_back).value("error", o.error).end_object();
   }
   j.end_array();
   j.end_object();
@@ -168,14 +195,10 @@ std::string stats_json(const Arguments& args, const Session& session, const para
 
 void print_summary(std::ostream& os, const cad::CadModel& model, const parallel::PipelineResult& r,
                    const mesh::MeshStats& s, const Checks& checks, const StageTimes& times) {
-  std::int64_t failed = 0, fell_back = 0;
-  for (const auto& rep : r.reports) {
-    failed += rep.ok ? 0 : 1;
-    fell_back += rep.fell_back ? 1 : 0;
-  }
+  const auto [failed, fell_back] = count_failures(r);
   os << "\nsummary\n"
      << "  faces:      " << model.num_faces() << " (" << failed << " failed, " << fell_back
-     << " kept their boundary-only triangulation)\n"
+     << " fell back to a simpler method)\n"
      << "  vertices:   " << s.vertices << "\n"
      << "  triangles:  " << s.triangles << "\n"
      << "  quads:      " << s.quads << "\n"
@@ -192,8 +215,8 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
   os << "  conforming: " << (checks.conformity.ok() ? "yes" : "NO (" + checks.conformity.summary() + ")")
      << "; largest vertex distance to its CAD entity: " << checks.max_distance_to_cad << " of the diagonal\n";
   os << "  time (s):" << times_line(times) << "\n";
-  for (const auto& rep : r.reports)
-    if (!rep.ok || rep.fell_back) os << "  face " << rep.face << ": " << rep.error << "\n";
+  for (const auto& o : outcomes(r))
+    if (!o.ok || (o.fell_back && !o.error.empty())) os << "  face " << o.face << ": " << o.error << "\n";
 }
 
 }  // namespace
@@ -250,6 +273,7 @@ int run_mesh(const Arguments& args) {
   Session s(args, "mesh");
   parallel::PipelineOptions options;
   options.background.sizes.size = s.size;
+  options.sizemap.size_max = s.size;
   options.until = until;
   parallel::PipelineResult result = parallel::run_pipeline(s.comm, s.model, options, *s.tasks, s.log);
   for (const auto& [stage, sec] : result.times.entries()) s.times.add(stage, sec);
@@ -268,8 +292,8 @@ int run_mesh(const Arguments& args) {
     if (!args.quiet) print_summary(std::cout, s.model, result, stats, checks, s.times);
     if (!args.stats.empty())
       write_text_file_atomically(args.stats, stats_json(args, s, result, stats, checks));
-    for (const auto& rep : result.reports)
-      if (!rep.ok) s.log.warn(rep.error);
+    for (const auto& o : outcomes(result))
+      if (!o.ok) s.log.warn(o.error);
   }
   return 0;
 }

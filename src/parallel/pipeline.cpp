@@ -16,13 +16,15 @@ namespace qsmesh::parallel {
 const char* to_string(Stage s) {
   switch (s) {
     case Stage::Background: return "background";
+    case Stage::Unstructured: return "unstructured";
   }
   return "?";
 }
 
 Stage parse_stage(const std::string& name) {
   if (name == "background") return Stage::Background;
-  throw InputError("--until: unknown stage '" + name + "' (valid: background)");
+  if (name == "unstructured") return Stage::Unstructured;
+  throw InputError("--until: unknown stage '" + name + "' (valid: background, unstructured)");
 }
 
 std::vector<double> estimate_face_costs(const cad::CadModel& model, double size) {
@@ -214,7 +216,9 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
 
   // Cross fields (paper 000 Sec. 3) on the same faces, one task per face. The size map keeps the
   // whole fields (it needs H at every vertex); the drivers get summaries.
-  const bool keep_fields = options.size_map && options.sizemap.method == sizemap::Method::CrossField;
+  const bool quads = options.until >= Stage::Unstructured;
+  const bool size_map = options.size_map || quads;
+  const bool keep_fields = size_map && options.sizemap.method == sizemap::Method::CrossField;
   const bool want_fields = options.cross_fields || keep_fields;
   std::vector<CrossFieldOutput> fields;
   std::vector<std::unique_ptr<crossfield::FaceCrossField>> full(mine.size());
@@ -244,8 +248,8 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
   // Size map (paper 000 Sec. 4.1-4.2): curve sizes known to every rank, face fields on the faces'
   // ranks, their union on shared curves by an MPI min-reduction, then quantization (Sec. 4.3)
   // computed identically on every rank.
-  std::vector<FaceSizeOutput> sizes(options.size_map ? mine.size() : 0);
-  if (options.size_map) {
+  std::vector<FaceSizeOutput> sizes(size_map ? mine.size() : 0);
+  if (size_map) {
     clock.reset();
     const sizemap::SizeMapOptions& so = options.sizemap;
     const sizemap::CurveSizes initial = sizemap::initial_curve_sizes(model, curves, so, tasks);
@@ -279,13 +283,39 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
                  result.quantization.total_edges, " edges"));
   }
 
+  // Unstructured all-quad meshes (paper 000 Sec. 5) on the quantized curve meshes: faces meshed
+  // on the halved curves, recombined, subdivided onto the full ones, smoothed.
+  std::vector<quad::UnstructuredReport> quad_reports(quads ? mine.size() : 0);
+  if (quads) {
+    clock.reset();
+    const std::vector<mesh::CurveMesh> halved = quantize::place_vertices(
+        model, curves, result.curve_sizes.at, result.quantization, /*halved=*/true, tasks);
+    quad::UnstructuredOptions qo;
+    qo.size = options.background.sizes.size;
+    std::atomic<std::int64_t> q_done{0};
+    tasks.parallel_for(total, [&](std::int64_t i) {
+      meshes[i] = quad::mesh_face_unstructured(model, mine[i], halved, result.quantized_curves, qo, &quad_reports[i]);
+      const std::int64_t n = ++q_done;
+      if (n * 10 / total != (n - 1) * 10 / total)
+        log.info(cat("unstructured: ", n, "/", mine.size(), " faces on rank ", rank));
+    });
+    result.times.add("unstructured", comm.allreduce_max(clock.seconds()));
+  }
+
   // Gather on rank 0 and assemble in face order.
   clock.reset();
   std::vector<char> buffer;
   for (std::size_t i = 0; i < mine.size(); ++i) {
     pack(meshes[i], reports[i], buffer);
     if (options.cross_fields) pack(fields[i], buffer);
-    if (options.size_map) pack(sizes[i], buffer);
+    if (size_map) pack(sizes[i], buffer);
+    if (quads) {
+      put<std::uint8_t>(buffer, quad_reports[i].ok ? 1 : 0);
+      put<std::uint8_t>(buffer, quad_reports[i].fell_back ? 1 : 0);
+      put_vec(buffer, std::vector<char>(quad_reports[i].error.begin(), quad_reports[i].error.end()));
+      put<double>(buffer, quad_reports[i].sicn_min);
+      put<std::int64_t>(buffer, quad_reports[i].quads);
+    }
   }
   meshes.clear();
   const auto gathered = comm.gather_bytes(buffer, 0);
@@ -293,7 +323,8 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     std::vector<mesh::FaceMesh> all(static_cast<std::size_t>(nfaces));
     result.reports.resize(static_cast<std::size_t>(nfaces));
     if (options.cross_fields) result.cross_fields.resize(static_cast<std::size_t>(nfaces));
-    if (options.size_map) result.face_sizes.resize(static_cast<std::size_t>(nfaces));
+    if (size_map) result.face_sizes.resize(static_cast<std::size_t>(nfaces));
+    if (quads) result.quad_reports.resize(static_cast<std::size_t>(nfaces));
     for (const auto& bytes : gathered) {
       std::size_t pos = 0;
       while (pos < bytes.size()) {
@@ -305,12 +336,24 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
         result.reports[f] = std::move(r);
         all[f] = std::move(m);
         if (options.cross_fields) unpack(bytes, pos, result.cross_fields[f]);
-        if (options.size_map) unpack(bytes, pos, result.face_sizes[f]);
+        if (size_map) unpack(bytes, pos, result.face_sizes[f]);
+        if (quads) {
+          auto& qr = result.quad_reports[f];
+          qr.ok = get<std::uint8_t>(bytes, pos) != 0;
+          qr.fell_back = get<std::uint8_t>(bytes, pos) != 0;
+          std::vector<char> err;
+          get_vec(bytes, pos, err);
+          qr.error.assign(err.begin(), err.end());
+          qr.sicn_min = get<double>(bytes, pos);
+          qr.quads = get<std::int64_t>(bytes, pos);
+        }
       }
     }
     for (LO f = 0; f < nfaces; ++f) all[f].face = f;
-    result.mesh = mesh::assemble(model, curves, all);
-    if (options.size_map) result.background = std::move(all);
+    result.mesh = mesh::assemble(model, quads ? std::span<const mesh::CurveMesh>(result.quantized_curves)
+                                              : std::span<const mesh::CurveMesh>(curves),
+                                 all);
+    if (size_map && !quads) result.background = std::move(all);
   }
   result.times.add("assemble", comm.allreduce_max(clock.seconds()));
   return result;

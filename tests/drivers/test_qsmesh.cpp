@@ -108,6 +108,22 @@ TEST_F(Qsmesh, MeshWritesEveryFormatAndStats) {
   }
 }
 
+TEST_F(Qsmesh, UnstructuredStageGivesValidQuads) {
+  const std::string out = tmp("e2e_quads.msh");
+  const std::string stats = tmp("e2e_quads.json");
+  const ExeResult r = run("mesh " + model_ + " -o " + out + " --size 0.8 --until unstructured --stats " + stats);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string json = slurp(stats);
+  EXPECT_NE(json.find("\"triangles\": 0,"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"faces_failed\": 0"), std::string::npos) << json;
+  EXPECT_NE(json.find("\"conforming\": true"), std::string::npos) << json;
+  const auto at = json.find("\"sicn_min\": ");
+  ASSERT_NE(at, std::string::npos);
+  EXPECT_GT(std::stod(json.substr(at + 12)), 0.0) << json.substr(at, 40);
+  const auto quads = json.find("\"quads\": ");
+  EXPECT_GT(std::stol(json.substr(quads + 9)), 500) << json.substr(quads, 30);
+}
+
 TEST_F(Qsmesh, SameFileWhateverTheThreads) {
   const std::string a = tmp("e2e_t1.msh"), b = tmp("e2e_t2.msh");
   ASSERT_EQ(run("mesh " + model_ + " -o " + a + " --size 0.7 --threads 1 -q").code, 0);

@@ -169,6 +169,28 @@ void check_size_map(const Comm& comm, const cad::CadModel& model, double size) {
   EXPECT_EQ(all[0], mine * comm.size());
 }
 
+TEST(Pipeline, QuadMeshDoesNotDependOnRanks) {
+  const Comm comm = Comm::world();
+  const cad::CadModel model = shared_model(comm, "pipe_quads");
+  PipelineOptions options;
+  options.background.sizes.size = 0.7;
+  options.sizemap.size_max = 0.7;
+  options.until = Stage::Unstructured;
+  std::ostringstream sink;
+  Logger log(sink, LogLevel::Quiet);
+  const PipelineResult dist = run_pipeline(comm, model, options, TaskArena(2), log);
+  if (comm.rank() != 0) return;
+  const PipelineResult serial = run_pipeline(Comm::self(), model, options, TaskArena(1), log);
+  ASSERT_EQ(dist.mesh.points.size(), serial.mesh.points.size());
+  for (std::size_t i = 0; i < serial.mesh.points.size(); ++i) ASSERT_EQ(dist.mesh.points[i], serial.mesh.points[i]);
+  EXPECT_EQ(dist.mesh.quads, serial.mesh.quads);
+  EXPECT_TRUE(dist.mesh.triangles.empty());
+  EXPECT_GT(dist.mesh.quads.size(), 500u);
+  const auto conformity = mesh::check_conformity(dist.mesh, model);
+  EXPECT_TRUE(conformity.ok()) << conformity.summary();
+  for (const auto& q : dist.quad_reports) EXPECT_TRUE(q.ok) << q.error;
+}
+
 TEST(Pipeline, SizeMapAndCurveMeshesDoNotDependOnRanks) {
   const Comm comm = Comm::world();
   check_size_map(comm, shared_model(comm, "pipe_sm"), 0.6);

@@ -8,6 +8,7 @@
 
 #include "qsmesh/background/face_mesh.hpp"
 #include "qsmesh/crossfield/cross_field.hpp"
+#include "qsmesh/quad/unstructured.hpp"
 #include "qsmesh/quantize/quantize.hpp"
 #include "qsmesh/sizemap/size_map.hpp"
 #include "qsmesh/cad/model.hpp"
@@ -19,8 +20,8 @@
 
 namespace qsmesh::parallel {
 
-/// Pipeline stages, in order. Later issues add unstructured and quasi-structured quads.
-enum class Stage { Background };
+/// Pipeline stages, in order. The quasi-structured stage (paper 000 Sec. 6) comes next.
+enum class Stage { Background, Unstructured };
 [[nodiscard]] const char* to_string(Stage s);
 /// Parses a stage name; throws InputError listing the valid names.
 [[nodiscard]] Stage parse_stage(const std::string& name);
@@ -66,11 +67,14 @@ struct PipelineResult {
   sizemap::CurveSizes curve_sizes;              ///< size map on the background curve meshes (every rank)
   quantize::Quantization quantization;          ///< curve edge counts (every rank)
   std::vector<mesh::CurveMesh> quantized_curves;  ///< final curve meshes (every rank)
+  std::vector<quad::UnstructuredReport> quad_reports;  ///< by face, Stage::Unstructured (rank 0)
   std::vector<int> face_rank;                   ///< rank that meshed each face (every rank)
   StageTimes times;                             ///< wall time per stage (max over ranks)
 };
 
-/// Runs the pipeline up to options.until on all ranks of `comm` (collective). `lane` serialises
+/// Runs the pipeline up to options.until on all ranks of `comm` (collective). Stage::Unstructured
+/// needs the size map and quantization (options.size_map is then implied): the assembled mesh is
+/// the all-quad mesh on the quantized curve meshes. `lane` serialises
 /// this rank's PETSc solves (null: Eigen only).
 [[nodiscard]] PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
                                           const PipelineOptions& options, const TaskArena& tasks,
