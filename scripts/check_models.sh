@@ -3,16 +3,19 @@
 #  - `qsmesh info` counts against ../shared/cad/README.md;
 #  - the background triangulation written as CGNS, VTU and MSH at 1, 2 and 4 ranks, files compared
 #    byte for byte across rank counts, cgnscheck output scanned for warnings and errors;
-#  - statistics (vertices, triangles, smallest angles, time) from --stats.
-# Usage: scripts/check_models.sh [--size-factor F] [--threads T]   (run after scripts/build.sh)
+#  - statistics (vertices, triangles, smallest angles, time) from --stats; with --until unstructured
+#    the quad statistics instead (quads, interior irregular vertices, SICN min/avg, failed faces).
+# Usage: scripts/check_models.sh [--size-factor F] [--threads T] [--until STAGE]   (after scripts/build.sh)
 set -uo pipefail
 cd "$(dirname "$0")/.."
 factor=0.02
 threads=1
+until=background
 while [ $# -gt 0 ]; do
   case "$1" in
     --size-factor) factor=$2; shift 2 ;;
     --threads) threads=$2; shift 2 ;;
+    --until) until=$2; shift 2 ;;
     *) echo "unknown option $1" >&2; exit 2 ;;
   esac
 done
@@ -33,8 +36,13 @@ for m in Block.stp A319.brep wing_fuselage.step mambo_s34.step cube_filet.stp t2
 done
 $exe example wing-body -o "$out/wing_body.step" >/dev/null && models+=("$out/wing_body.step")
 
-printf "| model | corners/curves/faces | ranks 1/2/4 identical (cgns, vtu, msh) | cgnscheck | vertices | triangles | min angle | tris < 10 deg (at sharp corners) | faces failed / fell back | time 1 rank (s) |\n"
-printf "|---|---|---|---|---|---|---|---|---|---|\n"
+if [ "$until" = unstructured ]; then
+  printf "| model | corners/curves/faces | ranks 1/2/4 identical (cgns, vtu, msh) | cgnscheck | vertices | quads | interior irregular (%% of vertices) | SICN min / avg | conforming | faces failed / fell back | time 1 rank (s) |\n"
+  printf "|---|---|---|---|---|---|---|---|---|---|---|\n"
+else
+  printf "| model | corners/curves/faces | ranks 1/2/4 identical (cgns, vtu, msh) | cgnscheck | vertices | triangles | min angle | tris < 10 deg (at sharp corners) | faces failed / fell back | time 1 rank (s) |\n"
+  printf "|---|---|---|---|---|---|---|---|---|---|\n"
+fi
 for model in "${models[@]}"; do
   name=$(basename "$model")
   counts=$($exe info --json "$model" 2>/dev/null | python3 -c 'import json,sys; d=json.load(sys.stdin); print(d["corners"], d["curves"], d["faces"])')
@@ -45,7 +53,7 @@ for model in "${models[@]}"; do
   for ext in cgns vtu msh; do
     for np in 1 2 4; do
       mpiexec --oversubscribe --bind-to none -n $np $exe mesh "$model" -o "$out/m_$np.$ext" --size-factor "$factor" \
-        --threads "$threads" -q --stats "$out/s_$np.json" >/dev/null 2>"$out/err_$np" || { same="FAILED (np $np)"; status=1; }
+        --until "$until" --threads "$threads" -q --stats "$out/s_$np.json" >/dev/null 2>"$out/err_$np" || { same="FAILED (np $np)"; status=1; }
     done
     cmp -s "$out/m_1.$ext" "$out/m_2.$ext" && cmp -s "$out/m_1.$ext" "$out/m_4.$ext" || { same="no ($ext)"; status=1; }
     if [ "$ext" = cgns ]; then
@@ -54,6 +62,17 @@ for model in "${models[@]}"; do
       cp "$out/s_1.json" "$out/stats.json"
     fi
   done
+  if [ "$until" = unstructured ]; then
+    python3 - "$out/stats.json" "$name" "$counts" "$same" "$check" <<'PY'
+import json, sys
+d = json.load(open(sys.argv[1]))
+irr = 100.0 * d["irregular_interior"] / max(1, d["vertices"])
+print(f"| {sys.argv[2]} | {sys.argv[3]} | {sys.argv[4]} | {sys.argv[5]} | {d['vertices']} | {d['quads']} | "
+      f"{d['irregular_interior']} ({irr:.1f}%) | {d['sicn_min']:.3f} / {d['sicn_avg']:.3f} | {d['conforming']} | "
+      f"{d['faces_failed']} / {d['faces_fell_back']} | {d['seconds']['total']:.2f} |")
+PY
+    continue
+  fi
   read -r v t a h0 h1 sc ff fb sec < <(python3 - "$out/stats.json" <<'PY'
 import json, sys
 d = json.load(open(sys.argv[1]))

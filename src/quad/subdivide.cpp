@@ -177,6 +177,12 @@ mesh::FaceMesh subdivide(const mesh::FaceMesh& mesh, const cad::FaceGeometry& su
   std::vector<Snap> snaps;
 
   const BoundaryResolver resolver(mesh, full_curves);
+  // Poles (a corner where the parametrization is singular) have an arbitrary uv on their
+  // degenerate line: what touches them is placed in 3D and projected, guided by the other vertices.
+  std::vector<char> pole(mesh.vclass.size(), 0);
+  for (std::size_t v = 0; v < mesh.vclass.size(); ++v)
+    pole[v] = mesh.vclass[v].dim == 0 && norm(surface.normal(mesh.uv[v])) < 0.5 ? 1 : 0;
+
   // elem_mid[e][k]: new vertex at the middle of edge k of element e.
   std::vector<std::array<LO, 4>> elem_mid(elems.size(), {kNoIndex, kNoIndex, kNoIndex, kNoIndex});
   for (std::size_t i = 0; i < uses.size();) {
@@ -210,6 +216,8 @@ mesh::FaceMesh subdivide(const mesh::FaceMesh& mesh, const cad::FaceGeometry& su
       vc = mesh.vclass[a];
       p = out.points[a];
     } else {
+      if (pole[a] != 0 || pole[b] != 0)
+        uv = surface.project(0.5 * (mesh.points[a] + mesh.points[b]), pole[a] != 0 ? mesh.uv[b] : mesh.uv[a], nullptr);
       vc.dim = 2;
       vc.entity = mesh.face;
       vc.param = {uv.u, uv.v};
@@ -235,6 +243,14 @@ mesh::FaceMesh subdivide(const mesh::FaceMesh& mesh, const cad::FaceGeometry& su
     }
     uv = uv / n;
     g = g / n;
+    Vec2 guess{0, 0};
+    int regular = 0;
+    for (int k = 0; k < n; ++k)
+      if (pole[elems[e][k]] == 0) {
+        guess += mesh.uv[elems[e][k]];
+        ++regular;
+      }
+    if (regular > 0 && regular < n) uv = surface.project(g, guess / regular, nullptr);
     const LO c = out.num_vertices();
     mesh::VertexClass vc;
     vc.dim = 2;
