@@ -4,11 +4,14 @@
 #include <cmath>
 #include <functional>
 #include <limits>
+#include <memory>
 #include <queue>
 #include <sstream>
 #include <string>
 
+#include "qsmesh/background/curve_mesh.hpp"
 #include "qsmesh/background/feature_size.hpp"
+#include "qsmesh/background/size.hpp"
 #include "qsmesh/core/error.hpp"
 
 namespace qsmesh::sizemap {
@@ -170,6 +173,31 @@ CurveSizes initial_curve_sizes(const cad::CadModel& model, std::span<const mesh:
     for (double& x : out.at[c]) x = std::min(x, v);
   };
   for (const auto& [c, v] : options.curve_sizes) cap_curve(c, v);
+
+  // (0) Curvature: 2 pi R / n along the curve and across its faces, as for the background mesh;
+  //     without it a half circle may get two edges and its faces fold.
+  if (options.edges_per_turn > 0) {
+    background::SizeOptions curvature;
+    curvature.size = options.size_max;
+    curvature.min_size = floor;
+    curvature.edges_per_turn = options.edges_per_turn;
+    const auto uses = background::curve_uses(model);
+    tasks.parallel_for(nc, [&](std::int64_t i) {
+      const auto c = static_cast<LO>(i);
+      if (model.curves()[c].degenerate) return;
+      const auto geometry = model.curve_geometry(c);
+      std::vector<std::unique_ptr<cad::FaceGeometry>> faces;
+      for (const auto& u : uses[c]) faces.push_back(model.face_geometry(u.face));
+      for (std::size_t k = 0; k < curves[c].t.size(); ++k) {
+        const double t = curves[c].t[k];
+        double h = curvature.from_curvature(background::curve_curvature(*geometry, t));
+        for (std::size_t j = 0; j < faces.size(); ++j)
+          h = std::min(h, curvature.from_curvature(background::max_principal_curvature(
+                              *faces[j], faces[j]->boundary_uv(uses[c][j].loop, uses[c][j].use, t))));
+        out.at[c][k] = std::min(out.at[c][k], h);
+      }
+    });
+  }
   for (const auto& [f, v] : options.face_sizes)
     for (const auto& loop : model.faces()[f].loops)
       for (const auto& use : loop.uses) cap_curve(use.curve, v);

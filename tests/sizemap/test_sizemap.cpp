@@ -1,6 +1,8 @@
 // Size map (paper 000 Sec. 4.1, 4.2) on OpenCASCADE-built models.
 #include <gtest/gtest.h>
 
+#include <numbers>
+
 #include <BRepBuilderAPI_MakeEdge.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepBuilderAPI_MakePolygon.hxx>
@@ -263,6 +265,7 @@ TEST(SizeMap, CrossFieldSizesVaryOnADiskAndFeaturesDoNot) {
   SizeMapOptions o;
   o.size_max = 2.0;
   o.target_quads = 300;
+  o.edges_per_turn = 0;  // this test is about features and the cross field, not curvature
   const auto n = face_quad_targets(m.cad, o);
   ASSERT_NEAR(n[0], 300, 1e-9);
   const auto& fm = m.faces[0];
@@ -428,6 +431,27 @@ TEST(SizeMap, DeterministicWhateverTheThreadCount) {
     // Seam copies (glued) get the same value.
     EXPECT_LE(gradation_excess(m.faces[f], x.s, o.gradation), 1e-9);
   }
+}
+
+TEST(SizeMap, CurvatureBoundsTheSizeOnCurvedCurves) {
+  // A disk of radius 5: with 16 edges per turn its circle asks for 2 pi 5 / 16 = 1.963, below the
+  // cap of 2; with the curvature switched off the cap alone remains.
+  const Model m = prepare(disk(5), 0.5, false);
+  SizeMapOptions o;
+  o.size_max = 2.0;
+  o.method = Method::Features;
+  const CurveSizes with = initial_curve_sizes(m.cad, m.curves, o, TaskArena(1));
+  o.edges_per_turn = 0;
+  const CurveSizes without = initial_curve_sizes(m.cad, m.curves, o, TaskArena(1));
+  const double expected = 2 * std::numbers::pi * 5 / 16;
+  int checked = 0;
+  for (std::size_t c = 0; c < with.at.size(); ++c)
+    for (std::size_t i = 0; i < with.at[c].size(); ++i) {
+      EXPECT_NEAR(with.at[c][i], expected, 1e-6);
+      EXPECT_DOUBLE_EQ(without.at[c][i], 2.0);
+      ++checked;
+    }
+  EXPECT_GT(checked, 0);
 }
 
 }  // namespace

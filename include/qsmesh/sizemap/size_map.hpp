@@ -40,6 +40,9 @@ struct SizeMapOptions {
   double size_min = 0;
   /// g_max of Eq. 10: largest growth of the size per unit distance (0.2: progression ratio 1.2).
   double gradation = 0.2;
+  /// Edges per full turn on curved curves and faces (a radius R gives 2 pi R / n on the curves);
+  /// 0 switches the curvature sizes off.
+  double edges_per_turn = 16;
   /// N, the target number of quads of the whole model; 0: total area / size_max^2.
   double target_quads = 0;
   /// (face id, quad count) fixed by the user: that face gets this N_i instead of its area share.
