@@ -12,6 +12,21 @@
 
 namespace qsmesh::background {
 
+CurveCurvatureSize::CurveCurvatureSize(const cad::CadModel& model, LO curve, std::span<const CurveUseRef> uses,
+                                       const SizeOptions& sizes)
+    : geometry_(model.curve_geometry(curve)), refs_(uses.begin(), uses.end()), sizes_(sizes) {
+  for (const CurveUseRef& u : uses) faces_.push_back(model.face_geometry(u.face));
+}
+
+double CurveCurvatureSize::operator()(double t) const {
+  double h = sizes_.from_curvature(curve_curvature(*geometry_, t));
+  for (std::size_t i = 0; i < faces_.size(); ++i) {
+    const Vec2 uv = faces_[i]->boundary_uv(refs_[i].loop, refs_[i].use, t);
+    h = std::min(h, sizes_.from_curvature(max_principal_curvature(*faces_[i], uv)));
+  }
+  return h;
+}
+
 std::vector<std::vector<CurveUseRef>> curve_uses(const cad::CadModel& model) {
   std::vector<std::vector<CurveUseRef>> uses(static_cast<std::size_t>(model.num_curves()));
   for (LO f = 0; f < model.num_faces(); ++f) {
@@ -25,36 +40,6 @@ std::vector<std::vector<CurveUseRef>> curve_uses(const cad::CadModel& model) {
 
 namespace {
 
-/// Size at curve parameter t: user cap, curve curvature, and curvature of every adjacent face.
-class CurveSizer {
- public:
-  CurveSizer(const cad::CadModel& model, LO curve, std::span<const CurveUseRef> uses,
-             const SizeOptions& sizes)
-      : geometry_(model.curve_geometry(curve)), sizes_(sizes) {
-    for (const CurveUseRef& u : uses) {
-      faces_.push_back(model.face_geometry(u.face));
-      refs_.push_back(u);
-    }
-  }
-
-  [[nodiscard]] const cad::CurveGeometry& geometry() const { return *geometry_; }
-
-  [[nodiscard]] double size_at(double t) const {
-    double h = sizes_.from_curvature(curve_curvature(*geometry_, t));
-    for (std::size_t i = 0; i < faces_.size(); ++i) {
-      const Vec2 uv = faces_[i]->boundary_uv(refs_[i].loop, refs_[i].use, t);
-      h = std::min(h, sizes_.from_curvature(max_principal_curvature(*faces_[i], uv)));
-    }
-    return h;
-  }
-
- private:
-  std::unique_ptr<cad::CurveGeometry> geometry_;
-  std::vector<std::unique_ptr<cad::FaceGeometry>> faces_;
-  std::vector<CurveUseRef> refs_;
-  const SizeOptions& sizes_;
-};
-
 /// A curve sampled finely enough to resolve its size field: parameters, points, arc length, and
 /// the size at each sample (reduced by the feature and gradation passes).
 struct CurveSamples {
@@ -63,7 +48,7 @@ struct CurveSamples {
   [[nodiscard]] double length() const { return s.empty() ? 0.0 : s.back(); }
 };
 
-CurveSamples sample_curve(const CurveSizer& sizer, const cad::Curve& curve, double cap) {
+CurveSamples sample_curve(const CurveCurvatureSize& sizer, const cad::Curve& curve, double cap) {
   // A coarse pass estimates the edge count from the curvature sizes; the samples then resolve the
   // size field at ~8 per edge and are never further apart than cap / 4 (for the feature search).
   // Size evaluations (second derivatives of the curve and of every adjacent surface) dominate the
@@ -75,7 +60,7 @@ CurveSamples sample_curve(const CurveSizer& sizer, const cad::Curve& curve, doub
     const double t = curve.t0 + (curve.t1 - curve.t0) * i / coarse_n;
     const Vec3 q = sizer.geometry().point(t);
     const double ds = distance(prev, q);
-    estimate += ds / sizer.size_at(t);
+    estimate += ds / sizer(t);
     length += ds;
     prev = q;
   }
@@ -88,7 +73,7 @@ CurveSamples sample_curve(const CurveSizer& sizer, const cad::Curve& curve, doub
   for (int i = 0; i <= n; ++i) {
     cs.t[i] = curve.t0 + (curve.t1 - curve.t0) * i / n;
     cs.p[i] = sizer.geometry().point(cs.t[i]);
-    cs.h[i] = sizer.size_at(cs.t[i]);
+    cs.h[i] = sizer(cs.t[i]);
     if (i > 0) cs.s[i] = cs.s[i - 1] + distance(cs.p[i - 1], cs.p[i]);
   }
   return cs;
@@ -105,7 +90,7 @@ void grade_along(CurveSamples& cs, double h_start, double h_end, double g) {
 }
 
 /// Places round(integral of ds / h) edges (at least min_edges) at equal steps of that integral.
-mesh::CurveMesh place_vertices(const CurveSamples& cs, const CurveSizer& sizer, LO c,
+mesh::CurveMesh place_vertices(const CurveSamples& cs, const CurveCurvatureSize& sizer, LO c,
                                const Vec3& p0, const Vec3& p1, int min_edges) {
   const std::size_t n = cs.t.size();
   std::vector<double> cumulative(n, 0.0);
@@ -151,13 +136,13 @@ std::vector<mesh::CurveMesh> mesh_curves(const cad::CadModel& model, const SizeO
   };
 
   // 1. Sample every curve with its curvature sizes.
-  std::vector<std::unique_ptr<CurveSizer>> sizers(static_cast<std::size_t>(n));
+  std::vector<std::unique_ptr<CurveCurvatureSize>> sizers(static_cast<std::size_t>(n));
   std::vector<CurveSamples> samples(static_cast<std::size_t>(n));
   tasks.parallel_for(n, [&](std::int64_t i) {
     const auto c = static_cast<LO>(i);
     if (model.curves()[c].degenerate) return;
     with_context(c, [&] {
-      sizers[c] = std::make_unique<CurveSizer>(model, c, uses[c], sizes);
+      sizers[c] = std::make_unique<CurveCurvatureSize>(model, c, uses[c], sizes);
       samples[c] = sample_curve(*sizers[c], model.curves()[c], sizes.size);
     });
   });

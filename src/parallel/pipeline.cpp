@@ -152,16 +152,34 @@ void unpack(const std::vector<char>& in, std::size_t& pos, CrossFieldOutput& c) 
   c.seconds = get<double>(in, pos);
 }
 
-void pack(const FaceSizeOutput& s, std::vector<char>& out) {
+void pack(const sizemap::FaceSizes& s, std::vector<char>& out) {
   put_vec(out, s.s);
   put_vec(out, s.s_min);
   put_vec(out, s.s_cf);
 }
 
-void unpack(const std::vector<char>& in, std::size_t& pos, FaceSizeOutput& s) {
+void unpack(const std::vector<char>& in, std::size_t& pos, sizemap::FaceSizes& s) {
   get_vec(in, pos, s.s);
   get_vec(in, pos, s.s_min);
   get_vec(in, pos, s.s_cf);
+}
+
+void pack(const quad::UnstructuredReport& r, std::vector<char>& out) {
+  put<std::uint8_t>(out, r.ok ? 1 : 0);
+  put<std::uint8_t>(out, r.fell_back ? 1 : 0);
+  put_vec(out, std::vector<char>(r.error.begin(), r.error.end()));
+  put<double>(out, r.sicn_min);
+  put<std::int64_t>(out, r.quads);
+}
+
+void unpack(const std::vector<char>& in, std::size_t& pos, quad::UnstructuredReport& r) {
+  r.ok = get<std::uint8_t>(in, pos) != 0;
+  r.fell_back = get<std::uint8_t>(in, pos) != 0;
+  std::vector<char> err;
+  get_vec(in, pos, err);
+  r.error.assign(err.begin(), err.end());
+  r.sicn_min = get<double>(in, pos);
+  r.quads = get<std::int64_t>(in, pos);
 }
 
 PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
@@ -248,7 +266,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
   // Size map (paper 000 Sec. 4.1-4.2): curve sizes known to every rank, face fields on the faces'
   // ranks, their union on shared curves by an MPI min-reduction, then quantization (Sec. 4.3)
   // computed identically on every rank.
-  std::vector<FaceSizeOutput> sizes(size_map ? mine.size() : 0);
+  std::vector<sizemap::FaceSizes> sizes(size_map ? mine.size() : 0);
   if (size_map) {
     clock.reset();
     const sizemap::SizeMapOptions& so = options.sizemap;
@@ -256,8 +274,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     const std::vector<double> targets = sizemap::face_quad_targets(model, so);
     auto face_pass = [&](const sizemap::CurveSizes& on_curves) {
       tasks.parallel_for(total, [&](std::int64_t i) {
-        sizemap::FaceSizes fs = sizemap::face_sizes(meshes[i], full[i].get(), curves, on_curves, targets[mine[i]], so);
-        sizes[i] = FaceSizeOutput{std::move(fs.s), std::move(fs.s_min), std::move(fs.s_cf)};
+        sizes[i] = sizemap::face_sizes(meshes[i], full[i].get(), curves, on_curves, targets[mine[i]], so);
       });
     };
     face_pass(initial);
@@ -309,13 +326,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     pack(meshes[i], reports[i], buffer);
     if (options.cross_fields) pack(fields[i], buffer);
     if (size_map) pack(sizes[i], buffer);
-    if (quads) {
-      put<std::uint8_t>(buffer, quad_reports[i].ok ? 1 : 0);
-      put<std::uint8_t>(buffer, quad_reports[i].fell_back ? 1 : 0);
-      put_vec(buffer, std::vector<char>(quad_reports[i].error.begin(), quad_reports[i].error.end()));
-      put<double>(buffer, quad_reports[i].sicn_min);
-      put<std::int64_t>(buffer, quad_reports[i].quads);
-    }
+    if (quads) pack(quad_reports[i], buffer);
   }
   meshes.clear();
   const auto gathered = comm.gather_bytes(buffer, 0);
@@ -337,16 +348,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
         all[f] = std::move(m);
         if (options.cross_fields) unpack(bytes, pos, result.cross_fields[f]);
         if (size_map) unpack(bytes, pos, result.face_sizes[f]);
-        if (quads) {
-          auto& qr = result.quad_reports[f];
-          qr.ok = get<std::uint8_t>(bytes, pos) != 0;
-          qr.fell_back = get<std::uint8_t>(bytes, pos) != 0;
-          std::vector<char> err;
-          get_vec(bytes, pos, err);
-          qr.error.assign(err.begin(), err.end());
-          qr.sicn_min = get<double>(bytes, pos);
-          qr.quads = get<std::int64_t>(bytes, pos);
-        }
+        if (quads) unpack(bytes, pos, result.quad_reports[f]);
       }
     }
     for (LO f = 0; f < nfaces; ++f) all[f].face = f;

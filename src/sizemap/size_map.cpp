@@ -185,17 +185,8 @@ CurveSizes initial_curve_sizes(const cad::CadModel& model, std::span<const mesh:
     tasks.parallel_for(nc, [&](std::int64_t i) {
       const auto c = static_cast<LO>(i);
       if (model.curves()[c].degenerate) return;
-      const auto geometry = model.curve_geometry(c);
-      std::vector<std::unique_ptr<cad::FaceGeometry>> faces;
-      for (const auto& u : uses[c]) faces.push_back(model.face_geometry(u.face));
-      for (std::size_t k = 0; k < curves[c].t.size(); ++k) {
-        const double t = curves[c].t[k];
-        double h = curvature.from_curvature(background::curve_curvature(*geometry, t));
-        for (std::size_t j = 0; j < faces.size(); ++j)
-          h = std::min(h, curvature.from_curvature(background::max_principal_curvature(
-                              *faces[j], faces[j]->boundary_uv(uses[c][j].loop, uses[c][j].use, t))));
-        out.at[c][k] = std::min(out.at[c][k], h);
-      }
+      const background::CurveCurvatureSize size(model, c, uses[c], curvature);
+      for (std::size_t k = 0; k < curves[c].t.size(); ++k) out.at[c][k] = std::min(out.at[c][k], size(curves[c].t[k]));
     });
   }
   for (const auto& [f, v] : options.face_sizes)

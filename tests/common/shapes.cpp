@@ -1,6 +1,8 @@
 #include "shapes.hpp"
 
 #include <BRepAlgoAPI_Cut.hxx>
+#include <BRepBuilderAPI_MakeFace.hxx>
+#include <BRepBuilderAPI_MakePolygon.hxx>
 #include <BRepFilletAPI_MakeFillet.hxx>
 #include <BRepPrimAPI_MakeBox.hxx>
 #include <BRepPrimAPI_MakeCylinder.hxx>
@@ -39,6 +41,15 @@ std::string write_cylinder(const std::string& path) {
 
 std::string write_sphere(const std::string& path) {
   return write(BRepPrimAPI_MakeSphere(3.0).Shape(), path);
+}
+
+std::string write_polygon_face(const std::vector<std::pair<double, double>>& xy, const std::string& path) {
+  BRepBuilderAPI_MakePolygon poly;
+  for (const auto& [x, y] : xy) poly.Add(gp_Pnt(x, y, 0));
+  poly.Close();
+  BRepBuilderAPI_MakeFace face(poly.Wire(), /*OnlyPlane=*/true);
+  if (!face.IsDone()) throw std::runtime_error("polygon face construction failed");
+  return write(face.Face(), path);
 }
 
 std::string write_filleted_box(const std::string& path) {

@@ -2,6 +2,8 @@
 #pragma once
 
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace qsmesh::test {
 
@@ -11,6 +13,8 @@ std::string write_box_with_hole(const std::string& path);
 std::string write_cylinder(const std::string& path);
 /// Writes a sphere of radius 3: one face, a seam and two degenerate pole curves.
 std::string write_sphere(const std::string& path);
+/// Writes the planar face (z = 0) bounded by the polygon through `xy`, as BREP; returns path.
+std::string write_polygon_face(const std::vector<std::pair<double, double>>& xy, const std::string& path);
 /// Writes a box with filleted edges (radius 1), as STEP.
 std::string write_filleted_box(const std::string& path);
 

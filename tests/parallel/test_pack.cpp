@@ -52,5 +52,34 @@ TEST(Pack, RoundTripOfFaceMeshesAndReports) {
   EXPECT_THROW(unpack(buf, pos, b2, rb2), Error);
 }
 
+TEST(Pack, RoundTripOfQuadReportsAndSizes) {
+  quad::UnstructuredReport r;
+  r.ok = false;
+  r.fell_back = true;
+  r.error = "[unstructured] face 8: a quad is folded";
+  r.sicn_min = -0.25;
+  r.quads = 1234;
+  sizemap::FaceSizes sz;
+  sz.s = {1, 2, 3};
+  sz.s_min = {0.5, 2, 3};
+  std::vector<char> buf;
+  pack(r, buf);
+  pack(sz, buf);
+  std::size_t pos = 0;
+  quad::UnstructuredReport r2;
+  sizemap::FaceSizes sz2;
+  unpack(buf, pos, r2);
+  unpack(buf, pos, sz2);
+  EXPECT_EQ(pos, buf.size());
+  EXPECT_FALSE(r2.ok);
+  EXPECT_TRUE(r2.fell_back);
+  EXPECT_EQ(r2.error, r.error);
+  EXPECT_EQ(r2.sicn_min, -0.25);
+  EXPECT_EQ(r2.quads, 1234);
+  EXPECT_EQ(sz2.s, sz.s);
+  EXPECT_EQ(sz2.s_min, sz.s_min);
+  EXPECT_TRUE(sz2.s_cf.empty());
+}
+
 }  // namespace
 }  // namespace qsmesh::parallel

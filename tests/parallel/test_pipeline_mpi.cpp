@@ -127,15 +127,18 @@ TEST(Pipeline, CrossFieldsDoNotDependOnRanks) {
 }
 
 /// Runs the size map and quantization on `model` and checks, on every rank, that the curve data
-/// equal those of the same stage functions run serially (no MPI), and that ranks agree.
-void check_size_map(const Comm& comm, const cad::CadModel& model, double size) {
+/// equal those of the same stage functions run serially (no MPI), and that ranks agree. `out`, when
+/// given, receives the distributed result for further checks.
+void check_size_map(const Comm& comm, const cad::CadModel& model, double size, PipelineResult* out = nullptr) {
   PipelineOptions options;
   options.background.sizes.size = size;
   options.size_map = true;
   options.sizemap.size_max = size;
   std::ostringstream sink;
   Logger log(sink, LogLevel::Quiet);
-  const PipelineResult result = run_pipeline(comm, model, options, TaskArena(2), log);
+  PipelineResult local;
+  PipelineResult& result = out != nullptr ? *out : local;
+  result = run_pipeline(comm, model, options, TaskArena(2), log);
 
   // Serial reference: every face on this process, the same flow.
   const TaskArena one(1);
@@ -203,18 +206,12 @@ TEST(Pipeline, SizeMapOnSharedModels) {
   for (const char* name : {"A319.brep", "Block.stp"}) {
     const cad::CadModel model = cad::load_cad(dir + "/" + name);
     const double size = 0.02 * model.diagonal();
-    check_size_map(comm, model, size);
-    if (comm.rank() != 0) continue;
     // The checks on the real size map: opposite sides of the four-sided faces of conformal
     // chains have equal counts, and the size never exceeds the length of its curve (degenerate
-    // curves, poles, have no length: their vertices carry the pole corner's size).
-    PipelineOptions options;
-    options.background.sizes.size = size;
-    options.size_map = true;
-    options.sizemap.size_max = size;
-    std::ostringstream sink;
-    Logger log(sink, LogLevel::Quiet);
-    const PipelineResult r = run_pipeline(Comm::self(), model, options, TaskArena(2), log);
+    // curves, poles, have no length: their vertices carry the pole corner's size). Every rank holds
+    // the same curve data, so every rank checks.
+    PipelineResult r;
+    check_size_map(comm, model, size, &r);
     const auto& q = r.quantization;
     int pairs = 0, unequal = 0, too_large = 0;
     for (const auto& face : model.faces()) {
@@ -236,7 +233,7 @@ TEST(Pipeline, SizeMapOnSharedModels) {
     EXPECT_GT(pairs, 0) << name;
     EXPECT_EQ(unequal, 0) << name;
     EXPECT_EQ(too_large, 0) << name;
-    std::cout << name << ": " << q.num_chords << " chords, " << pairs << " opposite pairs in chords\n";
+    if (comm.rank() == 0) std::cout << name << ": " << q.num_chords << " chords, " << pairs << " opposite pairs in chords\n";
   }
 }
 

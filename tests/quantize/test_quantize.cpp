@@ -33,14 +33,8 @@ cad::CadModel load(const TopoDS_Shape& shape, const std::string& name) {
 }
 
 // A planar polygonal face through the given (x, y) points.
-cad::CadModel polygon_face(const std::vector<std::pair<double, double>>& xy,
-                           const std::string& name) {
-  BRepBuilderAPI_MakePolygon poly;
-  for (const auto& [x, y] : xy) poly.Add(gp_Pnt(x, y, 0));
-  poly.Close();
-  BRepBuilderAPI_MakeFace face(poly.Wire(), /*OnlyPlane=*/true);
-  if (!face.IsDone()) throw std::runtime_error("face construction failed");
-  return load(face.Shape(), name);
+cad::CadModel polygon_face(const std::vector<std::pair<double, double>>& xy, const std::string& name) {
+  return cad::load_cad(test::write_polygon_face(xy, tmp(name)));
 }
 
 // Curves of face 0's outer loop, in loop order.

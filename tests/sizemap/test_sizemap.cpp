@@ -41,13 +41,8 @@ cad::CadModel load_shape(const TopoDS_Shape& s, const std::string& name) {
 }
 
 /// A planar face bounded by the polygon through `xy` (z = 0).
-cad::CadModel polygon_face(const std::vector<std::pair<double, double>>& xy,
-                           const std::string& name) {
-  BRepBuilderAPI_MakePolygon poly;
-  for (const auto& [x, y] : xy) poly.Add(gp_Pnt(x, y, 0));
-  poly.Close();
-  const TopoDS_Shape face = BRepBuilderAPI_MakeFace(poly.Wire(), true).Face();
-  return load_shape(face, name);
+cad::CadModel polygon_face(const std::vector<std::pair<double, double>>& xy, const std::string& name) {
+  return cad::load_cad(test::write_polygon_face(xy, tmp(name)));
 }
 
 /// 10 x 10 plate with a slot 0.2 wide and 6 deep cut in from the top edge (x in [4.9, 5.1]).

@@ -2,6 +2,7 @@
 // every face bounded by a curve uses the same vertices).
 #pragma once
 
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -30,5 +31,23 @@ struct CurveUseRef {
   LO use = kNoIndex;
 };
 [[nodiscard]] std::vector<std::vector<CurveUseRef>> curve_uses(const cad::CadModel& model);
+
+/// The curvature size along one curve: the smallest of `sizes.from_curvature` of the curve's own
+/// curvature and of the largest principal curvature of every face using it, at the curve parameter
+/// t. Owns its evaluators: one object per task.
+class CurveCurvatureSize {
+ public:
+  CurveCurvatureSize(const cad::CadModel& model, LO curve, std::span<const CurveUseRef> uses,
+                     const SizeOptions& sizes);
+  [[nodiscard]] const cad::CurveGeometry& geometry() const { return *geometry_; }
+  /// Size (model units) at curve parameter t, within the bounds of the SizeOptions.
+  [[nodiscard]] double operator()(double t) const;
+
+ private:
+  std::unique_ptr<cad::CurveGeometry> geometry_;
+  std::vector<std::unique_ptr<cad::FaceGeometry>> faces_;
+  std::vector<CurveUseRef> refs_;
+  SizeOptions sizes_;
+};
 
 }  // namespace qsmesh::background

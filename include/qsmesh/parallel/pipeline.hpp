@@ -39,10 +39,6 @@ struct PipelineOptions {
   quantize::QuantizeOptions quantize;
 };
 
-/// Size fields of one face at its background mesh vertices (FaceMesh order), for output.
-struct FaceSizeOutput {
-  std::vector<double> s, s_min, s_cf;
-};
 
 /// What the drivers need of a face's cross field, per triangle of its background mesh in the
 /// order of the assembled mesh (triangles collapsed at poles excluded, as in assembly).
@@ -63,7 +59,7 @@ struct PipelineResult {
   std::vector<background::FaceReport> reports;  ///< one per face, by face id (rank 0 only)
   std::vector<CrossFieldOutput> cross_fields;   ///< one per face when requested (rank 0 only)
   std::vector<mesh::FaceMesh> background;       ///< background meshes by face (rank 0, size map only)
-  std::vector<FaceSizeOutput> face_sizes;       ///< size fields by face (rank 0, size map only)
+  std::vector<sizemap::FaceSizes> face_sizes;   ///< size fields by face (rank 0, size map only)
   sizemap::CurveSizes curve_sizes;              ///< size map on the background curve meshes (every rank)
   quantize::Quantization quantization;          ///< curve edge counts (every rank)
   std::vector<mesh::CurveMesh> quantized_curves;  ///< final curve meshes (every rank)
@@ -92,8 +88,10 @@ void pack(const mesh::FaceMesh& m, const background::FaceReport& r, std::vector<
 void unpack(const std::vector<char>& in, std::size_t& pos, mesh::FaceMesh& m,
             background::FaceReport& r);
 void pack(const CrossFieldOutput& c, std::vector<char>& out);
-void pack(const FaceSizeOutput& s, std::vector<char>& out);
-void unpack(const std::vector<char>& in, std::size_t& pos, FaceSizeOutput& s);
+void pack(const sizemap::FaceSizes& s, std::vector<char>& out);
+void unpack(const std::vector<char>& in, std::size_t& pos, sizemap::FaceSizes& s);
+void pack(const quad::UnstructuredReport& r, std::vector<char>& out);
+void unpack(const std::vector<char>& in, std::size_t& pos, quad::UnstructuredReport& r);
 void unpack(const std::vector<char>& in, std::size_t& pos, CrossFieldOutput& c);
 
 }  // namespace qsmesh::parallel
