@@ -78,6 +78,9 @@ mesh::FaceMesh mesh_face_background(const cad::CadModel& model, LO f,
     const bool reversed = model.faces()[f].reversed;
     try {
       out = mesh::triangulate_face(*surface, reversed, loops, size, options.triangulate);
+      // The kernel's flips and moves work in (u, v); around poles and on strongly anisotropic
+      // parametrisations some thin triangles are only visible, and fixable, in 3D.
+      out = mesh::improve_small_angles(out, *surface, reversed, options.improve);
     } catch (const Error& e) {
       // Refinement is what usually fails on bad geometry; the boundary-only triangulation is still
       // a conforming mesh of the face and keeps the model watertight.

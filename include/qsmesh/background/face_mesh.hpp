@@ -9,6 +9,7 @@
 #include "qsmesh/background/size.hpp"
 #include "qsmesh/cad/model.hpp"
 #include "qsmesh/mesh/delaunay.hpp"
+#include "qsmesh/mesh/improve.hpp"
 #include "qsmesh/mesh/surface_mesh.hpp"
 
 namespace qsmesh::background {
@@ -16,6 +17,7 @@ namespace qsmesh::background {
 struct BackgroundOptions {
   SizeOptions sizes;
   mesh::TriangulateOptions triangulate;
+  mesh::ImproveOptions improve;  ///< 3D clean-up of small angles after the kernel
 };
 
 /// What happened on one face.
