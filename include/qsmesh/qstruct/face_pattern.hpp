@@ -1,0 +1,112 @@
+// Pattern-based quad meshing of whole CAD faces (paper 000 Sec. 6.1.2): a face with one boundary
+// loop is split into sides at its convex corners, the side edge counts of the final (quantized)
+// curve meshes are matched with the coarse patterns (Sec. 6.1.1), the refined pattern is laid out
+// in the parameter plane and smoothed (Sec. 5.3), and kept only when its quality is good; else
+// the caller uses the unstructured path (Sec. 5).
+#pragma once
+
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "qsmesh/cad/model.hpp"
+#include "qsmesh/mesh/delaunay.hpp"
+#include "qsmesh/mesh/surface_mesh.hpp"
+#include "qsmesh/qstruct/patterns.hpp"
+#include "qsmesh/smooth/smooth.hpp"
+
+namespace qsmesh::qstruct {
+
+struct PatternFaceOptions {
+  /// A CAD corner whose interior angle in the face (3D, degrees) is below this splits the
+  /// boundary into sides (a convex corner, paper 000 Sec. 6: n_in = 1).
+  double corner_angle_deg = 150;
+  /// When no pattern mesh is kept with those sides, the convex corners whose angle is at least
+  /// this (degrees) are taken as flat and matching is tried once more (blunt corners, e.g. 140
+  /// degrees, fit one quad or two about as badly).
+  double soft_corner_angle_deg = 120;
+  /// The pattern mesh is kept only when, after smoothing, every quad has SICN (Eq. 12) above
+  /// min_sicn and the mean SICN is above min_sicn_avg. SICN also measures stretching (a w x h
+  /// rectangle has 2wh / (w^2 + h^2)): 0.2 allows an angle of 12 degrees or an aspect ratio of 10,
+  /// 0.45 a mean aspect ratio of 4, the stretching that quantized counts alone may impose on a
+  /// grid (e.g. 12 x 24 edges on a 2 x 16 rectangle).
+  double min_sicn = 0.2;
+  double min_sicn_avg = 0.45;
+  /// Matches tried geometrically (laid out, smoothed, measured) before giving up, best first.
+  int max_candidates = 4;
+  MatchOptions match;
+  smooth::SmoothOptions smooth;
+};
+
+/// Why a face was not meshed by a pattern.
+enum class Refusal : std::uint8_t {
+  None,        ///< meshed
+  Loops,       ///< not exactly one boundary loop (holes), or a loop that is not closed
+  Degenerate,  ///< a degenerate curve (pole, cone apex) or a corner where the surface is singular
+  NoCorner,    ///< fewer than two convex corners
+  NoPattern,   ///< no pattern has as many sides, or none fits the side counts (Eq. 14)
+  Quality,     ///< every candidate tried left a quad at or below the quality thresholds
+  Error,       ///< an error from the geometry or the smoother
+};
+[[nodiscard]] const char* to_string(Refusal r);
+
+/// What happened on one face.
+struct PatternFaceReport {
+  bool ok = false;
+  Refusal refusal = Refusal::None;
+  std::string reason;            ///< refusal details, with the face id
+  std::vector<LO> side_edges;    ///< edges of each side, from the side after the first corner
+  LO pattern = kNoIndex;         ///< index in the pattern list of the mesh kept (or last tried)
+  std::string pattern_name;
+  int start = 0;                 ///< face side holding pattern side 0 (PatternMatch::start)
+  bool reversed = false;
+  std::vector<LO> chords;        ///< chord subdivisions of that match
+  int candidates = 0;            ///< matches tried geometrically
+  double sicn_min = 0, sicn_avg = 0;  ///< of the mesh kept (or of the best refused one)
+  std::int64_t quads = 0;
+};
+
+/// The boundary of a face split at its convex corners.
+struct FaceSides {
+  std::vector<mesh::BoundaryPoint> points;  ///< the loop of background::face_boundary
+  /// Interior angle (degrees, 3D, in (0, 360)) at each point that is a CAD corner (vclass.dim 0);
+  /// 180 elsewhere.
+  std::vector<double> angle_deg;
+  std::vector<LO> corners;  ///< positions in `points` of the convex corners, increasing
+  std::vector<LO> side_edges;  ///< side k runs from corners[k] to corners[k + 1] (cyclic)
+  double uv_area = 0;       ///< signed area of the loop in the parameter plane (> 0: CCW)
+};
+
+/// Splits the boundary of face f (one loop) into sides. `curves`: the final curve meshes of all
+/// curves, by curve id. Throws qsmesh::Error when the face does not have exactly one closed loop,
+/// uses a degenerate curve, or has a corner where a tangent or the surface normal vanishes.
+[[nodiscard]] FaceSides face_sides(const cad::CadModel& model, LO f,
+                                   const cad::FaceGeometry& surface,
+                                   std::span<const mesh::CurveMesh> curves,
+                                   const PatternFaceOptions& options);
+
+/// Paper 000 Sec. 6.1.2 on face f.
+///  - Input: the model, the final curve meshes of all curves (`full_curves`, by curve id, as
+///    quad::subdivide uses them), the pattern list (builtin_patterns()) and options.
+///  - The face must have one boundary loop (seams included: a cylinder's lateral face is a 4-sided
+///    disk in its parameter plane, the seam used twice) and no degenerate curve.
+///  - The boundary is split at the corners below options.corner_angle_deg; when that gives no
+///    mesh, once more at the corners below options.soft_corner_angle_deg only.
+///  - Matches (match_patterns) are ranked by how well the refined pattern's boundary valences fit
+///    the CAD corners that do not split sides (ideal valence max(2, round(angle / 90))), then by
+///    pattern order and energy; up to options.max_candidates of them are laid out (interior
+///    vertices by a uniform-weight Laplace solve in (u, v), the boundary fixed), smoothed with
+///    smooth::smooth_face and measured; the first above the thresholds is returned.
+///  - Output: an all-quad FaceMesh whose boundary vertices are exactly those of
+///    background::face_boundary (same uv, xyz, VertexClass: assembly merges them with the
+///    neighbouring faces), interior vertices classified on f, quads oriented along the face
+///    normal. When the face is refused: an empty mesh (face id set) and the reason in the report.
+/// Never throws for a face-level failure. Deterministic.
+[[nodiscard]] mesh::FaceMesh mesh_face_pattern(const cad::CadModel& model, LO f,
+                                               std::span<const mesh::CurveMesh> full_curves,
+                                               std::span<const Pattern> patterns,
+                                               const PatternFaceOptions& options,
+                                               PatternFaceReport* report = nullptr);
+
+}  // namespace qsmesh::qstruct

@@ -1,0 +1,331 @@
+#include "qsmesh/qstruct/face_pattern.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <set>
+#include <sstream>
+#include <utility>
+
+#include "qsmesh/background/face_mesh.hpp"
+#include "qsmesh/core/error.hpp"
+#include "qsmesh/linalg/solver.hpp"
+
+namespace qsmesh::qstruct {
+
+const char* to_string(Refusal r) {
+  switch (r) {
+    case Refusal::None: return "none";
+    case Refusal::Loops: return "loops";
+    case Refusal::Degenerate: return "degenerate";
+    case Refusal::NoCorner: return "no_corner";
+    case Refusal::NoPattern: return "no_pattern";
+    case Refusal::Quality: return "quality";
+    case Refusal::Error: return "error";
+  }
+  return "?";
+}
+
+namespace {
+
+constexpr double kDeg = 180.0 / std::numbers::pi;
+
+Vec3 project_tangent(const Vec3& t, const Vec3& n) { return t - n * dot(t, n); }
+
+// Tangent of a curve use at its start (at_end false) or end, along the traversal direction.
+// Where the parametrisation stalls (zero derivative), the first or last mesh edge stands in.
+Vec3 use_tangent(const cad::CadModel& model, const cad::CurveUse& use, const mesh::CurveMesh& cm, bool at_end) {
+  const cad::Curve& curve = model.curves()[use.curve];
+  const bool at_t1 = at_end != use.reversed;
+  const auto geo = model.curve_geometry(use.curve);
+  Vec3 d = geo->derivative(at_t1 ? curve.t1 : curve.t0);
+  const LO n = cm.num_edges();
+  const Vec3 edge = at_t1 ? cm.points[n] - cm.points[n - 1] : cm.points[1] - cm.points[0];
+  // |dC/dt| (t1 - t0) and the mesh length are both the curve's length scale.
+  if (!(norm(d) * (curve.t1 - curve.t0) > 1e-9 * norm(edge) * n)) d = edge;
+  return use.reversed ? d * -1.0 : d;
+}
+
+struct Candidate {
+  PatternMatch match;
+  RefinedPattern refined;
+  std::vector<LO> seq;  // face loop point of each refined boundary position
+  int score = 0;        // boundary valence mismatch at the corners that do not split sides
+};
+
+// Interior vertices by a uniform-weight Laplace solve in (u, v), the boundary fixed: for a grid
+// with evenly spaced sides this is the bilinear grid, and it is invariant under affine maps of
+// the parameter plane, so anisotropic (u, v) scales do not matter.
+bool laplace_uv(const std::vector<std::array<LO, 4>>& quads, LO num_boundary, std::vector<Vec2>& uv) {
+  const LO n = static_cast<LO>(uv.size());
+  const LO nu = n - num_boundary;
+  if (nu == 0) return true;
+  std::vector<std::set<LO>> nbr(static_cast<std::size_t>(n));
+  for (const auto& q : quads)
+    for (int k = 0; k < 4; ++k) {
+      nbr[q[k]].insert(q[(k + 1) % 4]);
+      nbr[q[(k + 1) % 4]].insert(q[k]);
+    }
+  std::vector<linalg::SparseMatrix::Triplet> trip;
+  std::vector<double> bu(static_cast<std::size_t>(nu), 0.0), bv(static_cast<std::size_t>(nu), 0.0);
+  for (LO v = num_boundary; v < n; ++v) {
+    const LO i = v - num_boundary;
+    trip.push_back({i, i, static_cast<double>(nbr[v].size())});
+    for (const LO w : nbr[v]) {
+      if (w >= num_boundary) {
+        trip.push_back({i, w - num_boundary, -1.0});
+      } else {
+        bu[i] += uv[w].u;
+        bv[i] += uv[w].v;
+      }
+    }
+  }
+  const linalg::SparseMatrix A(nu, trip);
+  std::vector<double> xu(static_cast<std::size_t>(nu)), xv(static_cast<std::size_t>(nu));
+  auto solver = linalg::make_solver(nu, linalg::SolverOptions{linalg::Backend::Eigen}, nullptr);
+  solver->analyze(A);
+  solver->factorize(A);
+  solver->solve(bu, xu);
+  solver->solve(bv, xv);
+  for (LO i = 0; i < nu; ++i) {
+    if (!std::isfinite(xu[i]) || !std::isfinite(xv[i])) return false;
+    uv[num_boundary + i] = {xu[i], xv[i]};
+  }
+  return true;
+}
+
+mesh::FaceMesh build_mesh(LO f, const cad::Face& face, const cad::FaceGeometry& surface, const FaceSides& fs,
+                          const Candidate& cand) {
+  const LO nb = static_cast<LO>(fs.points.size());
+  const RefinedPattern& r = cand.refined;
+  std::vector<LO> r2m(static_cast<std::size_t>(r.num_vertices), kNoIndex);
+  for (std::size_t p = 0; p < r.boundary.size(); ++p) r2m[r.boundary[p]] = cand.seq[p];
+  LO next = nb;
+  for (LO v = 0; v < r.num_vertices; ++v)
+    if (r2m[v] == kNoIndex) r2m[v] = next++;
+  mesh::FaceMesh m;
+  m.face = f;
+  m.points.resize(next);
+  m.uv.resize(next);
+  m.vclass.resize(next);
+  for (LO i = 0; i < nb; ++i) {
+    m.points[i] = fs.points[i].xyz;
+    m.uv[i] = fs.points[i].uv;
+    m.vclass[i] = fs.points[i].vclass;
+  }
+  // The pattern's quads follow its boundary (interior on the left); mapped onto the face loop they
+  // follow the loop, or run against it for a mirrored match. Counter-clockwise in (u, v) is along
+  // du x dv, which is the face normal unless the face is reversed.
+  const bool flip = ((fs.uv_area < 0) != cand.match.reversed) != face.reversed;
+  m.quads.reserve(r.quads.size());
+  for (const auto& q : r.quads) {
+    const std::array<LO, 4> t{r2m[q[0]], r2m[q[1]], r2m[q[2]], r2m[q[3]]};
+    m.quads.push_back(flip ? std::array<LO, 4>{t[0], t[3], t[2], t[1]} : t);
+  }
+  QSMESH_CHECK(laplace_uv(m.quads, nb, m.uv), "the Laplace layout is not finite");
+  for (LO v = nb; v < next; ++v) {
+    m.points[v] = surface.eval(m.uv[v]).p;
+    m.vclass[v].dim = 2;
+    m.vclass[v].entity = f;
+    m.vclass[v].index = kNoIndex;
+    m.vclass[v].param = {m.uv[v].u, m.uv[v].v};
+  }
+  return m;
+}
+
+void set_side_edges(FaceSides& fs) {
+  const LO n = static_cast<LO>(fs.points.size());
+  const LO m = static_cast<LO>(fs.corners.size());
+  fs.side_edges.clear();
+  for (LO k = 0; k < m; ++k) {
+    const LO a = fs.corners[k], b = k + 1 < m ? fs.corners[k + 1] : fs.corners[0] + n;
+    fs.side_edges.push_back(b - a);
+  }
+}
+
+// Matching, ranking and geometric trials for one split of the boundary into sides. Fills `rep`
+// (ok, or the refusal and its reason) and returns the mesh kept, or an empty one.
+mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& surface, const FaceSides& fs,
+                         std::span<const Pattern> patterns, const PatternFaceOptions& options,
+                         PatternFaceReport& rep) {
+  const ErrorContext context{"qstruct", 2, f};
+  mesh::FaceMesh empty;
+  empty.face = f;
+  rep = PatternFaceReport{};
+  rep.side_edges = fs.side_edges;
+  const auto refuse = [&](Refusal why, const std::string& msg) {
+    rep.ok = false;
+    rep.refusal = why;
+    rep.reason = Error(msg, context).what();
+    rep.quads = 0;
+    return empty;
+  };
+  if (fs.corners.size() < 2)
+    return refuse(Refusal::NoCorner, std::to_string(fs.corners.size()) + " convex corner(s)");
+  const std::vector<PatternMatch> matches = match_patterns(patterns, fs.side_edges, options.match);
+  if (matches.empty()) {
+    std::ostringstream os;
+    os << "no pattern fits the sides [";
+    for (std::size_t i = 0; i < fs.side_edges.size(); ++i) os << (i ? "," : "") << fs.side_edges[i];
+    os << "]";
+    return refuse(Refusal::NoPattern, os.str());
+  }
+
+  const LO nb = static_cast<LO>(fs.points.size());
+  const LO m = static_cast<LO>(fs.corners.size());
+  std::vector<char> splits(nb, 0);
+  for (const LO c : fs.corners) splits[c] = 1;
+  std::vector<Candidate> cands;
+  for (const auto& match : matches) {
+    Candidate c;
+    c.match = match;
+    c.refined = refine_pattern(patterns[match.pattern], match.chords);
+    QSMESH_CHECK(static_cast<LO>(c.refined.boundary.size()) == nb,
+                 "refined boundary has " << c.refined.boundary.size() << " vertices, the face " << nb);
+    const LO first = match.reversed ? fs.corners[(match.start + 1) % m] : fs.corners[match.start];
+    c.seq.resize(nb);
+    for (LO p = 0; p < nb; ++p) c.seq[p] = (((match.reversed ? first - p : first + p) % nb) + nb) % nb;
+    std::vector<int> valence(static_cast<std::size_t>(c.refined.num_vertices), 0);
+    for (const auto& q : c.refined.quads)
+      for (const LO v : q) ++valence[v];
+    for (LO p = 0; p < nb; ++p) {
+      const LO i = c.seq[p];
+      if (splits[i]) continue;
+      const int ideal =
+          fs.points[i].vclass.dim == 0 ? std::max(2, static_cast<int>(std::lround(fs.angle_deg[i] / 90.0))) : 2;
+      c.score += std::abs(valence[c.refined.boundary[p]] - ideal);
+    }
+    cands.push_back(std::move(c));
+  }
+  // matches come sorted by pattern order and energy; the valence fit goes first.
+  std::stable_sort(cands.begin(), cands.end(), [](const Candidate& a, const Candidate& b) { return a.score < b.score; });
+
+  mesh::FaceMesh best;
+  const int tries = std::min<int>(std::max(1, options.max_candidates), static_cast<int>(cands.size()));
+  for (int k = 0; k < tries; ++k) {
+    const Candidate& c = cands[k];
+    mesh::FaceMesh mesh = smooth::smooth_face(build_mesh(f, face, surface, fs, c), surface, options.smooth);
+    const smooth::QualityReport q = smooth::measure(mesh);
+    ++rep.candidates;
+    const bool good = q.invalid == 0 && q.sicn_min > options.min_sicn && q.sicn_avg > options.min_sicn_avg;
+    if (good || k == 0 || q.sicn_min > rep.sicn_min) {
+      rep.pattern = c.match.pattern;
+      rep.pattern_name = patterns[c.match.pattern].name;
+      rep.start = c.match.start;
+      rep.reversed = c.match.reversed;
+      rep.chords = c.match.chords;
+      rep.sicn_min = q.sicn_min;
+      rep.sicn_avg = q.sicn_avg;
+      rep.quads = static_cast<std::int64_t>(mesh.quads.size());
+      best = std::move(mesh);
+    }
+    if (good) {
+      rep.ok = true;
+      rep.refusal = Refusal::None;
+      return best;
+    }
+  }
+  std::ostringstream os;
+  os << rep.candidates << " candidate(s) tried, best " << rep.pattern_name << " with SICN min " << rep.sicn_min
+     << " avg " << rep.sicn_avg << " (thresholds " << options.min_sicn << ", " << options.min_sicn_avg << ")";
+  return refuse(Refusal::Quality, os.str());
+}
+
+}  // namespace
+
+FaceSides face_sides(const cad::CadModel& model, LO f, const cad::FaceGeometry& surface,
+                     std::span<const mesh::CurveMesh> curves, const PatternFaceOptions& options) {
+  const cad::Face& face = model.faces()[f];
+  QSMESH_CHECK(face.loops.size() == 1, "the face has " << face.loops.size() << " boundary loops");
+  QSMESH_CHECK(face.loops_closed, "the boundary loop is not closed");
+  const auto& uses = face.loops[0].uses;
+  for (const auto& use : uses)
+    QSMESH_CHECK(!model.curves()[use.curve].degenerate, "degenerate curve " << use.curve << " (pole)");
+  FaceSides fs;
+  auto loops = background::face_boundary(model, f, surface, curves);
+  fs.points = std::move(loops[0].points);
+  const LO n = static_cast<LO>(fs.points.size());
+  for (LO i = 0; i < n; ++i) fs.uv_area += 0.5 * cross(fs.points[i].uv, fs.points[(i + 1) % n].uv);
+  QSMESH_CHECK(fs.uv_area != 0, "the boundary loop has no area in the parameter plane");
+
+  fs.angle_deg.assign(n, 180.0);
+  const LO nu = static_cast<LO>(uses.size());
+  LO pos = 0;
+  for (LO u = 0; u < nu; ++u) {
+    const auto& prev = uses[(u + nu - 1) % nu];
+    const auto& use = uses[u];
+    const Vec3 t_in = use_tangent(model, prev, curves[prev.curve], true);
+    const Vec3 t_out = use_tangent(model, use, curves[use.curve], false);
+    const auto ev = surface.eval(fs.points[pos].uv);
+    Vec3 normal = cross(ev.du, ev.dv);
+    QSMESH_CHECK(norm(normal) > 0 && norm(t_in) > 0 && norm(t_out) > 0,
+                 "singular surface or curve at the corner of curve " << use.curve);
+    // With the normal du x dv flipped for a clockwise (u, v) loop, the interior lies on the left.
+    normal = normalized(normal) * (fs.uv_area > 0 ? 1.0 : -1.0);
+    const Vec3 a = normalized(project_tangent(t_in, normal)), b = normalized(project_tangent(t_out, normal));
+    const double turn = std::atan2(dot(cross(a, b), normal), dot(a, b)) * kDeg;
+    fs.angle_deg[pos] = 180.0 - turn;
+    if (fs.angle_deg[pos] < options.corner_angle_deg) fs.corners.push_back(pos);
+    pos += curves[use.curve].num_edges();
+  }
+  set_side_edges(fs);
+  return fs;
+}
+
+mesh::FaceMesh mesh_face_pattern(const cad::CadModel& model, LO f, std::span<const mesh::CurveMesh> full_curves,
+                                 std::span<const Pattern> patterns, const PatternFaceOptions& options,
+                                 PatternFaceReport* report) {
+  PatternFaceReport local;
+  PatternFaceReport& rep = report != nullptr ? *report : local;
+  rep = PatternFaceReport{};
+  const ErrorContext context{"qstruct", 2, f};
+  mesh::FaceMesh empty;
+  empty.face = f;
+  const auto refuse = [&](Refusal why, const std::string& msg) {
+    rep.ok = false;
+    rep.refusal = why;
+    rep.reason = Error(msg, context).what();
+    return empty;
+  };
+  const cad::Face& face = model.faces()[f];
+  if (face.loops.size() != 1) return refuse(Refusal::Loops, "the face has " + std::to_string(face.loops.size()) + " boundary loops");
+  if (!face.loops_closed) return refuse(Refusal::Loops, "the boundary loop is not closed");
+  for (const auto& use : face.loops[0].uses)
+    if (model.curves()[use.curve].degenerate)
+      return refuse(Refusal::Degenerate, "degenerate curve " + std::to_string(use.curve) + " (pole)");
+
+  try {
+    const auto surface = model.face_geometry(f);
+    FaceSides fs;
+    try {
+      fs = face_sides(model, f, *surface, full_curves, options);
+    } catch (const Error& e) {
+      return refuse(Refusal::Degenerate, e.message());
+    }
+    mesh::FaceMesh out = try_sides(f, face, *surface, fs, patterns, options, rep);
+    if (rep.ok) return out;
+    // Convex but blunt corners may be better taken as flat: one more try without them.
+    FaceSides soft = fs;
+    soft.corners.clear();
+    for (const LO c : fs.corners)
+      if (fs.angle_deg[c] < options.soft_corner_angle_deg) soft.corners.push_back(c);
+    if (soft.corners.size() == fs.corners.size()) return out;
+    set_side_edges(soft);
+    PatternFaceReport second;
+    out = try_sides(f, face, *surface, soft, patterns, options, second);
+    // Report the attempt that got further (a quality refusal says more than no pattern).
+    if (second.ok || (rep.refusal != Refusal::Quality && second.refusal == Refusal::Quality)) rep = second;
+    return out;
+  } catch (const Error& e) {
+    rep.quads = 0;
+    rep.ok = false;
+    rep.refusal = Refusal::Error;
+    rep.reason = e.with_context(context).what();
+    return empty;
+  } catch (const std::exception& e) {
+    return refuse(Refusal::Error, e.what());
+  }
+}
+
+}  // namespace qsmesh::qstruct

@@ -1,0 +1,130 @@
+// qstruct_survey MODEL [--size-factor F] [--threads T] [--faces]
+// How many faces of MODEL the pattern path (paper 000 Sec. 6.1.2) meshes on the curve meshes the
+// pipeline quantizes (size map, crossfield method, as `qsmesh sizemap`), and why the others are
+// refused. Serial (MPI_COMM_SELF); --faces prints one line per face.
+#include <cstdlib>
+#include <iostream>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "qsmesh/cad/model.hpp"
+#include "qsmesh/core/error.hpp"
+#include "qsmesh/core/log.hpp"
+#include "qsmesh/core/timer.hpp"
+#include "qsmesh/parallel/comm.hpp"
+#include "qsmesh/parallel/pipeline.hpp"
+#include "qsmesh/qstruct/face_pattern.hpp"
+
+using namespace qsmesh;
+
+int main(int argc, char** argv) {
+  parallel::MpiSession mpi(&argc, &argv);
+  std::string path;
+  double size_factor = 0.02;
+  int threads = 1;
+  bool per_face = false;
+  LO detail = kNoIndex;
+  for (int i = 1; i < argc; ++i) {
+    const std::string a = argv[i];
+    if (a == "--size-factor" && i + 1 < argc) {
+      size_factor = std::atof(argv[++i]);
+    } else if (a == "--threads" && i + 1 < argc) {
+      threads = std::atoi(argv[++i]);
+    } else if (a == "--face" && i + 1 < argc) {
+      detail = std::atoi(argv[++i]);
+    } else if (a == "--faces") {
+      per_face = true;
+    } else if (path.empty() && a.rfind("--", 0) != 0) {
+      path = a;
+    } else {
+      std::cerr << "usage: qstruct_survey MODEL [--size-factor F] [--threads T] [--faces]\n";
+      return 2;
+    }
+  }
+  if (path.empty() || !(size_factor > 0)) {
+    std::cerr << "usage: qstruct_survey MODEL [--size-factor F] [--threads T] [--faces]\n";
+    return 2;
+  }
+  try {
+    cad::set_kernel_messages(true);
+    const cad::CadModel model = cad::load_cad(path);
+    Logger log(std::cerr, LogLevel::Warning);
+    parallel::PipelineOptions options;
+    const double size = model.diagonal() * size_factor;
+    options.background.sizes.size = size;
+    options.sizemap.size_max = size;
+    options.size_map = true;
+    options.until = parallel::Stage::Background;
+    const TaskArena tasks(threads);
+    Stopwatch clock;
+    const parallel::PipelineResult result = parallel::run_pipeline(parallel::Comm::self(), model, options, tasks, log);
+    const double pipeline_s = clock.seconds();
+
+    const auto patterns = qstruct::builtin_patterns();
+    const qstruct::PatternFaceOptions fo;
+    clock.reset();
+    std::map<std::string, int> refusals, used, no_pattern_sides, quality_patterns;
+    std::int64_t quads = 0;
+    double worst = 1, sum_avg = 0;
+    int meshed = 0;
+    for (LO f = 0; f < model.num_faces(); ++f) {
+      qstruct::PatternFaceReport rep;
+      const auto m = qstruct::mesh_face_pattern(model, f, result.quantized_curves, patterns, fo, &rep);
+      std::string sides = std::to_string(rep.side_edges.size());
+      if (rep.ok) {
+        ++meshed;
+        ++used[rep.pattern_name];
+        quads += static_cast<std::int64_t>(m.quads.size());
+        worst = std::min(worst, rep.sicn_min);
+        sum_avg += rep.sicn_avg;
+      } else {
+        ++refusals[qstruct::to_string(rep.refusal)];
+        if (rep.refusal == qstruct::Refusal::NoPattern) ++no_pattern_sides[sides + " sides"];
+        if (rep.refusal == qstruct::Refusal::Quality) ++quality_patterns[rep.pattern_name];
+      }
+      if (per_face) {
+        std::cout << "face " << f << " " << cad::to_string(model.faces()[f].type) << " sides [";
+        for (std::size_t i = 0; i < rep.side_edges.size(); ++i) std::cout << (i ? "," : "") << rep.side_edges[i];
+        std::cout << "] ";
+        if (rep.ok)
+          std::cout << "ok " << rep.pattern_name << " quads " << rep.quads << " sicn " << rep.sicn_min << "/"
+                    << rep.sicn_avg << "\n";
+        else
+          std::cout << qstruct::to_string(rep.refusal) << ": " << rep.reason << "\n";
+      }
+    }
+    const double faces_s = clock.seconds();
+    if (detail != kNoIndex) {
+      // One face in detail: the corners, their angles and sides, for looking into a refusal.
+      const auto surface = model.face_geometry(detail);
+      const auto fs = qstruct::face_sides(model, detail, *surface, result.quantized_curves, fo);
+      std::cout << "face " << detail << ": " << fs.points.size() << " boundary points, uv area " << fs.uv_area << "\n";
+      for (std::size_t i = 0; i < fs.points.size(); ++i)
+        if (fs.points[i].vclass.dim == 0)
+          std::cout << "  point " << i << " corner " << fs.points[i].vclass.entity << " angle " << fs.angle_deg[i]
+                    << " uv (" << fs.points[i].uv.u << ", " << fs.points[i].uv.v << ") xyz (" << fs.points[i].xyz.x
+                    << ", " << fs.points[i].xyz.y << ", " << fs.points[i].xyz.z << ")\n";
+      for (const auto& use : model.faces()[detail].loops[0].uses)
+        std::cout << "  curve " << use.curve << (use.reversed ? " (rev) " : " ") << cad::to_string(model.curves()[use.curve].type)
+                  << " edges " << result.quantized_curves[use.curve].num_edges() << " length "
+                  << model.curves()[use.curve].length << "\n";
+    }
+    std::cout << path << ": " << meshed << "/" << model.num_faces() << " faces meshed by patterns (size factor "
+              << size_factor << ", " << quads << " quads";
+    if (meshed > 0) std::cout << ", SICN min " << worst << ", mean of face averages " << sum_avg / meshed;
+    std::cout << ")\n  patterns:";
+    for (const auto& [k, n] : used) std::cout << " " << k << " " << n << ";";
+    std::cout << "\n  refused:";
+    for (const auto& [k, n] : refusals) std::cout << " " << k << " " << n << ";";
+    std::cout << "\n  no_pattern by sides:";
+    for (const auto& [k, n] : no_pattern_sides) std::cout << " " << k << ": " << n << ";";
+    std::cout << "\n  quality refusals by best pattern:";
+    for (const auto& [k, n] : quality_patterns) std::cout << " " << k << " " << n << ";";
+    std::cout << "\n  time (s): pipeline to quantization " << pipeline_s << ", pattern meshing " << faces_s << "\n";
+  } catch (const std::exception& e) {
+    std::cerr << "qstruct_survey: " << e.what() << "\n";
+    return 1;
+  }
+  return 0;
+}

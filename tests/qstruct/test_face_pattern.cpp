@@ -1,0 +1,270 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "qsmesh/background/face_mesh.hpp"
+#include "qsmesh/cad/model.hpp"
+#include "qsmesh/mesh/quality.hpp"
+#include "qsmesh/qstruct/face_pattern.hpp"
+#include "shapes.hpp"
+
+namespace qsmesh::qstruct {
+namespace {
+
+using XY = std::vector<std::pair<double, double>>;
+
+std::string tmp(const std::string& name) { return std::string(QSMESH_TEST_TMP_DIR) + "/" + name; }
+
+// Evenly spaced curve mesh with n edges, its ends exactly the corner points.
+mesh::CurveMesh uniform_curve(const cad::CadModel& model, LO c, LO n) {
+  const auto& curve = model.curves()[c];
+  const auto geo = model.curve_geometry(c);
+  mesh::CurveMesh cm;
+  cm.curve = c;
+  for (LO i = 0; i <= n; ++i) {
+    const double t = curve.t0 + (curve.t1 - curve.t0) * i / n;
+    cm.t.push_back(t);
+    cm.points.push_back(geo->point(t));
+  }
+  cm.points.front() = model.corners()[curve.corners[0]].point;
+  cm.points.back() = model.corners()[curve.corners[1]].point;
+  return cm;
+}
+
+// Curve meshes of a polygon face: counts[k] edges on the polygon edge from xy[k] to xy[k + 1].
+std::vector<mesh::CurveMesh> polygon_curves(const cad::CadModel& model, const XY& xy, const std::vector<LO>& counts) {
+  std::vector<mesh::CurveMesh> out;
+  const auto near = [](const Vec3& p, const std::pair<double, double>& q) {
+    return std::abs(p.x - q.first) + std::abs(p.y - q.second) < 1e-9;
+  };
+  for (LO c = 0; c < model.num_curves(); ++c) {
+    const auto& curve = model.curves()[c];
+    const Vec3 a = model.corners()[curve.corners[0]].point, b = model.corners()[curve.corners[1]].point;
+    LO n = 0;
+    for (std::size_t k = 0; k < xy.size(); ++k) {
+      const auto& p = xy[k];
+      const auto& q = xy[(k + 1) % xy.size()];
+      if ((near(a, p) && near(b, q)) || (near(a, q) && near(b, p))) n = counts[k];
+    }
+    if (n == 0) throw std::runtime_error("curve not on the polygon");
+    out.push_back(uniform_curve(model, c, n));
+  }
+  return out;
+}
+
+struct Valences {
+  std::map<int, int> interior;  // valence -> interior vertices
+  std::vector<int> of;          // per vertex
+};
+Valences valences(const mesh::FaceMesh& m) {
+  Valences v;
+  v.of.assign(m.num_vertices(), 0);
+  for (const auto& q : m.quads)
+    for (const LO x : q) ++v.of[x];
+  for (LO i = 0; i < m.num_vertices(); ++i)
+    if (m.vclass[i].dim == 2) ++v.interior[v.of[i]];
+  return v;
+}
+
+// Checks every property the caller relies on; returns the interior valence histogram.
+Valences check_face(const cad::CadModel& model, LO f, const std::vector<mesh::CurveMesh>& curves,
+                    const mesh::FaceMesh& m, const PatternFaceReport& rep) {
+  EXPECT_TRUE(rep.ok) << rep.reason;
+  EXPECT_EQ(rep.refusal, Refusal::None);
+  EXPECT_EQ(m.face, f);
+  EXPECT_TRUE(m.triangles.empty());
+  EXPECT_EQ(rep.quads, static_cast<std::int64_t>(m.quads.size()));
+  const auto surface = model.face_geometry(f);
+  // The boundary is exactly background::face_boundary's loop.
+  const auto loop = background::face_boundary(model, f, *surface, curves)[0].points;
+  EXPECT_GE(m.num_vertices(), static_cast<LO>(loop.size()));
+  for (std::size_t i = 0; i < loop.size() && i < m.points.size(); ++i) {
+    EXPECT_EQ(m.points[i], loop[i].xyz);
+    EXPECT_EQ(m.uv[i], loop[i].uv);
+    EXPECT_EQ(m.vclass[i].dim, loop[i].vclass.dim);
+    EXPECT_EQ(m.vclass[i].entity, loop[i].vclass.entity);
+    EXPECT_EQ(m.vclass[i].index, loop[i].vclass.index);
+  }
+  for (LO i = static_cast<LO>(loop.size()); i < m.num_vertices(); ++i) {
+    EXPECT_EQ(m.vclass[i].dim, 2);
+    EXPECT_EQ(m.vclass[i].entity, f);
+    EXPECT_LT(distance(surface->eval(m.uv[i]).p, m.points[i]), 1e-9 * model.diagonal());
+  }
+  // Valid quads, oriented along the face normal.
+  for (const auto& q : m.quads) {
+    const std::array<Vec3, 4> p{m.points[q[0]], m.points[q[1]], m.points[q[2]], m.points[q[3]]};
+    EXPECT_GT(mesh::quad_sicn(p), 0);
+    const Vec3 n = cross(p[1] - p[0], p[3] - p[0]) + cross(p[3] - p[2], p[1] - p[2]);
+    const Vec2 c = (m.uv[q[0]] + m.uv[q[1]] + m.uv[q[2]] + m.uv[q[3]]) / 4.0;
+    EXPECT_GT(dot(n, surface->normal(c)), 0);
+  }
+  EXPECT_GT(rep.sicn_min, 0);
+  return valences(m);
+}
+
+struct PolygonCase {
+  cad::CadModel model;
+  std::vector<mesh::CurveMesh> curves;
+};
+PolygonCase polygon(const XY& xy, const std::vector<LO>& counts, const std::string& name) {
+  PolygonCase c{cad::load_cad(test::write_polygon_face(xy, tmp(name))), {}};
+  c.curves = polygon_curves(c.model, xy, counts);
+  return c;
+}
+
+TEST(FacePattern, RectangleWithEqualOppositeSidesIsAGrid) {
+  const XY xy = {{0, 0}, {10, 0}, {10, 4}, {0, 4}};
+  const auto pc = polygon(xy, {10, 4, 10, 4}, "qs_rect.brep");
+  const auto patterns = builtin_patterns();
+  PatternFaceReport rep;
+  const auto m = mesh_face_pattern(pc.model, 0, pc.curves, patterns, {}, &rep);
+  const auto v = check_face(pc.model, 0, pc.curves, m, rep);
+  EXPECT_EQ(rep.pattern_name, "grid");
+  EXPECT_EQ(m.quads.size(), 40u);
+  EXPECT_EQ(v.interior, (std::map<int, int>{{4, 27}}));
+  std::vector<LO> sides = rep.side_edges;
+  std::sort(sides.begin(), sides.end());
+  EXPECT_EQ(sides, (std::vector<LO>{4, 4, 10, 10}));
+  EXPECT_GT(rep.sicn_min, 0.99);
+}
+
+TEST(FacePattern, RectangleWithATransitionGetsOneValence3And5) {
+  const XY xy = {{0, 0}, {10, 0}, {10, 5}, {0, 5}};
+  const auto pc = polygon(xy, {11, 4, 9, 6}, "qs_trans.brep");
+  const auto patterns = builtin_patterns();
+  PatternFaceReport rep;
+  const auto m = mesh_face_pattern(pc.model, 0, pc.curves, patterns, {}, &rep);
+  const auto v = check_face(pc.model, 0, pc.curves, m, rep);
+  EXPECT_EQ(rep.pattern_name, "transition_1");
+  EXPECT_EQ(v.interior.count(3) ? v.interior.at(3) : 0, 1);
+  EXPECT_EQ(v.interior.count(5) ? v.interior.at(5) : 0, 1);
+  EXPECT_EQ(v.interior.size(), 3u);  // valences 3, 4, 5 only
+  // Boundary vertices off the corners have two quads.
+  for (LO i = 0; i < m.num_vertices(); ++i)
+    if (m.vclass[i].dim == 1) {
+      EXPECT_EQ(v.of[i], 2);
+    }
+
+  // Thresholds are honoured: nothing is that good, so the face is refused with the reason.
+  PatternFaceOptions strict;
+  strict.min_sicn = 0.999;
+  const auto r = mesh_face_pattern(pc.model, 0, pc.curves, patterns, strict, &rep);
+  EXPECT_FALSE(rep.ok);
+  EXPECT_EQ(rep.refusal, Refusal::Quality);
+  EXPECT_GE(rep.candidates, 1);
+  EXPECT_TRUE(r.quads.empty());
+  EXPECT_NE(rep.reason.find("face 0"), std::string::npos) << rep.reason;
+}
+
+TEST(FacePattern, TriangleAndPentagonGetTheirIrregularVertex) {
+  const auto patterns = builtin_patterns();
+  {
+    const XY xy = {{0, 0}, {6, 0}, {3, 3 * std::sqrt(3.0)}};
+    const auto pc = polygon(xy, {6, 6, 6}, "qs_tri.brep");
+    PatternFaceReport rep;
+    const auto m = mesh_face_pattern(pc.model, 0, pc.curves, patterns, {}, &rep);
+    const auto v = check_face(pc.model, 0, pc.curves, m, rep);
+    EXPECT_EQ(rep.pattern_name, "triangle");
+    EXPECT_EQ(v.interior.at(3), 1);
+    EXPECT_EQ(v.interior.size(), 2u);
+    EXPECT_EQ(m.quads.size(), 27u);
+  }
+  {
+    XY xy;
+    for (int k = 0; k < 5; ++k) {
+      const double a = std::numbers::pi / 2 + 2 * std::numbers::pi * k / 5;
+      xy.emplace_back(5 * std::cos(a), 5 * std::sin(a));
+    }
+    const auto pc = polygon(xy, {4, 4, 4, 4, 4}, "qs_penta.brep");
+    PatternFaceReport rep;
+    const auto m = mesh_face_pattern(pc.model, 0, pc.curves, patterns, {}, &rep);
+    const auto v = check_face(pc.model, 0, pc.curves, m, rep);
+    EXPECT_EQ(rep.pattern_name, "pentagon");
+    EXPECT_EQ(v.interior.at(5), 1);
+    EXPECT_EQ(v.interior.size(), 2u);
+  }
+}
+
+TEST(FacePattern, LShapeKeepsItsConcaveCornerOnTheBoundary) {
+  const XY xy = {{0, 0}, {6, 0}, {6, 3}, {3, 3}, {3, 6}, {0, 6}};
+  const auto pc = polygon(xy, {6, 3, 3, 3, 3, 6}, "qs_l.brep");
+  const auto patterns = builtin_patterns();
+  PatternFaceReport rep;
+  const auto m = mesh_face_pattern(pc.model, 0, pc.curves, patterns, {}, &rep);
+  const auto v = check_face(pc.model, 0, pc.curves, m, rep);
+  EXPECT_EQ(rep.pattern_name, "l_shape");
+  EXPECT_EQ(rep.side_edges.size(), 5u);  // the concave corner does not split a side
+  EXPECT_EQ(v.interior, (std::map<int, int>{{4, static_cast<int>(v.interior.at(4))}}));
+  for (LO i = 0; i < m.num_vertices(); ++i)
+    if (m.vclass[i].dim == 0 && std::abs(m.points[i].x - 3) < 1e-12 && std::abs(m.points[i].y - 3) < 1e-12) {
+      EXPECT_EQ(v.of[i], 3);
+    }
+}
+
+TEST(FacePattern, CylinderSideIsAFourSidedDiskAcrossItsSeam) {
+  const auto model = cad::load_cad(test::write_cylinder(tmp("qs_cyl.brep")));
+  LO side = kNoIndex;
+  for (LO f = 0; f < model.num_faces(); ++f)
+    if (model.faces()[f].type == cad::SurfaceType::Cylinder) side = f;
+  ASSERT_NE(side, kNoIndex);
+  std::vector<mesh::CurveMesh> curves;
+  for (LO c = 0; c < model.num_curves(); ++c)
+    curves.push_back(uniform_curve(model, c, model.curves()[c].type == cad::CurveType::Circle ? 12 : 5));
+  const auto patterns = builtin_patterns();
+  PatternFaceReport rep;
+  const auto m = mesh_face_pattern(model, side, curves, patterns, {}, &rep);
+  const auto v = check_face(model, side, curves, m, rep);
+  EXPECT_EQ(rep.pattern_name, "grid");
+  EXPECT_EQ(m.quads.size(), 60u);
+  EXPECT_EQ(v.interior, (std::map<int, int>{{4, 44}}));
+  // The seam's vertices appear twice (two uv images, one 3D point).
+  std::map<std::pair<LO, LO>, int> copies;
+  for (const auto& vc : m.vclass)
+    if (vc.dim == 1) ++copies[{vc.entity, vc.index}];
+  int twice = 0;
+  for (const auto& [k, n] : copies) twice += n == 2;
+  EXPECT_EQ(twice, 4);
+}
+
+TEST(FacePattern, PolesAndHolesAreRefused) {
+  const auto patterns = builtin_patterns();
+  {
+    const auto model = cad::load_cad(test::write_sphere(tmp("qs_sphere.brep")));
+    std::vector<mesh::CurveMesh> curves;
+    for (LO c = 0; c < model.num_curves(); ++c)
+      curves.push_back(uniform_curve(model, c, model.curves()[c].degenerate ? 1 : 8));
+    PatternFaceReport rep;
+    const auto m = mesh_face_pattern(model, 0, curves, patterns, {}, &rep);
+    EXPECT_FALSE(rep.ok);
+    EXPECT_EQ(rep.refusal, Refusal::Degenerate) << rep.reason;
+    EXPECT_TRUE(m.quads.empty());
+  }
+  {
+    const auto model = cad::load_cad(test::write_box_with_hole(tmp("qs_holed.brep")));
+    std::vector<mesh::CurveMesh> curves;
+    for (LO c = 0; c < model.num_curves(); ++c) curves.push_back(uniform_curve(model, c, 4));
+    int holes = 0, meshed = 0;
+    for (LO f = 0; f < model.num_faces(); ++f) {
+      PatternFaceReport rep;
+      const auto m = mesh_face_pattern(model, f, curves, patterns, {}, &rep);
+      if (model.faces()[f].loops.size() > 1) {
+        ++holes;
+        EXPECT_EQ(rep.refusal, Refusal::Loops);
+        EXPECT_TRUE(m.quads.empty());
+      } else if (rep.ok) {
+        ++meshed;
+      }
+    }
+    EXPECT_EQ(holes, 2);
+    EXPECT_GE(meshed, 4);  // the four box sides without the hole, all 4 x 4 grids
+  }
+}
+
+}  // namespace
+}  // namespace qsmesh::qstruct

@@ -1,0 +1,283 @@
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "qsmesh/core/error.hpp"
+#include "qsmesh/qstruct/patterns.hpp"
+
+namespace qsmesh::qstruct {
+namespace {
+
+const Pattern& by_name(const std::vector<Pattern>& all, const std::string& name) {
+  for (const auto& p : all)
+    if (p.name == name) return p;
+  throw std::runtime_error("no pattern " + name);
+}
+
+LO index_of(const std::vector<Pattern>& all, const std::string& name) {
+  for (LO i = 0; i < static_cast<LO>(all.size()); ++i)
+    if (all[i].name == name) return i;
+  return kNoIndex;
+}
+
+// Columns of w as vectors, sorted: w up to a renumbering of the chords.
+std::vector<std::vector<int>> columns(const std::vector<int>& w, int rows, int cols) {
+  std::vector<std::vector<int>> out(cols, std::vector<int>(rows));
+  for (int i = 0; i < rows; ++i)
+    for (int j = 0; j < cols; ++j) out[j][i] = w[i * cols + j];
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+TEST(Patterns, BuiltinPatternsAreValidDisks) {
+  const auto all = builtin_patterns();
+  // name -> {sides, chords, irregular vertices}
+  const std::map<std::string, std::array<int, 3>> expected = {
+      {"grid", {4, 2, 0}},     {"transition_1", {4, 5, 2}}, {"transition_2", {4, 7, 4}}, {"triangle", {3, 3, 1}},
+      {"transition_2_joined", {4, 6, 3}},
+      {"pentagon", {5, 5, 1}}, {"l_shape", {5, 4, 1}},      {"hexagon", {6, 6, 1}},      {"half_disk", {2, 3, 2}}};
+  ASSERT_EQ(all.size(), expected.size());
+  for (const auto& p : all) {
+    SCOPED_TRACE(p.name);
+    ASSERT_TRUE(expected.count(p.name));
+    const auto& e = expected.at(p.name);
+    EXPECT_EQ(p.num_sides(), e[0]);
+    EXPECT_EQ(p.num_chords, e[1]);
+    EXPECT_EQ(p.irregular, e[2]);
+    // Counter-clockwise in the drawing of the data file.
+    for (const auto& q : p.quads) {
+      double area = 0;
+      for (int k = 0; k < 4; ++k) area += cross(p.xy[q[k]], p.xy[q[(k + 1) % 4]]);
+      EXPECT_GT(area, 0);
+    }
+    // Every side count equals its chord weights; w entries are 0, 1 or 2; each chord reaches
+    // the boundary exactly twice.
+    std::vector<int> per_chord(p.num_chords, 0);
+    for (int i = 0; i < p.num_sides(); ++i)
+      for (LO j = 0; j < p.num_chords; ++j) {
+        EXPECT_GE(p.weight(i, j), 0);
+        EXPECT_LE(p.weight(i, j), 2);
+        per_chord[j] += p.weight(i, j);
+      }
+    for (const int c : per_chord) EXPECT_EQ(c, 2);
+    EXPECT_EQ(p.valence[p.boundary[p.side_start[0]]], 1);
+  }
+  // The half disk has chords turning inside a side (w = 2).
+  const auto& hd = by_name(all, "half_disk");
+  EXPECT_EQ(*std::max_element(hd.w.begin(), hd.w.end()), 2);
+}
+
+TEST(Patterns, ThirdPatternGivesThePapersSystem) {
+  const auto all = builtin_patterns();
+  const auto& p = by_name(all, "transition_1");
+  // a + b + c = N1, d + e = N2, a + c = N3, b + d + e = N4 (paper 000 Sec. 6.1.1), columns a..e.
+  const std::vector<int> paper = {1, 1, 1, 0, 0,  //
+                                  0, 0, 0, 1, 1,  //
+                                  1, 0, 1, 0, 0,  //
+                                  0, 1, 0, 1, 1};
+  ASSERT_EQ(p.num_sides(), 4);
+  ASSERT_EQ(p.num_chords, 5);
+  EXPECT_EQ(columns(p.w, 4, 5), columns(paper, 4, 5));
+  // Chords are numbered along side 1 first: a, b, c.
+  EXPECT_EQ(p.weight(0, 0) + p.weight(0, 1) + p.weight(0, 2), 3);
+}
+
+TEST(Patterns, InvalidPatternsAreRejected) {
+  // Two quads with inconsistent orientation.
+  EXPECT_THROW((void)make_pattern("bad", {{0, 0}, {1, 0}, {1, 1}, {0, 1}, {2, 0}, {2, 1}}, {{0, 1, 2, 3}, {1, 2, 5, 4}}),
+               Error);
+  // An annulus (not a disk).
+  std::vector<Vec2> xy(8);
+  EXPECT_THROW((void)make_pattern("ring", xy, {{0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}}), Error);
+  // Index out of range.
+  EXPECT_THROW((void)make_pattern("range", {{0, 0}, {1, 0}, {1, 1}}, {{0, 1, 2, 3}}), Error);
+}
+
+TEST(Match, SolveChordsSmallSystems) {
+  const auto all = builtin_patterns();
+  const auto& tri = by_name(all, "triangle");
+  const std::vector<LO> n6 = {6, 6, 6};
+  auto s = solve_chords(tri.w, 3, tri.num_chords, n6);
+  ASSERT_TRUE(s.found);
+  EXPECT_EQ(s.s, (std::vector<LO>{3, 3, 3}));
+  EXPECT_DOUBLE_EQ(s.energy, 0);
+  // a + b, b + c, c + a with an odd total: no integer solution.
+  const std::vector<LO> odd = {6, 6, 5};
+  EXPECT_FALSE(solve_chords(tri.w, 3, tri.num_chords, odd).found);
+  // [4, 6, 8]: a = 3, b = 1, c = 5 in some chord order; strictly positive.
+  const std::vector<LO> skew = {4, 6, 8};
+  s = solve_chords(tri.w, 3, tri.num_chords, skew);
+  ASSERT_TRUE(s.found);
+  // [2, 10, 2]: c + a = 2 forces a = c = 1 but then b = 1 and b + c = 2 != 10.
+  const std::vector<LO> none = {2, 10, 2};
+  EXPECT_FALSE(solve_chords(tri.w, 3, tri.num_chords, none).found);
+
+  // In the hexagon each chord joins sides two apart: sides 0, 2, 4 and sides 1, 3, 5 form two
+  // triangle systems, each needing an even total.
+  const auto& hex = by_name(all, "hexagon");
+  const std::vector<LO> h = {4, 4, 4, 4, 4, 4};
+  s = solve_chords(hex.w, 6, hex.num_chords, h);
+  ASSERT_TRUE(s.found);
+  EXPECT_EQ(s.s, std::vector<LO>(6, 2));
+  const std::vector<LO> h_even = {4, 4, 4, 4, 4, 6};
+  EXPECT_TRUE(solve_chords(hex.w, 6, hex.num_chords, h_even).found);
+  const std::vector<LO> h_odd = {4, 4, 4, 4, 4, 5};
+  EXPECT_FALSE(solve_chords(hex.w, 6, hex.num_chords, h_odd).found);
+
+  // An undetermined system (one pair: 5 chords, rank 3): the balanced solution wins.
+  const auto& t1 = by_name(all, "transition_1");
+  const std::vector<LO> n = {12, 4, 10, 6};  // a + b + c, d + e, a + c, b + d + e
+  s = solve_chords(t1.w, 4, t1.num_chords, n);
+  ASSERT_TRUE(s.found);
+  std::vector<LO> sorted = s.s;
+  std::sort(sorted.begin(), sorted.end());
+  EXPECT_EQ(sorted, (std::vector<LO>{2, 2, 2, 5, 5}));  // b = 2, a = c = 5, d = e = 2
+
+  // Every solution satisfies the system exactly and is strictly positive.
+  const auto& hd = by_name(all, "half_disk");
+  const std::vector<LO> d = {7, 5};
+  s = solve_chords(hd.w, 2, hd.num_chords, d);
+  ASSERT_TRUE(s.found);
+  for (int i = 0; i < 2; ++i) {
+    LO sum = 0;
+    for (LO j = 0; j < hd.num_chords; ++j) sum += hd.weight(i, j) * s.s[j];
+    EXPECT_EQ(sum, d[i]);
+  }
+  for (const LO x : s.s) EXPECT_GE(x, 1);
+}
+
+TEST(Match, SearchIsAbandonedAfterTheAttemptBudget) {
+  // 2 a + 2 b = 2001 has no integer solution but every b in [1, 999] must be tried to see it.
+  const std::vector<int> w = {2, 2};
+  const std::vector<LO> n = {2001};
+  MatchOptions o;
+  o.max_attempts = 300;
+  const auto s = solve_chords(w, 1, 2, n, o);
+  EXPECT_FALSE(s.found);
+  EXPECT_EQ(s.attempts, o.max_attempts);
+  // 2 a + 2 b = 2000: found at once near the ideal a = b = 500.
+  const std::vector<LO> even = {2000};
+  const auto t = solve_chords(w, 1, 2, even, o);
+  ASSERT_TRUE(t.found);
+  EXPECT_EQ(t.s, (std::vector<LO>{500, 500}));
+  EXPECT_LE(t.attempts, o.max_attempts);
+}
+
+TEST(Match, RegularSidesMatchTheGrid) {
+  const auto all = builtin_patterns();
+  const std::vector<LO> n = {10, 4, 10, 4};
+  const auto matches = match_patterns(all, n);
+  ASSERT_FALSE(matches.empty());
+  EXPECT_EQ(all[matches[0].pattern].name, "grid");
+  // The grid's 8 placements are one mesh.
+  EXPECT_EQ(std::count_if(matches.begin(), matches.end(),
+                          [&](const PatternMatch& m) { return all[m.pattern].name == "grid"; }),
+            1);
+  auto chords = matches[0].chords;
+  std::sort(chords.begin(), chords.end());
+  EXPECT_EQ(chords, (std::vector<LO>{4, 10}));
+}
+
+TEST(Match, OnePairTransition) {
+  const auto all = builtin_patterns();
+  const LO grid = index_of(all, "grid"), t1 = index_of(all, "transition_1");
+  const std::vector<LO> n = {11, 4, 9, 6};
+  const auto matches = match_patterns(all, n);
+  bool any_t1 = false;
+  for (const auto& m : matches) {
+    EXPECT_NE(m.pattern, grid);
+    if (m.pattern != t1) continue;
+    any_t1 = true;
+    // The solution satisfies Eq. 14 on the rotated sides and b = N1 - N3 = N4 - N2 = 2.
+    const auto& p = all[t1];
+    for (int i = 0; i < 4; ++i) {
+      const LO side = ((m.reversed ? m.start - i : m.start + i) % 4 + 4) % 4;
+      LO sum = 0;
+      for (LO j = 0; j < p.num_chords; ++j) sum += p.weight(i, j) * m.chords[j];
+      EXPECT_EQ(sum, n[side]);
+    }
+    for (LO j = 0; j < p.num_chords; ++j) {
+      // The chord on two adjacent sides is the turning one.
+      int sides = 0;
+      for (int i = 0; i < 4; ++i) sides += p.weight(i, j) > 0;
+      bool adjacent = false;
+      for (int i = 0; i < 4; ++i) adjacent |= p.weight(i, j) > 0 && p.weight((i + 1) % 4, j) > 0;
+      if (adjacent) {
+        EXPECT_EQ(m.chords[j], 2);
+      }
+    }
+  }
+  EXPECT_TRUE(any_t1);
+  // N1 - N3 = 1 but N4 - N2 = 2: no placement of the one-pair pattern (nor of the grid) fits.
+  const std::vector<LO> bad = {10, 4, 9, 6};
+  for (const auto& m : match_patterns(all, bad)) {
+    EXPECT_NE(m.pattern, grid);
+    EXPECT_NE(m.pattern, t1);
+  }
+}
+
+TEST(Match, TwoPairTransitionTakesUnequalDifferences) {
+  const auto all = builtin_patterns();
+  // N1 - N3 = 4, N4 - N2 = 2: neither the grid nor one pair; two pairs with b = 3, f = 1.
+  const std::vector<LO> n = {12, 4, 8, 6};
+  const auto matches = match_patterns(all, n);
+  ASSERT_FALSE(matches.empty());
+  EXPECT_EQ(all[matches[0].pattern].name, "transition_2");
+}
+
+TEST(Refine, GridAndTransitionTopology) {
+  const auto all = builtin_patterns();
+  const auto& grid = by_name(all, "grid");
+  const std::vector<LO> s = {3, 2};
+  const auto r = refine_pattern(grid, s);
+  EXPECT_EQ(r.quads.size(), 6u);
+  EXPECT_EQ(r.num_vertices, 12);
+  EXPECT_EQ(r.boundary.size(), 10u);
+  EXPECT_EQ(r.side_start, (std::vector<LO>{0, 3, 5, 8}));
+  EXPECT_THROW((void)refine_pattern(grid, std::vector<LO>{3, 0}), Error);
+
+  const auto& t1 = by_name(all, "transition_1");
+  const std::vector<LO> c = {3, 2, 4, 2, 3};
+  const auto t = refine_pattern(t1, c);
+  std::vector<int> val(t.num_vertices, 0);
+  std::map<std::pair<LO, LO>, int> edges;
+  for (const auto& q : t.quads)
+    for (int k = 0; k < 4; ++k) {
+      ++val[q[k]];
+      ++edges[{std::min(q[k], q[(k + 1) % 4]), std::max(q[k], q[(k + 1) % 4])}];
+    }
+  LO boundary_edges = 0;
+  for (const auto& [e, n] : edges) {
+    EXPECT_LE(n, 2);
+    boundary_edges += n == 1;
+  }
+  EXPECT_EQ(boundary_edges, static_cast<LO>(t.boundary.size()));
+  EXPECT_EQ(t.num_vertices - static_cast<LO>(edges.size()) + static_cast<LO>(t.quads.size()), 1);
+  std::set<LO> on_boundary(t.boundary.begin(), t.boundary.end());
+  EXPECT_EQ(on_boundary.size(), t.boundary.size());
+  int v3 = 0, v5 = 0, other = 0;
+  for (LO v = 0; v < t.num_vertices; ++v) {
+    if (on_boundary.count(v)) continue;
+    v3 += val[v] == 3;
+    v5 += val[v] == 5;
+    other += val[v] != 3 && val[v] != 4 && val[v] != 5;
+  }
+  EXPECT_EQ(v3, 1);
+  EXPECT_EQ(v5, 1);
+  EXPECT_EQ(other, 0);
+  // Side lengths follow Eq. 14.
+  const LO nb = static_cast<LO>(t.boundary.size());
+  for (int i = 0; i < 4; ++i) {
+    const LO len = (i + 1 < 4 ? t.side_start[i + 1] : nb) - t.side_start[i];
+    LO sum = 0;
+    for (LO j = 0; j < t1.num_chords; ++j) sum += t1.weight(i, j) * c[j];
+    EXPECT_EQ(len, sum);
+  }
+}
+
+}  // namespace
+}  // namespace qsmesh::qstruct
