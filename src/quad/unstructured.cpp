@@ -45,7 +45,8 @@ mesh::FaceMesh frontal_quads(const cad::CadModel& model, LO f, const cad::FaceGe
   directions.reserve(tri.triangles.size());
   for (const auto& t : tri.triangles)
     directions.push_back(guide.at((tri.uv[t[0]] + tri.uv[t[1]] + tri.uv[t[2]]) / 3.0).cross);
-  mesh::FaceMesh out = subdivide(recombine(tri, directions, options.recombine), surface, full);
+  RecombineStats rs;
+  mesh::FaceMesh out = subdivide(recombine(tri, directions, options.recombine, &rs), surface, full);
   if (valid(out)) return out;
   rep.fell_back = true;
   out = subdivide(tri, surface, full);
@@ -65,8 +66,8 @@ mesh::FaceMesh mesh_face_unstructured(const cad::CadModel& model, LO f, std::spa
   try {
     const auto surface = model.face_geometry(f);
     mesh::FaceMesh out;
-    if (options.use_frontal && fields.background != nullptr && fields.cross_field != nullptr &&
-        !fields.sizes.empty()) {
+    const bool want_frontal = options.use_frontal;
+    if (want_frontal && fields.background != nullptr && fields.cross_field != nullptr && !fields.sizes.empty()) {
       try {
         out = frontal_quads(model, f, *surface, halved, full, fields, options, rep);
         rep.frontal = !out.quads.empty();
@@ -78,7 +79,8 @@ mesh::FaceMesh mesh_face_unstructured(const cad::CadModel& model, LO f, std::spa
       // Fallback path: the kernel's own refinement at a uniform size. The triangles become quads
       // of half their size by subdivision: mesh at twice the size, with half the edges per turn
       // on curved geometry.
-      rep.fell_back = false;
+      // A face that should have had the frontal path counts as fallen back whatever follows.
+      rep.fell_back = want_frontal;
       background::BackgroundOptions tri_options;
       tri_options.sizes.size = 2 * options.size;
       tri_options.sizes.edges_per_turn = 8;

@@ -59,8 +59,9 @@ struct FrontalOptions {
   /// Target spacing = spacing_factor x the size map. 2 at the halved level of the pipeline (the
   /// triangles become quads of half their size by midpoint subdivision).
   double spacing_factor = 2.0;
-  /// A point closer than min_distance x its target spacing to an existing point is rejected.
-  double min_distance = 0.7;
+  /// A point closer than min_distance x its target spacing to an existing point is rejected (0.6:
+  /// fewest irregular vertices on Block.stp among 0.5, 0.6, 0.7, 0.8).
+  double min_distance = 0.6;
   /// At most this many interior points (guards against runaway insertion).
   std::int64_t max_points = 5'000'000;
 };

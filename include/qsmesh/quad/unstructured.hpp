@@ -26,7 +26,8 @@ struct UnstructuredOptions {
   /// the halved triangulation.
   FrontalOptions frontal;
   bool use_frontal = true;  ///< false: always the fallback path
-  RecombineOptions recombine;
+  /// Recombination (Sec. 5.2): greedy, then augmenting paths pair the triangles left alone.
+  RecombineOptions recombine{.augment_depth = 30, .augment_min_sicn = 0.1};
 };
 
 /// What the frontal path reads for one face, from the earlier stages (all from the same face).
@@ -39,7 +40,10 @@ struct FaceFields {
 /// What happened on one face.
 struct UnstructuredReport {
   bool ok = false;          ///< an all-quad mesh with every quad valid (SICN > 0)
-  bool fell_back = false;   ///< recombination failed or folded a quad: every triangle was subdivided instead
+  /// The face did not get the intended method: the frontal path was wanted (options.use_frontal)
+  /// but the face has no fields or the path failed, or recombination failed or folded a quad and
+  /// every triangle was subdivided instead.
+  bool fell_back = false;
   bool frontal = false;     ///< the mesh comes from the frontal triangulation (else the fallback path)
   std::int64_t frontal_points = 0;  ///< interior points the frontal insertion placed
   std::string error;        ///< the error met, with stage and face id
