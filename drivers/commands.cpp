@@ -163,6 +163,11 @@ std::string stats_json(const Arguments& args, const Session& session, const para
   const auto [failed, fell_back] = count_failures(r);
   j.value("faces_failed", failed);
   j.value("faces_fell_back", fell_back);
+  if (!r.quad_reports.empty()) {
+    std::int64_t frontal = 0;
+    for (const auto& q : r.quad_reports) frontal += q.frontal ? 1 : 0;
+    j.value("faces_frontal", frontal);  // faces meshed by the frontal path (Sec. 5.1)
+  }
   j.value("vertices", s.vertices);
   j.value("triangles", s.triangles);
   j.value("quads", s.quads);

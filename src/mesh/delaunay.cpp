@@ -84,7 +84,8 @@ class FaceMesher {
     insert_boundary();
     recover_segments();
     remove_outside();
-    refine();
+    insert_given();
+    if (opt_.refine) refine();
     optimize();
     return output(reversed);
   }
@@ -425,6 +426,48 @@ class FaceMesher {
         for (LO v : tr_.tris[t].v) tr_.v2t[v] = t;
   }
 
+  // ---------------------------------------------------------------- given points
+  // The caller's points (Sec. 5.1 frontal points) in their order. The walk from the last
+  // insertion is blocked by the locked boundary when the domain is not convex between two
+  // consecutive points; it then restarts from the vertex nearest in (u, v), whose star sees it.
+  void insert_given() {
+    if (opt_.interior_points.empty()) return;
+    LO hint = kNoIndex;
+    for (LO t = 0; t < static_cast<LO>(tr_.tris.size()) && hint == kNoIndex; ++t)
+      if (tr_.tris[t].alive) hint = t;
+    if (hint == kNoIndex) return;
+    for (const Vec2& x : opt_.interior_points) {
+      if (stats_.inserted >= opt_.max_points) break;
+      if (!std::isfinite(x.u) || !std::isfinite(x.v)) {
+        ++stats_.rejected;
+        continue;
+      }
+      Location loc = tr_.locate(x, hint, true);
+      if (loc.kind == LocKind::kBlocked || loc.kind == LocKind::kFailed) {
+        LO nearest = kNoIndex;
+        double best = 1e300;
+        for (LO v = first_real_; v < static_cast<LO>(tr_.pts.size()); ++v) {
+          if (tr_.v2t[v] == kNoIndex || !tr_.tris[tr_.v2t[v]].alive) continue;
+          const double d = norm(tr_.pts[v] - x);
+          if (d < best) {
+            best = d;
+            nearest = v;
+          }
+        }
+        if (nearest != kNoIndex) loc = tr_.locate(x, tr_.v2t[nearest], true);
+      }
+      const cad::SurfaceEval ex = surf_.eval(x);
+      const double hx = size_(x, ex.p);
+      const LO v = try_insert_at(loc, x, ex, hx, hx);
+      if (v == kNoIndex) {
+        ++stats_.rejected;
+        continue;
+      }
+      ++stats_.inserted;
+      hint = created_.front();
+    }
+  }
+
   // ---------------------------------------------------------------- refinement
   struct TriGeom {
     std::array<double, 3> l;  // 3D length of edge i (opposite v[i])
@@ -520,7 +563,9 @@ class FaceMesher {
   // Tries to insert x (evaluated as ex) with a metric Delaunay cavity; spacing is the local
   // target used for the too-close test. Returns the new vertex or kNoIndex.
   LO try_insert(const Vec2& x, const cad::SurfaceEval& ex, double hx, double spacing, LO hint) {
-    const Location loc = tr_.locate(x, hint, true);
+    return try_insert_at(tr_.locate(x, hint, true), x, ex, hx, spacing);
+  }
+  LO try_insert_at(const Location& loc, const Vec2& x, const cad::SurfaceEval& ex, double hx, double spacing) {
     if (loc.kind != LocKind::kInside && loc.kind != LocKind::kOnEdge) return kNoIndex;
     const Frame f = frame_of(ex);
     const Vec2 origin{0, 0};

@@ -167,6 +167,8 @@ void unpack(const std::vector<char>& in, std::size_t& pos, sizemap::FaceSizes& s
 void pack(const quad::UnstructuredReport& r, std::vector<char>& out) {
   put<std::uint8_t>(out, r.ok ? 1 : 0);
   put<std::uint8_t>(out, r.fell_back ? 1 : 0);
+  put<std::uint8_t>(out, r.frontal ? 1 : 0);
+  put<std::int64_t>(out, r.frontal_points);
   put_vec(out, std::vector<char>(r.error.begin(), r.error.end()));
   put<double>(out, r.sicn_min);
   put<std::int64_t>(out, r.quads);
@@ -175,6 +177,8 @@ void pack(const quad::UnstructuredReport& r, std::vector<char>& out) {
 void unpack(const std::vector<char>& in, std::size_t& pos, quad::UnstructuredReport& r) {
   r.ok = get<std::uint8_t>(in, pos) != 0;
   r.fell_back = get<std::uint8_t>(in, pos) != 0;
+  r.frontal = get<std::uint8_t>(in, pos) != 0;
+  r.frontal_points = get<std::int64_t>(in, pos);
   std::vector<char> err;
   get_vec(in, pos, err);
   r.error.assign(err.begin(), err.end());
@@ -232,11 +236,13 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
   });
   result.times.add("background", comm.allreduce_max(clock.seconds()));
 
-  // Cross fields (paper 000 Sec. 3) on the same faces, one task per face. The size map keeps the
-  // whole fields (it needs H at every vertex); the drivers get summaries.
+  // Cross fields (paper 000 Sec. 3) on the same faces, one task per face. The size map (it needs H
+  // at every vertex) and the frontal insertion (the crosses) keep the whole fields; the drivers
+  // get summaries.
   const bool quads = options.until >= Stage::Unstructured;
   const bool size_map = options.size_map || quads;
-  const bool keep_fields = size_map && options.sizemap.method == sizemap::Method::CrossField;
+  const bool cf_sizes = size_map && options.sizemap.method == sizemap::Method::CrossField;
+  const bool keep_fields = cf_sizes || quads;
   const bool want_fields = options.cross_fields || keep_fields;
   std::vector<CrossFieldOutput> fields;
   std::vector<std::unique_ptr<crossfield::FaceCrossField>> full(mine.size());
@@ -274,7 +280,8 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     const std::vector<double> targets = sizemap::face_quad_targets(model, so);
     auto face_pass = [&](const sizemap::CurveSizes& on_curves) {
       tasks.parallel_for(total, [&](std::int64_t i) {
-        sizes[i] = sizemap::face_sizes(meshes[i], full[i].get(), curves, on_curves, targets[mine[i]], so);
+        sizes[i] = sizemap::face_sizes(meshes[i], cf_sizes ? full[i].get() : nullptr, curves, on_curves,
+                                       targets[mine[i]], so);
       });
     };
     face_pass(initial);
@@ -300,8 +307,10 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
                  result.quantization.total_edges, " edges"));
   }
 
-  // Unstructured all-quad meshes (paper 000 Sec. 5) on the quantized curve meshes: faces meshed
-  // on the halved curves, recombined, subdivided onto the full ones, smoothed.
+  // Unstructured all-quad meshes (paper 000 Sec. 5) on the quantized curve meshes: frontal points
+  // guided by the face's cross field and size map (read on its background mesh) on the halved
+  // curves, recombined, subdivided onto the full ones, smoothed. The background meshes stay
+  // until every face of the rank is done; the quad meshes replace them afterwards.
   std::vector<quad::UnstructuredReport> quad_reports(quads ? mine.size() : 0);
   if (quads) {
     clock.reset();
@@ -310,12 +319,21 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     quad::UnstructuredOptions qo;
     qo.size = options.background.sizes.size;
     std::atomic<std::int64_t> q_done{0};
+    std::vector<mesh::FaceMesh> quad_meshes(mine.size());
     tasks.parallel_for(total, [&](std::int64_t i) {
-      meshes[i] = quad::mesh_face_unstructured(model, mine[i], halved, result.quantized_curves, qo, &quad_reports[i]);
+      quad::FaceFields face_fields;
+      if (reports[i].ok && full[i] != nullptr) {
+        face_fields.background = &meshes[i];
+        face_fields.cross_field = full[i].get();
+        face_fields.sizes = sizes[i].s;
+      }
+      quad_meshes[i] = quad::mesh_face_unstructured(model, mine[i], halved, result.quantized_curves, face_fields, qo,
+                                                    &quad_reports[i]);
       const std::int64_t n = ++q_done;
       if (n * 10 / total != (n - 1) * 10 / total)
         log.info(cat("unstructured: ", n, "/", mine.size(), " faces on rank ", rank));
     });
+    meshes = std::move(quad_meshes);
     result.times.add("unstructured", comm.allreduce_max(clock.seconds()));
   }
 

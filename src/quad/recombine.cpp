@@ -36,6 +36,63 @@ double edge_alignment(const Vec3& e, const std::array<Vec3, 2>& cross_dirs) {
   return std::clamp((c - c45) / (1 - c45), 0.0, 1.0);
 }
 
+// A triangle the greedy pass left alone becomes a valence-3 vertex after subdivision. Augmenting
+// paths of the matching (alternating free/held candidates from one lone triangle to another) pair
+// two of them at the price of re-pairing the triangles in between; breadth first, bounded depth,
+// only through candidates of acceptable quality, lone triangles in increasing order.
+void augment(const std::vector<Candidate>& candidates, const RecombineOptions& options, std::vector<LO>& mate) {
+  const auto nt = static_cast<LO>(mate.size());
+  std::vector<std::vector<LO>> tri2cand(static_cast<std::size_t>(nt));
+  for (LO ci = 0; ci < static_cast<LO>(candidates.size()); ++ci) {
+    const Candidate& c = candidates[ci];
+    if (c.sicn < options.augment_min_sicn) continue;
+    tri2cand[c.t1].push_back(ci);
+    tri2cand[c.t2].push_back(ci);
+  }
+  auto other = [&](LO ci, LO t) { return candidates[ci].t1 == t ? candidates[ci].t2 : candidates[ci].t1; };
+  std::vector<std::uint32_t> seen(static_cast<std::size_t>(nt), 0);
+  std::vector<LO> parent(static_cast<std::size_t>(nt), kNoIndex);  // odd triangle -> candidate reaching it
+  std::vector<int> depth(static_cast<std::size_t>(nt), 0);
+  std::uint32_t stamp = 0;
+  std::vector<LO> queue;
+  for (LO u = 0; u < nt; ++u) {
+    if (mate[u] != kNoIndex || tri2cand[u].empty()) continue;
+    ++stamp;
+    queue.assign(1, u);
+    seen[u] = stamp;
+    depth[u] = 0;
+    LO found = kNoIndex;
+    for (std::size_t k = 0; k < queue.size() && found == kNoIndex; ++k) {
+      const LO e = queue[k];
+      for (LO ci : tri2cand[e]) {
+        if (ci == mate[e]) continue;
+        const LO o = other(ci, e);
+        if (seen[o] == stamp) continue;
+        seen[o] = stamp;
+        parent[o] = ci;
+        if (mate[o] == kNoIndex) {
+          found = o;
+          break;
+        }
+        const LO w = other(mate[o], o);
+        if (seen[w] == stamp || depth[e] + 1 > options.augment_depth) continue;
+        seen[w] = stamp;
+        depth[w] = depth[e] + 1;
+        queue.push_back(w);
+      }
+    }
+    if (found == kNoIndex) continue;
+    for (LO o = found;;) {
+      const LO ci = parent[o];
+      const LO e = other(ci, o);
+      const LO held = mate[e];  // e's current pair (none for u), released for the new one
+      mate[o] = mate[e] = ci;
+      if (e == u) break;
+      o = other(held, e);
+    }
+  }
+}
+
 }  // namespace
 
 mesh::FaceMesh recombine(const mesh::FaceMesh& mesh,
@@ -108,14 +165,18 @@ mesh::FaceMesh recombine(const mesh::FaceMesh& mesh,
   out.uv = mesh.uv;
   out.vclass = mesh.vclass;
   out.quads = mesh.quads;
-  std::vector<char> used(mesh.triangles.size(), 0);
-  for (const Candidate& c : candidates) {
-    if (used[c.t1] || used[c.t2]) continue;
-    used[c.t1] = used[c.t2] = 1;
-    out.quads.push_back(c.quad);
+  // Greedy selection, best score first.
+  std::vector<LO> mate(static_cast<std::size_t>(nt), kNoIndex);  // candidate holding the triangle
+  for (LO ci = 0; ci < static_cast<LO>(candidates.size()); ++ci) {
+    const Candidate& c = candidates[ci];
+    if (mate[c.t1] != kNoIndex || mate[c.t2] != kNoIndex) continue;
+    mate[c.t1] = mate[c.t2] = ci;
   }
+  if (options.augment_depth > 0) augment(candidates, options, mate);
+  for (LO ci = 0; ci < static_cast<LO>(candidates.size()); ++ci)
+    if (mate[candidates[ci].t1] == ci) out.quads.push_back(candidates[ci].quad);
   for (LO t = 0; t < nt; ++t)
-    if (!used[t]) out.triangles.push_back(mesh.triangles[t]);
+    if (mate[t] == kNoIndex) out.triangles.push_back(mesh.triangles[t]);
 
   if (stats) {
     *stats = {};

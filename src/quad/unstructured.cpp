@@ -4,6 +4,7 @@
 #include <limits>
 
 #include "qsmesh/core/error.hpp"
+#include "qsmesh/mesh/delaunay.hpp"
 #include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/quad/subdivide.hpp"
 #include "qsmesh/smooth/smooth.hpp"
@@ -19,40 +20,88 @@ double min_sicn(const mesh::FaceMesh& m) {
   return m.quads.empty() ? -1.0 : worst;
 }
 
+bool valid(const mesh::FaceMesh& m) { return !m.quads.empty() && min_sicn(m) > 0; }
+
+// Sec. 5.1-5.2: frontal points, their triangulation, recombination along the cross, subdivision.
+// Returns an empty mesh when neither the recombined nor the plain subdivided triangles are valid.
+mesh::FaceMesh frontal_quads(const cad::CadModel& model, LO f, const cad::FaceGeometry& surface,
+                             std::span<const mesh::CurveMesh> halved, std::span<const mesh::CurveMesh> full,
+                             const FaceFields& fields, const UnstructuredOptions& options,
+                             UnstructuredReport& rep) {
+  const FaceGuide guide(*fields.background, *fields.cross_field, fields.sizes);
+  const auto loops = background::face_boundary(model, f, surface, halved);
+  const std::vector<Vec2> points = frontal_points(surface, loops, guide, options.frontal);
+  rep.frontal_points = static_cast<std::int64_t>(points.size());
+  const double factor = options.frontal.spacing_factor;
+  const mesh::SizeFunction size = [&](const Vec2& uv, const Vec3&) { return factor * guide.at(uv).size; };
+  mesh::TriangulateOptions to;
+  to.interior_points = points;
+  to.refine = false;
+  mesh::FaceMesh tri = mesh::triangulate_face(surface, model.faces()[f].reversed, loops, size, to);
+  tri.face = f;
+  for (auto& vc : tri.vclass)
+    if (vc.dim == 2) vc.entity = f;
+  std::vector<std::array<Vec3, 2>> directions;
+  directions.reserve(tri.triangles.size());
+  for (const auto& t : tri.triangles)
+    directions.push_back(guide.at((tri.uv[t[0]] + tri.uv[t[1]] + tri.uv[t[2]]) / 3.0).cross);
+  RecombineStats rs;
+  mesh::FaceMesh out = subdivide(recombine(tri, directions, options.recombine, &rs), surface, full);
+  if (valid(out)) return out;
+  rep.fell_back = true;
+  out = subdivide(tri, surface, full);
+  if (valid(out)) return out;
+  return {};
+}
+
 }  // namespace
 
 mesh::FaceMesh mesh_face_unstructured(const cad::CadModel& model, LO f, std::span<const mesh::CurveMesh> halved,
-                                      std::span<const mesh::CurveMesh> full, const UnstructuredOptions& options,
-                                      UnstructuredReport* report) {
+                                      std::span<const mesh::CurveMesh> full, const FaceFields& fields,
+                                      const UnstructuredOptions& options, UnstructuredReport* report) {
   UnstructuredReport local;
   UnstructuredReport& rep = report != nullptr ? *report : local;
   rep = UnstructuredReport{};
   const ErrorContext context{"unstructured", 2, f};
-  // The triangles become quads of half their size by subdivision: mesh at twice the size, with
-  // half the edges per turn on curved geometry.
-  background::BackgroundOptions tri_options;
-  tri_options.sizes.size = 2 * options.size;
-  tri_options.sizes.edges_per_turn = 8;
-  background::FaceReport tri_report;
-  const mesh::FaceMesh tri = background::mesh_face_background(model, f, halved, tri_options, &tri_report);
-  if (!tri_report.ok) {
-    rep.error = tri_report.error;
-    mesh::FaceMesh empty;
-    empty.face = f;
-    return empty;
-  }
   try {
     const auto surface = model.face_geometry(f);
     mesh::FaceMesh out;
-    try {
-      out = subdivide(recombine(tri, {}, options.recombine), *surface, full);
-    } catch (const Error& e) {
-      rep.error = e.with_context(context).what();
+    const bool want_frontal = options.use_frontal;
+    if (want_frontal && fields.background != nullptr && fields.cross_field != nullptr && !fields.sizes.empty()) {
+      try {
+        out = frontal_quads(model, f, *surface, halved, full, fields, options, rep);
+        rep.frontal = !out.quads.empty();
+      } catch (const Error& e) {
+        rep.error = e.with_context(context).what();
+      }
     }
-    if (out.quads.empty() || min_sicn(out) <= 0) {
-      // Subdividing the triangles alone always gives quads; recombination is what may fold one.
-      rep.fell_back = true;
-      out = subdivide(tri, *surface, full);
+    if (!rep.frontal) {
+      // Fallback path: the kernel's own refinement at a uniform size. The triangles become quads
+      // of half their size by subdivision: mesh at twice the size, with half the edges per turn
+      // on curved geometry.
+      // A face that should have had the frontal path counts as fallen back whatever follows.
+      rep.fell_back = want_frontal;
+      background::BackgroundOptions tri_options;
+      tri_options.sizes.size = 2 * options.size;
+      tri_options.sizes.edges_per_turn = 8;
+      background::FaceReport tri_report;
+      const mesh::FaceMesh tri = background::mesh_face_background(model, f, halved, tri_options, &tri_report);
+      if (!tri_report.ok) {
+        rep.error = tri_report.error;
+        mesh::FaceMesh empty;
+        empty.face = f;
+        return empty;
+      }
+      try {
+        out = subdivide(recombine(tri, {}, options.recombine), *surface, full);
+      } catch (const Error& e) {
+        rep.error = e.with_context(context).what();
+      }
+      if (!valid(out)) {
+        // Subdividing the triangles alone always gives quads; recombination is what may fold one.
+        rep.fell_back = true;
+        out = subdivide(tri, *surface, full);
+      }
     }
     // Geometry optimisation (Sec. 5.3): measured before and after, rolled back if it hurts.
     smooth::SmoothStats smoothed;

@@ -59,6 +59,8 @@ TEST(Pack, RoundTripOfQuadReportsAndSizes) {
   r.error = "[unstructured] face 8: a quad is folded";
   r.sicn_min = -0.25;
   r.quads = 1234;
+  r.frontal = true;
+  r.frontal_points = 77;
   sizemap::FaceSizes sz;
   sz.s = {1, 2, 3};
   sz.s_min = {0.5, 2, 3};
@@ -76,6 +78,8 @@ TEST(Pack, RoundTripOfQuadReportsAndSizes) {
   EXPECT_EQ(r2.error, r.error);
   EXPECT_EQ(r2.sicn_min, -0.25);
   EXPECT_EQ(r2.quads, 1234);
+  EXPECT_TRUE(r2.frontal);
+  EXPECT_EQ(r2.frontal_points, 77);
   EXPECT_EQ(sz2.s, sz.s);
   EXPECT_EQ(sz2.s_min, sz.s_min);
   EXPECT_TRUE(sz2.s_cf.empty());

@@ -37,6 +37,16 @@ struct TriangulateOptions {
   std::int64_t max_points = 5'000'000;
   /// Triangles whose smallest 3D angle is below this (degrees) are refined when possible.
   double min_angle_deg = 25.0;
+  /// Interior points (u, v) inserted in this order after the boundary, before any refinement
+  /// (paper 000 Sec. 5.1: the frontal points), each by a metric Delaunay cavity. A point outside
+  /// the face, on an existing vertex or edge of the boundary, closer than half size(x) to a cavity
+  /// vertex or hugging a boundary segment is skipped (counted in TriangulateStats::rejected).
+  /// The span must stay valid during the call.
+  std::span<const Vec2> interior_points;
+  /// false: no size-driven refinement; the output has the boundary points, the accepted interior
+  /// points and only the final quality clean-up (flips on 3D angles, moves of badly placed interior
+  /// vertices). The size function then only sets the spacing tests and the pole fans.
+  bool refine = true;
 };
 
 /// Statistics of a triangulation run.

@@ -17,6 +17,12 @@ struct RecombineOptions {
   /// sicn * (1 - w + w * alignment), alignment in [0, 1] (1: every edge along a cross branch,
   /// 0: every edge at 45 degrees). Ignored when no directions are given.
   double alignment_weight = 0.5;
+  /// After the greedy pass, triangles left alone are paired by augmenting paths of at most this
+  /// many re-paired quads (0: greedy only). Each lone triangle becomes an irregular vertex after
+  /// midpoint subdivision.
+  int augment_depth = 0;
+  /// Quads that augmenting paths may form must have at least this SICN.
+  double augment_min_sicn = 0.3;
 };
 
 struct RecombineStats {
@@ -30,7 +36,9 @@ struct RecombineStats {
 /// crossed) is a candidate quad, scored by its SICN (Eq. 12, mesh::quad_sicn on the 3D points),
 /// weighted by its alignment with the cross field when `directions` is not empty. Candidates are
 /// selected greedily, best score first (ties: smaller triangle ids first), when both triangles are
-/// still free and the SICN is above options.min_sicn.
+/// still free and the SICN is above options.min_sicn; then, with options.augment_depth > 0, lone
+/// triangles are paired along augmenting paths (breadth first from each lone triangle in id order,
+/// through candidates with SICN >= options.augment_min_sicn).
 /// `directions`: empty, or one entry per triangle of `mesh`: two unit tangent vectors (the two
 /// branches of the cross; the other two are their opposites).
 /// Returns the mesh with the same vertices (points, uv, classification unchanged), the input quads

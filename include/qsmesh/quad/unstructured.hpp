@@ -1,7 +1,9 @@
-// The unstructured all-quad mesh of one CAD face (paper 000 Sec. 5): triangulation of the face on
-// the halved quantized curve meshes, triangle recombination, midpoint subdivision onto the full
-// curve meshes, smoothing (Sec. 5.3). Not yet the cross-field-guided frontal insertion of Sec. 5.1: the triangulation is
-// the Delaunay kernel's frontal refinement with sizes graded from the curve meshes.
+// The unstructured all-quad mesh of one CAD face (paper 000 Sec. 5): cross-field-guided frontal
+// point insertion on the halved quantized curve meshes (Sec. 5.1) and their Delaunay
+// triangulation, triangle recombination weighted by the cross-field alignment (Sec. 5.2), midpoint
+// subdivision onto the full curve meshes, smoothing (Sec. 5.3). Faces without a cross field (or
+// where that path fails or folds a quad) take the Delaunay kernel's own refinement at a uniform
+// size instead.
 #pragma once
 
 #include <span>
@@ -9,20 +11,41 @@
 
 #include "qsmesh/background/face_mesh.hpp"
 #include "qsmesh/cad/model.hpp"
+#include "qsmesh/crossfield/cross_field.hpp"
 #include "qsmesh/mesh/surface_mesh.hpp"
+#include "qsmesh/quad/frontal.hpp"
 #include "qsmesh/quad/recombine.hpp"
 
 namespace qsmesh::quad {
 
 struct UnstructuredOptions {
-  double size = 0;  ///< largest final edge length (model units, > 0); the triangulation uses twice it
-  RecombineOptions recombine;
+  /// Largest final edge length (model units, > 0): the uniform size of the fallback path, whose
+  /// triangulation uses twice it.
+  double size = 0;
+  /// Frontal insertion (Sec. 5.1); its spacing_factor (2) turns the size map into the spacing of
+  /// the halved triangulation.
+  FrontalOptions frontal;
+  bool use_frontal = true;  ///< false: always the fallback path
+  /// Recombination (Sec. 5.2): greedy, then augmenting paths pair the triangles left alone.
+  RecombineOptions recombine{.augment_depth = 30, .augment_min_sicn = 0.1};
+};
+
+/// What the frontal path reads for one face, from the earlier stages (all from the same face).
+struct FaceFields {
+  const mesh::FaceMesh* background = nullptr;               ///< background triangulation
+  const crossfield::FaceCrossField* cross_field = nullptr;  ///< its cross field (null: none)
+  std::span<const double> sizes;                            ///< size map per background vertex
 };
 
 /// What happened on one face.
 struct UnstructuredReport {
   bool ok = false;          ///< an all-quad mesh with every quad valid (SICN > 0)
-  bool fell_back = false;   ///< recombination failed or folded a quad: every triangle was subdivided instead
+  /// The face did not get the intended method: the frontal path was wanted (options.use_frontal)
+  /// but the face has no fields or the path failed, or recombination failed or folded a quad and
+  /// every triangle was subdivided instead.
+  bool fell_back = false;
+  bool frontal = false;     ///< the mesh comes from the frontal triangulation (else the fallback path)
+  std::int64_t frontal_points = 0;  ///< interior points the frontal insertion placed
   std::string error;        ///< the error met, with stage and face id
   double sicn_min = 0;      ///< of the face's quads
   std::int64_t quads = 0;
@@ -30,11 +53,17 @@ struct UnstructuredReport {
 
 /// All-quad mesh of face f. `halved`: curve meshes with half the final edge counts (quantize::
 /// place_vertices(..., halved=true)); `full`: the final curve meshes, whose odd vertices the
-/// subdivision uses on the boundary. Never throws for a face-level failure: the report says what
-/// happened and an empty mesh is returned when nothing valid could be made.
+/// subdivision uses on the boundary. `fields`: the face's background mesh, cross field and size
+/// map; with all three (and options.use_frontal) the triangulation is the frontal one (Sec. 5.1,
+/// spacing options.frontal.spacing_factor x size map) and the recombination is weighted by the
+/// cross at each triangle. If that path throws, or neither its recombined nor its subdivided
+/// triangles give valid quads, the face falls back to the Delaunay refinement at uniform size 2 x
+/// options.size. Never throws for a face-level failure: the report says what happened and an
+/// empty mesh is returned when nothing valid could be made.
 [[nodiscard]] mesh::FaceMesh mesh_face_unstructured(const cad::CadModel& model, LO f,
                                                     std::span<const mesh::CurveMesh> halved,
                                                     std::span<const mesh::CurveMesh> full,
+                                                    const FaceFields& fields,
                                                     const UnstructuredOptions& options,
                                                     UnstructuredReport* report);
 

@@ -1,0 +1,238 @@
+// Frontal point insertion guided by the cross field (paper 000 Sec. 5.1) and the unstructured
+// quad stage built on it (Sec. 5.2).
+#include <gtest/gtest.h>
+
+#include <BRepBuilderAPI_MakeEdge.hxx>
+#include <BRepBuilderAPI_MakeFace.hxx>
+#include <BRepBuilderAPI_MakePolygon.hxx>
+#include <BRepBuilderAPI_MakeWire.hxx>
+#include <BRepTools.hxx>
+#include <TopoDS_Shape.hxx>
+#include <TopoDS_Wire.hxx>
+#include <TopoDS_Face.hxx>
+#include <cmath>
+#include <cstdio>
+#include <gp_Ax2.hxx>
+#include <gp_Circ.hxx>
+#include <gp_Pnt.hxx>
+#include <stdexcept>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "qsmesh/background/curve_mesh.hpp"
+#include "qsmesh/background/face_mesh.hpp"
+#include "qsmesh/crossfield/cross_field.hpp"
+#include "qsmesh/mesh/quality.hpp"
+#include "qsmesh/quad/frontal.hpp"
+#include "qsmesh/quad/unstructured.hpp"
+#include "qsmesh/quantize/quantize.hpp"
+
+namespace qsmesh::quad {
+namespace {
+
+std::string tmp(const std::string& name) { return std::string(QSMESH_TEST_TMP_DIR) + "/" + name; }
+
+cad::CadModel load_shape(const TopoDS_Shape& shape, const std::string& name) {
+  const std::string path = tmp(name);
+  if (!BRepTools::Write(shape, path.c_str())) throw std::runtime_error("cannot write " + path);
+  return cad::load_cad(path);
+}
+
+cad::CadModel rectangle(double w, double h) {
+  BRepBuilderAPI_MakePolygon poly;
+  for (const auto& [x, y] : std::vector<std::pair<double, double>>{{0, 0}, {w, 0}, {w, h}, {0, h}})
+    poly.Add(gp_Pnt(x, y, 0));
+  poly.Close();
+  BRepBuilderAPI_MakeFace face(poly.Wire(), /*OnlyPlane=*/true);
+  if (!face.IsDone()) throw std::runtime_error("face construction failed");
+  return load_shape(face.Shape(), "fr_rect.brep");
+}
+
+cad::CadModel disk(double r) {
+  const gp_Circ c(gp_Ax2(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), r);
+  const TopoDS_Wire w = BRepBuilderAPI_MakeWire(BRepBuilderAPI_MakeEdge(c).Edge()).Wire();
+  return load_shape(BRepBuilderAPI_MakeFace(w).Face(), "fr_disk.brep");
+}
+
+// What the pipeline hands the quad stage for face 0 with a uniform size map `size`: the curve
+// meshes at the final size (full) and at twice it (halved), the background mesh and its cross field.
+struct Prepared {
+  std::vector<mesh::CurveMesh> full, halved;
+  mesh::FaceMesh background;
+  crossfield::FaceCrossField cf;
+  std::vector<double> sizes;
+};
+
+Prepared prepare(const cad::CadModel& model, double size) {
+  const TaskArena tasks(1);
+  background::BackgroundOptions options;
+  options.sizes.size = size;
+  const auto bg = background::mesh_curves(model, options.sizes, tasks);
+  std::vector<std::vector<double>> sizes;
+  for (const auto& m : bg) sizes.emplace_back(m.points.size(), size);
+  quantize::QuantizeOptions qo;
+  qo.halved_minimums = true;
+  const auto q = quantize::quantize_curves(model, quantize::ideal_edge_counts(bg, sizes), qo);
+  Prepared p;
+  p.full = quantize::place_vertices(model, bg, sizes, q, false, tasks);
+  p.halved = quantize::place_vertices(model, bg, sizes, q, true, tasks);
+  background::FaceReport report;
+  p.background = background::mesh_face_background(model, 0, bg, options, &report);
+  EXPECT_TRUE(report.ok) << report.error;
+  p.cf = crossfield::compute_face_cross_field(p.background, {}, nullptr);
+  p.sizes.assign(p.background.points.size(), size);
+  return p;
+}
+
+// Interior vertices (dim 2) whose number of quads is not 4.
+std::vector<LO> irregular_interior(const mesh::FaceMesh& m) {
+  std::vector<int> valence(m.points.size(), 0);
+  for (const auto& q : m.quads)
+    for (LO v : q) ++valence[v];
+  std::vector<LO> out;
+  for (LO v = 0; v < m.num_vertices(); ++v)
+    if (m.vclass[v].dim == 2 && valence[v] != 4) out.push_back(v);
+  return out;
+}
+
+double sicn_min(const mesh::FaceMesh& m) {
+  double worst = 1;
+  for (const auto& q : m.quads)
+    worst = std::min(worst, mesh::quad_sicn({m.points[q[0]], m.points[q[1]], m.points[q[2]], m.points[q[3]]}));
+  return worst;
+}
+
+mesh::FaceMesh run_face(const cad::CadModel& model, const Prepared& p, UnstructuredReport& rep) {
+  FaceFields fields{&p.background, &p.cf, p.sizes};
+  UnstructuredOptions options;
+  options.size = p.sizes.front();
+  return mesh_face_unstructured(model, 0, p.halved, p.full, fields, options, &rep);
+}
+
+TEST(FaceGuide, InterpolatesTheSizeAndFindsTheCross) {
+  const auto model = rectangle(4, 3);
+  Prepared p = prepare(model, 0.5);
+  // A size growing with x: the guide must return the linear interpolant exactly on a plane.
+  for (LO v = 0; v < p.background.num_vertices(); ++v) p.sizes[v] = 0.2 + 0.1 * p.background.points[v].x;
+  const FaceGuide guide(p.background, p.cf, p.sizes);
+  const auto surface = model.face_geometry(0);
+  for (std::size_t t = 0; t < p.background.triangles.size(); t += 7) {
+    const auto& T = p.background.triangles[t];
+    const Vec2 uv = (p.background.uv[T[0]] * 0.2 + p.background.uv[T[1]] * 0.3 + p.background.uv[T[2]] * 0.5);
+    const Vec3 x = surface->eval(uv).p;
+    const FaceGuide::Sample s = guide.at(uv);
+    EXPECT_TRUE(s.found);
+    EXPECT_NEAR(s.size, 0.2 + 0.1 * x.x, 1e-9);
+    // Axis-aligned cross on a rectangle.
+    for (const Vec3& d : s.cross) EXPECT_GT(std::max(std::abs(d.x), std::abs(d.y)), 0.999);
+  }
+  Box2 box;
+  for (const Vec2& uv : p.background.uv) box.add(uv);
+  EXPECT_FALSE(guide.at(box.hi + Vec2{1, 1}).found);
+  const auto [lo, hi] = guide.size_range();
+  EXPECT_NEAR(lo, 0.2, 1e-9);
+  EXPECT_NEAR(hi, 0.6, 1e-9);
+}
+
+TEST(Frontal, PointsRespectTheMinimumSpacingAndAreDeterministic) {
+  const auto model = disk(3);
+  const Prepared p = prepare(model, 0.4);
+  const FaceGuide guide(p.background, p.cf, p.sizes);
+  const auto surface = model.face_geometry(0);
+  const auto loops = background::face_boundary(model, 0, *surface, p.halved);
+  FrontalOptions options;
+  FrontalStats stats;
+  const std::vector<Vec2> pts = frontal_points(*surface, loops, guide, options, &stats);
+  ASSERT_GT(pts.size(), 20U);
+  EXPECT_EQ(stats.accepted, static_cast<std::int64_t>(pts.size()));
+  EXPECT_GT(stats.too_close, 0);
+  std::vector<Vec3> all;
+  for (const auto& L : loops)
+    for (const auto& b : L.points) all.push_back(b.xyz);
+  const std::size_t nb = all.size();
+  for (const Vec2& uv : pts) {
+    EXPECT_LT(uv.u * uv.u + uv.v * uv.v, 9.0) << "point outside the disk";
+    all.push_back(surface->eval(uv).p);
+  }
+  const double spacing = options.spacing_factor * 0.4;
+  double closest = 1e300;
+  for (std::size_t i = nb; i < all.size(); ++i)
+    for (std::size_t j = 0; j < i; ++j) closest = std::min(closest, distance(all[i], all[j]));
+  EXPECT_GE(closest, options.min_distance * spacing * (1 - 1e-9));
+  // The disk is covered: about area / spacing^2 points.
+  const double expected = 3.14159 * 9 / (spacing * spacing);
+  EXPECT_GT(static_cast<double>(pts.size() + nb), 0.7 * expected);
+  EXPECT_EQ(pts, frontal_points(*surface, loops, guide, options));
+}
+
+TEST(Unstructured, RectangleWithAxisAlignedFieldGivesARegularGrid) {
+  const auto model = rectangle(6, 4);
+  const Prepared p = prepare(model, 0.25);
+  UnstructuredReport rep;
+  const mesh::FaceMesh m = run_face(model, p, rep);
+  EXPECT_TRUE(rep.ok) << rep.error;
+  EXPECT_TRUE(rep.frontal) << rep.error;
+  EXPECT_FALSE(rep.fell_back);
+  EXPECT_TRUE(m.triangles.empty());
+  const auto irr = irregular_interior(m);
+  std::printf("[frontal] rectangle: %zu quads, %zu irregular interior vertices, SICN min %.3f\n",
+              m.quads.size(), irr.size(), sicn_min(m));
+  EXPECT_EQ(irr.size(), 0U);
+  EXPECT_GT(sicn_min(m), 0.9);
+  EXPECT_NEAR(static_cast<double>(m.quads.size()), 24.0 * 16.0, 1.0);
+}
+
+TEST(Unstructured, DiskHasIrregularVerticesAtTheSingularitiesAndFewerThanWithoutTheField) {
+  const auto model = disk(3);
+  const double size = 0.15;
+  const Prepared p = prepare(model, size);
+  UnstructuredReport rep;
+  const mesh::FaceMesh m = run_face(model, p, rep);
+  EXPECT_TRUE(rep.ok) << rep.error;
+  EXPECT_TRUE(rep.frontal) << rep.error;
+  const auto irr = irregular_interior(m);
+  std::size_t near = 0;
+  for (LO v : irr) {
+    double d = 1e300;
+    for (const auto& s : p.cf.singularities) d = std::min(d, distance(s.position, m.points[v]));
+    near += d < 4 * 2 * size ? 1 : 0;
+  }
+  std::printf("[frontal] disk: %zu quads, %zu irregular interior vertices (%zu near the %zu singularities), "
+              "SICN min %.3f\n", m.quads.size(), irr.size(), near, p.cf.singularities.size(), sicn_min(m));
+  EXPECT_EQ(p.cf.singularities.size(), 4U);
+  // Every singularity of the field shows up as an irregular vertex nearby (the others come from
+  // fronts meeting).
+  for (const auto& sing : p.cf.singularities) {
+    double d = 1e300;
+    for (LO v : irr) d = std::min(d, distance(sing.position, m.points[v]));
+    EXPECT_LT(d, 4 * 2 * size) << "no irregular vertex near a singularity";
+  }
+  EXPECT_GT(sicn_min(m), 0.3);
+  // Against the same face meshed without the cross field (Delaunay refinement at uniform size,
+  // recombination without alignment): fewer irregular vertices.
+  UnstructuredOptions options;
+  options.size = size;
+  UnstructuredReport plain_rep;
+  const mesh::FaceMesh plain = mesh_face_unstructured(model, 0, p.halved, p.full, FaceFields{}, options, &plain_rep);
+  const auto plain_irr = irregular_interior(plain);
+  std::printf("[frontal] disk without cross field: %zu quads, %zu irregular interior vertices\n", plain.quads.size(),
+              plain_irr.size());
+  EXPECT_LT(static_cast<double>(irr.size()), 0.8 * static_cast<double>(plain_irr.size()));
+}
+
+TEST(Unstructured, WithoutCrossFieldFallsBackToTheUniformPath) {
+  const auto model = rectangle(3, 2);
+  const Prepared p = prepare(model, 0.25);
+  UnstructuredOptions options;
+  options.size = 0.25;
+  UnstructuredReport rep;
+  const mesh::FaceMesh m = mesh_face_unstructured(model, 0, p.halved, p.full, FaceFields{}, options, &rep);
+  EXPECT_TRUE(rep.ok) << rep.error;
+  EXPECT_FALSE(rep.frontal);
+  EXPECT_TRUE(rep.fell_back);
+  EXPECT_GT(m.quads.size(), 0U);
+}
+
+}  // namespace
+}  // namespace qsmesh::quad
