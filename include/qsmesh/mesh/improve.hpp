@@ -19,6 +19,11 @@ struct ImproveOptions {
   double target_angle_deg = 20.0;
   /// Rounds of (flips, vertex moves).
   int rounds = 4;
+  /// Move interior vertices too (the flips alone are much cheaper: no surface projection).
+  bool move_vertices = true;
+  /// When the centroids do not help, search the tangent plane around the vertex (costly: surface
+  /// projections).
+  bool compass_search = true;
 };
 
 struct ImproveStats {
