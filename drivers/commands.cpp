@@ -168,6 +168,11 @@ std::string stats_json(const Arguments& args, const Session& session, const para
     for (const auto& q : r.quad_reports) frontal += q.frontal ? 1 : 0;
     j.value("faces_frontal", frontal);  // faces meshed by the frontal path (Sec. 5.1)
   }
+  if (!r.quasi_reports.empty()) {
+    std::int64_t by_pattern = 0;
+    for (const auto& q : r.quasi_reports) by_pattern += q.by_pattern ? 1 : 0;
+    j.value("faces_meshed_by_pattern", by_pattern);  // Sec. 6.1.2
+  }
   j.value("vertices", s.vertices);
   j.value("triangles", s.triangles);
   j.value("quads", s.quads);
@@ -209,6 +214,11 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
      << "  quads:      " << s.quads << "\n"
      << "  irregular interior vertices: " << s.irregular_interior << " of " << s.interior_vertices << "\n";
   if (s.quads > 0) os << "  SICN min/avg: " << s.sicn_min << " / " << s.sicn_avg << "\n";
+  if (!r.quasi_reports.empty()) {
+    std::int64_t by_pattern = 0;
+    for (const auto& q : r.quasi_reports) by_pattern += q.by_pattern ? 1 : 0;
+    os << "  faces meshed by patterns: " << by_pattern << " of " << model.num_faces() << "\n";
+  }
   if (s.triangles > 0) {
     os << "  triangle quality min/avg: " << s.tri_quality_min << " / " << s.tri_quality_avg << "\n"
        << "  smallest angle: " << s.min_angle_deg << " deg; triangles by smallest angle: "

@@ -17,6 +17,7 @@ const char* to_string(Stage s) {
   switch (s) {
     case Stage::Background: return "background";
     case Stage::Unstructured: return "unstructured";
+    case Stage::QuasiStructured: return "quasi-structured";
   }
   return "?";
 }
@@ -24,7 +25,8 @@ const char* to_string(Stage s) {
 Stage parse_stage(const std::string& name) {
   if (name == "background") return Stage::Background;
   if (name == "unstructured") return Stage::Unstructured;
-  throw InputError("--until: unknown stage '" + name + "' (valid: background, unstructured)");
+  if (name == "quasi-structured") return Stage::QuasiStructured;
+  throw InputError("--until: unknown stage '" + name + "' (valid: background, unstructured, quasi-structured)");
 }
 
 std::vector<double> estimate_face_costs(const cad::CadModel& model, double size) {
@@ -186,6 +188,21 @@ void unpack(const std::vector<char>& in, std::size_t& pos, quad::UnstructuredRep
   r.quads = get<std::int64_t>(in, pos);
 }
 
+void pack(const QuasiReport& r, std::vector<char>& out) {
+  put<std::uint8_t>(out, r.by_pattern ? 1 : 0);
+  put_vec(out, std::vector<char>(r.pattern.begin(), r.pattern.end()));
+  put_vec(out, std::vector<char>(r.refusal.begin(), r.refusal.end()));
+}
+
+void unpack(const std::vector<char>& in, std::size_t& pos, QuasiReport& r) {
+  r.by_pattern = get<std::uint8_t>(in, pos) != 0;
+  std::vector<char> text;
+  get_vec(in, pos, text);
+  r.pattern.assign(text.begin(), text.end());
+  get_vec(in, pos, text);
+  r.refusal.assign(text.begin(), text.end());
+}
+
 PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
                             const PipelineOptions& options, const TaskArena& tasks, Logger& log,
                             linalg::PetscLane* lane) {
@@ -312,15 +329,42 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
   // curves, recombined, subdivided onto the full ones, smoothed. The background meshes stay
   // until every face of the rank is done; the quad meshes replace them afterwards.
   std::vector<quad::UnstructuredReport> quad_reports(quads ? mine.size() : 0);
+  const bool quasi = options.until >= Stage::QuasiStructured;
+  std::vector<QuasiReport> quasi_reports(quasi ? mine.size() : 0);
+  std::vector<mesh::FaceMesh> quad_meshes(quads ? mine.size() : 0);
+  if (quasi) {
+    // Simple CAD faces meshed directly by a pattern (paper 000 Sec. 6.1.2, pipeline step 4); the
+    // others go through the unstructured path below.
+    clock.reset();
+    const std::vector<qstruct::Pattern> patterns = qstruct::builtin_patterns();
+    std::atomic<std::int64_t> p_done{0};
+    tasks.parallel_for(total, [&](std::int64_t i) {
+      qstruct::PatternFaceReport pr;
+      mesh::FaceMesh m = qstruct::mesh_face_pattern(model, mine[i], result.quantized_curves, patterns,
+                                                    options.patterns, &pr);
+      if (pr.ok) {
+        quasi_reports[i].by_pattern = true;
+        quasi_reports[i].pattern = pr.pattern_name;
+        quad_reports[i].ok = true;
+        quad_reports[i].sicn_min = pr.sicn_min;
+        quad_reports[i].quads = pr.quads;
+        quad_meshes[i] = std::move(m);
+      } else {
+        quasi_reports[i].refusal = qstruct::to_string(pr.refusal);
+      }
+      const std::int64_t n = ++p_done;
+      if (n * 10 / total != (n - 1) * 10 / total)
+        log.info(cat("patterns: ", n, "/", mine.size(), " faces on rank ", rank));
+    });
+    result.times.add("patterns", comm.allreduce_max(clock.seconds()));
+  }
   if (quads) {
     clock.reset();
     const std::vector<mesh::CurveMesh> halved = quantize::place_vertices(
         model, curves, result.curve_sizes.at, result.quantization, /*halved=*/true, tasks);
     quad::UnstructuredOptions qo;
     qo.size = options.background.sizes.size;
-    std::atomic<std::int64_t> q_done{0};
-    std::vector<mesh::FaceMesh> quad_meshes(mine.size());
-    tasks.parallel_for(total, [&](std::int64_t i) {
+    auto mesh_unstructured = [&](std::int64_t i) {
       quad::FaceFields face_fields;
       if (reports[i].ok && full[i] != nullptr) {
         face_fields.background = &meshes[i];
@@ -329,6 +373,10 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
       }
       quad_meshes[i] = quad::mesh_face_unstructured(model, mine[i], halved, result.quantized_curves, face_fields, qo,
                                                     &quad_reports[i]);
+    };
+    std::atomic<std::int64_t> q_done{0};
+    tasks.parallel_for(total, [&](std::int64_t i) {
+      if (!(quasi && quasi_reports[i].by_pattern)) mesh_unstructured(i);
       const std::int64_t n = ++q_done;
       if (n * 10 / total != (n - 1) * 10 / total)
         log.info(cat("unstructured: ", n, "/", mine.size(), " faces on rank ", rank));
@@ -345,6 +393,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     if (options.cross_fields) pack(fields[i], buffer);
     if (size_map) pack(sizes[i], buffer);
     if (quads) pack(quad_reports[i], buffer);
+    if (quasi) pack(quasi_reports[i], buffer);
   }
   meshes.clear();
   const auto gathered = comm.gather_bytes(buffer, 0);
@@ -354,6 +403,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     if (options.cross_fields) result.cross_fields.resize(static_cast<std::size_t>(nfaces));
     if (size_map) result.face_sizes.resize(static_cast<std::size_t>(nfaces));
     if (quads) result.quad_reports.resize(static_cast<std::size_t>(nfaces));
+    if (quasi) result.quasi_reports.resize(static_cast<std::size_t>(nfaces));
     for (const auto& bytes : gathered) {
       std::size_t pos = 0;
       while (pos < bytes.size()) {
@@ -367,6 +417,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
         if (options.cross_fields) unpack(bytes, pos, result.cross_fields[f]);
         if (size_map) unpack(bytes, pos, result.face_sizes[f]);
         if (quads) unpack(bytes, pos, result.quad_reports[f]);
+        if (quasi) unpack(bytes, pos, result.quasi_reports[f]);
       }
     }
     for (LO f = 0; f < nfaces; ++f) all[f].face = f;

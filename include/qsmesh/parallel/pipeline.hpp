@@ -9,6 +9,7 @@
 #include "qsmesh/background/face_mesh.hpp"
 #include "qsmesh/crossfield/cross_field.hpp"
 #include "qsmesh/quad/unstructured.hpp"
+#include "qsmesh/qstruct/face_pattern.hpp"
 #include "qsmesh/quantize/quantize.hpp"
 #include "qsmesh/sizemap/size_map.hpp"
 #include "qsmesh/cad/model.hpp"
@@ -20,8 +21,10 @@
 
 namespace qsmesh::parallel {
 
-/// Pipeline stages, in order. The quasi-structured stage (paper 000 Sec. 6) comes next.
-enum class Stage { Background, Unstructured };
+/// Pipeline stages, in order. QuasiStructured (paper 000 Sec. 6): for now the simple CAD faces
+/// meshed by patterns (Sec. 6.1.2) before the unstructured path meshes the others; the cavity and
+/// disk remeshing of Sec. 6.2-6.3 come next.
+enum class Stage { Background, Unstructured, QuasiStructured };
 [[nodiscard]] const char* to_string(Stage s);
 /// Parses a stage name; throws InputError listing the valid names.
 [[nodiscard]] Stage parse_stage(const std::string& name);
@@ -37,6 +40,15 @@ struct PipelineOptions {
   bool size_map = false;
   sizemap::SizeMapOptions sizemap;
   quantize::QuantizeOptions quantize;
+  /// Stage::QuasiStructured: pattern meshing of simple CAD faces (Sec. 6.1.2).
+  qstruct::PatternFaceOptions patterns;
+};
+
+/// How the quasi-structured stage treated one face.
+struct QuasiReport {
+  bool by_pattern = false;  ///< meshed by a pattern (Sec. 6.1.2); else by the unstructured path
+  std::string pattern;      ///< the pattern's name when by_pattern
+  std::string refusal;      ///< why no pattern was kept (qstruct::to_string of the refusal)
 };
 
 
@@ -64,6 +76,7 @@ struct PipelineResult {
   quantize::Quantization quantization;          ///< curve edge counts (every rank)
   std::vector<mesh::CurveMesh> quantized_curves;  ///< final curve meshes (every rank)
   std::vector<quad::UnstructuredReport> quad_reports;  ///< by face, Stage::Unstructured (rank 0)
+  std::vector<QuasiReport> quasi_reports;  ///< by face, Stage::QuasiStructured (rank 0)
   std::vector<int> face_rank;                   ///< rank that meshed each face (every rank)
   StageTimes times;                             ///< wall time per stage (max over ranks)
 };
@@ -93,5 +106,7 @@ void unpack(const std::vector<char>& in, std::size_t& pos, sizemap::FaceSizes& s
 void pack(const quad::UnstructuredReport& r, std::vector<char>& out);
 void unpack(const std::vector<char>& in, std::size_t& pos, quad::UnstructuredReport& r);
 void unpack(const std::vector<char>& in, std::size_t& pos, CrossFieldOutput& c);
+void pack(const QuasiReport& r, std::vector<char>& out);
+void unpack(const std::vector<char>& in, std::size_t& pos, QuasiReport& r);
 
 }  // namespace qsmesh::parallel
