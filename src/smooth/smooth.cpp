@@ -9,6 +9,7 @@
 #include <utility>
 #include <vector>
 
+#include "internal.hpp"
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/core/timer.hpp"
 #include "qsmesh/linalg/solver.hpp"
@@ -118,22 +119,6 @@ const char* uv_discontinuity(const mesh::FaceMesh& m, const cad::FaceGeometry& s
     if (norm2(surface.normal(m.uv[v])) == 0) return "pole";
   }
   return nullptr;
-}
-
-// Orientation of the mesh against the face normal: +1 when quads turn counter-clockwise around it.
-double orientation(const mesh::FaceMesh& m, const cad::FaceGeometry& surface) {
-  double votes = 0;
-  for (const auto& q : m.quads) {
-    Vec3 s{};
-    for (int k = 0; k < 4; ++k)
-      s += cross(m.points[q[k]] - m.points[q[(k + 3) % 4]],
-                 m.points[q[(k + 1) % 4]] - m.points[q[k]]);
-    // The centroid uv of a quad along a seam may be meaningless; a vertex uv is not.
-    const Vec3 n = surface.normal(m.uv[q[0]]);
-    const double d = dot(s, n);
-    votes += d > 0 ? 1 : (d < 0 ? -1 : 0);
-  }
-  return votes >= 0 ? 1.0 : -1.0;
 }
 
 class Smoother {
@@ -331,7 +316,7 @@ mesh::FaceMesh smooth_face(const mesh::FaceMesh& input, const cad::FaceGeometry&
   const Stopwatch clock;
   if (!m.quads.empty()) {
     const Topology topo = build_topology(m);
-    Smoother sm(m, surface, topo, orientation(m, surface));
+    Smoother sm(m, surface, topo, detail::orientation(m, surface));
     const LO nq = static_cast<LO>(m.quads.size());
 
     if (options.laplacian_uv) {
