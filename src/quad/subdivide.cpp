@@ -309,6 +309,13 @@ mesh::FaceMesh subdivide(const mesh::FaceMesh& mesh, const cad::FaceGeometry& su
       uv = uv0 + s * (uv1 - uv0);
       const Vec2 proj = surface.project(p, uv, nullptr);
       if (norm(proj - uv) <= 0.25 * norm(uv1 - uv0)) uv = proj;
+      // A pole's uv is an arbitrary point of its degenerate line, so the interpolation is off
+      // along that line: search from the other end instead, keeping whichever uv lands nearer.
+      if (pole[a] != pole[b]) {
+        const Vec2 from = pole[a] != 0 ? mesh.uv[b] : mesh.uv[a];
+        const Vec2 alt = surface.project(p, from, nullptr);
+        if (distance(surface.eval(alt).p, p) < distance(surface.eval(uv).p, p)) uv = alt;
+      }
     } else if (j - i == 1) {
       // Edge of a degenerate curve (pole): another copy of the corner.
       vc = mesh.vclass[a];
