@@ -19,6 +19,9 @@ namespace {
 // compete for the minimum, which a plain max-min compass search cannot cross.
 constexpr double kTau = 0.02;
 constexpr int kLaplacianSweeps = 30;
+// Progress check: every kStallSweeps sweeps the patch's worst quad must have gained kStallGain.
+constexpr int kStallSweeps = 10;
+constexpr double kStallGain = 1e-3;
 
 struct Score {
   double soft = -std::numeric_limits<double>::infinity();  // soft minimum of the corner values
@@ -264,8 +267,10 @@ mesh::FaceMesh untangle_face(const mesh::FaceMesh& input, const cad::FaceGeometr
     st.patch_vertices = static_cast<std::int64_t>(patch.size());
     // Start from the tangent-plane Laplacian of the patch (its boundary fixed), which unfolds most
     // tangles inside a patch of reasonable shape, unless it makes the patch's worst quad worse.
+    int valid_sweeps = 0;
+    double last_worst = -std::numeric_limits<double>::infinity();
+    std::vector<LO> pq;  // quads of the patch
     {
-      std::vector<LO> pq;
       for (const LO v : patch) pq.insert(pq.end(), v2q[v].begin(), v2q[v].end());
       std::sort(pq.begin(), pq.end());
       pq.erase(std::unique(pq.begin(), pq.end()), pq.end());
@@ -295,6 +300,20 @@ mesh::FaceMesh untangle_face(const mesh::FaceMesh& input, const cad::FaceGeometr
       for (const LO v : patch) moved = un.search(v, &step[v], step_min[v]) || moved;
       ++st.sweeps;
       if (!moved) break;
+      // Once the patch is above the target, a few more sweeps lift its minimum; the rest is the
+      // smoother's job.
+      bool above = true;
+      for (const LO q : pq) above = above && un.quad_quality(q) > options.target;
+      valid_sweeps = above ? valid_sweeps + 1 : 0;
+      if (valid_sweeps > options.polish_sweeps) break;
+      // A patch whose worst quad stalls is left: a tangle that small moves cannot undo (e.g. quads
+      // wrapped around an edge too sharp for their size) would otherwise use every sweep.
+      if (st.sweeps % kStallSweeps == 0) {
+        double worst = std::numeric_limits<double>::infinity();
+        for (const LO q : pq) worst = std::min(worst, un.quad_quality(q));
+        if (!(worst > last_worst + kStallGain)) break;
+        last_worst = worst;
+      }
     }
     seed = seeds();
     if (rings >= options.max_rings) break;

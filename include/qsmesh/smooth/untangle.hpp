@@ -22,6 +22,8 @@ struct UntangleOptions {
   int max_rings = 8;
   /// Sweeps over the free vertices of a patch (each sweep gives every vertex one pattern search).
   int sweeps = 60;
+  /// Sweeps done after every quad of the patch is above `target` (lifting its minimum further).
+  int polish_sweeps = 5;
   /// Wall-clock bound on the whole call (0: none). When it stops a run early the result depends
   /// on timing; leave 0 where reproducibility matters (the iteration bounds always apply).
   double time_budget_s = 0;
