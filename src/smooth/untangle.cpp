@@ -216,7 +216,8 @@ mesh::FaceMesh untangle_face(const mesh::FaceMesh& input, const cad::FaceGeometr
   std::vector<LO> seed = seeds();
   st.seeds = static_cast<std::int64_t>(seed.size());
 
-  // Per-vertex step: a quarter of the shortest incident edge, kept across sweeps and patches.
+  // Per-vertex initial step: a quarter of the shortest incident edge (reset for each patch, kept
+  // across the sweeps of a patch).
   std::vector<double> step0(static_cast<std::size_t>(nv), 0.0), step_min(step0);
   for (LO v = 0; v < nv; ++v) {
     double shortest = std::numeric_limits<double>::infinity();
@@ -308,7 +309,7 @@ mesh::FaceMesh untangle_face(const mesh::FaceMesh& input, const cad::FaceGeometr
       if (valid_sweeps > options.polish_sweeps) break;
       // A patch whose worst quad stalls is left: a tangle that small moves cannot undo (e.g. quads
       // wrapped around an edge too sharp for their size) would otherwise use every sweep.
-      if (st.sweeps % kStallSweeps == 0) {
+      if ((sweep + 1) % kStallSweeps == 0) {
         double worst = std::numeric_limits<double>::infinity();
         for (const LO q : pq) worst = std::min(worst, un.quad_quality(q));
         if (!(worst > last_worst + kStallGain)) break;

@@ -48,13 +48,19 @@ struct UntangleStats {
 /// (orientation of the majority of the quads).
 ///
 /// Method: the patch is the set of free vertices within `rings` quad rings of the seed quads.
-/// Sweeps in vertex order over the patch; each vertex does a compass (pattern) search in the tangent
-/// plane of the surface at its position (8 directions, step from a quarter of its shortest incident
-/// edge, halved on failure), each trial mapped to (u, v) through the surface's first derivatives
-/// and evaluated exactly as S(u, v); a trial is taken when it raises the minimum quality of the
-/// vertex's quads, or keeps it and raises their sum. Trials stay inside the uv box of the input.
-/// Stops when a sweep moves nothing, after `sweeps`, or on the time budget; grows the patch while
-/// seeds remain. Every moved vertex ends on the surface at its uv (dim-2 vclass.param updated).
+///  1) Start: 30 Gauss-Seidel sweeps moving each patch vertex to the mean of its edge neighbours
+///     (in the tangent plane, mapped to (u, v) through the first derivatives), kept only when the
+///     worst quad of the patch gets better.
+///  2) Sweeps in vertex order over the patch; each vertex does a compass (pattern) search in the
+///     tangent plane at its position (8 directions, step from a quarter of its shortest incident
+///     edge, grown after a success, halved after a failure), each trial mapped to (u, v) and
+///     evaluated exactly as S(u, v). The score is a soft minimum (log-sum-exp, sharpness 0.02) of
+///     the Eq. 12 corner values of the vertex's quads; a trial is taken when it raises the score and
+///     makes no valid quad invalid. Trials stay inside the uv box of the input.
+///  3) A patch stops after a sweep that moves nothing, after `sweeps`, `polish_sweeps` sweeps after
+///     all its quads passed `target`, when its worst quad gained less than 1e-3 over 10 sweeps, or
+///     on the time budget; then the patch grows by `rings` while seeds remain, up to `max_rings`.
+/// Every moved vertex ends on the surface at its uv (dim-2 vclass.param updated).
 /// The result is returned only when its minimum SICN is larger than the input's and it has no
 /// more invalid quads; otherwise the input is returned (stats->rolled_back).
 /// Deterministic when time_budget_s is 0: no randomness, fixed order, no threads.
