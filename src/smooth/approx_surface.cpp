@@ -96,7 +96,9 @@ LO ApproxSurface::build(LO first, LO count, std::vector<Vec3>& centres) {
   }
   const Vec3 ext = cbox.hi - cbox.lo;
   const int axis = ext.x >= ext.y && ext.x >= ext.z ? 0 : (ext.y >= ext.z ? 1 : 2);
-  auto key = [&](LO t) { return axis == 0 ? centres[t].x : (axis == 1 ? centres[t].y : centres[t].z); };
+  auto key = [&](LO t) {
+    return axis == 0 ? centres[t].x : (axis == 1 ? centres[t].y : centres[t].z);
+  };
   const LO half = count / 2;
   std::nth_element(order_.begin() + first, order_.begin() + first + half,
                    order_.begin() + first + count, [&](LO a, LO b) {

@@ -1,5 +1,4 @@
 #include "internal.hpp"
-
 #include "qsmesh/mesh/quality.hpp"
 
 namespace qsmesh::smooth::detail {

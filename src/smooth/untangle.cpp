@@ -66,7 +66,8 @@ class Untangler {
       const Vec3 nq = norm2(ref) > 0 && dot(sum, ref) <= 0 ? normalized(ref) : normalized(sum);
       for (int k = 0; k < 4; ++k) {
         const Vec3& x = m_.points[qd[k]];
-        const double den = norm2(m_.points[qd[(k + 1) % 4]] - x) + norm2(m_.points[qd[(k + 3) % 4]] - x);
+        const double den =
+            norm2(m_.points[qd[(k + 1) % 4]] - x) + norm2(m_.points[qd[(k + 3) % 4]] - x);
         corner_.push_back(den > 0 && norm2(nq) > 0 ? 2.0 * dot(cr[k], nq) / den : -1.0);
       }
       sc.hard = std::min(sc.hard, quad_quality(q));

@@ -100,8 +100,8 @@ void expect_agrees_with_cad(const Case& c, int n, double offset, double tol, con
       (void)exact;
       worst = std::max(worst, distance(c.geometry->eval(hit.uv).p, foot));
     }
-  std::printf("%s: %d x %d quads, largest |S(uv_approx) - CAD foot| = %.3g (tolerance %.3g)\n", what,
-              n, n, worst, tol);
+  std::printf("%s: %d x %d quads, largest |S(uv_approx) - CAD foot| = %.3g (tolerance %.3g)\n",
+              what, n, n, worst, tol);
   EXPECT_LT(worst, tol);
 }
 
@@ -113,30 +113,31 @@ TEST(ApproxSurface, PlaneIsExact) {
 }
 
 TEST(ApproxSurface, CylinderAgreesWithCadProjection) {
-  const Case c = load_face(
-      BRepBuilderAPI_MakeFace(gp_Cylinder(gp_Ax3(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), 2.0), 0.0,
-                              std::numbers::pi, 0.0, 3.0)
-          .Face(),
-      "approx_cyl.brep");
+  const Case c =
+      load_face(BRepBuilderAPI_MakeFace(gp_Cylinder(gp_Ax3(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), 2.0),
+                                        0.0, std::numbers::pi, 0.0, 3.0)
+                    .Face(),
+                "approx_cyl.brep");
   // Chord sag of a 2 pi / 40 arc of radius 2: about 0.012; the uv error is of that order.
   expect_agrees_with_cad(c, 20, 0.2, 0.03, "cylinder 20");
   expect_agrees_with_cad(c, 40, 0.2, 0.008, "cylinder 40");
 }
 
 TEST(ApproxSurface, SpherePatchAgreesWithCadProjection) {
-  const Case c = load_face(BRepBuilderAPI_MakeFace(gp_Sphere(gp_Ax3(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), 3.0),
-                                                   0.2, 2.0, -0.8, 0.9)
-                               .Face(),
-                           "approx_sphere.brep");
+  const Case c =
+      load_face(BRepBuilderAPI_MakeFace(gp_Sphere(gp_Ax3(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), 3.0),
+                                        0.2, 2.0, -0.8, 0.9)
+                    .Face(),
+                "approx_sphere.brep");
   expect_agrees_with_cad(c, 24, 0.3, 0.03, "sphere patch");
 }
 
 TEST(ApproxSurface, SmoothingWithItKeepsPointsOnTheSurface) {
-  const Case c = load_face(
-      BRepBuilderAPI_MakeFace(gp_Cylinder(gp_Ax3(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), 2.0), 0.0,
-                              std::numbers::pi, 0.0, 3.0)
-          .Face(),
-      "approx_smooth.brep");
+  const Case c =
+      load_face(BRepBuilderAPI_MakeFace(gp_Cylinder(gp_Ax3(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), 2.0),
+                                        0.0, std::numbers::pi, 0.0, 3.0)
+                    .Face(),
+                "approx_smooth.brep");
   const auto in = grid(*c.geometry, c.model.faces()[0].uv_box, 14, 0.35);
   SmoothOptions o;
   o.laplacian_uv = false;
@@ -144,9 +145,9 @@ TEST(ApproxSurface, SmoothingWithItKeepsPointsOnTheSurface) {
   o.approximate_projection = true;
   SmoothStats st;
   const auto out = smooth_face(in, *c.geometry, o, &st);
-  std::printf("cylinder, approximate projection: SICN min %.4f -> %.4f, avg %.4f -> %.4f, %d passes\n",
-              st.before.sicn_min, st.after.sicn_min, st.before.sicn_avg, st.after.sicn_avg,
-              st.iterations);
+  std::printf(
+      "cylinder, approximate projection: SICN min %.4f -> %.4f, avg %.4f -> %.4f, %d passes\n",
+      st.before.sicn_min, st.after.sicn_min, st.before.sicn_avg, st.after.sicn_avg, st.iterations);
   // Same quality as with Gauss-Newton on the CAD surface (cells of aspect 2: SICN 0.8 at best).
   o.approximate_projection = false;
   SmoothStats exact;

@@ -40,7 +40,8 @@ mesh::FaceMesh grid(const cad::FaceGeometry& g, Box2 box, int n) {
   m.face = 0;
   for (int j = 0; j <= n; ++j)
     for (int i = 0; i <= n; ++i) {
-      const Vec2 uv{box.lo.u + (box.hi.u - box.lo.u) * i / n, box.lo.v + (box.hi.v - box.lo.v) * j / n};
+      const Vec2 uv{box.lo.u + (box.hi.u - box.lo.u) * i / n,
+                    box.lo.v + (box.hi.v - box.lo.v) * j / n};
       mesh::VertexClass c;
       const bool bi = i == 0 || i == n, bj = j == 0 || j == n;
       if (bi && bj) {
@@ -101,11 +102,12 @@ TEST(Untangle, FoldedPatchOnAPlaneBecomesValid) {
   fold(in, *c.geometry, box, 8, 5, 5, {0.3, -1.7});
   UntangleStats st;
   const auto out = untangle_face(in, *c.geometry, UntangleOptions{}, &st);
-  std::printf("plane: before min %.4f invalid %lld, after min %.4f invalid %lld, %lld seeds, %d "
-              "rings, %d sweeps\n",
-              st.before.sicn_min, static_cast<long long>(st.before.invalid), st.after.sicn_min,
-              static_cast<long long>(st.after.invalid), static_cast<long long>(st.seeds), st.rings,
-              st.sweeps);
+  std::printf(
+      "plane: before min %.4f invalid %lld, after min %.4f invalid %lld, %lld seeds, %d "
+      "rings, %d sweeps\n",
+      st.before.sicn_min, static_cast<long long>(st.before.invalid), st.after.sicn_min,
+      static_cast<long long>(st.after.invalid), static_cast<long long>(st.seeds), st.rings,
+      st.sweeps);
   EXPECT_GE(st.before.invalid, 4);
   EXPECT_EQ(st.after.invalid, 0);
   EXPECT_GT(st.after.sicn_min, 0.2);
@@ -117,11 +119,11 @@ TEST(Untangle, FoldedPatchOnAPlaneBecomesValid) {
 }
 
 TEST(Untangle, FoldedPatchOnACylinderBecomesValid) {
-  const Case c = load_face(
-      BRepBuilderAPI_MakeFace(gp_Cylinder(gp_Ax3(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), 2.0), 0.0,
-                              std::numbers::pi, 0.0, 3.0)
-          .Face(),
-      "untangle_cyl.brep");
+  const Case c =
+      load_face(BRepBuilderAPI_MakeFace(gp_Cylinder(gp_Ax3(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), 2.0),
+                                        0.0, std::numbers::pi, 0.0, 3.0)
+                    .Face(),
+                "untangle_cyl.brep");
   const Box2 box = c.model.faces()[0].uv_box;
   auto in = grid(*c.geometry, box, 10);
   fold(in, *c.geometry, box, 10, 4, 5, {1.5, 0.5});
@@ -166,11 +168,11 @@ TEST(Untangle, ImpossibleFoldIsRolledBack) {
 }
 
 TEST(Untangle, Deterministic) {
-  const Case c = load_face(
-      BRepBuilderAPI_MakeFace(gp_Cylinder(gp_Ax3(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), 2.0), 0.0,
-                              std::numbers::pi, 0.0, 3.0)
-          .Face(),
-      "untangle_det.brep");
+  const Case c =
+      load_face(BRepBuilderAPI_MakeFace(gp_Cylinder(gp_Ax3(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), 2.0),
+                                        0.0, std::numbers::pi, 0.0, 3.0)
+                    .Face(),
+                "untangle_det.brep");
   const Box2 box = c.model.faces()[0].uv_box;
   auto in = grid(*c.geometry, box, 8);
   fold(in, *c.geometry, box, 8, 3, 4, {1.5, 0.5});

@@ -24,10 +24,10 @@ class ApproxSurface {
   [[nodiscard]] static ApproxSurface from_mesh(const mesh::FaceMesh& mesh);
 
   struct Hit {
-    Vec3 point;                ///< closest point on the triangulation
-    Vec2 uv;                   ///< its (u, v), interpolated linearly in the triangle
-    LO triangle = kNoIndex;    ///< kNoIndex when the triangulation is empty
-    double distance = 0;       ///< |p - point|
+    Vec3 point;              ///< closest point on the triangulation
+    Vec2 uv;                 ///< its (u, v), interpolated linearly in the triangle
+    LO triangle = kNoIndex;  ///< kNoIndex when the triangulation is empty
+    double distance = 0;     ///< |p - point|
   };
   /// Closest point of the triangulation to p (exact on the triangles; ties broken by the lowest
   /// triangle index, so the answer is deterministic). The uv approximates the CAD projection of p

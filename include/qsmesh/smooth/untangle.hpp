@@ -31,12 +31,12 @@ struct UntangleOptions {
 
 struct UntangleStats {
   QualityReport before, after;
-  std::int64_t seeds = 0;     ///< quads at or below the target on input
+  std::int64_t seeds = 0;           ///< quads at or below the target on input
   std::int64_t patch_vertices = 0;  ///< free vertices of the last patch optimised
-  int rings = 0;              ///< rings of the last patch optimised (0: nothing to do)
-  int sweeps = 0;             ///< sweeps done, all patches together
-  bool rolled_back = false;   ///< the output is the input: the minimum SICN did not improve
-  bool timed_out = false;     ///< stopped by time_budget_s
+  int rings = 0;                    ///< rings of the last patch optimised (0: nothing to do)
+  int sweeps = 0;                   ///< sweeps done, all patches together
+  bool rolled_back = false;         ///< the output is the input: the minimum SICN did not improve
+  bool timed_out = false;           ///< stopped by time_budget_s
 };
 
 /// Untangles the quads of one face mesh.
@@ -55,8 +55,8 @@ struct UntangleStats {
 ///     tangent plane at its position (8 directions, step from a quarter of its shortest incident
 ///     edge, grown after a success, halved after a failure), each trial mapped to (u, v) and
 ///     evaluated exactly as S(u, v). The score is a soft minimum (log-sum-exp, sharpness 0.02) of
-///     the Eq. 12 corner values of the vertex's quads; a trial is taken when it raises the score and
-///     makes no valid quad invalid. Trials stay inside the uv box of the input.
+///     the Eq. 12 corner values of the vertex's quads; a trial is taken when it raises the score
+///     and makes no valid quad invalid. Trials stay inside the uv box of the input.
 ///  3) A patch stops after a sweep that moves nothing, after `sweeps`, `polish_sweeps` sweeps after
 ///     all its quads passed `target`, when its worst quad gained less than 1e-3 over 10 sweeps, or
 ///     on the time budget; then the patch grows by `rings` while seeds remain, up to `max_rings`.
