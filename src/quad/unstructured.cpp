@@ -7,6 +7,7 @@
 #include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/quad/subdivide.hpp"
 #include "qsmesh/smooth/smooth.hpp"
+#include "qsmesh/smooth/untangle.hpp"
 
 namespace qsmesh::quad {
 
@@ -43,20 +44,26 @@ mesh::FaceMesh mesh_face_unstructured(const cad::CadModel& model, LO f, std::spa
   }
   try {
     const auto surface = model.face_geometry(f);
+    // Geometry optimisation (Sec. 5.3), each step measured and rolled back if it hurts; the
+    // untangler only where a quad is still invalid.
+    const auto optimise = [&](mesh::FaceMesh m) {
+      m = smooth::smooth_face(m, *surface, smooth::SmoothOptions{});
+      if (min_sicn(m) <= 0) m = smooth::untangle_face(m, *surface, smooth::UntangleOptions{});
+      return m;
+    };
     mesh::FaceMesh out;
     try {
-      out = subdivide(recombine(tri, {}, options.recombine), *surface, full);
+      out = optimise(subdivide(recombine(tri, {}, options.recombine), *surface, full));
     } catch (const Error& e) {
       rep.error = e.with_context(context).what();
     }
     if (out.quads.empty() || min_sicn(out) <= 0) {
       // Subdividing the triangles alone always gives quads; recombination is what may fold one.
+      // The better of the two meshes is kept.
       rep.fell_back = true;
-      out = subdivide(tri, *surface, full);
+      mesh::FaceMesh alt = optimise(subdivide(tri, *surface, full));
+      if (out.quads.empty() || min_sicn(alt) > min_sicn(out)) out = std::move(alt);
     }
-    // Geometry optimisation (Sec. 5.3): measured before and after, rolled back if it hurts.
-    smooth::SmoothStats smoothed;
-    out = smooth::smooth_face(out, *surface, smooth::SmoothOptions{}, &smoothed);
     out.face = f;
     rep.quads = static_cast<std::int64_t>(out.quads.size());
     rep.sicn_min = min_sicn(out);
