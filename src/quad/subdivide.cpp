@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <utility>
 #include <tuple>
 #include <vector>
 
@@ -122,18 +124,114 @@ class BoundaryResolver {
   std::span<const mesh::CurveMesh> curves_;
 };
 
+
+// A boundary vertex X whose only element is a triangle (A, X, B) with both XA and XB on the
+// boundary keeps a single sub-quad after subdivision, with the boundary's angle at X: about 180
+// degrees where the boundary is straight, a quad that no smoothing can make valid (its corners
+// on the curve are fixed). Such triangles come in strips along slightly concave boundaries
+// (every vertex of the strip on the boundary). The strip is grown across its one interior edge
+// until a triangle with a vertex Z inside the face is reached, and the polygon is triangulated
+// again as a fan from Z: every boundary vertex of the strip then has two elements. Only done when
+// every fan triangle is oriented like the old ones in (u, v); the triangle count does not change.
+constexpr double kFlatBoundaryAngle = 2.8;  // radians (about 160 degrees)
+constexpr int kMaxStrip = 8;
+
+double uv_area(const mesh::FaceMesh& m, LO a, LO b, LO c) {
+  return cross(m.uv[b] - m.uv[a], m.uv[c] - m.uv[a]);
+}
+
+std::int64_t refan_flat_boundary_strips(const mesh::FaceMesh& m, const std::vector<std::array<LO, 4>>& quads,
+                                        std::vector<std::array<LO, 3>>& tris) {
+  using Edge = std::pair<LO, LO>;
+  std::map<Edge, int> uses;  // over all elements
+  for (const auto& q : quads)
+    for (int k = 0; k < 4; ++k) ++uses[std::minmax(q[k], q[(k + 1) % 4])];
+  for (const auto& t : tris)
+    for (int k = 0; k < 3; ++k) ++uses[std::minmax(t[k], t[(k + 1) % 3])];
+  std::map<Edge, std::vector<LO>> e2t;  // directed edge -> triangle
+  auto index = [&] {
+    e2t.clear();
+    for (LO t = 0; t < static_cast<LO>(tris.size()); ++t)
+      for (int k = 0; k < 3; ++k) e2t[{tris[t][k], tris[t][(k + 1) % 3]}].push_back(t);
+  };
+  index();
+  auto boundary = [&](LO a, LO b) { return uses[std::minmax(a, b)] == 1; };
+  std::int64_t done = 0;
+  for (LO t0 = 0; t0 < static_cast<LO>(tris.size()); ++t0) {
+    for (int k = 0; k < 3; ++k) {
+      const auto& t = tris[t0];
+      const LO a = t[k], x = t[(k + 1) % 3], b = t[(k + 2) % 3];
+      if (m.vclass[x].dim > 1 || !boundary(a, x) || !boundary(x, b)) continue;
+      const Vec3 xa = m.points[a] - m.points[x], xb = m.points[b] - m.points[x];
+      if (std::atan2(norm(cross(xa, xb)), dot(xa, xb)) < kFlatBoundaryAngle) continue;
+      const double sign = uv_area(m, a, x, b) > 0 ? 1.0 : -1.0;
+      // Grow the strip: polygon kept as a cycle; its one interior edge (p, q) is crossed.
+      std::vector<LO> strip{t0};
+      std::vector<LO> cycle{a, x, b};  // b -> a is the interior edge
+      LO z = kNoIndex;
+      while (static_cast<int>(strip.size()) < kMaxStrip) {
+        const LO p = cycle.back(), q = cycle.front();
+        const auto it = e2t.find({q, p});  // the neighbour runs the edge the other way
+        if (it == e2t.end() || it->second.size() != 1) break;
+        const LO tn = it->second.front();
+        const auto& tt = tris[tn];
+        int j = 0;
+        while (tt[j] != q) ++j;
+        const LO apex = tt[(j + 2) % 3];
+        strip.push_back(tn);
+        if (m.vclass[apex].dim == 2) {
+          z = apex;
+          break;
+        }
+        // A boundary apex: the strip goes on across whichever of its two new edges is interior.
+        const bool qa_in = !boundary(q, apex), ap_in = !boundary(apex, p);
+        if (qa_in == ap_in) break;
+        if (qa_in)
+          cycle.push_back(apex);  // ... p, apex | q ...: interior edge apex -> q
+        else
+          cycle.insert(cycle.begin(), apex);  // interior edge p -> apex
+      }
+      if (z == kNoIndex) continue;
+      // Fan from z over the cycle (q ... p), which closes through z.
+      std::vector<std::array<LO, 3>> fan;
+      bool ok = true;
+      for (std::size_t i = 0; i + 1 < cycle.size(); ++i) {
+        const std::array<LO, 3> f{cycle[i], cycle[i + 1], z};
+        if (!(sign * uv_area(m, f[0], f[1], f[2]) > 0)) ok = false;
+        fan.push_back(f);
+      }
+      if (!ok || fan.size() != strip.size()) continue;
+      std::sort(strip.begin(), strip.end());
+      for (std::size_t i = 0; i < strip.size(); ++i) tris[strip[i]] = fan[i];
+      // Interior edge counts: recount from scratch (strips are rare and small).
+      uses.clear();
+      for (const auto& q : quads)
+        for (int e = 0; e < 4; ++e) ++uses[std::minmax(q[e], q[(e + 1) % 4])];
+      for (const auto& tr : tris)
+        for (int e = 0; e < 3; ++e) ++uses[std::minmax(tr[e], tr[(e + 1) % 3])];
+      index();
+      ++done;
+      break;
+    }
+  }
+  return done;
+}
+
 }  // namespace
 
 mesh::FaceMesh subdivide(const mesh::FaceMesh& mesh, const cad::FaceGeometry& surface,
                          std::span<const mesh::CurveMesh> full_curves, SubdivideStats* stats) {
   // Elements: quads first, then triangles.
+  const std::vector<std::array<LO, 4>>& in_quads = mesh.quads;
+  std::vector<std::array<LO, 3>> in_tris = mesh.triangles;
+  const std::int64_t flat_splits = refan_flat_boundary_strips(mesh, in_quads, in_tris);
   std::vector<std::array<LO, 4>> elems;
   std::vector<int> sides;
-  for (const auto& q : mesh.quads) {
+  for (const auto& q : in_quads) {
     elems.push_back(q);
     sides.push_back(4);
   }
-  for (const auto& t : mesh.triangles) {
+  for (const auto& t : in_tris) {
     elems.push_back({t[0], t[1], t[2], kNoIndex});
     sides.push_back(3);
   }
@@ -211,6 +309,13 @@ mesh::FaceMesh subdivide(const mesh::FaceMesh& mesh, const cad::FaceGeometry& su
       uv = uv0 + s * (uv1 - uv0);
       const Vec2 proj = surface.project(p, uv, nullptr);
       if (norm(proj - uv) <= 0.25 * norm(uv1 - uv0)) uv = proj;
+      // A pole's uv is an arbitrary point of its degenerate line, so the interpolation is off
+      // along that line: search from the other end instead, keeping whichever uv lands nearer.
+      if (pole[a] != pole[b]) {
+        const Vec2 from = pole[a] != 0 ? mesh.uv[b] : mesh.uv[a];
+        const Vec2 alt = surface.project(p, from, nullptr);
+        if (distance(surface.eval(alt).p, p) < distance(surface.eval(uv).p, p)) uv = alt;
+      }
     } else if (j - i == 1) {
       // Edge of a degenerate curve (pole): another copy of the corner.
       vc = mesh.vclass[a];
@@ -299,6 +404,7 @@ mesh::FaceMesh subdivide(const mesh::FaceMesh& mesh, const cad::FaceGeometry& su
   if (stats) {
     stats->quads = static_cast<std::int64_t>(out.quads.size());
     stats->snaps_reverted = reverted;
+    stats->flat_boundary_splits = flat_splits;
   }
   return out;
 }

@@ -8,6 +8,7 @@
 #include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/quad/subdivide.hpp"
 #include "qsmesh/smooth/smooth.hpp"
+#include "qsmesh/smooth/untangle.hpp"
 
 namespace qsmesh::quad {
 
@@ -21,6 +22,15 @@ double min_sicn(const mesh::FaceMesh& m) {
 }
 
 bool valid(const mesh::FaceMesh& m) { return !m.quads.empty() && min_sicn(m) > 0; }
+
+// Geometry optimisation (Sec. 5.3) of one candidate mesh, each step measured and rolled back if it
+// hurts; the untangler only where a quad is still invalid.
+mesh::FaceMesh optimise(mesh::FaceMesh m, const cad::FaceGeometry& surface) {
+  if (m.quads.empty()) return m;
+  m = smooth::smooth_face(m, surface, smooth::SmoothOptions{});
+  if (min_sicn(m) <= 0) m = smooth::untangle_face(m, surface, smooth::UntangleOptions{});
+  return m;
+}
 
 // Sec. 5.1-5.2: frontal points, their triangulation, recombination along the cross, subdivision.
 // Returns an empty mesh when neither the recombined nor the plain subdivided triangles are valid.
@@ -50,10 +60,10 @@ mesh::FaceMesh frontal_quads(const cad::CadModel& model, LO f, const cad::FaceGe
   for (const auto& t : tri.triangles)
     directions.push_back(guide.at((tri.uv[t[0]] + tri.uv[t[1]] + tri.uv[t[2]]) / 3.0).cross);
   RecombineStats rs;
-  mesh::FaceMesh out = subdivide(recombine(tri, directions, options.recombine, &rs), surface, full);
+  mesh::FaceMesh out = optimise(subdivide(recombine(tri, directions, options.recombine, &rs), surface, full), surface);
   if (valid(out)) return out;
   rep.fell_back = true;
-  out = subdivide(tri, surface, full);
+  out = optimise(subdivide(tri, surface, full), surface);
   if (valid(out)) return out;
   return {};
 }
@@ -97,19 +107,18 @@ mesh::FaceMesh mesh_face_unstructured(const cad::CadModel& model, LO f, std::spa
         return empty;
       }
       try {
-        out = subdivide(recombine(tri, {}, options.recombine), *surface, full);
+        out = optimise(subdivide(recombine(tri, {}, options.recombine), *surface, full), *surface);
       } catch (const Error& e) {
         rep.error = e.with_context(context).what();
       }
       if (!valid(out)) {
         // Subdividing the triangles alone always gives quads; recombination is what may fold one.
+        // The better of the two meshes is kept.
         rep.fell_back = true;
-        out = subdivide(tri, *surface, full);
+        mesh::FaceMesh alt = optimise(subdivide(tri, *surface, full), *surface);
+        if (out.quads.empty() || min_sicn(alt) > min_sicn(out)) out = std::move(alt);
       }
     }
-    // Geometry optimisation (Sec. 5.3): measured before and after, rolled back if it hurts.
-    smooth::SmoothStats smoothed;
-    out = smooth::smooth_face(out, *surface, smooth::SmoothOptions{}, &smoothed);
     out.face = f;
     rep.quads = static_cast<std::int64_t>(out.quads.size());
     rep.sicn_min = min_sicn(out);

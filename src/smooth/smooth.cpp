@@ -5,14 +5,17 @@
 #include <limits>
 #include <map>
 #include <numbers>
+#include <optional>
 #include <tuple>
 #include <utility>
 #include <vector>
 
+#include "internal.hpp"
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/core/timer.hpp"
 #include "qsmesh/linalg/solver.hpp"
 #include "qsmesh/mesh/quality.hpp"
+#include "qsmesh/smooth/approx_surface.hpp"
 
 namespace qsmesh::smooth {
 
@@ -120,26 +123,15 @@ const char* uv_discontinuity(const mesh::FaceMesh& m, const cad::FaceGeometry& s
   return nullptr;
 }
 
-// Orientation of the mesh against the face normal: +1 when quads turn counter-clockwise around it.
-double orientation(const mesh::FaceMesh& m, const cad::FaceGeometry& surface) {
-  double votes = 0;
-  for (const auto& q : m.quads) {
-    Vec3 s{};
-    for (int k = 0; k < 4; ++k)
-      s += cross(m.points[q[k]] - m.points[q[(k + 3) % 4]],
-                 m.points[q[(k + 1) % 4]] - m.points[q[k]]);
-    // The centroid uv of a quad along a seam may be meaningless; a vertex uv is not.
-    const Vec3 n = surface.normal(m.uv[q[0]]);
-    const double d = dot(s, n);
-    votes += d > 0 ? 1 : (d < 0 ? -1 : 0);
-  }
-  return votes >= 0 ? 1.0 : -1.0;
-}
-
 class Smoother {
  public:
-  Smoother(mesh::FaceMesh& m, const cad::FaceGeometry& s, const Topology& t, double sign)
-      : m_(m), s_(s), t_(t), sign_(sign) {}
+  Smoother(mesh::FaceMesh& m, const cad::FaceGeometry& s, const Topology& t, double sign,
+           const ApproxSurface* approx)
+      : m_(m), s_(s), t_(t), sign_(sign), approx_(approx) {}
+
+  // Kernel targets go to the surface through the approximate surface when there is one, unless
+  // `exact` (then by Gauss-Newton on the CAD surface from the current uv).
+  void set_exact(bool exact) { exact_ = exact; }
 
   // SICN of a quad, -1 when it turns against the face normal (quad_sicn alone cannot see a quad
   // flipped as a whole, its normal being the average of its own corners).
@@ -177,7 +169,15 @@ class Smoother {
       Vec3 target;
       if (!kernel(v, x0, n, &target)) continue;
       Vec2 uv;
-      if (!to_uv(uv0, target, &uv)) continue;
+      if (approx_ != nullptr && !exact_) {
+        if (hint_.empty()) hint_.assign(m_.points.size(), kNoIndex);
+        const auto hit = approx_->closest(target, hint_[v]);
+        if (hit.triangle == kNoIndex) continue;
+        hint_[v] = hit.triangle;
+        uv = hit.uv;
+      } else if (!to_uv(uv0, target, &uv)) {
+        continue;
+      }
       const auto before = local_quality(v);
       m_.uv[v] = uv;
       m_.points[v] = s_.eval(uv).p;
@@ -266,6 +266,9 @@ class Smoother {
   const cad::FaceGeometry& s_;
   const Topology& t_;
   double sign_;
+  const ApproxSurface* approx_;
+  bool exact_ = false;
+  std::vector<LO> hint_;  // last triangle of the approximate surface found for each vertex
 };
 
 // Minimum quality (with flip detection) over all quads.
@@ -331,7 +334,12 @@ mesh::FaceMesh smooth_face(const mesh::FaceMesh& input, const cad::FaceGeometry&
   const Stopwatch clock;
   if (!m.quads.empty()) {
     const Topology topo = build_topology(m);
-    Smoother sm(m, surface, topo, orientation(m, surface));
+    // The approximate surface is the input mesh itself, triangulated: it lies on the CAD surface
+    // at its vertices and is as fine as the mesh being smoothed.
+    const std::optional<ApproxSurface> approx =
+        options.approximate_projection ? std::optional<ApproxSurface>(ApproxSurface::from_mesh(input))
+                                       : std::nullopt;
+    Smoother sm(m, surface, topo, detail::orientation(m, surface), approx ? &*approx : nullptr);
     const LO nq = static_cast<LO>(m.quads.size());
 
     if (options.laplacian_uv) {
@@ -362,9 +370,21 @@ mesh::FaceMesh smooth_face(const mesh::FaceMesh& input, const cad::FaceGeometry&
       }();
       for (int it = 0; it < options.iterations; ++it) {
         if (options.time_budget_s > 0 && clock.seconds() > options.time_budget_s) break;
+        // With the approximate surface, the last pass projects exactly (it is also the pass after
+        // convergence).
+        const bool last = it + 1 == options.iterations;
+        sm.set_exact(last);
         const double moved = sm.pass();
         ++st.iterations;
-        if (moved <= 1e-9 * size) break;
+        if (last) break;
+        if (moved <= 1e-9 * size) {
+          if (approx) {
+            sm.set_exact(true);
+            sm.pass();
+            ++st.iterations;
+          }
+          break;
+        }
       }
       st.method += st.method.empty() ? "kernels" : "+kernels";
     }

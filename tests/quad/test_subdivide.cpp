@@ -3,6 +3,7 @@
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepBuilderAPI_MakePolygon.hxx>
 #include <BRepPrimAPI_MakeBox.hxx>
+#include <BRepPrimAPI_MakeCone.hxx>
 #include <BRepTools.hxx>
 #include <TopoDS_Shape.hxx>
 #include <algorithm>
@@ -23,6 +24,8 @@
 #include "qsmesh/quad/recombine.hpp"
 #include "qsmesh/quad/subdivide.hpp"
 #include "qsmesh/quantize/quantize.hpp"
+#include "qsmesh/smooth/smooth.hpp"
+#include "qsmesh/smooth/untangle.hpp"
 #include "shapes.hpp"
 
 namespace qsmesh::quad {
@@ -257,6 +260,108 @@ TEST(Subdivide, BoxFacesAgreeOnSharedCurves) {
 TEST(Subdivide, BoxWithHoleEndToEnd) {
   const auto model = cad::load_cad(test::write_box_with_hole(tmp("sd_box_hole.brep")));
   expect_model_all_quad(model, 0.5, "box with hole");
+}
+
+}  // namespace
+}  // namespace qsmesh::quad
+
+namespace qsmesh::quad {
+namespace {
+
+// Faces with poles (degenerate curves): the subdivided sphere and cone, smoothed and untangled as
+// the face pipeline does, have every quad valid and every vertex on the surface at its uv.
+void expect_pole_faces_valid(const cad::CadModel& model, double size, const char* what) {
+  const auto p = prepare(model, size);
+  int pole_faces = 0;
+  for (LO f = 0; f < model.num_faces(); ++f) {
+    bool has_pole = false;
+    for (const auto& loop : model.faces()[f].loops)
+      for (const auto& use : loop.uses) has_pole = has_pole || model.curves()[use.curve].degenerate;
+    if (!has_pole) continue;
+    ++pole_faces;
+    const auto surface = model.face_geometry(f);
+    SubdivideStats ss;
+    auto out = subdivide(recombine(p.faces[f], {}, {}), *surface, p.full, &ss);
+    out = smooth::smooth_face(out, *surface, smooth::SmoothOptions{});
+    smooth::UntangleStats us;
+    out = smooth::untangle_face(out, *surface, smooth::UntangleOptions{}, &us);
+    const Quality q = quality(out);
+    std::printf("%s face %d: %zu quads, SICN min %.3f avg %.3f (untangler: %lld seeds)\n", what, f,
+                out.quads.size(), q.min, q.avg, static_cast<long long>(us.seeds));
+    EXPECT_TRUE(out.triangles.empty());
+    EXPECT_GT(q.min, 0) << what << " face " << f;
+    for (LO v = 0; v < out.num_vertices(); ++v)
+      EXPECT_LT(distance(surface->eval(out.uv[v]).p, out.points[v]), 1e-6 * model.diagonal())
+          << what << " vertex " << v << " dim " << int(out.vclass[v].dim) << " entity "
+          << out.vclass[v].entity << " index " << out.vclass[v].index << " new " << (v >= p.faces[f].num_vertices());
+  }
+  EXPECT_GT(pole_faces, 0) << what;
+}
+
+TEST(Subdivide, SphereWithTwoPolesGivesValidQuads) {
+  const auto model = cad::load_cad(test::write_sphere(tmp("sd_sphere.brep")));
+  expect_pole_faces_valid(model, 0.8, "sphere");
+}
+
+TEST(Subdivide, ConeApexGivesValidQuads) {
+  const auto model = load_shape(BRepPrimAPI_MakeCone(2.0, 0.0, 3.0).Shape(), "sd_cone.brep");
+  expect_pole_faces_valid(model, 0.4, "cone");
+}
+
+}  // namespace
+}  // namespace qsmesh::quad
+
+namespace qsmesh::quad {
+namespace {
+
+// A pentagon whose bottom side bends by half a degree at corner C1, meshed by hand with the sliver
+// triangle (C0, C1, C2) that a triangulator may leave along such a side: without re-triangulation
+// C1 would keep one sub-quad with a 179.4 degree corner.
+TEST(Subdivide, FlatBoundaryStripIsRefannedFromAnInteriorVertex) {
+  const std::vector<std::pair<double, double>> xy{{0, 0}, {5, -0.05}, {10, 0}, {10, 7}, {0, 7}};
+  const auto model = cad::load_cad(test::write_polygon_face(xy, tmp("sd_flat.brep")));
+  ASSERT_EQ(model.num_faces(), 1);
+  const auto p = prepare(model, 12.0);
+  for (const auto& cm : p.full) ASSERT_EQ(cm.num_edges(), 2) << "curve " << cm.curve;
+  const auto surface = model.face_geometry(0);
+  mesh::FaceMesh in;
+  in.face = 0;
+  for (const auto& [x, y] : xy) {
+    const Vec3 pt{x, y, 0};
+    LO corner = kNoIndex;
+    for (LO c = 0; c < model.num_corners(); ++c)
+      if (distance(model.corners()[c].point, pt) < 1e-9) corner = c;
+    ASSERT_NE(corner, kNoIndex);
+    mesh::VertexClass vc;
+    vc.dim = 0;
+    vc.entity = corner;
+    in.points.push_back(pt);
+    in.uv.push_back(surface->project(pt, {0, 0}, nullptr));
+    in.vclass.push_back(vc);
+  }
+  const Vec3 z{5, 3.5, 0};
+  mesh::VertexClass vz;
+  vz.entity = 0;
+  in.points.push_back(z);
+  in.uv.push_back(surface->project(z, {0, 0}, nullptr));
+  vz.param = {in.uv.back().u, in.uv.back().v};
+  in.vclass.push_back(vz);
+  // Counter-clockwise in (x, y); the same turn in (u, v) or the opposite one, whichever the plane's
+  // parametrization gives: the sliver and its neighbours turn alike.
+  in.triangles = {{0, 1, 2}, {0, 2, 5}, {2, 3, 5}, {3, 4, 5}, {4, 0, 5}};
+  SubdivideStats ss;
+  const auto out = subdivide(in, *surface, p.full, &ss);
+  const Quality q = quality(out);
+  std::printf("flat boundary strip: %lld re-triangulated, %zu quads, SICN min %.3f avg %.3f\n",
+              static_cast<long long>(ss.flat_boundary_splits), out.quads.size(), q.min, q.avg);
+  EXPECT_EQ(ss.flat_boundary_splits, 1);
+  EXPECT_EQ(out.quads.size(), 15u);
+  EXPECT_GT(q.min, 0.2);
+  // C1 (vertex 1) now has two sub-quads.
+  int at_c1 = 0;
+  for (const auto& e : out.quads)
+    for (const LO v : e) at_c1 += v == 1 ? 1 : 0;
+  EXPECT_EQ(at_c1, 2);
 }
 
 }  // namespace

@@ -12,10 +12,17 @@ namespace qsmesh::quad {
 struct SubdivideStats {
   std::int64_t quads = 0;           ///< quads of the result
   std::int64_t snaps_reverted = 0;  ///< new face vertices moved back off their uv placement
+  std::int64_t flat_boundary_splits = 0;  ///< strips re-triangulated at flat boundary vertices
 };
 
 /// Midpoint subdivision (paper 000 Sec. 5.2): each quad into 4 quads, each triangle into 3.
 /// New vertices are the edge midpoints and the element centres.
+///  - First, a triangle (A, X, B) whose two edges at the boundary vertex X are boundary edges
+///    meeting at more than about 160 degrees (in 3D) would leave X a single sub-quad with that
+///    angle, which nothing can make valid. Such triangles form strips along slightly concave
+///    boundaries; the strip (grown across its one interior edge, at most 8 triangles) up to the
+///    first triangle with a vertex Z inside the face is triangulated again as a fan from Z, when
+///    every fan triangle is oriented like the old ones in (u, v). Counted in stats->flat_boundary_splits; the element counts do not change.
 ///  - `mesh` is a face mesh whose boundary lies on the halved curve meshes
 ///  (quantize::place_vertices
 ///    with halved = true); `full_curves` are the full meshes of all curves (halved = false),

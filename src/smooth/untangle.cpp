@@ -1,0 +1,336 @@
+#include "qsmesh/smooth/untangle.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <limits>
+#include <numbers>
+#include <vector>
+
+#include "internal.hpp"
+#include "qsmesh/core/error.hpp"
+#include "qsmesh/core/timer.hpp"
+
+namespace qsmesh::smooth {
+namespace {
+
+// Sharpness of the soft minimum driving the search: small enough to track the true minimum
+// (about tau * log(corners) below it), large enough to give a smooth landscape where two quads
+// compete for the minimum, which a plain max-min compass search cannot cross.
+constexpr double kTau = 0.02;
+constexpr int kLaplacianSweeps = 30;
+// Progress check: every kStallSweeps sweeps the patch's worst quad must have gained kStallGain.
+constexpr int kStallSweeps = 10;
+constexpr double kStallGain = 1e-3;
+
+struct Score {
+  double soft = -std::numeric_limits<double>::infinity();  // soft minimum of the corner values
+  double hard = -std::numeric_limits<double>::infinity();  // minimum oriented SICN of the quads
+};
+
+class Untangler {
+ public:
+  Untangler(mesh::FaceMesh& m, const cad::FaceGeometry& s, std::vector<std::vector<LO>> v2q,
+            double sign)
+      : m_(m), s_(s), v2q_(std::move(v2q)), sign_(sign), normal_(m.points.size()) {
+    for (LO v = 0; v < m_.num_vertices(); ++v) normal_[v] = s_.normal(m_.uv[v]) * sign_;
+    for (const auto& uv : m_.uv) box_.add(uv);
+  }
+
+  [[nodiscard]] double quad_quality(LO q) const {
+    const auto& qd = m_.quads[q];
+    Vec3 n{};
+    for (const LO w : qd) n += normal_[w];
+    return detail::oriented_sicn(
+        {m_.points[qd[0]], m_.points[qd[1]], m_.points[qd[2]], m_.points[qd[3]]}, n, 1.0);
+  }
+
+  // Corner values of Eq. 12 (what mesh::quad_sicn takes the minimum of: against the quad's own
+  // mean normal), soft minimum over the quads of v, and the hard minimum. A quad turned against the
+  // surface is measured against the surface normal instead, so that all its corners score negative
+  // and unfolding it raises the score.
+  [[nodiscard]] Score score(LO v) const {
+    corner_.clear();
+    Score sc;
+    sc.hard = std::numeric_limits<double>::infinity();
+    for (const LO q : v2q_[v]) {
+      const auto& qd = m_.quads[q];
+      Vec3 ref{}, sum{};
+      std::array<Vec3, 4> cr;
+      for (int k = 0; k < 4; ++k) {
+        const Vec3& x = m_.points[qd[k]];
+        cr[k] = cross(m_.points[qd[(k + 1) % 4]] - x, m_.points[qd[(k + 3) % 4]] - x);
+        sum += cr[k];
+        ref += normal_[qd[k]];
+      }
+      const Vec3 nq = norm2(ref) > 0 && dot(sum, ref) <= 0 ? normalized(ref) : normalized(sum);
+      for (int k = 0; k < 4; ++k) {
+        const Vec3& x = m_.points[qd[k]];
+        const double den =
+            norm2(m_.points[qd[(k + 1) % 4]] - x) + norm2(m_.points[qd[(k + 3) % 4]] - x);
+        corner_.push_back(den > 0 && norm2(nq) > 0 ? 2.0 * dot(cr[k], nq) / den : -1.0);
+      }
+      sc.hard = std::min(sc.hard, quad_quality(q));
+    }
+    const double lo = *std::min_element(corner_.begin(), corner_.end());
+    double sum = 0;
+    for (const double c : corner_) sum += std::exp(-(c - lo) / kTau);
+    sc.soft = lo - kTau * std::log(sum);
+    return sc;
+  }
+
+  // Compass search for vertex v from step *h; returns true when v moved.
+  bool search(LO v, double* h, double h_min) {
+    bool moved = false;
+    Score cur = score(v);
+    for (int round = 0; round < 8 && *h > h_min; ++round) {
+      const auto e = s_.eval(m_.uv[v]);
+      const double g11 = dot(e.du, e.du), g12 = dot(e.du, e.dv), g22 = dot(e.dv, e.dv);
+      const double det = g11 * g22 - g12 * g12;
+      const bool metric_ok = det > 1e-12 * g11 * g22 && std::isfinite(det);
+      Vec3 e1 = normalized(norm2(e.du) > 0 ? e.du : e.dv);
+      Vec3 e2 = normalized(cross(normalized(cross(e.du, e.dv)), e1));
+      const Vec2 uv0 = m_.uv[v];
+      const Vec3 x0 = m_.points[v], n0 = normal_[v];
+      Vec2 best_uv = uv0;
+      Vec3 best_x = x0, best_n = n0;
+      Score best = cur;
+      for (int k = 0; k < 8; ++k) {
+        const double th = k * std::numbers::pi / 4;
+        Vec2 duv;
+        if (metric_ok) {
+          const Vec3 d = (e1 * std::cos(th) + e2 * std::sin(th)) * *h;
+          const double b1 = dot(e.du, d), b2 = dot(e.dv, d);
+          duv = {(g22 * b1 - g12 * b2) / det, (g11 * b2 - g12 * b1) / det};
+        } else {
+          // Near a singular point of the parametrization: steps straight in (u, v), scaled by the
+          // longer derivative.
+          const double scale = std::sqrt(std::max(g11, g22));
+          if (!(scale > 0)) break;
+          duv = Vec2{std::cos(th), std::sin(th)} * (*h / scale);
+        }
+        const Vec2 uv = uv0 + duv;
+        if (!(uv.u >= box_.lo.u && uv.u <= box_.hi.u && uv.v >= box_.lo.v && uv.v <= box_.hi.v))
+          continue;
+        m_.uv[v] = uv;
+        m_.points[v] = s_.eval(uv).p;
+        normal_[v] = s_.normal(uv) * sign_;
+        const Score sc = score(v);
+        const bool valid_kept = sc.hard > 0 || sc.hard >= cur.hard;
+        if (valid_kept && sc.soft > best.soft) {
+          best = sc;
+          best_uv = uv;
+          best_x = m_.points[v];
+          best_n = normal_[v];
+        }
+      }
+      m_.uv[v] = best_uv;
+      m_.points[v] = best_x;
+      normal_[v] = best_n;
+      if (best.soft > cur.soft) {
+        cur = best;
+        moved = true;
+        *h *= 1.5;
+      } else {
+        *h *= 0.5;
+      }
+    }
+    return moved;
+  }
+
+  // One Gauss-Seidel step of v towards the mean of its edge neighbours, in the tangent plane at v
+  // mapped to (u, v) through the first derivatives (3D, so seams in the patch do not matter).
+  void relax(LO v) {
+    Vec3 mean{};
+    int count = 0;
+    for (const LO q : v2q_[v]) {
+      const auto& qd = m_.quads[q];
+      int k = 0;
+      while (qd[k] != v) ++k;
+      mean += m_.points[qd[(k + 1) % 4]] + m_.points[qd[(k + 3) % 4]];
+      count += 2;
+    }
+    if (count == 0) return;
+    const auto e = s_.eval(m_.uv[v]);
+    const Vec3 d = mean / count - m_.points[v];
+    const double g11 = dot(e.du, e.du), g12 = dot(e.du, e.dv), g22 = dot(e.dv, e.dv);
+    const double det = g11 * g22 - g12 * g12;
+    if (!(det > 1e-12 * g11 * g22) || !std::isfinite(det)) return;
+    const double b1 = dot(e.du, d), b2 = dot(e.dv, d);
+    const Vec2 uv = m_.uv[v] + Vec2{(g22 * b1 - g12 * b2) / det, (g11 * b2 - g12 * b1) / det};
+    if (!(uv.u >= box_.lo.u && uv.u <= box_.hi.u && uv.v >= box_.lo.v && uv.v <= box_.hi.v)) return;
+    m_.uv[v] = uv;
+    m_.points[v] = s_.eval(uv).p;
+    normal_[v] = s_.normal(uv) * sign_;
+  }
+
+  void restore(LO v, const Vec2& uv, const Vec3& x) {
+    m_.uv[v] = uv;
+    m_.points[v] = x;
+    normal_[v] = s_.normal(uv) * sign_;
+  }
+
+  [[nodiscard]] const std::vector<std::vector<LO>>& v2q() const { return v2q_; }
+
+ private:
+  mesh::FaceMesh& m_;
+  const cad::FaceGeometry& s_;
+  std::vector<std::vector<LO>> v2q_;
+  double sign_;
+  std::vector<Vec3> normal_;  // oriented unit surface normal at each vertex (zero at a pole)
+  Box2 box_;
+  mutable std::vector<double> corner_;
+};
+
+}  // namespace
+
+mesh::FaceMesh untangle_face(const mesh::FaceMesh& input, const cad::FaceGeometry& surface,
+                             const UntangleOptions& options, UntangleStats* stats) {
+  QSMESH_CHECK(input.uv.size() == input.points.size() && input.vclass.size() == input.points.size(),
+               "face " << input.face << ": points, uv and vclass sizes differ");
+  QSMESH_CHECK(options.rings >= 0 && options.max_rings >= options.rings && options.sweeps >= 0,
+               "untangle: rings, max_rings and sweeps must be >= 0 with max_rings >= rings");
+  UntangleStats st;
+  st.before = measure(input);
+  st.after = st.before;
+  mesh::FaceMesh m = input;
+  const Stopwatch clock;
+  const LO nv = m.num_vertices();
+  const LO nq = static_cast<LO>(m.quads.size());
+  if (nq == 0) {
+    if (stats) *stats = st;
+    return m;
+  }
+  std::vector<char> free(static_cast<std::size_t>(nv), 0);
+  for (LO v = 0; v < nv; ++v) free[v] = m.vclass[v].dim == 2 ? 1 : 0;
+  for (const auto& t : m.triangles)
+    for (const LO v : t) free[v] = 0;
+
+  Untangler un(m, surface, detail::vertex_quads(m), detail::orientation(m, surface));
+  const auto& v2q = un.v2q();
+  auto seeds = [&] {
+    std::vector<LO> s;
+    for (LO q = 0; q < nq; ++q)
+      if (un.quad_quality(q) <= options.target) s.push_back(q);
+    return s;
+  };
+  std::vector<LO> seed = seeds();
+  st.seeds = static_cast<std::int64_t>(seed.size());
+
+  // Per-vertex initial step: a quarter of the shortest incident edge (reset for each patch, kept
+  // across the sweeps of a patch).
+  std::vector<double> step0(static_cast<std::size_t>(nv), 0.0), step_min(step0);
+  for (LO v = 0; v < nv; ++v) {
+    double shortest = std::numeric_limits<double>::infinity();
+    for (const LO q : v2q[v]) {
+      const auto& qd = m.quads[q];
+      int k = 0;
+      while (qd[k] != v) ++k;
+      shortest = std::min({shortest, distance(m.points[v], m.points[qd[(k + 1) % 4]]),
+                           distance(m.points[v], m.points[qd[(k + 3) % 4]])});
+    }
+    if (std::isfinite(shortest)) {
+      step0[v] = 0.25 * shortest;
+      step_min[v] = 1e-7 * shortest;
+    }
+  }
+
+  for (int rings = options.rings; !seed.empty() && !st.timed_out;
+       rings += std::max(options.rings, 1)) {
+    // Patch: vertices of the seeds grown by `rings` rings of quads.
+    std::vector<char> in_patch(static_cast<std::size_t>(nv), 0), quad_seen(nq, 0);
+    std::vector<LO> front;
+    for (const LO q : seed)
+      for (const LO v : m.quads[q])
+        if (!in_patch[v]) {
+          in_patch[v] = 1;
+          front.push_back(v);
+        }
+    for (int r = 0; r < rings; ++r) {
+      std::vector<LO> next;
+      for (const LO v : front)
+        for (const LO q : v2q[v]) {
+          if (quad_seen[q]) continue;
+          quad_seen[q] = 1;
+          for (const LO w : m.quads[q])
+            if (!in_patch[w]) {
+              in_patch[w] = 1;
+              next.push_back(w);
+            }
+        }
+      front = std::move(next);
+    }
+    std::vector<LO> patch;
+    for (LO v = 0; v < nv; ++v)
+      if (in_patch[v] && free[v] && step0[v] > 0) patch.push_back(v);
+    // A vertex stuck at its smallest step in a smaller patch may move again with new neighbours.
+    std::vector<double> step = step0;
+    st.rings = rings;
+    st.patch_vertices = static_cast<std::int64_t>(patch.size());
+    // Start from the tangent-plane Laplacian of the patch (its boundary fixed), which unfolds most
+    // tangles inside a patch of reasonable shape, unless it makes the patch's worst quad worse.
+    int valid_sweeps = 0;
+    double last_worst = -std::numeric_limits<double>::infinity();
+    std::vector<LO> pq;  // quads of the patch
+    {
+      for (const LO v : patch) pq.insert(pq.end(), v2q[v].begin(), v2q[v].end());
+      std::sort(pq.begin(), pq.end());
+      pq.erase(std::unique(pq.begin(), pq.end()), pq.end());
+      const auto worst = [&] {
+        double w = std::numeric_limits<double>::infinity();
+        for (const LO q : pq) w = std::min(w, un.quad_quality(q));
+        return w;
+      };
+      const double w0 = worst();
+      std::vector<Vec2> uv0(patch.size());
+      std::vector<Vec3> x0(patch.size());
+      for (std::size_t i = 0; i < patch.size(); ++i) {
+        uv0[i] = m.uv[patch[i]];
+        x0[i] = m.points[patch[i]];
+      }
+      for (int it = 0; it < kLaplacianSweeps; ++it)
+        for (const LO v : patch) un.relax(v);
+      if (!(worst() > w0))
+        for (std::size_t i = 0; i < patch.size(); ++i) un.restore(patch[i], uv0[i], x0[i]);
+    }
+    for (int sweep = 0; sweep < options.sweeps; ++sweep) {
+      if (options.time_budget_s > 0 && clock.seconds() > options.time_budget_s) {
+        st.timed_out = true;
+        break;
+      }
+      bool moved = false;
+      for (const LO v : patch) moved = un.search(v, &step[v], step_min[v]) || moved;
+      ++st.sweeps;
+      if (!moved) break;
+      // Once the patch is above the target, a few more sweeps lift its minimum; the rest is the
+      // smoother's job.
+      bool above = true;
+      for (const LO q : pq) above = above && un.quad_quality(q) > options.target;
+      valid_sweeps = above ? valid_sweeps + 1 : 0;
+      if (valid_sweeps > options.polish_sweeps) break;
+      // A patch whose worst quad stalls is left: a tangle that small moves cannot undo (e.g. quads
+      // wrapped around an edge too sharp for their size) would otherwise use every sweep.
+      if ((sweep + 1) % kStallSweeps == 0) {
+        double worst = std::numeric_limits<double>::infinity();
+        for (const LO q : pq) worst = std::min(worst, un.quad_quality(q));
+        if (!(worst > last_worst + kStallGain)) break;
+        last_worst = worst;
+      }
+    }
+    seed = seeds();
+    if (rings >= options.max_rings) break;
+  }
+
+  for (LO v = 0; v < nv; ++v)
+    if (m.vclass[v].dim == 2) m.vclass[v].param = {m.uv[v].u, m.uv[v].v};
+  st.after = measure(m);
+  if (!(st.after.sicn_min > st.before.sicn_min) || st.after.invalid > st.before.invalid) {
+    m = input;
+    st.after = st.before;
+    st.rolled_back = true;
+  }
+  if (stats) *stats = st;
+  return m;
+}
+
+}  // namespace qsmesh::smooth
