@@ -4,10 +4,13 @@
 #include <unistd.h>
 
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <string>
+#include <vector>
 
 #include "shapes.hpp"
 
@@ -122,6 +125,39 @@ TEST_F(Qsmesh, UnstructuredStageGivesValidQuads) {
   EXPECT_GT(std::stod(json.substr(at + 12)), 0.0) << json.substr(at, 40);
   const auto quads = json.find("\"quads\": ");
   EXPECT_GT(std::stol(json.substr(quads + 9)), 500) << json.substr(quads, 30);
+}
+
+/// The number after "key": in a stats JSON (NaN when absent).
+double json_number(const std::string& json, const std::string& key) {
+  const auto at = json.find("\"" + key + "\": ");
+  if (at == std::string::npos) return std::nan("");
+  return std::stod(json.substr(at + key.size() + 4));
+}
+
+// Issue "valid all-quad meshes": on the small shared models and the built-in example, at the
+// default size: no triangle, every quad valid, conforming, every vertex on its CAD entity.
+TEST_F(Qsmesh, UnstructuredValidOnSmallModels) {
+  std::vector<std::string> models;
+  const std::string example = tmp("e2e_wing_body.step");
+  ASSERT_EQ(run("example wing-body -o " + example).code, 0);
+  models.push_back(example);
+  for (const char* name : {"cube_filet.stp", "t20_data.step", "wing_fuselage.step", "mambo_s34.step"}) {
+    const std::string path = std::string(QSMESH_SHARED_CAD_DIR) + "/" + name;
+    if (fs::exists(path)) models.push_back(path);
+  }
+  for (const std::string& model : models) {
+    SCOPED_TRACE(model);
+    const std::string stats = tmp("e2e_valid.json");
+    const ExeResult r = run("mesh " + model + " -o " + tmp("e2e_valid.msh") + " --until unstructured --threads 2 -q --stats " + stats);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const std::string json = slurp(stats);
+    EXPECT_EQ(json_number(json, "triangles"), 0);
+    EXPECT_GT(json_number(json, "quads"), 1000);
+    EXPECT_EQ(json_number(json, "faces_failed"), 0) << r.err;
+    EXPECT_GT(json_number(json, "sicn_min"), 0);
+    EXPECT_LE(json_number(json, "max_distance_to_cad"), 1e-6);
+    EXPECT_NE(json.find("\"conforming\": true"), std::string::npos);
+  }
 }
 
 TEST_F(Qsmesh, SameFileWhateverTheThreads) {
