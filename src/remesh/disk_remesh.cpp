@@ -91,6 +91,23 @@ Replacement best_replacement(const DiskQuadTable& table, const Cavity& cavity,
   return best;
 }
 
+std::vector<std::array<LO, 4>> place_replacement(const DiskQuadTable& table, const Replacement& r,
+                                                 std::span<const LO> cycle, LO first_new) {
+  const int b = static_cast<int>(cycle.size());
+  QSMESH_CHECK(r.entry != kNoIndex && table.boundary_size(r.entry) == b,
+               "replacement does not fit a cavity of " << b << " vertices");
+  auto global = [&](int k) {
+    return k < b ? cycle[cavity_vertex(r, k, b)] : first_new + static_cast<LO>(k - b);
+  };
+  std::vector<std::array<LO, 4>> out;
+  for (const auto& lq : table.quads(r.entry)) {
+    std::array<LO, 4> q{global(lq[0]), global(lq[1]), global(lq[2]), global(lq[3])};
+    if (r.reversed) std::swap(q[1], q[3]);  // the same cycle, walked the other way
+    out.push_back(q);
+  }
+  return out;
+}
+
 namespace {
 
 // Ideal valence of a corner from its angle in the face: the sum of its quads' 3D angles.
@@ -172,9 +189,10 @@ struct Work {
     }
     return false;
   }
-  [[nodiscard]] double sicn(const std::array<LO, 4>& q) const {
-    return mesh::quad_sicn({points[q[0]], points[q[1]], points[q[2]], points[q[3]]});
+  [[nodiscard]] static double sicn_of(const std::array<LO, 4>& q, const std::vector<Vec3>& p) {
+    return mesh::quad_sicn({p[q[0]], p[q[1]], p[q[2]], p[q[3]]});
   }
+  [[nodiscard]] double sicn(const std::array<LO, 4>& q) const { return sicn_of(q, points); }
   // Number of corners of q turning with the surface normal minus those turning against it.
   [[nodiscard]] int orientation(const std::array<LO, 4>& q, const std::vector<Vec3>& p,
                                 const std::vector<Vec2>& u) const {
@@ -265,26 +283,14 @@ bool Work::try_fix(LO x) {
   // The replacement's quads in mesh ids; new interior vertices numbered after the current ones.
   const LO first_new = static_cast<LO>(points.size());
   const int n = best.num_interior;
-  auto global = [&](int k) {
-    return k < b ? cycle[cavity_vertex(best, k, b)] : first_new + (k - b);
-  };
-  std::vector<std::array<LO, 4>> new_quads;
-  for (const auto& lq : table.quads(best.entry)) {
-    std::array<LO, 4> q{global(lq[0]), global(lq[1]), global(lq[2]), global(lq[3])};
-    if (best.reversed) std::swap(q[1], q[3]);  // same cycle, opposite direction
-    new_quads.push_back(q);
-  }
+  const std::vector<std::array<LO, 4>> new_quads = place_replacement(table, best, cycle, first_new);
 
-  // Tentative geometry: copies of the arrays, grown by the new vertices.
-  std::vector<Vec3> p = points;
-  std::vector<Vec2> u = uv;
+  // Tentative positions of the new vertices only: the face's arrays change at commit.
   Vec2 centre{0, 0};
   for (LO v : cycle) centre += uv[v];
   centre = centre / b;
-  for (int k = 0; k < n; ++k) {
-    u.push_back(centre);
-    p.push_back({});
-  }
+  std::vector<Vec2> new_uv(n, centre);
+  auto uv_of = [&](LO v) { return v >= first_new ? new_uv[v - first_new] : uv[v]; };
   // Uniform harmonic (Tutte) placement of the new vertices in uv: a few hundred Gauss-Seidel sweeps
   // on at most four unknowns, enough to converge; smoothing below does the real work.
   std::vector<std::set<LO>> nbr(n);
@@ -297,14 +303,12 @@ bool Work::try_fix(LO x) {
   for (int it = 0; it < 200 && n > 0; ++it)
     for (int k = 0; k < n; ++k) {
       Vec2 s{0, 0};
-      for (LO w : nbr[k]) s += u[w];
-      u[first_new + k] = s / static_cast<double>(nbr[k].size());
+      for (LO w : nbr[k]) s += uv_of(w);
+      new_uv[k] = s / static_cast<double>(nbr[k].size());
     }
-  for (int k = 0; k < n; ++k) p[first_new + k] = surface.eval(u[first_new + k]).p;
 
-  // The enlarged cavity: the new quads and every other live quad touching them.
-  std::set<LO> touched(cycle.begin(), cycle.end());
-  std::set<LO> ring;  // old quads around the cavity
+  // The enlarged cavity: the new quads and every other live quad touching the cavity boundary.
+  std::set<LO> ring;
   for (LO v : cycle)
     for (LO q : v2q[v])
       if (!in_cavity.count(q)) ring.insert(q);
@@ -320,18 +324,20 @@ bool Work::try_fix(LO x) {
   for (LO q : ring) min_before = std::min(min_before, sicn(quads[q]));
   const int sign = orient >= 0 ? 1 : -1;
 
-  // Free vertices: new ones, and dim-2 vertices whose quads after the change all lie in the region.
+  // The region as a face mesh of its own. Free: new vertices, and dim-2 vertices whose quads after
+  // the change all lie in the region; the others are locked for smooth_face by classifying them as
+  // corners of their own (unique entities below kNoIndex).
   std::map<LO, LO> local;  // mesh id -> submesh id
   mesh::FaceMesh sub;
   sub.face = face;
   for (const auto& q : region)
     for (LO v : q)
       if (local.emplace(v, static_cast<LO>(sub.points.size())).second) {
-        sub.points.push_back(p[v]);
-        sub.uv.push_back(u[v]);
-        mesh::VertexClass c =
-            v >= first_new ? mesh::VertexClass{2, face, kNoIndex, {u[v].u, u[v].v}} : vclass[v];
-        sub.vclass.push_back(c);
+        const Vec2 w = uv_of(v);
+        sub.points.push_back(v >= first_new ? surface.eval(w).p : points[v]);
+        sub.uv.push_back(w);
+        sub.vclass.push_back(v >= first_new ? mesh::VertexClass{2, face, kNoIndex, {w.u, w.v}}
+                                            : vclass[v]);
       }
   for (const auto& [v, lv] : local) {
     bool free_vertex = v >= first_new;
@@ -340,24 +346,17 @@ bool Work::try_fix(LO x) {
       for (LO q : v2q[v])
         if (!in_cavity.count(q) && !ring.count(q)) free_vertex = false;
     }
-    if (!free_vertex) {
-      // Locked for smooth_face: a corner of its own (a unique entity below kNoIndex).
-      sub.vclass[lv] = mesh::VertexClass{0, -2 - lv, kNoIndex, {u[v].u, u[v].v}};
-    }
+    if (!free_vertex) sub.vclass[lv] = mesh::VertexClass{0, -2 - lv, kNoIndex, {0, 0}};
   }
   for (const auto& q : region)
     sub.quads.push_back({local[q[0]], local[q[1]], local[q[2]], local[q[3]]});
   const mesh::FaceMesh smoothed = smooth::smooth_face(sub, surface, options.smoothing);
 
-  for (const auto& [v, lv] : local) {
-    p[v] = smoothed.points[lv];
-    u[v] = smoothed.uv[lv];
-  }
   double min_after = 1.0;
-  for (const auto& q : region) {
-    min_after = std::min(min_after, mesh::quad_sicn({p[q[0]], p[q[1]], p[q[2]], p[q[3]]}));
+  for (const auto& q : smoothed.quads) {
+    min_after = std::min(min_after, sicn_of(q, smoothed.points));
     for (int k = 0; k < 4; ++k)
-      if (corner_turn(q, k, p, u) * sign <= 0) min_after = -1.0;  // folded against the face
+      if (corner_turn(q, k, smoothed.points, smoothed.uv) * sign <= 0) min_after = -1.0;
   }
   const bool good =
       min_after >= options.min_sicn || (options.accept_if_not_worse && min_after >= min_before);
@@ -369,15 +368,15 @@ bool Work::try_fix(LO x) {
   // Commit.
   for (const auto& [v, lv] : local)
     if (v < first_new && sub.vclass[lv].dim == 2) {
-      points[v] = p[v];
-      uv[v] = u[v];
-      vclass[v].param = {u[v].u, u[v].v};
+      points[v] = smoothed.points[lv];
+      uv[v] = smoothed.uv[lv];
+      vclass[v].param = {uv[v].u, uv[v].v};
     }
   for (int k = 0; k < n; ++k) {
-    points.push_back(p[first_new + k]);
-    uv.push_back(u[first_new + k]);
-    vclass.push_back(
-        mesh::VertexClass{2, face, kNoIndex, {u[first_new + k].u, u[first_new + k].v}});
+    const LO lv = local.at(first_new + k);
+    points.push_back(smoothed.points[lv]);
+    uv.push_back(smoothed.uv[lv]);
+    vclass.push_back(mesh::VertexClass{2, face, kNoIndex, {uv.back().u, uv.back().v}});
     vertex_alive.push_back(1);
     seam.push_back(0);
     ideal.push_back(0);

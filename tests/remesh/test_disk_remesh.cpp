@@ -3,6 +3,7 @@
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepTools.hxx>
 #include <TopoDS_Face.hxx>
+#include <algorithm>
 #include <gp_Pln.hxx>
 #include <iostream>
 #include <map>
@@ -80,6 +81,34 @@ TEST(DiskChoice, HexagonCavitiesPickTheEq15Optimum) {
   }
   // No table entry has 14 boundary vertices.
   EXPECT_EQ(best_replacement(t, interior_cavity(std::vector<int>(14, 2)), {}).entry, kNoIndex);
+}
+
+TEST(DiskChoice, PlacedQuadsFollowTheCavityInBothDirections) {
+  const DiskQuadTable t = DiskQuadTable::builtin();
+  const std::vector<LO> cycle{10, 11, 12, 13, 14, 15, 16, 17};  // an octagon cavity
+  for (LO e : t.with_boundary(8))
+    for (int rot = 0; rot < 8; ++rot)
+      for (bool rev : {false, true}) {
+        const Replacement r{e, rot, rev, 0, t.interior_size(e)};
+        const auto quads = place_replacement(t, r, cycle, 100);
+        std::set<std::pair<LO, LO>> directed;
+        for (const auto& q : quads)
+          for (int k = 0; k < 4; ++k) ASSERT_TRUE(directed.emplace(q[k], q[(k + 1) % 4]).second);
+        std::set<std::pair<LO, LO>> boundary;
+        for (const auto& [a, c] : directed)
+          if (!directed.count({c, a})) boundary.emplace(a, c);
+        std::set<std::pair<LO, LO>> expected;
+        for (int j = 0; j < 8; ++j) expected.emplace(cycle[j], cycle[(j + 1) % 8]);
+        EXPECT_EQ(boundary, expected)
+            << "entry " << e << " rotation " << rot << " reversed " << rev;
+        // The in-valences the choice assumed are those of the placed quads.
+        for (int k = 0; k < 8; ++k) {
+          int in = 0;
+          for (const auto& q : quads)
+            in += std::count(q.begin(), q.end(), cycle[cavity_vertex(r, k, 8)]);
+          EXPECT_EQ(in, t.valences(e)[k]);
+        }
+      }
 }
 
 TEST(DiskChoice, AllowedRanges) {

@@ -5,6 +5,7 @@
 // smoothing, before the larger cavity remeshing (Sec. 6.2).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -75,6 +76,15 @@ struct Replacement {
 /// Returns entry kNoIndex when b is not in the table or nothing is allowed.
 [[nodiscard]] Replacement best_replacement(const DiskQuadTable& table, const Cavity& cavity,
                                            const ChoiceOptions& options);
+
+/// The quads of replacement `r` on a cavity whose boundary vertices are `cycle`
+/// (counter-clockwise), its interior vertices numbered first_new, first_new + 1, ...:
+/// counter-clockwise like the cavity in both directions (a mirrored entry has its quads reversed),
+/// so that the boundary edges of the result are exactly cycle[j] -> cycle[j+1].
+[[nodiscard]] std::vector<std::array<LO, 4>> place_replacement(const DiskQuadTable& table,
+                                                               const Replacement& r,
+                                                               std::span<const LO> cycle,
+                                                               LO first_new);
 
 struct DiskRemeshOptions {
   /// Ideal valence of each dim-0 vertex of the face mesh, indexed by face-mesh vertex (empty: all
