@@ -63,6 +63,10 @@ endfunction()
 # METIS
 qsmesh_find_plain(qsmesh_metis metis.h metis "METIS" "libmetis-dev")
 
+# nauty (canonical labelling), used only by the build-time generator of the disk-quadrangulation
+# table (src/remesh/tools); its header sits in a multiarch folder, hence the nauty/ prefix.
+qsmesh_find_plain(qsmesh_nauty nauty/nauty.h nauty "nauty" "libnauty2-dev")
+
 # HDF5 (serial: Debian's libcgns is built against it)
 pkg_check_modules(HDF5S QUIET IMPORTED_TARGET hdf5-serial)
 qsmesh_require(HDF5S_FOUND "HDF5 (serial)" "libhdf5-dev")

@@ -12,6 +12,7 @@ packages=(
   petsc-dev libmumps-dev
   libeigen3-dev
   libmetis-dev
+  libnauty2-dev
   libhdf5-dev
   libcgns-dev cgns-convert
   libgtest-dev
