@@ -172,6 +172,17 @@ std::string stats_json(const Arguments& args, const Session& session, const para
     std::int64_t by_pattern = 0;
     for (const auto& q : r.quasi_reports) by_pattern += q.by_pattern ? 1 : 0;
     j.value("faces_meshed_by_pattern", by_pattern);  // Sec. 6.1.2
+    std::int64_t before = 0, after = 0, replaced = 0;
+    for (const auto& q : r.quasi_reports) {
+      before += q.defects_before;
+      after += q.defects_after;
+      replaced += q.disk_replaced;
+    }
+    // Sec. 6.3 on the unstructured faces: interior valence >= 6, curve vertices of valence != 2,
+    // corners away from their ideal valence.
+    j.value("disk_defects_before", before);
+    j.value("disk_defects_after", after);
+    j.value("disk_cavities_replaced", replaced);
   }
   j.value("vertices", s.vertices);
   j.value("triangles", s.triangles);
@@ -217,7 +228,15 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
   if (!r.quasi_reports.empty()) {
     std::int64_t by_pattern = 0;
     for (const auto& q : r.quasi_reports) by_pattern += q.by_pattern ? 1 : 0;
-    os << "  faces meshed by patterns: " << by_pattern << " of " << model.num_faces() << "\n";
+    std::int64_t before = 0, after = 0, replaced = 0;
+    for (const auto& q : r.quasi_reports) {
+      before += q.defects_before;
+      after += q.defects_after;
+      replaced += q.disk_replaced;
+    }
+    os << "  faces meshed by patterns: " << by_pattern << " of " << model.num_faces() << "\n"
+       << "  disk remeshing: defects " << before << " -> " << after << " (" << replaced
+       << " cavities replaced)\n";
   }
   if (s.triangles > 0) {
     os << "  triangle quality min/avg: " << s.tri_quality_min << " / " << s.tri_quality_avg << "\n"

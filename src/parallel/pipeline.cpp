@@ -192,6 +192,9 @@ void pack(const QuasiReport& r, std::vector<char>& out) {
   put<std::uint8_t>(out, r.by_pattern ? 1 : 0);
   put_vec(out, std::vector<char>(r.pattern.begin(), r.pattern.end()));
   put_vec(out, std::vector<char>(r.refusal.begin(), r.refusal.end()));
+  put<std::int64_t>(out, r.defects_before);
+  put<std::int64_t>(out, r.defects_after);
+  put<std::int64_t>(out, r.disk_replaced);
 }
 
 void unpack(const std::vector<char>& in, std::size_t& pos, QuasiReport& r) {
@@ -201,6 +204,9 @@ void unpack(const std::vector<char>& in, std::size_t& pos, QuasiReport& r) {
   r.pattern.assign(text.begin(), text.end());
   get_vec(in, pos, text);
   r.refusal.assign(text.begin(), text.end());
+  r.defects_before = get<std::int64_t>(in, pos);
+  r.defects_after = get<std::int64_t>(in, pos);
+  r.disk_replaced = get<std::int64_t>(in, pos);
 }
 
 PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
@@ -381,8 +387,31 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
       if (n * 10 / total != (n - 1) * 10 / total)
         log.info(cat("unstructured: ", n, "/", mine.size(), " faces on rank ", rank));
     });
-    meshes = std::move(quad_meshes);
     result.times.add("unstructured", comm.allreduce_max(clock.seconds()));
+    if (quasi) {
+      // Local topological clean-up of the unstructured faces (Sec. 6.3): defects remeshed with
+      // the best disk quadrangulation, each replacement a transaction.
+      clock.reset();
+      const remesh::DiskQuadTable table = remesh::DiskQuadTable::builtin();
+      tasks.parallel_for(total, [&](std::int64_t i) {
+        if (quasi_reports[i].by_pattern || !quad_reports[i].ok || !quad_meshes[i].triangles.empty()) return;
+        try {
+          const auto surface = model.face_geometry(mine[i]);
+          remesh::DiskRemeshStats ds;
+          mesh::FaceMesh out = remesh::remesh_disk_defects(quad_meshes[i], *surface, table, options.disk, &ds);
+          out.face = mine[i];
+          quad_meshes[i] = std::move(out);
+          quasi_reports[i].defects_before = ds.defects_before;
+          quasi_reports[i].defects_after = ds.defects_after;
+          quasi_reports[i].disk_replaced = ds.replaced;
+        } catch (const std::exception& e) {
+          // The face keeps its valid unstructured mesh.
+          log.warn(Error(e.what(), ErrorContext{"disk remeshing", 2, mine[i]}).what());
+        }
+      });
+      result.times.add("disk_remesh", comm.allreduce_max(clock.seconds()));
+    }
+    meshes = std::move(quad_meshes);
   }
 
   // Gather on rank 0 and assemble in face order.

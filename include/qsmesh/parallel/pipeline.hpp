@@ -10,6 +10,7 @@
 #include "qsmesh/crossfield/cross_field.hpp"
 #include "qsmesh/quad/unstructured.hpp"
 #include "qsmesh/qstruct/face_pattern.hpp"
+#include "qsmesh/remesh/disk_remesh.hpp"
 #include "qsmesh/quantize/quantize.hpp"
 #include "qsmesh/sizemap/size_map.hpp"
 #include "qsmesh/cad/model.hpp"
@@ -21,9 +22,9 @@
 
 namespace qsmesh::parallel {
 
-/// Pipeline stages, in order. QuasiStructured (paper 000 Sec. 6): for now the simple CAD faces
-/// meshed by patterns (Sec. 6.1.2) before the unstructured path meshes the others; the cavity and
-/// disk remeshing of Sec. 6.2-6.3 come next.
+/// Pipeline stages, in order. QuasiStructured (paper 000 Sec. 6): the simple CAD faces meshed by
+/// patterns (Sec. 6.1.2) before the unstructured path meshes the others, whose defects are then
+/// remeshed with disk quadrangulations (Sec. 6.3); the cavity remeshing of Sec. 6.2 comes next.
 enum class Stage { Background, Unstructured, QuasiStructured };
 [[nodiscard]] const char* to_string(Stage s);
 /// Parses a stage name; throws InputError listing the valid names.
@@ -42,6 +43,8 @@ struct PipelineOptions {
   quantize::QuantizeOptions quantize;
   /// Stage::QuasiStructured: pattern meshing of simple CAD faces (Sec. 6.1.2).
   qstruct::PatternFaceOptions patterns;
+  /// Stage::QuasiStructured: disk remeshing of the defects of the unstructured faces (Sec. 6.3).
+  remesh::DiskRemeshOptions disk;
 };
 
 /// How the quasi-structured stage treated one face.
@@ -49,6 +52,8 @@ struct QuasiReport {
   bool by_pattern = false;  ///< meshed by a pattern (Sec. 6.1.2); else by the unstructured path
   std::string pattern;      ///< the pattern's name when by_pattern
   std::string refusal;      ///< why no pattern was kept (qstruct::to_string of the refusal)
+  /// Disk remeshing (unstructured faces only): defects before/after, cavities replaced.
+  std::int64_t defects_before = 0, defects_after = 0, disk_replaced = 0;
 };
 
 
