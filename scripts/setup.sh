@@ -17,6 +17,7 @@ packages=(
   libcgns-dev cgns-convert
   libgtest-dev
   python3
+  time
 )
 
 missing=()
