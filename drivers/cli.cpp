@@ -187,7 +187,8 @@ std::string help(const std::string& topic) {
           "  --stats FILE.json     also write the run statistics as JSON\n"
           "  --sew                 sew faces that arrive disconnected\n"
           "  -q, --quiet           print only warnings and errors\n"
-          "  -v, --verbose         print per-face details\n\n"
+          "  -v, --verbose         print per-face details (with the quad stages: method, counts,\n"
+          "                        irregular vertices, SICN and time of every face)\n\n"
           "Exit codes: 0 success, 2 bad input (one line on stderr says what to fix), 1 internal error.\n";
   } else if (topic == "crossfield") {
     os << "usage: [mpirun -np P] qsmesh crossfield MODEL [-o OUT.vtu] [--check] [options]\n\n"

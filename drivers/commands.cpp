@@ -149,6 +149,18 @@ std::pair<std::int64_t, std::int64_t> count_failures(const parallel::PipelineRes
   return {failed, fell_back};
 }
 
+/// How face f got its quad mesh: "pattern:<name>", "frontal" or "fallback".
+std::string quad_method(const parallel::PipelineResult& r, std::size_t f) {
+  if (f < r.quasi_reports.size() && r.quasi_reports[f].by_pattern) return "pattern:" + r.quasi_reports[f].pattern;
+  return f < r.quad_reports.size() && r.quad_reports[f].frontal ? "frontal" : "fallback";
+}
+
+std::int64_t total_irregular_boundary(const parallel::PipelineResult& r) {
+  std::int64_t n = 0;
+  for (const auto& st : r.face_stats) n += st.irregular_boundary;
+  return n;
+}
+
 std::string stats_json(const Arguments& args, const Session& session, const parallel::PipelineResult& r,
                        const mesh::MeshStats& s, const Checks& checks) {
   const cad::CadModel& model = session.model;
@@ -190,6 +202,7 @@ std::string stats_json(const Arguments& args, const Session& session, const para
   j.value("curve_edges", s.bars);
   j.value("interior_vertices", s.interior_vertices);
   j.value("irregular_interior", s.irregular_interior);
+  if (!r.face_stats.empty()) j.value("irregular_boundary", total_irregular_boundary(r));
   j.value("sicn_min", s.sicn_min);
   j.value("sicn_avg", s.sicn_avg);
   j.value("triangle_quality_min", s.tri_quality_min);
@@ -210,12 +223,32 @@ std::string stats_json(const Arguments& args, const Session& session, const para
         .value("fell_back", o.fell_back).value("error", o.error).end_object();
   }
   j.end_array();
+  if (!r.face_stats.empty()) {
+    // Per face (quad stages): how it was meshed, its statistics and the time spent on it.
+    j.begin_array("face_stats");
+    for (std::size_t f = 0; f < r.face_stats.size(); ++f) {
+      const auto& st = r.face_stats[f];
+      j.begin_object()
+          .value("face", static_cast<std::int64_t>(f))
+          .value("method", quad_method(r, f))
+          .value("vertices", st.vertices)
+          .value("quads", st.quads)
+          .value("triangles", st.triangles)
+          .value("irregular_interior", st.irregular_interior)
+          .value("irregular_boundary", st.irregular_boundary)
+          .value("sicn_min", st.sicn_min)
+          .value("sicn_avg", st.sicn_avg)
+          .value("seconds", r.face_seconds[f])
+          .end_object();
+    }
+    j.end_array();
+  }
   j.end_object();
   return j.str();
 }
 
 void print_summary(std::ostream& os, const cad::CadModel& model, const parallel::PipelineResult& r,
-                   const mesh::MeshStats& s, const Checks& checks, const StageTimes& times) {
+                   const mesh::MeshStats& s, const Checks& checks, const StageTimes& times, bool per_face) {
   const auto [failed, fell_back] = count_failures(r);
   os << "\nsummary\n"
      << "  faces:      " << model.num_faces() << " (" << failed << " failed, " << fell_back
@@ -224,6 +257,8 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
      << "  triangles:  " << s.triangles << "\n"
      << "  quads:      " << s.quads << "\n"
      << "  irregular interior vertices: " << s.irregular_interior << " of " << s.interior_vertices << "\n";
+  if (!r.face_stats.empty())
+    os << "  boundary vertices away from their ideal valence (per face): " << total_irregular_boundary(r) << "\n";
   if (s.quads > 0) os << "  SICN min/avg: " << s.sicn_min << " / " << s.sicn_avg << "\n";
   if (!r.quasi_reports.empty()) {
     std::int64_t by_pattern = 0;
@@ -251,6 +286,15 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
   os << "  time (s):" << times_line(times) << "\n";
   for (const auto& o : outcomes(r))
     if (!o.ok || (o.fell_back && !o.error.empty())) os << "  face " << o.face << ": " << o.error << "\n";
+  if (per_face && !r.face_stats.empty()) {
+    os << "  per face: method, vertices, quads, triangles, irregular interior / boundary, SICN min / avg, seconds\n";
+    for (std::size_t f = 0; f < r.face_stats.size(); ++f) {
+      const auto& st = r.face_stats[f];
+      os << "    face " << f << ": " << quad_method(r, f) << ", " << st.vertices << ", " << st.quads << ", "
+         << st.triangles << ", " << st.irregular_interior << " / " << st.irregular_boundary << ", " << st.sicn_min
+         << " / " << st.sicn_avg << ", " << r.face_seconds[f] << "\n";
+    }
+  }
 }
 
 }  // namespace
@@ -323,7 +367,7 @@ int run_mesh(const Arguments& args) {
     io::write_mesh(result.mesh, args.output);
     s.times.add("write", clock.seconds());
     s.log.info(cat("wrote ", args.output));
-    if (!args.quiet) print_summary(std::cout, s.model, result, stats, checks, s.times);
+    if (!args.quiet) print_summary(std::cout, s.model, result, stats, checks, s.times, args.verbose);
     if (!args.stats.empty())
       write_text_file_atomically(args.stats, stats_json(args, s, result, stats, checks));
     for (const auto& o : outcomes(result))

@@ -46,6 +46,68 @@ std::array<double, 3> triangle_angles(const Vec3& a, const Vec3& b, const Vec3& 
   return {angle(a, b, c), angle(b, c, a), angle(c, a, b)};
 }
 
+FaceQuadStats face_quad_stats(const FaceMesh& mesh) {
+  FaceQuadStats s;
+  s.vertices = mesh.num_vertices();
+  s.quads = static_cast<std::int64_t>(mesh.quads.size());
+  s.triangles = static_cast<std::int64_t>(mesh.triangles.size());
+  const auto nv = static_cast<std::size_t>(s.vertices);
+  std::vector<std::int32_t> valence(nv, 0);
+  std::vector<double> angle(nv, 0.0);  // degrees, sum of the element angles at the vertex
+  auto corner_angle = [&](LO v, LO prev, LO next) {
+    const Vec3 a = mesh.points[prev] - mesh.points[v], b = mesh.points[next] - mesh.points[v];
+    return std::atan2(norm(cross(a, b)), dot(a, b)) * 180.0 / std::numbers::pi;
+  };
+  for (const auto& t : mesh.triangles)
+    for (int k = 0; k < 3; ++k) {
+      ++valence[t[k]];
+      angle[t[k]] += corner_angle(t[k], t[(k + 2) % 3], t[(k + 1) % 3]);
+    }
+  double sum = 0;
+  s.sicn_min = s.quads > 0 ? std::numeric_limits<double>::max() : 0.0;
+  for (const auto& q : mesh.quads) {
+    for (int k = 0; k < 4; ++k) {
+      ++valence[q[k]];
+      angle[q[k]] += corner_angle(q[k], q[(k + 3) % 4], q[(k + 1) % 4]);
+    }
+    const double v = quad_sicn({mesh.points[q[0]], mesh.points[q[1]], mesh.points[q[2]], mesh.points[q[3]]});
+    s.sicn_min = std::min(s.sicn_min, v);
+    sum += v;
+  }
+  if (s.quads > 0) s.sicn_avg = sum / static_cast<double>(s.quads);
+  const std::int32_t regular = s.quads >= s.triangles ? 4 : 6;
+  // Boundary vertices: copies of one CAD vertex (seams) are summed before comparing with the ideal.
+  struct Total {
+    std::int32_t valence = 0, copies = 0;
+    double angle = 0;
+    int dim = 0;
+  };
+  std::unordered_map<std::uint64_t, Total> boundary;
+  for (std::size_t v = 0; v < nv; ++v) {
+    const VertexClass& c = mesh.vclass[v];
+    if (valence[v] == 0) continue;
+    if (c.dim == 2) {
+      s.irregular_interior += valence[v] != regular ? 1 : 0;
+      continue;
+    }
+    const std::uint64_t key = (static_cast<std::uint64_t>(c.dim) << 62) ^
+                              (static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.entity)) << 31) ^
+                              static_cast<std::uint32_t>(c.index);
+    Total& t = boundary[key];
+    t.valence += valence[v];
+    t.copies += 1;
+    t.angle += angle[v];
+    t.dim = c.dim;
+  }
+  for (const auto& [key, t] : boundary) {
+    const std::int32_t ideal = t.dim == 1 ? (regular / 2) * t.copies
+                                          : std::max<std::int32_t>(1, static_cast<std::int32_t>(
+                                                std::lround(t.angle / (regular == 4 ? 90.0 : 60.0))));
+    s.irregular_boundary += t.valence != ideal ? 1 : 0;
+  }
+  return s;
+}
+
 MeshStats compute_stats(const SurfaceMesh& mesh) {
   MeshStats s;
   s.vertices = mesh.num_vertices();

@@ -338,6 +338,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
   const bool quasi = options.until >= Stage::QuasiStructured;
   std::vector<QuasiReport> quasi_reports(quasi ? mine.size() : 0);
   std::vector<mesh::FaceMesh> quad_meshes(quads ? mine.size() : 0);
+  std::vector<double> face_seconds(quads ? mine.size() : 0, 0.0);
   if (quasi) {
     // Simple CAD faces meshed directly by a pattern (paper 000 Sec. 6.1.2, pipeline step 4); the
     // others go through the unstructured path below.
@@ -345,6 +346,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     const std::vector<qstruct::Pattern> patterns = qstruct::builtin_patterns();
     std::atomic<std::int64_t> p_done{0};
     tasks.parallel_for(total, [&](std::int64_t i) {
+      const Stopwatch face_clock;
       qstruct::PatternFaceReport pr;
       mesh::FaceMesh m = qstruct::mesh_face_pattern(model, mine[i], result.quantized_curves, patterns,
                                                     options.patterns, &pr);
@@ -358,6 +360,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
       } else {
         quasi_reports[i].refusal = qstruct::to_string(pr.refusal);
       }
+      face_seconds[i] += face_clock.seconds();
       const std::int64_t n = ++p_done;
       if (n * 10 / total != (n - 1) * 10 / total)
         log.info(cat("patterns: ", n, "/", mine.size(), " faces on rank ", rank));
@@ -371,6 +374,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     quad::UnstructuredOptions qo;
     qo.size = options.background.sizes.size;
     auto mesh_unstructured = [&](std::int64_t i) {
+      const Stopwatch face_clock;
       quad::FaceFields face_fields;
       if (reports[i].ok && full[i] != nullptr) {
         face_fields.background = &meshes[i];
@@ -379,6 +383,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
       }
       quad_meshes[i] = quad::mesh_face_unstructured(model, mine[i], halved, result.quantized_curves, face_fields, qo,
                                                     &quad_reports[i]);
+      face_seconds[i] += face_clock.seconds();
     };
     std::atomic<std::int64_t> q_done{0};
     tasks.parallel_for(total, [&](std::int64_t i) {
@@ -395,6 +400,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
       const remesh::DiskQuadTable table = remesh::DiskQuadTable::builtin();
       tasks.parallel_for(total, [&](std::int64_t i) {
         if (quasi_reports[i].by_pattern || !quad_reports[i].ok || !quad_meshes[i].triangles.empty()) return;
+        const Stopwatch face_clock;
         try {
           const auto surface = model.face_geometry(mine[i]);
           remesh::DiskRemeshStats ds;
@@ -408,6 +414,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
           // The face keeps its valid unstructured mesh.
           log.warn(Error(e.what(), ErrorContext{"disk remeshing", 2, mine[i]}).what());
         }
+        face_seconds[i] += face_clock.seconds();
       });
       result.times.add("disk_remesh", comm.allreduce_max(clock.seconds()));
     }
@@ -423,6 +430,14 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     if (size_map) pack(sizes[i], buffer);
     if (quads) pack(quad_reports[i], buffer);
     if (quasi) pack(quasi_reports[i], buffer);
+    if (quads) {
+      const mesh::FaceQuadStats st = mesh::face_quad_stats(meshes[i]);
+      for (std::int64_t x : {st.vertices, st.quads, st.triangles, st.irregular_interior, st.irregular_boundary})
+        put<std::int64_t>(buffer, x);
+      put<double>(buffer, st.sicn_min);
+      put<double>(buffer, st.sicn_avg);
+      put<double>(buffer, face_seconds[i]);
+    }
   }
   meshes.clear();
   const auto gathered = comm.gather_bytes(buffer, 0);
@@ -433,6 +448,10 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     if (size_map) result.face_sizes.resize(static_cast<std::size_t>(nfaces));
     if (quads) result.quad_reports.resize(static_cast<std::size_t>(nfaces));
     if (quasi) result.quasi_reports.resize(static_cast<std::size_t>(nfaces));
+    if (quads) {
+      result.face_stats.resize(static_cast<std::size_t>(nfaces));
+      result.face_seconds.resize(static_cast<std::size_t>(nfaces));
+    }
     for (const auto& bytes : gathered) {
       std::size_t pos = 0;
       while (pos < bytes.size()) {
@@ -447,6 +466,14 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
         if (size_map) unpack(bytes, pos, result.face_sizes[f]);
         if (quads) unpack(bytes, pos, result.quad_reports[f]);
         if (quasi) unpack(bytes, pos, result.quasi_reports[f]);
+        if (quads) {
+          mesh::FaceQuadStats& st = result.face_stats[f];
+          for (std::int64_t* x : {&st.vertices, &st.quads, &st.triangles, &st.irregular_interior, &st.irregular_boundary})
+            *x = get<std::int64_t>(bytes, pos);
+          st.sicn_min = get<double>(bytes, pos);
+          st.sicn_avg = get<double>(bytes, pos);
+          result.face_seconds[f] = get<double>(bytes, pos);
+        }
       }
     }
     for (LO f = 0; f < nfaces; ++f) all[f].face = f;

@@ -157,6 +157,8 @@ TEST_F(Qsmesh, UnstructuredValidOnSmallModels) {
     EXPECT_GT(json_number(json, "sicn_min"), 0);
     EXPECT_LE(json_number(json, "max_distance_to_cad"), 1e-6);
     EXPECT_NE(json.find("\"conforming\": true"), std::string::npos);
+    EXPECT_GE(json_number(json, "irregular_boundary"), 0);
+    EXPECT_NE(json.find("\"face_stats\": ["), std::string::npos);  // per face: method, counts, SICN, time
   }
 }
 

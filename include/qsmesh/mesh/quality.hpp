@@ -38,6 +38,24 @@ struct MeshStats {
   std::int64_t small_angle_at_sharp_corner = 0;
 };
 
+/// Statistics of one face's mesh (paper 000 Sec. 5, the per-face report of the quad stages).
+struct FaceQuadStats {
+  std::int64_t vertices = 0;  ///< FaceMesh vertices (the two copies of a seam vertex count twice)
+  std::int64_t quads = 0, triangles = 0;
+  /// dim-2 vertices whose element valence is not 4.
+  std::int64_t irregular_interior = 0;
+  /// Boundary vertices away from their ideal valence in this face: curve vertices (dim 1) with
+  /// other than 2 elements per side (a seam vertex: 4 over its two copies), corners (dim 0) with
+  /// other than max(1, round(angle / 90 deg)) elements, angle = the sum of their element angles
+  /// in this face (3D).
+  std::int64_t irregular_boundary = 0;
+  double sicn_min = 0, sicn_avg = 0;  ///< over quads (0 when none)
+};
+
+/// Statistics of a face mesh (FaceMesh: boundary vertices classified dim 0 / 1 with their
+/// (entity, index); seam copies share them).
+[[nodiscard]] FaceQuadStats face_quad_stats(const FaceMesh& mesh);
+
 /// Statistics of an assembled mesh.
 [[nodiscard]] MeshStats compute_stats(const SurfaceMesh& mesh);
 

@@ -17,6 +17,7 @@
 #include "qsmesh/core/log.hpp"
 #include "qsmesh/core/tasks.hpp"
 #include "qsmesh/core/timer.hpp"
+#include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/mesh/surface_mesh.hpp"
 #include "qsmesh/parallel/comm.hpp"
 
@@ -82,6 +83,10 @@ struct PipelineResult {
   std::vector<mesh::CurveMesh> quantized_curves;  ///< final curve meshes (every rank)
   std::vector<quad::UnstructuredReport> quad_reports;  ///< by face, Stage::Unstructured (rank 0)
   std::vector<QuasiReport> quasi_reports;  ///< by face, Stage::QuasiStructured (rank 0)
+  /// By face, quad stages (rank 0): statistics of the face's final mesh, and the wall time spent
+  /// on the face in the quad stages (patterns, unstructured, disk remeshing), seconds.
+  std::vector<mesh::FaceQuadStats> face_stats;
+  std::vector<double> face_seconds;
   std::vector<int> face_rank;                   ///< rank that meshed each face (every rank)
   StageTimes times;                             ///< wall time per stage (max over ranks)
 };
