@@ -291,6 +291,9 @@ class Grower {
         seed_valence = rval[v] == t_.valence(seed_);
       }
       if (!ok || after >= before) continue;
+      const double nq = static_cast<double>(quads_.size());
+      if (o_.max_quad_change >= 0 && std::abs(static_cast<double>(r.quads.size()) - nq) > o_.max_quad_change * nq)
+        continue;
       if (o_.seed_is_singularity && !(irregular_new == 1 && seed_valence)) continue;
       c.matches.push_back(match);
       if (c.irregularity_after == 0 || after < c.irregularity_after) c.irregularity_after = after;
@@ -457,8 +460,12 @@ class Remesher {
       for (const LO q : t.quads_of(v))
         if (!in_cavity[q]) old_quads.insert(q);
 
-    double before = std::numeric_limits<double>::max();
-    for (const LO q : c.quads) before = std::min(before, quad_quality(w_.points, w_.uv, w_.quads[q], s_, sign_));
+    double before = std::numeric_limits<double>::max(), before_sum = 0;
+    for (const LO q : c.quads) {
+      const double x = quad_quality(w_.points, w_.uv, w_.quads[q], s_, sign_);
+      before = std::min(before, x);
+      before_sum += x;
+    }
     for (const LO q : old_quads) before = std::min(before, quad_quality(w_.points, w_.uv, w_.quads[q], s_, sign_));
 
     // Local mesh: old vertices first (locked ones relabelled so that the smoother keeps them), new
@@ -505,10 +512,16 @@ class Remesher {
     }
     lm = smooth::smooth_face(lm, s_, o_.smooth);
 
-    double after = std::numeric_limits<double>::max();
-    for (const auto& q : lm.quads) after = std::min(after, quad_quality(lm.points, lm.uv, q, s_, sign_));
+    double after = std::numeric_limits<double>::max(), after_sum = 0;
+    for (LO q = 0; q < static_cast<LO>(lm.quads.size()); ++q) {
+      const double x = quad_quality(lm.points, lm.uv, lm.quads[q], s_, sign_);
+      after = std::min(after, x);
+      if (q < n_new_quads) after_sum += x;
+    }
     const double need = std::max(o_.min_sicn, std::min(o_.good_sicn, o_.keep_ratio * before));
     if (!(after > o_.min_sicn) || after < need) return false;
+    const double avg_before = before_sum / static_cast<double>(c.quads.size());
+    if (after_sum / static_cast<double>(n_new_quads) < o_.keep_avg_ratio * avg_before) return false;
 
     for (LO i = nold; i < nold + n_new; ++i) {
       out.new_uv.push_back(lm.uv[i]);
@@ -683,6 +696,7 @@ mesh::FaceMesh remesh_cavities(const mesh::FaceMesh& input, const cad::FaceGeome
       go.seed_is_singularity = from_singularity;
       go.max_quads = maximal ? options.max_quads_maximal : options.max_quads_minimal;
       go.max_candidates = options.max_candidates;
+      go.max_quad_change = options.max_quad_change;
       go.match = options.match;
       const GrowResult g = grow_cavity(work, topo, seed, singular, go);
       const int n = static_cast<int>(g.remeshable.size());

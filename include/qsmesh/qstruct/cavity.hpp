@@ -68,6 +68,9 @@ struct GrowOptions {
   /// 5-sided shapes between two absorptions.
   bool check_every_step = true;
   LO max_quads = 400;      ///< growth stops at this many quads
+  /// A match is kept only when its refined pattern has between (1 - f) and (1 + f) times the
+  /// cavity's quads (the mesh size is the size map's business, not the pattern's); < 0: any.
+  double max_quad_change = 0.25;
   int max_candidates = 2;  ///< matches kept per remeshable cavity (best first)
   MatchOptions match;
 };
@@ -105,8 +108,9 @@ struct GrowResult {
 ///  - Each time the cavity is convex and has absorbed new irregular interior vertices (or at every
 ///    convex state, GrowOptions::check_every_step), its sides
 ///    are matched with options.patterns (match_patterns); it is remeshable when a match's
-///    refined pattern leaves every flagged boundary vertex and every CAD corner with its valence
-///    and strictly lowers the irregularity of the cavity's vertices.
+///    refined pattern leaves every flagged boundary vertex and every CAD corner with its valence,
+///    strictly lowers the irregularity of the cavity's vertices and keeps the number of quads
+///    within GrowOptions::max_quad_change.
 /// `singular` has one flag per vertex. Deterministic.
 [[nodiscard]] GrowResult grow_cavity(const mesh::FaceMesh& mesh, const QuadTopology& topo, LO seed,
                                      std::span<const char> singular, const GrowOptions& options);
@@ -129,9 +133,13 @@ struct CavityOptions {
   /// Acceptance after smoothing, over the touched quads (the new quads and the quads around the
   /// smoothed vertices): every quad valid, facing like the face, with SICN (Eq. 12) above
   /// min_sicn, and the minimum SICN at least min(good_sicn, keep_ratio x the minimum before).
+  /// The mean SICN of the new quads must also be at least keep_avg_ratio x the mean SICN of the
+  /// cavity's quads before.
   double min_sicn = 0.1;
   double keep_ratio = 0.8;
   double good_sicn = 0.6;
+  double keep_avg_ratio = 0.95;
+  double max_quad_change = 0.15;  ///< GrowOptions::max_quad_change
   int max_rounds = 10;     ///< passes of Steps 1-4 (the loop stops earlier when nothing changes)
   /// Deterministic work bound: growths started, all steps together (0: none).
   std::int64_t max_cavities = 0;
