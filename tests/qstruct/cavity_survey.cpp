@@ -1,4 +1,5 @@
 // cavity_survey MODEL [--size-factor F] [--threads T] [--first N] [--faces] [--quad-change F] [--avg-ratio R]
+//                      [--candidates N] [--rings N]
 // Paper 000 Sec. 6.2 on the unstructured quad meshes of a model's faces: the pipeline runs to the
 // quantized curves with cross fields (as `qsmesh mesh --until unstructured`), each face (the first
 // N, default all) is meshed by quad::mesh_face_unstructured and then given to
@@ -13,6 +14,7 @@
 
 #include "qsmesh/background/curve_mesh.hpp"
 #include "qsmesh/cad/model.hpp"
+#include "qsmesh/core/error.hpp"
 #include "qsmesh/core/log.hpp"
 #include "qsmesh/core/timer.hpp"
 #include "qsmesh/parallel/comm.hpp"
@@ -43,6 +45,10 @@ int main(int argc, char** argv) {
       co.max_quad_change = std::atof(argv[++i]);
     } else if (a == "--avg-ratio" && i + 1 < argc) {
       co.keep_avg_ratio = std::atof(argv[++i]);
+    } else if (a == "--candidates" && i + 1 < argc) {
+      co.max_candidates = std::atoi(argv[++i]);
+    } else if (a == "--rings" && i + 1 < argc) {
+      co.smooth_rings = std::atoi(argv[++i]);
     } else if (a == "--faces") {
       per_face = true;
     } else if (path.empty() && a.rfind("--", 0) != 0) {
@@ -54,7 +60,7 @@ int main(int argc, char** argv) {
   }
   if (path.empty() || !(size_factor > 0)) {
     std::cerr << "usage: cavity_survey MODEL [--size-factor F] [--threads T] [--first N] [--faces] [--quad-change F] "
-                 "[--avg-ratio R]\n";
+                 "[--avg-ratio R] [--candidates N] [--rings N]\n";
     return 2;
   }
   try {
@@ -77,6 +83,7 @@ int main(int argc, char** argv) {
     qo.size = size;
 
     const auto patterns = qstruct::builtin_patterns();
+    std::int64_t broken = 0;
     std::int64_t faces = 0, skipped = 0, irr0 = 0, irr1 = 0, quads0 = 0, quads1 = 0, sings = 0, flagged = 0, kept = 0;
     double min0 = 1, min1 = 1, sum0 = 0, sum1 = 0, seconds = 0;
     std::array<std::int64_t, 4> grown{}, remeshed{}, rejected{};
@@ -98,6 +105,28 @@ int main(int argc, char** argv) {
         ++skipped;
         if (per_face) std::cout << "face " << f << " skipped: " << rep.skipped << "\n";
         continue;
+      }
+      // What assembly relies on: the CAD-classified vertices unchanged and in order, a manifold
+      // consistently oriented quad mesh.
+      {
+        std::vector<LO> a, b;
+        for (LO v = 0; v < in.num_vertices(); ++v)
+          if (in.vclass[v].dim < 2) a.push_back(v);
+        for (LO v = 0; v < out.num_vertices(); ++v)
+          if (out.vclass[v].dim < 2) b.push_back(v);
+        bool same = a.size() == b.size();
+        for (std::size_t i = 0; same && i < a.size(); ++i)
+          same = in.points[a[i]] == out.points[b[i]] && in.uv[a[i]] == out.uv[b[i]] &&
+                 in.vclass[a[i]].entity == out.vclass[b[i]].entity && in.vclass[a[i]].index == out.vclass[b[i]].index;
+        try {
+          const qstruct::QuadTopology topo(out);
+        } catch (const Error&) {
+          same = false;
+        }
+        if (!same || rep.sicn_min_after <= 0) {
+          ++broken;
+          std::cout << "face " << f << ": output check failed\n";
+        }
       }
       irr0 += rep.irregular_before;
       irr1 += rep.irregular_after;
@@ -122,7 +151,7 @@ int main(int argc, char** argv) {
                   << " remeshed " << rep.remeshed[0] << "/" << rep.remeshed[1] << "/" << rep.remeshed[2] << "/"
                   << rep.remeshed[3] << " flagged " << rep.flagged << "/" << rep.singularities << " (" << t << " s)\n";
     }
-    std::cout << path << " (size factor " << size_factor << "): " << faces << " faces, " << skipped << " skipped\n"
+    std::cout << path << " (size factor " << size_factor << "): " << faces << " faces, " << skipped << " skipped, " << broken << " failed the output checks\n"
               << "  interior irregular vertices " << irr0 << " -> " << irr1 << "\n"
               << "  quads " << quads0 << " -> " << quads1 << ", SICN min " << min0 << " -> " << min1 << ", avg "
               << (quads0 ? sum0 / quads0 : 0) << " -> " << (quads1 ? sum1 / quads1 : 0) << "\n"
