@@ -44,15 +44,16 @@ QuadTopology::QuadTopology(const mesh::FaceMesh& mesh) {
            std::get<1>(edges[j]) == std::get<1>(edges[i]))
       ++j;
     const auto& e = edges[i];
-    QSMESH_CHECK(j - i <= 2, "edge (" << std::get<0>(e) << ", " << std::get<1>(e) << ") is used by " << j - i
-                                      << " quads");
+    QSMESH_CHECK(j - i <= 2, "edge (" << std::get<0>(e) << ", " << std::get<1>(e) << ") is used by "
+                                      << j - i << " quads");
     if (j - i == 1) {
       on_boundary_[std::get<0>(e)] = 1;
       on_boundary_[std::get<1>(e)] = 1;
     } else {
       const auto& f = edges[i + 1];
-      QSMESH_CHECK(std::get<4>(e) != std::get<4>(f),
-                   "edge (" << std::get<0>(e) << ", " << std::get<1>(e) << ") is used twice in one direction");
+      QSMESH_CHECK(std::get<4>(e) != std::get<4>(f), "edge ("
+                                                         << std::get<0>(e) << ", " << std::get<1>(e)
+                                                         << ") is used twice in one direction");
       q2q_[std::get<2>(e)][std::get<3>(e)] = std::get<2>(f);
       q2q_[std::get<2>(f)][std::get<3>(f)] = std::get<2>(e);
     }
@@ -122,16 +123,19 @@ class Grower {
     }
     while (true) {
       if (!concave_.empty()) {
-        // A concave vertex has exactly one outside quad; the cavity cannot become convex without it.
+        // A concave vertex has exactly one outside quad; the cavity cannot become convex without
+        // it.
         const LO v = *concave_.begin();
         LO out = kNoIndex;
         for (const LO q : t_.quads_of(v))
           if (!in_[q]) out = q;
-        if (out == kNoIndex || static_cast<LO>(quads_.size()) >= o_.max_quads || !can_add(out)) break;
+        if (out == kNoIndex || static_cast<LO>(quads_.size()) >= o_.max_quads || !can_add(out))
+          break;
         add(out);
         continue;
       }
-      if (irregular_inside_ > checked_irregular_ || (o_.check_every_step && irregular_inside_ > 0)) {
+      if (irregular_inside_ > checked_irregular_ ||
+          (o_.check_every_step && irregular_inside_ > 0)) {
         checked_irregular_ = irregular_inside_;
         if (!o_.seed_is_singularity || irregular_inside_ >= 2) {
           ++res.checks;
@@ -179,7 +183,7 @@ class Grower {
       if (starts != 1) return false;  // two separate chains would enclose a hole or pinch
       for (int i = 0; i < 4; ++i) {
         const bool on_chain = shared[i] || shared[(i + 3) % 4];  // edges i and i-1 touch vertex i
-        if (!on_chain && n_in_[qd[i]] > 0) return false;       // touching the cavity at a vertex only
+        if (!on_chain && n_in_[qd[i]] > 0) return false;  // touching the cavity at a vertex only
       }
     }
     for (int i = 0; i < 4; ++i) {
@@ -257,7 +261,8 @@ class Grower {
     }
     const LO m = static_cast<LO>(c.corners.size());
     if (m < 2) return false;
-    for (LO k = 0; k < m; ++k) c.side_edges.push_back((k + 1 < m ? c.corners[k + 1] : c.corners[0] + nb) - c.corners[k]);
+    for (LO k = 0; k < m; ++k)
+      c.side_edges.push_back((k + 1 < m ? c.corners[k + 1] : c.corners[0] + nb) - c.corners[k]);
     bool any = false;
     for (const auto& p : o_.patterns) any = any || p.num_sides() == m;
     if (!any) return false;
@@ -267,6 +272,7 @@ class Grower {
     int before = 0;
     for (LO i = 0; i < nb; ++i) before += irregularity(m_, t_, cycle[i], t_.valence(cycle[i]));
     for (const LO v : interior_) before += irregularity(m_, t_, v, t_.valence(v));
+    int best_after = std::numeric_limits<int>::max();
     for (const auto& match : matches) {
       const RefinedPattern r = refine_pattern(o_.patterns[match.pattern], match.chords);
       if (static_cast<LO>(r.boundary.size()) != nb) continue;
@@ -292,15 +298,17 @@ class Grower {
       }
       if (!ok || after >= before) continue;
       const double nq = static_cast<double>(quads_.size());
-      if (o_.max_quad_change >= 0 && std::abs(static_cast<double>(r.quads.size()) - nq) > o_.max_quad_change * nq)
+      if (o_.max_quad_change >= 0 &&
+          std::abs(static_cast<double>(r.quads.size()) - nq) > o_.max_quad_change * nq)
         continue;
       if (o_.seed_is_singularity && !(irregular_new == 1 && seed_valence)) continue;
       c.matches.push_back(match);
-      if (c.irregularity_after == 0 || after < c.irregularity_after) c.irregularity_after = after;
+      best_after = std::min(best_after, after);
       if (static_cast<int>(c.matches.size()) >= std::max(1, o_.max_candidates)) break;
     }
     if (c.matches.empty()) return false;
     c.irregularity_before = before;
+    c.irregularity_after = best_after;
     c.quads = quads_;
     c.interior = interior_;
     return true;
@@ -327,7 +335,8 @@ double orientation(const mesh::FaceMesh& m, const cad::FaceGeometry& surface) {
   for (const auto& q : m.quads) {
     Vec3 s{};
     for (int k = 0; k < 4; ++k)
-      s += cross(m.points[q[k]] - m.points[q[(k + 3) % 4]], m.points[q[(k + 1) % 4]] - m.points[q[k]]);
+      s += cross(m.points[q[k]] - m.points[q[(k + 3) % 4]],
+                 m.points[q[(k + 1) % 4]] - m.points[q[k]]);
     const double d = dot(s, surface.normal(m.uv[q[0]]));
     votes += d > 0 ? 1 : (d < 0 ? -1 : 0);
   }
@@ -336,8 +345,8 @@ double orientation(const mesh::FaceMesh& m, const cad::FaceGeometry& surface) {
 
 // SICN of a quad, -1 when it faces against the face (quad_sicn alone cannot see a quad flipped as
 // a whole: its normal is the average of its own corners).
-double quad_quality(const std::vector<Vec3>& pts, const std::vector<Vec2>& uv, const std::array<LO, 4>& q,
-                    const cad::FaceGeometry& surface, double sign) {
+double quad_quality(const std::vector<Vec3>& pts, const std::vector<Vec2>& uv,
+                    const std::array<LO, 4>& q, const cad::FaceGeometry& surface, double sign) {
   const std::array<Vec3, 4> p{pts[q[0]], pts[q[1]], pts[q[2]], pts[q[3]]};
   Vec3 sum{};
   for (int k = 0; k < 4; ++k) sum += cross(p[k] - p[(k + 3) % 4], p[(k + 1) % 4] - p[k]);
@@ -397,27 +406,29 @@ struct Replacement {
   std::vector<std::array<LO, 4>> quads;  // in work ids (new vertices from work.num_vertices())
   std::vector<Vec2> new_uv;
   std::vector<Vec3> new_points;
-  std::vector<LO> moved;                  // old vertices moved by the smoothing
+  std::vector<LO> moved;  // old vertices moved by the smoothing
   std::vector<Vec2> moved_uv;
   std::vector<Vec3> moved_points;
-  LO new_irregular = kNoIndex;            // work id of the one irregular new vertex (if one)
+  LO new_irregular = kNoIndex;  // work id of the one irregular new vertex (if one)
 };
 
 class Remesher {
  public:
-  Remesher(mesh::FaceMesh& work, const cad::FaceGeometry& surface, const CavityOptions& o, double sign)
+  Remesher(mesh::FaceMesh& work, const cad::FaceGeometry& surface, const CavityOptions& o,
+           double sign)
       : w_(work), s_(surface), o_(o), sign_(sign) {}
 
   // Builds, lays out, smooths and measures the replacement of cavity c by `match` of `patterns`.
-  bool build(const QuadTopology& t, const Cavity& c, const PatternMatch& match, std::span<const Pattern> patterns,
-             Replacement& out) const {
+  bool build(const QuadTopology& t, const Cavity& c, const PatternMatch& match,
+             std::span<const Pattern> patterns, Replacement& out) const {
     const RefinedPattern r = refine_pattern(patterns[match.pattern], match.chords);
     const LO nb = static_cast<LO>(c.boundary.size());
     QSMESH_CHECK(static_cast<LO>(r.boundary.size()) == nb,
                  "refined boundary has " << r.boundary.size() << " vertices, the cavity " << nb);
     const LO n0 = w_.num_vertices();
     std::vector<LO> r2w(static_cast<std::size_t>(r.num_vertices), kNoIndex);
-    for (LO p = 0; p < nb; ++p) r2w[r.boundary[p]] = c.boundary[boundary_position(match, c.corners, nb, p)];
+    for (LO p = 0; p < nb; ++p)
+      r2w[r.boundary[p]] = c.boundary[boundary_position(match, c.corners, nb, p)];
     LO next = n0;
     for (LO v = 0; v < r.num_vertices; ++v)
       if (r2w[v] == kNoIndex) r2w[v] = next++;
@@ -430,7 +441,8 @@ class Remesher {
     }
     const std::vector<LO> rval = refined_valence(r);
     for (LO v = 0; v < r.num_vertices; ++v)
-      if (r2w[v] >= n0 && rval[v] != 4) out.new_irregular = out.new_irregular == kNoIndex ? r2w[v] : kNoIndex - 1;
+      if (r2w[v] >= n0 && rval[v] != 4)
+        out.new_irregular = out.new_irregular == kNoIndex ? r2w[v] : kNoIndex - 1;
     if (out.new_irregular == kNoIndex - 1) out.new_irregular = kNoIndex;
 
     // Free vertices: the new ones, then rings of old ones around the cavity (never CAD vertices).
@@ -466,7 +478,8 @@ class Remesher {
       before = std::min(before, x);
       before_sum += x;
     }
-    for (const LO q : old_quads) before = std::min(before, quad_quality(w_.points, w_.uv, w_.quads[q], s_, sign_));
+    for (const LO q : old_quads)
+      before = std::min(before, quad_quality(w_.points, w_.uv, w_.quads[q], s_, sign_));
 
     // Local mesh: old vertices first (locked ones relabelled so that the smoother keeps them), new
     // ones after, in work order.
@@ -493,9 +506,11 @@ class Remesher {
       lm.points[i] = w_.points[v];
       lm.uv[i] = w_.uv[v];
       lm.vclass[i] = w_.vclass[v];
-      if (lm.vclass[i].dim == 2 && !free_old.count(v)) lm.vclass[i] = mesh::VertexClass{1, -2, i, {0, 0}};
+      if (lm.vclass[i].dim == 2 && !free_old.count(v))
+        lm.vclass[i] = mesh::VertexClass{1, -2, i, {0, 0}};
     }
-    for (const auto& q : out.quads) lm.quads.push_back({local(q[0]), local(q[1]), local(q[2]), local(q[3])});
+    for (const auto& q : out.quads)
+      lm.quads.push_back({local(q[0]), local(q[1]), local(q[2]), local(q[3])});
     const LO n_new_quads = static_cast<LO>(lm.quads.size());
     for (const LO q : old_quads) {
       const auto& qd = w_.quads[q];
@@ -579,7 +594,8 @@ bool convex_pattern(const Pattern& p) {
 std::vector<Pattern> select(std::span<const Pattern> patterns, int sides, bool regular_only) {
   std::vector<Pattern> out;
   for (const auto& p : patterns)
-    if (p.num_sides() == sides && convex_pattern(p) && (!regular_only || p.irregular == 0)) out.push_back(p);
+    if (p.num_sides() == sides && convex_pattern(p) && (!regular_only || p.irregular == 0))
+      out.push_back(p);
   return out;
 }
 
@@ -587,9 +603,11 @@ std::vector<Pattern> select(std::span<const Pattern> patterns, int sides, bool r
 
 GrowResult grow_cavity(const mesh::FaceMesh& mesh, const QuadTopology& topo, LO seed,
                        std::span<const char> singular, const GrowOptions& options) {
-  QSMESH_CHECK(topo.num_vertices() == mesh.num_vertices() && topo.num_quads() == static_cast<LO>(mesh.quads.size()),
+  QSMESH_CHECK(topo.num_vertices() == mesh.num_vertices() &&
+                   topo.num_quads() == static_cast<LO>(mesh.quads.size()),
                "the topology does not belong to the mesh");
-  QSMESH_CHECK(static_cast<LO>(singular.size()) == mesh.num_vertices(), "one singular flag per vertex");
+  QSMESH_CHECK(static_cast<LO>(singular.size()) == mesh.num_vertices(),
+               "one singular flag per vertex");
   QSMESH_CHECK(seed >= 0 && seed < mesh.num_vertices(), "seed " << seed << " out of range");
   return Grower(mesh, topo, seed, singular, options).run();
 }
@@ -597,7 +615,8 @@ GrowResult grow_cavity(const mesh::FaceMesh& mesh, const QuadTopology& topo, LO 
 std::int64_t count_irregular(const mesh::FaceMesh& mesh) {
   const QuadTopology t(mesh);
   std::int64_t n = 0;
-  for (LO v = 0; v < mesh.num_vertices(); ++v) n += interior_vertex(mesh, t, v) && t.valence(v) != 4 ? 1 : 0;
+  for (LO v = 0; v < mesh.num_vertices(); ++v)
+    n += interior_vertex(mesh, t, v) && t.valence(v) != 4 ? 1 : 0;
   return n;
 }
 
@@ -609,7 +628,8 @@ mesh::FaceMesh remesh_cavities(const mesh::FaceMesh& input, const cad::FaceGeome
   CavityReport& rep = report != nullptr ? *report : local;
   rep = CavityReport{};
   for (const auto& s : singularities)
-    if (s.where != crossfield::Singularity::Where::AcuteCorner && (s.index == 1 || s.index == -1)) ++rep.singularities;
+    if (s.where != crossfield::Singularity::Where::AcuteCorner && (s.index == 1 || s.index == -1))
+      ++rep.singularities;
   const auto q0 = smooth::measure(input);
   rep.sicn_min_before = rep.sicn_min_after = q0.sicn_min;
   rep.sicn_avg_before = rep.sicn_avg_after = q0.sicn_avg;
@@ -622,19 +642,22 @@ mesh::FaceMesh remesh_cavities(const mesh::FaceMesh& input, const cad::FaceGeome
     return input;
   }
   try {
-    QSMESH_CHECK(input.uv.size() == input.points.size() && input.vclass.size() == input.points.size(),
-                 "points, uv and vclass sizes differ");
+    QSMESH_CHECK(
+        input.uv.size() == input.points.size() && input.vclass.size() == input.points.size(),
+        "points, uv and vclass sizes differ");
     mesh::FaceMesh work = input;
     QuadTopology topo(work);
     rep.irregular_before = count_irregular(work);
     const double sign = orientation(work, surface);
 
-    // Flag the singular vertices: nearest free vertex of the singularity's valence within the bound.
+    // Flag the singular vertices: nearest free vertex of the singularity's valence within the
+    // bound.
     std::vector<char> singular(static_cast<std::size_t>(work.num_vertices()), 0);
     std::vector<LO> flagged;      // flagged vertex of each accepted singularity
     std::vector<LO> flagged_val;  // its valence
     for (const auto& s : singularities) {
-      if (s.where == crossfield::Singularity::Where::AcuteCorner || (s.index != 1 && s.index != -1)) continue;
+      if (s.where == crossfield::Singularity::Where::AcuteCorner || (s.index != 1 && s.index != -1))
+        continue;
       const LO want = s.index == 1 ? 3 : 5;
       LO best = kNoIndex;
       double best_d = std::numeric_limits<double>::max();
@@ -700,7 +723,8 @@ mesh::FaceMesh remesh_cavities(const mesh::FaceMesh& input, const cad::FaceGeome
       go.match = options.match;
       const GrowResult g = grow_cavity(work, topo, seed, singular, go);
       const int n = static_cast<int>(g.remeshable.size());
-      const int tries = maximal ? std::min(n, std::max(1, options.max_geometric_tries)) : std::min(n, 1);
+      const int tries =
+          maximal ? std::min(n, std::max(1, options.max_geometric_tries)) : std::min(n, 1);
       for (int k = 0; k < tries; ++k) {
         const Cavity& c = g.remeshable[n - 1 - k];
         for (const auto& match : c.matches) {
@@ -723,9 +747,11 @@ mesh::FaceMesh remesh_cavities(const mesh::FaceMesh& input, const cad::FaceGeome
       bool changed = false;
       std::vector<LO> seeds;
       for (LO v = 0; v < work.num_vertices(); ++v)
-        if (interior_vertex(work, topo, v) && topo.valence(v) != 4 && !singular[v]) seeds.push_back(v);
+        if (interior_vertex(work, topo, v) && topo.valence(v) != 4 && !singular[v])
+          seeds.push_back(v);
       for (const LO v : seeds) {
-        if (!interior_vertex(work, topo, v) || topo.valence(v) == 4 || singular[v]) continue;  // changed since
+        if (!interior_vertex(work, topo, v) || topo.valence(v) == 4 || singular[v])
+          continue;  // changed since
         if (out_of_budget()) {
           stop = true;
           break;
@@ -759,15 +785,17 @@ mesh::FaceMesh remesh_cavities(const mesh::FaceMesh& input, const cad::FaceGeome
 
     for (int round = 0; round < options.max_rounds && !stop; ++round) {
       ++rep.rounds;
-      bool changed = unnecessary_step(0, grid, true);
-      if (!stop) changed = singular_step() || changed;
-      if (!stop) changed = unnecessary_step(2, grid, true) || changed;
-      if (!stop) changed = unnecessary_step(3, four, false) || changed;
+      const auto& on = options.steps;
+      bool changed = on[0] && unnecessary_step(0, grid, true);
+      if (!stop && on[1]) changed = singular_step() || changed;
+      if (!stop && on[2]) changed = unnecessary_step(2, grid, true) || changed;
+      if (!stop && on[3]) changed = unnecessary_step(3, four, false) || changed;
       if (!changed) break;
     }
 
     for (std::size_t i = 0; i < flagged.size(); ++i)
-      if (flagged[i] != kNoIndex && interior_vertex(work, topo, flagged[i]) && topo.valence(flagged[i]) == flagged_val[i])
+      if (flagged[i] != kNoIndex && interior_vertex(work, topo, flagged[i]) &&
+          topo.valence(flagged[i]) == flagged_val[i])
         ++rep.flagged_kept;
 
     // Compaction: drop the vertices no quad uses any more (face-interior ones only), keep order.
@@ -782,7 +810,8 @@ mesh::FaceMesh remesh_cavities(const mesh::FaceMesh& input, const cad::FaceGeome
       out.vclass.push_back(work.vclass[v]);
     }
     out.quads.reserve(work.quads.size());
-    for (const auto& q : work.quads) out.quads.push_back({old2new[q[0]], old2new[q[1]], old2new[q[2]], old2new[q[3]]});
+    for (const auto& q : work.quads)
+      out.quads.push_back({old2new[q[0]], old2new[q[1]], old2new[q[2]], old2new[q[3]]});
     rep.irregular_after = count_irregular(out);
     const auto q1 = smooth::measure(out);
     rep.sicn_min_after = q1.sicn_min;

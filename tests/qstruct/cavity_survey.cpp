@@ -1,4 +1,5 @@
-// cavity_survey MODEL [--size-factor F] [--threads T] [--first N] [--faces] [--quad-change F] [--avg-ratio R]
+// cavity_survey MODEL [--size-factor F] [--threads T] [--first N] [--faces] [--quad-change F]
+// [--avg-ratio R]
 //                      [--candidates N] [--rings N]
 // Paper 000 Sec. 6.2 on the unstructured quad meshes of a model's faces: the pipeline runs to the
 // quantized curves with cross fields (as `qsmesh mesh --until unstructured`), each face (the first
@@ -59,7 +60,8 @@ int main(int argc, char** argv) {
     }
   }
   if (path.empty() || !(size_factor > 0)) {
-    std::cerr << "usage: cavity_survey MODEL [--size-factor F] [--threads T] [--first N] [--faces] [--quad-change F] "
+    std::cerr << "usage: cavity_survey MODEL [--size-factor F] [--threads T] [--first N] [--faces] "
+                 "[--quad-change F] "
                  "[--avg-ratio R] [--candidates N] [--rings N]\n";
     return 2;
   }
@@ -75,8 +77,10 @@ int main(int argc, char** argv) {
     options.cross_fields = true;
     options.until = parallel::Stage::Background;
     const TaskArena tasks(threads);
-    const parallel::PipelineResult result = parallel::run_pipeline(parallel::Comm::self(), model, options, tasks, log);
-    const std::vector<mesh::CurveMesh> curves = background::mesh_curves(model, options.background.sizes, tasks);
+    const parallel::PipelineResult result =
+        parallel::run_pipeline(parallel::Comm::self(), model, options, tasks, log);
+    const std::vector<mesh::CurveMesh> curves =
+        background::mesh_curves(model, options.background.sizes, tasks);
     const std::vector<mesh::CurveMesh> halved = quantize::place_vertices(
         model, curves, result.curve_sizes.at, result.quantization, /*halved=*/true, tasks);
     quad::UnstructuredOptions qo;
@@ -84,17 +88,20 @@ int main(int argc, char** argv) {
 
     const auto patterns = qstruct::builtin_patterns();
     std::int64_t broken = 0;
-    std::int64_t faces = 0, skipped = 0, irr0 = 0, irr1 = 0, quads0 = 0, quads1 = 0, sings = 0, flagged = 0, kept = 0;
+    std::int64_t faces = 0, skipped = 0, irr0 = 0, irr1 = 0, quads0 = 0, quads1 = 0, sings = 0,
+                 flagged = 0, kept = 0;
     double min0 = 1, min1 = 1, sum0 = 0, sum1 = 0, seconds = 0;
     std::array<std::int64_t, 4> grown{}, remeshed{}, rejected{};
     const LO nf = std::min(first, model.num_faces());
     for (LO f = 0; f < nf; ++f) {
       quad::UnstructuredReport ur;
-      const mesh::FaceMesh in = quad::mesh_face_unstructured(model, f, halved, result.quantized_curves, qo, &ur);
+      const mesh::FaceMesh in =
+          quad::mesh_face_unstructured(model, f, halved, result.quantized_curves, qo, &ur);
       if (in.quads.empty()) continue;
       const auto surface = model.face_geometry(f);
       std::vector<crossfield::Singularity> s;
-      if (f < static_cast<LO>(result.cross_fields.size()) && result.cross_fields[f].ok) s = result.cross_fields[f].singularities;
+      if (f < static_cast<LO>(result.cross_fields.size()) && result.cross_fields[f].ok)
+        s = result.cross_fields[f].singularities;
       qstruct::CavityReport rep;
       Stopwatch clock;
       const mesh::FaceMesh out = qstruct::remesh_cavities(in, *surface, s, patterns, co, &rep);
@@ -117,7 +124,8 @@ int main(int argc, char** argv) {
         bool same = a.size() == b.size();
         for (std::size_t i = 0; same && i < a.size(); ++i)
           same = in.points[a[i]] == out.points[b[i]] && in.uv[a[i]] == out.uv[b[i]] &&
-                 in.vclass[a[i]].entity == out.vclass[b[i]].entity && in.vclass[a[i]].index == out.vclass[b[i]].index;
+                 in.vclass[a[i]].entity == out.vclass[b[i]].entity &&
+                 in.vclass[a[i]].index == out.vclass[b[i]].index;
         try {
           const qstruct::QuadTopology topo(out);
         } catch (const Error&) {
@@ -145,19 +153,24 @@ int main(int argc, char** argv) {
         rejected[k] += rep.rejected_quality[k];
       }
       if (per_face)
-        std::cout << "face " << f << " quads " << in.quads.size() << " -> " << out.quads.size() << " irregular "
-                  << rep.irregular_before << " -> " << rep.irregular_after << " sicn min " << rep.sicn_min_before
-                  << " -> " << rep.sicn_min_after << " avg " << rep.sicn_avg_before << " -> " << rep.sicn_avg_after
-                  << " remeshed " << rep.remeshed[0] << "/" << rep.remeshed[1] << "/" << rep.remeshed[2] << "/"
-                  << rep.remeshed[3] << " flagged " << rep.flagged << "/" << rep.singularities << " (" << t << " s)\n";
+        std::cout << "face " << f << " quads " << in.quads.size() << " -> " << out.quads.size()
+                  << " irregular " << rep.irregular_before << " -> " << rep.irregular_after
+                  << " sicn min " << rep.sicn_min_before << " -> " << rep.sicn_min_after << " avg "
+                  << rep.sicn_avg_before << " -> " << rep.sicn_avg_after << " remeshed "
+                  << rep.remeshed[0] << "/" << rep.remeshed[1] << "/" << rep.remeshed[2] << "/"
+                  << rep.remeshed[3] << " flagged " << rep.flagged << "/" << rep.singularities
+                  << " (" << t << " s)\n";
     }
-    std::cout << path << " (size factor " << size_factor << "): " << faces << " faces, " << skipped << " skipped, " << broken << " failed the output checks\n"
+    std::cout << path << " (size factor " << size_factor << "): " << faces << " faces, " << skipped
+              << " skipped, " << broken << " failed the output checks\n"
               << "  interior irregular vertices " << irr0 << " -> " << irr1 << "\n"
-              << "  quads " << quads0 << " -> " << quads1 << ", SICN min " << min0 << " -> " << min1 << ", avg "
-              << (quads0 ? sum0 / quads0 : 0) << " -> " << (quads1 ? sum1 / quads1 : 0) << "\n"
+              << "  quads " << quads0 << " -> " << quads1 << ", SICN min " << min0 << " -> " << min1
+              << ", avg " << (quads0 ? sum0 / quads0 : 0) << " -> " << (quads1 ? sum1 / quads1 : 0)
+              << "\n"
               << "  singularities " << sings << ", flagged " << flagged << ", kept " << kept << "\n"
               << "  cavities grown / remeshed / refused by quality, Steps 1-4:";
-    for (int k = 0; k < 4; ++k) std::cout << " " << grown[k] << "/" << remeshed[k] << "/" << rejected[k];
+    for (int k = 0; k < 4; ++k)
+      std::cout << " " << grown[k] << "/" << remeshed[k] << "/" << rejected[k];
     std::cout << "\n  remesh_cavities time " << seconds << " s\n";
   } catch (const std::exception& e) {
     std::cerr << "cavity_survey: " << e.what() << "\n";

@@ -4,7 +4,9 @@
 #include <array>
 #include <cmath>
 #include <map>
+#include <numbers>
 #include <set>
+#include <string>
 #include <vector>
 
 #include "qsmesh/core/error.hpp"
@@ -16,7 +18,9 @@ namespace {
 
 class Plane : public cad::FaceGeometry {
  public:
-  [[nodiscard]] cad::SurfaceEval eval(const Vec2& uv) const override { return {{uv.u, uv.v, 0}, {1, 0, 0}, {0, 1, 0}}; }
+  [[nodiscard]] cad::SurfaceEval eval(const Vec2& uv) const override {
+    return {{uv.u, uv.v, 0}, {1, 0, 0}, {0, 1, 0}};
+  }
   [[nodiscard]] cad::SurfaceEval2 eval2(const Vec2& uv) const override {
     cad::SurfaceEval2 e;
     static_cast<cad::SurfaceEval&>(e) = eval(uv);
@@ -32,7 +36,8 @@ class Plane : public cad::FaceGeometry {
 };
 
 // nx x ny grid of unit squares on face 0: boundary vertices first (counter-clockwise from the
-// origin, corners dim 0, the rest on curves 0..3), interior vertices after, quads counter-clockwise.
+// origin, corners dim 0, the rest on curves 0..3), interior vertices after, quads
+// counter-clockwise.
 mesh::FaceMesh grid(int nx, int ny) {
   mesh::FaceMesh m;
   m.face = 0;
@@ -53,13 +58,16 @@ mesh::FaceMesh grid(int nx, int ny) {
     const auto [i, j] = loop[k];
     const bool is_corner = (i == 0 || i == nx) && (j == 0 || j == ny);
     const int side = j == 0 && i < nx ? 0 : (i == nx && j < ny ? 1 : (j == ny && i > 0 ? 2 : 3));
-    add(i, j, is_corner ? mesh::VertexClass{0, corner++, kNoIndex, {0, 0}}
-                        : mesh::VertexClass{1, side, static_cast<LO>(k), {double(k), 0}});
+    add(i, j,
+        is_corner ? mesh::VertexClass{0, corner++, kNoIndex, {0, 0}}
+                  : mesh::VertexClass{1, side, static_cast<LO>(k), {double(k), 0}});
   }
   for (int j = 1; j < ny; ++j)
-    for (int i = 1; i < nx; ++i) add(i, j, mesh::VertexClass{2, 0, kNoIndex, {double(i), double(j)}});
+    for (int i = 1; i < nx; ++i)
+      add(i, j, mesh::VertexClass{2, 0, kNoIndex, {double(i), double(j)}});
   for (int j = 0; j < ny; ++j)
-    for (int i = 0; i < nx; ++i) m.quads.push_back({id[{i, j}], id[{i + 1, j}], id[{i + 1, j + 1}], id[{i, j + 1}]});
+    for (int i = 0; i < nx; ++i)
+      m.quads.push_back({id[{i, j}], id[{i + 1, j}], id[{i + 1, j + 1}], id[{i, j + 1}]});
   return m;
 }
 
@@ -77,17 +85,20 @@ void rotate_edge(mesh::FaceMesh& m, LO b, LO e) {
   for (LO q = 0; q < static_cast<LO>(m.quads.size()); ++q) {
     const auto& qd = m.quads[q];
     for (int k = 0; k < 4; ++k)
-      if ((qd[k] == b && qd[(k + 1) % 4] == e) || (qd[k] == e && qd[(k + 1) % 4] == b)) qs.push_back(q);
+      if ((qd[k] == b && qd[(k + 1) % 4] == e) || (qd[k] == e && qd[(k + 1) % 4] == b))
+        qs.push_back(q);
   }
   ASSERT_EQ(qs.size(), 2u);
-  // Rotate both quads so that quad 0 is (x b e y) ... i.e. find the cycle (a b c d e f) of the hexagon.
+  // Rotate both quads so that quad 0 is (x b e y) ... i.e. find the cycle (a b c d e f) of the
+  // hexagon.
   auto at = [&](LO q, LO v) {
     int k = 0;
     while (m.quads[q][k] != v) ++k;
     return k;
   };
   LO q1 = qs[0], q2 = qs[1];
-  // q1 holds b -> e? then swap roles so that q1 has e -> b, i.e. q1 = (a b e f) reads b then e backwards.
+  // q1 holds b -> e? then swap roles so that q1 has e -> b, i.e. q1 = (a b e f) reads b then e
+  // backwards.
   int k = at(q1, b);
   if (m.quads[q1][(k + 1) % 4] != e) std::swap(q1, q2);
   // q1 = (b e f a) in cyclic order, q2 = (e b c d).
@@ -95,8 +106,8 @@ void rotate_edge(mesh::FaceMesh& m, LO b, LO e) {
   const LO f = m.quads[q1][(k + 2) % 4], a = m.quads[q1][(k + 3) % 4];
   const int k2 = at(q2, e);
   const LO c = m.quads[q2][(k2 + 2) % 4], d = m.quads[q2][(k2 + 3) % 4];
-  // Hexagon b e f a ... cyclic: a b ... going around: (b, c, d, e, f, a) with q1 = b e f a, q2 = e b c d.
-  // New diagonal joins c and f: quads (f a b c) and (c d e f), same orientation.
+  // Hexagon b e f a ... cyclic: a b ... going around: (b, c, d, e, f, a) with q1 = b e f a, q2 = e
+  // b c d. New diagonal joins c and f: quads (f a b c) and (c d e f), same orientation.
   m.quads[q1] = {f, a, b, c};
   m.quads[q2] = {c, d, e, f};
 }
@@ -114,7 +125,8 @@ std::map<LO, int> interior_valences(const mesh::FaceMesh& m) {
 double min_sicn(const mesh::FaceMesh& m) {
   double w = 2;
   for (const auto& q : m.quads)
-    w = std::min(w, mesh::quad_sicn({m.points[q[0]], m.points[q[1]], m.points[q[2]], m.points[q[3]]}));
+    w = std::min(w,
+                 mesh::quad_sicn({m.points[q[0]], m.points[q[1]], m.points[q[2]], m.points[q[3]]}));
   return w;
 }
 
@@ -267,7 +279,8 @@ TEST(Cavity, SingularityIsNeverInside) {
       }
     }
   }
-  // Without the flag, a maximal growth from a valence-5 vertex finds a grid cavity holding all four.
+  // Without the flag, a maximal growth from a valence-5 vertex finds a grid cavity holding all
+  // four.
   std::vector<char> none(m.num_vertices(), 0);
   std::vector<Pattern> grid_only{patterns[0]};
   GrowOptions go;
@@ -275,7 +288,8 @@ TEST(Cavity, SingularityIsNeverInside) {
   go.patterns = grid_only;
   const GrowResult g = grow_cavity(m, t, others.back(), none, go);
   ASSERT_FALSE(g.remeshable.empty());
-  EXPECT_EQ(std::count(g.remeshable.back().interior.begin(), g.remeshable.back().interior.end(), s), 1);
+  EXPECT_EQ(std::count(g.remeshable.back().interior.begin(), g.remeshable.back().interior.end(), s),
+            1);
 }
 
 TEST(Cavity, FlaggedSingularityIsPreserved) {
@@ -309,45 +323,60 @@ TEST(Cavity, FlaggedSingularityIsPreserved) {
   expect_boundary_kept(in, out);
 }
 
-// The triangle pattern refined with n edges per chord, laid out on an equilateral triangle of side
-// 2n (boundary on the triangle, interior by smoothing): one valence-3 vertex at the centre.
-mesh::FaceMesh triangle_face(const Plane& plane, LO n, LO* centre) {
+// A pattern with one interior vertex (triangle: valence 3, pentagon: valence 5) refined with n
+// edges per chord, laid out on a regular polygon of side 2n (the boundary on the polygon, the
+// interior by smoothing).
+mesh::FaceMesh polygon_face(const Plane& plane, const std::string& name, LO n, LO* centre) {
   const auto patterns = builtin_patterns();
-  const Pattern* tri = nullptr;
+  const Pattern* pat = nullptr;
   for (const auto& p : patterns)
-    if (p.name == "triangle") tri = &p;
-  EXPECT_NE(tri, nullptr);
-  const std::vector<LO> chords(static_cast<std::size_t>(tri->num_chords), n);
-  const RefinedPattern r = refine_pattern(*tri, chords);
-  const std::array<Vec2, 3> corner{Vec2{0, 0}, Vec2{2.0 * n, 0}, Vec2{double(n), std::sqrt(3.0) * n}};
+    if (p.name == name) pat = &p;
+  EXPECT_NE(pat, nullptr);
+  const std::vector<LO> chords(static_cast<std::size_t>(pat->num_chords), n);
+  const RefinedPattern r = refine_pattern(*pat, chords);
+  const int sides = pat->num_sides();
+  const double radius = n / std::sin(std::numbers::pi / sides);
+  std::vector<Vec2> corner;
+  for (int k = 0; k < sides; ++k) {
+    const double a = 2 * std::numbers::pi * k / sides;
+    corner.push_back({radius * std::cos(a), radius * std::sin(a)});
+  }
   mesh::FaceMesh m;
   m.face = 0;
   m.points.resize(r.num_vertices);
-  m.uv.assign(r.num_vertices, Vec2{double(n), std::sqrt(3.0) * n / 3});
+  m.uv.assign(r.num_vertices, Vec2{0, 0});
   m.vclass.assign(r.num_vertices, mesh::VertexClass{2, 0, kNoIndex, {0, 0}});
   const LO nb = static_cast<LO>(r.boundary.size());
-  for (int side = 0; side < 3; ++side) {
-    const LO b0 = r.side_start[side], b1 = side < 2 ? r.side_start[side + 1] : nb;
+  for (int side = 0; side < sides; ++side) {
+    const LO b0 = r.side_start[side], b1 = side + 1 < sides ? r.side_start[side + 1] : nb;
     for (LO p = b0; p < b1; ++p) {
       const double t = double(p - b0) / double(b1 - b0);
       const LO v = r.boundary[p];
-      m.uv[v] = corner[side] * (1 - t) + corner[(side + 1) % 3] * t;
-      m.vclass[v] = p == b0 ? mesh::VertexClass{0, side, kNoIndex, {0, 0}} : mesh::VertexClass{1, side, p, {t, 0}};
+      m.uv[v] = corner[side] * (1 - t) + corner[(side + 1) % sides] * t;
+      m.vclass[v] = p == b0 ? mesh::VertexClass{0, side, kNoIndex, {0, 0}}
+                            : mesh::VertexClass{1, side, p, {t, 0}};
     }
   }
   for (LO v = 0; v < r.num_vertices; ++v) m.points[v] = plane.eval(m.uv[v]).p;
   m.quads = r.quads;
-  *centre = r.coarse_vertex[6];
+  *centre = kNoIndex;
+  for (LO v = 0; v < pat->num_vertices(); ++v)
+    if (std::count(pat->boundary.begin(), pat->boundary.end(), v) == 0)
+      *centre = r.coarse_vertex[v];
   return m;
 }
 
-TEST(Cavity, SingularityAbsorbsAPair) {
+// The polygon face of `name` with one edge rotated two steps from the centre (one more +1/-1
+// pair on each side of it), smoothed, the centre flagged by a singularity of `index`: the
+// remeshing ends with the centre's irregular vertex only.
+void absorb_pair(const std::string& name, int index, const CavityOptions& options, int by_step) {
   const Plane plane;
   LO centre = kNoIndex;
-  mesh::FaceMesh m = triangle_face(plane, 6, &centre);
+  mesh::FaceMesh m = polygon_face(plane, name, 6, &centre);
+  const LO valence = index == 1 ? 3 : 5;
   {
     const QuadTopology t(m);
-    ASSERT_EQ(t.valence(centre), 3);
+    ASSERT_EQ(t.valence(centre), valence);
     // An edge two steps away from the centre, between valence-4 interior vertices.
     LO b = kNoIndex, e = kNoIndex;
     for (const LO q : t.quads_of(centre)) {
@@ -357,7 +386,7 @@ TEST(Cavity, SingularityAbsorbsAPair) {
       const LO n1 = qd[(k + 1) % 4], n2 = qd[(k + 2) % 4];
       if (t.valence(n1) == 4 && t.valence(n2) == 4 && !t.on_boundary(n1) && !t.on_boundary(n2)) {
         b = n1;
-        // n1 -> the vertex beyond it, away from the centre: the edge opposite to (centre, n1).
+        // From n1, a neighbour outside the quads around the centre.
         for (const LO q2 : t.quads_of(n1)) {
           const auto& d = m.quads[q2];
           if (std::count(d.begin(), d.end(), centre)) continue;
@@ -366,7 +395,8 @@ TEST(Cavity, SingularityAbsorbsAPair) {
           for (const LO x : {d[(j + 1) % 4], d[(j + 3) % 4]}) {
             bool touches_centre_quad = false;
             for (const LO q3 : t.quads_of(centre))
-              touches_centre_quad = touches_centre_quad || std::count(m.quads[q3].begin(), m.quads[q3].end(), x);
+              touches_centre_quad =
+                  touches_centre_quad || std::count(m.quads[q3].begin(), m.quads[q3].end(), x);
             if (!touches_centre_quad && !t.on_boundary(x) && e == kNoIndex) e = x;
           }
         }
@@ -383,20 +413,32 @@ TEST(Cavity, SingularityAbsorbsAPair) {
   ASSERT_EQ(count_irregular(m), 5);
   crossfield::Singularity sing;
   sing.position = m.points[centre];
-  sing.index = 1;
+  sing.index = index;
   const std::vector<crossfield::Singularity> sings{sing};
   CavityReport rep;
   const auto patterns = builtin_patterns();
-  const mesh::FaceMesh out = remesh_cavities(m, plane, sings, patterns, CavityOptions{}, &rep);
+  const mesh::FaceMesh out = remesh_cavities(m, plane, sings, patterns, options, &rep);
   EXPECT_EQ(rep.flagged, 1);
   EXPECT_EQ(rep.flagged_kept, 1);
   EXPECT_EQ(rep.irregular_after, 1);
   std::map<int, int> hist;
   for (const auto& [v, val] : interior_valences(out)) ++hist[val];
-  EXPECT_EQ(hist[3], 1);
+  EXPECT_EQ(hist[valence], 1);
   EXPECT_GT(min_sicn(out), 0.3);
-  EXPECT_GE(rep.remeshed[1], 1);  // Step 2: the singularity absorbed the pair
+  EXPECT_GE(rep.remeshed[by_step - 1], 1);
   expect_boundary_kept(m, out);
+}
+
+// Step 2: the singularity absorbs the pair (a triangular cavity around the valence-3 centre).
+TEST(Cavity, PlusOneSingularityAbsorbsAPair) { absorb_pair("triangle", 1, CavityOptions{}, 2); }
+
+TEST(Cavity, MinusOneSingularityAbsorbsAPair) {
+  // All steps: Step 1 finds a grid cavity beside the centre.
+  absorb_pair("pentagon", -1, CavityOptions{}, 1);
+  // Step 2 alone: a pentagonal cavity around the valence-5 centre.
+  CavityOptions only2;
+  only2.steps = {false, true, false, false};
+  absorb_pair("pentagon", -1, only2, 2);
 }
 
 TEST(Cavity, Deterministic) {
@@ -424,6 +466,13 @@ TEST(Cavity, Deterministic) {
   EXPECT_TRUE(r3.work_bound_hit);
   EXPECT_EQ(r3.grown[0] + r3.grown[1] + r3.grown[2] + r3.grown[3], 1);
   EXPECT_GT(min_sicn(c), 0);
+  // So does the time budget (here spent before the first growth).
+  CavityOptions timed = options;
+  timed.time_budget_s = 1e-12;
+  CavityReport r4;
+  const mesh::FaceMesh d = remesh_cavities(in, plane, {}, patterns, timed, &r4);
+  EXPECT_TRUE(r4.time_budget_hit);
+  EXPECT_EQ(d.quads, in.quads);
 }
 
 TEST(Cavity, TrianglesLeaveTheMeshAlone) {

@@ -67,7 +67,7 @@ struct GrowOptions {
   /// boundary changes at each step, and the isotropic growth often passes through the 3- or
   /// 5-sided shapes between two absorptions.
   bool check_every_step = true;
-  LO max_quads = 400;      ///< growth stops at this many quads
+  LO max_quads = 400;  ///< growth stops at this many quads
   /// A match is kept only when its refined pattern has between (1 - f) and (1 + f) times the
   /// cavity's quads (the mesh size is the size map's business, not the pattern's); < 0: any.
   double max_quad_change = 0.25;
@@ -77,23 +77,24 @@ struct GrowOptions {
 
 /// A remeshable cavity and how to remesh it.
 struct Cavity {
-  std::vector<LO> quads;     ///< the cavity, in order of growth (a topological disk)
+  std::vector<LO> quads;  ///< the cavity, in order of growth (a topological disk)
   /// Boundary vertices in order, along the quads' orientation (the cavity on the left when quads
   /// turn counter-clockwise), starting at a convex corner.
   std::vector<LO> boundary;
-  std::vector<LO> n_in;      ///< n_in of each boundary vertex
-  std::vector<LO> corners;   ///< positions in `boundary` of the convex corners (n_in = 1)
-  std::vector<LO> side_edges;  ///< side k runs from corners[k] to corners[k + 1] (cyclic)
-  std::vector<LO> interior;  ///< vertices inside (all their quads in the cavity)
+  std::vector<LO> n_in;               ///< n_in of each boundary vertex
+  std::vector<LO> corners;            ///< positions in `boundary` of the convex corners (n_in = 1)
+  std::vector<LO> side_edges;         ///< side k runs from corners[k] to corners[k + 1] (cyclic)
+  std::vector<LO> interior;           ///< vertices inside (all their quads in the cavity)
   std::vector<PatternMatch> matches;  ///< at most GrowOptions::max_candidates, best first
-  int irregularity_before = 0, irregularity_after = 0;  ///< over interior + boundary vertices
+  /// Irregularity of the cavity's vertices (interior and boundary) now, and after the best match.
+  int irregularity_before = 0, irregularity_after = 0;
 };
 
 /// Result of one growth: the remeshable cavities met, in order of growth (minimal: at most one).
 struct GrowResult {
   std::vector<Cavity> remeshable;
-  LO grown_quads = 0;   ///< size of the cavity when the growth stopped
-  int checks = 0;       ///< pattern matchings done
+  LO grown_quads = 0;  ///< size of the cavity when the growth stopped
+  int checks = 0;      ///< pattern matchings done
 };
 
 /// Paper 000 Sec. 6.2.1: grows a cavity from the quads around `seed` (an interior vertex).
@@ -140,7 +141,8 @@ struct CavityOptions {
   double good_sicn = 0.6;
   double keep_avg_ratio = 0.95;
   double max_quad_change = 0.15;  ///< GrowOptions::max_quad_change
-  int max_rounds = 10;     ///< passes of Steps 1-4 (the loop stops earlier when nothing changes)
+  int max_rounds = 10;  ///< passes of Steps 1-4 (the loop stops earlier when nothing changes)
+  std::array<bool, 4> steps{true, true, true, true};  ///< which of Steps 1-4 run (experiments)
   /// Deterministic work bound: growths started, all steps together (0: none).
   std::int64_t max_cavities = 0;
   /// Wall-clock bound in seconds (0: none). When it stops the run the result depends on timing:
