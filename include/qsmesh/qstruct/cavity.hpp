@@ -1,0 +1,201 @@
+// Quasi-structured topology by cavity remeshing (paper 000 Sec. 6.2): a quad-mesh topology over a
+// face mesh, the growth of convex remeshable cavities (Sec. 6.2.1) and the four-step remeshing
+// strategy that removes unnecessary irregular vertices while keeping the ones matching cross-field
+// singularities (Sec. 6.2.2). Cavities are replaced by refined patterns (Sec. 6.1.1, patterns.hpp).
+//
+// Terms (paper 000 Sec. 6): for a vertex x on the cavity boundary, n_in / n_out are its quads
+// inside / outside the cavity (quads of this face only). x is a convex corner when n_in = 1 and a
+// concave corner when x is not on the face boundary and n_out = 1. The sides are the boundary
+// split at the convex corners (a convex cavity has no concave corner). Irregularity of a vertex:
+// |valence - 4| inside the face, |valence - 2| on the face boundary (CAD curves), 0 on CAD corners
+// (their valence is never changed here; Sec. 6.3 handles corners).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "qsmesh/cad/geometry.hpp"
+#include "qsmesh/core/adjacency.hpp"
+#include "qsmesh/crossfield/cross_field.hpp"
+#include "qsmesh/mesh/surface_mesh.hpp"
+#include "qsmesh/qstruct/patterns.hpp"
+#include "qsmesh/smooth/smooth.hpp"
+
+namespace qsmesh::qstruct {
+
+/// Topology of the quads of a FaceMesh (triangles ignored): vertex -> quads (CSR, increasing quad
+/// ids), quad -> quad across each edge, mesh-boundary flags. Edge k of quad q joins q[k] and
+/// q[(k + 1) % 4]. Throws qsmesh::Error when an edge is used by more than two quads or twice in
+/// the same direction (inconsistent orientation).
+class QuadTopology {
+ public:
+  QuadTopology() = default;
+  explicit QuadTopology(const mesh::FaceMesh& mesh);
+
+  [[nodiscard]] LO num_vertices() const { return static_cast<LO>(on_boundary_.size()); }
+  [[nodiscard]] LO num_quads() const { return static_cast<LO>(q2q_.size()); }
+  /// Quads around v (increasing ids); the quadrilateral valence is their number.
+  [[nodiscard]] std::span<const LO> quads_of(LO v) const { return v2q_[v]; }
+  [[nodiscard]] LO valence(LO v) const { return static_cast<LO>(v2q_[v].size()); }
+  /// Quad across edge k of q, kNoIndex on the mesh boundary.
+  [[nodiscard]] LO neighbour(LO q, int k) const { return q2q_[q][k]; }
+  /// v lies on an edge used by one quad only (the face boundary, or the border of a hole).
+  [[nodiscard]] bool on_boundary(LO v) const { return on_boundary_[v] != 0; }
+
+ private:
+  Adjacency v2q_;
+  std::vector<std::array<LO, 4>> q2q_;
+  std::vector<char> on_boundary_;
+};
+
+/// Which cavities the growth accepts as remeshable.
+struct GrowOptions {
+  /// Minimal: stop at the first remeshable cavity; maximal: grow on and keep the last one.
+  bool maximal = false;
+  /// Replacement patterns (a subset of builtin_patterns(); only patterns whose boundary vertices
+  /// are corners or valence 2, i.e. convex ones, make sense for convex cavities).
+  std::span<const Pattern> patterns;
+  /// Step 2 of Sec. 6.2.2: the seed is a singularity allowed inside the cavity; a remeshable
+  /// cavity then also holds at least one other irregular vertex, and its replacement has exactly
+  /// one irregular interior vertex, of the seed's valence.
+  bool seed_is_singularity = false;
+  /// The paper matches the cavity each time it is convex and has absorbed new irregular
+  /// vertices; with this set, at every convex state once it holds one (two for Step 2). The
+  /// boundary changes at each step, and the isotropic growth often passes through the 3- or
+  /// 5-sided shapes between two absorptions.
+  bool check_every_step = true;
+  LO max_quads = 400;  ///< growth stops at this many quads
+  /// A match is kept only when its refined pattern has between (1 - f) and (1 + f) times the
+  /// cavity's quads (the mesh size is the size map's business, not the pattern's); < 0: any.
+  double max_quad_change = 0.25;
+  int max_candidates = 2;  ///< matches kept per remeshable cavity (best first)
+  MatchOptions match;
+};
+
+/// A remeshable cavity and how to remesh it.
+struct Cavity {
+  std::vector<LO> quads;  ///< the cavity, in order of growth (a topological disk)
+  /// Boundary vertices in order, along the quads' orientation (the cavity on the left when quads
+  /// turn counter-clockwise), starting at a convex corner.
+  std::vector<LO> boundary;
+  std::vector<LO> n_in;               ///< n_in of each boundary vertex
+  std::vector<LO> corners;            ///< positions in `boundary` of the convex corners (n_in = 1)
+  std::vector<LO> side_edges;         ///< side k runs from corners[k] to corners[k + 1] (cyclic)
+  std::vector<LO> interior;           ///< vertices inside (all their quads in the cavity)
+  std::vector<PatternMatch> matches;  ///< at most GrowOptions::max_candidates, best first
+  /// Irregularity of the cavity's vertices (interior and boundary) now, and after the best match.
+  int irregularity_before = 0, irregularity_after = 0;
+};
+
+/// Result of one growth: the remeshable cavities met, in order of growth (minimal: at most one).
+struct GrowResult {
+  std::vector<Cavity> remeshable;
+  LO grown_quads = 0;  ///< size of the cavity when the growth stopped
+  int checks = 0;      ///< pattern matchings done
+};
+
+/// Paper 000 Sec. 6.2.1: grows a cavity from the quads around `seed` (an interior vertex).
+///  - Concave boundary vertices (not on the mesh boundary, n_out = 1) are absorbed first; when one
+///    cannot be absorbed the growth stops. Otherwise the outside quad next to the cavity whose
+///    centroid is nearest to the seed (3D; ties: lowest id) is added.
+///  - A quad is added only when the cavity stays a topological disk (the quad shares one chain of
+///    1 to 3 consecutive edges with it and touches it nowhere else), no flagged vertex
+///    (singular[v] != 0, the seed excepted when seed_is_singularity) and no vertex on a CAD
+///    curve or corner (vclass.dim < 2) not on the mesh boundary becomes interior, and no CAD
+///    corner of valence >= 3 (a concave corner) gets n_out = 0.
+///  - Each time the cavity is convex and has absorbed new irregular interior vertices (or at every
+///    convex state, GrowOptions::check_every_step), its sides
+///    are matched with options.patterns (match_patterns); it is remeshable when a match's
+///    refined pattern leaves every flagged boundary vertex and every CAD corner with its valence,
+///    strictly lowers the irregularity of the cavity's vertices and keeps the number of quads
+///    within GrowOptions::max_quad_change.
+/// `singular` has one flag per vertex. Deterministic.
+[[nodiscard]] GrowResult grow_cavity(const mesh::FaceMesh& mesh, const QuadTopology& topo, LO seed,
+                                     std::span<const char> singular, const GrowOptions& options);
+
+/// Options of the remeshing strategy.
+struct CavityOptions {
+  /// A singularity flags the nearest interior vertex of valence 3 (index +1) or 5 (index -1)
+  /// within this many local edge lengths (the mean length of the vertex's edges).
+  double singularity_distance = 3.0;
+  /// Size bounds of the growth (GrowOptions::max_quads) for the maximal grid cavities (Steps 1
+  /// and 3) and the minimal ones (Steps 2 and 4).
+  LO max_quads_maximal = 600;
+  LO max_quads_minimal = 150;
+  /// Remeshable cavities of a maximal growth tried geometrically, largest first.
+  int max_geometric_tries = 3;
+  int max_candidates = 2;  ///< matches tried per cavity (GrowOptions::max_candidates)
+  /// Vertex rings around the cavity smoothed with it (0: only the new interior vertices; 1: the
+  /// cavity boundary too, CAD vertices always stay).
+  int smooth_rings = 1;
+  /// Acceptance after smoothing, over the touched quads (the new quads and the quads around the
+  /// smoothed vertices): every quad valid, facing like the face, with SICN (Eq. 12) above
+  /// min_sicn, and the minimum SICN at least min(good_sicn, keep_ratio x the minimum before).
+  /// The mean SICN of the new quads must also be at least keep_avg_ratio x the mean SICN of the
+  /// cavity's quads before.
+  double min_sicn = 0.1;
+  double keep_ratio = 0.8;
+  double good_sicn = 0.6;
+  double keep_avg_ratio = 0.95;
+  double max_quad_change = 0.15;  ///< GrowOptions::max_quad_change
+  int max_rounds = 10;  ///< passes of Steps 1-4 (the loop stops earlier when nothing changes)
+  std::array<bool, 4> steps{true, true, true, true};  ///< which of Steps 1-4 run (experiments)
+  /// Deterministic work bound: growths started, all steps together (0: none).
+  std::int64_t max_cavities = 0;
+  /// Wall-clock bound in seconds (0: none). When it stops the run the result depends on timing:
+  /// not reproducible, leave 0 where that matters.
+  double time_budget_s = 0;
+  MatchOptions match;
+  smooth::SmoothOptions smooth;
+};
+
+struct CavityReport {
+  /// Per step of Sec. 6.2.2 (index 0..3 = Steps 1..4): growths started, cavities remeshed.
+  std::array<std::int64_t, 4> grown{}, remeshed{};
+  std::array<std::int64_t, 4> rejected_quality{};  ///< remeshable cavities refused after smoothing
+  int rounds = 0;
+  std::int64_t irregular_before = 0, irregular_after = 0;  ///< interior vertices of valence != 4
+  std::int64_t singularities = 0;  ///< singularities given (acute-corner ones excluded)
+  std::int64_t flagged = 0;        ///< flagged vertices at the start
+  std::int64_t flagged_kept = 0;   ///< flagged vertices at the end (with their valence)
+  double sicn_min_before = 0, sicn_avg_before = 0, sicn_min_after = 0, sicn_avg_after = 0;
+  bool work_bound_hit = false, time_budget_hit = false;
+  std::string skipped;  ///< why the face was left as it is (empty when processed)
+};
+
+/// Paper 000 Sec. 6.2.2 on the all-quad mesh of one face.
+///  - Input: an all-quad FaceMesh oriented along the face (consistent uv; triangles: the mesh is
+///    returned unchanged), its surface, the face's cross-field singularities (3D points, index
+///    +1/-1; AcuteCorner ones are ignored: corners are never remeshed here), the pattern list
+///    (builtin_patterns()) and options.
+///  - Singularities flag vertices (CavityOptions::singularity_distance). Then, while a round
+///    changes something: Step 1 maximal cavities matching the 4-sided regular patterns (grid)
+///    from each unnecessary irregular vertex; Step 2 minimal 3-sided (+1) / 5-sided (-1) convex
+///    cavities around each flagged vertex (the pattern's irregular vertex becomes the flagged
+///    one); Step 3 = Step 1; Step 4 minimal cavities matching the 4-sided convex patterns
+///    (transitions) from each unnecessary irregular vertex.
+///  - Each replacement is a transaction: the refined pattern is glued to the cavity boundary (same
+///    vertex ids), new vertices placed by a uniform Laplace solve in (u, v), the cavity and
+///    CavityOptions::smooth_rings rings smoothed (smooth::smooth_face on that region, the rest
+///    locked), and rolled back unless the acceptance of CavityOptions holds. Every accepted
+///    replacement strictly lowers the total irregularity, so the loop ends.
+///  - Output: the mesh compacted: vertices no longer used dropped (only face-interior ones can
+///    be), survivors in their input order (CAD-classified vertices keep ids, points, uv and
+///    vclass), new vertices after them, classified on the face; quads keep the orientation.
+/// Never throws for a face-level failure (report->skipped says why; the input is returned).
+/// Deterministic unless time_budget_s is set.
+[[nodiscard]] mesh::FaceMesh remesh_cavities(const mesh::FaceMesh& quads,
+                                             const cad::FaceGeometry& surface,
+                                             std::span<const crossfield::Singularity> singularities,
+                                             std::span<const Pattern> patterns,
+                                             const CavityOptions& options,
+                                             CavityReport* report = nullptr);
+
+/// Interior vertices (vclass.dim 2, not on the mesh boundary, used by a quad) whose quad valence
+/// is not 4.
+[[nodiscard]] std::int64_t count_irregular(const mesh::FaceMesh& mesh);
+
+}  // namespace qsmesh::qstruct

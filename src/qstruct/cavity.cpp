@@ -1,0 +1,827 @@
+#include "qsmesh/qstruct/cavity.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <set>
+#include <tuple>
+#include <utility>
+
+#include "qsmesh/core/error.hpp"
+#include "qsmesh/core/timer.hpp"
+#include "qsmesh/linalg/solver.hpp"
+#include "qsmesh/mesh/quality.hpp"
+
+namespace qsmesh::qstruct {
+
+// ---------------------------------------------------------------------------------- topology
+
+QuadTopology::QuadTopology(const mesh::FaceMesh& mesh) {
+  const LO n = mesh.num_vertices();
+  const LO nq = static_cast<LO>(mesh.quads.size());
+  std::vector<std::pair<LO, LO>> pairs;
+  pairs.reserve(4 * static_cast<std::size_t>(nq));
+  for (LO q = 0; q < nq; ++q)
+    for (const LO v : mesh.quads[q]) {
+      QSMESH_CHECK(v >= 0 && v < n, "quad " << q << " uses vertex " << v << " of " << n);
+      pairs.emplace_back(v, q);
+    }
+  v2q_ = Adjacency::from_pairs(n, std::move(pairs));
+  q2q_.assign(static_cast<std::size_t>(nq), {kNoIndex, kNoIndex, kNoIndex, kNoIndex});
+  on_boundary_.assign(static_cast<std::size_t>(n), 0);
+  // (low, high, quad, edge, forward): equal keys are the uses of one edge.
+  std::vector<std::tuple<LO, LO, LO, int, bool>> edges;
+  edges.reserve(4 * static_cast<std::size_t>(nq));
+  for (LO q = 0; q < nq; ++q)
+    for (int k = 0; k < 4; ++k) {
+      const LO a = mesh.quads[q][k], b = mesh.quads[q][(k + 1) % 4];
+      edges.emplace_back(std::min(a, b), std::max(a, b), q, k, a < b);
+    }
+  std::sort(edges.begin(), edges.end());
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i + 1;
+    while (j < edges.size() && std::get<0>(edges[j]) == std::get<0>(edges[i]) &&
+           std::get<1>(edges[j]) == std::get<1>(edges[i]))
+      ++j;
+    const auto& e = edges[i];
+    QSMESH_CHECK(j - i <= 2, "edge (" << std::get<0>(e) << ", " << std::get<1>(e) << ") is used by "
+                                      << j - i << " quads");
+    if (j - i == 1) {
+      on_boundary_[std::get<0>(e)] = 1;
+      on_boundary_[std::get<1>(e)] = 1;
+    } else {
+      const auto& f = edges[i + 1];
+      QSMESH_CHECK(std::get<4>(e) != std::get<4>(f), "edge ("
+                                                         << std::get<0>(e) << ", " << std::get<1>(e)
+                                                         << ") is used twice in one direction");
+      q2q_[std::get<2>(e)][std::get<3>(e)] = std::get<2>(f);
+      q2q_[std::get<2>(f)][std::get<3>(f)] = std::get<2>(e);
+    }
+    i = j;
+  }
+}
+
+namespace {
+
+int irregularity(const mesh::FaceMesh& m, const QuadTopology& t, LO v, LO valence) {
+  if (m.vclass[v].dim == 0) return 0;
+  return std::abs(valence - (t.on_boundary(v) ? 2 : 4));
+}
+
+bool interior_vertex(const mesh::FaceMesh& m, const QuadTopology& t, LO v) {
+  return m.vclass[v].dim == 2 && !t.on_boundary(v) && t.valence(v) > 0;
+}
+
+Vec3 centroid(const mesh::FaceMesh& m, LO q) {
+  const auto& qd = m.quads[q];
+  return (m.points[qd[0]] + m.points[qd[1]] + m.points[qd[2]] + m.points[qd[3]]) * 0.25;
+}
+
+// The valences of a refined pattern.
+std::vector<LO> refined_valence(const RefinedPattern& r) {
+  std::vector<LO> val(static_cast<std::size_t>(r.num_vertices), 0);
+  for (const auto& q : r.quads)
+    for (const LO v : q) ++val[v];
+  return val;
+}
+
+// Cavity boundary position of refined boundary position p (same convention as face_pattern.cpp:
+// a mirrored match walks the cavity boundary backwards from the end of side `start`).
+LO boundary_position(const PatternMatch& match, std::span<const LO> corners, LO nb, LO p) {
+  const LO m = static_cast<LO>(corners.size());
+  const LO first = match.reversed ? corners[(match.start + 1) % m] : corners[match.start];
+  return (((match.reversed ? first - p : first + p) % nb) + nb) % nb;
+}
+
+class Grower {
+ public:
+  Grower(const mesh::FaceMesh& m, const QuadTopology& t, LO seed, std::span<const char> singular,
+         const GrowOptions& o)
+      : m_(m), t_(t), seed_(seed), singular_(singular), o_(o) {
+    in_.assign(static_cast<std::size_t>(t.num_quads()), 0);
+    frontier_flag_.assign(static_cast<std::size_t>(t.num_quads()), 0);
+    n_in_.assign(static_cast<std::size_t>(t.num_vertices()), 0);
+    next_.assign(static_cast<std::size_t>(t.num_vertices()), kNoIndex);
+    seed_point_ = m.points[seed];
+  }
+
+  GrowResult run() {
+    GrowResult res;
+    if (!interior_vertex(m_, t_, seed_)) return res;
+    // The seed fan, quad by quad in an order that keeps it a disk.
+    const auto fan = t_.quads_of(seed_);
+    add(fan[0]);
+    for (std::size_t added = 1; added < fan.size();) {
+      bool progress = false;
+      for (const LO q : fan)
+        if (!in_[q] && can_add(q)) {
+          add(q);
+          ++added;
+          progress = true;
+        }
+      if (!progress) return res;
+    }
+    while (true) {
+      if (!concave_.empty()) {
+        // A concave vertex has exactly one outside quad; the cavity cannot become convex without
+        // it.
+        const LO v = *concave_.begin();
+        LO out = kNoIndex;
+        for (const LO q : t_.quads_of(v))
+          if (!in_[q]) out = q;
+        if (out == kNoIndex || static_cast<LO>(quads_.size()) >= o_.max_quads || !can_add(out))
+          break;
+        add(out);
+        continue;
+      }
+      if (irregular_inside_ > checked_irregular_ ||
+          (o_.check_every_step && irregular_inside_ > 0)) {
+        checked_irregular_ = irregular_inside_;
+        if (!o_.seed_is_singularity || irregular_inside_ >= 2) {
+          ++res.checks;
+          Cavity c;
+          if (evaluate(c)) {
+            res.remeshable.push_back(std::move(c));
+            if (!o_.maximal) break;
+          }
+        }
+      }
+      if (static_cast<LO>(quads_.size()) >= o_.max_quads) break;
+      LO best = kNoIndex;
+      double best_d = std::numeric_limits<double>::max();
+      for (const LO q : frontier_) {
+        if (in_[q]) continue;
+        const double d = distance(centroid(m_, q), seed_point_);
+        if (d < best_d || (d == best_d && q < best)) {
+          if (!can_add(q)) continue;
+          best = q;
+          best_d = d;
+        }
+      }
+      if (best == kNoIndex) break;
+      add(best);
+    }
+    res.grown_quads = static_cast<LO>(quads_.size());
+    return res;
+  }
+
+ private:
+  bool can_add(LO q) const {
+    if (in_[q]) return false;
+    const auto& qd = m_.quads[q];
+    std::array<bool, 4> shared{};
+    int count = 0;
+    for (int k = 0; k < 4; ++k) {
+      const LO nb = t_.neighbour(q, k);
+      shared[k] = nb != kNoIndex && in_[nb];
+      count += shared[k] ? 1 : 0;
+    }
+    if (!quads_.empty()) {
+      if (count == 0 || count == 4) return false;
+      int starts = 0;
+      for (int k = 0; k < 4; ++k) starts += (shared[k] && !shared[(k + 3) % 4]) ? 1 : 0;
+      if (starts != 1) return false;  // two separate chains would enclose a hole or pinch
+      for (int i = 0; i < 4; ++i) {
+        const bool on_chain = shared[i] || shared[(i + 3) % 4];  // edges i and i-1 touch vertex i
+        if (!on_chain && n_in_[qd[i]] > 0) return false;  // touching the cavity at a vertex only
+      }
+    }
+    for (int i = 0; i < 4; ++i) {
+      const LO v = qd[i];
+      if (n_in_[v] + 1 != t_.valence(v)) continue;
+      const auto& c = m_.vclass[v];
+      if (c.dim == 0 && t_.valence(v) >= 3) return false;  // a concave CAD corner, fully surrounded
+      if (t_.on_boundary(v)) continue;
+      if (c.dim < 2) return false;
+      if (singular_[v] && !(o_.seed_is_singularity && v == seed_)) return false;
+    }
+    return true;
+  }
+
+  void add(LO q) {
+    in_[q] = 1;
+    quads_.push_back(q);
+    for (const LO v : m_.quads[q]) {
+      ++n_in_[v];
+      const LO val = t_.valence(v);
+      if (n_in_[v] == val && !t_.on_boundary(v)) {
+        interior_.push_back(v);
+        if (val != 4) ++irregular_inside_;
+      }
+      if (!t_.on_boundary(v) && val - n_in_[v] == 1)
+        concave_.insert(v);
+      else
+        concave_.erase(v);
+    }
+    for (int k = 0; k < 4; ++k) {
+      const LO nb = t_.neighbour(q, k);
+      if (nb != kNoIndex && !in_[nb] && !frontier_flag_[nb]) {
+        frontier_flag_[nb] = 1;
+        frontier_.push_back(nb);
+      }
+    }
+  }
+
+  // Boundary, sides and matches of the current (convex) cavity; true when remeshable.
+  bool evaluate(Cavity& c) {
+    std::vector<LO> starts;
+    bool simple = true;
+    for (const LO q : quads_)
+      for (int k = 0; k < 4; ++k) {
+        const LO nb = t_.neighbour(q, k);
+        if (nb != kNoIndex && in_[nb]) continue;
+        const LO a = m_.quads[q][k], b = m_.quads[q][(k + 1) % 4];
+        if (next_[a] != kNoIndex) simple = false;
+        next_[a] = b;
+        starts.push_back(a);
+      }
+    std::vector<LO> cycle;
+    if (simple && !starts.empty()) {
+      LO v0 = kNoIndex;
+      for (const LO v : starts)
+        if (n_in_[v] == 1 && (v0 == kNoIndex || v < v0)) v0 = v;
+      if (v0 != kNoIndex) {
+        LO v = v0;
+        do {
+          cycle.push_back(v);
+          v = next_[v];
+        } while (v != v0 && v != kNoIndex && cycle.size() <= starts.size());
+        if (v != v0 || cycle.size() != starts.size()) cycle.clear();
+      }
+    }
+    for (const LO v : starts) next_[v] = kNoIndex;
+    if (cycle.empty()) return false;
+
+    const LO nb = static_cast<LO>(cycle.size());
+    c.boundary = cycle;
+    c.n_in.resize(nb);
+    for (LO i = 0; i < nb; ++i) {
+      c.n_in[i] = n_in_[cycle[i]];
+      if (c.n_in[i] == 1) c.corners.push_back(i);
+    }
+    const LO m = static_cast<LO>(c.corners.size());
+    if (m < 2) return false;
+    for (LO k = 0; k < m; ++k)
+      c.side_edges.push_back((k + 1 < m ? c.corners[k + 1] : c.corners[0] + nb) - c.corners[k]);
+    bool any = false;
+    for (const auto& p : o_.patterns) any = any || p.num_sides() == m;
+    if (!any) return false;
+    const std::vector<PatternMatch> matches = match_patterns(o_.patterns, c.side_edges, o_.match);
+    if (matches.empty()) return false;
+
+    int before = 0;
+    for (LO i = 0; i < nb; ++i) before += irregularity(m_, t_, cycle[i], t_.valence(cycle[i]));
+    for (const LO v : interior_) before += irregularity(m_, t_, v, t_.valence(v));
+    int best_after = std::numeric_limits<int>::max();
+    for (const auto& match : matches) {
+      const RefinedPattern r = refine_pattern(o_.patterns[match.pattern], match.chords);
+      if (static_cast<LO>(r.boundary.size()) != nb) continue;
+      const std::vector<LO> rval = refined_valence(r);
+      std::vector<char> on_b(static_cast<std::size_t>(r.num_vertices), 0);
+      int after = 0;
+      bool ok = true;
+      for (LO p = 0; p < nb && ok; ++p) {
+        on_b[r.boundary[p]] = 1;
+        const LO i = boundary_position(match, c.corners, nb, p);
+        const LO v = cycle[i];
+        const LO val = t_.valence(v) - c.n_in[i] + rval[r.boundary[p]];
+        if (val != t_.valence(v) && (m_.vclass[v].dim == 0 || singular_[v])) ok = false;
+        after += irregularity(m_, t_, v, val);
+      }
+      int irregular_new = 0;
+      bool seed_valence = false;
+      for (LO v = 0; v < r.num_vertices && ok; ++v) {
+        if (on_b[v] || rval[v] == 4) continue;
+        ++irregular_new;
+        after += std::abs(rval[v] - 4);
+        seed_valence = rval[v] == t_.valence(seed_);
+      }
+      if (!ok || after >= before) continue;
+      const double nq = static_cast<double>(quads_.size());
+      if (o_.max_quad_change >= 0 &&
+          std::abs(static_cast<double>(r.quads.size()) - nq) > o_.max_quad_change * nq)
+        continue;
+      if (o_.seed_is_singularity && !(irregular_new == 1 && seed_valence)) continue;
+      c.matches.push_back(match);
+      best_after = std::min(best_after, after);
+      if (static_cast<int>(c.matches.size()) >= std::max(1, o_.max_candidates)) break;
+    }
+    if (c.matches.empty()) return false;
+    c.irregularity_before = before;
+    c.irregularity_after = best_after;
+    c.quads = quads_;
+    c.interior = interior_;
+    return true;
+  }
+
+  const mesh::FaceMesh& m_;
+  const QuadTopology& t_;
+  LO seed_;
+  std::span<const char> singular_;
+  const GrowOptions& o_;
+  Vec3 seed_point_;
+  std::vector<char> in_, frontier_flag_;
+  std::vector<LO> n_in_, next_, quads_, frontier_, interior_;
+  std::set<LO> concave_;
+  int irregular_inside_ = 0, checked_irregular_ = 0;
+};
+
+// ------------------------------------------------------------------------- replacement
+
+// Orientation of the mesh against the face normal: +1 when the quads turn counter-clockwise
+// around it (majority vote).
+double orientation(const mesh::FaceMesh& m, const cad::FaceGeometry& surface) {
+  double votes = 0;
+  for (const auto& q : m.quads) {
+    Vec3 s{};
+    for (int k = 0; k < 4; ++k)
+      s += cross(m.points[q[k]] - m.points[q[(k + 3) % 4]],
+                 m.points[q[(k + 1) % 4]] - m.points[q[k]]);
+    const double d = dot(s, surface.normal(m.uv[q[0]]));
+    votes += d > 0 ? 1 : (d < 0 ? -1 : 0);
+  }
+  return votes >= 0 ? 1.0 : -1.0;
+}
+
+// SICN of a quad, -1 when it faces against the face (quad_sicn alone cannot see a quad flipped as
+// a whole: its normal is the average of its own corners).
+double quad_quality(const std::vector<Vec3>& pts, const std::vector<Vec2>& uv,
+                    const std::array<LO, 4>& q, const cad::FaceGeometry& surface, double sign) {
+  const std::array<Vec3, 4> p{pts[q[0]], pts[q[1]], pts[q[2]], pts[q[3]]};
+  Vec3 sum{};
+  for (int k = 0; k < 4; ++k) sum += cross(p[k] - p[(k + 3) % 4], p[(k + 1) % 4] - p[k]);
+  Vec3 n{};
+  for (int k = 0; k < 4 && norm2(n) == 0; ++k) n = surface.normal(uv[q[k]]);  // skip a pole corner
+  if (sign * dot(sum, n) <= 0) return -1.0;
+  return mesh::quad_sicn(p);
+}
+
+// Uniform-weight Laplace solve in (u, v) for the vertices >= num_fixed of a small quad mesh.
+bool laplace_uv(const std::vector<std::array<LO, 4>>& quads, LO num_fixed, std::vector<Vec2>& uv) {
+  const LO n = static_cast<LO>(uv.size());
+  const LO nu = n - num_fixed;
+  if (nu == 0) return true;
+  std::vector<std::vector<LO>> nbr(static_cast<std::size_t>(n));
+  for (const auto& q : quads)
+    for (int k = 0; k < 4; ++k) {
+      nbr[q[k]].push_back(q[(k + 1) % 4]);
+      nbr[q[(k + 1) % 4]].push_back(q[k]);
+    }
+  std::vector<linalg::SparseMatrix::Triplet> trip;
+  std::vector<double> bu(static_cast<std::size_t>(nu), 0.0), bv(static_cast<std::size_t>(nu), 0.0);
+  for (LO v = num_fixed; v < n; ++v) {
+    auto& nb = nbr[v];
+    std::sort(nb.begin(), nb.end());
+    nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
+    const LO i = v - num_fixed;
+    trip.push_back({i, i, static_cast<double>(nb.size())});
+    for (const LO w : nb) {
+      if (w >= num_fixed) {
+        trip.push_back({i, w - num_fixed, -1.0});
+      } else {
+        bu[i] += uv[w].u;
+        bv[i] += uv[w].v;
+      }
+    }
+  }
+  const linalg::SparseMatrix A(nu, trip);
+  std::vector<double> xu(static_cast<std::size_t>(nu)), xv(static_cast<std::size_t>(nu));
+  try {
+    auto solver = linalg::make_solver(nu, linalg::SolverOptions{linalg::Backend::Eigen}, nullptr);
+    solver->analyze(A);
+    solver->factorize(A);
+    solver->solve(bu, xu);
+    solver->solve(bv, xv);
+  } catch (const Error&) {
+    return false;
+  }
+  for (LO i = 0; i < nu; ++i) {
+    if (!std::isfinite(xu[i]) || !std::isfinite(xv[i])) return false;
+    uv[num_fixed + i] = {xu[i], xv[i]};
+  }
+  return true;
+}
+
+struct Replacement {
+  std::vector<std::array<LO, 4>> quads;  // in work ids (new vertices from work.num_vertices())
+  std::vector<Vec2> new_uv;
+  std::vector<Vec3> new_points;
+  std::vector<LO> moved;  // old vertices moved by the smoothing
+  std::vector<Vec2> moved_uv;
+  std::vector<Vec3> moved_points;
+  LO new_irregular = kNoIndex;  // work id of the one irregular new vertex (if one)
+};
+
+class Remesher {
+ public:
+  Remesher(mesh::FaceMesh& work, const cad::FaceGeometry& surface, const CavityOptions& o,
+           double sign)
+      : w_(work), s_(surface), o_(o), sign_(sign) {}
+
+  // Builds, lays out, smooths and measures the replacement of cavity c by `match` of `patterns`.
+  bool build(const QuadTopology& t, const Cavity& c, const PatternMatch& match,
+             std::span<const Pattern> patterns, Replacement& out) const {
+    const RefinedPattern r = refine_pattern(patterns[match.pattern], match.chords);
+    const LO nb = static_cast<LO>(c.boundary.size());
+    QSMESH_CHECK(static_cast<LO>(r.boundary.size()) == nb,
+                 "refined boundary has " << r.boundary.size() << " vertices, the cavity " << nb);
+    const LO n0 = w_.num_vertices();
+    std::vector<LO> r2w(static_cast<std::size_t>(r.num_vertices), kNoIndex);
+    for (LO p = 0; p < nb; ++p)
+      r2w[r.boundary[p]] = c.boundary[boundary_position(match, c.corners, nb, p)];
+    LO next = n0;
+    for (LO v = 0; v < r.num_vertices; ++v)
+      if (r2w[v] == kNoIndex) r2w[v] = next++;
+    const LO n_new = next - n0;
+    // The pattern's boundary runs with the cavity's (the cavity on the left, as the quads turn)
+    // unless the match is mirrored.
+    for (const auto& q : r.quads) {
+      const std::array<LO, 4> m{r2w[q[0]], r2w[q[1]], r2w[q[2]], r2w[q[3]]};
+      out.quads.push_back(match.reversed ? std::array<LO, 4>{m[0], m[3], m[2], m[1]} : m);
+    }
+    const std::vector<LO> rval = refined_valence(r);
+    for (LO v = 0; v < r.num_vertices; ++v)
+      if (r2w[v] >= n0 && rval[v] != 4)
+        out.new_irregular = out.new_irregular == kNoIndex ? r2w[v] : kNoIndex - 1;
+    if (out.new_irregular == kNoIndex - 1) out.new_irregular = kNoIndex;
+
+    // Free vertices: the new ones, then rings of old ones around the cavity (never CAD vertices).
+    std::vector<char> in_cavity(static_cast<std::size_t>(t.num_quads()), 0);
+    for (const LO q : c.quads) in_cavity[q] = 1;
+    std::set<LO> free_old;
+    std::vector<LO> ring(c.boundary.begin(), c.boundary.end());
+    std::set<LO> seen(ring.begin(), ring.end());
+    for (const LO v : c.interior) seen.insert(v);
+    for (int k = 1; k <= o_.smooth_rings; ++k) {
+      for (const LO v : ring)
+        if (w_.vclass[v].dim == 2 && !t.on_boundary(v)) free_old.insert(v);
+      if (k == o_.smooth_rings) break;
+      std::vector<LO> next_ring;
+      for (const LO v : ring)
+        for (const LO q : t.quads_of(v)) {
+          if (in_cavity[q]) continue;
+          for (const LO x : w_.quads[q])
+            if (seen.insert(x).second) next_ring.push_back(x);
+        }
+      std::sort(next_ring.begin(), next_ring.end());
+      ring = std::move(next_ring);
+    }
+    // Region: the new quads and the old ones around a free old vertex.
+    std::set<LO> old_quads;
+    for (const LO v : free_old)
+      for (const LO q : t.quads_of(v))
+        if (!in_cavity[q]) old_quads.insert(q);
+
+    double before = std::numeric_limits<double>::max(), before_sum = 0;
+    for (const LO q : c.quads) {
+      const double x = quad_quality(w_.points, w_.uv, w_.quads[q], s_, sign_);
+      before = std::min(before, x);
+      before_sum += x;
+    }
+    for (const LO q : old_quads)
+      before = std::min(before, quad_quality(w_.points, w_.uv, w_.quads[q], s_, sign_));
+
+    // Local mesh: old vertices first (locked ones relabelled so that the smoother keeps them), new
+    // ones after, in work order.
+    std::vector<LO> verts;
+    for (const auto& q : out.quads)
+      for (const LO v : q)
+        if (v < n0) verts.push_back(v);
+    for (const LO q : old_quads)
+      for (const LO v : w_.quads[q]) verts.push_back(v);
+    std::sort(verts.begin(), verts.end());
+    verts.erase(std::unique(verts.begin(), verts.end()), verts.end());
+    const LO nold = static_cast<LO>(verts.size());
+    const auto local = [&](LO v) -> LO {
+      if (v >= n0) return nold + (v - n0);
+      return static_cast<LO>(std::lower_bound(verts.begin(), verts.end(), v) - verts.begin());
+    };
+    mesh::FaceMesh lm;
+    lm.face = w_.face;
+    lm.points.resize(nold + n_new);
+    lm.uv.resize(nold + n_new);
+    lm.vclass.resize(nold + n_new);
+    for (LO i = 0; i < nold; ++i) {
+      const LO v = verts[i];
+      lm.points[i] = w_.points[v];
+      lm.uv[i] = w_.uv[v];
+      lm.vclass[i] = w_.vclass[v];
+      if (lm.vclass[i].dim == 2 && !free_old.count(v))
+        lm.vclass[i] = mesh::VertexClass{1, -2, i, {0, 0}};
+    }
+    for (const auto& q : out.quads)
+      lm.quads.push_back({local(q[0]), local(q[1]), local(q[2]), local(q[3])});
+    const LO n_new_quads = static_cast<LO>(lm.quads.size());
+    for (const LO q : old_quads) {
+      const auto& qd = w_.quads[q];
+      lm.quads.push_back({local(qd[0]), local(qd[1]), local(qd[2]), local(qd[3])});
+    }
+    // Laplace layout of the new vertices on the new quads only, the cavity boundary fixed.
+    {
+      std::vector<std::array<LO, 4>> nq(lm.quads.begin(), lm.quads.begin() + n_new_quads);
+      if (!laplace_uv(nq, nold, lm.uv)) return false;
+    }
+    for (LO i = nold; i < nold + n_new; ++i) {
+      lm.points[i] = s_.eval(lm.uv[i]).p;
+      lm.vclass[i] = mesh::VertexClass{2, w_.face, kNoIndex, {lm.uv[i].u, lm.uv[i].v}};
+    }
+    lm = smooth::smooth_face(lm, s_, o_.smooth);
+
+    double after = std::numeric_limits<double>::max(), after_sum = 0;
+    for (LO q = 0; q < static_cast<LO>(lm.quads.size()); ++q) {
+      const double x = quad_quality(lm.points, lm.uv, lm.quads[q], s_, sign_);
+      after = std::min(after, x);
+      if (q < n_new_quads) after_sum += x;
+    }
+    const double need = std::max(o_.min_sicn, std::min(o_.good_sicn, o_.keep_ratio * before));
+    if (!(after > o_.min_sicn) || after < need) return false;
+    const double avg_before = before_sum / static_cast<double>(c.quads.size());
+    if (after_sum / static_cast<double>(n_new_quads) < o_.keep_avg_ratio * avg_before) return false;
+
+    for (LO i = nold; i < nold + n_new; ++i) {
+      out.new_uv.push_back(lm.uv[i]);
+      out.new_points.push_back(lm.points[i]);
+    }
+    for (LO i = 0; i < nold; ++i) {
+      const LO v = verts[i];
+      if (!free_old.count(v)) continue;
+      if (lm.uv[i] == w_.uv[v] && lm.points[i] == w_.points[v]) continue;
+      out.moved.push_back(v);
+      out.moved_uv.push_back(lm.uv[i]);
+      out.moved_points.push_back(lm.points[i]);
+    }
+    return true;
+  }
+
+  void commit(const Cavity& c, const Replacement& r) {
+    for (std::size_t i = 0; i < r.new_uv.size(); ++i) {
+      w_.points.push_back(r.new_points[i]);
+      w_.uv.push_back(r.new_uv[i]);
+      w_.vclass.push_back(mesh::VertexClass{2, w_.face, kNoIndex, {r.new_uv[i].u, r.new_uv[i].v}});
+    }
+    for (std::size_t i = 0; i < r.moved.size(); ++i) {
+      const LO v = r.moved[i];
+      w_.points[v] = r.moved_points[i];
+      w_.uv[v] = r.moved_uv[i];
+      w_.vclass[v].param = {r.moved_uv[i].u, r.moved_uv[i].v};
+    }
+    std::vector<char> gone(w_.quads.size(), 0);
+    for (const LO q : c.quads) gone[q] = 1;
+    std::vector<std::array<LO, 4>> quads;
+    quads.reserve(w_.quads.size() - c.quads.size() + r.quads.size());
+    for (std::size_t q = 0; q < w_.quads.size(); ++q)
+      if (!gone[q]) quads.push_back(w_.quads[q]);
+    quads.insert(quads.end(), r.quads.begin(), r.quads.end());
+    w_.quads = std::move(quads);
+  }
+
+ private:
+  mesh::FaceMesh& w_;
+  const cad::FaceGeometry& s_;
+  const CavityOptions& o_;
+  double sign_;
+};
+
+// Corners have valence 1, other boundary vertices valence 2: the pattern fits convex cavities.
+bool convex_pattern(const Pattern& p) {
+  std::vector<char> corner(static_cast<std::size_t>(p.num_vertices()), 0);
+  for (const LO s : p.side_start) corner[p.boundary[s]] = 1;
+  for (const LO v : p.boundary)
+    if (!corner[v] && p.valence[v] != 2) return false;
+  return true;
+}
+
+std::vector<Pattern> select(std::span<const Pattern> patterns, int sides, bool regular_only) {
+  std::vector<Pattern> out;
+  for (const auto& p : patterns)
+    if (p.num_sides() == sides && convex_pattern(p) && (!regular_only || p.irregular == 0))
+      out.push_back(p);
+  return out;
+}
+
+}  // namespace
+
+GrowResult grow_cavity(const mesh::FaceMesh& mesh, const QuadTopology& topo, LO seed,
+                       std::span<const char> singular, const GrowOptions& options) {
+  QSMESH_CHECK(topo.num_vertices() == mesh.num_vertices() &&
+                   topo.num_quads() == static_cast<LO>(mesh.quads.size()),
+               "the topology does not belong to the mesh");
+  QSMESH_CHECK(static_cast<LO>(singular.size()) == mesh.num_vertices(),
+               "one singular flag per vertex");
+  QSMESH_CHECK(seed >= 0 && seed < mesh.num_vertices(), "seed " << seed << " out of range");
+  return Grower(mesh, topo, seed, singular, options).run();
+}
+
+std::int64_t count_irregular(const mesh::FaceMesh& mesh) {
+  const QuadTopology t(mesh);
+  std::int64_t n = 0;
+  for (LO v = 0; v < mesh.num_vertices(); ++v)
+    n += interior_vertex(mesh, t, v) && t.valence(v) != 4 ? 1 : 0;
+  return n;
+}
+
+mesh::FaceMesh remesh_cavities(const mesh::FaceMesh& input, const cad::FaceGeometry& surface,
+                               std::span<const crossfield::Singularity> singularities,
+                               std::span<const Pattern> patterns, const CavityOptions& options,
+                               CavityReport* report) {
+  CavityReport local;
+  CavityReport& rep = report != nullptr ? *report : local;
+  rep = CavityReport{};
+  for (const auto& s : singularities)
+    if (s.where != crossfield::Singularity::Where::AcuteCorner && (s.index == 1 || s.index == -1))
+      ++rep.singularities;
+  const auto q0 = smooth::measure(input);
+  rep.sicn_min_before = rep.sicn_min_after = q0.sicn_min;
+  rep.sicn_avg_before = rep.sicn_avg_after = q0.sicn_avg;
+  if (!input.triangles.empty()) {
+    rep.skipped = "the mesh has triangles";
+    return input;
+  }
+  if (input.quads.empty()) {
+    rep.skipped = "no quads";
+    return input;
+  }
+  try {
+    QSMESH_CHECK(
+        input.uv.size() == input.points.size() && input.vclass.size() == input.points.size(),
+        "points, uv and vclass sizes differ");
+    mesh::FaceMesh work = input;
+    QuadTopology topo(work);
+    rep.irregular_before = count_irregular(work);
+    const double sign = orientation(work, surface);
+
+    // Flag the singular vertices: nearest free vertex of the singularity's valence within the
+    // bound.
+    std::vector<char> singular(static_cast<std::size_t>(work.num_vertices()), 0);
+    std::vector<LO> flagged;      // flagged vertex of each accepted singularity
+    std::vector<LO> flagged_val;  // its valence
+    for (const auto& s : singularities) {
+      if (s.where == crossfield::Singularity::Where::AcuteCorner || (s.index != 1 && s.index != -1))
+        continue;
+      const LO want = s.index == 1 ? 3 : 5;
+      LO best = kNoIndex;
+      double best_d = std::numeric_limits<double>::max();
+      for (LO v = 0; v < work.num_vertices(); ++v) {
+        if (!interior_vertex(work, topo, v) || topo.valence(v) != want || singular[v]) continue;
+        const double d = distance(work.points[v], s.position);
+        if (!(d < best_d)) continue;
+        double h = 0;
+        int ne = 0;
+        for (const LO q : topo.quads_of(v)) {
+          const auto& qd = work.quads[q];
+          int k = 0;
+          while (qd[k] != v) ++k;
+          h += distance(work.points[v], work.points[qd[(k + 1) % 4]]);
+          ++ne;
+        }
+        if (d <= options.singularity_distance * h / ne) {
+          best = v;
+          best_d = d;
+        }
+      }
+      if (best != kNoIndex) {
+        singular[best] = 1;
+        flagged.push_back(best);
+        flagged_val.push_back(want);
+      }
+    }
+    rep.flagged = static_cast<std::int64_t>(flagged.size());
+
+    const std::vector<Pattern> grid = select(patterns, 4, true);
+    const std::vector<Pattern> four = select(patterns, 4, false);
+    const std::vector<Pattern> tri = select(patterns, 3, false);
+    const std::vector<Pattern> pent = select(patterns, 5, false);
+
+    Remesher remesher(work, surface, options, sign);
+    const Stopwatch clock;
+    std::int64_t started = 0;
+    bool stop = false;
+    const auto out_of_budget = [&] {
+      if (options.max_cavities > 0 && started >= options.max_cavities) {
+        rep.work_bound_hit = true;
+        return true;
+      }
+      if (options.time_budget_s > 0 && clock.seconds() > options.time_budget_s) {
+        rep.time_budget_hit = true;
+        return true;
+      }
+      return false;
+    };
+
+    // One growth from `seed` and the geometric trials of what it found; true when committed.
+    const auto grow_and_remesh = [&](int step, LO seed, std::span<const Pattern> pats, bool maximal,
+                                     bool from_singularity, LO* new_singular) {
+      ++started;
+      ++rep.grown[step];
+      GrowOptions go;
+      go.maximal = maximal;
+      go.patterns = pats;
+      go.seed_is_singularity = from_singularity;
+      go.max_quads = maximal ? options.max_quads_maximal : options.max_quads_minimal;
+      go.max_candidates = options.max_candidates;
+      go.max_quad_change = options.max_quad_change;
+      go.match = options.match;
+      const GrowResult g = grow_cavity(work, topo, seed, singular, go);
+      const int n = static_cast<int>(g.remeshable.size());
+      const int tries =
+          maximal ? std::min(n, std::max(1, options.max_geometric_tries)) : std::min(n, 1);
+      for (int k = 0; k < tries; ++k) {
+        const Cavity& c = g.remeshable[n - 1 - k];
+        for (const auto& match : c.matches) {
+          Replacement r;
+          if (!remesher.build(topo, c, match, pats, r)) continue;
+          remesher.commit(c, r);
+          singular.resize(work.points.size(), 0);
+          topo = QuadTopology(work);
+          ++rep.remeshed[step];
+          if (new_singular != nullptr) *new_singular = r.new_irregular;
+          return true;
+        }
+        ++rep.rejected_quality[step];
+      }
+      return false;
+    };
+
+    const auto unnecessary_step = [&](int step, std::span<const Pattern> pats, bool maximal) {
+      if (pats.empty()) return false;
+      bool changed = false;
+      std::vector<LO> seeds;
+      for (LO v = 0; v < work.num_vertices(); ++v)
+        if (interior_vertex(work, topo, v) && topo.valence(v) != 4 && !singular[v])
+          seeds.push_back(v);
+      for (const LO v : seeds) {
+        if (!interior_vertex(work, topo, v) || topo.valence(v) == 4 || singular[v])
+          continue;  // changed since
+        if (out_of_budget()) {
+          stop = true;
+          break;
+        }
+        changed = grow_and_remesh(step, v, pats, maximal, false, nullptr) || changed;
+      }
+      return changed;
+    };
+
+    const auto singular_step = [&] {
+      bool changed = false;
+      for (std::size_t i = 0; i < flagged.size(); ++i) {
+        const LO v = flagged[i];
+        if (v == kNoIndex || !interior_vertex(work, topo, v)) continue;
+        const std::vector<Pattern>& pats = flagged_val[i] == 3 ? tri : pent;
+        if (pats.empty() || topo.valence(v) != flagged_val[i]) continue;
+        if (out_of_budget()) {
+          stop = true;
+          break;
+        }
+        LO moved_to = kNoIndex;
+        if (grow_and_remesh(1, v, pats, false, true, &moved_to)) {
+          changed = true;
+          singular[v] = 0;
+          flagged[i] = moved_to;
+          if (moved_to != kNoIndex) singular[moved_to] = 1;
+        }
+      }
+      return changed;
+    };
+
+    for (int round = 0; round < options.max_rounds && !stop; ++round) {
+      ++rep.rounds;
+      const auto& on = options.steps;
+      bool changed = on[0] && unnecessary_step(0, grid, true);
+      if (!stop && on[1]) changed = singular_step() || changed;
+      if (!stop && on[2]) changed = unnecessary_step(2, grid, true) || changed;
+      if (!stop && on[3]) changed = unnecessary_step(3, four, false) || changed;
+      if (!changed) break;
+    }
+
+    for (std::size_t i = 0; i < flagged.size(); ++i)
+      if (flagged[i] != kNoIndex && interior_vertex(work, topo, flagged[i]) &&
+          topo.valence(flagged[i]) == flagged_val[i])
+        ++rep.flagged_kept;
+
+    // Compaction: drop the vertices no quad uses any more (face-interior ones only), keep order.
+    mesh::FaceMesh out;
+    out.face = work.face;
+    std::vector<LO> old2new(static_cast<std::size_t>(work.num_vertices()), kNoIndex);
+    for (LO v = 0; v < work.num_vertices(); ++v) {
+      if (topo.valence(v) == 0 && work.vclass[v].dim == 2) continue;
+      old2new[v] = out.num_vertices();
+      out.points.push_back(work.points[v]);
+      out.uv.push_back(work.uv[v]);
+      out.vclass.push_back(work.vclass[v]);
+    }
+    out.quads.reserve(work.quads.size());
+    for (const auto& q : work.quads)
+      out.quads.push_back({old2new[q[0]], old2new[q[1]], old2new[q[2]], old2new[q[3]]});
+    rep.irregular_after = count_irregular(out);
+    const auto q1 = smooth::measure(out);
+    rep.sicn_min_after = q1.sicn_min;
+    rep.sicn_avg_after = q1.sicn_avg;
+    return out;
+  } catch (const Error& e) {
+    rep.skipped = e.with_context(ErrorContext{"qstruct", 2, input.face}).what();
+    rep.irregular_after = rep.irregular_before;
+    return input;
+  }
+}
+
+}  // namespace qsmesh::qstruct

@@ -1,0 +1,490 @@
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "qsmesh/core/error.hpp"
+#include "qsmesh/mesh/quality.hpp"
+#include "qsmesh/qstruct/cavity.hpp"
+
+namespace qsmesh::qstruct {
+namespace {
+
+class Plane : public cad::FaceGeometry {
+ public:
+  [[nodiscard]] cad::SurfaceEval eval(const Vec2& uv) const override {
+    return {{uv.u, uv.v, 0}, {1, 0, 0}, {0, 1, 0}};
+  }
+  [[nodiscard]] cad::SurfaceEval2 eval2(const Vec2& uv) const override {
+    cad::SurfaceEval2 e;
+    static_cast<cad::SurfaceEval&>(e) = eval(uv);
+    return e;
+  }
+  [[nodiscard]] Vec3 normal(const Vec2&) const override { return {0, 0, 1}; }
+  [[nodiscard]] Vec2 project(const Vec3& p, const Vec2&, Vec3* foot) const override {
+    if (foot) *foot = {p.x, p.y, 0};
+    return {p.x, p.y};
+  }
+  [[nodiscard]] Vec2 boundary_uv(LO, LO, double) const override { return {}; }
+  [[nodiscard]] bool contains(const Vec2&) const override { return true; }
+};
+
+// nx x ny grid of unit squares on face 0: boundary vertices first (counter-clockwise from the
+// origin, corners dim 0, the rest on curves 0..3), interior vertices after, quads
+// counter-clockwise.
+mesh::FaceMesh grid(int nx, int ny) {
+  mesh::FaceMesh m;
+  m.face = 0;
+  std::map<std::pair<int, int>, LO> id;
+  const auto add = [&](int i, int j, mesh::VertexClass c) {
+    id[{i, j}] = m.num_vertices();
+    m.points.push_back({double(i), double(j), 0});
+    m.uv.push_back({double(i), double(j)});
+    m.vclass.push_back(c);
+  };
+  std::vector<std::pair<int, int>> loop;
+  for (int i = 0; i < nx; ++i) loop.emplace_back(i, 0);
+  for (int j = 0; j < ny; ++j) loop.emplace_back(nx, j);
+  for (int i = nx; i > 0; --i) loop.emplace_back(i, ny);
+  for (int j = ny; j > 0; --j) loop.emplace_back(0, j);
+  LO corner = 0;
+  for (std::size_t k = 0; k < loop.size(); ++k) {
+    const auto [i, j] = loop[k];
+    const bool is_corner = (i == 0 || i == nx) && (j == 0 || j == ny);
+    const int side = j == 0 && i < nx ? 0 : (i == nx && j < ny ? 1 : (j == ny && i > 0 ? 2 : 3));
+    add(i, j,
+        is_corner ? mesh::VertexClass{0, corner++, kNoIndex, {0, 0}}
+                  : mesh::VertexClass{1, side, static_cast<LO>(k), {double(k), 0}});
+  }
+  for (int j = 1; j < ny; ++j)
+    for (int i = 1; i < nx; ++i)
+      add(i, j, mesh::VertexClass{2, 0, kNoIndex, {double(i), double(j)}});
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i)
+      m.quads.push_back({id[{i, j}], id[{i + 1, j}], id[{i + 1, j + 1}], id[{i, j + 1}]});
+  return m;
+}
+
+LO vertex_at(const mesh::FaceMesh& m, double x, double y) {
+  for (LO v = 0; v < m.num_vertices(); ++v)
+    if (m.points[v].x == x && m.points[v].y == y) return v;
+  return kNoIndex;
+}
+
+// Rotates the edge shared by two quads: the two quads (a b e f), (b c d e) sharing b-e become
+// (a b c f), (c d e f). b and e lose a quad (valence 3), c and f gain one (valence 5). Then the
+// interior is smoothed so that the input is valid.
+void rotate_edge(mesh::FaceMesh& m, LO b, LO e) {
+  std::vector<LO> qs;
+  for (LO q = 0; q < static_cast<LO>(m.quads.size()); ++q) {
+    const auto& qd = m.quads[q];
+    for (int k = 0; k < 4; ++k)
+      if ((qd[k] == b && qd[(k + 1) % 4] == e) || (qd[k] == e && qd[(k + 1) % 4] == b))
+        qs.push_back(q);
+  }
+  ASSERT_EQ(qs.size(), 2u);
+  // Rotate both quads so that quad 0 is (x b e y) ... i.e. find the cycle (a b c d e f) of the
+  // hexagon.
+  auto at = [&](LO q, LO v) {
+    int k = 0;
+    while (m.quads[q][k] != v) ++k;
+    return k;
+  };
+  LO q1 = qs[0], q2 = qs[1];
+  // q1 holds b -> e? then swap roles so that q1 has e -> b, i.e. q1 = (a b e f) reads b then e
+  // backwards.
+  int k = at(q1, b);
+  if (m.quads[q1][(k + 1) % 4] != e) std::swap(q1, q2);
+  // q1 = (b e f a) in cyclic order, q2 = (e b c d).
+  k = at(q1, b);
+  const LO f = m.quads[q1][(k + 2) % 4], a = m.quads[q1][(k + 3) % 4];
+  const int k2 = at(q2, e);
+  const LO c = m.quads[q2][(k2 + 2) % 4], d = m.quads[q2][(k2 + 3) % 4];
+  // Hexagon b e f a ... cyclic: a b ... going around: (b, c, d, e, f, a) with q1 = b e f a, q2 = e
+  // b c d. New diagonal joins c and f: quads (f a b c) and (c d e f), same orientation.
+  m.quads[q1] = {f, a, b, c};
+  m.quads[q2] = {c, d, e, f};
+}
+
+std::map<LO, int> interior_valences(const mesh::FaceMesh& m) {
+  std::vector<int> val(m.num_vertices(), 0);
+  for (const auto& q : m.quads)
+    for (const LO v : q) ++val[v];
+  std::map<LO, int> out;
+  for (LO v = 0; v < m.num_vertices(); ++v)
+    if (m.vclass[v].dim == 2 && val[v] != 0) out[v] = val[v];
+  return out;
+}
+
+double min_sicn(const mesh::FaceMesh& m) {
+  double w = 2;
+  for (const auto& q : m.quads)
+    w = std::min(w,
+                 mesh::quad_sicn({m.points[q[0]], m.points[q[1]], m.points[q[2]], m.points[q[3]]}));
+  return w;
+}
+
+// An nx x ny grid with rotated edges (two valence-3 and two valence-5 vertices each), smoothed.
+mesh::FaceMesh perturbed(const Plane& plane, int nx = 10, int ny = 8,
+                         const std::vector<std::array<double, 4>>& edges = {{4, 4, 5, 4}}) {
+  mesh::FaceMesh m = grid(nx, ny);
+  for (const auto& e : edges) rotate_edge(m, vertex_at(m, e[0], e[1]), vertex_at(m, e[2], e[3]));
+  smooth::SmoothOptions so;
+  so.iterations = 20;
+  return smooth::smooth_face(m, plane, so);
+}
+
+// The CAD-classified vertices are kept, in the same order, with the same points, uv and class.
+void expect_boundary_kept(const mesh::FaceMesh& in, const mesh::FaceMesh& out) {
+  std::vector<LO> a, b;
+  for (LO v = 0; v < in.num_vertices(); ++v)
+    if (in.vclass[v].dim < 2) a.push_back(v);
+  for (LO v = 0; v < out.num_vertices(); ++v)
+    if (out.vclass[v].dim < 2) b.push_back(v);
+  ASSERT_EQ(a.size(), b.size());
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const LO v = a[i], w = b[i];
+    EXPECT_EQ(out.vclass[w].dim, in.vclass[v].dim);
+    EXPECT_EQ(out.vclass[w].entity, in.vclass[v].entity);
+    EXPECT_EQ(out.vclass[w].index, in.vclass[v].index);
+    EXPECT_EQ(out.points[w], in.points[v]);
+    EXPECT_TRUE(out.uv[w] == in.uv[v]);
+  }
+}
+
+TEST(Cavity, Topology) {
+  const mesh::FaceMesh m = grid(3, 2);
+  const QuadTopology t(m);
+  EXPECT_EQ(t.num_quads(), 6);
+  const LO center = vertex_at(m, 1, 1);
+  EXPECT_EQ(t.valence(center), 4);
+  EXPECT_FALSE(t.on_boundary(center));
+  EXPECT_TRUE(t.on_boundary(vertex_at(m, 0, 0)));
+  EXPECT_EQ(t.valence(vertex_at(m, 0, 0)), 1);
+  int boundary_edges = 0;
+  for (LO q = 0; q < t.num_quads(); ++q)
+    for (int k = 0; k < 4; ++k) {
+      const LO n = t.neighbour(q, k);
+      if (n == kNoIndex) {
+        ++boundary_edges;
+        continue;
+      }
+      bool back = false;
+      for (int j = 0; j < 4; ++j) back = back || t.neighbour(n, j) == q;
+      EXPECT_TRUE(back);
+    }
+  EXPECT_EQ(boundary_edges, 10);
+  mesh::FaceMesh bad = m;
+  bad.quads[1] = {bad.quads[1][3], bad.quads[1][2], bad.quads[1][1], bad.quads[1][0]};  // flipped
+  EXPECT_THROW({ const QuadTopology bad_topology(bad); }, Error);
+}
+
+TEST(Cavity, Step1RemovesUnnecessaryPair) {
+  const Plane plane;
+  const mesh::FaceMesh in = perturbed(plane);
+  ASSERT_GT(min_sicn(in), 0);
+  ASSERT_EQ(count_irregular(in), 4);
+  CavityReport rep;
+  const auto patterns = builtin_patterns();
+  const mesh::FaceMesh out = remesh_cavities(in, plane, {}, patterns, CavityOptions{}, &rep);
+  EXPECT_TRUE(rep.skipped.empty()) << rep.skipped;
+  EXPECT_EQ(rep.irregular_before, 4);
+  EXPECT_EQ(rep.irregular_after, 0);
+  EXPECT_GE(rep.remeshed[0], 1);
+  for (const auto& [v, val] : interior_valences(out)) EXPECT_EQ(val, 4) << "vertex " << v;
+  EXPECT_GT(min_sicn(out), 0.5);
+  EXPECT_EQ(out.quads.size(), in.quads.size());
+  expect_boundary_kept(in, out);
+  // Quads keep facing +z (counter-clockwise in the plane).
+  for (const auto& q : out.quads) {
+    const Vec3 n = cross(out.points[q[1]] - out.points[q[0]], out.points[q[2]] - out.points[q[0]]);
+    EXPECT_GT(n.z, 0);
+  }
+}
+
+TEST(Cavity, Step1IsLocal) {
+  const Plane plane;
+  const mesh::FaceMesh in = perturbed(plane, 16, 16);
+  CavityOptions options;
+  options.max_quads_maximal = 30;
+  CavityReport rep;
+  const auto patterns = builtin_patterns();
+  const mesh::FaceMesh out = remesh_cavities(in, plane, {}, patterns, options, &rep);
+  EXPECT_EQ(rep.irregular_after, 0);
+  EXPECT_GE(rep.remeshed[0], 1);
+  EXPECT_GT(min_sicn(out), 0.5);
+  expect_boundary_kept(in, out);
+  // Far from the rotated edge nothing moved (ids shift when vertices are dropped; points do not).
+  const Vec3 pair{4.5, 4, 0};
+  std::set<std::array<double, 3>> kept;
+  for (const auto& p : out.points) kept.insert({p.x, p.y, p.z});
+  int far = 0, missing = 0;
+  for (LO v = 0; v < in.num_vertices(); ++v) {
+    if (distance(in.points[v], pair) < 9) continue;
+    ++far;
+    missing += kept.count({in.points[v].x, in.points[v].y, in.points[v].z}) ? 0 : 1;
+  }
+  EXPECT_GT(far, 50);
+  EXPECT_EQ(missing, 0);
+}
+
+TEST(Cavity, SingularityIsNeverInside) {
+  const Plane plane;
+  const mesh::FaceMesh m = perturbed(plane);
+  const QuadTopology t(m);
+  // Flag one of the valence-3 vertices; grow from the other irregular ones.
+  std::vector<char> singular(m.num_vertices(), 0);
+  LO s = kNoIndex;
+  std::vector<LO> others;
+  for (const auto& [v, val] : interior_valences(m)) {
+    if (val == 3 && s == kNoIndex) {
+      s = v;
+    } else if (val != 4) {
+      others.push_back(v);
+    }
+  }
+  ASSERT_NE(s, kNoIndex);
+  ASSERT_EQ(others.size(), 3u);
+  singular[s] = 1;
+  const auto patterns = builtin_patterns();
+  std::vector<Pattern> four;
+  for (const auto& p : patterns)
+    if (p.num_sides() == 4) four.push_back(p);
+  for (const bool maximal : {false, true}) {
+    GrowOptions go;
+    go.maximal = maximal;
+    go.patterns = four;
+    for (const LO seed : others) {
+      const GrowResult g = grow_cavity(m, t, seed, singular, go);
+      for (const auto& c : g.remeshable) {
+        EXPECT_EQ(std::count(c.interior.begin(), c.interior.end(), s), 0);
+        EXPECT_LT(c.irregularity_after, c.irregularity_before);
+        EXPECT_FALSE(c.matches.empty());
+        // Convex: every boundary vertex inside the face has n_out != 1.
+        for (std::size_t i = 0; i < c.boundary.size(); ++i) {
+          const LO v = c.boundary[i];
+          if (!t.on_boundary(v)) {
+            EXPECT_NE(t.valence(v) - c.n_in[i], 1);
+          }
+        }
+        LO sum = 0;
+        for (const LO e : c.side_edges) sum += e;
+        EXPECT_EQ(sum, static_cast<LO>(c.boundary.size()));
+      }
+    }
+  }
+  // Without the flag, a maximal growth from a valence-5 vertex finds a grid cavity holding all
+  // four.
+  std::vector<char> none(m.num_vertices(), 0);
+  std::vector<Pattern> grid_only{patterns[0]};
+  GrowOptions go;
+  go.maximal = true;
+  go.patterns = grid_only;
+  const GrowResult g = grow_cavity(m, t, others.back(), none, go);
+  ASSERT_FALSE(g.remeshable.empty());
+  EXPECT_EQ(std::count(g.remeshable.back().interior.begin(), g.remeshable.back().interior.end(), s),
+            1);
+}
+
+TEST(Cavity, FlaggedSingularityIsPreserved) {
+  const Plane plane;
+  const mesh::FaceMesh in = perturbed(plane);
+  LO s = kNoIndex;
+  for (const auto& [v, val] : interior_valences(in))
+    if (val == 3) {
+      s = v;
+      break;
+    }
+  ASSERT_NE(s, kNoIndex);
+  crossfield::Singularity sing;
+  sing.position = in.points[s];
+  sing.index = 1;
+  CavityReport rep;
+  const auto patterns = builtin_patterns();
+  const std::vector<crossfield::Singularity> sings{sing};
+  const mesh::FaceMesh out = remesh_cavities(in, plane, sings, patterns, CavityOptions{}, &rep);
+  EXPECT_TRUE(rep.skipped.empty()) << rep.skipped;
+  EXPECT_EQ(rep.flagged, 1);
+  EXPECT_EQ(rep.flagged_kept, 1);
+  // A valence-3 vertex remains near the singularity, and the mesh is valid.
+  bool found = false;
+  for (const auto& [v, val] : interior_valences(out))
+    if (val == 3 && distance(out.points[v], sing.position) < 3.0) found = true;
+  EXPECT_TRUE(found);
+  EXPECT_LE(rep.irregular_after, rep.irregular_before);
+  EXPECT_GE(rep.irregular_after, 1);
+  EXPECT_GT(min_sicn(out), 0);
+  expect_boundary_kept(in, out);
+}
+
+// A pattern with one interior vertex (triangle: valence 3, pentagon: valence 5) refined with n
+// edges per chord, laid out on a regular polygon of side 2n (the boundary on the polygon, the
+// interior by smoothing).
+mesh::FaceMesh polygon_face(const Plane& plane, const std::string& name, LO n, LO* centre) {
+  const auto patterns = builtin_patterns();
+  const Pattern* pat = nullptr;
+  for (const auto& p : patterns)
+    if (p.name == name) pat = &p;
+  EXPECT_NE(pat, nullptr);
+  const std::vector<LO> chords(static_cast<std::size_t>(pat->num_chords), n);
+  const RefinedPattern r = refine_pattern(*pat, chords);
+  const int sides = pat->num_sides();
+  const double radius = n / std::sin(std::numbers::pi / sides);
+  std::vector<Vec2> corner;
+  for (int k = 0; k < sides; ++k) {
+    const double a = 2 * std::numbers::pi * k / sides;
+    corner.push_back({radius * std::cos(a), radius * std::sin(a)});
+  }
+  mesh::FaceMesh m;
+  m.face = 0;
+  m.points.resize(r.num_vertices);
+  m.uv.assign(r.num_vertices, Vec2{0, 0});
+  m.vclass.assign(r.num_vertices, mesh::VertexClass{2, 0, kNoIndex, {0, 0}});
+  const LO nb = static_cast<LO>(r.boundary.size());
+  for (int side = 0; side < sides; ++side) {
+    const LO b0 = r.side_start[side], b1 = side + 1 < sides ? r.side_start[side + 1] : nb;
+    for (LO p = b0; p < b1; ++p) {
+      const double t = double(p - b0) / double(b1 - b0);
+      const LO v = r.boundary[p];
+      m.uv[v] = corner[side] * (1 - t) + corner[(side + 1) % sides] * t;
+      m.vclass[v] = p == b0 ? mesh::VertexClass{0, side, kNoIndex, {0, 0}}
+                            : mesh::VertexClass{1, side, p, {t, 0}};
+    }
+  }
+  for (LO v = 0; v < r.num_vertices; ++v) m.points[v] = plane.eval(m.uv[v]).p;
+  m.quads = r.quads;
+  *centre = kNoIndex;
+  for (LO v = 0; v < pat->num_vertices(); ++v)
+    if (std::count(pat->boundary.begin(), pat->boundary.end(), v) == 0)
+      *centre = r.coarse_vertex[v];
+  return m;
+}
+
+// The polygon face of `name` with one edge rotated two steps from the centre (one more +1/-1
+// pair on each side of it), smoothed, the centre flagged by a singularity of `index`: the
+// remeshing ends with the centre's irregular vertex only.
+void absorb_pair(const std::string& name, int index, const CavityOptions& options, int by_step) {
+  const Plane plane;
+  LO centre = kNoIndex;
+  mesh::FaceMesh m = polygon_face(plane, name, 6, &centre);
+  const LO valence = index == 1 ? 3 : 5;
+  {
+    const QuadTopology t(m);
+    ASSERT_EQ(t.valence(centre), valence);
+    // An edge two steps away from the centre, between valence-4 interior vertices.
+    LO b = kNoIndex, e = kNoIndex;
+    for (const LO q : t.quads_of(centre)) {
+      const auto& qd = m.quads[q];
+      int k = 0;
+      while (qd[k] != centre) ++k;
+      const LO n1 = qd[(k + 1) % 4], n2 = qd[(k + 2) % 4];
+      if (t.valence(n1) == 4 && t.valence(n2) == 4 && !t.on_boundary(n1) && !t.on_boundary(n2)) {
+        b = n1;
+        // From n1, a neighbour outside the quads around the centre.
+        for (const LO q2 : t.quads_of(n1)) {
+          const auto& d = m.quads[q2];
+          if (std::count(d.begin(), d.end(), centre)) continue;
+          int j = 0;
+          while (d[j] != n1) ++j;
+          for (const LO x : {d[(j + 1) % 4], d[(j + 3) % 4]}) {
+            bool touches_centre_quad = false;
+            for (const LO q3 : t.quads_of(centre))
+              touches_centre_quad =
+                  touches_centre_quad || std::count(m.quads[q3].begin(), m.quads[q3].end(), x);
+            if (!touches_centre_quad && !t.on_boundary(x) && e == kNoIndex) e = x;
+          }
+        }
+        break;
+      }
+    }
+    ASSERT_NE(e, kNoIndex);
+    rotate_edge(m, b, e);
+  }
+  smooth::SmoothOptions so;
+  so.iterations = 30;
+  m = smooth::smooth_face(m, plane, so);
+  ASSERT_GT(min_sicn(m), 0);
+  ASSERT_EQ(count_irregular(m), 5);
+  crossfield::Singularity sing;
+  sing.position = m.points[centre];
+  sing.index = index;
+  const std::vector<crossfield::Singularity> sings{sing};
+  CavityReport rep;
+  const auto patterns = builtin_patterns();
+  const mesh::FaceMesh out = remesh_cavities(m, plane, sings, patterns, options, &rep);
+  EXPECT_EQ(rep.flagged, 1);
+  EXPECT_EQ(rep.flagged_kept, 1);
+  EXPECT_EQ(rep.irregular_after, 1);
+  std::map<int, int> hist;
+  for (const auto& [v, val] : interior_valences(out)) ++hist[val];
+  EXPECT_EQ(hist[valence], 1);
+  EXPECT_GT(min_sicn(out), 0.3);
+  EXPECT_GE(rep.remeshed[by_step - 1], 1);
+  expect_boundary_kept(m, out);
+}
+
+// Step 2: the singularity absorbs the pair (a triangular cavity around the valence-3 centre).
+TEST(Cavity, PlusOneSingularityAbsorbsAPair) { absorb_pair("triangle", 1, CavityOptions{}, 2); }
+
+TEST(Cavity, MinusOneSingularityAbsorbsAPair) {
+  // All steps: Step 1 finds a grid cavity beside the centre.
+  absorb_pair("pentagon", -1, CavityOptions{}, 1);
+  // Step 2 alone: a pentagonal cavity around the valence-5 centre.
+  CavityOptions only2;
+  only2.steps = {false, true, false, false};
+  absorb_pair("pentagon", -1, only2, 2);
+}
+
+TEST(Cavity, Deterministic) {
+  const Plane plane;
+  const mesh::FaceMesh in = perturbed(plane, 12, 10, {{4, 4, 5, 4}, {9, 2, 9, 3}});
+  ASSERT_EQ(count_irregular(in), 8);
+  ASSERT_GT(min_sicn(in), 0);
+  const auto patterns = builtin_patterns();
+  // Small cavities: several growths and replacements.
+  CavityOptions options;
+  options.max_quads_maximal = 30;
+  CavityReport r1, r2;
+  const mesh::FaceMesh a = remesh_cavities(in, plane, {}, patterns, options, &r1);
+  const mesh::FaceMesh b = remesh_cavities(in, plane, {}, patterns, options, &r2);
+  ASSERT_EQ(a.num_vertices(), b.num_vertices());
+  ASSERT_EQ(a.quads, b.quads);
+  for (LO v = 0; v < a.num_vertices(); ++v) EXPECT_EQ(a.points[v], b.points[v]);
+  EXPECT_EQ(r1.remeshed, r2.remeshed);
+  EXPECT_LT(r1.irregular_after, r1.irregular_before);
+  // The work bound stops early and says so.
+  CavityOptions bounded = options;
+  bounded.max_cavities = 1;
+  CavityReport r3;
+  const mesh::FaceMesh c = remesh_cavities(in, plane, {}, patterns, bounded, &r3);
+  EXPECT_TRUE(r3.work_bound_hit);
+  EXPECT_EQ(r3.grown[0] + r3.grown[1] + r3.grown[2] + r3.grown[3], 1);
+  EXPECT_GT(min_sicn(c), 0);
+  // So does the time budget (here spent before the first growth).
+  CavityOptions timed = options;
+  timed.time_budget_s = 1e-12;
+  CavityReport r4;
+  const mesh::FaceMesh d = remesh_cavities(in, plane, {}, patterns, timed, &r4);
+  EXPECT_TRUE(r4.time_budget_hit);
+  EXPECT_EQ(d.quads, in.quads);
+}
+
+TEST(Cavity, TrianglesLeaveTheMeshAlone) {
+  const Plane plane;
+  mesh::FaceMesh m = grid(2, 2);
+  m.triangles.push_back({0, 1, 2});
+  CavityReport rep;
+  const auto patterns = builtin_patterns();
+  const mesh::FaceMesh out = remesh_cavities(m, plane, {}, patterns, CavityOptions{}, &rep);
+  EXPECT_FALSE(rep.skipped.empty());
+  EXPECT_EQ(out.quads, m.quads);
+}
+
+}  // namespace
+}  // namespace qsmesh::qstruct
