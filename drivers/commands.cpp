@@ -192,6 +192,20 @@ std::string stats_json(const Arguments& args, const Session& session, const para
     }
     // Sec. 6.3 on the unstructured faces: interior valence >= 6, curve vertices of valence != 2,
     // corners away from their ideal valence.
+    std::int64_t irr_before = 0, irr_after = 0;
+    std::array<std::int64_t, 4> steps{};
+    for (const auto& q : r.quasi_reports) {
+      irr_before += q.irregular_before;
+      irr_after += q.irregular_after;
+      for (int k = 0; k < 4; ++k) steps[k] += q.cavities[k];
+    }
+    // Sec. 6.2 on the unstructured faces: interior irregular vertices of their unstructured meshes
+    // before and after cavity remeshing, cavities remeshed by step.
+    j.value("irregular_unstructured_before", irr_before);
+    j.value("irregular_unstructured_after_cavities", irr_after);
+    j.begin_array("cavities_remeshed_per_step");
+    for (auto c : steps) j.value(std::string(), c);
+    j.end_array();
     j.value("disk_defects_before", before);
     j.value("disk_defects_after", after);
     j.value("disk_cavities_replaced", replaced);
@@ -269,7 +283,16 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
       after += q.defects_after;
       replaced += q.disk_replaced;
     }
+    std::int64_t irr_before = 0, irr_after = 0;
+    std::array<std::int64_t, 4> steps{};
+    for (const auto& q : r.quasi_reports) {
+      irr_before += q.irregular_before;
+      irr_after += q.irregular_after;
+      for (int k = 0; k < 4; ++k) steps[k] += q.cavities[k];
+    }
     os << "  faces meshed by patterns: " << by_pattern << " of " << model.num_faces() << "\n"
+       << "  cavity remeshing (other faces): irregular interior vertices " << irr_before << " -> " << irr_after
+       << "; cavities remeshed by step " << steps[0] << ", " << steps[1] << ", " << steps[2] << ", " << steps[3] << "\n"
        << "  disk remeshing: defects " << before << " -> " << after << " (" << replaced
        << " cavities replaced)\n";
   }

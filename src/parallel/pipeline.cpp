@@ -192,6 +192,9 @@ void pack(const QuasiReport& r, std::vector<char>& out) {
   put<std::uint8_t>(out, r.by_pattern ? 1 : 0);
   put_vec(out, std::vector<char>(r.pattern.begin(), r.pattern.end()));
   put_vec(out, std::vector<char>(r.refusal.begin(), r.refusal.end()));
+  put<std::int64_t>(out, r.irregular_before);
+  put<std::int64_t>(out, r.irregular_after);
+  for (auto c : r.cavities) put<std::int64_t>(out, c);
   put<std::int64_t>(out, r.defects_before);
   put<std::int64_t>(out, r.defects_after);
   put<std::int64_t>(out, r.disk_replaced);
@@ -204,6 +207,9 @@ void unpack(const std::vector<char>& in, std::size_t& pos, QuasiReport& r) {
   r.pattern.assign(text.begin(), text.end());
   get_vec(in, pos, text);
   r.refusal.assign(text.begin(), text.end());
+  r.irregular_before = get<std::int64_t>(in, pos);
+  r.irregular_after = get<std::int64_t>(in, pos);
+  for (auto& c : r.cavities) c = get<std::int64_t>(in, pos);
   r.defects_before = get<std::int64_t>(in, pos);
   r.defects_after = get<std::int64_t>(in, pos);
   r.disk_replaced = get<std::int64_t>(in, pos);
@@ -393,6 +399,34 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
         log.info(cat("unstructured: ", n, "/", mine.size(), " faces on rank ", rank));
     });
     result.times.add("unstructured", comm.allreduce_max(clock.seconds()));
+    if (quasi) {
+      // Cavity remeshing of the unstructured faces (Sec. 6.2): irregular vertices that the cross
+      // field does not ask for are removed by remeshing convex cavities with patterns.
+      clock.reset();
+      const std::vector<qstruct::Pattern> patterns = qstruct::builtin_patterns();
+      tasks.parallel_for(total, [&](std::int64_t i) {
+        if (quasi_reports[i].by_pattern || !quad_reports[i].ok || !quad_meshes[i].triangles.empty()) return;
+        const Stopwatch face_clock;
+        try {
+          const auto surface = model.face_geometry(mine[i]);
+          const std::span<const crossfield::Singularity> singular =
+              full[i] != nullptr ? std::span<const crossfield::Singularity>(full[i]->singularities)
+                                 : std::span<const crossfield::Singularity>();
+          qstruct::CavityReport cr;
+          mesh::FaceMesh out = qstruct::remesh_cavities(quad_meshes[i], *surface, singular, patterns,
+                                                        options.cavities, &cr);
+          out.face = mine[i];
+          quad_meshes[i] = std::move(out);
+          quasi_reports[i].irregular_before = cr.irregular_before;
+          quasi_reports[i].irregular_after = cr.irregular_after;
+          quasi_reports[i].cavities = cr.remeshed;
+        } catch (const std::exception& e) {
+          log.warn(Error(e.what(), ErrorContext{"cavity remeshing", 2, mine[i]}).what());
+        }
+        face_seconds[i] += face_clock.seconds();
+      });
+      result.times.add("cavities", comm.allreduce_max(clock.seconds()));
+    }
     if (quasi) {
       // Local topological clean-up of the unstructured faces (Sec. 6.3): defects remeshed with
       // the best disk quadrangulation, each replacement a transaction.

@@ -172,13 +172,13 @@ void check_size_map(const Comm& comm, const cad::CadModel& model, double size, P
   EXPECT_EQ(all[0], mine * comm.size());
 }
 
-TEST(Pipeline, QuadMeshDoesNotDependOnRanks) {
+void check_quads_do_not_depend_on_ranks(Stage until, const std::string& name) {
   const Comm comm = Comm::world();
-  const cad::CadModel model = shared_model(comm, "pipe_quads");
+  const cad::CadModel model = shared_model(comm, name);
   PipelineOptions options;
   options.background.sizes.size = 0.7;
   options.sizemap.size_max = 0.7;
-  options.until = Stage::Unstructured;
+  options.until = until;
   std::ostringstream sink;
   Logger log(sink, LogLevel::Quiet);
   const PipelineResult dist = run_pipeline(comm, model, options, TaskArena(2), log);
@@ -192,6 +192,22 @@ TEST(Pipeline, QuadMeshDoesNotDependOnRanks) {
   const auto conformity = mesh::check_conformity(dist.mesh, model);
   EXPECT_TRUE(conformity.ok()) << conformity.summary();
   for (const auto& q : dist.quad_reports) EXPECT_TRUE(q.ok) << q.error;
+  for (std::size_t f = 0; f < dist.face_stats.size(); ++f) EXPECT_GT(dist.face_stats[f].sicn_min, 0) << "face " << f;
+  if (until == Stage::QuasiStructured) {
+    ASSERT_EQ(dist.quasi_reports.size(), serial.quasi_reports.size());
+    int by_pattern = 0;
+    for (std::size_t f = 0; f < dist.quasi_reports.size(); ++f) {
+      EXPECT_EQ(dist.quasi_reports[f].by_pattern, serial.quasi_reports[f].by_pattern);
+      by_pattern += dist.quasi_reports[f].by_pattern ? 1 : 0;
+    }
+    EXPECT_GT(by_pattern, 0);  // the box's planar sides are simple faces
+  }
+}
+
+TEST(Pipeline, QuadMeshDoesNotDependOnRanks) { check_quads_do_not_depend_on_ranks(Stage::Unstructured, "pipe_quads"); }
+
+TEST(Pipeline, QuasiStructuredMeshDoesNotDependOnRanks) {
+  check_quads_do_not_depend_on_ranks(Stage::QuasiStructured, "pipe_quasi");
 }
 
 TEST(Pipeline, SizeMapAndCurveMeshesDoNotDependOnRanks) {

@@ -96,7 +96,7 @@ int main(int argc, char** argv) {
     for (LO f = 0; f < nf; ++f) {
       quad::UnstructuredReport ur;
       const mesh::FaceMesh in =
-          quad::mesh_face_unstructured(model, f, halved, result.quantized_curves, qo, &ur);
+          quad::mesh_face_unstructured(model, f, halved, result.quantized_curves, quad::FaceFields{}, qo, &ur);
       if (in.quads.empty()) continue;
       const auto surface = model.face_geometry(f);
       std::vector<crossfield::Singularity> s;

@@ -9,6 +9,7 @@
 #include "qsmesh/background/face_mesh.hpp"
 #include "qsmesh/crossfield/cross_field.hpp"
 #include "qsmesh/quad/unstructured.hpp"
+#include "qsmesh/qstruct/cavity.hpp"
 #include "qsmesh/qstruct/face_pattern.hpp"
 #include "qsmesh/remesh/disk_remesh.hpp"
 #include "qsmesh/quantize/quantize.hpp"
@@ -24,8 +25,9 @@
 namespace qsmesh::parallel {
 
 /// Pipeline stages, in order. QuasiStructured (paper 000 Sec. 6): the simple CAD faces meshed by
-/// patterns (Sec. 6.1.2) before the unstructured path meshes the others, whose defects are then
-/// remeshed with disk quadrangulations (Sec. 6.3); the cavity remeshing of Sec. 6.2 comes next.
+/// patterns (Sec. 6.1.2) before the unstructured path meshes the others, whose irregular vertices
+/// are then reduced by cavity remeshing (Sec. 6.2) and their defects by disk quadrangulations
+/// (Sec. 6.3).
 enum class Stage { Background, Unstructured, QuasiStructured };
 [[nodiscard]] const char* to_string(Stage s);
 /// Parses a stage name; throws InputError listing the valid names.
@@ -44,6 +46,8 @@ struct PipelineOptions {
   quantize::QuantizeOptions quantize;
   /// Stage::QuasiStructured: pattern meshing of simple CAD faces (Sec. 6.1.2).
   qstruct::PatternFaceOptions patterns;
+  /// Stage::QuasiStructured: cavity remeshing of the unstructured faces (Sec. 6.2).
+  qstruct::CavityOptions cavities;
   /// Stage::QuasiStructured: disk remeshing of the defects of the unstructured faces (Sec. 6.3).
   remesh::DiskRemeshOptions disk;
 };
@@ -53,6 +57,10 @@ struct QuasiReport {
   bool by_pattern = false;  ///< meshed by a pattern (Sec. 6.1.2); else by the unstructured path
   std::string pattern;      ///< the pattern's name when by_pattern
   std::string refusal;      ///< why no pattern was kept (qstruct::to_string of the refusal)
+  /// Cavity remeshing (unstructured faces only): interior irregular vertices before it (the
+  /// unstructured mesh) and after it, cavities remeshed by step (Steps 1-4 of Sec. 6.2.2).
+  std::int64_t irregular_before = 0, irregular_after = 0;
+  std::array<std::int64_t, 4> cavities{};
   /// Disk remeshing (unstructured faces only): defects before/after, cavities replaced.
   std::int64_t defects_before = 0, defects_after = 0, disk_replaced = 0;
 };
