@@ -161,6 +161,28 @@ std::int64_t total_irregular_boundary(const parallel::PipelineResult& r) {
   return n;
 }
 
+/// Totals of the quasi-structured stage over the faces.
+struct QuasiTotals {
+  std::int64_t by_pattern = 0;
+  std::int64_t irregular_before = 0, irregular_after = 0;  // cavity remeshing (Sec. 6.2)
+  std::array<std::int64_t, 4> cavities{};                  // remeshed, by step
+  std::int64_t defects_before = 0, defects_after = 0, disk_replaced = 0;  // Sec. 6.3
+};
+
+QuasiTotals quasi_totals(const parallel::PipelineResult& r) {
+  QuasiTotals t;
+  for (const auto& q : r.quasi_reports) {
+    t.by_pattern += q.by_pattern ? 1 : 0;
+    t.irregular_before += q.irregular_before;
+    t.irregular_after += q.irregular_after;
+    for (int k = 0; k < 4; ++k) t.cavities[k] += q.cavities[k];
+    t.defects_before += q.defects_before;
+    t.defects_after += q.defects_after;
+    t.disk_replaced += q.disk_replaced;
+  }
+  return t;
+}
+
 std::string stats_json(const Arguments& args, const Session& session, const parallel::PipelineResult& r,
                        const mesh::MeshStats& s, const Checks& checks) {
   const cad::CadModel& model = session.model;
@@ -181,34 +203,20 @@ std::string stats_json(const Arguments& args, const Session& session, const para
     j.value("faces_frontal", frontal);  // faces meshed by the frontal path (Sec. 5.1)
   }
   if (!r.quasi_reports.empty()) {
-    std::int64_t by_pattern = 0;
-    for (const auto& q : r.quasi_reports) by_pattern += q.by_pattern ? 1 : 0;
-    j.value("faces_meshed_by_pattern", by_pattern);  // Sec. 6.1.2
-    std::int64_t before = 0, after = 0, replaced = 0;
-    for (const auto& q : r.quasi_reports) {
-      before += q.defects_before;
-      after += q.defects_after;
-      replaced += q.disk_replaced;
-    }
-    // Sec. 6.3 on the unstructured faces: interior valence >= 6, curve vertices of valence != 2,
-    // corners away from their ideal valence.
-    std::int64_t irr_before = 0, irr_after = 0;
-    std::array<std::int64_t, 4> steps{};
-    for (const auto& q : r.quasi_reports) {
-      irr_before += q.irregular_before;
-      irr_after += q.irregular_after;
-      for (int k = 0; k < 4; ++k) steps[k] += q.cavities[k];
-    }
-    // Sec. 6.2 on the unstructured faces: interior irregular vertices of their unstructured meshes
+    const QuasiTotals t = quasi_totals(r);
+    j.value("faces_meshed_by_pattern", t.by_pattern);  // Sec. 6.1.2
+    // Sec. 6.2 on the other faces: interior irregular vertices of their unstructured meshes
     // before and after cavity remeshing, cavities remeshed by step.
-    j.value("irregular_unstructured_before", irr_before);
-    j.value("irregular_unstructured_after_cavities", irr_after);
+    j.value("irregular_unstructured_before", t.irregular_before);
+    j.value("irregular_unstructured_after_cavities", t.irregular_after);
     j.begin_array("cavities_remeshed_per_step");
-    for (auto c : steps) j.value(std::string(), c);
+    for (auto c : t.cavities) j.value(std::string(), c);
     j.end_array();
-    j.value("disk_defects_before", before);
-    j.value("disk_defects_after", after);
-    j.value("disk_cavities_replaced", replaced);
+    // Sec. 6.3 on the same faces: interior valence >= 6, curve vertices of valence != 2, corners
+    // away from their ideal valence.
+    j.value("disk_defects_before", t.defects_before);
+    j.value("disk_defects_after", t.defects_after);
+    j.value("disk_cavities_replaced", t.disk_replaced);
   }
   j.value("vertices", s.vertices);
   j.value("triangles", s.triangles);
@@ -275,26 +283,13 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
     os << "  boundary vertices away from their ideal valence (per face): " << total_irregular_boundary(r) << "\n";
   if (s.quads > 0) os << "  SICN min/avg: " << s.sicn_min << " / " << s.sicn_avg << "\n";
   if (!r.quasi_reports.empty()) {
-    std::int64_t by_pattern = 0;
-    for (const auto& q : r.quasi_reports) by_pattern += q.by_pattern ? 1 : 0;
-    std::int64_t before = 0, after = 0, replaced = 0;
-    for (const auto& q : r.quasi_reports) {
-      before += q.defects_before;
-      after += q.defects_after;
-      replaced += q.disk_replaced;
-    }
-    std::int64_t irr_before = 0, irr_after = 0;
-    std::array<std::int64_t, 4> steps{};
-    for (const auto& q : r.quasi_reports) {
-      irr_before += q.irregular_before;
-      irr_after += q.irregular_after;
-      for (int k = 0; k < 4; ++k) steps[k] += q.cavities[k];
-    }
-    os << "  faces meshed by patterns: " << by_pattern << " of " << model.num_faces() << "\n"
-       << "  cavity remeshing (other faces): irregular interior vertices " << irr_before << " -> " << irr_after
-       << "; cavities remeshed by step " << steps[0] << ", " << steps[1] << ", " << steps[2] << ", " << steps[3] << "\n"
-       << "  disk remeshing: defects " << before << " -> " << after << " (" << replaced
-       << " cavities replaced)\n";
+    const QuasiTotals t = quasi_totals(r);
+    os << "  faces meshed by patterns: " << t.by_pattern << " of " << model.num_faces() << "\n"
+       << "  cavity remeshing (other faces): irregular interior vertices " << t.irregular_before << " -> "
+       << t.irregular_after << "; cavities remeshed by step " << t.cavities[0] << ", " << t.cavities[1] << ", "
+       << t.cavities[2] << ", " << t.cavities[3] << "\n"
+       << "  disk remeshing: defects " << t.defects_before << " -> " << t.defects_after << " ("
+       << t.disk_replaced << " cavities replaced)\n";
   }
   if (s.triangles > 0) {
     os << "  triangle quality min/avg: " << s.tri_quality_min << " / " << s.tri_quality_avg << "\n"
