@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <array>
 #include <string_view>
 #include <cstdio>
 #include <filesystem>
