@@ -19,7 +19,7 @@ struct Arguments {
   std::optional<double> size_factor;  ///< --size-factor (fraction of the bounding-box diagonal)
   /// Last stage to run. `unstructured` exists but still fails on some faces of the shared models
   /// (reported per face), so the default stays the furthest stage that is complete.
-  std::string until = "background";
+  std::string until = "quasi-structured";
   int threads = 0;                 ///< 0: automatic
   std::string stats;               ///< --stats FILE.json
   bool json = false;               ///< info --json

@@ -29,6 +29,8 @@ TEST(Cli, MeshOptions) {
   EXPECT_EQ(a.stats, "s.json");
   EXPECT_EQ(a.until, "background");
   EXPECT_DOUBLE_EQ(*p({"mesh", "m.step", "-o", "o.vtu", "--size-factor", "0.01"}).size_factor, 0.01);
+  // The default is the furthest stage that exists.
+  EXPECT_EQ(p({"mesh", "m.step", "-o", "o.vtu"}).until, "quasi-structured");
 }
 
 TEST(Cli, HelpEverywhere) {
