@@ -9,8 +9,8 @@
 
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/core/timer.hpp"
-#include "qsmesh/linalg/solver.hpp"
 #include "qsmesh/mesh/quality.hpp"
+#include "qsmesh/smooth/quad_tools.hpp"
 
 namespace qsmesh::qstruct {
 
@@ -328,78 +328,23 @@ class Grower {
 
 // ------------------------------------------------------------------------- replacement
 
-// Orientation of the mesh against the face normal: +1 when the quads turn counter-clockwise
-// around it (majority vote).
-double orientation(const mesh::FaceMesh& m, const cad::FaceGeometry& surface) {
-  double votes = 0;
-  for (const auto& q : m.quads) {
-    Vec3 s{};
-    for (int k = 0; k < 4; ++k)
-      s += cross(m.points[q[k]] - m.points[q[(k + 3) % 4]],
-                 m.points[q[(k + 1) % 4]] - m.points[q[k]]);
-    const double d = dot(s, surface.normal(m.uv[q[0]]));
-    votes += d > 0 ? 1 : (d < 0 ? -1 : 0);
-  }
-  return votes >= 0 ? 1.0 : -1.0;
-}
-
-// SICN of a quad, -1 when it faces against the face (quad_sicn alone cannot see a quad flipped as
-// a whole: its normal is the average of its own corners).
+// SICN of a quad, -1 when it faces against the face; the normal is taken at the first corner
+// that is not a pole, and a quad with all its corners at poles counts as flipped.
 double quad_quality(const std::vector<Vec3>& pts, const std::vector<Vec2>& uv,
                     const std::array<LO, 4>& q, const cad::FaceGeometry& surface, double sign) {
-  const std::array<Vec3, 4> p{pts[q[0]], pts[q[1]], pts[q[2]], pts[q[3]]};
-  Vec3 sum{};
-  for (int k = 0; k < 4; ++k) sum += cross(p[k] - p[(k + 3) % 4], p[(k + 1) % 4] - p[k]);
   Vec3 n{};
   for (int k = 0; k < 4 && norm2(n) == 0; ++k) n = surface.normal(uv[q[k]]);  // skip a pole corner
-  if (sign * dot(sum, n) <= 0) return -1.0;
-  return mesh::quad_sicn(p);
+  if (norm2(n) == 0) return -1.0;
+  return smooth::oriented_sicn({pts[q[0]], pts[q[1]], pts[q[2]], pts[q[3]]}, n, sign);
 }
 
-// Uniform-weight Laplace solve in (u, v) for the vertices >= num_fixed of a small quad mesh.
+// The Laplace layout of the cavity's new vertices; a solver failure counts as a failed layout.
 bool laplace_uv(const std::vector<std::array<LO, 4>>& quads, LO num_fixed, std::vector<Vec2>& uv) {
-  const LO n = static_cast<LO>(uv.size());
-  const LO nu = n - num_fixed;
-  if (nu == 0) return true;
-  std::vector<std::vector<LO>> nbr(static_cast<std::size_t>(n));
-  for (const auto& q : quads)
-    for (int k = 0; k < 4; ++k) {
-      nbr[q[k]].push_back(q[(k + 1) % 4]);
-      nbr[q[(k + 1) % 4]].push_back(q[k]);
-    }
-  std::vector<linalg::SparseMatrix::Triplet> trip;
-  std::vector<double> bu(static_cast<std::size_t>(nu), 0.0), bv(static_cast<std::size_t>(nu), 0.0);
-  for (LO v = num_fixed; v < n; ++v) {
-    auto& nb = nbr[v];
-    std::sort(nb.begin(), nb.end());
-    nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
-    const LO i = v - num_fixed;
-    trip.push_back({i, i, static_cast<double>(nb.size())});
-    for (const LO w : nb) {
-      if (w >= num_fixed) {
-        trip.push_back({i, w - num_fixed, -1.0});
-      } else {
-        bu[i] += uv[w].u;
-        bv[i] += uv[w].v;
-      }
-    }
-  }
-  const linalg::SparseMatrix A(nu, trip);
-  std::vector<double> xu(static_cast<std::size_t>(nu)), xv(static_cast<std::size_t>(nu));
   try {
-    auto solver = linalg::make_solver(nu, linalg::SolverOptions{linalg::Backend::Eigen}, nullptr);
-    solver->analyze(A);
-    solver->factorize(A);
-    solver->solve(bu, xu);
-    solver->solve(bv, xv);
+    return smooth::laplace_uv(quads, num_fixed, uv);
   } catch (const Error&) {
     return false;
   }
-  for (LO i = 0; i < nu; ++i) {
-    if (!std::isfinite(xu[i]) || !std::isfinite(xv[i])) return false;
-    uv[num_fixed + i] = {xu[i], xv[i]};
-  }
-  return true;
 }
 
 struct Replacement {
@@ -648,7 +593,7 @@ mesh::FaceMesh remesh_cavities(const mesh::FaceMesh& input, const cad::FaceGeome
     mesh::FaceMesh work = input;
     QuadTopology topo(work);
     rep.irregular_before = count_irregular(work);
-    const double sign = orientation(work, surface);
+    const double sign = smooth::quad_orientation(work, surface);
 
     // Flag the singular vertices: nearest free vertex of the singularity's valence within the
     // bound.

@@ -4,13 +4,12 @@
 #include <cmath>
 #include <map>
 #include <numbers>
-#include <set>
 #include <sstream>
 #include <utility>
 
 #include "qsmesh/background/face_mesh.hpp"
 #include "qsmesh/core/error.hpp"
-#include "qsmesh/linalg/solver.hpp"
+#include "qsmesh/smooth/quad_tools.hpp"
 
 namespace qsmesh::qstruct {
 
@@ -54,47 +53,6 @@ struct Candidate {
   int score = 0;        // boundary valence mismatch at the corners that do not split sides
 };
 
-// Interior vertices by a uniform-weight Laplace solve in (u, v), the boundary fixed: for a grid
-// with evenly spaced sides this is the bilinear grid, and it is invariant under affine maps of
-// the parameter plane, so anisotropic (u, v) scales do not matter.
-bool laplace_uv(const std::vector<std::array<LO, 4>>& quads, LO num_boundary, std::vector<Vec2>& uv) {
-  const LO n = static_cast<LO>(uv.size());
-  const LO nu = n - num_boundary;
-  if (nu == 0) return true;
-  std::vector<std::set<LO>> nbr(static_cast<std::size_t>(n));
-  for (const auto& q : quads)
-    for (int k = 0; k < 4; ++k) {
-      nbr[q[k]].insert(q[(k + 1) % 4]);
-      nbr[q[(k + 1) % 4]].insert(q[k]);
-    }
-  std::vector<linalg::SparseMatrix::Triplet> trip;
-  std::vector<double> bu(static_cast<std::size_t>(nu), 0.0), bv(static_cast<std::size_t>(nu), 0.0);
-  for (LO v = num_boundary; v < n; ++v) {
-    const LO i = v - num_boundary;
-    trip.push_back({i, i, static_cast<double>(nbr[v].size())});
-    for (const LO w : nbr[v]) {
-      if (w >= num_boundary) {
-        trip.push_back({i, w - num_boundary, -1.0});
-      } else {
-        bu[i] += uv[w].u;
-        bv[i] += uv[w].v;
-      }
-    }
-  }
-  const linalg::SparseMatrix A(nu, trip);
-  std::vector<double> xu(static_cast<std::size_t>(nu)), xv(static_cast<std::size_t>(nu));
-  auto solver = linalg::make_solver(nu, linalg::SolverOptions{linalg::Backend::Eigen}, nullptr);
-  solver->analyze(A);
-  solver->factorize(A);
-  solver->solve(bu, xu);
-  solver->solve(bv, xv);
-  for (LO i = 0; i < nu; ++i) {
-    if (!std::isfinite(xu[i]) || !std::isfinite(xv[i])) return false;
-    uv[num_boundary + i] = {xu[i], xv[i]};
-  }
-  return true;
-}
-
 mesh::FaceMesh build_mesh(LO f, const cad::Face& face, const cad::FaceGeometry& surface, const FaceSides& fs,
                           const Candidate& cand) {
   const LO nb = static_cast<LO>(fs.points.size());
@@ -123,7 +81,7 @@ mesh::FaceMesh build_mesh(LO f, const cad::Face& face, const cad::FaceGeometry& 
     const std::array<LO, 4> t{r2m[q[0]], r2m[q[1]], r2m[q[2]], r2m[q[3]]};
     m.quads.push_back(flip ? std::array<LO, 4>{t[0], t[3], t[2], t[1]} : t);
   }
-  QSMESH_CHECK(laplace_uv(m.quads, nb, m.uv), "the Laplace layout is not finite");
+  QSMESH_CHECK(smooth::laplace_uv(m.quads, nb, m.uv), "the Laplace layout is not finite");
   for (LO v = nb; v < next; ++v) {
     m.points[v] = surface.eval(m.uv[v]).p;
     m.vclass[v].dim = 2;

@@ -6,18 +6,25 @@
 
 #include "qsmesh/cad/geometry.hpp"
 #include "qsmesh/mesh/surface_mesh.hpp"
+#include "qsmesh/smooth/smooth.hpp"
 
 namespace qsmesh::smooth::detail {
 
-/// +1 when most quads turn counter-clockwise around the face normal, -1 otherwise.
-[[nodiscard]] double orientation(const mesh::FaceMesh& m, const cad::FaceGeometry& surface);
-
-/// SICN of the quad (x0..x3), or -1 when its summed corner normal points against `normal` times
-/// `sign` (mesh::quad_sicn alone cannot see a quad flipped as a whole: it measures against the
-/// quad's own average normal). `normal` zero (pole) skips that test.
-[[nodiscard]] double oriented_sicn(const std::array<Vec3, 4>& x, const Vec3& normal, double sign);
-
 /// Incident quads of every vertex, in increasing order.
 [[nodiscard]] std::vector<std::vector<LO>> vertex_quads(const mesh::FaceMesh& m);
+
+/// Sets the param of every dim-2 vertex to its uv.
+void sync_interior_params(mesh::FaceMesh& m);
+
+/// When an optimiser's output is accepted against its input's quality `before`.
+enum class Accept {
+  kGain,    ///< the minimum SICN must rise
+  kNoDrop,  ///< the minimum SICN must not drop
+};
+
+/// Measures m into `after`; when it fails `accept` or has more invalid quads than `before`, m
+/// becomes `input` and `after` becomes `before`. Returns true when it rolled back.
+bool keep_or_roll_back(mesh::FaceMesh& m, const mesh::FaceMesh& input, const QualityReport& before,
+                       Accept accept, QualityReport& after);
 
 }  // namespace qsmesh::smooth::detail

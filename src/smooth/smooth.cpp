@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "internal.hpp"
+#include "qsmesh/smooth/quad_tools.hpp"
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/core/timer.hpp"
 #include "qsmesh/linalg/solver.hpp"
@@ -339,7 +340,7 @@ mesh::FaceMesh smooth_face(const mesh::FaceMesh& input, const cad::FaceGeometry&
     const std::optional<ApproxSurface> approx =
         options.approximate_projection ? std::optional<ApproxSurface>(ApproxSurface::from_mesh(input))
                                        : std::nullopt;
-    Smoother sm(m, surface, topo, detail::orientation(m, surface), approx ? &*approx : nullptr);
+    Smoother sm(m, surface, topo, quad_orientation(m, surface), approx ? &*approx : nullptr);
     const LO nq = static_cast<LO>(m.quads.size());
 
     if (options.laplacian_uv) {
@@ -388,15 +389,9 @@ mesh::FaceMesh smooth_face(const mesh::FaceMesh& input, const cad::FaceGeometry&
       }
       st.method += st.method.empty() ? "kernels" : "+kernels";
     }
-    for (LO v = 0; v < m.num_vertices(); ++v)
-      if (m.vclass[v].dim == 2) m.vclass[v].param = {m.uv[v].u, m.uv[v].v};
+    detail::sync_interior_params(m);
   }
-  st.after = measure(m);
-  if (st.after.sicn_min < st.before.sicn_min || st.after.invalid > st.before.invalid) {
-    m = input;
-    st.after = st.before;
-    st.rolled_back = true;
-  }
+  st.rolled_back = detail::keep_or_roll_back(m, input, st.before, detail::Accept::kNoDrop, st.after);
   if (stats) *stats = st;
   return m;
 }

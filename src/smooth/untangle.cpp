@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "internal.hpp"
+#include "qsmesh/smooth/quad_tools.hpp"
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/core/timer.hpp"
 
@@ -41,7 +42,7 @@ class Untangler {
     const auto& qd = m_.quads[q];
     Vec3 n{};
     for (const LO w : qd) n += normal_[w];
-    return detail::oriented_sicn(
+    return oriented_sicn(
         {m_.points[qd[0]], m_.points[qd[1]], m_.points[qd[2]], m_.points[qd[3]]}, n, 1.0);
   }
 
@@ -206,7 +207,7 @@ mesh::FaceMesh untangle_face(const mesh::FaceMesh& input, const cad::FaceGeometr
   for (const auto& t : m.triangles)
     for (const LO v : t) free[v] = 0;
 
-  Untangler un(m, surface, detail::vertex_quads(m), detail::orientation(m, surface));
+  Untangler un(m, surface, detail::vertex_quads(m), quad_orientation(m, surface));
   const auto& v2q = un.v2q();
   auto seeds = [&] {
     std::vector<LO> s;
@@ -321,14 +322,8 @@ mesh::FaceMesh untangle_face(const mesh::FaceMesh& input, const cad::FaceGeometr
     if (rings >= options.max_rings) break;
   }
 
-  for (LO v = 0; v < nv; ++v)
-    if (m.vclass[v].dim == 2) m.vclass[v].param = {m.uv[v].u, m.uv[v].v};
-  st.after = measure(m);
-  if (!(st.after.sicn_min > st.before.sicn_min) || st.after.invalid > st.before.invalid) {
-    m = input;
-    st.after = st.before;
-    st.rolled_back = true;
-  }
+  detail::sync_interior_params(m);
+  st.rolled_back = detail::keep_or_roll_back(m, input, st.before, detail::Accept::kGain, st.after);
   if (stats) *stats = st;
   return m;
 }

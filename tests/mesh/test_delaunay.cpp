@@ -12,6 +12,7 @@
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/mesh/delaunay.hpp"
 #include "qsmesh/mesh/predicates.hpp"
+#include "analytic_surfaces.hpp"
 
 namespace {
 
@@ -19,51 +20,11 @@ using namespace qsmesh;
 using namespace qsmesh::mesh;
 constexpr double kPi = 3.14159265358979323846;
 
-// ------------------------------------------------------------------ analytic surfaces
-class Analytic : public cad::FaceGeometry {
- public:
-  [[nodiscard]] cad::SurfaceEval2 eval2(const Vec2& uv) const override {
-    cad::SurfaceEval2 e;
-    static_cast<cad::SurfaceEval&>(e) = eval(uv);
-    return e;
-  }
-  [[nodiscard]] Vec3 normal(const Vec2& uv) const override {
-    const auto e = eval(uv);
-    return normalized(cross(e.du, e.dv));
-  }
-  [[nodiscard]] Vec2 project(const Vec3&, const Vec2& g, Vec3*) const override { return g; }
-  [[nodiscard]] Vec2 boundary_uv(LO, LO, double) const override { return {}; }
-  [[nodiscard]] bool contains(const Vec2&) const override { return true; }
-};
-
-class Plane : public Analytic {
- public:
-  [[nodiscard]] cad::SurfaceEval eval(const Vec2& uv) const override {
-    return {{uv.u, uv.v, 0}, {1, 0, 0}, {0, 1, 0}};
-  }
-};
-
-class Cylinder : public Analytic {  // u: angle, v: height
- public:
-  explicit Cylinder(double r) : r_(r) {}
-  [[nodiscard]] cad::SurfaceEval eval(const Vec2& uv) const override {
-    const double c = std::cos(uv.u), s = std::sin(uv.u);
-    return {{r_ * c, r_ * s, uv.v}, {-r_ * s, r_ * c, 0}, {0, 0, 1}};
-  }
-  double r_;
-};
-
-class Sphere : public Analytic {  // u: longitude, v: latitude
- public:
-  explicit Sphere(double r) : r_(r) {}
-  [[nodiscard]] cad::SurfaceEval eval(const Vec2& uv) const override {
-    const double cu = std::cos(uv.u), su = std::sin(uv.u), cv = std::cos(uv.v), sv = std::sin(uv.v);
-    return {{r_ * cv * cu, r_ * cv * su, r_ * sv},
-            {-r_ * cv * su, r_ * cv * cu, 0},
-            {-r_ * sv * cu, -r_ * sv * su, r_ * cv}};
-  }
-  double r_;
-};
+// The kernel never projects: the surfaces return the guess, as they always did here.
+constexpr test::Projection kProjection = test::Projection::kGuess;
+using test::Cylinder;
+using test::Plane;
+using test::Sphere;
 
 // ------------------------------------------------------------------ loops
 // Appends the side uv0 -> uv1 (uv-linear, n segments; the end point is left to the next side).
@@ -197,7 +158,7 @@ void expect_quality(const Report& r, double len_ok = 0.97, double angle_ok = 0.9
 
 // ------------------------------------------------------------------ tests
 TEST(Delaunay, PlaneSquare) {
-  Plane plane;
+  const Plane plane(kProjection);
   const double h = 0.5;
   std::vector<BoundaryLoop> loops{polygon(plane, {{0, 0}, {10, 0}, {10, 10}, {0, 10}}, h)};
   SizeFunction size = [&](const Vec2&, const Vec3&) { return h; };
@@ -223,7 +184,7 @@ TEST(Delaunay, PlaneSquare) {
 }
 
 TEST(Delaunay, ReversedAndClockwiseLoop) {
-  Plane plane;
+  const Plane plane(kProjection);
   const double h = 0.7;
   // Clockwise outer loop, reversed face.
   std::vector<BoundaryLoop> loops{polygon(plane, {{0, 0}, {0, 5}, {8, 5}, {8, 0}}, h)};
@@ -235,7 +196,7 @@ TEST(Delaunay, ReversedAndClockwiseLoop) {
 }
 
 TEST(Delaunay, SquareWithHole) {
-  Plane plane;
+  const Plane plane(kProjection);
   const double h = 0.4;
   std::vector<BoundaryLoop> loops{polygon(plane, {{0, 0}, {10, 0}, {10, 10}, {0, 10}}, h),
                                   polygon(plane, {{3, 3}, {7, 3}, {7, 7}, {3, 7}}, h)};
@@ -251,7 +212,7 @@ TEST(Delaunay, SquareWithHole) {
 }
 
 TEST(Delaunay, LShape) {
-  Plane plane;
+  const Plane plane(kProjection);
   const double h = 0.3;
   std::vector<BoundaryLoop> loops{
       polygon(plane, {{0, 0}, {6, 0}, {6, 3}, {3, 3}, {3, 6}, {0, 6}}, h)};
@@ -263,7 +224,7 @@ TEST(Delaunay, LShape) {
 }
 
 TEST(Delaunay, CylinderPatchAnisotropicUV) {
-  Cylinder cyl(10);
+  const Cylinder cyl(10, kProjection);
   const double h = 0.8;
   // u in [0, 1.2] rad (12 mm of arc), v in [0, 6] mm.
   BoundaryLoop loop;
@@ -281,7 +242,7 @@ TEST(Delaunay, CylinderPatchAnisotropicUV) {
 }
 
 TEST(Delaunay, FullCylinderWithSeam) {
-  Cylinder cyl(10);
+  const Cylinder cyl(10, kProjection);
   const double h = 1.0, H = 12;
   BoundaryLoop loop;
   const int nc = segs(2 * kPi * 10, h), ns = segs(H, h);
@@ -300,7 +261,7 @@ TEST(Delaunay, FullCylinderWithSeam) {
 
 TEST(Delaunay, SphereWithPoles) {
   const double R = 5, h = 0.6;
-  Sphere sph(R);
+  const Sphere sph(R, kProjection);
   const Vec3 south{0, 0, -R}, north{0, 0, R};
   BoundaryLoop loop;
   const int nm = segs(kPi * R, h);
@@ -347,7 +308,7 @@ TEST(Delaunay, SphereWithPoles) {
 }
 
 TEST(Delaunay, GradedSize) {
-  Plane plane;
+  const Plane plane(kProjection);
   SizeFunction size = [](const Vec2& uv, const Vec3&) { return 0.1 + 0.08 * uv.u; };
   // Boundary sampled with the same size (graded along the bottom/top sides).
   BoundaryLoop loop;
@@ -396,7 +357,7 @@ TEST(Delaunay, GradedSize) {
 }
 
 TEST(Delaunay, Deterministic) {
-  Cylinder cyl(10);
+  const Cylinder cyl(10, kProjection);
   const double h = 0.9;
   // Sides sampled by their 3D length (u is an angle on a radius-10 cylinder).
   auto loop_of = [&](const std::vector<Vec2>& corners) {
@@ -421,14 +382,14 @@ TEST(Delaunay, Deterministic) {
 }
 
 TEST(Delaunay, RejectsSelfIntersectingLoop) {
-  Plane plane;
+  const Plane plane(kProjection);
   std::vector<BoundaryLoop> loops{polygon(plane, {{0, 0}, {4, 4}, {4, 0}, {0, 4}}, 0.5)};
   SizeFunction size = [](const Vec2&, const Vec3&) { return 0.5; };
   EXPECT_THROW((void)triangulate_face(plane, false, loops, size), Error);
 }
 
 TEST(Delaunay, MaxPointsGuard) {
-  Plane plane;
+  const Plane plane(kProjection);
   std::vector<BoundaryLoop> loops{polygon(plane, {{0, 0}, {10, 0}, {10, 10}, {0, 10}}, 1.0)};
   SizeFunction size = [](const Vec2&, const Vec3&) { return 0.05; };
   TriangulateOptions opt;
@@ -440,7 +401,7 @@ TEST(Delaunay, MaxPointsGuard) {
 }
 
 TEST(Delaunay, LargePlanePerformance) {
-  Plane plane;
+  const Plane plane(kProjection);
   const double h = 0.0465;
   std::vector<BoundaryLoop> loops{polygon(plane, {{0, 0}, {10, 0}, {10, 10}, {0, 10}}, h)};
   SizeFunction size = [&](const Vec2&, const Vec3&) { return h; };
@@ -464,7 +425,7 @@ using namespace qsmesh::mesh;
 // Very anisotropic parametrisation (u in radians on a 1000 mm radius) and a boundary sampled
 // much finer, or much coarser, than the size: valid output, no runaway refinement.
 TEST(Delaunay, AnisotropicAndMismatchedBoundary) {
-  Cylinder cyl(1000);
+  const Cylinder cyl(1000, kProjection);
   for (const double bh : {0.1, 3.0}) {
     const double h = 1.0;
     BoundaryLoop loop;

@@ -7,57 +7,15 @@
 
 #include "qsmesh/mesh/improve.hpp"
 #include "qsmesh/mesh/predicates.hpp"
+#include "analytic_surfaces.hpp"
 
 namespace {
 
 using namespace qsmesh;
 using namespace qsmesh::mesh;
 
-class Analytic : public cad::FaceGeometry {
- public:
-  [[nodiscard]] cad::SurfaceEval2 eval2(const Vec2& uv) const override {
-    cad::SurfaceEval2 e;
-    static_cast<cad::SurfaceEval&>(e) = eval(uv);
-    return e;
-  }
-  [[nodiscard]] Vec3 normal(const Vec2& uv) const override {
-    const auto e = eval(uv);
-    return normalized(cross(e.du, e.dv));
-  }
-  [[nodiscard]] Vec2 project(const Vec3& p, const Vec2& g, Vec3* foot) const override {
-    // Newton steps on the normal equations; enough for the smooth surfaces below.
-    Vec2 uv = g;
-    for (int it = 0; it < 30; ++it) {
-      const auto e = eval(uv);
-      const Vec3 r = e.p - p;
-      const double a = dot(e.du, e.du), b = dot(e.du, e.dv), c = dot(e.dv, e.dv);
-      const double det = a * c - b * b;
-      if (det <= 1e-300) break;
-      const double gu = dot(r, e.du), gv = dot(r, e.dv);
-      uv = uv - Vec2{(c * gu - b * gv) / det, (a * gv - b * gu) / det};
-    }
-    if (foot != nullptr) *foot = eval(uv).p;
-    return uv;
-  }
-  [[nodiscard]] Vec2 boundary_uv(LO, LO, double) const override { return {}; }
-  [[nodiscard]] bool contains(const Vec2&) const override { return true; }
-};
-
-class Plane : public Analytic {
- public:
-  [[nodiscard]] cad::SurfaceEval eval(const Vec2& uv) const override {
-    return {{uv.u, uv.v, 0}, {1, 0, 0}, {0, 1, 0}};
-  }
-};
-
-// The plane in polar coordinates, u the angle, v the radius: singular (a pole) at v = 0.
-class Polar : public Analytic {
- public:
-  [[nodiscard]] cad::SurfaceEval eval(const Vec2& uv) const override {
-    const double c = std::cos(uv.u), s = std::sin(uv.u);
-    return {{uv.v * c, uv.v * s, 0}, {-uv.v * s, uv.v * c, 0}, {c, s, 0}};
-  }
-};
+using test::Plane;  // Newton projection: the moves project their targets
+using test::Polar;
 
 double degrees(double rad) { return rad * 180.0 / 3.14159265358979323846; }
 

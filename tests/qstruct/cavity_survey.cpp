@@ -23,62 +23,47 @@
 #include "qsmesh/qstruct/cavity.hpp"
 #include "qsmesh/quad/unstructured.hpp"
 #include "qsmesh/quantize/quantize.hpp"
+#include "survey_common.hpp"
 
 using namespace qsmesh;
 
 int main(int argc, char** argv) {
   parallel::MpiSession mpi(&argc, &argv);
-  std::string path;
-  double size_factor = 0.02;
-  int threads = 1;
+  test::SurveyArgs args;
   LO first = std::numeric_limits<LO>::max();
-  bool per_face = false;
   qstruct::CavityOptions co;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--size-factor" && i + 1 < argc) {
-      size_factor = std::atof(argv[++i]);
-    } else if (a == "--threads" && i + 1 < argc) {
-      threads = std::atoi(argv[++i]);
-    } else if (a == "--first" && i + 1 < argc) {
-      first = std::atoi(argv[++i]);
-    } else if (a == "--quad-change" && i + 1 < argc) {
-      co.max_quad_change = std::atof(argv[++i]);
-    } else if (a == "--avg-ratio" && i + 1 < argc) {
-      co.keep_avg_ratio = std::atof(argv[++i]);
-    } else if (a == "--candidates" && i + 1 < argc) {
-      co.max_candidates = std::atoi(argv[++i]);
-    } else if (a == "--rings" && i + 1 < argc) {
-      co.smooth_rings = std::atoi(argv[++i]);
-    } else if (a == "--faces") {
-      per_face = true;
-    } else if (path.empty() && a.rfind("--", 0) != 0) {
-      path = a;
-    } else {
-      path.clear();
-      break;
-    }
-  }
-  if (path.empty() || !(size_factor > 0)) {
-    std::cerr << "usage: cavity_survey MODEL [--size-factor F] [--threads T] [--first N] [--faces] "
-                 "[--quad-change F] "
-                 "[--avg-ratio R] [--candidates N] [--rings N]\n";
-    return 2;
-  }
-  try {
-    cad::set_kernel_messages(true);
-    const cad::CadModel model = cad::load_cad(path);
-    Logger log(std::cerr, LogLevel::Warning);
-    parallel::PipelineOptions options;
-    const double size = model.diagonal() * size_factor;
-    options.background.sizes.size = size;
-    options.sizemap.size_max = size;
-    options.size_map = true;
-    options.cross_fields = true;
-    options.until = parallel::Stage::Background;
-    const TaskArena tasks(threads);
-    const parallel::PipelineResult result =
-        parallel::run_pipeline(parallel::Comm::self(), model, options, tasks, log);
+  const bool ok = test::parse_survey_args(
+      argc, argv,
+      "usage: cavity_survey MODEL [--size-factor F] [--threads T] [--first N] [--faces] "
+      "[--quad-change F] [--avg-ratio R] [--candidates N] [--rings N]",
+      args, [&](const std::string& a, int& i) {
+        if (i + 1 >= argc) return false;
+        if (a == "--first") {
+          first = std::atoi(argv[++i]);
+        } else if (a == "--quad-change") {
+          co.max_quad_change = std::atof(argv[++i]);
+        } else if (a == "--avg-ratio") {
+          co.keep_avg_ratio = std::atof(argv[++i]);
+        } else if (a == "--candidates") {
+          co.max_candidates = std::atoi(argv[++i]);
+        } else if (a == "--rings") {
+          co.smooth_rings = std::atoi(argv[++i]);
+        } else {
+          return false;
+        }
+        return true;
+      });
+  if (!ok) return 2;
+  const std::string& path = args.path;
+  const double size_factor = args.size_factor;
+  const bool per_face = args.per_face;
+  return test::run_reporting_errors("cavity_survey", [&] {
+    const cad::CadModel model = test::load_survey_model(path);
+    const TaskArena tasks(args.threads);
+    const test::SurveyRun run = test::run_survey_pipeline(model, size_factor, /*cross_fields=*/true, tasks);
+    const parallel::PipelineResult& result = run.result;
+    const parallel::PipelineOptions& options = run.options;
+    const double size = run.size;
     const std::vector<mesh::CurveMesh> curves =
         background::mesh_curves(model, options.background.sizes, tasks);
     const std::vector<mesh::CurveMesh> halved = quantize::place_vertices(
@@ -172,9 +157,5 @@ int main(int argc, char** argv) {
     for (int k = 0; k < 4; ++k)
       std::cout << " " << grown[k] << "/" << remeshed[k] << "/" << rejected[k];
     std::cout << "\n  remesh_cavities time " << seconds << " s\n";
-  } catch (const std::exception& e) {
-    std::cerr << "cavity_survey: " << e.what() << "\n";
-    return 1;
-  }
-  return 0;
+  });
 }

@@ -15,55 +15,35 @@
 #include "qsmesh/parallel/comm.hpp"
 #include "qsmesh/parallel/pipeline.hpp"
 #include "qsmesh/qstruct/face_pattern.hpp"
+#include "survey_common.hpp"
 
 using namespace qsmesh;
 
 int main(int argc, char** argv) {
   parallel::MpiSession mpi(&argc, &argv);
-  std::string path;
-  double size_factor = 0.02;
-  int threads = 1;
-  bool per_face = false;
+  test::SurveyArgs args;
   LO detail = kNoIndex;
-  for (int i = 1; i < argc; ++i) {
-    const std::string a = argv[i];
-    if (a == "--size-factor" && i + 1 < argc) {
-      size_factor = std::atof(argv[++i]);
-    } else if (a == "--threads" && i + 1 < argc) {
-      threads = std::atoi(argv[++i]);
-    } else if (a == "--face" && i + 1 < argc) {
-      detail = std::atoi(argv[++i]);
-    } else if (a == "--faces") {
-      per_face = true;
-    } else if (path.empty() && a.rfind("--", 0) != 0) {
-      path = a;
-    } else {
-      std::cerr << "usage: qstruct_survey MODEL [--size-factor F] [--threads T] [--faces]\n";
-      return 2;
-    }
-  }
-  if (path.empty() || !(size_factor > 0)) {
-    std::cerr << "usage: qstruct_survey MODEL [--size-factor F] [--threads T] [--faces]\n";
-    return 2;
-  }
-  try {
-    cad::set_kernel_messages(true);
-    const cad::CadModel model = cad::load_cad(path);
-    Logger log(std::cerr, LogLevel::Warning);
-    parallel::PipelineOptions options;
-    const double size = model.diagonal() * size_factor;
-    options.background.sizes.size = size;
-    options.sizemap.size_max = size;
-    options.size_map = true;
-    options.until = parallel::Stage::Background;
-    const TaskArena tasks(threads);
-    Stopwatch clock;
-    const parallel::PipelineResult result = parallel::run_pipeline(parallel::Comm::self(), model, options, tasks, log);
-    const double pipeline_s = clock.seconds();
+  const bool ok = test::parse_survey_args(
+      argc, argv, "usage: qstruct_survey MODEL [--size-factor F] [--threads T] [--faces]", args,
+      [&](const std::string& a, int& i) {
+        if (a != "--face" || i + 1 >= argc) return false;
+        detail = std::atoi(argv[++i]);
+        return true;
+      });
+  if (!ok) return 2;
+  const std::string& path = args.path;
+  const double size_factor = args.size_factor;
+  const bool per_face = args.per_face;
+  return test::run_reporting_errors("qstruct_survey", [&] {
+    const cad::CadModel model = test::load_survey_model(path);
+    const TaskArena tasks(args.threads);
+    const test::SurveyRun run = test::run_survey_pipeline(model, size_factor, /*cross_fields=*/false, tasks);
+    const parallel::PipelineResult& result = run.result;
+    const double pipeline_s = run.pipeline_seconds;
 
     const auto patterns = qstruct::builtin_patterns();
     const qstruct::PatternFaceOptions fo;
-    clock.reset();
+    Stopwatch clock;
     std::map<std::string, int> refusals, used, no_pattern_sides, quality_patterns;
     std::int64_t quads = 0;
     double worst = 1, sum_avg = 0;
@@ -122,9 +102,5 @@ int main(int argc, char** argv) {
     std::cout << "\n  quality refusals by best pattern:";
     for (const auto& [k, n] : quality_patterns) std::cout << " " << k << " " << n << ";";
     std::cout << "\n  time (s): pipeline to quantization " << pipeline_s << ", pattern meshing " << faces_s << "\n";
-  } catch (const std::exception& e) {
-    std::cerr << "qstruct_survey: " << e.what() << "\n";
-    return 1;
-  }
-  return 0;
+  });
 }

@@ -12,27 +12,19 @@
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/qstruct/cavity.hpp"
+#include "analytic_surfaces.hpp"
 
 namespace qsmesh::qstruct {
 namespace {
 
-class Plane : public cad::FaceGeometry {
+// The shared plane with its projection in closed form (the orthogonal foot), as these tests
+// always had it, rather than Newton steps.
+class Plane : public test::Plane {
  public:
-  [[nodiscard]] cad::SurfaceEval eval(const Vec2& uv) const override {
-    return {{uv.u, uv.v, 0}, {1, 0, 0}, {0, 1, 0}};
-  }
-  [[nodiscard]] cad::SurfaceEval2 eval2(const Vec2& uv) const override {
-    cad::SurfaceEval2 e;
-    static_cast<cad::SurfaceEval&>(e) = eval(uv);
-    return e;
-  }
-  [[nodiscard]] Vec3 normal(const Vec2&) const override { return {0, 0, 1}; }
   [[nodiscard]] Vec2 project(const Vec3& p, const Vec2&, Vec3* foot) const override {
     if (foot) *foot = {p.x, p.y, 0};
     return {p.x, p.y};
   }
-  [[nodiscard]] Vec2 boundary_uv(LO, LO, double) const override { return {}; }
-  [[nodiscard]] bool contains(const Vec2&) const override { return true; }
 };
 
 // nx x ny grid of unit squares on face 0: boundary vertices first (counter-clockwise from the

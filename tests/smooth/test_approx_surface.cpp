@@ -19,24 +19,13 @@
 #include "qsmesh/cad/model.hpp"
 #include "qsmesh/smooth/approx_surface.hpp"
 #include "qsmesh/smooth/smooth.hpp"
+#include "face_case.hpp"
 
 namespace qsmesh::smooth {
 namespace {
 
-std::string tmp(const std::string& name) { return std::string(QSMESH_TEST_TMP_DIR) + "/" + name; }
-
-struct Case {
-  cad::CadModel model;
-  std::unique_ptr<cad::FaceGeometry> geometry;
-};
-
-Case load_face(const TopoDS_Shape& s, const std::string& name) {
-  const std::string path = tmp(name);
-  if (!BRepTools::Write(s, path.c_str())) throw std::runtime_error("cannot write " + path);
-  Case c{cad::load_cad(path), nullptr};
-  c.geometry = c.model.face_geometry(0);
-  return c;
-}
+using Case = test::FaceCase;
+using test::load_face;
 
 // n x n quads over the uv box (boundary dim 1, corners dim 0); interior uv perturbed by `amp`.
 mesh::FaceMesh grid(const cad::FaceGeometry& g, Box2 box, int n, double amp) {

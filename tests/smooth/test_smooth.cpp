@@ -13,18 +13,16 @@
 
 #include "qsmesh/cad/model.hpp"
 #include "qsmesh/smooth/smooth.hpp"
+#include "face_case.hpp"
 #include "shapes.hpp"
 
 namespace qsmesh::smooth {
 namespace {
 
-std::string tmp(const std::string& name) { return std::string(QSMESH_TEST_TMP_DIR) + "/" + name; }
-
-std::string write_face(const TopoDS_Shape& s, const std::string& name) {
-  const std::string path = tmp(name);
-  if (!BRepTools::Write(s, path.c_str())) throw std::runtime_error("cannot write " + path);
-  return path;
-}
+using test::load_face;
+using test::tmp_path;
+using test::write_face;
+using Case = test::FaceCase;
 
 // 10 x 6 plate in the z = 0 plane, u = x, v = y.
 std::string write_plate() {
@@ -49,21 +47,6 @@ struct Lcg {
     return static_cast<double>(s >> 11) / static_cast<double>(1ULL << 53) * 2.0 - 1.0;
   }
 };
-
-struct Case {
-  cad::CadModel model;
-  std::unique_ptr<cad::FaceGeometry> geometry;
-  LO face = 0;
-};
-
-Case load_face(const std::string& path, cad::SurfaceType type) {
-  Case c{cad::load_cad(path), nullptr, kNoIndex};
-  for (LO f = 0; f < c.model.num_faces(); ++f)
-    if (c.model.faces()[f].type == type) c.face = f;
-  if (c.face == kNoIndex) throw std::runtime_error("no face of the wanted type in " + path);
-  c.geometry = c.model.face_geometry(c.face);
-  return c;
-}
 
 // Structured nu x nv grid of quads over the uv box; interior uv perturbed by `amp` cell sizes.
 // seam_u: the sides u = lo and u = hi are the two images of one seam curve.
@@ -168,15 +151,7 @@ mesh::FaceMesh split_triangles(const cad::FaceGeometry& g, Box2 box, int nu, int
 
 void expect_boundary_locked_and_on_surface(const mesh::FaceMesh& in, const mesh::FaceMesh& out,
                                            const cad::FaceGeometry& g, double size) {
-  ASSERT_EQ(in.points.size(), out.points.size());
-  EXPECT_EQ(in.quads, out.quads);
-  for (std::size_t v = 0; v < in.points.size(); ++v) {
-    if (in.vclass[v].dim != 2) {
-      EXPECT_TRUE(in.points[v] == out.points[v]) << "boundary vertex " << v << " moved";
-      EXPECT_TRUE(in.uv[v] == out.uv[v]) << "boundary vertex " << v << " moved in uv";
-    }
-    EXPECT_LT(distance(g.eval(out.uv[v]).p, out.points[v]), 1e-9 * size) << v;
-  }
+  test::expect_locked_and_on_surface(in, out, g, size, /*check_params=*/false);
 }
 
 TEST(Smooth, MeasureOfSquaresIsOne) {
@@ -241,7 +216,7 @@ TEST(Smooth, PerturbedCylinderPatchBecomesRegular) {
 
 TEST(Smooth, SeamSkipsUvLaplacianButKernelsImprove) {
   const Case c =
-      load_face(test::write_cylinder(tmp("smooth_cyl.brep")), cad::SurfaceType::Cylinder);
+      load_face(test::write_cylinder(tmp_path("smooth_cyl.brep")), cad::SurfaceType::Cylinder);
   Box2 box = c.model.faces()[c.face].uv_box;
   ASSERT_TRUE(c.model.faces()[c.face].u_periodic);
   const auto in = grid(*c.geometry, box, 24, 10, 0.35, 5, /*seam_u=*/true);

@@ -15,24 +15,13 @@
 #include "qsmesh/cad/model.hpp"
 #include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/smooth/untangle.hpp"
+#include "face_case.hpp"
 
 namespace qsmesh::smooth {
 namespace {
 
-std::string tmp(const std::string& name) { return std::string(QSMESH_TEST_TMP_DIR) + "/" + name; }
-
-struct Case {
-  cad::CadModel model;
-  std::unique_ptr<cad::FaceGeometry> geometry;
-};
-
-Case load_face(const TopoDS_Shape& s, const std::string& name) {
-  const std::string path = tmp(name);
-  if (!BRepTools::Write(s, path.c_str())) throw std::runtime_error("cannot write " + path);
-  Case c{cad::load_cad(path), nullptr};
-  c.geometry = c.model.face_geometry(0);
-  return c;
-}
+using Case = test::FaceCase;
+using test::load_face;
 
 // n x n grid of quads over the uv box, boundary classified on one curve (dim 1) or a corner.
 mesh::FaceMesh grid(const cad::FaceGeometry& g, Box2 box, int n) {
@@ -76,18 +65,7 @@ void fold(mesh::FaceMesh& m, const cad::FaceGeometry& g, Box2 box, int n, int i,
 
 void expect_locked_and_on_surface(const mesh::FaceMesh& in, const mesh::FaceMesh& out,
                                   const cad::FaceGeometry& g, double size) {
-  ASSERT_EQ(in.points.size(), out.points.size());
-  EXPECT_EQ(in.quads, out.quads);
-  for (std::size_t v = 0; v < in.points.size(); ++v) {
-    if (in.vclass[v].dim != 2) {
-      EXPECT_TRUE(in.points[v] == out.points[v]) << "boundary vertex " << v << " moved";
-      EXPECT_TRUE(in.uv[v] == out.uv[v]) << "boundary vertex " << v << " moved in uv";
-    } else {
-      EXPECT_EQ(out.vclass[v].param[0], out.uv[v].u);
-      EXPECT_EQ(out.vclass[v].param[1], out.uv[v].v);
-    }
-    EXPECT_LT(distance(g.eval(out.uv[v]).p, out.points[v]), 1e-9 * size) << v;
-  }
+  test::expect_locked_and_on_surface(in, out, g, size, /*check_params=*/true);
 }
 
 TEST(Untangle, FoldedPatchOnAPlaneBecomesValid) {
