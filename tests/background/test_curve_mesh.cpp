@@ -1,3 +1,4 @@
+#include "tmp_dir.hpp"
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -10,7 +11,7 @@
 namespace qsmesh::background {
 namespace {
 
-std::string tmp(const std::string& name) { return std::string(QSMESH_TEST_TMP_DIR) + "/" + name; }
+std::string tmp(const std::string& name) { return qsmesh::test::tmp_dir() + "/" + name; }
 
 TEST(CurveMesh, StraightEdgesFollowTheSize) {
   const cad::CadModel model = cad::load_cad(test::write_box_with_hole(tmp("cm_box.brep")));

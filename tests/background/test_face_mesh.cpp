@@ -1,3 +1,4 @@
+#include "tmp_dir.hpp"
 #include <gtest/gtest.h>
 
 #include <numbers>
@@ -12,7 +13,7 @@
 namespace qsmesh::background {
 namespace {
 
-std::string tmp(const std::string& name) { return std::string(QSMESH_TEST_TMP_DIR) + "/" + name; }
+std::string tmp(const std::string& name) { return qsmesh::test::tmp_dir() + "/" + name; }
 
 struct Meshed {
   mesh::SurfaceMesh mesh;

@@ -1,6 +1,7 @@
 // Helpers of the cad tests: writing OpenCASCADE shapes to files, loop geometry in (u, v).
 #pragma once
 
+#include "tmp_dir.hpp"
 #include <gtest/gtest.h>
 
 #include <BRepTools.hxx>
@@ -16,7 +17,7 @@
 namespace qsmesh::cad::test {
 
 inline std::string tmp_path(const std::string& name) {
-  return std::string(QSMESH_TEST_TMP_DIR) + "/" + name;
+  return qsmesh::test::tmp_dir() + "/" + name;
 }
 
 inline void write_brep(const TopoDS_Shape& s, const std::string& path) {

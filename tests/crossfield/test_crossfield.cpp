@@ -1,4 +1,5 @@
 // Cross field of single faces built with OpenCASCADE (paper 000 Sec. 3.1-3.3).
+#include "tmp_dir.hpp"
 #include <gtest/gtest.h>
 
 #include <BRepBuilderAPI_MakeEdge.hxx>
@@ -25,7 +26,7 @@ namespace {
 
 constexpr double kPi = std::numbers::pi;
 
-std::string tmp(const std::string& name) { return std::string(QSMESH_TEST_TMP_DIR) + "/" + name; }
+std::string tmp(const std::string& name) { return qsmesh::test::tmp_dir() + "/" + name; }
 
 cad::CadModel load_shape(const TopoDS_Shape& s, const std::string& name) {
   const std::string path = tmp(name);

@@ -7,6 +7,7 @@
 //  0 ---7--- 1 ----9----- 4        Vertex 11 (3.5, 0.5) is inside face 1.
 #pragma once
 
+#include "tmp_dir.hpp"
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -52,7 +53,7 @@ inline mesh::SurfaceMesh make_test_mesh() {
 
 /// A fresh, empty folder under the test temp folder.
 inline std::filesystem::path fresh_dir(const std::string& name) {
-  const std::filesystem::path dir = std::filesystem::path(QSMESH_TEST_TMP_DIR) / name;
+  const std::filesystem::path dir = std::filesystem::path(qsmesh::test::tmp_dir()) / name;
   std::filesystem::remove_all(dir);
   std::filesystem::create_directories(dir);
   return dir;

@@ -1,3 +1,4 @@
+#include "tmp_dir.hpp"
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -19,7 +20,7 @@ namespace {
 
 using XY = std::vector<std::pair<double, double>>;
 
-std::string tmp(const std::string& name) { return std::string(QSMESH_TEST_TMP_DIR) + "/" + name; }
+std::string tmp(const std::string& name) { return qsmesh::test::tmp_dir() + "/" + name; }
 
 // Evenly spaced curve mesh with n edges, its ends exactly the corner points.
 mesh::CurveMesh uniform_curve(const cad::CadModel& model, LO c, LO n) {

@@ -1,3 +1,4 @@
+#include "tmp_dir.hpp"
 #include <gtest/gtest.h>
 
 #include <BRepBuilderAPI_MakeFace.hxx>
@@ -24,7 +25,7 @@
 namespace qsmesh::quad {
 namespace {
 
-std::string tmp(const std::string& name) { return std::string(QSMESH_TEST_TMP_DIR) + "/" + name; }
+std::string tmp(const std::string& name) { return qsmesh::test::tmp_dir() + "/" + name; }
 
 cad::CadModel square_plate(double side, const std::string& name) {
   BRepBuilderAPI_MakePolygon poly;

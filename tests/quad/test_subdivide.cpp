@@ -1,3 +1,4 @@
+#include "tmp_dir.hpp"
 #include <gtest/gtest.h>
 
 #include <BRepBuilderAPI_MakeFace.hxx>
@@ -31,7 +32,7 @@
 namespace qsmesh::quad {
 namespace {
 
-std::string tmp(const std::string& name) { return std::string(QSMESH_TEST_TMP_DIR) + "/" + name; }
+std::string tmp(const std::string& name) { return qsmesh::test::tmp_dir() + "/" + name; }
 
 cad::CadModel load_shape(const TopoDS_Shape& shape, const std::string& name) {
   const std::string path = tmp(name);

@@ -1,3 +1,4 @@
+#include "tmp_dir.hpp"
 #include <gtest/gtest.h>
 
 #include <BRepBuilderAPI_MakeFace.hxx>
@@ -135,7 +136,7 @@ struct Plate {
 };
 
 Plate load_plate() {
-  const std::string path = std::string(QSMESH_TEST_TMP_DIR) + "/remesh_plate.brep";
+  const std::string path = qsmesh::test::tmp_dir() + "/remesh_plate.brep";
   const auto face =
       BRepBuilderAPI_MakeFace(gp_Pln(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), 0.0, 6.0, 0.0, 6.0).Face();
   if (!BRepTools::Write(face, path.c_str())) throw std::runtime_error("cannot write " + path);

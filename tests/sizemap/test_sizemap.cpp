@@ -1,4 +1,5 @@
 // Size map (paper 000 Sec. 4.1, 4.2) on OpenCASCADE-built models.
+#include "tmp_dir.hpp"
 #include <gtest/gtest.h>
 
 #include <numbers>
@@ -32,7 +33,7 @@
 namespace qsmesh::sizemap {
 namespace {
 
-std::string tmp(const std::string& name) { return std::string(QSMESH_TEST_TMP_DIR) + "/" + name; }
+std::string tmp(const std::string& name) { return qsmesh::test::tmp_dir() + "/" + name; }
 
 cad::CadModel load_shape(const TopoDS_Shape& s, const std::string& name) {
   const std::string path = tmp(name);

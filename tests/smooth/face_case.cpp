@@ -1,3 +1,4 @@
+#include "tmp_dir.hpp"
 #include "face_case.hpp"
 
 #include <gtest/gtest.h>
@@ -7,7 +8,7 @@
 
 namespace qsmesh::test {
 
-std::string tmp_path(const std::string& name) { return std::string(QSMESH_TEST_TMP_DIR) + "/" + name; }
+std::string tmp_path(const std::string& name) { return qsmesh::test::tmp_dir() + "/" + name; }
 
 std::string write_face(const TopoDS_Shape& shape, const std::string& name) {
   const std::string path = tmp_path(name);
