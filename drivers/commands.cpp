@@ -3,13 +3,13 @@
 #include <unistd.h>
 
 #include <array>
-#include <string_view>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <sstream>
+#include <string_view>
 #include <thread>
 
 #include "json.hpp"
@@ -34,9 +34,11 @@ void check_writable(const std::string& option, const std::string& path) {
   const fs::path dir = p.parent_path().empty() ? fs::path(".") : p.parent_path();
   std::error_code ec;
   if (!fs::is_directory(dir, ec))
-    throw InputError(option + ": cannot write '" + path + "': directory '" + dir.string() + "' does not exist");
+    throw InputError(option + ": cannot write '" + path + "': directory '" + dir.string() +
+                     "' does not exist");
   if (::access(dir.c_str(), W_OK) != 0)
-    throw InputError(option + ": cannot write '" + path + "': directory '" + dir.string() + "' is not writable");
+    throw InputError(option + ": cannot write '" + path + "': directory '" + dir.string() +
+                     "' is not writable");
   if (fs::is_directory(p, ec)) throw InputError(option + ": '" + path + "' is a directory");
 }
 
@@ -61,19 +63,32 @@ int run_info(const Arguments& args) {
     for (const auto& c : model.curves()) degenerate += c.degenerate ? 1 : 0;
     j.value("degenerate_curves", degenerate);
     j.value("diagonal", model.diagonal());
-    j.begin_array("box").begin_object().value("x", model.box().lo.x).value("y", model.box().lo.y)
-        .value("z", model.box().lo.z).end_object();
-    j.begin_object().value("x", model.box().hi.x).value("y", model.box().hi.y).value("z", model.box().hi.z)
-        .end_object().end_array();
+    j.begin_array("box")
+        .begin_object()
+        .value("x", model.box().lo.x)
+        .value("y", model.box().lo.y)
+        .value("z", model.box().lo.z)
+        .end_object();
+    j.begin_object()
+        .value("x", model.box().hi.x)
+        .value("y", model.box().hi.y)
+        .value("z", model.box().hi.z)
+        .end_object()
+        .end_array();
     j.begin_array("face_list");
     for (LO f = 0; f < model.num_faces(); ++f) {
       const cad::Face& face = model.faces()[f];
       std::int64_t uses = 0;
       for (const auto& l : face.loops) uses += static_cast<std::int64_t>(l.uses.size());
-      j.begin_object().value("id", static_cast<std::int64_t>(f)).value("type", cad::to_string(face.type))
-          .value("loops", static_cast<std::int64_t>(face.loops.size())).value("curve_uses", uses)
-          .value("seams", static_cast<std::int64_t>(face.seams.size())).value("area", face.area)
-          .value("reversed", face.reversed).end_object();
+      j.begin_object()
+          .value("id", static_cast<std::int64_t>(f))
+          .value("type", cad::to_string(face.type))
+          .value("loops", static_cast<std::int64_t>(face.loops.size()))
+          .value("curve_uses", uses)
+          .value("seams", static_cast<std::int64_t>(face.seams.size()))
+          .value("area", face.area)
+          .value("reversed", face.reversed)
+          .end_object();
     }
     j.end_array();
     j.end_object();
@@ -87,19 +102,20 @@ int run_info(const Arguments& args) {
   std::int64_t degenerate = 0;
   for (const auto& c : model.curves()) degenerate += c.degenerate ? 1 : 0;
   std::cout << "degenerate curves: " << degenerate << "\n"
-            << "bounding box: (" << model.box().lo.x << ", " << model.box().lo.y << ", " << model.box().lo.z
-            << ") - (" << model.box().hi.x << ", " << model.box().hi.y << ", " << model.box().hi.z
-            << "), diagonal " << model.diagonal() << "\n\n";
+            << "bounding box: (" << model.box().lo.x << ", " << model.box().lo.y << ", "
+            << model.box().lo.z << ") - (" << model.box().hi.x << ", " << model.box().hi.y << ", "
+            << model.box().hi.z << "), diagonal " << model.diagonal() << "\n\n";
   std::cout << std::setw(6) << "face" << std::setw(12) << "surface" << std::setw(7) << "loops"
-            << std::setw(7) << "uses" << std::setw(7) << "seams" << std::setw(15) << "area" << "\n";
+            << std::setw(7) << "uses" << std::setw(7) << "seams" << std::setw(15) << "area"
+            << "\n";
   for (LO f = 0; f < model.num_faces(); ++f) {
     const cad::Face& face = model.faces()[f];
     std::size_t uses = 0;
     for (const auto& l : face.loops) uses += l.uses.size();
     std::cout << std::setw(6) << f << std::setw(12) << cad::to_string(face.type) << std::setw(7)
               << face.loops.size() << std::setw(7) << uses << std::setw(7) << face.seams.size()
-              << std::setw(15) << std::setprecision(6) << face.area << (face.reversed ? "  reversed" : "")
-              << "\n";
+              << std::setw(15) << std::setprecision(6) << face.area
+              << (face.reversed ? "  reversed" : "") << "\n";
   }
   return 0;
 }
@@ -152,7 +168,8 @@ std::pair<std::int64_t, std::int64_t> count_failures(const parallel::PipelineRes
 
 /// How face f got its quad mesh: "pattern:<name>", "frontal" or "fallback".
 std::string quad_method(const parallel::PipelineResult& r, std::size_t f) {
-  if (f < r.quasi_reports.size() && r.quasi_reports[f].by_pattern) return "pattern:" + r.quasi_reports[f].pattern;
+  if (f < r.quasi_reports.size() && r.quasi_reports[f].by_pattern)
+    return "pattern:" + r.quasi_reports[f].pattern;
   return f < r.quad_reports.size() && r.quad_reports[f].frontal ? "frontal" : "fallback";
 }
 
@@ -184,8 +201,9 @@ QuasiTotals quasi_totals(const parallel::PipelineResult& r) {
   return t;
 }
 
-std::string stats_json(const Arguments& args, const Session& session, const parallel::PipelineResult& r,
-                       const mesh::MeshStats& s, const Checks& checks) {
+std::string stats_json(const Arguments& args, const Session& session,
+                       const parallel::PipelineResult& r, const mesh::MeshStats& s,
+                       const Checks& checks) {
   const cad::CadModel& model = session.model;
   JsonWriter j;
   j.begin_object();
@@ -242,8 +260,12 @@ std::string stats_json(const Arguments& args, const Session& session, const para
   j.begin_array("face_reports");
   for (const auto& o : outcomes(r)) {
     if (o.ok && !o.fell_back) continue;
-    j.begin_object().value("face", static_cast<std::int64_t>(o.face)).value("ok", o.ok)
-        .value("fell_back", o.fell_back).value("error", o.error).end_object();
+    j.begin_object()
+        .value("face", static_cast<std::int64_t>(o.face))
+        .value("ok", o.ok)
+        .value("fell_back", o.fell_back)
+        .value("error", o.error)
+        .end_object();
   }
   j.end_array();
   if (!r.face_stats.empty()) {
@@ -271,7 +293,8 @@ std::string stats_json(const Arguments& args, const Session& session, const para
 }
 
 void print_summary(std::ostream& os, const cad::CadModel& model, const parallel::PipelineResult& r,
-                   const mesh::MeshStats& s, const Checks& checks, const StageTimes& times, bool per_face) {
+                   const mesh::MeshStats& s, const Checks& checks, const StageTimes& times,
+                   bool per_face) {
   const auto [failed, fell_back] = count_failures(r);
   os << "\nsummary\n"
      << "  faces:      " << model.num_faces() << " (" << failed << " failed, " << fell_back
@@ -279,16 +302,18 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
      << "  vertices:   " << s.vertices << "\n"
      << "  triangles:  " << s.triangles << "\n"
      << "  quads:      " << s.quads << "\n"
-     << "  irregular interior vertices: " << s.irregular_interior << " of " << s.interior_vertices << "\n";
+     << "  irregular interior vertices: " << s.irregular_interior << " of " << s.interior_vertices
+     << "\n";
   if (!r.face_stats.empty())
-    os << "  boundary vertices away from their ideal valence (per face): " << total_irregular_boundary(r) << "\n";
+    os << "  boundary vertices away from their ideal valence (per face): "
+       << total_irregular_boundary(r) << "\n";
   if (s.quads > 0) os << "  SICN min/avg: " << s.sicn_min << " / " << s.sicn_avg << "\n";
   if (!r.quasi_reports.empty()) {
     const QuasiTotals t = quasi_totals(r);
     os << "  faces meshed by patterns: " << t.by_pattern << " of " << model.num_faces() << "\n"
-       << "  cavity remeshing (other faces): irregular interior vertices " << t.irregular_before << " -> "
-       << t.irregular_after << "; cavities remeshed by step " << t.cavities[0] << ", " << t.cavities[1] << ", "
-       << t.cavities[2] << ", " << t.cavities[3] << "\n"
+       << "  cavity remeshing (other faces): irregular interior vertices " << t.irregular_before
+       << " -> " << t.irregular_after << "; cavities remeshed by step " << t.cavities[0] << ", "
+       << t.cavities[1] << ", " << t.cavities[2] << ", " << t.cavities[3] << "\n"
        << "  disk remeshing: defects " << t.defects_before << " -> " << t.defects_after << " ("
        << t.disk_replaced << " cavities replaced)\n";
   }
@@ -300,18 +325,22 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
        << ", >=30: " << s.min_angle_histogram[4] << " (" << s.small_angle_at_sharp_corner
        << " below 10 at CAD corners sharper than 10)\n";
   }
-  os << "  conforming: " << (checks.conformity.ok() ? "yes" : "NO (" + checks.conformity.summary() + ")")
-     << "; largest vertex distance to its CAD entity: " << checks.max_distance_to_cad << " of the diagonal\n";
+  os << "  conforming: "
+     << (checks.conformity.ok() ? "yes" : "NO (" + checks.conformity.summary() + ")")
+     << "; largest vertex distance to its CAD entity: " << checks.max_distance_to_cad
+     << " of the diagonal\n";
   os << "  time (s):" << times_line(times) << "\n";
   for (const auto& o : outcomes(r))
-    if (!o.ok || (o.fell_back && !o.error.empty())) os << "  face " << o.face << ": " << o.error << "\n";
+    if (!o.ok || (o.fell_back && !o.error.empty()))
+      os << "  face " << o.face << ": " << o.error << "\n";
   if (per_face && !r.face_stats.empty()) {
-    os << "  per face: method, vertices, quads, triangles, irregular interior / boundary, SICN min / avg, seconds\n";
+    os << "  per face: method, vertices, quads, triangles, irregular interior / boundary, SICN min "
+          "/ avg, seconds\n";
     for (std::size_t f = 0; f < r.face_stats.size(); ++f) {
       const auto& st = r.face_stats[f];
-      os << "    face " << f << ": " << quad_method(r, f) << ", " << st.vertices << ", " << st.quads << ", "
-         << st.triangles << ", " << st.irregular_interior << " / " << st.irregular_boundary << ", " << st.sicn_min
-         << " / " << st.sicn_avg << ", " << r.face_seconds[f] << "\n";
+      os << "    face " << f << ": " << quad_method(r, f) << ", " << st.vertices << ", " << st.quads
+         << ", " << st.triangles << ", " << st.irregular_interior << " / " << st.irregular_boundary
+         << ", " << st.sicn_min << " / " << st.sicn_avg << ", " << r.face_seconds[f] << "\n";
     }
   }
 }
@@ -345,20 +374,24 @@ Session::Session(const Arguments& args, const char* command)
       rank(comm.rank()),
       ranks(comm.size()),
       log(std::cerr,
-          rank == 0 ? (args.quiet ? LogLevel::Warning : (args.verbose ? LogLevel::Debug : LogLevel::Info))
-                    : LogLevel::Warning,
+          rank == 0
+              ? (args.quiet ? LogLevel::Warning : (args.verbose ? LogLevel::Debug : LogLevel::Info))
+              : LogLevel::Warning,
           ranks > 1 ? cat("[rank ", rank, "] ") : "") {
   Stopwatch clock;
   model = cad::load_cad(args.model, cad::LoadOptions{args.sew, 0});
   times.add("load", comm.allreduce_max(clock.seconds()));
   size = args.size ? *args.size : model.diagonal() * args.size_factor.value_or(kDefaultSizeFactor);
-  if (!(size > 0)) throw InputError("size: the model '" + args.model + "' has an empty bounding box");
+  if (!(size > 0))
+    throw InputError("size: the model '" + args.model + "' has an empty bounding box");
   threads = args.threads;
-  if (threads <= 0) threads = std::max(1, static_cast<int>(std::thread::hardware_concurrency()) / comm.local_size());
+  if (threads <= 0)
+    threads =
+        std::max(1, static_cast<int>(std::thread::hardware_concurrency()) / comm.local_size());
   tasks = std::make_unique<TaskArena>(threads);
-  log.info(cat("qsmesh ", command, " ", args.model, ": ", model.num_corners(), " corners, ", model.num_curves(),
-               " curves, ", model.num_faces(), " faces; size ", size, "; ", ranks, " rank(s) x ", threads,
-               " thread(s)"));
+  log.info(cat("qsmesh ", command, " ", args.model, ": ", model.num_corners(), " corners, ",
+               model.num_curves(), " curves, ", model.num_faces(), " faces; size ", size, "; ",
+               ranks, " rank(s) x ", threads, " thread(s)"));
 }
 
 int run_mesh(const Arguments& args) {
@@ -372,7 +405,8 @@ int run_mesh(const Arguments& args) {
   options.background.sizes.size = s.size;
   options.sizemap.size_max = s.size;
   options.until = until;
-  parallel::PipelineResult result = parallel::run_pipeline(s.comm, s.model, options, *s.tasks, s.log);
+  parallel::PipelineResult result =
+      parallel::run_pipeline(s.comm, s.model, options, *s.tasks, s.log);
   for (const auto& [stage, sec] : result.times.entries()) s.times.add(stage, sec);
 
   if (s.rank == 0) {
@@ -380,13 +414,15 @@ int run_mesh(const Arguments& args) {
     const mesh::MeshStats stats = mesh::compute_stats(result.mesh);
     Checks checks;
     checks.conformity = mesh::check_conformity(result.mesh, s.model);
-    checks.max_distance_to_cad = mesh::max_distance_to_cad(result.mesh, s.model) / s.model.diagonal();
+    checks.max_distance_to_cad =
+        mesh::max_distance_to_cad(result.mesh, s.model) / s.model.diagonal();
     s.times.add("statistics", clock.seconds());
     clock.reset();
     io::write_mesh(result.mesh, args.output);
     s.times.add("write", clock.seconds());
     s.log.info(cat("wrote ", args.output));
-    if (!args.quiet) print_summary(std::cout, s.model, result, stats, checks, s.times, args.verbose);
+    if (!args.quiet)
+      print_summary(std::cout, s.model, result, stats, checks, s.times, args.verbose);
     if (!args.stats.empty())
       write_text_file_atomically(args.stats, stats_json(args, s, result, stats, checks));
     for (const auto& o : outcomes(result))

@@ -39,7 +39,8 @@ class Improver {
       : m_(std::move(mesh)), surf_(surface), sign_(reversed ? -1.0 : 1.0), opt_(o) {
     const LO nv = m_.num_vertices();
     pole_.assign(static_cast<std::size_t>(nv), 0);
-    // A pole is a corner where the parametrisation is singular: only its 3D position means anything.
+    // A pole is a corner where the parametrisation is singular: only its 3D position means
+    // anything.
     for (LO v = 0; v < nv; ++v)
       if (m_.vclass[v].dim == 0 && norm(surf_.normal(m_.uv[v])) < 0.5) pole_[v] = 1;
     v2t_.assign(static_cast<std::size_t>(nv), {});
@@ -47,8 +48,9 @@ class Improver {
       const auto& T = m_.triangles[t];
       for (int k = 0; k < 3; ++k) {
         v2t_[T[k]].push_back(t);
-        auto& e = e2t_.try_emplace(edge_key(T[k], T[(k + 1) % 3]), std::array<LO, 2>{kNoIndex, kNoIndex})
-                      .first->second;
+        auto& e =
+            e2t_.try_emplace(edge_key(T[k], T[(k + 1) % 3]), std::array<LO, 2>{kNoIndex, kNoIndex})
+                .first->second;
         if (e[0] == kNoIndex) {
           e[0] = t;
         } else {
@@ -102,7 +104,8 @@ class Improver {
 
   double mesh_min_angle() const {
     double worst = kPi;
-    for (LO t = 0; t < static_cast<LO>(m_.triangles.size()); ++t) worst = std::min(worst, tri_angle(t));
+    for (LO t = 0; t < static_cast<LO>(m_.triangles.size()); ++t)
+      worst = std::min(worst, tri_angle(t));
     return worst * 180.0 / kPi;
   }
 
@@ -160,7 +163,8 @@ class Improver {
     LO t1 = it->second[0], t2 = it->second[1];
     LO c = kNoIndex, d = kNoIndex;
     if (!orient_as(m_.triangles[t1], a, b, c)) std::swap(t1, t2);
-    if (!orient_as(m_.triangles[t1], a, b, c) || !orient_as(m_.triangles[t2], b, a, d)) return false;
+    if (!orient_as(m_.triangles[t1], a, b, c) || !orient_as(m_.triangles[t2], b, a, d))
+      return false;
     if (c == d || e2t_.count(edge_key(c, d)) != 0) return false;
     const std::array<LO, 3> n1{c, a, d}, n2{d, b, c};
     const double before = std::min(tri_angle(t1), tri_angle(t2));
@@ -217,7 +221,8 @@ class Improver {
     std::vector<Vec2> candidates;
     Vec3 foot;
     candidates.push_back(surf_.project(centroid, m_.uv[v], &foot));
-    for (const double w : {1.0, 0.5, 0.25}) candidates.push_back(m_.uv[v] + (uv_centroid - m_.uv[v]) * w);
+    for (const double w : {1.0, 0.5, 0.25})
+      candidates.push_back(m_.uv[v] + (uv_centroid - m_.uv[v]) * w);
     double best = before + kGain;
     Vec2 best_uv{};
     bool found = false;

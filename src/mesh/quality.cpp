@@ -70,7 +70,8 @@ FaceQuadStats face_quad_stats(const FaceMesh& mesh) {
       ++valence[q[k]];
       angle[q[k]] += corner_angle(q[k], q[(k + 3) % 4], q[(k + 1) % 4]);
     }
-    const double v = quad_sicn({mesh.points[q[0]], mesh.points[q[1]], mesh.points[q[2]], mesh.points[q[3]]});
+    const double v =
+        quad_sicn({mesh.points[q[0]], mesh.points[q[1]], mesh.points[q[2]], mesh.points[q[3]]});
     s.sicn_min = std::min(s.sicn_min, v);
     sum += v;
   }
@@ -90,9 +91,10 @@ FaceQuadStats face_quad_stats(const FaceMesh& mesh) {
       s.irregular_interior += valence[v] != regular ? 1 : 0;
       continue;
     }
-    const std::uint64_t key = (static_cast<std::uint64_t>(c.dim) << 62) ^
-                              (static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.entity)) << 31) ^
-                              static_cast<std::uint32_t>(c.index);
+    const std::uint64_t key =
+        (static_cast<std::uint64_t>(c.dim) << 62) ^
+        (static_cast<std::uint64_t>(static_cast<std::uint32_t>(c.entity)) << 31) ^
+        static_cast<std::uint32_t>(c.index);
     Total& t = boundary[key];
     t.valence += valence[v];
     t.copies += 1;
@@ -100,9 +102,10 @@ FaceQuadStats face_quad_stats(const FaceMesh& mesh) {
     t.dim = c.dim;
   }
   for (const auto& [key, t] : boundary) {
-    const std::int32_t ideal = t.dim == 1 ? (regular / 2) * t.copies
-                                          : std::max<std::int32_t>(1, static_cast<std::int32_t>(
-                                                std::lround(t.angle / (regular == 4 ? 90.0 : 60.0))));
+    const std::int32_t ideal =
+        t.dim == 1 ? (regular / 2) * t.copies
+                   : std::max<std::int32_t>(1, static_cast<std::int32_t>(std::lround(
+                                                   t.angle / (regular == 4 ? 90.0 : 60.0))));
     s.irregular_boundary += t.valence != ideal ? 1 : 0;
   }
   return s;
@@ -131,7 +134,8 @@ MeshStats compute_stats(const SurfaceMesh& mesh) {
     double sum = 0;
     s.sicn_min = std::numeric_limits<double>::max();
     for (const auto& q : mesh.quads) {
-      const double v = quad_sicn({mesh.points[q[0]], mesh.points[q[1]], mesh.points[q[2]], mesh.points[q[3]]});
+      const double v =
+          quad_sicn({mesh.points[q[0]], mesh.points[q[1]], mesh.points[q[2]], mesh.points[q[3]]});
       s.sicn_min = std::min(s.sicn_min, v);
       sum += v;
     }
@@ -147,7 +151,8 @@ MeshStats compute_stats(const SurfaceMesh& mesh) {
       const auto& t = mesh.triangles[i];
       angles[i] = triangle_angles(mesh.points[t[0]], mesh.points[t[1]], mesh.points[t[2]]);
       for (int k = 0; k < 3; ++k)
-        if (mesh.vclass[t[k]].dim == 0) corner_angle[key(mesh.triangle_face[i], t[k])] += angles[i][k];
+        if (mesh.vclass[t[k]].dim == 0)
+          corner_angle[key(mesh.triangle_face[i], t[k])] += angles[i][k];
     }
     // Curves forming a sharp corner of a face: (face, curve) pairs.
     std::unordered_map<std::int64_t, std::vector<GO>> sharp_curves;  // face -> corners
@@ -178,7 +183,8 @@ MeshStats compute_stats(const SurfaceMesh& mesh) {
       const double q = triangle_quality(mesh.points[t[0]], mesh.points[t[1]], mesh.points[t[2]]);
       s.tri_quality_min = std::min(s.tri_quality_min, q);
       qsum += q;
-      const int k = static_cast<int>(std::min_element(angles[i].begin(), angles[i].end()) - angles[i].begin());
+      const int k = static_cast<int>(std::min_element(angles[i].begin(), angles[i].end()) -
+                                     angles[i].begin());
       const double a = angles[i][k];
       s.min_angle_deg = std::min(s.min_angle_deg, a);
       const int bin = a < 5 ? 0 : a < 10 ? 1 : a < 20 ? 2 : a < 30 ? 3 : 4;

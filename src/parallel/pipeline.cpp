@@ -15,9 +15,12 @@ namespace qsmesh::parallel {
 
 const char* to_string(Stage s) {
   switch (s) {
-    case Stage::Background: return "background";
-    case Stage::Unstructured: return "unstructured";
-    case Stage::QuasiStructured: return "quasi-structured";
+    case Stage::Background:
+      return "background";
+    case Stage::Unstructured:
+      return "unstructured";
+    case Stage::QuasiStructured:
+      return "quasi-structured";
   }
   return "?";
 }
@@ -26,7 +29,8 @@ Stage parse_stage(const std::string& name) {
   if (name == "background") return Stage::Background;
   if (name == "unstructured") return Stage::Unstructured;
   if (name == "quasi-structured") return Stage::QuasiStructured;
-  throw InputError("--until: unknown stage '" + name + "' (valid: background, unstructured, quasi-structured)");
+  throw InputError("--until: unknown stage '" + name +
+                   "' (valid: background, unstructured, quasi-structured)");
 }
 
 std::vector<double> estimate_face_costs(const cad::CadModel& model, double size) {
@@ -235,8 +239,8 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
 
   // Faces: METIS partition weighted by the estimated cost.
   clock.reset();
-  result.face_rank = partition_faces(model.face2faces(),
-                                     estimate_face_costs(model, options.background.sizes.size), nranks);
+  result.face_rank = partition_faces(
+      model.face2faces(), estimate_face_costs(model, options.background.sizes.size), nranks);
   std::vector<LO> mine;
   for (LO f = 0; f < nfaces; ++f)
     if (result.face_rank[f] == rank) mine.push_back(f);
@@ -258,7 +262,8 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
   std::atomic<std::int64_t> done{0};
   const auto total = static_cast<std::int64_t>(mine.size());
   tasks.parallel_for(static_cast<std::int64_t>(mine.size()), [&](std::int64_t i) {
-    meshes[i] = background::mesh_face_background(model, mine[i], curves, options.background, &reports[i]);
+    meshes[i] =
+        background::mesh_face_background(model, mine[i], curves, options.background, &reports[i]);
     const std::int64_t n = ++done;
     if (n * 10 / total != (n - 1) * 10 / total)  // every tenth of the faces
       log.info(cat("background: ", n, "/", mine.size(), " faces on rank ", rank));
@@ -309,15 +314,16 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     const std::vector<double> targets = sizemap::face_quad_targets(model, so);
     auto face_pass = [&](const sizemap::CurveSizes& on_curves) {
       tasks.parallel_for(total, [&](std::int64_t i) {
-        sizes[i] = sizemap::face_sizes(meshes[i], cf_sizes ? full[i].get() : nullptr, curves, on_curves,
-                                       targets[mine[i]], so);
+        sizes[i] = sizemap::face_sizes(meshes[i], cf_sizes ? full[i].get() : nullptr, curves,
+                                       on_curves, targets[mine[i]], so);
       });
     };
     face_pass(initial);
     // The union on shared curves and corners starts from the initial sizes on every rank (the
     // minimum is idempotent), so curves that no face of this rank touches keep their values.
     sizemap::CurveSizes united = initial;
-    for (std::size_t i = 0; i < mine.size(); ++i) sizemap::fold_boundary_min(meshes[i], sizes[i].s, united);
+    for (std::size_t i = 0; i < mine.size(); ++i)
+      sizemap::fold_boundary_min(meshes[i], sizes[i].s, united);
     std::vector<double> flat = united.pack();
     comm.allreduce_min(flat);
     united.unpack(flat);
@@ -329,11 +335,12 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     clock.reset();
     const std::vector<double> ideal = quantize::ideal_edge_counts(curves, result.curve_sizes.at);
     result.quantization = quantize::quantize_curves(model, ideal, options.quantize);
-    result.quantized_curves = quantize::place_vertices(model, curves, result.curve_sizes.at, result.quantization,
-                                                       /*halved=*/false, tasks);
+    result.quantized_curves =
+        quantize::place_vertices(model, curves, result.curve_sizes.at, result.quantization,
+                                 /*halved=*/false, tasks);
     result.times.add("quantize", comm.allreduce_max(clock.seconds()));
-    log.info(cat("quantize: ", model.num_curves(), " curves, ", result.quantization.num_chords, " chords, ",
-                 result.quantization.total_edges, " edges"));
+    log.info(cat("quantize: ", model.num_curves(), " curves, ", result.quantization.num_chords,
+                 " chords, ", result.quantization.total_edges, " edges"));
   }
 
   // Unstructured all-quad meshes (paper 000 Sec. 5) on the quantized curve meshes: frontal points
@@ -354,8 +361,8 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     tasks.parallel_for(total, [&](std::int64_t i) {
       const Stopwatch face_clock;
       qstruct::PatternFaceReport pr;
-      mesh::FaceMesh m = qstruct::mesh_face_pattern(model, mine[i], result.quantized_curves, patterns,
-                                                    options.patterns, &pr);
+      mesh::FaceMesh m = qstruct::mesh_face_pattern(model, mine[i], result.quantized_curves,
+                                                    patterns, options.patterns, &pr);
       if (pr.ok) {
         quasi_reports[i].by_pattern = true;
         quasi_reports[i].pattern = pr.pattern_name;
@@ -387,8 +394,8 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
         face_fields.cross_field = full[i].get();
         face_fields.sizes = sizes[i].s;
       }
-      quad_meshes[i] = quad::mesh_face_unstructured(model, mine[i], halved, result.quantized_curves, face_fields, qo,
-                                                    &quad_reports[i]);
+      quad_meshes[i] = quad::mesh_face_unstructured(model, mine[i], halved, result.quantized_curves,
+                                                    face_fields, qo, &quad_reports[i]);
       face_seconds[i] += face_clock.seconds();
     };
     std::atomic<std::int64_t> q_done{0};
@@ -405,7 +412,8 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
       clock.reset();
       const std::vector<qstruct::Pattern> patterns = qstruct::builtin_patterns();
       tasks.parallel_for(total, [&](std::int64_t i) {
-        if (quasi_reports[i].by_pattern || !quad_reports[i].ok || !quad_meshes[i].triangles.empty()) return;
+        if (quasi_reports[i].by_pattern || !quad_reports[i].ok || !quad_meshes[i].triangles.empty())
+          return;
         const Stopwatch face_clock;
         try {
           const auto surface = model.face_geometry(mine[i]);
@@ -413,8 +421,8 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
               full[i] != nullptr ? std::span<const crossfield::Singularity>(full[i]->singularities)
                                  : std::span<const crossfield::Singularity>();
           qstruct::CavityReport cr;
-          mesh::FaceMesh out = qstruct::remesh_cavities(quad_meshes[i], *surface, singular, patterns,
-                                                        options.cavities, &cr);
+          mesh::FaceMesh out = qstruct::remesh_cavities(quad_meshes[i], *surface, singular,
+                                                        patterns, options.cavities, &cr);
           out.face = mine[i];
           quad_meshes[i] = std::move(out);
           quasi_reports[i].irregular_before = cr.irregular_before;
@@ -433,12 +441,14 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
       clock.reset();
       const remesh::DiskQuadTable table = remesh::DiskQuadTable::builtin();
       tasks.parallel_for(total, [&](std::int64_t i) {
-        if (quasi_reports[i].by_pattern || !quad_reports[i].ok || !quad_meshes[i].triangles.empty()) return;
+        if (quasi_reports[i].by_pattern || !quad_reports[i].ok || !quad_meshes[i].triangles.empty())
+          return;
         const Stopwatch face_clock;
         try {
           const auto surface = model.face_geometry(mine[i]);
           remesh::DiskRemeshStats ds;
-          mesh::FaceMesh out = remesh::remesh_disk_defects(quad_meshes[i], *surface, table, options.disk, &ds);
+          mesh::FaceMesh out =
+              remesh::remesh_disk_defects(quad_meshes[i], *surface, table, options.disk, &ds);
           out.face = mine[i];
           quad_meshes[i] = std::move(out);
           quasi_reports[i].defects_before = ds.defects_before;
@@ -466,7 +476,8 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     if (quasi) pack(quasi_reports[i], buffer);
     if (quads) {
       const mesh::FaceQuadStats st = mesh::face_quad_stats(meshes[i]);
-      for (std::int64_t x : {st.vertices, st.quads, st.triangles, st.irregular_interior, st.irregular_boundary})
+      for (std::int64_t x :
+           {st.vertices, st.quads, st.triangles, st.irregular_interior, st.irregular_boundary})
         put<std::int64_t>(buffer, x);
       put<double>(buffer, st.sicn_min);
       put<double>(buffer, st.sicn_avg);
@@ -502,7 +513,8 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
         if (quasi) unpack(bytes, pos, result.quasi_reports[f]);
         if (quads) {
           mesh::FaceQuadStats& st = result.face_stats[f];
-          for (std::int64_t* x : {&st.vertices, &st.quads, &st.triangles, &st.irregular_interior, &st.irregular_boundary})
+          for (std::int64_t* x : {&st.vertices, &st.quads, &st.triangles, &st.irregular_interior,
+                                  &st.irregular_boundary})
             *x = get<std::int64_t>(bytes, pos);
           st.sicn_min = get<double>(bytes, pos);
           st.sicn_avg = get<double>(bytes, pos);
@@ -511,8 +523,9 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
       }
     }
     for (LO f = 0; f < nfaces; ++f) all[f].face = f;
-    result.mesh = mesh::assemble(model, quads ? std::span<const mesh::CurveMesh>(result.quantized_curves)
-                                              : std::span<const mesh::CurveMesh>(curves),
+    result.mesh = mesh::assemble(model,
+                                 quads ? std::span<const mesh::CurveMesh>(result.quantized_curves)
+                                       : std::span<const mesh::CurveMesh>(curves),
                                  all);
     if (size_map && !quads) result.background = std::move(all);
   }

@@ -17,7 +17,8 @@ namespace {
 double min_sicn(const mesh::FaceMesh& m) {
   double worst = std::numeric_limits<double>::max();
   for (const auto& q : m.quads)
-    worst = std::min(worst, mesh::quad_sicn({m.points[q[0]], m.points[q[1]], m.points[q[2]], m.points[q[3]]}));
+    worst = std::min(
+        worst, mesh::quad_sicn({m.points[q[0]], m.points[q[1]], m.points[q[2]], m.points[q[3]]}));
   return m.quads.empty() ? -1.0 : worst;
 }
 
@@ -35,15 +36,17 @@ mesh::FaceMesh optimise(mesh::FaceMesh m, const cad::FaceGeometry& surface) {
 // Sec. 5.1-5.2: frontal points, their triangulation, recombination along the cross, subdivision.
 // Returns an empty mesh when neither the recombined nor the plain subdivided triangles are valid.
 mesh::FaceMesh frontal_quads(const cad::CadModel& model, LO f, const cad::FaceGeometry& surface,
-                             std::span<const mesh::CurveMesh> halved, std::span<const mesh::CurveMesh> full,
-                             const FaceFields& fields, const UnstructuredOptions& options,
-                             UnstructuredReport& rep) {
+                             std::span<const mesh::CurveMesh> halved,
+                             std::span<const mesh::CurveMesh> full, const FaceFields& fields,
+                             const UnstructuredOptions& options, UnstructuredReport& rep) {
   const FaceGuide guide(*fields.background, *fields.cross_field, fields.sizes);
   const auto loops = background::face_boundary(model, f, surface, halved);
   const std::vector<Vec2> points = frontal_points(surface, loops, guide, options.frontal);
   rep.frontal_points = static_cast<std::int64_t>(points.size());
   const double factor = options.frontal.spacing_factor;
-  const mesh::SizeFunction size = [&](const Vec2& uv, const Vec3&) { return factor * guide.at(uv).size; };
+  const mesh::SizeFunction size = [&](const Vec2& uv, const Vec3&) {
+    return factor * guide.at(uv).size;
+  };
   mesh::TriangulateOptions to;
   to.interior_points = points;
   to.refine = false;
@@ -54,13 +57,15 @@ mesh::FaceMesh frontal_quads(const cad::CadModel& model, LO f, const cad::FaceGe
   // Moving badly placed points (where fronts met) before pairing: thin triangles there have no
   // good partner and become lone triangles, each a valence-3 vertex after subdivision. Measured on
   // Block.stp at 258k vertices: interior irregular vertices 6.01% -> 5.62%.
-  tri = mesh::improve_small_angles(tri, surface, model.faces()[f].reversed, options.improve_triangles);
+  tri = mesh::improve_small_angles(tri, surface, model.faces()[f].reversed,
+                                   options.improve_triangles);
   std::vector<std::array<Vec3, 2>> directions;
   directions.reserve(tri.triangles.size());
   for (const auto& t : tri.triangles)
     directions.push_back(guide.at((tri.uv[t[0]] + tri.uv[t[1]] + tri.uv[t[2]]) / 3.0).cross);
   RecombineStats rs;
-  mesh::FaceMesh out = optimise(subdivide(recombine(tri, directions, options.recombine, &rs), surface, full), surface);
+  mesh::FaceMesh out = optimise(
+      subdivide(recombine(tri, directions, options.recombine, &rs), surface, full), surface);
   if (valid(out)) return out;
   rep.fell_back = true;
   out = optimise(subdivide(tri, surface, full), surface);
@@ -70,9 +75,11 @@ mesh::FaceMesh frontal_quads(const cad::CadModel& model, LO f, const cad::FaceGe
 
 }  // namespace
 
-mesh::FaceMesh mesh_face_unstructured(const cad::CadModel& model, LO f, std::span<const mesh::CurveMesh> halved,
-                                      std::span<const mesh::CurveMesh> full, const FaceFields& fields,
-                                      const UnstructuredOptions& options, UnstructuredReport* report) {
+mesh::FaceMesh mesh_face_unstructured(const cad::CadModel& model, LO f,
+                                      std::span<const mesh::CurveMesh> halved,
+                                      std::span<const mesh::CurveMesh> full,
+                                      const FaceFields& fields, const UnstructuredOptions& options,
+                                      UnstructuredReport* report) {
   UnstructuredReport local;
   UnstructuredReport& rep = report != nullptr ? *report : local;
   rep = UnstructuredReport{};
@@ -81,7 +88,8 @@ mesh::FaceMesh mesh_face_unstructured(const cad::CadModel& model, LO f, std::spa
     const auto surface = model.face_geometry(f);
     mesh::FaceMesh out;
     const bool want_frontal = options.use_frontal;
-    if (want_frontal && fields.background != nullptr && fields.cross_field != nullptr && !fields.sizes.empty()) {
+    if (want_frontal && fields.background != nullptr && fields.cross_field != nullptr &&
+        !fields.sizes.empty()) {
       try {
         out = frontal_quads(model, f, *surface, halved, full, fields, options, rep);
         rep.frontal = !out.quads.empty();
@@ -99,7 +107,8 @@ mesh::FaceMesh mesh_face_unstructured(const cad::CadModel& model, LO f, std::spa
       tri_options.sizes.size = 2 * options.size;
       tri_options.sizes.edges_per_turn = 8;
       background::FaceReport tri_report;
-      const mesh::FaceMesh tri = background::mesh_face_background(model, f, halved, tri_options, &tri_report);
+      const mesh::FaceMesh tri =
+          background::mesh_face_background(model, f, halved, tri_options, &tri_report);
       if (!tri_report.ok) {
         rep.error = tri_report.error;
         mesh::FaceMesh empty;
@@ -123,7 +132,8 @@ mesh::FaceMesh mesh_face_unstructured(const cad::CadModel& model, LO f, std::spa
     rep.quads = static_cast<std::int64_t>(out.quads.size());
     rep.sicn_min = min_sicn(out);
     rep.ok = rep.sicn_min > 0;
-    if (!rep.ok && rep.error.empty()) rep.error = Error("a quad is folded (SICN <= 0)", context).what();
+    if (!rep.ok && rep.error.empty())
+      rep.error = Error("a quad is folded (SICN <= 0)", context).what();
     return out;
   } catch (const std::exception& e) {
     rep.error = Error(e.what(), context).what();

@@ -20,13 +20,19 @@ FaceMesh grid2x2() {
       VertexClass c;
       const bool side_i = i == 0 || i == 2, side_j = j == 0 || j == 2;
       c.dim = static_cast<std::int8_t>(side_i && side_j ? 0 : (side_i || side_j ? 1 : 2));
-      c.entity = c.dim == 2 ? 0 : (c.dim == 0 ? i + 3 * j : (j == 0 ? 0 : j == 2 ? 2 : i == 0 ? 3 : 1));
+      c.entity = c.dim == 2 ? 0
+                            : (c.dim == 0 ? i + 3 * j
+                                          : (j == 0   ? 0
+                                             : j == 2 ? 2
+                                             : i == 0 ? 3
+                                                      : 1));
       c.index = c.dim == 1 ? 1 : kNoIndex;
       m.vclass.push_back(c);
     }
   auto v = [](int i, int j) { return static_cast<LO>(i + 3 * j); };
   for (int j = 0; j < 2; ++j)
-    for (int i = 0; i < 2; ++i) m.quads.push_back({v(i, j), v(i + 1, j), v(i + 1, j + 1), v(i, j + 1)});
+    for (int i = 0; i < 2; ++i)
+      m.quads.push_back({v(i, j), v(i + 1, j), v(i + 1, j + 1), v(i, j + 1)});
   return m;
 }
 

@@ -5,9 +5,9 @@
 
 #include <cmath>
 
+#include "analytic_surfaces.hpp"
 #include "qsmesh/mesh/improve.hpp"
 #include "qsmesh/mesh/predicates.hpp"
-#include "analytic_surfaces.hpp"
 
 namespace {
 
@@ -65,7 +65,8 @@ TEST(ImproveSmallAngles, FlipsThinPoleFanIntoOneCornerTriangle) {
   // face normal in 3D.
   for (const auto& t : out.triangles) {
     if (t[0] == 0 || t[1] == 0 || t[2] == 0) {
-      const Vec3 n = cross(out.points[t[1]] - out.points[t[0]], out.points[t[2]] - out.points[t[0]]);
+      const Vec3 n =
+          cross(out.points[t[1]] - out.points[t[0]], out.points[t[2]] - out.points[t[0]]);
       EXPECT_GT(dot(n, s.normal({0.15, 0.5})), 0);
     } else {
       EXPECT_GT(orient2d(out.uv[t[0]], out.uv[t[1]], out.uv[t[2]]), 0);
@@ -92,7 +93,8 @@ TEST(ImproveSmallAngles, MovesBadlyPlacedInteriorVertex) {
   EXPECT_GT(smallest_angle(out), 50.0);
   for (int k = 0; k < 6; ++k) EXPECT_EQ(out.points[k], m.points[k]);  // boundary untouched
   EXPECT_NEAR(out.vclass[6].param[0], out.uv[6].u, 0);
-  for (const auto& t : out.triangles) EXPECT_GT(orient2d(out.uv[t[0]], out.uv[t[1]], out.uv[t[2]]), 0);
+  for (const auto& t : out.triangles)
+    EXPECT_GT(orient2d(out.uv[t[0]], out.uv[t[1]], out.uv[t[2]]), 0);
 
   // Reversed face: the same mesh with clockwise triangles is improved the same way.
   FaceMesh rev = m;
