@@ -350,13 +350,15 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
   std::vector<quad::UnstructuredReport> quad_reports(quads ? mine.size() : 0);
   const bool quasi = options.until >= Stage::QuasiStructured;
   std::vector<QuasiReport> quasi_reports(quasi ? mine.size() : 0);
+  // The coarse patterns serve both whole faces (Sec. 6.1.2) and cavities (Sec. 6.2).
+  const std::vector<qstruct::Pattern> patterns =
+      quasi ? qstruct::builtin_patterns() : std::vector<qstruct::Pattern>{};
   std::vector<mesh::FaceMesh> quad_meshes(quads ? mine.size() : 0);
   std::vector<double> face_seconds(quads ? mine.size() : 0, 0.0);
   if (quasi) {
     // Simple CAD faces meshed directly by a pattern (paper 000 Sec. 6.1.2, pipeline step 4); the
     // others go through the unstructured path below.
     clock.reset();
-    const std::vector<qstruct::Pattern> patterns = qstruct::builtin_patterns();
     std::atomic<std::int64_t> p_done{0};
     tasks.parallel_for(total, [&](std::int64_t i) {
       const Stopwatch face_clock;
@@ -407,60 +409,56 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     });
     result.times.add("unstructured", comm.allreduce_max(clock.seconds()));
     if (quasi) {
-      // Cavity remeshing of the unstructured faces (Sec. 6.2): irregular vertices that the cross
-      // field does not ask for are removed by remeshing convex cavities with patterns.
-      clock.reset();
-      const std::vector<qstruct::Pattern> patterns = qstruct::builtin_patterns();
-      tasks.parallel_for(total, [&](std::int64_t i) {
-        if (quasi_reports[i].by_pattern || !quad_reports[i].ok || !quad_meshes[i].triangles.empty())
-          return;
-        const Stopwatch face_clock;
-        try {
-          const auto surface = model.face_geometry(mine[i]);
-          const std::span<const crossfield::Singularity> singular =
-              full[i] != nullptr ? std::span<const crossfield::Singularity>(full[i]->singularities)
-                                 : std::span<const crossfield::Singularity>();
-          qstruct::CavityReport cr;
-          mesh::FaceMesh out = qstruct::remesh_cavities(quad_meshes[i], *surface, singular,
-                                                        patterns, options.cavities, &cr);
-          out.face = mine[i];
-          quad_meshes[i] = std::move(out);
-          quasi_reports[i].irregular_before = cr.irregular_before;
-          quasi_reports[i].irregular_after = cr.irregular_after;
-          quasi_reports[i].cavities = cr.remeshed;
-        } catch (const std::exception& e) {
-          log.warn(Error(e.what(), ErrorContext{"cavity remeshing", 2, mine[i]}).what());
-        }
-        face_seconds[i] += face_clock.seconds();
-      });
-      result.times.add("cavities", comm.allreduce_max(clock.seconds()));
-    }
-    if (quasi) {
-      // Local topological clean-up of the unstructured faces (Sec. 6.3): defects remeshed with
-      // the best disk quadrangulation, each replacement a transaction.
-      clock.reset();
+      // Topological improvement of the faces the unstructured path meshed with quads only. A step
+      // that throws leaves the face's valid mesh as it was; each step is timed as its own stage.
+      auto improve = [&](const char* stage, const char* what, const auto& step) {
+        clock.reset();
+        tasks.parallel_for(total, [&](std::int64_t i) {
+          if (quasi_reports[i].by_pattern || !quad_reports[i].ok ||
+              !quad_meshes[i].triangles.empty())
+            return;
+          const Stopwatch face_clock;
+          try {
+            const auto surface = model.face_geometry(mine[i]);
+            mesh::FaceMesh out = step(i, *surface);
+            out.face = mine[i];
+            quad_meshes[i] = std::move(out);
+          } catch (const std::exception& e) {
+            log.warn(Error(e.what(), ErrorContext{what, 2, mine[i]}).what());
+          }
+          face_seconds[i] += face_clock.seconds();
+        });
+        result.times.add(stage, comm.allreduce_max(clock.seconds()));
+      };
+      // Cavity remeshing (Sec. 6.2): irregular vertices that the cross field does not ask for are
+      // removed by remeshing convex cavities with patterns.
+      improve("cavities", "cavity remeshing",
+              [&](std::int64_t i, const cad::FaceGeometry& surface) {
+                const std::span<const crossfield::Singularity> singular =
+                    full[i] != nullptr
+                        ? std::span<const crossfield::Singularity>(full[i]->singularities)
+                        : std::span<const crossfield::Singularity>();
+                qstruct::CavityReport cr;
+                mesh::FaceMesh out = qstruct::remesh_cavities(quad_meshes[i], surface, singular,
+                                                              patterns, options.cavities, &cr);
+                quasi_reports[i].irregular_before = cr.irregular_before;
+                quasi_reports[i].irregular_after = cr.irregular_after;
+                quasi_reports[i].cavities = cr.remeshed;
+                return out;
+              });
+      // Local clean-up (Sec. 6.3): defects remeshed with the best disk quadrangulation, each
+      // replacement a transaction.
       const remesh::DiskQuadTable table = remesh::DiskQuadTable::builtin();
-      tasks.parallel_for(total, [&](std::int64_t i) {
-        if (quasi_reports[i].by_pattern || !quad_reports[i].ok || !quad_meshes[i].triangles.empty())
-          return;
-        const Stopwatch face_clock;
-        try {
-          const auto surface = model.face_geometry(mine[i]);
-          remesh::DiskRemeshStats ds;
-          mesh::FaceMesh out =
-              remesh::remesh_disk_defects(quad_meshes[i], *surface, table, options.disk, &ds);
-          out.face = mine[i];
-          quad_meshes[i] = std::move(out);
-          quasi_reports[i].defects_before = ds.defects_before;
-          quasi_reports[i].defects_after = ds.defects_after;
-          quasi_reports[i].disk_replaced = ds.replaced;
-        } catch (const std::exception& e) {
-          // The face keeps its valid unstructured mesh.
-          log.warn(Error(e.what(), ErrorContext{"disk remeshing", 2, mine[i]}).what());
-        }
-        face_seconds[i] += face_clock.seconds();
-      });
-      result.times.add("disk_remesh", comm.allreduce_max(clock.seconds()));
+      improve("disk_remesh", "disk remeshing",
+              [&](std::int64_t i, const cad::FaceGeometry& surface) {
+                remesh::DiskRemeshStats ds;
+                mesh::FaceMesh out =
+                    remesh::remesh_disk_defects(quad_meshes[i], surface, table, options.disk, &ds);
+                quasi_reports[i].defects_before = ds.defects_before;
+                quasi_reports[i].defects_after = ds.defects_after;
+                quasi_reports[i].disk_replaced = ds.replaced;
+                return out;
+              });
     }
     meshes = std::move(quad_meshes);
   }

@@ -33,6 +33,22 @@ mesh::FaceMesh optimise(mesh::FaceMesh m, const cad::FaceGeometry& surface) {
   return m;
 }
 
+// Sec. 5.2-5.3 on a triangulation of the face: recombined (weighted by the cross `directions`, or
+// not when empty), subdivided and optimised. When a quad stays invalid, every triangle is
+// subdivided instead (that always gives quads; recombination is what may fold one) and the better
+// of the two meshes is returned, with `fell_back` set.
+mesh::FaceMesh quads_from(const mesh::FaceMesh& tri,
+                          std::span<const std::array<Vec3, 2>> directions,
+                          const cad::FaceGeometry& surface, std::span<const mesh::CurveMesh> full,
+                          const UnstructuredOptions& options, bool& fell_back) {
+  mesh::FaceMesh out =
+      optimise(subdivide(recombine(tri, directions, options.recombine), surface, full), surface);
+  if (valid(out)) return out;
+  fell_back = true;
+  mesh::FaceMesh alt = optimise(subdivide(tri, surface, full), surface);
+  return out.quads.empty() || min_sicn(alt) > min_sicn(out) ? alt : out;
+}
+
 // Sec. 5.1-5.2: frontal points, their triangulation, recombination along the cross, subdivision.
 // Returns an empty mesh when neither the recombined nor the plain subdivided triangles are valid.
 mesh::FaceMesh frontal_quads(const cad::CadModel& model, LO f, const cad::FaceGeometry& surface,
@@ -63,14 +79,8 @@ mesh::FaceMesh frontal_quads(const cad::CadModel& model, LO f, const cad::FaceGe
   directions.reserve(tri.triangles.size());
   for (const auto& t : tri.triangles)
     directions.push_back(guide.at((tri.uv[t[0]] + tri.uv[t[1]] + tri.uv[t[2]]) / 3.0).cross);
-  RecombineStats rs;
-  mesh::FaceMesh out = optimise(
-      subdivide(recombine(tri, directions, options.recombine, &rs), surface, full), surface);
-  if (valid(out)) return out;
-  rep.fell_back = true;
-  out = optimise(subdivide(tri, surface, full), surface);
-  if (valid(out)) return out;
-  return {};
+  mesh::FaceMesh out = quads_from(tri, directions, surface, full, options, rep.fell_back);
+  return valid(out) ? out : mesh::FaceMesh{};
 }
 
 }  // namespace
@@ -116,16 +126,11 @@ mesh::FaceMesh mesh_face_unstructured(const cad::CadModel& model, LO f,
         return empty;
       }
       try {
-        out = optimise(subdivide(recombine(tri, {}, options.recombine), *surface, full), *surface);
+        out = quads_from(tri, {}, *surface, full, options, rep.fell_back);
       } catch (const Error& e) {
         rep.error = e.with_context(context).what();
-      }
-      if (!valid(out)) {
-        // Subdividing the triangles alone always gives quads; recombination is what may fold one.
-        // The better of the two meshes is kept.
         rep.fell_back = true;
-        mesh::FaceMesh alt = optimise(subdivide(tri, *surface, full), *surface);
-        if (out.quads.empty() || min_sicn(alt) > min_sicn(out)) out = std::move(alt);
+        out = optimise(subdivide(tri, *surface, full), *surface);
       }
     }
     out.face = f;

@@ -1,4 +1,3 @@
-#include "tmp_dir.hpp"
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -7,6 +6,7 @@
 #include "qsmesh/background/curve_mesh.hpp"
 #include "qsmesh/core/error.hpp"
 #include "shapes.hpp"
+#include "tmp_dir.hpp"
 
 namespace qsmesh::background {
 namespace {

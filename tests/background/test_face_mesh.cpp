@@ -1,4 +1,3 @@
-#include "tmp_dir.hpp"
 #include <gtest/gtest.h>
 
 #include <numbers>
@@ -9,6 +8,7 @@
 #include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/mesh/validate.hpp"
 #include "shapes.hpp"
+#include "tmp_dir.hpp"
 
 namespace qsmesh::background {
 namespace {

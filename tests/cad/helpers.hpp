@@ -1,7 +1,6 @@
 // Helpers of the cad tests: writing OpenCASCADE shapes to files, loop geometry in (u, v).
 #pragma once
 
-#include "tmp_dir.hpp"
 #include <gtest/gtest.h>
 
 #include <BRepTools.hxx>
@@ -13,6 +12,7 @@
 #include <string>
 
 #include "qsmesh/cad/model.hpp"
+#include "tmp_dir.hpp"
 
 namespace qsmesh::cad::test {
 

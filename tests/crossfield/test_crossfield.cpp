@@ -1,5 +1,4 @@
 // Cross field of single faces built with OpenCASCADE (paper 000 Sec. 3.1-3.3).
-#include "tmp_dir.hpp"
 #include <gtest/gtest.h>
 
 #include <BRepBuilderAPI_MakeEdge.hxx>
@@ -20,6 +19,7 @@
 #include "qsmesh/background/face_mesh.hpp"
 #include "qsmesh/crossfield/cross_field.hpp"
 #include "shapes.hpp"
+#include "tmp_dir.hpp"
 
 namespace qsmesh::crossfield {
 namespace {

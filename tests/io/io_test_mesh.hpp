@@ -7,7 +7,6 @@
 //  0 ---7--- 1 ----9----- 4        Vertex 11 (3.5, 0.5) is inside face 1.
 #pragma once
 
-#include "tmp_dir.hpp"
 #include <gtest/gtest.h>
 
 #include <filesystem>
@@ -17,6 +16,7 @@
 #include <vector>
 
 #include "qsmesh/mesh/surface_mesh.hpp"
+#include "tmp_dir.hpp"
 
 namespace qsmesh::io::test {
 

@@ -1,4 +1,3 @@
-#include "tmp_dir.hpp"
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -14,6 +13,7 @@
 #include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/qstruct/face_pattern.hpp"
 #include "shapes.hpp"
+#include "tmp_dir.hpp"
 
 namespace qsmesh::qstruct {
 namespace {

@@ -1,6 +1,5 @@
 // Frontal point insertion guided by the cross field (paper 000 Sec. 5.1) and the unstructured
 // quad stage built on it (Sec. 5.2).
-#include "tmp_dir.hpp"
 #include <gtest/gtest.h>
 
 #include <BRepBuilderAPI_MakeEdge.hxx>
@@ -28,6 +27,8 @@
 #include "qsmesh/quad/frontal.hpp"
 #include "qsmesh/quad/unstructured.hpp"
 #include "qsmesh/quantize/quantize.hpp"
+#include "quantized_curves.hpp"
+#include "tmp_dir.hpp"
 
 namespace qsmesh::quad {
 namespace {
@@ -66,20 +67,14 @@ struct Prepared {
 };
 
 Prepared prepare(const cad::CadModel& model, double size) {
-  const TaskArena tasks(1);
+  const qsmesh::test::QuantizedCurves curves = qsmesh::test::quantized_curves(model, size);
+  Prepared p;
+  p.full = curves.full;
+  p.halved = curves.halved;
   background::BackgroundOptions options;
   options.sizes.size = size;
-  const auto bg = background::mesh_curves(model, options.sizes, tasks);
-  std::vector<std::vector<double>> sizes;
-  for (const auto& m : bg) sizes.emplace_back(m.points.size(), size);
-  quantize::QuantizeOptions qo;
-  qo.halved_minimums = true;
-  const auto q = quantize::quantize_curves(model, quantize::ideal_edge_counts(bg, sizes), qo);
-  Prepared p;
-  p.full = quantize::place_vertices(model, bg, sizes, q, false, tasks);
-  p.halved = quantize::place_vertices(model, bg, sizes, q, true, tasks);
   background::FaceReport report;
-  p.background = background::mesh_face_background(model, 0, bg, options, &report);
+  p.background = background::mesh_face_background(model, 0, curves.background, options, &report);
   EXPECT_TRUE(report.ok) << report.error;
   p.cf = crossfield::compute_face_cross_field(p.background, {}, nullptr);
   p.sizes.assign(p.background.points.size(), size);

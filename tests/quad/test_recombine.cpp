@@ -1,4 +1,3 @@
-#include "tmp_dir.hpp"
 #include <gtest/gtest.h>
 
 #include <BRepBuilderAPI_MakeFace.hxx>
@@ -21,6 +20,7 @@
 #include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/quad/recombine.hpp"
 #include "shapes.hpp"
+#include "tmp_dir.hpp"
 
 namespace qsmesh::quad {
 namespace {

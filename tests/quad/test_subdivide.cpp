@@ -1,4 +1,3 @@
-#include "tmp_dir.hpp"
 #include <gtest/gtest.h>
 
 #include <BRepBuilderAPI_MakeFace.hxx>
@@ -28,6 +27,8 @@
 #include "qsmesh/smooth/smooth.hpp"
 #include "qsmesh/smooth/untangle.hpp"
 #include "shapes.hpp"
+#include "quantized_curves.hpp"
+#include "tmp_dir.hpp"
 
 namespace qsmesh::quad {
 namespace {
@@ -59,18 +60,10 @@ struct Prepared {
 };
 
 Prepared prepare(const cad::CadModel& model, double size) {
-  const TaskArena tasks(1);
-  background::BackgroundOptions options;
-  options.sizes.size = size;
-  const auto bg = background::mesh_curves(model, options.sizes, tasks);
-  std::vector<std::vector<double>> sizes;
-  for (const auto& m : bg) sizes.emplace_back(m.points.size(), size);
-  quantize::QuantizeOptions qo;
-  qo.halved_minimums = true;
-  const auto q = quantize::quantize_curves(model, quantize::ideal_edge_counts(bg, sizes), qo);
+  const qsmesh::test::QuantizedCurves curves = qsmesh::test::quantized_curves(model, size);
   Prepared p;
-  p.full = quantize::place_vertices(model, bg, sizes, q, false, tasks);
-  p.halved = quantize::place_vertices(model, bg, sizes, q, true, tasks);
+  p.full = curves.full;
+  p.halved = curves.halved;
   background::BackgroundOptions face_options;
   face_options.sizes.size = 2 * size;
   for (LO f = 0; f < model.num_faces(); ++f) {

@@ -1,4 +1,3 @@
-#include "tmp_dir.hpp"
 #include <gtest/gtest.h>
 
 #include <BRepBuilderAPI_MakeFace.hxx>
@@ -16,6 +15,7 @@
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/remesh/disk_remesh.hpp"
+#include "tmp_dir.hpp"
 
 namespace qsmesh::remesh {
 namespace {

@@ -1,5 +1,4 @@
 // Size map (paper 000 Sec. 4.1, 4.2) on OpenCASCADE-built models.
-#include "tmp_dir.hpp"
 #include <gtest/gtest.h>
 
 #include <numbers>
@@ -29,6 +28,7 @@
 #include "qsmesh/crossfield/cross_field.hpp"
 #include "qsmesh/sizemap/size_map.hpp"
 #include "shapes.hpp"
+#include "tmp_dir.hpp"
 
 namespace qsmesh::sizemap {
 namespace {

@@ -1,5 +1,5 @@
-#include "tmp_dir.hpp"
 #include "face_case.hpp"
+#include "tmp_dir.hpp"
 
 #include <gtest/gtest.h>
 
