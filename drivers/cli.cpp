@@ -105,6 +105,8 @@ Arguments parse(const std::vector<std::string>& args) {
     else if (opt == "--size-factor" && meshing) a.size_factor = parse_positive(opt, value());
     else if (opt == "--until" && a.command == Command::Mesh) a.until = value();
     else if (opt == "--threads") a.threads = parse_threads(value());
+    else if (opt == "--face-time-budget" && a.command == Command::Mesh)
+      a.face_time_budget = parse_positive(opt, value());
     else if (opt == "--stats" && meshing) a.stats = value();
     else if (opt == "--check" && a.command == Command::CrossField) a.check = true;
     else if (opt == "--sizemap" && sizing) {
@@ -185,6 +187,10 @@ std::string help(const std::string& topic) {
           "  --threads T           threads per rank (default: the cores of the machine divided\n"
           "                        among the ranks running on it)\n"
           "  --stats FILE.json     also write the run statistics as JSON\n"
+          "  --face-time-budget S  at most S seconds of cavity remeshing (paper 000 Sec. 6.2) per\n"
+          "                        face; a face that reaches it keeps the mesh it has (valid) and is\n"
+          "                        counted in the summary. Without it the work is bounded by\n"
+          "                        iteration counts only and the mesh does not depend on timing\n"
           "  --sew                 sew faces that arrive disconnected\n"
           "  -q, --quiet           print only warnings and errors\n"
           "  -v, --verbose         print per-face details (with the quad stages: method, counts,\n"

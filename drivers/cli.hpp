@@ -21,6 +21,9 @@ struct Arguments {
   /// (reported per face), so the default stays the furthest stage that is complete.
   std::string until = "quasi-structured";
   int threads = 0;                 ///< 0: automatic
+  /// --face-time-budget S: wall-clock seconds the topological improvement (cavity remeshing,
+  /// paper 000 Sec. 6.2) may spend on one face (0: no bound; the result is then reproducible).
+  double face_time_budget = 0;
   std::string stats;               ///< --stats FILE.json
   bool json = false;               ///< info --json
   bool check = false;              ///< crossfield --check

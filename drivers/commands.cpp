@@ -185,6 +185,7 @@ struct QuasiTotals {
   std::int64_t irregular_before = 0, irregular_after = 0;  // cavity remeshing (Sec. 6.2)
   std::array<std::int64_t, 4> cavities{};                  // remeshed, by step
   std::int64_t defects_before = 0, defects_after = 0, disk_replaced = 0;  // Sec. 6.3
+  std::int64_t time_budget_hit = 0;  // faces whose cavity remeshing stopped on --face-time-budget
 };
 
 QuasiTotals quasi_totals(const parallel::PipelineResult& r) {
@@ -197,6 +198,7 @@ QuasiTotals quasi_totals(const parallel::PipelineResult& r) {
     t.defects_before += q.defects_before;
     t.defects_after += q.defects_after;
     t.disk_replaced += q.disk_replaced;
+    t.time_budget_hit += q.time_budget_hit ? 1 : 0;
   }
   return t;
 }
@@ -236,6 +238,7 @@ std::string stats_json(const Arguments& args, const Session& session,
     j.value("disk_defects_before", t.defects_before);
     j.value("disk_defects_after", t.defects_after);
     j.value("disk_cavities_replaced", t.disk_replaced);
+    j.value("faces_time_budget_hit", t.time_budget_hit);
   }
   j.value("vertices", s.vertices);
   j.value("triangles", s.triangles);
@@ -284,6 +287,7 @@ std::string stats_json(const Arguments& args, const Session& session,
           .value("sicn_min", st.sicn_min)
           .value("sicn_avg", st.sicn_avg)
           .value("seconds", r.face_seconds[f])
+          .value("time_budget_hit", !r.quasi_reports.empty() && r.quasi_reports[f].time_budget_hit)
           .end_object();
     }
     j.end_array();
@@ -316,6 +320,9 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
        << t.cavities[1] << ", " << t.cavities[2] << ", " << t.cavities[3] << "\n"
        << "  disk remeshing: defects " << t.defects_before << " -> " << t.defects_after << " ("
        << t.disk_replaced << " cavities replaced)\n";
+    if (t.time_budget_hit > 0)
+      os << "  faces stopped by --face-time-budget: " << t.time_budget_hit
+         << " (kept the valid mesh reached; list with -v)\n";
   }
   if (s.triangles > 0) {
     os << "  triangle quality min/avg: " << s.tri_quality_min << " / " << s.tri_quality_avg << "\n"
@@ -340,7 +347,11 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
       const auto& st = r.face_stats[f];
       os << "    face " << f << ": " << quad_method(r, f) << ", " << st.vertices << ", " << st.quads
          << ", " << st.triangles << ", " << st.irregular_interior << " / " << st.irregular_boundary
-         << ", " << st.sicn_min << " / " << st.sicn_avg << ", " << r.face_seconds[f] << "\n";
+         << ", " << st.sicn_min << " / " << st.sicn_avg << ", " << r.face_seconds[f]
+         << (!r.quasi_reports.empty() && r.quasi_reports[f].time_budget_hit
+                 ? " (stopped by --face-time-budget)"
+                 : "")
+         << "\n";
     }
   }
 }
@@ -405,6 +416,7 @@ int run_mesh(const Arguments& args) {
   options.background.sizes.size = s.size;
   options.sizemap.size_max = s.size;
   options.until = until;
+  options.cavities.time_budget_s = args.face_time_budget;
   parallel::PipelineResult result =
       parallel::run_pipeline(s.comm, s.model, options, *s.tasks, s.log);
   for (const auto& [stage, sec] : result.times.entries()) s.times.add(stage, sec);

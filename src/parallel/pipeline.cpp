@@ -202,6 +202,7 @@ void pack(const QuasiReport& r, std::vector<char>& out) {
   put<std::int64_t>(out, r.defects_before);
   put<std::int64_t>(out, r.defects_after);
   put<std::int64_t>(out, r.disk_replaced);
+  put<std::uint8_t>(out, r.time_budget_hit ? 1 : 0);
 }
 
 void unpack(const std::vector<char>& in, std::size_t& pos, QuasiReport& r) {
@@ -217,6 +218,7 @@ void unpack(const std::vector<char>& in, std::size_t& pos, QuasiReport& r) {
   r.defects_before = get<std::int64_t>(in, pos);
   r.defects_after = get<std::int64_t>(in, pos);
   r.disk_replaced = get<std::int64_t>(in, pos);
+  r.time_budget_hit = get<std::uint8_t>(in, pos) != 0;
 }
 
 PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
@@ -444,6 +446,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
                 quasi_reports[i].irregular_before = cr.irregular_before;
                 quasi_reports[i].irregular_after = cr.irregular_after;
                 quasi_reports[i].cavities = cr.remeshed;
+                quasi_reports[i].time_budget_hit = cr.time_budget_hit;
                 return out;
               });
       // Local clean-up (Sec. 6.3): defects remeshed with the best disk quadrangulation, each

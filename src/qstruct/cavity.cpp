@@ -341,7 +341,7 @@ double quad_quality(const std::vector<Vec3>& pts, const std::vector<Vec2>& uv,
 // The Laplace layout of the cavity's new vertices; a solver failure counts as a failed layout.
 bool laplace_uv(const std::vector<std::array<LO, 4>>& quads, LO num_fixed, std::vector<Vec2>& uv) {
   try {
-    return smooth::laplace_uv(quads, num_fixed, uv);
+    return smooth::chord_laplace_uv(quads, num_fixed, uv);
   } catch (const Error&) {
     return false;
   }

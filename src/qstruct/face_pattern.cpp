@@ -10,6 +10,7 @@
 #include "qsmesh/background/face_mesh.hpp"
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/smooth/quad_tools.hpp"
+#include "qsmesh/smooth/untangle.hpp"
 
 namespace qsmesh::qstruct {
 
@@ -81,7 +82,7 @@ mesh::FaceMesh build_mesh(LO f, const cad::Face& face, const cad::FaceGeometry& 
     const std::array<LO, 4> t{r2m[q[0]], r2m[q[1]], r2m[q[2]], r2m[q[3]]};
     m.quads.push_back(flip ? std::array<LO, 4>{t[0], t[3], t[2], t[1]} : t);
   }
-  QSMESH_CHECK(smooth::laplace_uv(m.quads, nb, m.uv), "the Laplace layout is not finite");
+  QSMESH_CHECK(smooth::chord_laplace_uv(m.quads, nb, m.uv), "the Laplace layout is not finite");
   for (LO v = nb; v < next; ++v) {
     m.points[v] = surface.eval(m.uv[v]).p;
     m.vclass[v].dim = 2;
@@ -164,7 +165,17 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
   for (int k = 0; k < tries; ++k) {
     const Candidate& c = cands[k];
     mesh::FaceMesh mesh = smooth::smooth_face(build_mesh(f, face, surface, fs, c), surface, options.smooth);
-    const smooth::QualityReport q = smooth::measure(mesh);
+    smooth::QualityReport q = smooth::measure(mesh);
+    // A layout good on average but with a few poor quads (usually next to an irregular vertex of
+    // the pattern, or a folded corner of a size transition) is worth lifting locally; the
+    // smoothing kernels never lower the minimum, so they cannot get out of a fold.
+    if (options.lift_poor_quads && (q.invalid > 0 || q.sicn_min <= options.min_sicn) &&
+        q.sicn_avg > options.min_sicn_avg) {
+      smooth::UntangleOptions uo;
+      uo.target = options.min_sicn + 0.05;
+      mesh = smooth::untangle_face(mesh, surface, uo);
+      q = smooth::measure(mesh);
+    }
     ++rep.candidates;
     const bool good = q.invalid == 0 && q.sicn_min > options.min_sicn && q.sicn_avg > options.min_sicn_avg;
     if (good || k == 0 || q.sicn_min > rep.sicn_min) {

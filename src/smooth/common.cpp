@@ -1,5 +1,7 @@
+#include <algorithm>
 #include <cmath>
-#include <set>
+#include <cstdint>
+#include <unordered_map>
 
 #include "internal.hpp"
 #include "qsmesh/linalg/solver.hpp"
@@ -31,30 +33,69 @@ double oriented_sicn(const std::array<Vec3, 4>& x, const Vec3& normal, double si
   return mesh::quad_sicn(x);
 }
 
-bool laplace_uv(const std::vector<std::array<LO, 4>>& quads, LO num_fixed, std::vector<Vec2>& uv) {
+namespace {
+
+std::uint64_t edge_key(LO a, LO b) {
+  const auto [lo, hi] = std::minmax(a, b);
+  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(lo)) << 32) | static_cast<std::uint32_t>(hi);
+}
+
+// Unique edges of `quads` and, per quad, its four edge ids (edge k joins corners k and k+1).
+struct QuadEdges {
+  std::vector<std::array<LO, 2>> ends;
+  std::vector<std::array<LO, 4>> quad2edges;
+  std::vector<std::array<LO, 2>> edge2quads;  // kNoIndex where there is no second quad
+  std::vector<int> num_quads;
+};
+
+QuadEdges quad_edges(const std::vector<std::array<LO, 4>>& quads) {
+  QuadEdges e;
+  std::unordered_map<std::uint64_t, LO> ids;
+  ids.reserve(quads.size() * 2);
+  e.quad2edges.resize(quads.size());
+  for (std::size_t q = 0; q < quads.size(); ++q)
+    for (int k = 0; k < 4; ++k) {
+      const LO a = quads[q][k], b = quads[q][(k + 1) % 4];
+      const auto [it, inserted] = ids.emplace(edge_key(a, b), static_cast<LO>(e.ends.size()));
+      if (inserted) {
+        e.ends.push_back({a, b});
+        e.edge2quads.push_back({kNoIndex, kNoIndex});
+        e.num_quads.push_back(0);
+      }
+      const LO id = it->second;
+      e.quad2edges[q][k] = id;
+      if (e.num_quads[id] < 2) e.edge2quads[id][e.num_quads[id]] = static_cast<LO>(q);
+      ++e.num_quads[id];
+    }
+  return e;
+}
+
+// Minimises sum over edges of weight * |uv_a - uv_b|^2 over the free vertices (one sparse direct
+// solve per coordinate).
+bool weighted_laplace(const QuadEdges& e, const std::vector<double>& weight, LO num_fixed,
+                      std::vector<Vec2>& uv) {
   const LO n = static_cast<LO>(uv.size());
   const LO nu = n - num_fixed;
   if (nu == 0) return true;
-  std::vector<std::set<LO>> nbr(static_cast<std::size_t>(n));
-  for (const auto& q : quads)
-    for (int k = 0; k < 4; ++k) {
-      nbr[q[k]].insert(q[(k + 1) % 4]);
-      nbr[q[(k + 1) % 4]].insert(q[k]);
-    }
+  std::vector<double> diag(static_cast<std::size_t>(nu), 0.0);
   std::vector<linalg::SparseMatrix::Triplet> trip;
   std::vector<double> bu(static_cast<std::size_t>(nu), 0.0), bv(static_cast<std::size_t>(nu), 0.0);
-  for (LO v = num_fixed; v < n; ++v) {
-    const LO i = v - num_fixed;
-    trip.push_back({i, i, static_cast<double>(nbr[v].size())});
-    for (const LO w : nbr[v]) {
-      if (w >= num_fixed) {
-        trip.push_back({i, w - num_fixed, -1.0});
+  for (std::size_t i = 0; i < e.ends.size(); ++i) {
+    const double w = weight[i];
+    const auto [a, b] = e.ends[i];
+    for (const auto& [v, o] : {std::pair{a, b}, std::pair{b, a}}) {
+      if (v < num_fixed) continue;
+      const LO r = v - num_fixed;
+      diag[r] += w;
+      if (o >= num_fixed) {
+        trip.push_back({r, o - num_fixed, -w});
       } else {
-        bu[i] += uv[w].u;
-        bv[i] += uv[w].v;
+        bu[r] += w * uv[o].u;
+        bv[r] += w * uv[o].v;
       }
     }
   }
+  for (LO r = 0; r < nu; ++r) trip.push_back({r, r, diag[r]});
   const linalg::SparseMatrix A(nu, trip);
   std::vector<double> xu(static_cast<std::size_t>(nu)), xv(static_cast<std::size_t>(nu));
   auto solver = linalg::make_solver(nu, linalg::SolverOptions{linalg::Backend::Eigen}, nullptr);
@@ -67,6 +108,66 @@ bool laplace_uv(const std::vector<std::array<LO, 4>>& quads, LO num_fixed, std::
     uv[num_fixed + i] = {xu[i], xv[i]};
   }
   return true;
+}
+
+}  // namespace
+
+bool laplace_uv(const std::vector<std::array<LO, 4>>& quads, LO num_fixed, std::vector<Vec2>& uv) {
+  const QuadEdges e = quad_edges(quads);
+  return weighted_laplace(e, std::vector<double>(e.ends.size(), 1.0), num_fixed, uv);
+}
+
+bool chord_laplace_uv(const std::vector<std::array<LO, 4>>& quads, LO num_fixed,
+                      std::vector<Vec2>& uv) {
+  const QuadEdges e = quad_edges(quads);
+  const LO ne = static_cast<LO>(e.ends.size());
+  std::vector<double> target(static_cast<std::size_t>(ne), -1.0);
+  std::vector<char> seen(static_cast<std::size_t>(ne), 0);
+  // Width of a chord where it ends: the (u, v) length of an edge whose two ends are fixed.
+  const auto width = [&](LO edge) {
+    const auto [a, b] = e.ends[edge];
+    if (a >= num_fixed || b >= num_fixed) return -1.0;
+    const Vec2 d{uv[a].u - uv[b].u, uv[a].v - uv[b].v};
+    return std::sqrt(d.u * d.u + d.v * d.v);
+  };
+  std::vector<LO> strip;
+  for (LO s = 0; s < ne; ++s) {
+    if (seen[s] || e.num_quads[s] != 1) continue;
+    // Walk the dual strip from boundary edge s through opposite edges to its other end.
+    strip.assign(1, s);
+    seen[s] = 1;
+    LO edge = s, q = e.edge2quads[s][0];
+    while (q != kNoIndex) {
+      const auto& qe = e.quad2edges[q];
+      const int k = static_cast<int>(std::find(qe.begin(), qe.end(), edge) - qe.begin());
+      if (k == 4) break;
+      edge = qe[(k + 2) % 4];
+      if (seen[edge]) break;  // a degenerate quad or a strip closing on itself
+      seen[edge] = 1;
+      strip.push_back(edge);
+      if (e.num_quads[edge] != 2) break;
+      q = e.edge2quads[edge][0] == q ? e.edge2quads[edge][1] : e.edge2quads[edge][0];
+    }
+    double w0 = width(strip.front()), w1 = width(strip.back());
+    if (w0 <= 0 && w1 <= 0) continue;
+    if (w0 <= 0) w0 = w1;
+    if (w1 <= 0) w1 = w0;
+    const double last = std::max<double>(1, static_cast<double>(strip.size() - 1));
+    for (std::size_t i = 0; i < strip.size(); ++i)
+      target[strip[i]] = w0 + (w1 - w0) * static_cast<double>(i) / last;
+  }
+  double sum = 0;
+  LO count = 0;
+  for (const double t : target)
+    if (t > 0) {
+      sum += t;
+      ++count;
+    }
+  const double mean = count > 0 ? sum / count : 1.0;
+  std::vector<double> weight(static_cast<std::size_t>(ne));
+  // A floor keeps the system well conditioned where a chord ends on a pole (zero width).
+  for (LO i = 0; i < ne; ++i) weight[i] = 1.0 / std::max(target[i] > 0 ? target[i] : mean, 1e-3 * mean);
+  return weighted_laplace(e, weight, num_fixed, uv);
 }
 
 namespace detail {

@@ -31,6 +31,12 @@ TEST(Cli, MeshOptions) {
   EXPECT_DOUBLE_EQ(*p({"mesh", "m.step", "-o", "o.vtu", "--size-factor", "0.01"}).size_factor, 0.01);
   // The default is the furthest stage that exists.
   EXPECT_EQ(p({"mesh", "m.step", "-o", "o.vtu"}).until, "quasi-structured");
+  // No time budget unless asked: the mesh then does not depend on timing.
+  EXPECT_EQ(p({"mesh", "m.step", "-o", "o.vtu"}).face_time_budget, 0.0);
+  EXPECT_DOUBLE_EQ(p({"mesh", "m.step", "-o", "o.vtu", "--face-time-budget", "0.5"}).face_time_budget, 0.5);
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--face-time-budget", "-1"}).find("--face-time-budget"),
+            std::string::npos);
+  EXPECT_NE(help("mesh").find("--face-time-budget"), std::string::npos);
 }
 
 TEST(Cli, HelpEverywhere) {

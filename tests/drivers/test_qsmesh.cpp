@@ -105,7 +105,7 @@ TEST_F(Qsmesh, MeshWritesEveryFormatAndStats) {
     EXPECT_NE(r.out.find("summary"), std::string::npos);
     const std::string json = slurp(stats);
     for (const char* key : {"\"vertices\"", "\"quads\"", "\"triangles\"", "\"irregular_interior\"", "\"sicn_min\"",
-                            "\"sicn_avg\"", "\"seconds\"", "\"background\""})
+                            "\"sicn_avg\"", "\"seconds\"", "\"background\"", "\"faces_time_budget_hit\""})
       EXPECT_NE(json.find(key), std::string::npos) << key;
     EXPECT_NE(json.find("\"faces_failed\": 0"), std::string::npos) << json;
   }

@@ -89,6 +89,12 @@ int main(int argc, char** argv) {
         std::cout << "  curve " << use.curve << (use.reversed ? " (rev) " : " ") << cad::to_string(model.curves()[use.curve].type)
                   << " edges " << result.quantized_curves[use.curve].num_edges() << " length "
                   << model.curves()[use.curve].length << "\n";
+      if (args.per_face)
+        for (const auto& use : model.faces()[detail].loops[0].uses) {
+          std::cout << "  curve " << use.curve << " vertices:";
+          for (const auto& p : result.quantized_curves[use.curve].points) std::cout << " (" << p.x << "," << p.y << "," << p.z << ")";
+          std::cout << "\n";
+        }
     }
     std::cout << path << ": " << meshed << "/" << model.num_faces() << " faces meshed by patterns (size factor "
               << size_factor << ", " << quads << " quads";

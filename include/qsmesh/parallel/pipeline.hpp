@@ -63,6 +63,9 @@ struct QuasiReport {
   std::array<std::int64_t, 4> cavities{};
   /// Disk remeshing (unstructured faces only): defects before/after, cavities replaced.
   std::int64_t defects_before = 0, defects_after = 0, disk_replaced = 0;
+  /// Cavity remeshing stopped by CavityOptions::time_budget_s on this face (the mesh reached
+  /// then is kept: every accepted step is valid).
+  bool time_budget_hit = false;
 };
 
 

@@ -34,6 +34,9 @@ struct PatternFaceOptions {
   /// (the unstructured path alone: 0.895).
   double min_sicn = 0.3;
   double min_sicn_avg = 0.7;
+  /// When the smoothed mesh has its mean above min_sicn_avg but quads at or below min_sicn (or
+  /// invalid), smooth::untangle_face lifts them (target min_sicn + 0.05) before the test.
+  bool lift_poor_quads = true;
   /// Matches tried geometrically (laid out, smoothed, measured) before giving up, best first.
   int max_candidates = 4;
   MatchOptions match;

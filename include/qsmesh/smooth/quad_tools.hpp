@@ -31,4 +31,17 @@ namespace qsmesh::smooth {
 [[nodiscard]] bool laplace_uv(const std::vector<std::array<LO, 4>>& quads, LO num_fixed,
                               std::vector<Vec2>& uv);
 
+/// Laplace layout that keeps the grading of the fixed boundary (paper 000 Sec. 6.1.2: the patterns
+/// are filled "with a layout following the boundary sizes"). Same inputs, outputs and errors as
+/// laplace_uv, but each edge is a spring of stiffness 1 / w, w being its target length: the edges
+/// are grouped in chords (dual strips: a quad's opposite edges are in one chord), each chord that
+/// starts and ends on edges of two fixed vertices gets the (u, v) lengths of these two end edges
+/// and interpolates them linearly along the strip. Chords closed or ending on a free vertex take
+/// the mean target of the others (all 1 when there is none: laplace_uv). On a grid whose opposite
+/// sides carry the same graded spacing this reproduces the spacing exactly (straight grid lines,
+/// as transfinite interpolation), where the uniform Laplacian pulls it towards even spacing and
+/// skews the quads near the fine end.
+[[nodiscard]] bool chord_laplace_uv(const std::vector<std::array<LO, 4>>& quads, LO num_fixed,
+                                    std::vector<Vec2>& uv);
+
 }  // namespace qsmesh::smooth
