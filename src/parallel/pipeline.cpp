@@ -337,6 +337,20 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     clock.reset();
     const std::vector<double> ideal = quantize::ideal_edge_counts(curves, result.curve_sizes.at);
     result.quantization = quantize::quantize_curves(model, ideal, options.quantize);
+    if (options.balance_counts) {
+      // Every rank balances the whole model the same way (deterministic, model-wide data only).
+      std::vector<LO> fixed;
+      for (const auto& [c, n] : options.quantize.prescribed) fixed.push_back(c);
+      const auto patterns = qstruct::builtin_patterns();
+      std::vector<int> edges = qstruct::balance_curve_counts(
+          model, curves, result.quantization, patterns, fixed, options.balance, &result.balance);
+      result.quantization.total_edges = 0;
+      for (const int e : edges) result.quantization.total_edges += e;
+      result.quantization.edges = std::move(edges);
+      log.info(cat("quantize: faces fitting a pattern ", result.balance.fitting_before, " -> ",
+                   result.balance.fitting_after, " of ", result.balance.faces_considered, " (",
+                   result.balance.curves_changed, " curves changed)"));
+    }
     result.quantized_curves =
         quantize::place_vertices(model, curves, result.curve_sizes.at, result.quantization,
                                  /*halved=*/false, tasks);

@@ -154,7 +154,8 @@ void check_size_map(const Comm& comm, const cad::CadModel& model, double size, P
   }
   sizemap::grade_curves(model, curves, options.sizemap.gradation, united);
   EXPECT_EQ(result.curve_sizes.pack(), united.pack());
-  const auto q = quantize::quantize_curves(model, quantize::ideal_edge_counts(curves, united.at), options.quantize);
+  auto q = quantize::quantize_curves(model, quantize::ideal_edge_counts(curves, united.at), options.quantize);
+  q.edges = qstruct::balance_curve_counts(model, curves, q, qstruct::builtin_patterns(), {}, options.balance);
   EXPECT_EQ(result.quantization.edges, q.edges);
   const auto placed = quantize::place_vertices(model, curves, united.at, q, false, one);
   ASSERT_EQ(result.quantized_curves.size(), placed.size());

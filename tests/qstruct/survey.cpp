@@ -1,4 +1,5 @@
-// qstruct_survey MODEL [--size-factor F] [--threads T] [--faces]
+// qstruct_survey MODEL [--size-factor F] [--threads T] [--faces] [--face F] [--min-sicn A]
+// [--min-sicn-avg B]
 // How many faces of MODEL the pattern path (paper 000 Sec. 6.1.2) meshes on the curve meshes the
 // pipeline quantizes (size map, crossfield method, as `qsmesh sizemap`), and why the others are
 // refused. Serial (MPI_COMM_SELF); --faces prints one line per face.
@@ -23,11 +24,15 @@ int main(int argc, char** argv) {
   parallel::MpiSession mpi(&argc, &argv);
   test::SurveyArgs args;
   LO detail = kNoIndex;
+  qstruct::PatternFaceOptions fo;
   const bool ok = test::parse_survey_args(
-      argc, argv, "usage: qstruct_survey MODEL [--size-factor F] [--threads T] [--faces]", args,
+      argc, argv, "usage: qstruct_survey MODEL [--size-factor F] [--threads T] [--faces] [--face F] [--min-sicn A] [--min-sicn-avg B]", args,
       [&](const std::string& a, int& i) {
-        if (a != "--face" || i + 1 >= argc) return false;
-        detail = std::atoi(argv[++i]);
+        if (i + 1 >= argc) return false;
+        if (a == "--face") detail = std::atoi(argv[++i]);
+        else if (a == "--min-sicn") fo.min_sicn = std::atof(argv[++i]);
+        else if (a == "--min-sicn-avg") fo.min_sicn_avg = std::atof(argv[++i]);
+        else return false;
         return true;
       });
   if (!ok) return 2;
@@ -42,7 +47,6 @@ int main(int argc, char** argv) {
     const double pipeline_s = run.pipeline_seconds;
 
     const auto patterns = qstruct::builtin_patterns();
-    const qstruct::PatternFaceOptions fo;
     Stopwatch clock;
     std::map<std::string, int> refusals, used, no_pattern_sides, quality_patterns;
     std::int64_t quads = 0;

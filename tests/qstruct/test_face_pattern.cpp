@@ -11,6 +11,7 @@
 #include "qsmesh/background/face_mesh.hpp"
 #include "qsmesh/cad/model.hpp"
 #include "qsmesh/mesh/quality.hpp"
+#include "qsmesh/qstruct/balance.hpp"
 #include "qsmesh/qstruct/face_pattern.hpp"
 #include "shapes.hpp"
 #include "tmp_dir.hpp"
@@ -270,6 +271,59 @@ TEST(FacePattern, PolesAndHolesAreRefused) {
     EXPECT_EQ(holes, 2);
     EXPECT_GE(meshed, 4);  // the four box sides without the hole, all 4 x 4 grids
   }
+}
+
+
+// Pattern-aware quantization: a long rectangle whose bottom side is two curves gets [14, 2, 10, 2]
+// from the per-curve rounding, which no pattern fits (a transition of 4 edges across a strip 2
+// edges wide); balancing moves one bottom curve or the top so that the opposite sides agree.
+TEST(Balance, SidesOfSeveralCurvesAreMadeToFit) {
+  const XY xy = {{0, 0}, {3, 0}, {10, 0}, {10, 1}, {0, 1}};
+  const std::vector<LO> counts = {6, 8, 2, 10, 2};
+  const auto pc = polygon(xy, counts, "qs_balance.brep");
+  ASSERT_EQ(pc.model.num_curves(), 5);
+  quantize::Quantization q;
+  for (LO c = 0; c < 5; ++c) {
+    q.edges.push_back(pc.curves[c].num_edges());
+    q.ideal.push_back(static_cast<double>(q.edges.back()));
+  }
+  q.curve2chord.assign(5, kNoIndex);
+  const auto patterns = builtin_patterns();
+  const auto sides = [&](const std::vector<int>& e) {
+    // The loop order of the face is not known here: sum the two bottom curves by position.
+    std::vector<LO> n;
+    const auto fs = face_sides(pc.model, 0, *pc.model.face_geometry(0), pc.curves, PatternFaceOptions{});
+    EXPECT_EQ(fs.corners.size(), 4u);  // the 180-degree vertex at (3, 0) is no corner
+    LO pos = 0;
+    n.assign(fs.corners.size(), 0);
+    for (const auto& use : pc.model.faces()[0].loops[0].uses) {
+      int side = static_cast<int>(fs.corners.size()) - 1;
+      for (std::size_t k = 0; k < fs.corners.size(); ++k)
+        if (fs.corners[k] <= pos) side = static_cast<int>(k);
+      n[side] += e[use.curve];
+      pos += pc.curves[use.curve].num_edges();
+    }
+    return n;
+  };
+  const std::vector<LO> before = sides(q.edges);
+  ASSERT_TRUE(match_patterns(patterns, before).empty());
+
+  BalanceReport rep;
+  const std::vector<int> edges = balance_curve_counts(pc.model, pc.curves, q, patterns, {}, BalanceOptions{}, &rep);
+  EXPECT_EQ(rep.faces_considered, 1);
+  EXPECT_EQ(rep.fitting_before, 0);
+  EXPECT_EQ(rep.fitting_after, 1);
+  EXPECT_FALSE(match_patterns(patterns, sides(edges)).empty());
+  for (LO c = 0; c < 5; ++c) {
+    EXPECT_EQ(edges[c] % 2, 0);
+    EXPECT_LE(std::abs(edges[c] - q.ideal[c]), std::max(2.0, 0.35 * q.ideal[c]) + 1e-9) << "curve " << c;
+  }
+
+  // With the bottom and top curves prescribed nothing may move, and nothing does.
+  std::vector<LO> fixed;
+  for (LO c = 0; c < 5; ++c)
+    if (q.edges[c] != 2) fixed.push_back(c);
+  EXPECT_EQ(balance_curve_counts(pc.model, pc.curves, q, patterns, fixed, BalanceOptions{}), q.edges);
 }
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include "qsmesh/background/face_mesh.hpp"
 #include "qsmesh/crossfield/cross_field.hpp"
 #include "qsmesh/quad/unstructured.hpp"
+#include "qsmesh/qstruct/balance.hpp"
 #include "qsmesh/qstruct/cavity.hpp"
 #include "qsmesh/qstruct/face_pattern.hpp"
 #include "qsmesh/remesh/disk_remesh.hpp"
@@ -44,6 +45,10 @@ struct PipelineOptions {
   bool size_map = false;
   sizemap::SizeMapOptions sizemap;
   quantize::QuantizeOptions quantize;
+  /// Pattern-aware quantization (qstruct::balance_curve_counts) after Sec. 4.3: curve counts
+  /// nudged so that more faces fit a coarse pattern (Sec. 6.1.2). Applies with the size map.
+  bool balance_counts = true;
+  qstruct::BalanceOptions balance;
   /// Stage::QuasiStructured: pattern meshing of simple CAD faces (Sec. 6.1.2).
   qstruct::PatternFaceOptions patterns;
   /// Stage::QuasiStructured: cavity remeshing of the unstructured faces (Sec. 6.2).
@@ -91,6 +96,7 @@ struct PipelineResult {
   std::vector<sizemap::FaceSizes> face_sizes;   ///< size fields by face (rank 0, size map only)
   sizemap::CurveSizes curve_sizes;              ///< size map on the background curve meshes (every rank)
   quantize::Quantization quantization;          ///< curve edge counts (every rank)
+  qstruct::BalanceReport balance;               ///< pattern-aware balancing of those counts (every rank)
   std::vector<mesh::CurveMesh> quantized_curves;  ///< final curve meshes (every rank)
   std::vector<quad::UnstructuredReport> quad_reports;  ///< by face, Stage::Unstructured (rank 0)
   std::vector<QuasiReport> quasi_reports;  ///< by face, Stage::QuasiStructured (rank 0)

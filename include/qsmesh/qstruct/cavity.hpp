@@ -140,7 +140,10 @@ struct CavityOptions {
   double keep_ratio = 0.8;
   double good_sicn = 0.6;
   double keep_avg_ratio = 0.95;
-  double max_quad_change = 0.15;  ///< GrowOptions::max_quad_change
+  /// GrowOptions::max_quad_change. 0.3 measured against 0.15 on Block.stp (all faces, size factor
+  /// 0.02, tests/qstruct/cavity_survey): interior irregular vertices 10475 -> 5346 instead of
+  /// 6669 at the same SICN average (0.870), for 8% fewer quads (the filled patterns are coarser).
+  double max_quad_change = 0.3;
   int max_rounds = 10;  ///< passes of Steps 1-4 (the loop stops earlier when nothing changes)
   std::array<bool, 4> steps{true, true, true, true};  ///< which of Steps 1-4 run (experiments)
   /// Deterministic work bound: growths started, all steps together (0: none).

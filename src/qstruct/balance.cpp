@@ -1,0 +1,234 @@
+#include "qsmesh/qstruct/balance.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <map>
+#include <tuple>
+
+#include "qsmesh/core/error.hpp"
+
+namespace qsmesh::qstruct {
+
+namespace {
+
+// One target face: the curve of each loop use and the side it belongs to.
+struct FaceSidesOfUses {
+  LO face = kNoIndex;
+  int num_sides = 0;
+  std::vector<std::pair<LO, int>> uses;  // (curve, side)
+};
+
+std::vector<LO> side_counts(const FaceSidesOfUses& f, const std::vector<int>& edges) {
+  std::vector<LO> n(static_cast<std::size_t>(f.num_sides), 0);
+  for (const auto& [c, s] : f.uses) n[s] += edges[c];
+  return n;
+}
+
+// How far the sides are from fitting a pattern; 0 when one fits or when the face is not one we
+// know how to steer (5 or 6 sides, 2 sides).
+int misfit(const std::vector<LO>& n, bool fits) {
+  if (fits) return 0;
+  if (n.size() == 4) return std::abs(n[0] - n[2]) + std::abs(n[1] - n[3]);
+  if (n.size() == 3) {
+    const LO big = *std::max_element(n.begin(), n.end());
+    const LO sum = n[0] + n[1] + n[2];
+    return std::max(0, 2 * big - sum + 2);
+  }
+  return 0;
+}
+
+// An even step of about half of d (0 when d is 2 or less).
+int half_step(int d) {
+  const int h = 2 * static_cast<int>(std::lround(static_cast<double>(d) / 4.0));
+  return h == d ? 0 : h;
+}
+
+}  // namespace
+
+std::vector<int> balance_curve_counts(const cad::CadModel& model,
+                                      std::span<const mesh::CurveMesh> curves,
+                                      const quantize::Quantization& q,
+                                      std::span<const Pattern> patterns, std::span<const LO> fixed,
+                                      const BalanceOptions& options, BalanceReport* report) {
+  const LO nc = model.num_curves();
+  QSMESH_CHECK(static_cast<LO>(curves.size()) == nc && static_cast<LO>(q.edges.size()) == nc &&
+                   static_cast<LO>(q.ideal.size()) == nc,
+               "balance: " << curves.size() << " curve meshes and " << q.edges.size()
+                           << " counts for " << nc << " curves");
+  const auto& cads = model.curves();
+  std::vector<int> edges = q.edges;
+  BalanceReport rep;
+
+  // Variables: a chord of q moves as one, other curves alone. Variable ids: curve ids for curves
+  // outside chords, nc + chord otherwise.
+  std::vector<std::vector<LO>> chord_members(static_cast<std::size_t>(q.num_chords));
+  for (LO c = 0; c < nc; ++c)
+    if (q.curve2chord[c] != kNoIndex) chord_members[q.curve2chord[c]].push_back(c);
+  const auto var_of = [&](LO c) { return q.curve2chord[c] == kNoIndex ? c : nc + q.curve2chord[c]; };
+  const auto members = [&](LO v) -> std::vector<LO> {
+    return v < nc ? std::vector<LO>{v} : chord_members[v - nc];
+  };
+  std::vector<char> frozen(static_cast<std::size_t>(nc + q.num_chords), 0);
+  for (const LO c : fixed)
+    if (c >= 0 && c < nc) frozen[var_of(c)] = 1;
+  for (LO c = 0; c < nc; ++c)
+    if (cads[c].degenerate || edges[c] <= 0) frozen[var_of(c)] = 1;
+
+  // Target faces and their sides.
+  std::vector<FaceSidesOfUses> targets;
+  for (LO f = 0; f < model.num_faces(); ++f) {
+    const cad::Face& face = model.faces()[f];
+    if (face.loops.size() != 1 || !face.loops_closed) continue;
+    const auto& uses = face.loops[0].uses;
+    if (std::any_of(uses.begin(), uses.end(), [&](const cad::CurveUse& u) { return cads[u.curve].degenerate; }))
+      continue;
+    FaceSides fs;
+    try {
+      const auto surface = model.face_geometry(f);
+      fs = face_sides(model, f, *surface, curves, options.faces);
+    } catch (const Error&) {
+      continue;  // the pattern path refuses these faces too
+    }
+    const int m = static_cast<int>(fs.corners.size());
+    if (m < 2 || m > 6) continue;
+    FaceSidesOfUses t;
+    t.face = f;
+    t.num_sides = m;
+    LO pos = 0;
+    for (const auto& use : uses) {
+      // Corners sit at use starts, so a use lies in one side: the last corner at or before it.
+      int side = m - 1;
+      for (int k = 0; k < m; ++k)
+        if (fs.corners[k] <= pos) side = k;
+      t.uses.emplace_back(use.curve, side);
+      pos += curves[use.curve].num_edges();
+    }
+    targets.push_back(std::move(t));
+  }
+  rep.faces_considered = static_cast<LO>(targets.size());
+  std::vector<std::vector<LO>> curve2targets(static_cast<std::size_t>(nc));
+  for (LO i = 0; i < static_cast<LO>(targets.size()); ++i)
+    for (const auto& [c, s] : targets[i].uses)
+      if (curve2targets[c].empty() || curve2targets[c].back() != i) curve2targets[c].push_back(i);
+  for (auto& t : curve2targets) {
+    std::sort(t.begin(), t.end());
+    t.erase(std::unique(t.begin(), t.end()), t.end());
+  }
+
+  const auto fits = [&](const std::vector<LO>& n) { return !match_patterns(patterns, n, options.faces.match).empty(); };
+  std::vector<char> fit(targets.size());
+  for (std::size_t i = 0; i < targets.size(); ++i) fit[i] = fits(side_counts(targets[i], edges));
+  rep.fitting_before = static_cast<LO>(std::count(fit.begin(), fit.end(), 1));
+
+  const auto allowed = [&](LO c, int n) {
+    const int lo = cads[c].corners[0] == cads[c].corners[1] ? 4 : 2;
+    if (n < lo) return false;
+    const double ideal = q.ideal[c];
+    const double now = std::abs(edges[c] - ideal), next = std::abs(n - ideal);
+    return next <= std::max(2.0, options.max_change * ideal) + 1e-9 || next < now;
+  };
+
+  struct Eval {
+    bool ok = false;
+    int gain = 0;        // fitting faces gained
+    int dmisfit = 0;     // change of the misfit of the touched faces
+    double rel = 0;      // relative size of the change
+    std::vector<std::pair<LO, char>> fit_after;
+  };
+  const auto evaluate = [&](LO var, int delta) {
+    Eval e;
+    const std::vector<LO> mem = members(var);
+    double ideal_sum = 0;
+    for (const LO c : mem) {
+      if (!allowed(c, edges[c] + delta)) return e;
+      ideal_sum += std::max(1.0, q.ideal[c]);
+    }
+    std::vector<LO> touched;
+    for (const LO c : mem) touched.insert(touched.end(), curve2targets[c].begin(), curve2targets[c].end());
+    std::sort(touched.begin(), touched.end());
+    touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+    for (const LO c : mem) edges[c] += delta;
+    for (const LO t : touched) {
+      const auto n = side_counts(targets[t], edges);
+      const bool after = fits(n);
+      e.fit_after.emplace_back(t, after ? 1 : 0);
+      e.gain += (after ? 1 : 0) - fit[t];
+      e.dmisfit += misfit(n, after);
+    }
+    for (const LO c : mem) edges[c] -= delta;
+    for (const LO t : touched) e.dmisfit -= misfit(side_counts(targets[t], edges), fit[t] != 0);
+    e.rel = std::abs(delta) * static_cast<double>(mem.size()) / ideal_sum;
+    e.ok = e.gain > 0 || (e.gain == 0 && e.dmisfit < 0);
+    return e;
+  };
+
+  std::vector<char> changed(static_cast<std::size_t>(nc), 0);
+  for (int pass = 0; pass < options.max_passes; ++pass) {
+    ++rep.passes;
+    bool any = false;
+    for (std::size_t i = 0; i < targets.size(); ++i) {
+      if (fit[i]) continue;
+      const FaceSidesOfUses& t = targets[i];
+      const auto n = side_counts(t, edges);
+      // Candidate moves: (variable, delta) pairs that shrink the failing differences.
+      std::vector<std::pair<LO, int>> moves;
+      const auto side_vars = [&](int side) {
+        std::vector<LO> v;
+        for (const auto& [c, s] : t.uses)
+          if (s == side && !frozen[var_of(c)]) v.push_back(var_of(c));
+        std::sort(v.begin(), v.end());
+        v.erase(std::unique(v.begin(), v.end()), v.end());
+        return v;
+      };
+      const auto add = [&](int side, int delta) {
+        if (delta == 0) return;
+        for (const LO v : side_vars(side)) moves.emplace_back(v, delta);
+      };
+      if (t.num_sides == 4) {
+        for (int a = 0; a < 2; ++a) {
+          const int d = n[a] - n[a + 2];
+          for (const int step : {d, half_step(d)}) {
+            add(a, -step);
+            add(a + 2, step);
+          }
+        }
+      } else if (t.num_sides == 3) {
+        const int big = static_cast<int>(std::max_element(n.begin(), n.end()) - n.begin());
+        const int excess = misfit(n, false);
+        for (const int step : {excess, half_step(excess)})
+          for (int s = 0; s < 3; ++s) add(s, s == big ? -step : step);
+      }
+      if (moves.empty()) continue;
+      std::sort(moves.begin(), moves.end());
+      moves.erase(std::unique(moves.begin(), moves.end()), moves.end());
+      Eval best;
+      LO best_var = kNoIndex;
+      int best_delta = 0;
+      for (const auto& [v, delta] : moves) {
+        Eval e = evaluate(v, delta);
+        if (!e.ok) continue;
+        const auto key = [](const Eval& x) { return std::make_tuple(-x.gain, x.dmisfit, x.rel); };
+        if (best_var == kNoIndex || key(e) < key(best)) {
+          best = std::move(e);
+          best_var = v;
+          best_delta = delta;
+        }
+      }
+      if (best_var == kNoIndex) continue;
+      for (const LO c : members(best_var)) {
+        edges[c] += best_delta;
+        changed[c] = 1;
+      }
+      for (const auto& [tt, f] : best.fit_after) fit[tt] = f;
+      any = true;
+    }
+    if (!any) break;
+  }
+  rep.fitting_after = static_cast<LO>(std::count(fit.begin(), fit.end(), 1));
+  for (LO c = 0; c < nc; ++c) rep.curves_changed += (changed[c] && edges[c] != q.edges[c]) ? 1 : 0;
+  if (report != nullptr) *report = rep;
+  return edges;
+}
+
+}  // namespace qsmesh::qstruct
