@@ -81,8 +81,8 @@ void augment(const std::vector<Candidate>& candidates, const RecombineOptions& o
     return candidates[ci].t1 == t ? candidates[ci].t2 : candidates[ci].t1;
   };
   std::vector<std::uint32_t> seen(static_cast<std::size_t>(nt), 0);
-  std::vector<LO> parent(static_cast<std::size_t>(nt),
-                         kNoIndex);  // odd triangle -> candidate reaching it
+  // Odd triangle -> candidate reaching it.
+  std::vector<LO> parent(static_cast<std::size_t>(nt), kNoIndex);
   std::vector<int> depth(static_cast<std::size_t>(nt), 0);
   std::uint32_t stamp = 0;
   std::vector<LO> queue;
