@@ -2,7 +2,10 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
+#include <numbers>
 #include <tuple>
+#include <unordered_set>
 #include <vector>
 
 #include "qsmesh/core/error.hpp"
@@ -36,11 +39,36 @@ double edge_alignment(const Vec3& e, const std::array<Vec3, 2>& cross_dirs) {
   return std::clamp((c - c45) / (1 - c45), 0.0, 1.0);
 }
 
+std::uint64_t edge_key(LO a, LO b) {
+  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(std::max(a, b))) << 32) |
+         static_cast<std::uint32_t>(std::min(a, b));
+}
+
+// Largest 3D angle (radians) of quad q at a corner on a CAD curve or corner whose two quad edges
+// both lie on `fixed` edges (curves); 0 when there is no such corner. Midpoint subdivision leaves
+// that corner a single sub-quad whose two edges run along the curve to the full-mesh midpoints,
+// where a smooth curve is about twice as flat as here, and no smoothing can open it: its corners
+// on the curve do not move.
+double flat_fixed_corner(const mesh::FaceMesh& m, const std::array<LO, 4>& q,
+                         const std::unordered_set<std::uint64_t>& fixed) {
+  double worst = 0;
+  for (int k = 0; k < 4; ++k) {
+    const LO v = q[k], prev = q[(k + 3) % 4], next = q[(k + 1) % 4];
+    if (m.vclass[v].dim > 1 || !fixed.contains(edge_key(prev, v)) ||
+        !fixed.contains(edge_key(v, next)))
+      continue;
+    const Vec3 a = m.points[prev] - m.points[v], b = m.points[next] - m.points[v];
+    worst = std::max(worst, std::atan2(norm(cross(a, b)), dot(a, b)));
+  }
+  return worst;
+}
+
 // A triangle the greedy pass left alone becomes a valence-3 vertex after subdivision. Augmenting
 // paths of the matching (alternating free/held candidates from one lone triangle to another) pair
 // two of them at the price of re-pairing the triangles in between; breadth first, bounded depth,
 // only through candidates of acceptable quality, lone triangles in increasing order.
-void augment(const std::vector<Candidate>& candidates, const RecombineOptions& options, std::vector<LO>& mate) {
+void augment(const std::vector<Candidate>& candidates, const RecombineOptions& options,
+             std::vector<LO>& mate) {
   const auto nt = static_cast<LO>(mate.size());
   std::vector<std::vector<LO>> tri2cand(static_cast<std::size_t>(nt));
   for (LO ci = 0; ci < static_cast<LO>(candidates.size()); ++ci) {
@@ -49,9 +77,12 @@ void augment(const std::vector<Candidate>& candidates, const RecombineOptions& o
     tri2cand[c.t1].push_back(ci);
     tri2cand[c.t2].push_back(ci);
   }
-  auto other = [&](LO ci, LO t) { return candidates[ci].t1 == t ? candidates[ci].t2 : candidates[ci].t1; };
+  auto other = [&](LO ci, LO t) {
+    return candidates[ci].t1 == t ? candidates[ci].t2 : candidates[ci].t1;
+  };
   std::vector<std::uint32_t> seen(static_cast<std::size_t>(nt), 0);
-  std::vector<LO> parent(static_cast<std::size_t>(nt), kNoIndex);  // odd triangle -> candidate reaching it
+  // Odd triangle -> candidate reaching it.
+  std::vector<LO> parent(static_cast<std::size_t>(nt), kNoIndex);
   std::vector<int> depth(static_cast<std::size_t>(nt), 0);
   std::uint32_t stamp = 0;
   std::vector<LO> queue;
@@ -114,6 +145,23 @@ mesh::FaceMesh recombine(const mesh::FaceMesh& mesh,
     }
   std::sort(edges.begin(), edges.end());
 
+  const auto on_curve = [&](LO a, LO b) {
+    const auto& ca = mesh.vclass[a];
+    const auto& cb = mesh.vclass[b];
+    return ca.dim == 1 && cb.dim == 1 && ca.entity == cb.entity &&
+           std::abs(ca.index - cb.index) == 1;
+  };
+  // Edges that stay where they are: the face boundary (one triangle) and curves inside the face.
+  std::unordered_set<std::uint64_t> fixed;
+  for (std::size_t i = 0; i < edges.size();) {
+    std::size_t j = i;
+    while (j < edges.size() && edges[j].a == edges[i].a && edges[j].b == edges[i].b) ++j;
+    if (j - i == 1 || on_curve(edges[i].a, edges[i].b))
+      fixed.insert(edge_key(edges[i].a, edges[i].b));
+    i = j;
+  }
+  const double max_flat = options.max_fixed_corner_angle_deg * std::numbers::pi / 180.0;
+
   std::vector<Candidate> candidates;
   for (std::size_t i = 0; i < edges.size();) {
     std::size_t j = i;
@@ -128,12 +176,9 @@ mesh::FaceMesh recombine(const mesh::FaceMesh& mesh,
       // Consistently oriented neighbours traverse the shared edge in opposite directions.
       const bool opposite = T2[e2.local] == b && T2[(e2.local + 1) % 3] == a;
       // An edge along a CAD curve inside the face (both ends consecutive on one curve) stays.
-      const auto& ca = mesh.vclass[a];
-      const auto& cb = mesh.vclass[b];
-      const bool on_curve = ca.dim == 1 && cb.dim == 1 && ca.entity == cb.entity &&
-                            std::abs(ca.index - cb.index) == 1;
-      if (opposite && !on_curve && c != d) {
-        const std::array<LO, 4> q{a, d, b, c};
+      const std::array<LO, 4> q{a, d, b, c};
+      if (opposite && !on_curve(a, b) && c != d &&
+          !(flat_fixed_corner(mesh, q, fixed) > max_flat)) {
         const double sicn = mesh::quad_sicn(
             {mesh.points[q[0]], mesh.points[q[1]], mesh.points[q[2]], mesh.points[q[3]]});
         if (sicn > options.min_sicn) {

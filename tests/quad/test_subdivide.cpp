@@ -10,6 +10,7 @@
 #include <cmath>
 #include <gp_Pnt.hxx>
 #include <map>
+#include <numbers>
 #include <set>
 #include <stdexcept>
 #include <string>
@@ -26,8 +27,8 @@
 #include "qsmesh/quantize/quantize.hpp"
 #include "qsmesh/smooth/smooth.hpp"
 #include "qsmesh/smooth/untangle.hpp"
-#include "shapes.hpp"
 #include "quantized_curves.hpp"
+#include "shapes.hpp"
 #include "tmp_dir.hpp"
 
 namespace qsmesh::quad {
@@ -287,7 +288,8 @@ void expect_pole_faces_valid(const cad::CadModel& model, double size, const char
     for (LO v = 0; v < out.num_vertices(); ++v)
       EXPECT_LT(distance(surface->eval(out.uv[v]).p, out.points[v]), 1e-6 * model.diagonal())
           << what << " vertex " << v << " dim " << int(out.vclass[v].dim) << " entity "
-          << out.vclass[v].entity << " index " << out.vclass[v].index << " new " << (v >= p.faces[f].num_vertices());
+          << out.vclass[v].entity << " index " << out.vclass[v].index << " new "
+          << (v >= p.faces[f].num_vertices());
   }
   EXPECT_GT(pole_faces, 0) << what;
 }
@@ -308,6 +310,37 @@ TEST(Subdivide, ConeApexGivesValidQuads) {
 namespace qsmesh::quad {
 namespace {
 
+// A hand-made face mesh of a polygon face: its corners in `xy` order (each matched with the
+// model's corner at that point), then the interior points `inside`.
+mesh::FaceMesh polygon_mesh(const cad::CadModel& model, const cad::FaceGeometry& surface,
+                            const std::vector<std::pair<double, double>>& xy,
+                            const std::vector<Vec3>& inside) {
+  mesh::FaceMesh in;
+  in.face = 0;
+  for (const auto& [x, y] : xy) {
+    const Vec3 pt{x, y, 0};
+    LO corner = kNoIndex;
+    for (LO c = 0; c < model.num_corners(); ++c)
+      if (distance(model.corners()[c].point, pt) < 1e-9) corner = c;
+    EXPECT_NE(corner, kNoIndex);
+    mesh::VertexClass vc;
+    vc.dim = 0;
+    vc.entity = corner;
+    in.points.push_back(pt);
+    in.uv.push_back(surface.project(pt, {0, 0}, nullptr));
+    in.vclass.push_back(vc);
+  }
+  for (const Vec3& z : inside) {
+    mesh::VertexClass vz;
+    vz.entity = 0;
+    in.points.push_back(z);
+    in.uv.push_back(surface.project(z, {0, 0}, nullptr));
+    vz.param = {in.uv.back().u, in.uv.back().v};
+    in.vclass.push_back(vz);
+  }
+  return in;
+}
+
 // A pentagon whose bottom side bends by half a degree at corner C1, meshed by hand with the sliver
 // triangle (C0, C1, C2) that a triangulator may leave along such a side: without re-triangulation
 // C1 would keep one sub-quad with a 179.4 degree corner.
@@ -318,28 +351,7 @@ TEST(Subdivide, FlatBoundaryStripIsRefannedFromAnInteriorVertex) {
   const auto p = prepare(model, 12.0);
   for (const auto& cm : p.full) ASSERT_EQ(cm.num_edges(), 2) << "curve " << cm.curve;
   const auto surface = model.face_geometry(0);
-  mesh::FaceMesh in;
-  in.face = 0;
-  for (const auto& [x, y] : xy) {
-    const Vec3 pt{x, y, 0};
-    LO corner = kNoIndex;
-    for (LO c = 0; c < model.num_corners(); ++c)
-      if (distance(model.corners()[c].point, pt) < 1e-9) corner = c;
-    ASSERT_NE(corner, kNoIndex);
-    mesh::VertexClass vc;
-    vc.dim = 0;
-    vc.entity = corner;
-    in.points.push_back(pt);
-    in.uv.push_back(surface->project(pt, {0, 0}, nullptr));
-    in.vclass.push_back(vc);
-  }
-  const Vec3 z{5, 3.5, 0};
-  mesh::VertexClass vz;
-  vz.entity = 0;
-  in.points.push_back(z);
-  in.uv.push_back(surface->project(z, {0, 0}, nullptr));
-  vz.param = {in.uv.back().u, in.uv.back().v};
-  in.vclass.push_back(vz);
+  mesh::FaceMesh in = polygon_mesh(model, *surface, xy, {Vec3{5, 3.5, 0}});
   // Counter-clockwise in (x, y); the same turn in (u, v) or the opposite one, whichever the plane's
   // parametrization gives: the sliver and its neighbours turn alike.
   in.triangles = {{0, 1, 2}, {0, 2, 5}, {2, 3, 5}, {3, 4, 5}, {4, 0, 5}};
@@ -352,6 +364,54 @@ TEST(Subdivide, FlatBoundaryStripIsRefannedFromAnInteriorVertex) {
   EXPECT_EQ(out.quads.size(), 15u);
   EXPECT_GT(q.min, 0.2);
   // C1 (vertex 1) now has two sub-quads.
+  int at_c1 = 0;
+  for (const auto& e : out.quads)
+    for (const LO v : e) at_c1 += v == 1 ? 1 : 0;
+  EXPECT_EQ(at_c1, 2);
+}
+
+// Largest 3D angle of a quad at a vertex on a curve or corner, in degrees.
+double largest_boundary_angle(const mesh::FaceMesh& m) {
+  double worst = 0;
+  for (const auto& q : m.quads)
+    for (int k = 0; k < 4; ++k) {
+      if (m.vclass[q[k]].dim > 1) continue;
+      const Vec3 a = m.points[q[(k + 3) % 4]] - m.points[q[k]];
+      const Vec3 b = m.points[q[(k + 1) % 4]] - m.points[q[k]];
+      worst = std::max(worst, std::atan2(norm(cross(a, b)), dot(a, b)) * 180 / std::numbers::pi);
+    }
+  return worst;
+}
+
+// A kite whose bottom side bends by 10 degrees at corner C1, triangulated with the two triangles
+// that meet at C1. Paired (quad SICN 0.18, above the recombination's minimum) they make a quad
+// with the 170 degree corner at C1, which subdivision leaves to a single sub-quad of SICN 0.18
+// that smoothing cannot open (measured before the recombination refused such quads: SICN min
+// 0.18, largest boundary angle 169.7 degrees); the triangles must stay apart instead, leaving C1
+// two sub-quads of about 85 degrees there.
+TEST(Recombine, FlatCurveCornerIsNotLeftToOneQuad) {
+  const std::vector<std::pair<double, double>> xy{{0, 0}, {5, -0.45}, {10, 0}, {5, 5}};
+  const auto model = cad::load_cad(test::write_polygon_face(xy, tmp("rc_flat_corner.brep")));
+  ASSERT_EQ(model.num_faces(), 1);
+  const auto p = prepare(model, 12.0);
+  for (const auto& cm : p.full) ASSERT_EQ(cm.num_edges(), 2) << "curve " << cm.curve;
+  const auto surface = model.face_geometry(0);
+  mesh::FaceMesh in = polygon_mesh(model, *surface, xy, {});
+  in.triangles = {{0, 1, 3}, {1, 2, 3}};
+  // Whichever way the plane's parametrization turns, both triangles turn alike.
+  RecombineStats rs;
+  const mesh::FaceMesh rec = recombine(in, {}, RecombineOptions{}, &rs);
+  SubdivideStats ss;
+  const mesh::FaceMesh out = subdivide(rec, *surface, p.full, &ss);
+  const Quality q = quality(out);
+  const double angle = largest_boundary_angle(out);
+  std::printf(
+      "flat curve corner: %lld quads recombined, %zu quads, SICN min %.3f, largest boundary "
+      "angle %.1f degrees\n",
+      static_cast<long long>(rs.quads), out.quads.size(), q.min, angle);
+  EXPECT_EQ(rs.quads, 0);
+  EXPECT_LT(angle, 150.0);
+  EXPECT_GT(q.min, 0.3);
   int at_c1 = 0;
   for (const auto& e : out.quads)
     for (const LO v : e) at_c1 += v == 1 ? 1 : 0;

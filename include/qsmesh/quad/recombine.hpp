@@ -23,6 +23,13 @@ struct RecombineOptions {
   int augment_depth = 0;
   /// Quads that augmenting paths may form must have at least this SICN.
   double augment_min_sicn = 0.3;
+  /// A quad with a corner on a CAD curve or corner whose two edges both lie on curves (the face
+  /// boundary or a curve inside the face) and meet at more than this 3D angle (degrees) is not
+  /// formed: midpoint subdivision gives that corner a single sub-quad with about the same angle
+  /// (flatter still on a smooth curve, whose full mesh turns half as much per edge), which
+  /// smoothing cannot open since its corners stay on the curve. Measured on Block.stp: halved
+  /// corners of 174 degrees (quad SICN 0.105) became 177 degrees (SICN 0.052) after subdivision.
+  double max_fixed_corner_angle_deg = 160.0;
 };
 
 struct RecombineStats {
@@ -36,7 +43,8 @@ struct RecombineStats {
 /// crossed) is a candidate quad, scored by its SICN (Eq. 12, mesh::quad_sicn on the 3D points),
 /// weighted by its alignment with the cross field when `directions` is not empty. Candidates are
 /// selected greedily, best score first (ties: smaller triangle ids first), when both triangles are
-/// still free and the SICN is above options.min_sicn; then, with options.augment_depth > 0, lone
+/// still free, the SICN is above options.min_sicn and no corner on the curves is flatter than
+/// options.max_fixed_corner_angle_deg; then, with options.augment_depth > 0, lone
 /// triangles are paired along augmenting paths (breadth first from each lone triangle in id order,
 /// through candidates with SICN >= options.augment_min_sicn).
 /// `directions`: empty, or one entry per triangle of `mesh`: two unit tangent vectors (the two
