@@ -22,6 +22,7 @@ const char* to_string(Refusal r) {
     case Refusal::NoCorner: return "no_corner";
     case Refusal::NoPattern: return "no_pattern";
     case Refusal::Quality: return "quality";
+    case Refusal::TooManyQuads: return "too_many_quads";
     case Refusal::Error: return "error";
   }
   return "?";
@@ -136,10 +137,14 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
   std::vector<char> splits(nb, 0);
   for (const LO c : fs.corners) splits[c] = 1;
   std::vector<Candidate> cands;
+  std::int64_t fewest_quads = -1;
   for (const auto& match : matches) {
     Candidate c;
     c.match = match;
     c.refined = refine_pattern(patterns[match.pattern], match.chords);
+    const auto nq = static_cast<std::int64_t>(c.refined.quads.size());
+    if (fewest_quads < 0 || nq < fewest_quads) fewest_quads = nq;
+    if (options.max_quads > 0 && nq > options.max_quads) continue;
     QSMESH_CHECK(static_cast<LO>(c.refined.boundary.size()) == nb,
                  "refined boundary has " << c.refined.boundary.size() << " vertices, the face " << nb);
     const LO first = match.reversed ? fs.corners[(match.start + 1) % m] : fs.corners[match.start];
@@ -156,6 +161,12 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
       c.score += std::abs(valence[c.refined.boundary[p]] - ideal);
     }
     cands.push_back(std::move(c));
+  }
+  if (cands.empty()) {
+    std::ostringstream os;
+    os << "every fitting pattern needs at least " << fewest_quads << " quads, more than the "
+       << options.max_quads << " the size map allows";
+    return refuse(Refusal::TooManyQuads, os.str());
   }
   // matches come sorted by pattern order and energy; the valence fit goes first.
   std::stable_sort(cands.begin(), cands.end(), [](const Candidate& a, const Candidate& b) { return a.score < b.score; });

@@ -136,6 +136,24 @@ TEST(FacePattern, RectangleWithEqualOppositeSidesIsAGrid) {
   EXPECT_GT(rep.sicn_min, 0.99);
 }
 
+TEST(FacePattern, QuadCountBoundRefusesTooFineFills) {
+  const XY xy = {{0, 0}, {10, 0}, {10, 4}, {0, 4}};
+  const auto pc = polygon(xy, {10, 4, 10, 4}, "qs_rect_bound.brep");
+  const auto patterns = builtin_patterns();
+  PatternFaceOptions o;
+  o.max_quads = 39;  // the grid needs 40
+  PatternFaceReport rep;
+  const auto refused = mesh_face_pattern(pc.model, 0, pc.curves, patterns, o, &rep);
+  EXPECT_FALSE(rep.ok);
+  EXPECT_EQ(rep.refusal, Refusal::TooManyQuads);
+  EXPECT_NE(rep.reason.find("40"), std::string::npos) << rep.reason;
+  EXPECT_TRUE(refused.quads.empty());
+  o.max_quads = 40;
+  const auto kept = mesh_face_pattern(pc.model, 0, pc.curves, patterns, o, &rep);
+  EXPECT_TRUE(rep.ok) << rep.reason;
+  EXPECT_EQ(kept.quads.size(), 40u);
+}
+
 TEST(FacePattern, RectangleWithATransitionGetsOneValence3And5) {
   const XY xy = {{0, 0}, {10, 0}, {10, 5}, {0, 5}};
   const auto pc = polygon(xy, {11, 4, 9, 6}, "qs_trans.brep");

@@ -51,6 +51,12 @@ struct PipelineOptions {
   qstruct::BalanceOptions balance;
   /// Stage::QuasiStructured: pattern meshing of simple CAD faces (Sec. 6.1.2).
   qstruct::PatternFaceOptions patterns;
+  /// A pattern mesh of a face may have at most this many times the quads the size map asks for
+  /// (the sum over the background triangles of area / s^2); patterns.max_quads is set from it per
+  /// face (0: no bound). Measured ratios of the pattern meshes kept at size factor 0.02: Block
+  /// 11 faces below 1, 146 in 1-1.5, 141 in 1.5-2, 15 in 2-3 (fine boundaries make structured
+  /// fills finer than the size map inside); wing_fuselage's two transition faces above 5.
+  double pattern_max_quad_ratio = 3.0;
   /// Stage::QuasiStructured: cavity remeshing of the unstructured faces (Sec. 6.2).
   qstruct::CavityOptions cavities;
   /// Stage::QuasiStructured: disk remeshing of the defects of the unstructured faces (Sec. 6.3).

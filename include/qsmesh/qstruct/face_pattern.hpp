@@ -37,6 +37,11 @@ struct PatternFaceOptions {
   /// When the smoothed mesh has its mean above min_sicn_avg but quads at or below min_sicn (or
   /// invalid), smooth::untangle_face lifts them (target min_sicn + 0.05) before the test.
   bool lift_poor_quads = true;
+  /// Largest quad count a pattern mesh of the face may have (0: no bound). A pattern fill is
+  /// structured, so a size transition along one side runs across the whole face: [96, 342, 26,
+  /// 342] on wing_fuselage.step gives 22k quads where the size map asks for 4k. The pipeline
+  /// sets it per face from the size map (PipelineOptions::pattern_max_quad_ratio).
+  std::int64_t max_quads = 0;
   /// Matches tried geometrically (laid out, smoothed, measured) before giving up, best first.
   int max_candidates = 4;
   MatchOptions match;
@@ -51,6 +56,7 @@ enum class Refusal : std::uint8_t {
   NoCorner,    ///< fewer than two convex corners
   NoPattern,   ///< no pattern has as many sides, or none fits the side counts (Eq. 14)
   Quality,     ///< every candidate tried left a quad at or below the quality thresholds
+  TooManyQuads,  ///< every fitting pattern needs more quads than PatternFaceOptions::max_quads
   Error,       ///< an error from the geometry or the smoother
 };
 [[nodiscard]] const char* to_string(Refusal r);
