@@ -497,6 +497,11 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
                 quasi_reports[i].disk_replaced = ds.replaced;
                 return out;
               });
+      if (options.final_smoothing)
+        improve("final_smoothing", "final smoothing",
+                [&](std::int64_t i, const cad::FaceGeometry& surface) {
+                  return smooth::smooth_face(quad_meshes[i], surface, options.final_smooth);
+                });
     }
     meshes = std::move(quad_meshes);
   }

@@ -61,6 +61,13 @@ struct PipelineOptions {
   qstruct::CavityOptions cavities;
   /// Stage::QuasiStructured: disk remeshing of the defects of the unstructured faces (Sec. 6.3).
   remesh::DiskRemeshOptions disk;
+  /// Stage::QuasiStructured: a last smoothing (Sec. 5.3) of each face the topological steps
+  /// changed, boundary locked; the smoother keeps its result only when the minimum SICN does not
+  /// drop. The cavity and disk steps smooth only around each replacement. Measured at size factor
+  /// 0.02: SICN avg mambo 0.920 -> 0.922, t20 0.881 -> 0.884, wing_fuselage 0.873 -> 0.878, Block
+  /// 0.884 -> 0.885 (min 0.093 -> 0.099) for 0.06-0.5 s; 30 iterations instead of 10 add nothing.
+  bool final_smoothing = true;
+  smooth::SmoothOptions final_smooth;
 };
 
 /// How the quasi-structured stage treated one face.
