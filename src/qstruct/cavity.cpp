@@ -122,6 +122,7 @@ class Grower {
         }
       if (!progress) {
         res.stop = GrowResult::Stop::Fan;
+        res.reach = reach();
         return res;
       }
     }
@@ -194,6 +195,7 @@ class Grower {
       add(best);
     }
     res.grown_quads = static_cast<LO>(quads_.size());
+    res.reach = reach();
     return res;
   }
 
@@ -252,6 +254,18 @@ class Grower {
         frontier_.push_back(nb);
       }
     }
+  }
+
+  // Farthest vertex from the seed of the quads the growth looked at (added, undone or frontier).
+  double reach() const {
+    double r = 0;
+    const auto visit = [&](LO q) {
+      for (const LO v : m_.quads[q]) r = std::max(r, distance(m_.points[v], seed_point_));
+    };
+    for (const LO q : t_.quads_of(seed_)) visit(q);
+    for (const LO q : quads_) visit(q);
+    for (const LO q : frontier_) visit(q);
+    return r;
   }
 
   // Undoes the last add() (the growth is LIFO: the vertices it made interior are the last ones).
@@ -727,9 +741,54 @@ mesh::FaceMesh remesh_cavities(const mesh::FaceMesh& input, const cad::FaceGeome
       return false;
     };
 
+    // A growth depends only on the quads, points and flags within its reach (GrowResult::reach),
+    // so one that found nothing finds nothing again until a commit changes something there: each
+    // commit is kept as a ball holding the old points of its removed quads and of the vertices
+    // it moved, and a growth of the same kind (grid maximal, Steps 1 and 3; transitions minimal,
+    // Step 4) is skipped while no later ball meets its reach.
+    struct Change {
+      Vec3 centre;
+      double radius;
+    };
+    std::vector<Change> changes;
+    struct Futile {
+      double reach = -1;  // < 0: no futile growth recorded
+      std::size_t changes = 0;
+    };
+    std::array<std::vector<Futile>, 2> futile;  // [0]: grid maximal, [1]: transitions minimal
+    const auto still_futile = [&](int kind, LO seed) {
+      auto& f = futile[kind];
+      if (seed >= static_cast<LO>(f.size()) || f[seed].reach < 0) return false;
+      const Vec3& p = work.points[seed];
+      for (std::size_t i = f[seed].changes; i < changes.size(); ++i)
+        if (distance(p, changes[i].centre) <= f[seed].reach + changes[i].radius) {
+          f[seed].reach = -1;
+          return false;
+        }
+      f[seed].changes = changes.size();
+      return true;
+    };
+    const auto record_change = [&](const Cavity& c, const Replacement& r) {
+      std::vector<Vec3> pts;
+      for (const LO q : c.quads)
+        for (const LO v : work.quads[q]) pts.push_back(work.points[v]);
+      for (const LO v : r.moved) pts.push_back(work.points[v]);
+      Vec3 centre{};
+      for (const auto& p : pts) centre = centre + p;
+      centre = centre * (1.0 / static_cast<double>(pts.size()));
+      double radius = 0;
+      for (const auto& p : pts) radius = std::max(radius, distance(p, centre));
+      changes.push_back({centre, radius * (1 + 1e-9) + 1e-12});
+    };
+
     // One growth from `seed` and the geometric trials of what it found; true when committed.
     const auto grow_and_remesh = [&](int step, LO seed, std::span<const Pattern> pats, bool maximal,
                                      bool from_singularity, LO* new_singular) {
+      const int kind = from_singularity || !options.skip_futile ? -1 : (maximal ? 0 : 1);
+      if (kind >= 0 && still_futile(kind, seed)) {
+        ++rep.diagnostics[step].skipped_futile;
+        return false;
+      }
       ++started;
       ++rep.grown[step];
       GrowOptions go;
@@ -756,6 +815,11 @@ mesh::FaceMesh remesh_cavities(const mesh::FaceMesh& input, const cad::FaceGeome
       d.no_match += g.no_match;
       d.not_better += g.not_better;
       const int n = static_cast<int>(g.remeshable.size());
+      if (n == 0 && kind >= 0) {
+        auto& f = futile[kind];
+        if (static_cast<LO>(f.size()) < work.num_vertices()) f.resize(work.points.size());
+        f[seed] = Futile{g.reach, changes.size()};
+      }
       const int tries = std::min(
           n, std::max(1, maximal ? options.max_geometric_tries : options.max_minimal_tries));
       for (int k = 0; k < tries; ++k) {
@@ -774,6 +838,7 @@ mesh::FaceMesh remesh_cavities(const mesh::FaceMesh& input, const cad::FaceGeome
             }
             continue;
           }
+          record_change(c, r);
           remesher.commit(c, r);
           singular.resize(work.points.size(), 0);
           topo = QuadTopology(work);

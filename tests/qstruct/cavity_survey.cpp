@@ -156,6 +156,7 @@ int main(int argc, char** argv) {
         b.refused_invalid += a.refused_invalid;
         b.refused_min += a.refused_min;
         b.refused_avg += a.refused_avg;
+        b.skipped_futile += a.skipped_futile;
       }
       if (per_face)
         std::cout << "face " << f << " quads " << in.quads.size() << " -> " << out.quads.size()
@@ -185,7 +186,7 @@ int main(int argc, char** argv) {
                 << " (no pattern " << b.no_pattern << ", no match " << b.no_match
                 << ", not better " << b.not_better << "); refused layout/invalid/min/avg "
                 << b.refused_layout << "/" << b.refused_invalid << "/" << b.refused_min << "/"
-                << b.refused_avg << "\n";
+                << b.refused_avg << "; skipped (nothing changed) " << b.skipped_futile << "\n";
     }
     std::cout << "  remesh_cavities time " << seconds << " s\n";
   });

@@ -371,6 +371,40 @@ TEST(Cavity, MinimalGrowthFallbacks) {
   EXPECT_GE(seeds_with_fallbacks, 1);
 }
 
+// Growths that found nothing are not repeated while nothing changed within their reach: the
+// result is the same as with every growth repeated.
+TEST(Cavity, SkippingFutileGrowthsKeepsTheResult) {
+  const Plane plane;
+  // Two pairs far apart and one +1 singularity between them (Step 2 commits), a 3-pair cluster.
+  const mesh::FaceMesh in =
+      perturbed(plane, 24, 12, {{4, 4, 5, 4}, {18, 6, 18, 7}, {11, 8, 12, 8}, {11, 3, 11, 4}});
+  std::vector<crossfield::Singularity> sings(1);
+  sings[0].position = {11.5, 8, 0};
+  sings[0].index = 1;
+  const auto patterns = builtin_patterns();
+  CavityOptions with, without;
+  without.skip_futile = false;
+  with.max_quads_maximal = without.max_quads_maximal = 80;
+  CavityReport a, b;
+  const mesh::FaceMesh out_a = remesh_cavities(in, plane, sings, patterns, with, &a);
+  const mesh::FaceMesh out_b = remesh_cavities(in, plane, sings, patterns, without, &b);
+  ASSERT_TRUE(a.skipped.empty()) << a.skipped;
+  EXPECT_LT(a.irregular_after, a.irregular_before);
+  EXPECT_EQ(out_a.quads, out_b.quads);
+  EXPECT_EQ(out_a.points.size(), out_b.points.size());
+  for (std::size_t i = 0; i < std::min(out_a.points.size(), out_b.points.size()); ++i)
+    EXPECT_EQ(out_a.points[i], out_b.points[i]) << "vertex " << i;
+  std::int64_t skipped = 0, skipped_without = 0;
+  for (int k = 0; k < 4; ++k) {
+    skipped += a.diagnostics[k].skipped_futile;
+    skipped_without += b.diagnostics[k].skipped_futile;
+    EXPECT_EQ(a.remeshed[k], b.remeshed[k]);
+    EXPECT_LE(a.grown[k], b.grown[k]);
+  }
+  EXPECT_EQ(skipped_without, 0);
+  EXPECT_GT(skipped, 0);
+}
+
 TEST(Cavity, FlaggedSingularityIsPreserved) {
   const Plane plane;
   const mesh::FaceMesh in = perturbed(plane);

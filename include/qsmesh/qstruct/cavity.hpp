@@ -109,6 +109,9 @@ struct GrowResult {
   /// attempts), matches none of which is remeshable (irregularity not lowered, quad change,
   /// a flagged vertex or a CAD corner would change valence, Step 2's single irregular vertex).
   int no_pattern = 0, no_match = 0, not_better = 0;
+  /// Largest distance from the seed's point to a vertex of a quad the growth looked at (added,
+  /// undone or next to the cavity): the growth depends on nothing farther.
+  double reach = 0;
 };
 
 /// Paper 000 Sec. 6.2.1: grows a cavity from the quads around `seed` (an interior vertex).
@@ -144,6 +147,10 @@ struct CavityOptions {
   /// Remeshable cavities of a minimal growth (Steps 2 and 4) tried geometrically, smallest first
   /// (GrowOptions::max_remeshable): when the minimal one is refused, the next larger ones.
   int max_minimal_tries = 3;
+  /// Skip a growth (Steps 1, 3, 4) that found nothing from the same seed before while no commit
+  /// has changed the mesh within its reach (CavityStepDiagnostics::skipped_futile). Same result,
+  /// less time (Block.stp, survey at 0.02: Step 3 starts 3.7k growths instead of 16.5k).
+  bool skip_futile = true;
   int max_candidates = 2;  ///< matches tried per cavity (GrowOptions::max_candidates)
   /// GrowOptions::max_backtracks. With 8 and max_minimal_tries 3 on Block.stp (cavity_survey,
   /// size factor 0.02): interior irregular vertices 10494 -> 4978 instead of 5345, SICN avg
@@ -187,6 +194,9 @@ struct CavityStepDiagnostics {
   /// flipped (SICN <= min_sicn), minimum SICN below the keep_ratio bound, mean SICN below the
   /// keep_avg_ratio bound.
   std::int64_t refused_layout = 0, refused_invalid = 0, refused_min = 0, refused_avg = 0;
+  /// Growths not started again: the same growth from that seed found no remeshable cavity and
+  /// no commit since changed anything within its reach (the result would be the same).
+  std::int64_t skipped_futile = 0;
 };
 
 struct CavityReport {
