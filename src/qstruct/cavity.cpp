@@ -99,6 +99,7 @@ class Grower {
          const GrowOptions& o)
       : m_(m), t_(t), seed_(seed), singular_(singular), o_(o) {
     in_.assign(static_cast<std::size_t>(t.num_quads()), 0);
+    forbidden_.assign(static_cast<std::size_t>(o.max_backtracks > 0 ? t.num_quads() : 0), 0);
     frontier_flag_.assign(static_cast<std::size_t>(t.num_quads()), 0);
     n_in_.assign(static_cast<std::size_t>(t.num_vertices()), 0);
     next_.assign(static_cast<std::size_t>(t.num_vertices()), kNoIndex);
@@ -119,9 +120,16 @@ class Grower {
           ++added;
           progress = true;
         }
-      if (!progress) return res;
+      if (!progress) {
+        res.stop = GrowResult::Stop::Fan;
+        res.reach = reach();
+        return res;
+      }
     }
+    std::size_t last_convex = quads_.size();
+    int backtracks = 0;
     while (true) {
+      if (concave_.empty()) last_convex = quads_.size();
       if (!concave_.empty()) {
         // A concave vertex has exactly one outside quad; the cavity cannot become convex without
         // it.
@@ -129,8 +137,23 @@ class Grower {
         LO out = kNoIndex;
         for (const LO q : t_.quads_of(v))
           if (!in_[q]) out = q;
-        if (out == kNoIndex || static_cast<LO>(quads_.size()) >= o_.max_quads || !can_add(out))
+        if (out == kNoIndex || static_cast<LO>(quads_.size()) >= o_.max_quads || !can_add(out)) {
+          if (static_cast<LO>(quads_.size()) < o_.max_quads && backtracks < o_.max_backtracks &&
+              quads_.size() > last_convex) {
+            // The quad that left the last convex state leads nowhere: undo the excursion, never
+            // add that quad again, and grow on elsewhere (the isotropic order otherwise ends the
+            // growth at the first blocked concave vertex, e.g. next to a singularity).
+            ++backtracks;
+            const LO culprit = quads_[last_convex];
+            while (quads_.size() > last_convex) remove_last();
+            forbidden_[culprit] = 1;
+            checked_irregular_ = std::min(checked_irregular_, irregular_inside_);
+            continue;
+          }
+          res.stop = static_cast<LO>(quads_.size()) >= o_.max_quads ? GrowResult::Stop::MaxQuads
+                                                                     : GrowResult::Stop::Concave;
           break;
+        }
         add(out);
         continue;
       }
@@ -140,13 +163,20 @@ class Grower {
         if (!o_.seed_is_singularity || irregular_inside_ >= 2) {
           ++res.checks;
           Cavity c;
-          if (evaluate(c)) {
+          if (evaluate(c, res)) {
             res.remeshable.push_back(std::move(c));
-            if (!o_.maximal) break;
+            if (!o_.maximal &&
+                static_cast<int>(res.remeshable.size()) >= std::max(1, o_.max_remeshable)) {
+              res.stop = GrowResult::Stop::Found;
+              break;
+            }
           }
         }
       }
-      if (static_cast<LO>(quads_.size()) >= o_.max_quads) break;
+      if (static_cast<LO>(quads_.size()) >= o_.max_quads) {
+        res.stop = GrowResult::Stop::MaxQuads;
+        break;
+      }
       LO best = kNoIndex;
       double best_d = std::numeric_limits<double>::max();
       for (const LO q : frontier_) {
@@ -158,16 +188,20 @@ class Grower {
           best_d = d;
         }
       }
-      if (best == kNoIndex) break;
+      if (best == kNoIndex) {
+        res.stop = GrowResult::Stop::NoFrontier;
+        break;
+      }
       add(best);
     }
     res.grown_quads = static_cast<LO>(quads_.size());
+    res.reach = reach();
     return res;
   }
 
  private:
   bool can_add(LO q) const {
-    if (in_[q]) return false;
+    if (in_[q] || (!forbidden_.empty() && forbidden_[q])) return false;
     const auto& qd = m_.quads[q];
     std::array<bool, 4> shared{};
     int count = 0;
@@ -222,8 +256,41 @@ class Grower {
     }
   }
 
+  // Farthest vertex from the seed of the quads the growth looked at (added, undone or frontier).
+  double reach() const {
+    double r = 0;
+    const auto visit = [&](LO q) {
+      for (const LO v : m_.quads[q]) r = std::max(r, distance(m_.points[v], seed_point_));
+    };
+    for (const LO q : t_.quads_of(seed_)) visit(q);
+    for (const LO q : quads_) visit(q);
+    for (const LO q : frontier_) visit(q);
+    return r;
+  }
+
+  // Undoes the last add() (the growth is LIFO: the vertices it made interior are the last ones).
+  void remove_last() {
+    const LO q = quads_.back();
+    quads_.pop_back();
+    in_[q] = 0;
+    for (int i = 3; i >= 0; --i) {
+      const LO v = m_.quads[q][i];
+      const LO val = t_.valence(v);
+      if (n_in_[v] == val && !t_.on_boundary(v)) {
+        QSMESH_CHECK(!interior_.empty() && interior_.back() == v, "cavity undo out of order");
+        interior_.pop_back();
+        if (val != 4) --irregular_inside_;
+      }
+      --n_in_[v];
+      if (!t_.on_boundary(v) && n_in_[v] > 0 && val - n_in_[v] == 1)
+        concave_.insert(v);
+      else
+        concave_.erase(v);
+    }
+  }
+
   // Boundary, sides and matches of the current (convex) cavity; true when remeshable.
-  bool evaluate(Cavity& c) {
+  bool evaluate(Cavity& c, GrowResult& res) {
     std::vector<LO> starts;
     bool simple = true;
     for (const LO q : quads_)
@@ -260,14 +327,23 @@ class Grower {
       if (c.n_in[i] == 1) c.corners.push_back(i);
     }
     const LO m = static_cast<LO>(c.corners.size());
-    if (m < 2) return false;
+    if (m < 2) {
+      ++res.no_pattern;
+      return false;
+    }
     for (LO k = 0; k < m; ++k)
       c.side_edges.push_back((k + 1 < m ? c.corners[k + 1] : c.corners[0] + nb) - c.corners[k]);
     bool any = false;
     for (const auto& p : o_.patterns) any = any || p.num_sides() == m;
-    if (!any) return false;
+    if (!any) {
+      ++res.no_pattern;
+      return false;
+    }
     const std::vector<PatternMatch> matches = match_patterns(o_.patterns, c.side_edges, o_.match);
-    if (matches.empty()) return false;
+    if (matches.empty()) {
+      ++res.no_match;
+      return false;
+    }
 
     int before = 0;
     for (LO i = 0; i < nb; ++i) before += irregularity(m_, t_, cycle[i], t_.valence(cycle[i]));
@@ -306,7 +382,10 @@ class Grower {
       best_after = std::min(best_after, after);
       if (static_cast<int>(c.matches.size()) >= std::max(1, o_.max_candidates)) break;
     }
-    if (c.matches.empty()) return false;
+    if (c.matches.empty()) {
+      ++res.not_better;
+      return false;
+    }
     c.irregularity_before = before;
     c.irregularity_after = best_after;
     c.quads = quads_;
@@ -320,7 +399,7 @@ class Grower {
   std::span<const char> singular_;
   const GrowOptions& o_;
   Vec3 seed_point_;
-  std::vector<char> in_, frontier_flag_;
+  std::vector<char> in_, frontier_flag_, forbidden_;
   std::vector<LO> n_in_, next_, quads_, frontier_, interior_;
   std::set<LO> concave_;
   int irregular_inside_ = 0, checked_irregular_ = 0;
@@ -364,8 +443,12 @@ class Remesher {
       : w_(work), s_(surface), o_(o), sign_(sign) {}
 
   // Builds, lays out, smooths and measures the replacement of cavity c by `match` of `patterns`.
+  // Why build() refused a replacement.
+  enum class Refusal { None, Layout, Invalid, MinSicn, AvgSicn };
+
   bool build(const QuadTopology& t, const Cavity& c, const PatternMatch& match,
-             std::span<const Pattern> patterns, Replacement& out) const {
+             std::span<const Pattern> patterns, Replacement& out, Refusal& why) const {
+    why = Refusal::Layout;
     const RefinedPattern r = refine_pattern(patterns[match.pattern], match.chords);
     const LO nb = static_cast<LO>(c.boundary.size());
     QSMESH_CHECK(static_cast<LO>(r.boundary.size()) == nb,
@@ -479,9 +562,14 @@ class Remesher {
       if (q < n_new_quads) after_sum += x;
     }
     const double need = std::max(o_.min_sicn, std::min(o_.good_sicn, o_.keep_ratio * before));
-    if (!(after > o_.min_sicn) || after < need) return false;
+    why = Refusal::Invalid;
+    if (!(after > o_.min_sicn)) return false;
+    why = Refusal::MinSicn;
+    if (after < need) return false;
     const double avg_before = before_sum / static_cast<double>(c.quads.size());
+    why = Refusal::AvgSicn;
     if (after_sum / static_cast<double>(n_new_quads) < o_.keep_avg_ratio * avg_before) return false;
+    why = Refusal::None;
 
     for (LO i = nold; i < nold + n_new; ++i) {
       out.new_uv.push_back(lm.uv[i]);
@@ -653,9 +741,54 @@ mesh::FaceMesh remesh_cavities(const mesh::FaceMesh& input, const cad::FaceGeome
       return false;
     };
 
+    // A growth depends only on the quads, points and flags within its reach (GrowResult::reach),
+    // so one that found nothing finds nothing again until a commit changes something there: each
+    // commit is kept as a ball holding the old points of its removed quads and of the vertices
+    // it moved, and a growth of the same kind (grid maximal, Steps 1 and 3; transitions minimal,
+    // Step 4) is skipped while no later ball meets its reach.
+    struct Change {
+      Vec3 centre;
+      double radius;
+    };
+    std::vector<Change> changes;
+    struct Futile {
+      double reach = -1;  // < 0: no futile growth recorded
+      std::size_t changes = 0;
+    };
+    std::array<std::vector<Futile>, 2> futile;  // [0]: grid maximal, [1]: transitions minimal
+    const auto still_futile = [&](int kind, LO seed) {
+      auto& f = futile[kind];
+      if (seed >= static_cast<LO>(f.size()) || f[seed].reach < 0) return false;
+      const Vec3& p = work.points[seed];
+      for (std::size_t i = f[seed].changes; i < changes.size(); ++i)
+        if (distance(p, changes[i].centre) <= f[seed].reach + changes[i].radius) {
+          f[seed].reach = -1;
+          return false;
+        }
+      f[seed].changes = changes.size();
+      return true;
+    };
+    const auto record_change = [&](const Cavity& c, const Replacement& r) {
+      std::vector<Vec3> pts;
+      for (const LO q : c.quads)
+        for (const LO v : work.quads[q]) pts.push_back(work.points[v]);
+      for (const LO v : r.moved) pts.push_back(work.points[v]);
+      Vec3 centre{};
+      for (const auto& p : pts) centre = centre + p;
+      centre = centre * (1.0 / static_cast<double>(pts.size()));
+      double radius = 0;
+      for (const auto& p : pts) radius = std::max(radius, distance(p, centre));
+      changes.push_back({centre, radius * (1 + 1e-9) + 1e-12});
+    };
+
     // One growth from `seed` and the geometric trials of what it found; true when committed.
     const auto grow_and_remesh = [&](int step, LO seed, std::span<const Pattern> pats, bool maximal,
                                      bool from_singularity, LO* new_singular) {
+      const int kind = from_singularity || !options.skip_futile ? -1 : (maximal ? 0 : 1);
+      if (kind >= 0 && still_futile(kind, seed)) {
+        ++rep.diagnostics[step].skipped_futile;
+        return false;
+      }
       ++started;
       ++rep.grown[step];
       GrowOptions go;
@@ -666,15 +799,46 @@ mesh::FaceMesh remesh_cavities(const mesh::FaceMesh& input, const cad::FaceGeome
       go.max_candidates = options.max_candidates;
       go.max_quad_change = options.max_quad_change;
       go.match = options.match;
+      go.max_backtracks = options.max_backtracks;
+      go.max_remeshable = maximal ? 0 : std::max(1, options.max_minimal_tries);
       const GrowResult g = grow_cavity(work, topo, seed, singular, go);
+      auto& d = rep.diagnostics[step];
+      switch (g.stop) {
+        case GrowResult::Stop::Concave: ++d.stop_concave; break;
+        case GrowResult::Stop::MaxQuads: ++d.stop_max_quads; break;
+        case GrowResult::Stop::NoFrontier: ++d.stop_no_frontier; break;
+        case GrowResult::Stop::Fan: ++d.stop_fan; break;
+        case GrowResult::Stop::Found: ++d.stop_found; break;
+      }
+      d.checks += g.checks;
+      d.no_pattern += g.no_pattern;
+      d.no_match += g.no_match;
+      d.not_better += g.not_better;
       const int n = static_cast<int>(g.remeshable.size());
-      const int tries =
-          maximal ? std::min(n, std::max(1, options.max_geometric_tries)) : std::min(n, 1);
+      if (n == 0 && kind >= 0) {
+        auto& f = futile[kind];
+        if (static_cast<LO>(f.size()) < work.num_vertices()) f.resize(work.points.size());
+        f[seed] = Futile{g.reach, changes.size()};
+      }
+      const int tries = std::min(
+          n, std::max(1, maximal ? options.max_geometric_tries : options.max_minimal_tries));
       for (int k = 0; k < tries; ++k) {
-        const Cavity& c = g.remeshable[n - 1 - k];
+        // Maximal: largest first; minimal: smallest first, the larger ones spread the distortion
+        // of a refused one over more quads.
+        const Cavity& c = g.remeshable[maximal ? n - 1 - k : k];
         for (const auto& match : c.matches) {
           Replacement r;
-          if (!remesher.build(topo, c, match, pats, r)) continue;
+          Remesher::Refusal why = Remesher::Refusal::None;
+          if (!remesher.build(topo, c, match, pats, r, why)) {
+            switch (why) {
+              case Remesher::Refusal::Layout: ++d.refused_layout; break;
+              case Remesher::Refusal::Invalid: ++d.refused_invalid; break;
+              case Remesher::Refusal::MinSicn: ++d.refused_min; break;
+              default: ++d.refused_avg; break;
+            }
+            continue;
+          }
+          record_change(c, r);
           remesher.commit(c, r);
           singular.resize(work.points.size(), 0);
           topo = QuadTopology(work);

@@ -1,6 +1,6 @@
 // cavity_survey MODEL [--size-factor F] [--threads T] [--first N] [--faces] [--quad-change F]
 // [--avg-ratio R]
-//                      [--candidates N] [--rings N]
+//                      [--candidates N] [--rings N] [--backtracks N] [--minimal-tries N]
 // Paper 000 Sec. 6.2 on the unstructured quad meshes of a model's faces: the pipeline runs to the
 // quantized curves with cross fields (as `qsmesh mesh --until unstructured`), each face (the first
 // N, default all) is meshed by quad::mesh_face_unstructured and then given to
@@ -35,7 +35,7 @@ int main(int argc, char** argv) {
   const bool ok = test::parse_survey_args(
       argc, argv,
       "usage: cavity_survey MODEL [--size-factor F] [--threads T] [--first N] [--faces] "
-      "[--quad-change F] [--avg-ratio R] [--candidates N] [--rings N]",
+      "[--quad-change F] [--avg-ratio R] [--candidates N] [--rings N] [--backtracks N] [--minimal-tries N]",
       args, [&](const std::string& a, int& i) {
         if (i + 1 >= argc) return false;
         if (a == "--first") {
@@ -46,6 +46,10 @@ int main(int argc, char** argv) {
           co.keep_avg_ratio = std::atof(argv[++i]);
         } else if (a == "--candidates") {
           co.max_candidates = std::atoi(argv[++i]);
+        } else if (a == "--minimal-tries") {
+          co.max_minimal_tries = std::atoi(argv[++i]);
+        } else if (a == "--backtracks") {
+          co.max_backtracks = std::atoi(argv[++i]);
         } else if (a == "--rings") {
           co.smooth_rings = std::atoi(argv[++i]);
         } else {
@@ -77,6 +81,7 @@ int main(int argc, char** argv) {
                  flagged = 0, kept = 0;
     double min0 = 1, min1 = 1, sum0 = 0, sum1 = 0, seconds = 0;
     std::array<std::int64_t, 4> grown{}, remeshed{}, rejected{};
+    std::array<qstruct::CavityStepDiagnostics, 4> diag{};
     const LO nf = std::min(first, model.num_faces());
     for (LO f = 0; f < nf; ++f) {
       quad::UnstructuredReport ur;
@@ -136,6 +141,22 @@ int main(int argc, char** argv) {
         grown[k] += rep.grown[k];
         remeshed[k] += rep.remeshed[k];
         rejected[k] += rep.rejected_quality[k];
+        const auto& a = rep.diagnostics[k];
+        auto& b = diag[k];
+        b.stop_concave += a.stop_concave;
+        b.stop_max_quads += a.stop_max_quads;
+        b.stop_no_frontier += a.stop_no_frontier;
+        b.stop_fan += a.stop_fan;
+        b.stop_found += a.stop_found;
+        b.checks += a.checks;
+        b.no_pattern += a.no_pattern;
+        b.no_match += a.no_match;
+        b.not_better += a.not_better;
+        b.refused_layout += a.refused_layout;
+        b.refused_invalid += a.refused_invalid;
+        b.refused_min += a.refused_min;
+        b.refused_avg += a.refused_avg;
+        b.skipped_futile += a.skipped_futile;
       }
       if (per_face)
         std::cout << "face " << f << " quads " << in.quads.size() << " -> " << out.quads.size()
@@ -156,6 +177,17 @@ int main(int argc, char** argv) {
               << "  cavities grown / remeshed / refused by quality, Steps 1-4:";
     for (int k = 0; k < 4; ++k)
       std::cout << " " << grown[k] << "/" << remeshed[k] << "/" << rejected[k];
-    std::cout << "\n  remesh_cavities time " << seconds << " s\n";
+    std::cout << "\n";
+    for (int k = 0; k < 4; ++k) {
+      const auto& b = diag[k];
+      std::cout << "  step " << k + 1 << ": growth stops concave/max_quads/no_frontier/fan/found "
+                << b.stop_concave << "/" << b.stop_max_quads << "/" << b.stop_no_frontier << "/"
+                << b.stop_fan << "/" << b.stop_found << "; checks " << b.checks
+                << " (no pattern " << b.no_pattern << ", no match " << b.no_match
+                << ", not better " << b.not_better << "); refused layout/invalid/min/avg "
+                << b.refused_layout << "/" << b.refused_invalid << "/" << b.refused_min << "/"
+                << b.refused_avg << "; skipped (nothing changed) " << b.skipped_futile << "\n";
+    }
+    std::cout << "  remesh_cavities time " << seconds << " s\n";
   });
 }

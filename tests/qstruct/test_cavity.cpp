@@ -284,6 +284,127 @@ TEST(Cavity, SingularityIsNeverInside) {
             1);
 }
 
+// A flagged vertex next to a +1/-1 pair blocks the isotropic growth (it would become an
+// unabsorbable concave vertex); backtracking grows around it instead, to larger grid cavities.
+TEST(Cavity, BacktrackingGrowsAroundABlockedConcaveVertex) {
+  const Plane plane;
+  const mesh::FaceMesh m = perturbed(plane, 16, 16);
+  const QuadTopology t(m);
+  const auto valences = interior_valences(m);
+  std::vector<LO> irregular;
+  for (const auto& [v, val] : valences)
+    if (val != 4) irregular.push_back(v);
+  ASSERT_EQ(irregular.size(), 4u);
+  const std::vector<Pattern> grid_only{builtin_patterns()[0]};
+  const auto holds_all = [&](const Cavity& c) {
+    for (const LO v : irregular)
+      if (std::count(c.interior.begin(), c.interior.end(), v) == 0) return false;
+    return true;
+  };
+  int unlocked = 0, candidates = 0;
+  for (const auto& [f, val] : valences) {
+    if (val != 4 || distance(m.points[f], Vec3{4.5, 4, 0}) > 3.5) continue;
+    ++candidates;
+    std::vector<char> singular(m.num_vertices(), 0);
+    singular[f] = 1;
+    // Largest remeshable cavity met holding the four irregular vertices, without and with.
+    std::size_t before = 0, after = 0;
+    for (const int backtracks : {0, 8}) {
+      GrowOptions go;
+      go.maximal = true;
+      go.patterns = grid_only;
+      go.max_backtracks = backtracks;
+      for (const LO seed : irregular) {
+        const GrowResult g = grow_cavity(m, t, seed, singular, go);
+        for (const auto& c : g.remeshable) {
+          EXPECT_EQ(std::count(c.interior.begin(), c.interior.end(), f), 0);
+          EXPECT_LT(c.irregularity_after, c.irregularity_before);
+          for (std::size_t i = 0; i < c.boundary.size(); ++i)
+            if (!t.on_boundary(c.boundary[i])) {
+              EXPECT_NE(t.valence(c.boundary[i]) - c.n_in[i], 1);
+            }
+          // The cavity is a disk of distinct quads.
+          std::set<LO> distinct(c.quads.begin(), c.quads.end());
+          EXPECT_EQ(distinct.size(), c.quads.size());
+          if (holds_all(c)) {
+            std::size_t& best = backtracks == 0 ? before : after;
+            best = std::max(best, c.quads.size());
+          }
+        }
+      }
+    }
+    // The growths agree up to the first blocked concave vertex, where the plain one stops.
+    EXPECT_GE(after, before);
+    unlocked += after > before ? 1 : 0;
+  }
+  EXPECT_GT(candidates, 10);
+  EXPECT_GE(unlocked, 1);
+}
+
+// Minimal growth asked for several remeshable cavities: the first is the minimal one, the next
+// ones are larger.
+TEST(Cavity, MinimalGrowthFallbacks) {
+  const Plane plane;
+  const mesh::FaceMesh m = perturbed(plane, 16, 16);
+  const QuadTopology t(m);
+  std::vector<char> none(m.num_vertices(), 0);
+  std::vector<Pattern> four;
+  for (const auto& p : builtin_patterns())
+    if (p.num_sides() == 4) four.push_back(p);
+  int seeds_with_fallbacks = 0;
+  for (const auto& [seed, val] : interior_valences(m)) {
+    if (val == 4) continue;
+    GrowOptions go;
+    go.patterns = four;
+    const GrowResult one = grow_cavity(m, t, seed, none, go);
+    go.max_remeshable = 3;
+    const GrowResult three = grow_cavity(m, t, seed, none, go);
+    ASSERT_FALSE(one.remeshable.empty());
+    ASSERT_LE(one.remeshable.size(), 1u);
+    ASSERT_FALSE(three.remeshable.empty());
+    EXPECT_LE(three.remeshable.size(), 3u);
+    EXPECT_EQ(three.remeshable[0].quads, one.remeshable[0].quads);
+    for (std::size_t k = 1; k < three.remeshable.size(); ++k)
+      EXPECT_GT(three.remeshable[k].quads.size(), three.remeshable[k - 1].quads.size());
+    seeds_with_fallbacks += three.remeshable.size() > 1 ? 1 : 0;
+  }
+  EXPECT_GE(seeds_with_fallbacks, 1);
+}
+
+// Growths that found nothing are not repeated while nothing changed within their reach: the
+// result is the same as with every growth repeated.
+TEST(Cavity, SkippingFutileGrowthsKeepsTheResult) {
+  const Plane plane;
+  // Two pairs far apart and one +1 singularity between them (Step 2 commits), a 3-pair cluster.
+  const mesh::FaceMesh in =
+      perturbed(plane, 24, 12, {{4, 4, 5, 4}, {18, 6, 18, 7}, {11, 8, 12, 8}, {11, 3, 11, 4}});
+  std::vector<crossfield::Singularity> sings(1);
+  sings[0].position = {11.5, 8, 0};
+  sings[0].index = 1;
+  const auto patterns = builtin_patterns();
+  CavityOptions with, without;
+  without.skip_futile = false;
+  with.max_quads_maximal = without.max_quads_maximal = 80;
+  CavityReport a, b;
+  const mesh::FaceMesh out_a = remesh_cavities(in, plane, sings, patterns, with, &a);
+  const mesh::FaceMesh out_b = remesh_cavities(in, plane, sings, patterns, without, &b);
+  ASSERT_TRUE(a.skipped.empty()) << a.skipped;
+  EXPECT_LT(a.irregular_after, a.irregular_before);
+  EXPECT_EQ(out_a.quads, out_b.quads);
+  EXPECT_EQ(out_a.points.size(), out_b.points.size());
+  for (std::size_t i = 0; i < std::min(out_a.points.size(), out_b.points.size()); ++i)
+    EXPECT_EQ(out_a.points[i], out_b.points[i]) << "vertex " << i;
+  std::int64_t skipped = 0, skipped_without = 0;
+  for (int k = 0; k < 4; ++k) {
+    skipped += a.diagnostics[k].skipped_futile;
+    skipped_without += b.diagnostics[k].skipped_futile;
+    EXPECT_EQ(a.remeshed[k], b.remeshed[k]);
+    EXPECT_LE(a.grown[k], b.grown[k]);
+  }
+  EXPECT_EQ(skipped_without, 0);
+  EXPECT_GT(skipped, 0);
+}
+
 TEST(Cavity, FlaggedSingularityIsPreserved) {
   const Plane plane;
   const mesh::FaceMesh in = perturbed(plane);
