@@ -49,7 +49,7 @@ for _ in range(5):
 f, v, d = min(runs, key=lambda r: abs(r[1] - target))
 irr = 100.0 * d["irregular_interior"] / v
 within = "" if abs(v - target) <= 0.1 * target else " (not within 10%)"
-print(f"| {model} | {f:.4g} | {v}{within} ({target}) | {d['irregular_interior']} = {irr:.2f}% ({ref[1]} = {100.0 * ref[1] / target:.2f}%) | "
+print(f"| {model} | {f:.6g} | {v}{within} ({target}) | {d['irregular_interior']} = {irr:.2f}% ({ref[1]} = {100.0 * ref[1] / target:.2f}%) | "
       f"{d['sicn_min']:.3f} / {d['sicn_avg']:.3f} ({ref[2]:.3f} / {ref[3]:.3f}) | {d.get('faces_meshed_by_pattern', '-')} / {d['faces']} | "
       f"{d['seconds']['total']:.1f} ({ref[4]}) | {d['peak_mb']:.0f} ({ref[5]}) |")
 PY
