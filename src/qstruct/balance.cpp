@@ -95,26 +95,16 @@ std::vector<int> balance_curve_counts(const cad::CadModel& model,
     FaceSidesOfUses t;
     t.face = f;
     t.num_sides = m;
-    LO pos = 0;
-    for (const auto& use : uses) {
-      // Corners sit at use starts, so a use lies in one side: the last corner at or before it.
-      int side = m - 1;
-      for (int k = 0; k < m; ++k)
-        if (fs.corners[k] <= pos) side = k;
-      t.uses.emplace_back(use.curve, side);
-      pos += curves[use.curve].num_edges();
-    }
+    for (std::size_t u = 0; u < uses.size(); ++u)
+      t.uses.emplace_back(uses[u].curve, side_of(fs, fs.use_start[u]));
     targets.push_back(std::move(t));
   }
   rep.faces_considered = static_cast<LO>(targets.size());
   std::vector<std::vector<LO>> curve2targets(static_cast<std::size_t>(nc));
   for (LO i = 0; i < static_cast<LO>(targets.size()); ++i)
     for (const auto& [c, s] : targets[i].uses)
+      // Faces come in increasing i: a repeat is always the last entry (a seam used twice).
       if (curve2targets[c].empty() || curve2targets[c].back() != i) curve2targets[c].push_back(i);
-  for (auto& t : curve2targets) {
-    std::sort(t.begin(), t.end());
-    t.erase(std::unique(t.begin(), t.end()), t.end());
-  }
 
   const auto fits = [&](const std::vector<LO>& n) { return !match_patterns(patterns, n, options.faces.match).empty(); };
   std::vector<char> fit(targets.size());

@@ -246,11 +246,18 @@ FaceSides face_sides(const cad::CadModel& model, LO f, const cad::FaceGeometry& 
     const Vec3 a = normalized(project_tangent(t_in, normal)), b = normalized(project_tangent(t_out, normal));
     const double turn = std::atan2(dot(cross(a, b), normal), dot(a, b)) * kDeg;
     fs.angle_deg[pos] = 180.0 - turn;
+    fs.use_start.push_back(pos);
     if (fs.angle_deg[pos] < options.corner_angle_deg) fs.corners.push_back(pos);
     pos += curves[use.curve].num_edges();
   }
   set_side_edges(fs);
   return fs;
+}
+
+int side_of(const FaceSides& fs, LO pos) {
+  const auto after = std::upper_bound(fs.corners.begin(), fs.corners.end(), pos);
+  return after == fs.corners.begin() ? static_cast<int>(fs.corners.size()) - 1
+                                     : static_cast<int>(after - fs.corners.begin()) - 1;
 }
 
 mesh::FaceMesh mesh_face_pattern(const cad::CadModel& model, LO f, std::span<const mesh::CurveMesh> full_curves,

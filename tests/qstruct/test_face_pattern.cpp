@@ -307,20 +307,13 @@ TEST(Balance, SidesOfSeveralCurvesAreMadeToFit) {
   }
   q.curve2chord.assign(5, kNoIndex);
   const auto patterns = builtin_patterns();
+  const auto fs = face_sides(pc.model, 0, *pc.model.face_geometry(0), pc.curves, PatternFaceOptions{});
+  ASSERT_EQ(fs.corners.size(), 4u);  // the 180-degree vertex at (3, 0) is no corner
+  const auto& uses = pc.model.faces()[0].loops[0].uses;
+  ASSERT_EQ(fs.use_start.size(), uses.size());
   const auto sides = [&](const std::vector<int>& e) {
-    // The loop order of the face is not known here: sum the two bottom curves by position.
-    std::vector<LO> n;
-    const auto fs = face_sides(pc.model, 0, *pc.model.face_geometry(0), pc.curves, PatternFaceOptions{});
-    EXPECT_EQ(fs.corners.size(), 4u);  // the 180-degree vertex at (3, 0) is no corner
-    LO pos = 0;
-    n.assign(fs.corners.size(), 0);
-    for (const auto& use : pc.model.faces()[0].loops[0].uses) {
-      int side = static_cast<int>(fs.corners.size()) - 1;
-      for (std::size_t k = 0; k < fs.corners.size(); ++k)
-        if (fs.corners[k] <= pos) side = static_cast<int>(k);
-      n[side] += e[use.curve];
-      pos += pc.curves[use.curve].num_edges();
-    }
+    std::vector<LO> n(fs.corners.size(), 0);
+    for (std::size_t u = 0; u < uses.size(); ++u) n[side_of(fs, fs.use_start[u])] += e[uses[u].curve];
     return n;
   };
   const std::vector<LO> before = sides(q.edges);

@@ -85,6 +85,9 @@ struct FaceSides {
   std::vector<double> angle_deg;
   std::vector<LO> corners;  ///< positions in `points` of the convex corners, increasing
   std::vector<LO> side_edges;  ///< side k runs from corners[k] to corners[k + 1] (cyclic)
+  /// Position in `points` where each use of the face's loop starts (loop order). Corners sit at
+  /// use starts, so a use lies in one side: side_of(fs, use_start[u]).
+  std::vector<LO> use_start;
   double uv_area = 0;       ///< signed area of the loop in the parameter plane (> 0: CCW)
 };
 
@@ -95,6 +98,11 @@ struct FaceSides {
                                    const cad::FaceGeometry& surface,
                                    std::span<const mesh::CurveMesh> curves,
                                    const PatternFaceOptions& options);
+
+/// The side (index into fs.side_edges) that the boundary point at position `pos` starts: the last
+/// corner at or before it, the last side before the first corner. Precondition: fs.corners not
+/// empty, 0 <= pos < fs.points.size().
+[[nodiscard]] int side_of(const FaceSides& fs, LO pos);
 
 /// Paper 000 Sec. 6.1.2 on face f.
 ///  - Input: the model, the final curve meshes of all curves (`full_curves`, by curve id, as
