@@ -10,6 +10,7 @@
 #include <BRepTools.hxx>
 #include <IFSelect_ReturnStatus.hxx>
 #include <STEPControl_Writer.hxx>
+
 #include <TopExp_Explorer.hxx>
 #include <TopoDS.hxx>
 #include <gp_Ax2.hxx>
@@ -63,6 +64,21 @@ std::string write_filleted_box(const std::string& path) {
       w.Write(path.c_str()) != IFSelect_RetDone)
     throw std::runtime_error("cannot write " + path);
   return path;
+}
+
+mesh::CurveMesh uniform_curve_mesh(const cad::CadModel& model, LO c, LO n) {
+  const auto& curve = model.curves()[c];
+  const auto geometry = model.curve_geometry(c);
+  mesh::CurveMesh cm;
+  cm.curve = c;
+  for (LO i = 0; i <= n; ++i) {
+    const double t = curve.t0 + (curve.t1 - curve.t0) * i / n;
+    cm.t.push_back(t);
+    cm.points.push_back(geometry->point(t));
+  }
+  cm.points.front() = model.corners()[curve.corners[0]].point;
+  cm.points.back() = model.corners()[curve.corners[1]].point;
+  return cm;
 }
 
 }  // namespace qsmesh::test

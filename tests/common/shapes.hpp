@@ -5,7 +5,14 @@
 #include <utility>
 #include <vector>
 
+#include "qsmesh/cad/model.hpp"
+#include "qsmesh/mesh/surface_mesh.hpp"
+
 namespace qsmesh::test {
+
+/// Curve mesh of curve c of `model` with n >= 1 edges at equal parameter steps, its end points
+/// exactly the curve's corners.
+mesh::CurveMesh uniform_curve_mesh(const cad::CadModel& model, LO c, LO n);
 
 /// Writes a 10 x 6 x 4 box with a cylindrical hole (radius 1.5) through it, as BREP; returns path.
 std::string write_box_with_hole(const std::string& path);

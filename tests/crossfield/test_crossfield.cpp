@@ -19,6 +19,7 @@
 #include "qsmesh/background/face_mesh.hpp"
 #include "qsmesh/crossfield/cross_field.hpp"
 #include "shapes.hpp"
+#include "load_shape.hpp"
 #include "tmp_dir.hpp"
 
 namespace qsmesh::crossfield {
@@ -27,12 +28,6 @@ namespace {
 constexpr double kPi = std::numbers::pi;
 
 std::string tmp(const std::string& name) { return qsmesh::test::tmp_dir() + "/" + name; }
-
-cad::CadModel load_shape(const TopoDS_Shape& s, const std::string& name) {
-  const std::string path = tmp(name);
-  if (!BRepTools::Write(s, path.c_str())) throw std::runtime_error("cannot write " + path);
-  return cad::load_cad(path);
-}
 
 TopoDS_Wire circle_wire(double r) {
   const gp_Circ c(gp_Ax2(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), r);
@@ -91,7 +86,7 @@ double cross_deviation_deg(const std::array<Vec3, 2>& d, const Vec3& a, const Ve
 
 TEST(CrossField, UnitSquareIsAlignedWithItsSides) {
   const TopoDS_Face face = BRepBuilderAPI_MakeFace(gp_Pln(gp::XOY()), 0.0, 1.0, 0.0, 1.0).Face();
-  const auto model = load_shape(face, "cf_square.brep");
+  const auto model = test::load_shape(face, "cf_square.brep");
   const auto r = run(model, 0, 0.03, "square");
   const auto& cf = r.cf;
   EXPECT_GT(cf.triangles.size(), 1000u);
@@ -113,7 +108,7 @@ TEST(CrossField, UnitSquareIsAlignedWithItsSides) {
 
 TEST(CrossField, DiskHasFourSymmetricSingularities) {
   const TopoDS_Face face = BRepBuilderAPI_MakeFace(circle_wire(1.0)).Face();
-  const auto model = load_shape(face, "cf_disk.brep");
+  const auto model = test::load_shape(face, "cf_disk.brep");
   const auto r = run(model, 0, 0.05, "disk");
   const auto& cf = r.cf;
   expect_stats(cf);
@@ -142,7 +137,7 @@ TEST(CrossField, DiskHasFourSymmetricSingularities) {
 TEST(CrossField, AnnulusIsRegularAndScalesLikeR) {
   BRepBuilderAPI_MakeFace mk(circle_wire(2.0));
   mk.Add(TopoDS::Wire(circle_wire(1.0).Reversed()));
-  const auto model = load_shape(mk.Face(), "cf_annulus.brep");
+  const auto model = test::load_shape(mk.Face(), "cf_annulus.brep");
   const auto r = run(model, 0, 0.09, "annulus");
   const auto& cf = r.cf;
   expect_stats(cf);
@@ -184,7 +179,7 @@ TEST(CrossField, LShapeWithReflexCorner) {
                         gp_Pnt(1, 2, 0), gp_Pnt(0, 2, 0)})
     poly.Add(p);
   poly.Close();
-  const auto model = load_shape(BRepBuilderAPI_MakeFace(poly.Wire()).Face(), "cf_lshape.brep");
+  const auto model = test::load_shape(BRepBuilderAPI_MakeFace(poly.Wire()).Face(), "cf_lshape.brep");
   const auto r = run(model, 0, 0.06, "L-shape");
   const auto& cf = r.cf;
   expect_stats(cf);
@@ -226,7 +221,7 @@ TEST(CrossField, CylinderSeamIsNotABoundary) {
 
 TEST(CrossField, HemisphereHasFourSingularitiesAwayFromThePole) {
   const auto model =
-      load_shape(BRepPrimAPI_MakeSphere(3.0, 0.0, kPi / 2).Shape(), "cf_hemisphere.brep");
+      test::load_shape(BRepPrimAPI_MakeSphere(3.0, 0.0, kPi / 2).Shape(), "cf_hemisphere.brep");
   const LO f = face_of_type(model, cad::SurfaceType::Sphere);
   const auto r = run(model, f, 0.35, "hemisphere");
   const auto& cf = r.cf;
@@ -261,7 +256,7 @@ TEST(CrossField, AcuteCornerGetsAnArtificialSingularity) {
   // Right triangle with angles 90, 60 and 30 degrees.
   BRepBuilderAPI_MakePolygon poly(gp_Pnt(0, 0, 0), gp_Pnt(2, 0, 0),
                                   gp_Pnt(2, 2 * std::tan(kPi / 6), 0), true);
-  const auto model = load_shape(BRepBuilderAPI_MakeFace(poly.Wire()).Face(), "cf_triangle.brep");
+  const auto model = test::load_shape(BRepBuilderAPI_MakeFace(poly.Wire()).Face(), "cf_triangle.brep");
   const auto r = run(model, 0, 0.04, "triangle");
   const auto& cf = r.cf;
   expect_stats(cf);
@@ -279,7 +274,7 @@ TEST(CrossField, AcuteCornerGetsAnArtificialSingularity) {
 
 TEST(CrossField, BoundaryExtensionPushesSingularitiesInwards) {
   const TopoDS_Face face = BRepBuilderAPI_MakeFace(circle_wire(1.0)).Face();
-  const auto model = load_shape(face, "cf_disk3.brep");
+  const auto model = test::load_shape(face, "cf_disk3.brep");
   CrossFieldOptions plain;
   plain.extend_boundary = false;
   const auto with = run(model, 0, 0.05, "disk-ext");
@@ -300,7 +295,7 @@ TEST(CrossField, BoundaryExtensionPushesSingularitiesInwards) {
 
 TEST(CrossField, Deterministic) {
   const TopoDS_Face face = BRepBuilderAPI_MakeFace(circle_wire(1.0)).Face();
-  const auto model = load_shape(face, "cf_disk2.brep");
+  const auto model = test::load_shape(face, "cf_disk2.brep");
   const auto a = run(model, 0, 0.08, "disk-a");
   const auto b = run(model, 0, 0.08, "disk-b");
   ASSERT_EQ(a.cf.u.size(), b.cf.u.size());
@@ -316,7 +311,7 @@ TEST(CrossField, Deterministic) {
 
 TEST(CrossField, ScalingConstantGivesTheQuadCount) {
   const TopoDS_Face face = BRepBuilderAPI_MakeFace(gp_Pln(gp::XOY()), 0.0, 2.0, 0.0, 1.0).Face();
-  const auto model = load_shape(face, "cf_rect.brep");
+  const auto model = test::load_shape(face, "cf_rect.brep");
   const auto r = run(model, 0, 0.1, "rectangle");
   // Constant H = 0 on a plane with aligned crosses: h = e^C, and area / h^2 = N.
   const double C = scaling_constant(r.cf, 200);

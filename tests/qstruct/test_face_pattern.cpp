@@ -23,22 +23,6 @@ using XY = std::vector<std::pair<double, double>>;
 
 std::string tmp(const std::string& name) { return qsmesh::test::tmp_dir() + "/" + name; }
 
-// Evenly spaced curve mesh with n edges, its ends exactly the corner points.
-mesh::CurveMesh uniform_curve(const cad::CadModel& model, LO c, LO n) {
-  const auto& curve = model.curves()[c];
-  const auto geo = model.curve_geometry(c);
-  mesh::CurveMesh cm;
-  cm.curve = c;
-  for (LO i = 0; i <= n; ++i) {
-    const double t = curve.t0 + (curve.t1 - curve.t0) * i / n;
-    cm.t.push_back(t);
-    cm.points.push_back(geo->point(t));
-  }
-  cm.points.front() = model.corners()[curve.corners[0]].point;
-  cm.points.back() = model.corners()[curve.corners[1]].point;
-  return cm;
-}
-
 // Curve meshes of a polygon face: counts[k] edges on the polygon edge from xy[k] to xy[k + 1].
 std::vector<mesh::CurveMesh> polygon_curves(const cad::CadModel& model, const XY& xy, const std::vector<LO>& counts) {
   std::vector<mesh::CurveMesh> out;
@@ -55,7 +39,7 @@ std::vector<mesh::CurveMesh> polygon_curves(const cad::CadModel& model, const XY
       if ((near(a, p) && near(b, q)) || (near(a, q) && near(b, p))) n = counts[k];
     }
     if (n == 0) throw std::runtime_error("curve not on the polygon");
-    out.push_back(uniform_curve(model, c, n));
+    out.push_back(test::uniform_curve_mesh(model, c, n));
   }
   return out;
 }
@@ -235,7 +219,7 @@ TEST(FacePattern, CylinderSideIsAFourSidedDiskAcrossItsSeam) {
   ASSERT_NE(side, kNoIndex);
   std::vector<mesh::CurveMesh> curves;
   for (LO c = 0; c < model.num_curves(); ++c)
-    curves.push_back(uniform_curve(model, c, model.curves()[c].type == cad::CurveType::Circle ? 12 : 5));
+    curves.push_back(test::uniform_curve_mesh(model, c, model.curves()[c].type == cad::CurveType::Circle ? 12 : 5));
   const auto patterns = builtin_patterns();
   PatternFaceReport rep;
   const auto m = mesh_face_pattern(model, side, curves, patterns, {}, &rep);
@@ -258,7 +242,7 @@ TEST(FacePattern, PolesAndHolesAreRefused) {
     const auto model = cad::load_cad(test::write_sphere(tmp("qs_sphere.brep")));
     std::vector<mesh::CurveMesh> curves;
     for (LO c = 0; c < model.num_curves(); ++c)
-      curves.push_back(uniform_curve(model, c, model.curves()[c].degenerate ? 1 : 8));
+      curves.push_back(test::uniform_curve_mesh(model, c, model.curves()[c].degenerate ? 1 : 8));
     PatternFaceReport rep;
     const auto m = mesh_face_pattern(model, 0, curves, patterns, {}, &rep);
     EXPECT_FALSE(rep.ok);
@@ -268,7 +252,7 @@ TEST(FacePattern, PolesAndHolesAreRefused) {
   {
     const auto model = cad::load_cad(test::write_box_with_hole(tmp("qs_holed.brep")));
     std::vector<mesh::CurveMesh> curves;
-    for (LO c = 0; c < model.num_curves(); ++c) curves.push_back(uniform_curve(model, c, 4));
+    for (LO c = 0; c < model.num_curves(); ++c) curves.push_back(test::uniform_curve_mesh(model, c, 4));
     int holes = 0, meshed = 0;
     // Quality bounds that accept the stretched 4 x 4 grids of the box's long sides: this test is
     // about the refusal of holes, not about the quality policy.

@@ -28,18 +28,12 @@
 #include "qsmesh/quad/unstructured.hpp"
 #include "qsmesh/quantize/quantize.hpp"
 #include "quantized_curves.hpp"
+#include "load_shape.hpp"
 #include "tmp_dir.hpp"
 
 namespace qsmesh::quad {
 namespace {
 
-std::string tmp(const std::string& name) { return qsmesh::test::tmp_dir() + "/" + name; }
-
-cad::CadModel load_shape(const TopoDS_Shape& shape, const std::string& name) {
-  const std::string path = tmp(name);
-  if (!BRepTools::Write(shape, path.c_str())) throw std::runtime_error("cannot write " + path);
-  return cad::load_cad(path);
-}
 
 cad::CadModel rectangle(double w, double h) {
   BRepBuilderAPI_MakePolygon poly;
@@ -48,13 +42,13 @@ cad::CadModel rectangle(double w, double h) {
   poly.Close();
   BRepBuilderAPI_MakeFace face(poly.Wire(), /*OnlyPlane=*/true);
   if (!face.IsDone()) throw std::runtime_error("face construction failed");
-  return load_shape(face.Shape(), "fr_rect.brep");
+  return test::load_shape(face.Shape(), "fr_rect.brep");
 }
 
 cad::CadModel disk(double r) {
   const gp_Circ c(gp_Ax2(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), r);
   const TopoDS_Wire w = BRepBuilderAPI_MakeWire(BRepBuilderAPI_MakeEdge(c).Edge()).Wire();
-  return load_shape(BRepBuilderAPI_MakeFace(w).Face(), "fr_disk.brep");
+  return test::load_shape(BRepBuilderAPI_MakeFace(w).Face(), "fr_disk.brep");
 }
 
 // What the pipeline hands the quad stage for face 0 with a uniform size map `size`: the curve

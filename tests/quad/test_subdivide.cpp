@@ -29,18 +29,13 @@
 #include "qsmesh/smooth/untangle.hpp"
 #include "quantized_curves.hpp"
 #include "shapes.hpp"
+#include "load_shape.hpp"
 #include "tmp_dir.hpp"
 
 namespace qsmesh::quad {
 namespace {
 
 std::string tmp(const std::string& name) { return qsmesh::test::tmp_dir() + "/" + name; }
-
-cad::CadModel load_shape(const TopoDS_Shape& shape, const std::string& name) {
-  const std::string path = tmp(name);
-  if (!BRepTools::Write(shape, path.c_str())) throw std::runtime_error("cannot write " + path);
-  return cad::load_cad(path);
-}
 
 cad::CadModel plate() {
   BRepBuilderAPI_MakePolygon poly;
@@ -50,7 +45,7 @@ cad::CadModel plate() {
   poly.Close();
   BRepBuilderAPI_MakeFace face(poly.Wire(), /*OnlyPlane=*/true);
   if (!face.IsDone()) throw std::runtime_error("face construction failed");
-  return load_shape(face.Shape(), "sd_plate.brep");
+  return test::load_shape(face.Shape(), "sd_plate.brep");
 }
 
 // Curve meshes of the final size `size` (full) and of twice that size (halved), and the face
@@ -248,7 +243,7 @@ void expect_model_all_quad(const cad::CadModel& model, double size, const char* 
 }
 
 TEST(Subdivide, BoxFacesAgreeOnSharedCurves) {
-  const auto model = load_shape(BRepPrimAPI_MakeBox(10.0, 6.0, 4.0).Shape(), "sd_box.brep");
+  const auto model = test::load_shape(BRepPrimAPI_MakeBox(10.0, 6.0, 4.0).Shape(), "sd_box.brep");
   expect_model_all_quad(model, 0.6, "box");
 }
 
@@ -300,7 +295,7 @@ TEST(Subdivide, SphereWithTwoPolesGivesValidQuads) {
 }
 
 TEST(Subdivide, ConeApexGivesValidQuads) {
-  const auto model = load_shape(BRepPrimAPI_MakeCone(2.0, 0.0, 3.0).Shape(), "sd_cone.brep");
+  const auto model = test::load_shape(BRepPrimAPI_MakeCone(2.0, 0.0, 3.0).Shape(), "sd_cone.brep");
   expect_pole_faces_valid(model, 0.4, "cone");
 }
 

@@ -60,22 +60,6 @@ std::vector<int> edges_by_use(const cad::CadModel& model, const Quantization& q)
   return out;
 }
 
-// Background mesh of curve c: m + 1 vertices at equal parameter steps.
-mesh::CurveMesh uniform_background(const cad::CadModel& model, LO c, int m) {
-  const auto& curve = model.curves()[c];
-  const auto geometry = model.curve_geometry(c);
-  mesh::CurveMesh bg;
-  bg.curve = c;
-  for (int i = 0; i <= m; ++i) {
-    const double t = curve.t0 + (curve.t1 - curve.t0) * i / m;
-    bg.t.push_back(t);
-    bg.points.push_back(geometry->point(t));
-  }
-  bg.points.front() = model.corners()[curve.corners[0]].point;
-  bg.points.back() = model.corners()[curve.corners[1]].point;
-  return bg;
-}
-
 // Arc length along a polyline, at each vertex.
 std::vector<double> arc_length(const std::vector<Vec3>& p) {
   std::vector<double> x(p.size(), 0.0);
@@ -334,7 +318,7 @@ TEST(Quantize, ClosedAndDegenerateCurves) {
 TEST(IdealEdgeCounts, StraightLine) {
   const auto& model = rectangle();
   std::vector<mesh::CurveMesh> bg;
-  for (LO c = 0; c < model.num_curves(); ++c) bg.push_back(uniform_background(model, c, 17));
+  for (LO c = 0; c < model.num_curves(); ++c) bg.push_back(test::uniform_curve_mesh(model, c, 17));
   // Constant size: L / s.
   std::vector<std::vector<double>> sizes;
   for (const auto& m : bg) sizes.emplace_back(m.points.size(), 0.37);
@@ -363,7 +347,7 @@ TEST(PlaceVertices, Eq11SpacingFollowsTheSize) {
   std::vector<std::vector<double>> sizes;
   const auto s_at = [](double x) { return 0.2 + 0.08 * x; };
   for (LO c = 0; c < model.num_curves(); ++c) {
-    bg.push_back(uniform_background(model, c, 40));
+    bg.push_back(test::uniform_curve_mesh(model, c, 40));
     std::vector<double> s;
     for (const double x : arc_length(bg.back().points)) s.push_back(s_at(x));
     sizes.push_back(s);
