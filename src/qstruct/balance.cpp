@@ -14,7 +14,6 @@ namespace {
 
 // One target face: the curve of each loop use and the side it belongs to.
 struct FaceSidesOfUses {
-  LO face = kNoIndex;
   int num_sides = 0;
   std::vector<std::pair<LO, int>> uses;  // (curve, side)
 };
@@ -93,7 +92,6 @@ std::vector<int> balance_curve_counts(const cad::CadModel& model,
     const int m = static_cast<int>(fs.corners.size());
     if (m < 2 || m > 6) continue;
     FaceSidesOfUses t;
-    t.face = f;
     t.num_sides = m;
     for (std::size_t u = 0; u < uses.size(); ++u)
       t.uses.emplace_back(uses[u].curve, side_of(fs, fs.use_start[u]));
@@ -153,7 +151,6 @@ std::vector<int> balance_curve_counts(const cad::CadModel& model,
     return e;
   };
 
-  std::vector<char> changed(static_cast<std::size_t>(nc), 0);
   for (int pass = 0; pass < options.max_passes; ++pass) {
     ++rep.passes;
     bool any = false;
@@ -206,17 +203,14 @@ std::vector<int> balance_curve_counts(const cad::CadModel& model,
         }
       }
       if (best_var == kNoIndex) continue;
-      for (const LO c : members(best_var)) {
-        edges[c] += best_delta;
-        changed[c] = 1;
-      }
+      for (const LO c : members(best_var)) edges[c] += best_delta;
       for (const auto& [tt, f] : best.fit_after) fit[tt] = f;
       any = true;
     }
     if (!any) break;
   }
   rep.fitting_after = static_cast<LO>(std::count(fit.begin(), fit.end(), 1));
-  for (LO c = 0; c < nc; ++c) rep.curves_changed += (changed[c] && edges[c] != q.edges[c]) ? 1 : 0;
+  for (LO c = 0; c < nc; ++c) rep.curves_changed += edges[c] != q.edges[c] ? 1 : 0;
   if (report != nullptr) *report = rep;
   return edges;
 }
