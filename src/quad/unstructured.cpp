@@ -49,6 +49,18 @@ mesh::FaceMesh quads_from(const mesh::FaceMesh& tri,
   return out.quads.empty() || min_sicn(alt) > min_sicn(out) ? alt : out;
 }
 
+// An edge of the triangulation longer than `ratio` times the spacing at its midpoint (3D).
+bool has_long_edge(const mesh::FaceMesh& tri, const mesh::SizeFunction& size, double ratio) {
+  for (const auto& t : tri.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const LO a = t[k], b = t[(k + 1) % 3];
+      const Vec3 mid = 0.5 * (tri.points[a] + tri.points[b]);
+      if (distance(tri.points[a], tri.points[b]) > ratio * size(0.5 * (tri.uv[a] + tri.uv[b]), mid))
+        return true;
+    }
+  return false;
+}
+
 // Sec. 5.1-5.2: frontal points, their triangulation, recombination along the cross, subdivision.
 // Returns an empty mesh when neither the recombined nor the plain subdivided triangles are valid.
 mesh::FaceMesh frontal_quads(const cad::CadModel& model, LO f, const cad::FaceGeometry& surface,
@@ -67,6 +79,16 @@ mesh::FaceMesh frontal_quads(const cad::CadModel& model, LO f, const cad::FaceGe
   to.interior_points = points;
   to.refine = false;
   mesh::FaceMesh tri = mesh::triangulate_face(surface, model.faces()[f].reversed, loops, size, to);
+  // Where the fronts left a hole (seen on a surface of revolution whose parametrisation is
+  // stretched 40 times along its axis), the kernel spans it with long thin triangles, which
+  // recombine and subdivide into folded quads. The kernel's own size refinement fills it; not used
+  // everywhere because it also adds points between well-placed frontal ones (Block.stp: 6% more
+  // vertices and more irregular ones).
+  if (options.refill_edge_ratio > 0 && has_long_edge(tri, size, options.refill_edge_ratio)) {
+    to.refine = true;
+    tri = mesh::triangulate_face(surface, model.faces()[f].reversed, loops, size, to);
+    rep.refilled = true;
+  }
   tri.face = f;
   for (auto& vc : tri.vclass)
     if (vc.dim == 2) vc.entity = f;
