@@ -897,7 +897,8 @@ mesh::FaceMesh remesh_cavities(const mesh::FaceMesh& input, const cad::FaceGeome
       const auto& on = options.steps;
       bool changed = on[0] && unnecessary_step(0, grid, true);
       if (!stop && on[1]) changed = singular_step() || changed;
-      if (!stop && on[2]) changed = unnecessary_step(2, grid, true) || changed;
+      if (!stop && on[2])
+        changed = unnecessary_step(2, options.step3_transitions ? four : grid, true) || changed;
       if (!stop && on[3]) changed = unnecessary_step(3, four, false) || changed;
       if (!changed) break;
     }

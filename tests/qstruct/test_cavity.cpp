@@ -12,6 +12,7 @@
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/qstruct/cavity.hpp"
+#include "qsmesh/smooth/quad_tools.hpp"
 #include "analytic_surfaces.hpp"
 
 namespace qsmesh::qstruct {
@@ -586,6 +587,96 @@ TEST(Cavity, Deterministic) {
   const mesh::FaceMesh d = remesh_cavities(in, plane, {}, patterns, timed, &r4);
   EXPECT_TRUE(r4.time_budget_hit);
   EXPECT_EQ(d.quads, in.quads);
+}
+
+// The refined pattern `name` fitting the sides `sides` (pattern side 0 along y = 0, counter-
+// clockwise on the w x h rectangle, each side uniformly spaced), its interior laid out by
+// chord_laplace_uv: face 0, corners dim 0, sides on curves 0..3, the interior after the boundary.
+mesh::FaceMesh pattern_mesh(const std::string& name, const std::vector<LO>& sides, double w,
+                            double h) {
+  const auto patterns = builtin_patterns();
+  LO pi = kNoIndex;
+  for (LO i = 0; i < static_cast<LO>(patterns.size()); ++i)
+    if (patterns[i].name == name) pi = i;
+  EXPECT_NE(pi, kNoIndex);
+  const auto matches = match_patterns(patterns, sides);
+  const auto it = std::find_if(matches.begin(), matches.end(), [&](const PatternMatch& m) {
+    return m.pattern == pi && m.start == 0 && !m.reversed;
+  });
+  EXPECT_NE(it, matches.end());
+  const RefinedPattern r = refine_pattern(patterns[pi], it->chords);
+  const LO nb = static_cast<LO>(r.boundary.size());
+  std::vector<LO> r2m(static_cast<std::size_t>(r.num_vertices), kNoIndex);
+  mesh::FaceMesh m;
+  m.face = 0;
+  const std::array<Vec2, 5> corner{Vec2{0, 0}, Vec2{w, 0}, Vec2{w, h}, Vec2{0, h}, Vec2{0, 0}};
+  for (int k = 0; k < 4; ++k) {
+    const LO a = r.side_start[k], b = k + 1 < 4 ? r.side_start[k + 1] : nb;
+    for (LO p = a; p < b; ++p) {
+      const double t = static_cast<double>(p - a) / static_cast<double>(b - a);
+      const Vec2 uv = corner[k] * (1 - t) + corner[k + 1] * t;
+      r2m[r.boundary[p]] = m.num_vertices();
+      m.uv.push_back(uv);
+      m.points.push_back({uv.u, uv.v, 0});
+      m.vclass.push_back(p == a ? mesh::VertexClass{0, k, kNoIndex, {0, 0}}
+                                : mesh::VertexClass{1, k, p, {t, 0}});
+    }
+  }
+  for (LO v = 0; v < r.num_vertices; ++v)
+    if (r2m[v] == kNoIndex) {
+      r2m[v] = m.num_vertices();
+      m.uv.push_back({0, 0});
+      m.points.push_back({0, 0, 0});
+      m.vclass.push_back(mesh::VertexClass{2, 0, kNoIndex, {0, 0}});
+    }
+  for (const auto& q : r.quads) m.quads.push_back({r2m[q[0]], r2m[q[1]], r2m[q[2]], r2m[q[3]]});
+  EXPECT_TRUE(smooth::chord_laplace_uv(m.quads, nb, m.uv));
+  for (LO v = nb; v < m.num_vertices(); ++v) {
+    m.points[v] = {m.uv[v].u, m.uv[v].v, 0};
+    m.vclass[v].param = {m.uv[v].u, m.uv[v].v};
+  }
+  return m;
+}
+
+// Step 3 with the transitions (CavityOptions::step3_transitions): a size transition (one 3-5
+// pair) with an edge rotated at its valence-5 vertex. No grid fits a cavity holding the pair, so
+// Step 3 with the grid alone (the paper's Step 1 repeated) leaves the rotated edge's irregular
+// vertices; with the transitions the whole region becomes one transition pattern again.
+TEST(Cavity, Step3TransitionsRemoveAPairNextToATransition) {
+  const Plane plane;
+  mesh::FaceMesh m = pattern_mesh("transition_1", {8, 6, 6, 8}, 8, 8);
+  ASSERT_EQ(count_irregular(m), 2);
+  const auto val = interior_valences(m);
+  LO five = kNoIndex;
+  for (const auto& [v, k] : val)
+    if (k == 5) five = v;
+  ASSERT_NE(five, kNoIndex);
+  // An interior neighbour of the valence-5 vertex whose edge with it can turn.
+  LO other = kNoIndex;
+  for (const auto& q : m.quads)
+    for (int k = 0; k < 4 && other == kNoIndex; ++k)
+      if (q[k] == five && m.vclass[q[(k + 1) % 4]].dim == 2 && val.at(q[(k + 1) % 4]) == 4)
+        other = q[(k + 1) % 4];
+  ASSERT_NE(other, kNoIndex);
+  rotate_edge(m, five, other);
+  smooth::SmoothOptions so;
+  so.iterations = 20;
+  m = smooth::smooth_face(m, plane, so);
+  ASSERT_GT(min_sicn(m), 0);
+  const std::int64_t before = count_irregular(m);
+  ASSERT_GT(before, 2);
+  const auto patterns = builtin_patterns();
+  CavityOptions only3;
+  only3.steps = {false, false, true, false};
+  only3.step3_transitions = false;
+  CavityReport grid_only, with_transitions;
+  const mesh::FaceMesh a = remesh_cavities(m, plane, {}, patterns, only3, &grid_only);
+  only3.step3_transitions = true;
+  const mesh::FaceMesh b = remesh_cavities(m, plane, {}, patterns, only3, &with_transitions);
+  EXPECT_EQ(grid_only.irregular_after, before);
+  EXPECT_EQ(with_transitions.irregular_after, 2);
+  EXPECT_GT(min_sicn(b), 0.3);
+  expect_boundary_kept(m, b);
 }
 
 TEST(Cavity, TrianglesLeaveTheMeshAlone) {
