@@ -1,6 +1,7 @@
 // cavity_survey MODEL [--size-factor F] [--threads T] [--first N] [--faces] [--quad-change F]
 // [--avg-ratio R]
 //                      [--candidates N] [--rings N] [--backtracks N] [--minimal-tries N]
+//                      [--smooth-iterations N] [--no-step3-transitions]
 // Paper 000 Sec. 6.2 on the unstructured quad meshes of a model's faces: the pipeline runs to the
 // quantized curves with cross fields (as `qsmesh mesh --until unstructured`), each face (the first
 // N, default all) is meshed by quad::mesh_face_unstructured and then given to
@@ -35,8 +36,13 @@ int main(int argc, char** argv) {
   const bool ok = test::parse_survey_args(
       argc, argv,
       "usage: cavity_survey MODEL [--size-factor F] [--threads T] [--first N] [--faces] "
-      "[--quad-change F] [--avg-ratio R] [--candidates N] [--rings N] [--backtracks N] [--minimal-tries N]",
+      "[--quad-change F] [--avg-ratio R] [--candidates N] [--rings N] [--backtracks N] [--minimal-tries N] "
+      "[--smooth-iterations N] [--no-step3-transitions]",
       args, [&](const std::string& a, int& i) {
+        if (a == "--no-step3-transitions") {
+          co.step3_transitions = false;
+          return true;
+        }
         if (i + 1 >= argc) return false;
         if (a == "--first") {
           first = std::atoi(argv[++i]);
@@ -52,6 +58,9 @@ int main(int argc, char** argv) {
           co.max_backtracks = std::atoi(argv[++i]);
         } else if (a == "--rings") {
           co.smooth_rings = std::atoi(argv[++i]);
+        } else if (a == "--smooth-iterations") {
+          co.smooth.iterations = std::atoi(argv[++i]);
+
         } else {
           return false;
         }
