@@ -1,5 +1,5 @@
 // qstruct_survey MODEL [--size-factor F] [--threads T] [--faces] [--face F] [--min-sicn A]
-// [--min-sicn-avg B]
+// [--min-sicn-avg B] [--smooth-iterations N]
 // How many faces of MODEL the pattern path (paper 000 Sec. 6.1.2) meshes on the curve meshes the
 // pipeline quantizes (size map, crossfield method, as `qsmesh sizemap`), and why the others are
 // refused. Serial (MPI_COMM_SELF); --faces prints one line per face.
@@ -26,12 +26,13 @@ int main(int argc, char** argv) {
   LO detail = kNoIndex;
   qstruct::PatternFaceOptions fo;
   const bool ok = test::parse_survey_args(
-      argc, argv, "usage: qstruct_survey MODEL [--size-factor F] [--threads T] [--faces] [--face F] [--min-sicn A] [--min-sicn-avg B]", args,
+      argc, argv, "usage: qstruct_survey MODEL [--size-factor F] [--threads T] [--faces] [--face F] [--min-sicn A] [--min-sicn-avg B] [--smooth-iterations N]", args,
       [&](const std::string& a, int& i) {
         if (i + 1 >= argc) return false;
         if (a == "--face") detail = std::atoi(argv[++i]);
         else if (a == "--min-sicn") fo.min_sicn = std::atof(argv[++i]);
         else if (a == "--min-sicn-avg") fo.min_sicn_avg = std::atof(argv[++i]);
+        else if (a == "--smooth-iterations") fo.smooth.iterations = std::atoi(argv[++i]);
         else return false;
         return true;
       });

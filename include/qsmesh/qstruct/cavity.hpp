@@ -176,10 +176,13 @@ struct CavityOptions {
   /// transitions too), not only the grid as Step 1 (the paper's Step 3 repeats Step 1). Once
   /// Steps 1-2 have removed what grids can, many of the remaining irregular pairs are transitions
   /// that only a large cavity can spread with good quads (Step 4's minimal ones are refused by
-  /// quality). Measured end to end at the reference vertex counts (2 threads), interior irregular
-  /// vertices: mambo_s34 0.92% -> 0.56%, t20 2.16% -> 1.92%, Block 2.93% -> 2.79%, A319 5.16% ->
-  /// 5.12%, wing_fuselage 6.43% -> 6.26%; SICN avg 0.002-0.004 lower; 6% (mambo) and 8% (t20)
-  /// fewer vertices (the transitions are coarser); the run takes 1.2-2x as long.
+  /// quality). These growths check a match only when new irregular vertices came in (the paper's
+  /// rule; GrowOptions::check_every_step is for the grid), and their futile seeds are kept apart
+  /// from the grid's. Measured end to end at the reference vertex counts (2 threads), interior
+  /// irregular vertices: mambo_s34 0.92% -> 0.53%, t20 2.16% -> 1.78%, Block 2.93% -> 2.75%, A319
+  /// 5.16% -> 5.16%, wing_fuselage 6.43% -> 6.19%; SICN avg within 0.008 (t20 0.947 -> 0.939);
+  /// 7% (mambo) and 10% (t20) fewer vertices (the transitions are coarser); cavity remeshing
+  /// takes 1.3-2x as long (Block 8.4 -> 16.9 s).
   bool step3_transitions = true;
   int max_rounds = 10;  ///< passes of Steps 1-4 (the loop stops earlier when nothing changes)
   std::array<bool, 4> steps{true, true, true, true};  ///< which of Steps 1-4 run (experiments)
