@@ -128,7 +128,15 @@ class Smoother {
  public:
   Smoother(mesh::FaceMesh& m, const cad::FaceGeometry& s, const Topology& t, double sign,
            const ApproxSurface* approx)
-      : m_(m), s_(s), t_(t), sign_(sign), approx_(approx) {}
+      : m_(m), s_(s), t_(t), sign_(sign), approx_(approx) {
+    invalidate_normals();
+  }
+
+  // The surface normal at each vertex is kept until the vertex moves: a move is judged by the
+  // quality of its quads before and after, each of which needs a normal, and on B-spline faces
+  // those evaluations were a quarter of the cavity remeshing (A319.brep). Call after changing
+  // uv behind the smoother's back.
+  void invalidate_normals() { normal_ok_.assign(m_.points.size(), 0); normal_.resize(m_.points.size()); }
 
   // Kernel targets go to the surface through the approximate surface when there is one, unless
   // `exact` (then by Gauss-Newton on the CAD surface from the current uv).
@@ -143,7 +151,7 @@ class Smoother {
     Vec3 sum{};
     for (int k = 0; k < 4; ++k) sum += cross(p[k] - p[(k + 3) % 4], p[(k + 1) % 4] - p[k]);
     Vec3 n{};
-    for (int k = 0; k < 4 && norm2(n) == 0; ++k) n = s_.normal(m_.uv[qd[k]]);  // skip a pole corner
+    for (int k = 0; k < 4 && norm2(n) == 0; ++k) n = vertex_normal(qd[k]);  // skip a pole corner
     if (sign_ * dot(sum, n) <= 0) return -1.0;
     return mesh::quad_sicn(p);
   }
@@ -165,7 +173,8 @@ class Smoother {
       if (!t_.free[v] || t_.ring[v].empty()) continue;
       const Vec2 uv0 = m_.uv[v];
       const Vec3 x0 = m_.points[v];
-      const Vec3 n = s_.normal(uv0) * sign_;
+      const Vec3 n0 = vertex_normal(v);
+      const Vec3 n = n0 * sign_;
       if (norm2(n) == 0) continue;
       Vec3 target;
       if (!kernel(v, x0, n, &target)) continue;
@@ -182,6 +191,7 @@ class Smoother {
       const auto before = local_quality(v);
       m_.uv[v] = uv;
       m_.points[v] = s_.eval(uv).p;
+      normal_ok_[v] = 0;
       const auto after = local_quality(v);
       // The minimum must not drop; on a tie (a folded quad stuck at -1) the sum decides, so that
       // a move cannot spoil the other quads for free.
@@ -190,6 +200,8 @@ class Smoother {
       if (!keep) {
         m_.uv[v] = uv0;
         m_.points[v] = x0;
+        normal_[v] = n0;
+        normal_ok_[v] = 1;
         continue;
       }
       moved = std::max(moved, distance(x0, m_.points[v]));
@@ -263,9 +275,19 @@ class Smoother {
     return true;
   }
 
+  const Vec3& vertex_normal(LO v) const {
+    if (!normal_ok_[v]) {
+      normal_[v] = s_.normal(m_.uv[v]);
+      normal_ok_[v] = 1;
+    }
+    return normal_[v];
+  }
+
   mesh::FaceMesh& m_;
   const cad::FaceGeometry& s_;
   const Topology& t_;
+  mutable std::vector<Vec3> normal_;
+  mutable std::vector<char> normal_ok_;
   double sign_;
   const ApproxSurface* approx_;
   bool exact_ = false;
@@ -354,11 +376,13 @@ mesh::FaceMesh smooth_face(const mesh::FaceMesh& input, const cad::FaceGeometry&
         if (kept) {
           for (LO v = 0; v < m.num_vertices(); ++v)
             if (!(m.uv[v] == uv0[v])) m.points[v] = surface.eval(m.uv[v]).p;
+          sm.invalidate_normals();
           kept = min_quality_all(sm, nq) >= q0;
         }
         if (!kept) {
           m.uv = uv0;
           m.points = p0;
+          sm.invalidate_normals();
         }
         st.method = kept ? "uv_laplacian" : "uv_laplacian(rejected)";
       }

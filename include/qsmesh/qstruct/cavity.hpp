@@ -182,7 +182,7 @@ struct CavityOptions {
   /// irregular vertices: mambo_s34 0.92% -> 0.53%, t20 2.16% -> 1.78%, Block 2.93% -> 2.75%, A319
   /// 5.16% -> 5.16%, wing_fuselage 6.43% -> 6.19%; SICN avg within 0.008 (t20 0.947 -> 0.939);
   /// 7% (mambo) and 10% (t20) fewer vertices (the transitions are coarser); cavity remeshing
-  /// takes 1.3-2x as long (Block 8.4 -> 16.9 s).
+  /// takes up to 2.4x as long (Block 8.5 -> 16.9 s, A319 3.4 -> 8.1 s; docs/benchmarks.md).
   bool step3_transitions = true;
   int max_rounds = 10;  ///< passes of Steps 1-4 (the loop stops earlier when nothing changes)
   std::array<bool, 4> steps{true, true, true, true};  ///< which of Steps 1-4 run (experiments)
