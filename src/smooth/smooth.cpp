@@ -129,14 +129,20 @@ class Smoother {
   Smoother(mesh::FaceMesh& m, const cad::FaceGeometry& s, const Topology& t, double sign,
            const ApproxSurface* approx)
       : m_(m), s_(s), t_(t), sign_(sign), approx_(approx) {
-    invalidate_normals();
+    forget_geometry();
   }
 
-  // The surface normal at each vertex is kept until the vertex moves: a move is judged by the
-  // quality of its quads before and after, each of which needs a normal, and on B-spline faces
-  // those evaluations were a quarter of the cavity remeshing (A319.brep). Call after changing
-  // uv behind the smoother's back.
-  void invalidate_normals() { normal_ok_.assign(m_.points.size(), 0); normal_.resize(m_.points.size()); }
+  // The surface normal at each vertex and the quality of each quad are kept until a vertex of
+  // theirs moves: a move is judged by the quality of its quads before and after, and recomputing
+  // both sides (with a surface normal per quad) was most of the smoothing time (A319.brep: the
+  // normals alone a quarter of the cavity remeshing). Call after moving vertices behind the
+  // smoother's back.
+  void forget_geometry() {
+    normal_ok_.assign(m_.points.size(), 0);
+    normal_.resize(m_.points.size());
+    quality_ok_.assign(m_.quads.size(), 0);
+    quality_.resize(m_.quads.size());
+  }
 
   // Kernel targets go to the surface through the approximate surface when there is one, unless
   // `exact` (then by Gauss-Newton on the CAD surface from the current uv).
@@ -145,6 +151,13 @@ class Smoother {
   // SICN of a quad, -1 when it turns against the face normal (quad_sicn alone cannot see a quad
   // flipped as a whole, its normal being the average of its own corners).
   double quality(LO q) const {
+    if (!quality_ok_[q]) {
+      quality_[q] = compute_quality(q);
+      quality_ok_[q] = 1;
+    }
+    return quality_[q];
+  }
+  double compute_quality(LO q) const {
     const auto& qd = m_.quads[q];
     const std::array<Vec3, 4> p{m_.points[qd[0]], m_.points[qd[1]], m_.points[qd[2]],
                                 m_.points[qd[3]]};
@@ -189,6 +202,11 @@ class Smoother {
         continue;
       }
       const auto before = local_quality(v);
+      saved_.clear();
+      for (LO q : t_.v2q[v]) {
+        saved_.push_back(quality_[q]);
+        quality_ok_[q] = 0;
+      }
       m_.uv[v] = uv;
       m_.points[v] = s_.eval(uv).p;
       normal_ok_[v] = 0;
@@ -202,6 +220,10 @@ class Smoother {
         m_.points[v] = x0;
         normal_[v] = n0;
         normal_ok_[v] = 1;
+        for (std::size_t i = 0; i < saved_.size(); ++i) {
+          quality_[t_.v2q[v][i]] = saved_[i];
+          quality_ok_[t_.v2q[v][i]] = 1;
+        }
         continue;
       }
       moved = std::max(moved, distance(x0, m_.points[v]));
@@ -213,7 +235,8 @@ class Smoother {
   // New position in the tangent plane at x (normal n, unit).
   bool kernel(LO v, const Vec3& x, const Vec3& n, Vec3* out) const {
     const auto& ring = t_.ring[v];
-    std::vector<Vec3> p(ring.size());
+    std::vector<Vec3>& p = ring_;
+    p.resize(ring.size());
     for (std::size_t i = 0; i < ring.size(); ++i) {
       const Vec3 d = m_.points[ring[i]] - x;
       p[i] = d - n * dot(d, n);  // relative to x, in the tangent plane
@@ -288,6 +311,10 @@ class Smoother {
   const Topology& t_;
   mutable std::vector<Vec3> normal_;
   mutable std::vector<char> normal_ok_;
+  mutable std::vector<double> quality_;
+  mutable std::vector<char> quality_ok_;
+  std::vector<double> saved_;       // qualities of the quads around the vertex being moved
+  mutable std::vector<Vec3> ring_;  // the kernel's one-ring in the tangent plane
   double sign_;
   const ApproxSurface* approx_;
   bool exact_ = false;
@@ -376,13 +403,13 @@ mesh::FaceMesh smooth_face(const mesh::FaceMesh& input, const cad::FaceGeometry&
         if (kept) {
           for (LO v = 0; v < m.num_vertices(); ++v)
             if (!(m.uv[v] == uv0[v])) m.points[v] = surface.eval(m.uv[v]).p;
-          sm.invalidate_normals();
+          sm.forget_geometry();
           kept = min_quality_all(sm, nq) >= q0;
         }
         if (!kept) {
           m.uv = uv0;
           m.points = p0;
-          sm.invalidate_normals();
+          sm.forget_geometry();
         }
         st.method = kept ? "uv_laplacian" : "uv_laplacian(rejected)";
       }
