@@ -79,15 +79,14 @@ mesh::FaceMesh frontal_quads(const cad::CadModel& model, LO f, const cad::FaceGe
   to.interior_points = points;
   to.refine = false;
   mesh::FaceMesh tri = mesh::triangulate_face(surface, model.faces()[f].reversed, loops, size, to);
-  // Where the fronts left a hole (seen on a surface of revolution whose parametrisation is
-  // stretched 40 times along its axis), the kernel spans it with long thin triangles, which
-  // recombine and subdivide into folded quads. The kernel's own size refinement fills it; not used
-  // everywhere because it also adds points between well-placed frontal ones (Block.stp: 6% more
-  // vertices and more irregular ones).
+  // Where the frontal points leave room that the kernel spans with long thin triangles (seen on a
+  // surface of revolution whose parametrisation is stretched 40 times along its axis: edges of 100
+  // across rows spaced 6), those recombine and subdivide into folded quads. The kernel's own size
+  // refinement fills such room; not used everywhere because it also adds points between
+  // well-placed frontal ones (Block.stp: 6% more vertices and more irregular ones).
   if (options.refill_edge_ratio > 0 && has_long_edge(tri, size, options.refill_edge_ratio)) {
     to.refine = true;
     tri = mesh::triangulate_face(surface, model.faces()[f].reversed, loops, size, to);
-    rep.refilled = true;
   }
   tri.face = f;
   for (auto& vc : tri.vclass)

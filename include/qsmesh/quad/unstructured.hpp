@@ -28,8 +28,8 @@ struct UnstructuredOptions {
   FrontalOptions frontal;
   bool use_frontal = true;  ///< false: always the fallback path
   /// When an edge of the frontal triangulation is longer than this times the spacing at its
-  /// midpoint (the fronts left a hole), the triangulation is redone with the frontal points and
-  /// the kernel's size refinement (0: never). wing_fuselage.step, size factor 0.083: the fuselage
+  /// midpoint (the frontal points left room the kernel spanned with thin triangles), the
+  /// triangulation is redone with the frontal points and the kernel's size refinement (0: never). wing_fuselage.step, size factor 0.083: the fuselage
   /// face got folded quads from such a hole and fell back (4 s, half of the unstructured stage).
   double refill_edge_ratio = 3.0;
   /// Recombination (Sec. 5.2): greedy, then augmenting paths pair the triangles left alone.
@@ -56,9 +56,6 @@ struct UnstructuredReport {
   /// every triangle was subdivided instead.
   bool fell_back = false;
   bool frontal = false;     ///< the mesh comes from the frontal triangulation (else the fallback path)
-  /// The frontal triangulation had a hole (UnstructuredOptions::refill_edge_ratio) and was redone
-  /// with the kernel's size refinement.
-  bool refilled = false;
   std::int64_t frontal_points = 0;  ///< interior points the frontal insertion placed
   std::string error;        ///< the error met, with stage and face id
   double sicn_min = 0;      ///< of the face's quads
