@@ -3,7 +3,8 @@
 # that gives the vertex count of the Gmsh reference run (../shared/cad/README.md), at 1 and 2
 # threads (one rank) and 1 and 2 ranks (one thread each), beside the reference's time and memory
 # (one thread). Time: wall clock of the whole command (mpiexec, loading, writing included). Prints
-# a markdown table. The size factors are those scripts/compare_reference.sh
+# a markdown table (the reference numbers are read from ../shared/cad/README.md by
+# scripts/gmsh_reference.py). The size factors are those scripts/compare_reference.sh
 # found (vertex count within 10% of the reference's; wing_fuselage cannot get there); give
 # MODEL=FACTOR arguments to use others. Peak memory: the largest resident set of one process (the
 # largest rank's under mpiexec), as GNU time reports it.
@@ -35,9 +36,10 @@ for m in "${models[@]}"; do
   done
   python3 - "$m" "$f" "${runs[@]}" <<'PY'
 import json, sys
+sys.path.insert(0, "scripts")
+import gmsh_reference
 model, f, runs = sys.argv[1], sys.argv[2], sys.argv[3:]
-ref = {"Block.stp": (163627, 183.4, 2651), "A319.brep": (26224, 119.5, 568), "wing_fuselage.step": (17616, 41.7, 196),
-       "mambo_s34.step": (102475, 88.6, 383), "cube_filet.stp": (25647, 7.5, 194), "t20_data.step": (67808, 64.3, 255)}[model]
+ref = gmsh_reference.runs()[model]
 cells, t, mem = [], [], []
 for r in runs:
     path, kb, wall = r.rsplit(":", 2)
@@ -45,7 +47,7 @@ for r in runs:
     t.append(float(wall)); mem.append(int(kb) / 1024)
     cells.append(f"{t[-1]:.1f} / {mem[-1]:.0f}")
     nv = d["vertices"]
-print(f"| {model} | {f} | {nv} ({ref[0]}) | {cells[0]} | {cells[1]} | {cells[2]} | {ref[1]} / {ref[2]} | "
-      f"{ref[1] / t[0]:.1f}x, {ref[1] / t[1]:.1f}x | {100 * mem[0] / ref[2]:.0f}% |")
+print(f"| {model} | {f} | {nv} ({ref.vertices}) | {cells[0]} | {cells[1]} | {cells[2]} | {ref.seconds} / {ref.mb} | "
+      f"{ref.seconds / t[0]:.1f}x, {ref.seconds / t[1]:.1f}x | {100 * mem[0] / ref.mb:.0f}% |")
 PY
 done

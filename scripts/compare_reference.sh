@@ -2,7 +2,8 @@
 # Runs `qsmesh mesh --until STAGE` on each shared model at a size that gives the vertex count of the
 # Gmsh reference run of ../shared/cad/README.md (within 10%: the size factor is searched, a few
 # runs per model), and prints qsmesh's numbers beside the reference's: vertices, interior irregular
-# vertices, SICN min / avg, wall time and peak memory (one thread, one rank).
+# vertices, SICN min / avg, wall time and peak memory (one thread, one rank). The reference numbers
+# are read from that README by scripts/gmsh_reference.py.
 # Usage: scripts/compare_reference.sh [STAGE] [MODEL...]   (after scripts/build.sh; default stage
 # quasi-structured, default models: all six)
 set -euo pipefail
@@ -20,12 +21,11 @@ for m in "${models[@]}"; do
   [ -f "../shared/cad/$m" ] || continue
   python3 - "$m" "$stage" "$out" <<'PY'
 import json, math, subprocess, sys
+sys.path.insert(0, "scripts")
+import gmsh_reference
 model, stage, out = sys.argv[1], sys.argv[2], sys.argv[3]
-# Reference runs (../shared/cad/README.md): vertices, interior irregular, SICN min, SICN avg, s, MB.
-ref = {"Block.stp": (163627, 1892, -0.876, 0.889, 183.4, 2651), "A319.brep": (26224, 617, -0.123, 0.857, 119.5, 568),
-       "wing_fuselage.step": (17616, 84, 0.000, 0.918, 41.7, 196), "mambo_s34.step": (102475, 517, 0.190, 0.982, 88.6, 383),
-       "cube_filet.stp": (25647, 8, 0.861, 0.992, 7.5, 194), "t20_data.step": (67808, 95, -0.004, 0.975, 64.3, 255)}[model]
-target = ref[0]
+ref = gmsh_reference.runs()[model]
+target = ref.vertices
 def run(f):
     cmd = ["/usr/bin/time", "-f", "%M", "-o", f"{out}/mem", "./build/drivers/qsmesh", "mesh", f"../shared/cad/{model}",
            "-o", f"{out}/m.vtu", "--size-factor", f"{f:.6g}", "--until", stage, "--threads", "1", "-q", "--stats", f"{out}/s.json"]
@@ -49,8 +49,8 @@ for _ in range(5):
 f, v, d = min(runs, key=lambda r: abs(r[1] - target))
 irr = 100.0 * d["irregular_interior"] / v
 within = "" if abs(v - target) <= 0.1 * target else " (not within 10%)"
-print(f"| {model} | {f:.6g} | {v}{within} ({target}) | {d['irregular_interior']} = {irr:.2f}% ({ref[1]} = {100.0 * ref[1] / target:.2f}%) | "
-      f"{d['sicn_min']:.3f} / {d['sicn_avg']:.3f} ({ref[2]:.3f} / {ref[3]:.3f}) | {d.get('faces_meshed_by_pattern', '-')} / {d['faces']} | "
-      f"{d['seconds']['total']:.1f} ({ref[4]}) | {d['peak_mb']:.0f} ({ref[5]}) |")
+print(f"| {model} | {f:.6g} | {v}{within} ({target}) | {d['irregular_interior']} = {irr:.2f}% ({ref.irregular} = {100.0 * ref.irregular / target:.2f}%) | "
+      f"{d['sicn_min']:.3f} / {d['sicn_avg']:.3f} ({ref.sicn_min:.3f} / {ref.sicn_avg:.3f}) | {d.get('faces_meshed_by_pattern', '-')} / {d['faces']} | "
+      f"{d['seconds']['total']:.1f} ({ref.seconds}) | {d['peak_mb']:.0f} ({ref.mb}) |")
 PY
 done

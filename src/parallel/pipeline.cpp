@@ -222,22 +222,6 @@ void unpack(const std::vector<char>& in, std::size_t& pos, QuasiReport& r) {
   r.time_budget_hit = get<std::uint8_t>(in, pos) != 0;
 }
 
-namespace {
-
-// Quads a mesh following the size map would have on a face: its background triangles' areas over
-// the squared mean size at their corners (an edge of length s per quad side).
-double expected_quads(const mesh::FaceMesh& m, const std::vector<double>& s) {
-  double sum = 0;
-  for (const auto& t : m.triangles) {
-    const double h = (s[t[0]] + s[t[1]] + s[t[2]]) / 3.0;
-    const double area = 0.5 * norm(cross(m.points[t[1]] - m.points[t[0]], m.points[t[2]] - m.points[t[0]]));
-    if (h > 0) sum += area / (h * h);
-  }
-  return sum;
-}
-
-}  // namespace
-
 PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
                             const PipelineOptions& options, const TaskArena& tasks, Logger& log,
                             linalg::PetscLane* lane) {
@@ -398,8 +382,8 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
       qstruct::PatternFaceReport pr;
       qstruct::PatternFaceOptions po = options.patterns;
       if (options.pattern_max_quad_ratio > 0 && !sizes.empty())
-        po.max_quads = static_cast<std::int64_t>(
-            std::ceil(options.pattern_max_quad_ratio * expected_quads(meshes[i], sizes[i].s)));
+        po.max_quads = static_cast<std::int64_t>(std::ceil(
+            options.pattern_max_quad_ratio * sizemap::expected_quads(meshes[i], sizes[i].s)));
       mesh::FaceMesh m =
           qstruct::mesh_face_pattern(model, mine[i], result.quantized_curves, patterns, po, &pr);
       if (pr.ok) {

@@ -442,10 +442,11 @@ class Remesher {
            double sign)
       : w_(work), s_(surface), o_(o), sign_(sign) {}
 
-  // Builds, lays out, smooths and measures the replacement of cavity c by `match` of `patterns`.
   // Why build() refused a replacement.
   enum class Refusal { None, Layout, Invalid, MinSicn, AvgSicn };
 
+  // Builds, lays out, smooths and measures the replacement of cavity c by `match` of `patterns`;
+  // false with `why` set when it is refused.
   bool build(const QuadTopology& t, const Cavity& c, const PatternMatch& match,
              std::span<const Pattern> patterns, Replacement& out, Refusal& why) const {
     why = Refusal::Layout;
@@ -787,9 +788,11 @@ mesh::FaceMesh remesh_cavities(const mesh::FaceMesh& input, const cad::FaceGeome
     // One growth from `seed` and the geometric trials of what it found; true when committed.
     const auto grow_and_remesh = [&](int step, LO seed, std::span<const Pattern> pats, bool maximal,
                                      bool from_singularity, LO* new_singular) {
-      const int kind = from_singularity || !options.skip_futile
-                           ? -1
-                           : (!maximal ? 1 : (pats.data() == grid.data() ? 0 : 2));
+      const bool maximal_transitions = maximal && pats.data() != grid.data();
+      const int kind = from_singularity || !options.skip_futile ? -1
+                       : !maximal                               ? 1
+                       : maximal_transitions                    ? 2
+                                                                : 0;
       if (kind >= 0 && still_futile(kind, seed)) {
         ++rep.diagnostics[step].skipped_futile;
         return false;
@@ -804,7 +807,7 @@ mesh::FaceMesh remesh_cavities(const mesh::FaceMesh& input, const cad::FaceGeome
       // Maximal growths with the transitions match as the paper does, when new irregular vertices
       // came in: matching every convex state against all four-sided patterns doubled the time of
       // Step 3 for no fewer irregular vertices (Block.stp, mambo_s34 at the reference counts).
-      if (maximal && pats.data() != grid.data()) go.check_every_step = false;
+      go.check_every_step = !maximal_transitions;
       go.max_candidates = options.max_candidates;
       go.max_quad_change = options.max_quad_change;
       go.match = options.match;

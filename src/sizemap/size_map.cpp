@@ -243,6 +243,19 @@ CurveSizes initial_curve_sizes(const cad::CadModel& model, std::span<const mesh:
   return out;
 }
 
+double expected_quads(const mesh::FaceMesh& background, std::span<const double> s) {
+  QSMESH_CHECK(s.size() == background.points.size(),
+               "sizemap: " << s.size() << " sizes for " << background.points.size() << " vertices");
+  double sum = 0;
+  for (const auto& t : background.triangles) {
+    const double h = (s[t[0]] + s[t[1]] + s[t[2]]) / 3.0;
+    const Vec3& a = background.points[t[0]];
+    const double area = 0.5 * norm(cross(background.points[t[1]] - a, background.points[t[2]] - a));
+    if (h > 0) sum += area / (h * h);
+  }
+  return sum;
+}
+
 std::vector<double> face_quad_targets(const cad::CadModel& model, const SizeMapOptions& options) {
   const LO nf = model.num_faces();
   double total = 0;

@@ -227,6 +227,17 @@ TEST(Cavity, Step1IsLocal) {
   EXPECT_EQ(missing, 0);
 }
 
+// What every remeshable cavity must be: free of the flagged vertex `flagged`, lowering the
+// irregularity, and convex (every boundary vertex inside the face has n_out != 1).
+void expect_remeshable_without(const QuadTopology& t, const Cavity& c, LO flagged) {
+  EXPECT_EQ(std::count(c.interior.begin(), c.interior.end(), flagged), 0);
+  EXPECT_LT(c.irregularity_after, c.irregularity_before);
+  for (std::size_t i = 0; i < c.boundary.size(); ++i)
+    if (!t.on_boundary(c.boundary[i])) {
+      EXPECT_NE(t.valence(c.boundary[i]) - c.n_in[i], 1);
+    }
+}
+
 TEST(Cavity, SingularityIsNeverInside) {
   const Plane plane;
   const mesh::FaceMesh m = perturbed(plane);
@@ -256,16 +267,8 @@ TEST(Cavity, SingularityIsNeverInside) {
     for (const LO seed : others) {
       const GrowResult g = grow_cavity(m, t, seed, singular, go);
       for (const auto& c : g.remeshable) {
-        EXPECT_EQ(std::count(c.interior.begin(), c.interior.end(), s), 0);
-        EXPECT_LT(c.irregularity_after, c.irregularity_before);
+        expect_remeshable_without(t, c, s);
         EXPECT_FALSE(c.matches.empty());
-        // Convex: every boundary vertex inside the face has n_out != 1.
-        for (std::size_t i = 0; i < c.boundary.size(); ++i) {
-          const LO v = c.boundary[i];
-          if (!t.on_boundary(v)) {
-            EXPECT_NE(t.valence(v) - c.n_in[i], 1);
-          }
-        }
         LO sum = 0;
         for (const LO e : c.side_edges) sum += e;
         EXPECT_EQ(sum, static_cast<LO>(c.boundary.size()));
@@ -318,12 +321,7 @@ TEST(Cavity, BacktrackingGrowsAroundABlockedConcaveVertex) {
       for (const LO seed : irregular) {
         const GrowResult g = grow_cavity(m, t, seed, singular, go);
         for (const auto& c : g.remeshable) {
-          EXPECT_EQ(std::count(c.interior.begin(), c.interior.end(), f), 0);
-          EXPECT_LT(c.irregularity_after, c.irregularity_before);
-          for (std::size_t i = 0; i < c.boundary.size(); ++i)
-            if (!t.on_boundary(c.boundary[i])) {
-              EXPECT_NE(t.valence(c.boundary[i]) - c.n_in[i], 1);
-            }
+          expect_remeshable_without(t, c, f);
           // The cavity is a disk of distinct quads.
           std::set<LO> distinct(c.quads.begin(), c.quads.end());
           EXPECT_EQ(distinct.size(), c.quads.size());

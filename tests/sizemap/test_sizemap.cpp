@@ -411,6 +411,18 @@ TEST(SizeMap, FaceQuadTargetsFollowAreas) {
   EXPECT_THROW((void)face_quad_targets(model, o), InputError);
 }
 
+TEST(SizeMap, ExpectedQuadsIsAreaOverSizeSquared) {
+  // A 2 x 1 rectangle in two triangles: 200 quads of size 0.1, 50 of size 0.2.
+  mesh::FaceMesh m;
+  m.points = {{0, 0, 0}, {2, 0, 0}, {2, 1, 0}, {0, 1, 0}};
+  m.triangles = {{0, 1, 2}, {0, 2, 3}};
+  EXPECT_NEAR(expected_quads(m, std::vector<double>(4, 0.1)), 200, 1e-9);
+  EXPECT_NEAR(expected_quads(m, std::vector<double>(4, 0.2)), 50, 1e-9);
+  // A triangle whose sizes are not positive counts for nothing.
+  EXPECT_NEAR(expected_quads(m, std::vector<double>{0.1, 0.1, 0.1, -1}), 100, 1e-9);
+  EXPECT_THROW((void)expected_quads(m, std::vector<double>(3, 0.1)), Error);
+}
+
 TEST(SizeMap, DeterministicWhateverTheThreadCount) {
   const Model m = prepare(cad::load_cad(test::write_cylinder(tmp("cylinder.brep"))), 0.8, true);
   SizeMapOptions o;

@@ -29,8 +29,9 @@ struct UnstructuredOptions {
   bool use_frontal = true;  ///< false: always the fallback path
   /// When an edge of the frontal triangulation is longer than this times the spacing at its
   /// midpoint (the frontal points left room the kernel spanned with thin triangles), the
-  /// triangulation is redone with the frontal points and the kernel's size refinement (0: never). wing_fuselage.step, size factor 0.083: the fuselage
-  /// face got folded quads from such a hole and fell back (4 s, half of the unstructured stage).
+  /// triangulation is redone with the frontal points and the kernel's size refinement (0: never).
+  /// wing_fuselage.step, size factor 0.08: the fuselage face got folded quads from such thin
+  /// triangles and fell back (4 s of the 4.3 s unstructured stage).
   double refill_edge_ratio = 3.0;
   /// Recombination (Sec. 5.2): greedy, then augmenting paths pair the triangles left alone.
   RecombineOptions recombine{.augment_depth = 30, .augment_min_sicn = 0.1};

@@ -94,6 +94,12 @@ struct CurveSizes {
 [[nodiscard]] std::vector<double> face_quad_targets(const cad::CadModel& model,
                                                     const SizeMapOptions& options);
 
+/// Quads a mesh following the size field `s` (one value per vertex of `background`, model units)
+/// would have on the face: the sum over the triangles of their 3D area over the squared mean of
+/// `s` at their corners (an edge of length s per quad side). Triangles where that mean is not
+/// positive count for nothing. Used to bound structured fills by what the size map asks for.
+[[nodiscard]] double expected_quads(const mesh::FaceMesh& background, std::span<const double> s);
+
 /// Per FaceMesh vertex (model units).
 struct FaceSizes {
   std::vector<double> s;  ///< the size map: min(s_cf, s_min) graded, capped, floored
