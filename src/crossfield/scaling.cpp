@@ -4,13 +4,45 @@
 // ∇H = (θ_y, -θ_x) = -∇⊥θ; Eq. 8 of the paper prints the opposite sign. Check: the polar grid
 // T = r e_r, S = r e_φ commutes and has θ = φ, ∇θ = e_φ / r, so ∇H = e_r / r and h = r; with
 // the printed sign h would be 1 / r, whose fields e_r / r, e_φ / r do not commute.
+#include <algorithm>
 #include <cmath>
+#include <numeric>
+#include <vector>
 
 #include "internal.hpp"
 #include "qsmesh/core/error.hpp"
 
 namespace qsmesh::crossfield {
 namespace detail {
+namespace {
+
+// Clamps H to its area-weighted quantiles q and 1 - q (vertex weight: a third of the area of its
+// triangles). Weighting by area keeps the bounds independent of how finely the background mesh is
+// graded near the very corners whose values are clamped.
+void clamp_to_quantiles(FaceCrossField& cf, const Geometry& g, double q) {
+  const LO nv = static_cast<LO>(cf.points.size());
+  std::vector<double> weight(static_cast<std::size_t>(nv), 0.0);
+  double total = 0;
+  for (LO t = 0; t < static_cast<LO>(cf.triangles.size()); ++t)
+    for (LO v : cf.triangles[t]) weight[v] += g.area[t] / 3, total += g.area[t] / 3;
+  if (!(total > 0)) return;
+  std::vector<LO> order(static_cast<std::size_t>(nv));
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(),
+            [&](LO a, LO b) { return cf.H[a] < cf.H[b] || (cf.H[a] == cf.H[b] && a < b); });
+  auto value_at = [&](double fraction) {
+    double acc = 0;
+    for (const LO v : order) {
+      acc += weight[v];
+      if (acc >= fraction * total) return cf.H[v];
+    }
+    return cf.H[order.back()];
+  };
+  const double lo = value_at(q), hi = value_at(1 - q);
+  for (double& h : cf.H) h = std::clamp(h, lo, hi);
+}
+
+}  // namespace
 
 void compute_scaling(FaceCrossField& cf, const Geometry& g, const CrossFieldOptions& options,
                      linalg::PetscLane* lane) {
@@ -60,8 +92,12 @@ void compute_scaling(FaceCrossField& cf, const Geometry& g, const CrossFieldOpti
   for (LO v = 0; v < nv; ++v) {
     cf.H[v] -= mean;
     QSMESH_CHECK(std::isfinite(cf.H[v]), "crossfield: face " << cf.face << ": non-finite scaling");
-    cf.h[v] = std::exp(cf.H[v]);
   }
+  QSMESH_CHECK(
+      options.scaling_quantile >= 0 && options.scaling_quantile < 0.5,
+      "crossfield: scaling_quantile " << options.scaling_quantile << " is not in [0, 0.5)");
+  if (options.scaling_quantile > 0) clamp_to_quantiles(cf, g, options.scaling_quantile);
+  for (LO v = 0; v < nv; ++v) cf.h[v] = std::exp(cf.H[v]);
 }
 
 }  // namespace detail

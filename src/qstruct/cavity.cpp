@@ -785,6 +785,9 @@ mesh::FaceMesh remesh_cavities(const mesh::FaceMesh& input, const cad::FaceGeome
       changes.push_back({centre, radius * (1 + 1e-9) + 1e-12});
     };
 
+    // Bound of the maximal growths, raised once the unnecessary irregular vertices are sparse.
+    LO maximal_cap = options.max_quads_maximal;
+
     // One growth from `seed` and the geometric trials of what it found; true when committed.
     const auto grow_and_remesh = [&](int step, LO seed, std::span<const Pattern> pats, bool maximal,
                                      bool from_singularity, LO* new_singular) {
@@ -803,7 +806,7 @@ mesh::FaceMesh remesh_cavities(const mesh::FaceMesh& input, const cad::FaceGeome
       go.maximal = maximal;
       go.patterns = pats;
       go.seed_is_singularity = from_singularity;
-      go.max_quads = maximal ? options.max_quads_maximal : options.max_quads_minimal;
+      go.max_quads = maximal ? maximal_cap : options.max_quads_minimal;
       // Maximal growths with the transitions match as the paper does, when new irregular vertices
       // came in: matching every convex state against all four-sided patterns doubled the time of
       // Step 3 for no fewer irregular vertices (Block.stp, mambo_s34 at the reference counts).
@@ -904,8 +907,27 @@ mesh::FaceMesh remesh_cavities(const mesh::FaceMesh& input, const cad::FaceGeome
       return changed;
     };
 
+    // Unnecessary irregular vertices (Steps 1, 3, 4 seeds) per quad at most sparse_irregular_ratio.
+    const auto sparse = [&] {
+      std::int64_t n = 0;
+      for (LO v = 0; v < work.num_vertices(); ++v)
+        if (interior_vertex(work, topo, v) && topo.valence(v) != 4 && !singular[v]) ++n;
+      return static_cast<double>(n) <=
+             options.sparse_irregular_ratio * static_cast<double>(work.quads.size());
+    };
+
     for (int round = 0; round < options.max_rounds && !stop; ++round) {
       ++rep.rounds;
+      // Where few unnecessary irregular vertices are left, the pairs are far apart and only larger
+      // grid cavities reach across them; with few seeds the larger bound costs little. Dense faces
+      // (size transitions everywhere) keep the small bound: larger cavities cost them 2-3x the
+      // time for nothing. The futile marks of the maximal growths were made with the small bound.
+      if (maximal_cap < options.max_quads_sparse && sparse()) {
+        maximal_cap = options.max_quads_sparse;
+        futile[0].clear();
+        futile[2].clear();
+        rep.escalated = 1;
+      }
       const auto& on = options.steps;
       bool changed = on[0] && unnecessary_step(0, grid, true);
       if (!stop && on[1]) changed = singular_step() || changed;

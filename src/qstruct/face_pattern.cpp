@@ -9,6 +9,7 @@
 
 #include "qsmesh/background/face_mesh.hpp"
 #include "qsmesh/core/error.hpp"
+#include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/smooth/quad_tools.hpp"
 #include "qsmesh/smooth/untangle.hpp"
 
@@ -92,6 +93,20 @@ mesh::FaceMesh build_mesh(LO f, const cad::Face& face, const cad::FaceGeometry& 
     m.vclass[v].param = {m.uv[v].u, m.uv[v].v};
   }
   return m;
+}
+
+// Whether the quads at or below min_sicn are few enough for the untangler to be worth a try
+// (PatternFaceOptions::lift_max_poor_fraction).
+bool few_poor_quads(const mesh::FaceMesh& m, const PatternFaceOptions& options) {
+  std::int64_t poor = 0;
+  for (const auto& q : m.quads)
+    if (mesh::quad_sicn({m.points[q[0]], m.points[q[1]], m.points[q[2]], m.points[q[3]]}) <=
+        options.min_sicn)
+      ++poor;
+  const double bound =
+      std::max(static_cast<double>(options.lift_min_poor_quads),
+               options.lift_max_poor_fraction * static_cast<double>(m.quads.size()));
+  return static_cast<double>(poor) <= bound;
 }
 
 void set_side_edges(FaceSides& fs) {
@@ -181,7 +196,8 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
     // the pattern, or a folded corner of a size transition) is worth lifting locally; the
     // smoothing kernels never lower the minimum, so they cannot get out of a fold.
     if (options.lift_poor_quads && (q.invalid > 0 || q.sicn_min <= options.min_sicn) &&
-        q.sicn_avg > options.min_sicn_avg) {
+        q.sicn_avg > options.min_sicn_avg && few_poor_quads(mesh, options)) {
+      ++rep.lifts;
       smooth::UntangleOptions uo;
       uo.target = options.min_sicn + 0.05;
       mesh = smooth::untangle_face(mesh, surface, uo);

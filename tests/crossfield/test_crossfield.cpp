@@ -9,6 +9,7 @@
 #include <BRepTools.hxx>
 #include <TopoDS.hxx>
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <gp_Circ.hxx>
 #include <gp_Pln.hxx>
@@ -138,7 +139,9 @@ TEST(CrossField, AnnulusIsRegularAndScalesLikeR) {
   BRepBuilderAPI_MakeFace mk(circle_wire(2.0));
   mk.Add(TopoDS::Wire(circle_wire(1.0).Reversed()));
   const auto model = test::load_shape(mk.Face(), "cf_annulus.brep");
-  const auto r = run(model, 0, 0.09, "annulus");
+  CrossFieldOptions raw;  // the scaling of Sec. 3.3 itself, outliers kept
+  raw.scaling_quantile = 0;
+  const auto r = run(model, 0, 0.09, "annulus", raw);
   const auto& cf = r.cf;
   expect_stats(cf);
   EXPECT_TRUE(cf.singularities.empty());
@@ -171,6 +174,39 @@ TEST(CrossField, AnnulusIsRegularAndScalesLikeR) {
       worst_dir, c, 100 * worst);
   EXPECT_LT(worst_dir, 2.0);
   EXPECT_LT(worst, 0.05);
+}
+
+TEST(CrossField, ScalingIsClampedToItsAreaQuantiles) {
+  // h = c r on the annulus 1 <= r <= 2. The area below radius rho is (rho^2 - 1) / 3 of the whole,
+  // so the 5% and 95% quantiles sit at rho = sqrt(1.15) and sqrt(3.85): clamping keeps h / r
+  // constant between them and flat outside.
+  BRepBuilderAPI_MakeFace mk(circle_wire(2.0));
+  mk.Add(TopoDS::Wire(circle_wire(1.0).Reversed()));
+  const auto model = test::load_shape(mk.Face(), "cf_annulus_q.brep");
+  CrossFieldOptions raw, clamped;
+  raw.scaling_quantile = 0;
+  clamped.scaling_quantile = 0.05;
+  const auto a = run(model, 0, 0.09, "annulus-raw", raw);
+  const auto b = run(model, 0, 0.09, "annulus-q", clamped);
+  ASSERT_EQ(a.cf.H.size(), b.cf.H.size());
+  const auto [lo, hi] = std::minmax_element(b.cf.H.begin(), b.cf.H.end());
+  const double rho_lo = std::sqrt(1.15), rho_hi = std::sqrt(3.85);
+  EXPECT_NEAR(std::exp(*hi - *lo), rho_hi / rho_lo, 0.03 * rho_hi / rho_lo);
+  // Inside the quantile band the field is the raw one, outside it is one of the two bounds.
+  int inside = 0, flat = 0;
+  for (std::size_t v = 0; v < b.cf.H.size(); ++v) {
+    if (b.cf.H[v] > *lo && b.cf.H[v] < *hi) {
+      EXPECT_EQ(b.cf.H[v], a.cf.H[v]);
+      ++inside;
+    } else {
+      const double r = std::hypot(b.cf.points[v].x, b.cf.points[v].y);
+      EXPECT_TRUE(r < rho_lo + 0.1 || r > rho_hi - 0.1) << "clamped at r = " << r;
+      ++flat;
+    }
+    EXPECT_EQ(b.cf.h[v], std::exp(b.cf.H[v]));
+  }
+  EXPECT_GT(inside, flat);
+  EXPECT_GT(flat, 0);
 }
 
 TEST(CrossField, LShapeWithReflexCorner) {

@@ -2,7 +2,7 @@
 // [--min-sicn-avg B] [--smooth-iterations N]
 // How many faces of MODEL the pattern path (paper 000 Sec. 6.1.2) meshes on the curve meshes the
 // pipeline quantizes (size map, crossfield method, as `qsmesh sizemap`), and why the others are
-// refused. Serial (MPI_COMM_SELF); --faces prints one line per face.
+// refused. Serial (MPI_COMM_SELF); --faces prints one line per face (with its pattern time).
 #include <cstdlib>
 #include <iostream>
 #include <map>
@@ -55,7 +55,9 @@ int main(int argc, char** argv) {
     int meshed = 0;
     for (LO f = 0; f < model.num_faces(); ++f) {
       qstruct::PatternFaceReport rep;
+      const Stopwatch face_clock;
       const auto m = qstruct::mesh_face_pattern(model, f, result.quantized_curves, patterns, fo, &rep);
+      const double face_seconds = face_clock.seconds();
       std::string sides = std::to_string(rep.side_edges.size());
       if (rep.ok) {
         ++meshed;
@@ -71,7 +73,7 @@ int main(int argc, char** argv) {
       if (per_face) {
         std::cout << "face " << f << " " << cad::to_string(model.faces()[f].type) << " sides [";
         for (std::size_t i = 0; i < rep.side_edges.size(); ++i) std::cout << (i ? "," : "") << rep.side_edges[i];
-        std::cout << "] ";
+        std::cout << "] (" << face_seconds << " s) ";
         if (rep.ok)
           std::cout << "ok " << rep.pattern_name << " quads " << rep.quads << " sicn " << rep.sicn_min << "/"
                     << rep.sicn_avg << "\n";

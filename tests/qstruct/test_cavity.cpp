@@ -206,6 +206,7 @@ TEST(Cavity, Step1IsLocal) {
   const mesh::FaceMesh in = perturbed(plane, 16, 16);
   CavityOptions options;
   options.max_quads_maximal = 30;
+  options.max_quads_sparse = 30;  // 4 irregular vertices in 256 quads are sparse: same bound
   CavityReport rep;
   const auto patterns = builtin_patterns();
   const mesh::FaceMesh out = remesh_cavities(in, plane, {}, patterns, options, &rep);
@@ -674,6 +675,35 @@ TEST(Cavity, Step3TransitionsRemoveAPairNextToATransition) {
   EXPECT_EQ(grid_only.irregular_after, before);
   EXPECT_EQ(with_transitions.irregular_after, 2);
   EXPECT_GT(min_sicn(b), 0.3);
+  expect_boundary_kept(m, b);
+}
+
+// CavityOptions::max_quads_sparse: a rotated edge in a 20 x 20 grid (4 unnecessary irregular
+// vertices for 400 quads, 1%) needs a grid cavity of more quads than a tiny maximal bound allows.
+// Step 1 alone leaves it with that bound; the sparse bound takes over from the first round.
+TEST(Cavity, SparseIrregularVerticesGetLargerMaximalCavities) {
+  const Plane plane;
+  const mesh::FaceMesh m = perturbed(plane, 20, 20, {{10, 10, 11, 10}});
+  ASSERT_EQ(count_irregular(m), 4);
+  const auto patterns = builtin_patterns();
+  CavityOptions o;
+  o.steps = {true, false, false, false};
+  o.max_quads_maximal = 1;
+  o.max_quads_sparse = 1;  // no larger bound
+  CavityReport fixed_bound, raised, dense;
+  const mesh::FaceMesh a = remesh_cavities(m, plane, {}, patterns, o, &fixed_bound);
+  EXPECT_EQ(fixed_bound.irregular_after, 4);
+  EXPECT_EQ(fixed_bound.escalated, 0);
+  o.max_quads_sparse = 600;
+  o.sparse_irregular_ratio = 0.005;  // 1% is not sparse for this ratio
+  (void)remesh_cavities(m, plane, {}, patterns, o, &dense);
+  EXPECT_EQ(dense.irregular_after, 4);
+  EXPECT_EQ(dense.escalated, 0);
+  o.sparse_irregular_ratio = 0.05;
+  const mesh::FaceMesh b = remesh_cavities(m, plane, {}, patterns, o, &raised);
+  EXPECT_EQ(raised.escalated, 1);
+  EXPECT_EQ(raised.irregular_after, 0);
+  EXPECT_GT(min_sicn(b), 0.9);
   expect_boundary_kept(m, b);
 }
 

@@ -166,6 +166,29 @@ TEST(FacePattern, RectangleWithATransitionGetsOneValence3And5) {
   EXPECT_NE(rep.reason.find("face 0"), std::string::npos) << rep.reason;
 }
 
+// PatternFaceOptions::lift_max_poor_fraction: the untangler only gets fills with few poor quads.
+// With min_sicn 0.95 most quads of the transition fill are "poor" (and the average bound is off),
+// so the default bound skips the untangler; without the bound it runs.
+TEST(FacePattern, UntanglerOnlyForFewPoorQuads) {
+  const XY xy = {{0, 0}, {10, 0}, {10, 5}, {0, 5}};
+  const auto pc = polygon(xy, {11, 4, 9, 6}, "qs_lift.brep");
+  const auto patterns = builtin_patterns();
+  PatternFaceOptions o;
+  o.min_sicn = 0.95;
+  o.min_sicn_avg = 0;
+  o.max_candidates = 1;
+  PatternFaceReport rep;
+  (void)mesh_face_pattern(pc.model, 0, pc.curves, patterns, o, &rep);
+  EXPECT_EQ(rep.candidates, 1);
+  EXPECT_EQ(rep.lifts, 0);
+  o.lift_max_poor_fraction = 1;
+  (void)mesh_face_pattern(pc.model, 0, pc.curves, patterns, o, &rep);
+  EXPECT_EQ(rep.lifts, 1);
+  o.lift_poor_quads = false;
+  (void)mesh_face_pattern(pc.model, 0, pc.curves, patterns, o, &rep);
+  EXPECT_EQ(rep.lifts, 0);
+}
+
 TEST(FacePattern, TriangleAndPentagonGetTheirIrregularVertex) {
   const auto patterns = builtin_patterns();
   {

@@ -21,6 +21,11 @@ struct CrossFieldOptions {
   int max_iterations_per_level = 50;
   bool extend_boundary = true;   ///< Sec. 3.1 boundary-condition extension
   double acute_corner_deg = 45;  ///< artificial +1 singularity at CAD corners sharper than this
+  /// Sec. 3.3 scaling, outliers clamped: H is clamped to its area-weighted quantiles q and 1 - q
+  /// over the face (0: no clamping). H has logarithmic singularities at cusps and sharp corners;
+  /// left as they are, exp(H) shrinks to the size floor there and the faces around fill with
+  /// slivers (docs/architecture.md, "Decisions worth knowing").
+  double scaling_quantile = 0.05;
   linalg::SolverOptions solver;
 };
 

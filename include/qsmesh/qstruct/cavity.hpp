@@ -142,6 +142,16 @@ struct CavityOptions {
   /// and 3) and the minimal ones (Steps 2 and 4).
   LO max_quads_maximal = 600;
   LO max_quads_minimal = 150;
+  /// From the round where at most sparse_irregular_ratio unnecessary irregular vertices per quad
+  /// are left, the maximal growths (Steps 1 and 3) may take max_quads_sparse quads
+  /// (CavityReport::escalated). Sparse pairs are far apart, and few seeds keep the larger bound
+  /// cheap. Measured end to end (2 threads, docs/benchmarks.md), interior irregular vertices:
+  /// mambo_s34 at size factor 0.00504703 610 -> 409, Block at 0.0043 3282 -> 3193, t20 307 ->
+  /// 290; A319, wing_fuselage and cube_filet unchanged.
+  /// Raising max_quads_maximal to 3000 everywhere gave mambo 396 but cost wing_fuselage 2.3x the
+  /// time for nothing (its faces keep 6% irregular vertices: size transitions).
+  LO max_quads_sparse = 3000;
+  double sparse_irregular_ratio = 0.05;
   /// Remeshable cavities of a maximal growth tried geometrically, largest first.
   int max_geometric_tries = 3;
   /// Remeshable cavities of a minimal growth (Steps 2 and 4) tried geometrically, smallest first
@@ -217,6 +227,7 @@ struct CavityReport {
   std::array<std::int64_t, 4> rejected_quality{};  ///< remeshable cavities refused after smoothing
   std::array<CavityStepDiagnostics, 4> diagnostics{};
   int rounds = 0;
+  int escalated = 0;  ///< 1 when the maximal growths got max_quads_sparse (from some round on)
   std::int64_t irregular_before = 0, irregular_after = 0;  ///< interior vertices of valence != 4
   std::int64_t singularities = 0;  ///< singularities given (acute-corner ones excluded)
   std::int64_t flagged = 0;        ///< flagged vertices at the start
@@ -237,7 +248,9 @@ struct CavityReport {
 ///    cavities around each flagged vertex (the pattern's irregular vertex becomes the flagged
 ///    one); Step 3 = Step 1, with the transitions too (CavityOptions::step3_transitions); Step 4
 ///    minimal cavities matching the 4-sided convex patterns
-///    (transitions) from each unnecessary irregular vertex.
+///    (transitions) from each unnecessary irregular vertex. A round that starts with few
+///    unnecessary irregular vertices left (CavityOptions::sparse_irregular_ratio) and every round
+///    after it bound the maximal cavities by max_quads_sparse instead of max_quads_maximal.
 ///  - Each replacement is a transaction: the refined pattern is glued to the cavity boundary (same
 ///    vertex ids), new vertices placed by a uniform Laplace solve in (u, v), the cavity and
 ///    CavityOptions::smooth_rings rings smoothed (smooth::smooth_face on that region, the rest

@@ -37,6 +37,13 @@ struct PatternFaceOptions {
   /// When the smoothed mesh has its mean above min_sicn_avg but quads at or below min_sicn (or
   /// invalid), smooth::untangle_face lifts them (target min_sicn + 0.05) before the test.
   bool lift_poor_quads = true;
+  /// ... but only when those quads are at most max(lift_min_poor_quads, lift_max_poor_fraction x
+  /// the quads): the untangler is a local repair. On the shared models at their reference sizes
+  /// the bound changes one face of 533 on Block.stp and no other, and cuts the pattern stage from
+  /// 21.8 to 4.0 s on Block at size factor 0.0037 (qstruct_survey, one thread: a half-disk fill of
+  /// face 380 with many folded quads took 10.7 s in the untangler and stayed folded).
+  double lift_max_poor_fraction = 0.01;
+  std::int64_t lift_min_poor_quads = 8;
   /// Largest quad count a pattern mesh of the face may have (0: no bound). A pattern fill is
   /// structured, so a size transition along one side runs across the whole face: [96, 342, 26,
   /// 342] on wing_fuselage.step gives 22k quads where the size map asks for 4k. The pipeline
@@ -73,6 +80,7 @@ struct PatternFaceReport {
   bool reversed = false;
   std::vector<LO> chords;        ///< chord subdivisions of that match
   int candidates = 0;            ///< matches tried geometrically
+  int lifts = 0;                 ///< candidates handed to the untangler (lift_poor_quads)
   double sicn_min = 0, sicn_avg = 0;  ///< of the mesh kept (or of the best refused one)
   std::int64_t quads = 0;
 };
