@@ -16,30 +16,26 @@ namespace qsmesh::crossfield {
 namespace detail {
 namespace {
 
-// Clamps H to its area-weighted quantiles q and 1 - q (vertex weight: a third of the area of its
-// triangles). Weighting by area keeps the bounds independent of how finely the background mesh is
-// graded near the very corners whose values are clamped.
-void clamp_to_quantiles(FaceCrossField& cf, const Geometry& g, double q) {
-  const LO nv = static_cast<LO>(cf.points.size());
-  std::vector<double> weight(static_cast<std::size_t>(nv), 0.0);
-  double total = 0;
-  for (LO t = 0; t < static_cast<LO>(cf.triangles.size()); ++t)
-    for (LO v : cf.triangles[t]) weight[v] += g.area[t] / 3, total += g.area[t] / 3;
+// Clamps H to its quantiles q and 1 - q, each vertex weighted by `weight` (a third of the area of
+// its triangles; `total` their sum). Weighting by area keeps the bounds independent of how finely
+// the background mesh is graded near the very corners whose values are clamped.
+void clamp_to_quantiles(std::vector<double>& H, const std::vector<double>& weight, double total,
+                        double q) {
   if (!(total > 0)) return;
-  std::vector<LO> order(static_cast<std::size_t>(nv));
+  std::vector<LO> order(H.size());
   std::iota(order.begin(), order.end(), 0);
   std::sort(order.begin(), order.end(),
-            [&](LO a, LO b) { return cf.H[a] < cf.H[b] || (cf.H[a] == cf.H[b] && a < b); });
+            [&](LO a, LO b) { return H[a] < H[b] || (H[a] == H[b] && a < b); });
   auto value_at = [&](double fraction) {
     double acc = 0;
     for (const LO v : order) {
       acc += weight[v];
-      if (acc >= fraction * total) return cf.H[v];
+      if (acc >= fraction * total) return H[v];
     }
-    return cf.H[order.back()];
+    return H[order.back()];
   };
   const double lo = value_at(q), hi = value_at(1 - q);
-  for (double& h : cf.H) h = std::clamp(h, lo, hi);
+  for (double& h : H) h = std::clamp(h, lo, hi);
 }
 
 }  // namespace
@@ -85,9 +81,13 @@ void compute_scaling(FaceCrossField& cf, const Geometry& g, const CrossFieldOpti
   std::vector<double> x(static_cast<std::size_t>(nv - 1));
   solver->solve(rhs, x);
   double mean = 0, total = 0;
+  std::vector<double> weight(static_cast<std::size_t>(nv), 0.0);  // a third of the area around
   for (LO v = 1; v < nv; ++v) cf.H[v] = x[v - 1];
   for (LO t = 0; t < nt; ++t)
-    for (LO v : cf.triangles[t]) mean += cf.H[v] * g.area[t] / 3, total += g.area[t] / 3;
+    for (LO v : cf.triangles[t]) {
+      mean += cf.H[v] * g.area[t] / 3, total += g.area[t] / 3;
+      weight[v] += g.area[t] / 3;
+    }
   if (total > 0) mean /= total;
   for (LO v = 0; v < nv; ++v) {
     cf.H[v] -= mean;
@@ -96,7 +96,8 @@ void compute_scaling(FaceCrossField& cf, const Geometry& g, const CrossFieldOpti
   QSMESH_CHECK(
       options.scaling_quantile >= 0 && options.scaling_quantile < 0.5,
       "crossfield: scaling_quantile " << options.scaling_quantile << " is not in [0, 0.5)");
-  if (options.scaling_quantile > 0) clamp_to_quantiles(cf, g, options.scaling_quantile);
+  if (options.scaling_quantile > 0)
+    clamp_to_quantiles(cf.H, weight, total, options.scaling_quantile);
   for (LO v = 0; v < nv; ++v) cf.h[v] = std::exp(cf.H[v]);
 }
 

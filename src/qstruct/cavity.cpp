@@ -866,16 +866,19 @@ mesh::FaceMesh remesh_cavities(const mesh::FaceMesh& input, const cad::FaceGeome
       return false;
     };
 
+    // An irregular interior vertex that no singularity asks for: the seeds of Steps 1, 3 and 4.
+    const auto unnecessary = [&](LO v) {
+      return interior_vertex(work, topo, v) && topo.valence(v) != 4 && !singular[v];
+    };
+
     const auto unnecessary_step = [&](int step, std::span<const Pattern> pats, bool maximal) {
       if (pats.empty()) return false;
       bool changed = false;
       std::vector<LO> seeds;
       for (LO v = 0; v < work.num_vertices(); ++v)
-        if (interior_vertex(work, topo, v) && topo.valence(v) != 4 && !singular[v])
-          seeds.push_back(v);
+        if (unnecessary(v)) seeds.push_back(v);
       for (const LO v : seeds) {
-        if (!interior_vertex(work, topo, v) || topo.valence(v) == 4 || singular[v])
-          continue;  // changed since
+        if (!unnecessary(v)) continue;  // changed since
         if (out_of_budget()) {
           stop = true;
           break;
@@ -907,11 +910,11 @@ mesh::FaceMesh remesh_cavities(const mesh::FaceMesh& input, const cad::FaceGeome
       return changed;
     };
 
-    // Unnecessary irregular vertices (Steps 1, 3, 4 seeds) per quad at most sparse_irregular_ratio.
+    // Unnecessary irregular vertices per quad at most sparse_irregular_ratio.
     const auto sparse = [&] {
       std::int64_t n = 0;
       for (LO v = 0; v < work.num_vertices(); ++v)
-        if (interior_vertex(work, topo, v) && topo.valence(v) != 4 && !singular[v]) ++n;
+        if (unnecessary(v)) ++n;
       return static_cast<double>(n) <=
              options.sparse_irregular_ratio * static_cast<double>(work.quads.size());
     };

@@ -123,14 +123,19 @@ double min_sicn(const mesh::FaceMesh& m) {
   return w;
 }
 
+// m after `iterations` passes of the smoother (test inputs made valid after edge rotations).
+mesh::FaceMesh smoothed(const mesh::FaceMesh& m, const Plane& plane, int iterations) {
+  smooth::SmoothOptions so;
+  so.iterations = iterations;
+  return smooth::smooth_face(m, plane, so);
+}
+
 // An nx x ny grid with rotated edges (two valence-3 and two valence-5 vertices each), smoothed.
 mesh::FaceMesh perturbed(const Plane& plane, int nx = 10, int ny = 8,
                          const std::vector<std::array<double, 4>>& edges = {{4, 4, 5, 4}}) {
   mesh::FaceMesh m = grid(nx, ny);
   for (const auto& e : edges) rotate_edge(m, vertex_at(m, e[0], e[1]), vertex_at(m, e[2], e[3]));
-  smooth::SmoothOptions so;
-  so.iterations = 20;
-  return smooth::smooth_face(m, plane, so);
+  return smoothed(m, plane, 20);
 }
 
 // The CAD-classified vertices are kept, in the same order, with the same points, uv and class.
@@ -519,9 +524,7 @@ void absorb_pair(const std::string& name, int index, const CavityOptions& option
     ASSERT_NE(e, kNoIndex);
     rotate_edge(m, b, e);
   }
-  smooth::SmoothOptions so;
-  so.iterations = 30;
-  m = smooth::smooth_face(m, plane, so);
+  m = smoothed(m, plane, 30);
   ASSERT_GT(min_sicn(m), 0);
   ASSERT_EQ(count_irregular(m), 5);
   crossfield::Singularity sing;
@@ -658,9 +661,7 @@ TEST(Cavity, Step3TransitionsRemoveAPairNextToATransition) {
         other = q[(k + 1) % 4];
   ASSERT_NE(other, kNoIndex);
   rotate_edge(m, five, other);
-  smooth::SmoothOptions so;
-  so.iterations = 20;
-  m = smooth::smooth_face(m, plane, so);
+  m = smoothed(m, plane, 20);
   ASSERT_GT(min_sicn(m), 0);
   const std::int64_t before = count_irregular(m);
   ASSERT_GT(before, 2);
