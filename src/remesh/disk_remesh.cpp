@@ -136,20 +136,15 @@ std::vector<int> corner_ideal_valences(const mesh::FaceMesh& m, const DiskRemesh
   return ideal;
 }
 
-// Vertices whose valence in this face mesh is not their whole valence: a seam vertex has two images
-// (same (dim, entity, index) twice), a pole's quads fan out of a collapsed curve.
-std::vector<char> seam_or_pole(const mesh::FaceMesh& m, const cad::FaceGeometry& surface) {
+// Vertices where the surface normal vanishes (poles): their quads fan out of a collapsed curve, so
+// the angles there say nothing about the valence they should have. A seam vertex is not one of them:
+// each of its two images (same (dim, entity, index), one per side of the seam in uv) is a curve
+// vertex of the face on its own side, ideal valence 2, and its curve edges stay in the cavity cycle.
+std::vector<char> poles(const mesh::FaceMesh& m, const cad::FaceGeometry& surface) {
   const LO nv = m.num_vertices();
-  std::map<std::tuple<int, LO, LO>, LO> first;
   std::vector<char> flag(nv, 0);
-  for (LO v = 0; v < nv; ++v) {
-    const auto& c = m.vclass[v];
-    if (c.dim == 2) continue;
-    const auto key = std::make_tuple(int(c.dim), c.entity, c.dim == 1 ? c.index : kNoIndex);
-    const auto [it, fresh] = first.emplace(key, v);
-    if (!fresh) flag[v] = flag[it->second] = 1;
-    if (norm(surface.normal(m.uv[v])) == 0) flag[v] = 1;
-  }
+  for (LO v = 0; v < nv; ++v)
+    if (m.vclass[v].dim != 2 && norm(surface.normal(m.uv[v])) == 0) flag[v] = 1;
   return flag;
 }
 
@@ -167,7 +162,7 @@ struct Work {
   std::vector<Vec2> uv;
   std::vector<mesh::VertexClass> vclass;
   std::vector<std::array<LO, 4>> quads;
-  std::vector<char> quad_alive, vertex_alive, seam;
+  std::vector<char> quad_alive, vertex_alive, pole;
   std::vector<int> ideal;
   std::vector<std::vector<LO>> v2q;
   DiskRemeshStats stats;
@@ -177,7 +172,7 @@ struct Work {
     return vclass[v].dim == 0 ? ideal[v] : vclass[v].dim == 1 ? 2 : 4;
   }
   [[nodiscard]] bool is_defect(LO v) const {
-    if (!vertex_alive[v] || seam[v] || v2q[v].empty()) return false;
+    if (!vertex_alive[v] || pole[v] || v2q[v].empty()) return false;
     const int val = valence(v);
     switch (kind_of(vclass[v])) {
       case VertexKind::interior:
@@ -197,7 +192,10 @@ struct Work {
   [[nodiscard]] int orientation(const std::array<LO, 4>& q, const std::vector<Vec3>& p,
                                 const std::vector<Vec2>& u) const {
     int s = 0;
-    for (int k = 0; k < 4; ++k) s += corner_turn(q, k, p, u) > 0 ? 1 : -1;
+    for (int k = 0; k < 4; ++k) {
+      const double t = corner_turn(q, k, p, u);
+      s += t > 0 ? 1 : t < 0 ? -1 : 0;  // 0: no normal there (a pole)
+    }
     return s;
   }
   [[nodiscard]] double corner_turn(const std::array<LO, 4>& q, int k, const std::vector<Vec3>& p,
@@ -207,10 +205,44 @@ struct Work {
   }
 
   bool try_fix(LO x);
+  bool try_cavity(LO x, std::vector<LO> cav, bool force);
 };
 
+// Two rules, each on two cavities.
+//  - Rules: first the replacement minimising Eq. 15, kept only when it lowers Eq. 15 over the
+//    cavity. For a corner or curve defect that finds nothing, has fewer quads than its ideal
+//    valence and a poor one (DiskRemeshOptions::force_below_sicn), then the priorities of
+//    Sec. 6.3.2 alone: the defect must reach its ideal valence, corners (and curves when fixing a curve) must
+//    end ideal or unchanged, and face-interior vertices may get worse within the relaxed range. A
+//    curve vertex with one quad spans 180 degrees (SICN near 0) and an interior vertex of valence
+//    3 or 5 costs the same in Eq. 15, yet only the first is a bad quad.
+//  - Cavities: the quads of x; then those with every quad around their face-interior vertices
+//    added (Gmsh's implementation tries that larger patch first). A curve vertex with one quad has
+//    no replacement of that quad alone that gives it two.
 bool Work::try_fix(LO x) {
-  const std::vector<LO> cav = v2q[x];
+  const std::vector<LO> small = v2q[x];
+  std::set<LO> grown(small.begin(), small.end());
+  if (options.larger_cavity)
+    for (LO q : small)
+      for (LO v : quads[q])
+        if (vclass[v].dim == 2 && !pole[v]) grown.insert(v2q[v].begin(), v2q[v].end());
+  std::vector<std::vector<LO>> cavities{small};
+  if (grown.size() > small.size()) cavities.emplace_back(grown.begin(), grown.end());
+  double worst = 1;
+  for (LO q : small) worst = std::min(worst, sicn(quads[q]));
+  const bool may_force = kind_of(vclass[x]) != VertexKind::interior &&
+                         valence(x) < ideal_valence(x) && worst < options.force_below_sicn;
+  for (int rule = 0; rule < (may_force ? 2 : 1); ++rule)
+    for (const auto& cav : cavities)
+      if (try_cavity(x, cav, rule == 1)) return true;
+  return false;
+}
+
+bool Work::try_cavity(LO x, std::vector<LO> cav, bool force) {  // cav by value: commit edits v2q
+  const auto refuse = [&](LO& counter) {
+    ++counter;
+    return false;
+  };
   std::set<LO> in_cavity(cav.begin(), cav.end());
   // Boundary of the union of the cavity's quads: directed edges whose reverse is not in it.
   std::set<std::pair<LO, LO>> directed;
@@ -218,14 +250,9 @@ bool Work::try_fix(LO x) {
     for (int k = 0; k < 4; ++k) directed.emplace(quads[q][k], quads[q][(k + 1) % 4]);
   std::map<LO, LO> next;
   for (const auto& [a, c] : directed)
-    if (directed.count({c, a}) == 0 && !next.emplace(a, c).second) {
-      ++stats.skipped;  // the boundary touches itself: not a disk with a simple boundary
-      return false;
-    }
-  if (next.empty()) {
-    ++stats.skipped;
-    return false;
-  }
+    if (directed.count({c, a}) == 0 && !next.emplace(a, c).second)
+      return refuse(stats.skipped);  // the boundary touches itself: not a simple disk
+  if (next.empty()) return refuse(stats.skipped);
   std::vector<LO> cycle{next.begin()->first};
   while (true) {
     const LO c = next.at(cycle.back());
@@ -234,10 +261,7 @@ bool Work::try_fix(LO x) {
     if (cycle.size() > next.size()) break;
   }
   const int b = static_cast<int>(cycle.size());
-  if (b != static_cast<int>(next.size()) || b > table.max_boundary()) {
-    ++stats.skipped;
-    return false;
-  }
+  if (b != static_cast<int>(next.size()) || b > table.max_boundary()) return refuse(stats.skipped);
   std::set<LO> on_cycle(cycle.begin(), cycle.end());
   std::vector<LO> inner;
   for (LO q : cav)
@@ -245,18 +269,10 @@ bool Work::try_fix(LO x) {
       if (!on_cycle.count(v) && std::find(inner.begin(), inner.end(), v) == inner.end())
         inner.push_back(v);
   for (LO v : inner) {
-    bool inside = vclass[v].dim == 2 && !seam[v];
+    bool inside = vclass[v].dim == 2 && !pole[v];
     for (LO q : v2q[v]) inside = inside && in_cavity.count(q) > 0;
-    if (!inside) {
-      ++stats.skipped;
-      return false;
-    }
+    if (!inside) return refuse(stats.skipped);
   }
-  for (LO v : cycle)
-    if (seam[v]) {
-      ++stats.skipped;
-      return false;
-    }
 
   Cavity cavity;
   std::vector<int> in_now(b), inner_now;
@@ -265,20 +281,20 @@ bool Work::try_fix(LO x) {
     int in = 0;
     for (LO q : v2q[v]) in += in_cavity.count(q) ? 1 : 0;
     in_now[j] = in;
-    cavity.kind.push_back(kind_of(vclass[v]));
+    // A pole on the cycle keeps its valence: its angles say nothing about the valence it needs.
+    cavity.kind.push_back(pole[v] ? VertexKind::corner : kind_of(vclass[v]));
     cavity.out_valence.push_back(valence(v) - in);
-    cavity.ideal_valence.push_back(ideal_valence(v));
-    cavity.current_valence.push_back(valence(v));
+    cavity.ideal_valence.push_back(pole[v] ? valence(v) : ideal_valence(v));
+    // force: x has no valence to keep (Cavity::current_valence < 0), it must reach its range.
+    cavity.current_valence.push_back(force && v == x ? -1 : valence(v));
   }
   for (LO v : inner) inner_now.push_back(valence(v));
   const int cost_now = irregularity(cavity, in_now, inner_now);
   ChoiceOptions choice;
   choice.enforce_up_to = kind_of(vclass[x]);
   const Replacement best = best_replacement(table, cavity, choice);
-  if (best.entry == kNoIndex || best.irregularity >= cost_now) {
-    ++stats.no_candidate;
-    return false;
-  }
+  if (best.entry == kNoIndex || (!force && best.irregularity >= cost_now))
+    return refuse(stats.no_candidate);
 
   // The replacement's quads in mesh ids; new interior vertices numbered after the current ones.
   const LO first_new = static_cast<LO>(points.size());
@@ -341,7 +357,7 @@ bool Work::try_fix(LO x) {
       }
   for (const auto& [v, lv] : local) {
     bool free_vertex = v >= first_new;
-    if (!free_vertex && vclass[v].dim == 2 && !seam[v]) {
+    if (!free_vertex && vclass[v].dim == 2 && !pole[v]) {
       free_vertex = true;
       for (LO q : v2q[v])
         if (!in_cavity.count(q) && !ring.count(q)) free_vertex = false;
@@ -356,13 +372,14 @@ bool Work::try_fix(LO x) {
   for (const auto& q : smoothed.quads) {
     min_after = std::min(min_after, sicn_of(q, smoothed.points));
     for (int k = 0; k < 4; ++k)
-      if (corner_turn(q, k, smoothed.points, smoothed.uv) * sign <= 0) min_after = -1.0;
+      if (norm(surface.normal(smoothed.uv[q[k]])) > 0 &&
+          corner_turn(q, k, smoothed.points, smoothed.uv) * sign <= 0)
+        min_after = -1.0;  // at a pole (no normal) the quad's SICN alone decides
   }
   const bool good =
       min_after >= options.min_sicn || (options.accept_if_not_worse && min_after >= min_before);
   if (!(min_after > 0 && good)) {
-    ++stats.rejected_geometry;
-    return false;
+    return refuse(stats.rejected_geometry);
   }
 
   // Commit.
@@ -378,7 +395,7 @@ bool Work::try_fix(LO x) {
     uv.push_back(smoothed.uv[lv]);
     vclass.push_back(mesh::VertexClass{2, face, kNoIndex, {uv.back().u, uv.back().v}});
     vertex_alive.push_back(1);
-    seam.push_back(0);
+    pole.push_back(0);
     ideal.push_back(0);
     v2q.emplace_back();
   }
@@ -413,7 +430,9 @@ LO count_defects(const mesh::FaceMesh& m, const DiskRemeshOptions& options) {
     if (val[v] == 0) continue;
     if (c.dim == 2) {
       defects += val[v] >= 6 ? 1 : 0;
-    } else if (uses[{int(c.dim), c.entity, c.dim == 1 ? c.index : kNoIndex}] == 1) {
+    } else if (c.dim == 1 || uses[{int(c.dim), c.entity, kNoIndex}] == 1) {
+      // A seam image is a curve vertex of its side; a corner seen twice (a seam end, a pole) has
+      // no ideal valence known here.
       defects += val[v] != (c.dim == 1 ? 2 : ideal[v]) ? 1 : 0;
     }
   }
@@ -438,7 +457,7 @@ mesh::FaceMesh remesh_disk_defects(const mesh::FaceMesh& mesh, const cad::FaceGe
          mesh.quads,
          std::vector<char>(mesh.quads.size(), 1),
          std::vector<char>(nv, 1),
-         seam_or_pole(mesh, surface),
+         poles(mesh, surface),
          corner_ideal_valences(mesh, options),
          std::vector<std::vector<LO>>(nv),
          {}};

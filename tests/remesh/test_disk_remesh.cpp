@@ -152,11 +152,13 @@ mesh::FaceMesh grid_with_valence6(const cad::FaceGeometry& g) {
   return grid_collapsed(g, 2, 2, false);
 }
 
-// The grid with the diagonal (ci, cj)-(ci+1, cj+1) of one quad collapsed: to its midpoint, or onto
-// (ci, cj) kept in place when keep_at_corner.
-mesh::FaceMesh grid_collapsed(const cad::FaceGeometry& g, int ci, int cj, bool keep_at_corner) {
-  constexpr int N = 6;
-  auto id = [](int i, int j) { return static_cast<LO>(j * (N + 1) + i); };
+constexpr int kN = 6;
+LO grid_id(int i, int j) { return static_cast<LO>(j * (kN + 1) + i); }
+
+// The (kN + 1)^2 vertices of the structured kN x kN grid of the plate, classified (corners 0-3,
+// curves 0 bottom, 1 right, 2 top, 3 left), no quads yet.
+mesh::FaceMesh plate_grid_vertices(const cad::FaceGeometry& g) {
+  constexpr int N = kN;
   mesh::FaceMesh m;
   m.face = 0;
   for (int j = 0; j <= N; ++j)
@@ -179,6 +181,15 @@ mesh::FaceMesh grid_collapsed(const cad::FaceGeometry& g, int ci, int cj, bool k
       m.points.push_back(g.eval({double(i), double(j)}).p);
       m.vclass.push_back(c);
     }
+  return m;
+}
+
+// The grid with the diagonal (ci, cj)-(ci+1, cj+1) of one quad collapsed: to its midpoint, or onto
+// (ci, cj) kept in place when keep_at_corner.
+mesh::FaceMesh grid_collapsed(const cad::FaceGeometry& g, int ci, int cj, bool keep_at_corner) {
+  constexpr int N = kN;
+  const auto id = grid_id;
+  mesh::FaceMesh m = plate_grid_vertices(g);
   for (int j = 0; j < N; ++j)
     for (int i = 0; i < N; ++i)
       if (!(i == ci && j == cj))
@@ -199,6 +210,37 @@ mesh::FaceMesh grid_collapsed(const cad::FaceGeometry& g, int ci, int cj, bool k
   for (auto& q : m.quads)
     for (LO& v : q)
       if (v > gone) --v;
+  return m;
+}
+
+// The grid with its 2 x 2 block [1,3] x [0,2] remeshed so that the curve vertex (2,0) has a single
+// quad, (1,0)-(2,0)-(3,0)-c1, flat at (2,0) (SICN 0), as a seam vertex next to a pole can end up;
+// (1,0) and (3,0) get three quads each. Two interior vertices: c1 = (2, 0.6) (valence 3) and
+// c2 = (2, 1.4) (vertex (2,1) moved).
+mesh::FaceMesh grid_with_flat_curve_quad(const cad::FaceGeometry& g) {
+  const auto id = grid_id;
+  mesh::FaceMesh m = plate_grid_vertices(g);
+  for (int j = 0; j < kN; ++j)
+    for (int i = 0; i < kN; ++i)
+      if (!(j < 2 && (i == 1 || i == 2)))
+        m.quads.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)});
+  const LO c2 = id(2, 1);
+  const auto place = [&](LO v, Vec2 uv) {
+    m.uv[v] = uv;
+    m.points[v] = g.eval(uv).p;
+    m.vclass[v].param = {uv.u, uv.v};
+  };
+  place(c2, {2.0, 1.4});
+  const auto c1 = static_cast<LO>(m.points.size());
+  m.points.emplace_back();
+  m.uv.emplace_back();
+  m.vclass.push_back(m.vclass[c2]);
+  place(c1, {2.0, 0.6});
+  m.quads.push_back({id(1, 0), id(2, 0), id(3, 0), c1});
+  m.quads.push_back({id(3, 0), id(3, 1), c2, c1});
+  m.quads.push_back({id(3, 1), id(3, 2), id(2, 2), c2});
+  m.quads.push_back({id(1, 0), c1, c2, id(1, 1)});
+  m.quads.push_back({id(1, 1), c2, id(2, 2), id(1, 2)});
   return m;
 }
 
@@ -300,6 +342,49 @@ TEST(DiskRemesh, FixesCurveVertices) {
         0);
   EXPECT_EQ(boundary(out), boundary(m));
   EXPECT_NEAR(area_xy(out), 36.0, 1e-9);
+}
+
+TEST(DiskRemesh, CurveVertexWithOneQuadIsFixedByPriority) {
+  // (2,0) has one quad spanning 180 degrees. No replacement lowers Eq. 15 (giving it a second quad
+  // costs an interior vertex of valence 3 or 5), and its one-quad cavity has none giving it two:
+  // the rule of Eq. 15 alone on the defect's own quads leaves the flat quad. Sec. 6.3.2's
+  // priorities (curves before the interior) on the cavity grown around c1 fix it.
+  const DiskQuadTable table = DiskQuadTable::builtin();
+  const Plate plate = load_plate();
+  const mesh::FaceMesh m = grid_with_flat_curve_quad(*plate.geometry);
+  ASSERT_NEAR(area_xy(m), 36.0, 1e-9);
+  const auto val_in = valences(m);
+  ASSERT_EQ(val_in[grid_id(2, 0)], 1);
+  DiskRemeshOptions options;
+  ASSERT_EQ(count_defects(m, options), 3);
+  const auto worst = [](const mesh::FaceMesh& mesh) {
+    double w = 1;
+    for (const auto& q : mesh.quads)
+      w = std::min(w, mesh::quad_sicn({mesh.points[q[0]], mesh.points[q[1]], mesh.points[q[2]],
+                                       mesh.points[q[3]]}));
+    return w;
+  };
+  ASSERT_LT(worst(m), 1e-12);
+
+  DiskRemeshStats stats;
+  const mesh::FaceMesh out = remesh_disk_defects(m, *plate.geometry, table, options, &stats);
+  EXPECT_EQ(stats.defects_after, 0);
+  const auto val = valences(out);
+  for (LO v = 0; v < out.num_vertices(); ++v)
+    if (out.vclass[v].dim == 1) {
+      EXPECT_EQ(val[v], 2) << "curve vertex " << v;
+    }
+  EXPECT_GT(worst(out), 0.3);
+  EXPECT_EQ(boundary(out), boundary(m));
+  EXPECT_NEAR(area_xy(out), 36.0, 1e-9);
+
+  // Without the grown cavity and the priority rule, the flat quad stays.
+  options.larger_cavity = false;
+  options.force_below_sicn = 0;
+  DiskRemeshStats old_stats;
+  const mesh::FaceMesh old = remesh_disk_defects(m, *plate.geometry, table, options, &old_stats);
+  EXPECT_GT(old_stats.defects_after, 0);
+  EXPECT_LT(worst(old), 1e-12);
 }
 
 // Each cell of an n x n grid of the plate split into two triangles, each triangle into three quads

@@ -27,7 +27,9 @@ struct Cavity {
   std::vector<VertexKind> kind;
   std::vector<int> out_valence;      ///< n_out: quads at x_j outside the cavity
   std::vector<int> ideal_valence;    ///< n-bar: 4 inside a face, 2 on a curve, the corner's own
-  std::vector<int> current_valence;  ///< total valence today (n_out + today's n_in)
+  /// Total valence today (n_out + today's n_in): keeping it is always allowed. Negative: the
+  /// vertex must end in its allowed range (the defect being fixed).
+  std::vector<int> current_valence;
 };
 
 /// Which vertex kinds must end in their allowed range (Sec. 6.3.2, priorities): fixing a corner
@@ -92,6 +94,20 @@ struct DiskRemeshOptions {
   /// angle in this face). Entries of other vertices are ignored.
   std::vector<int> corner_valence;
   int max_passes = 4;  ///< sweeps corners -> curves -> interior, until one changes nothing
+  /// When the cavity of a defect's own quads has no allowed replacement or fails the geometry
+  /// check, try once more with the quads around their face-interior vertices added (Gmsh's
+  /// implementation tries that larger patch first). A curve vertex with a single quad, e.g. on a
+  /// seam, has no replacement of that quad alone that gives it valence 2.
+  bool larger_cavity = true;
+  /// A corner or curve defect for which no replacement lowers Eq. 15, with fewer quads than its
+  /// ideal valence (they span too wide an angle) and one of them of SICN below this, is fixed by
+  /// priority alone (Sec. 6.3.2: corners first, then curves, then the interior): it must reach its
+  /// ideal valence, vertices of its kind and above end ideal or unchanged, and face-interior
+  /// vertices may get worse within ChoiceOptions' relaxed range (0: never). A curve vertex with
+  /// one quad spans 180 degrees. Measured at the reference sizes (docs/benchmarks.md): SICN min of
+  /// the built-in example 0.036 -> 0.140 and of mambo_s34 0.294 -> 0.468, for 10 and 5 more
+  /// interior irregular vertices.
+  double force_below_sicn = 0.3;
   /// Geometry acceptance: every quad of the enlarged cavity must have SICN > 0 and turn with the
   /// face normal at its four corners, and its minimum SICN must reach min_sicn or, when
   /// accept_if_not_worse, the minimum of the same region before the change.
@@ -105,12 +121,14 @@ struct DiskRemeshStats {
   LO replaced = 0;           ///< cavities replaced
   LO no_candidate = 0;       ///< tries without an allowed replacement better than today
   LO rejected_geometry = 0;  ///< replacements rolled back by the geometry check
-  LO skipped = 0;            ///< cavities not a simple disk, beyond the table, or on a seam/pole
+  LO skipped = 0;            ///< cavities tried that are not a simple disk or beyond the table
+  // no_candidate, rejected_geometry and skipped count tries: a defect may try up to four cavities.
 };
 
 /// Defects of a quad face mesh (Sec. 6.3): dim-2 vertices of valence >= 6, dim-1 vertices of
 /// valence != 2, dim-0 vertices of valence != ideal (options.corner_valence or the estimate).
-/// Vertices on a seam (their (dim, entity, index) twice in the mesh) are not counted.
+/// Each image of a seam vertex (its (dim, entity, index) twice in the mesh, one per side) counts as
+/// a curve vertex; a dim-0 vertex seen twice (a seam end, a pole) is not counted.
 [[nodiscard]] LO count_defects(const mesh::FaceMesh& mesh, const DiskRemeshOptions& options);
 
 /// Paper 000 Sec. 6.3.2 on one face.
@@ -118,8 +136,10 @@ struct DiskRemeshStats {
 /// Takes an all-quad FaceMesh (no triangle; quads counter-clockwise about the face normal; uv
 /// consistent with points) and the face's geometry. For each defect vertex, corners first, then
 /// curves, then the interior (vertex order inside each kind), the cavity of its quads (a simple
-/// disk, b <= table.max_boundary(), no seam vertex) is replaced by best_replacement (priorities of
-/// ChoiceOptions by the defect's kind) when that lowers Eq. 15. New interior vertices start at the
+/// disk, b <= table.max_boundary()) is replaced by best_replacement (priorities of ChoiceOptions by
+/// the defect's kind) when that lowers Eq. 15; failing that, the larger cavity and the priority
+/// rule of DiskRemeshOptions::larger_cavity and force_below_sicn. A pole (no surface normal) is
+/// never a defect; on a cavity's boundary it keeps its valence. New interior vertices start at the
 /// harmonic (uniform Tutte) position in uv; the enlarged cavity (the new quads and every quad
 /// touching them) is smoothed with smooth::smooth_face with its boundary locked, then checked
 /// (DiskRemeshOptions::min_sicn): a transaction, the whole replacement is kept or nothing changes.
