@@ -4,6 +4,7 @@
 #include <cmath>
 #include <deque>
 #include <limits>
+#include <numbers>
 #include <unordered_map>
 
 #include "qsmesh/core/error.hpp"
@@ -219,8 +220,13 @@ class PointIndex {
     }
   }
 
-  /// True when some point j lies closer to p than r x weight_j.
-  [[nodiscard]] bool crowded(const Vec3& p, double r) const {
+  /// True when some point j lies closer to p than r x weight_j; with a frame (d1, d2: unit,
+  /// orthogonal), when j lies in the square of half-width r x weight_j around p with sides along
+  /// d1 and d2 (its offset along the normal is not bounded).
+  [[nodiscard]] bool crowded(const Vec3& p, double r, const Vec3* d1 = nullptr,
+                             const Vec3* d2 = nullptr) const {
+    const bool square = d1 != nullptr && d2 != nullptr;
+    if (square) r *= std::numbers::sqrt2;  // the search reaches the square's corners
     int l = 0;
     while (l + 1 < levels_ && cell(l) < r) ++l;
     const double c = cell(l);
@@ -234,7 +240,11 @@ class PointIndex {
           if (it == grid.end()) continue;
           for (LO id : it->second) {
             const double rr = r * weight_[id];
-            if (norm2(pts_[id] - p) < rr * rr) return true;
+            const Vec3 d = pts_[id] - p;
+            if (norm2(d) >= rr * rr) continue;
+            if (!square) return true;
+            const double half = rr / std::numbers::sqrt2;
+            if (std::abs(dot(d, *d1)) < half && std::abs(dot(d, *d2)) < half) return true;
           }
         }
     return false;
@@ -371,7 +381,10 @@ std::vector<Vec2> frontal_points(const cad::FaceGeometry& surface, std::span<con
         continue;
       }
       const double hy = spacing_at(uv);
-      if (index.crowded(ey.p, options.min_distance * hy)) {
+      const bool crowded = options.cross_aligned_exclusion
+                               ? index.crowded(ey.p, options.min_distance * hy, &d1, &d2)
+                               : index.crowded(ey.p, options.min_distance * hy);
+      if (crowded) {
         ++st.too_close;
         continue;
       }

@@ -15,6 +15,7 @@
 #include <gp_Ax2.hxx>
 #include <gp_Circ.hxx>
 #include <gp_Pnt.hxx>
+#include <span>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -154,6 +155,56 @@ TEST(Frontal, PointsRespectTheMinimumSpacingAndAreDeterministic) {
   const double expected = 3.14159 * 9 / (spacing * spacing);
   EXPECT_GT(static_cast<double>(pts.size() + nb), 0.7 * expected);
   EXPECT_EQ(pts, frontal_points(*surface, loops, guide, options));
+}
+
+// Points of `pts` whose nearest other point (boundary points included) is closer than 0.8 x
+// spacing along a diagonal of the cross there (30 to 60 degrees from both branches): where two
+// fronts offset by half a spacing interleave into a lattice turned by 45 degrees.
+int diagonal_neighbours(const cad::FaceGeometry& surface, std::span<const mesh::BoundaryLoop> loops,
+                        const FaceGuide& guide, const std::vector<Vec2>& pts, double spacing) {
+  std::vector<Vec3> all;
+  for (const auto& L : loops)
+    for (const auto& b : L.points) all.push_back(b.xyz);
+  const std::size_t nb = all.size();
+  for (const Vec2& uv : pts) all.push_back(surface.eval(uv).p);
+  int diagonal = 0;
+  for (std::size_t i = nb; i < all.size(); ++i) {
+    std::size_t best = i;
+    double d_best = 1e300;
+    for (std::size_t j = 0; j < all.size(); ++j)
+      if (j != i && distance(all[i], all[j]) < d_best) d_best = distance(all[i], all[best = j]);
+    if (d_best >= 0.8 * spacing) continue;
+    const Vec3 d = (all[best] - all[i]) / d_best;
+    const auto cross = guide.at(pts[i - nb]).cross;
+    const double c0 = std::abs(dot(d, normalized(cross[0]))), c1 = std::abs(dot(d, normalized(cross[1])));
+    if (c0 > 0.5 && c0 < 0.866 && c1 > 0.5 && c1 < 0.866) ++diagonal;
+  }
+  return diagonal;
+}
+
+TEST(Frontal, FrontsDoNotInterleaveAcrossTheCross) {
+  // On a disk the fronts from the circle meet in the middle with every offset. With a disk-shaped
+  // exclusion zone of radius 0.5 spacing a point half a spacing off diagonally passes (0.71), and
+  // interleaved fronts form patches of a lattice turned by 45 degrees; the square zone along the
+  // cross rejects it.
+  const auto model = disk(3);
+  const Prepared p = prepare(model, 0.2);
+  const FaceGuide guide(p.background, p.cf, p.sizes);
+  const auto surface = model.face_geometry(0);
+  const auto loops = background::face_boundary(model, 0, *surface, p.halved);
+  FrontalOptions square;
+  ASSERT_TRUE(square.cross_aligned_exclusion);
+  FrontalOptions round = square;
+  round.cross_aligned_exclusion = false;
+  const double spacing = square.spacing_factor * 0.2;
+  const std::vector<Vec2> a = frontal_points(*surface, loops, guide, square);
+  const std::vector<Vec2> b = frontal_points(*surface, loops, guide, round);
+  const int da = diagonal_neighbours(*surface, loops, guide, a, spacing);
+  const int db = diagonal_neighbours(*surface, loops, guide, b, spacing);
+  std::printf("points %zu / %zu, with a diagonal nearest neighbour: square %d, disk %d\n", a.size(),
+              b.size(), da, db);
+  EXPECT_LT(da, static_cast<int>(a.size()) / 12);  // near the singularities some are natural
+  EXPECT_GT(db, 3 * da);
 }
 
 TEST(Unstructured, RectangleWithAxisAlignedFieldGivesARegularGrid) {

@@ -59,9 +59,19 @@ struct FrontalOptions {
   /// Target spacing = spacing_factor x the size map. 2 at the halved level of the pipeline (the
   /// triangles become quads of half their size by midpoint subdivision).
   double spacing_factor = 2.0;
-  /// A point closer than min_distance x its target spacing to an existing point is rejected (0.6:
-  /// fewest irregular vertices on Block.stp among 0.5, 0.6, 0.7, 0.8).
-  double min_distance = 0.6;
+  /// A candidate is rejected when an existing point lies in its exclusion zone: the square of
+  /// half-width min_distance x its target spacing with sides along the cross at the point it was
+  /// proposed from (cross_aligned_exclusion, as Gmsh's frontal quad mesher), else the disk of
+  /// that radius. With the disk, two fronts offset by half a spacing interleave (the diagonal
+  /// neighbour at 0.71 x spacing passes) into a lattice turned by 45 degrees: mambo_s34's H-shaped
+  /// face 41 had such a region of about 3000 quads across its middle, where the cross field is
+  /// aligned with the sides (719 irregular vertices in its all-quad mesh, 112 with the square).
+  /// Square, end to end at the reference vertex counts (docs/benchmarks.md), min_distance 0.5 /
+  /// 0.55 / 0.6: interior irregular Block 1.83 / 2.01 / 2.03%, A319 4.57 / 5.26 / 5.58%, mambo
+  /// 0.25 / 0.26 / 0.24%; SICN avg mambo 0.971 / 0.974 / 0.976. The disk had its best at 0.6
+  /// (Block 2.03%, A319 5.06%, mambo 0.39% and SICN avg 0.959).
+  double min_distance = 0.5;
+  bool cross_aligned_exclusion = true;
   /// At most this many interior points (guards against runaway insertion).
   std::int64_t max_points = 5'000'000;
 };
@@ -80,7 +90,8 @@ struct FrontalStats {
 /// plane, mapped to (u, v) by Gauss-Newton on the surface Jacobian, then evaluated on the
 /// surface). A proposal is kept when it is inside the face (even-odd test on the loops in
 /// (u, v)) and no existing point (boundary points and samples along the boundary segments
-/// included) lies within min_distance x its spacing in 3D (multilevel uniform hash grids); kept
+/// included) lies in its exclusion zone (FrontalOptions::cross_aligned_exclusion, min_distance x
+/// its spacing, in 3D; multilevel uniform hash grids); kept
 /// points join the end of the queue. Returns the (u, v) of the accepted points in insertion order.
 /// Deterministic. Seams: their two parameter-plane images are boundary segments, the 3D distance
 /// test sees across them. Poles: the 3D test sees the pole; the Gauss-Newton step is damped there.
