@@ -137,9 +137,10 @@ std::vector<int> corner_ideal_valences(const mesh::FaceMesh& m, const DiskRemesh
 }
 
 // Vertices where the surface normal vanishes (poles): their quads fan out of a collapsed curve, so
-// the angles there say nothing about the valence they should have. A seam vertex is not one of them:
-// each of its two images (same (dim, entity, index), one per side of the seam in uv) is a curve
-// vertex of the face on its own side, ideal valence 2, and its curve edges stay in the cavity cycle.
+// the angles there say nothing about the valence they should have. A seam vertex is not one of
+// them: each of its two images (same (dim, entity, index), one per side of the seam in uv) is a
+// curve vertex of the face on its own side, ideal valence 2, and its curve edges stay in the
+// cavity cycle.
 std::vector<char> poles(const mesh::FaceMesh& m, const cad::FaceGeometry& surface) {
   const LO nv = m.num_vertices();
   std::vector<char> flag(nv, 0);
@@ -212,10 +213,10 @@ struct Work {
 //  - Rules: first the replacement minimising Eq. 15, kept only when it lowers Eq. 15 over the
 //    cavity. For a corner or curve defect that finds nothing, has fewer quads than its ideal
 //    valence and a poor one (DiskRemeshOptions::force_below_sicn), then the priorities of
-//    Sec. 6.3.2 alone: the defect must reach its ideal valence, corners (and curves when fixing a curve) must
-//    end ideal or unchanged, and face-interior vertices may get worse within the relaxed range. A
-//    curve vertex with one quad spans 180 degrees (SICN near 0) and an interior vertex of valence
-//    3 or 5 costs the same in Eq. 15, yet only the first is a bad quad.
+//    Sec. 6.3.2 alone: the defect must reach its ideal valence, corners (and curves when fixing a
+//    curve) must end ideal or unchanged, and face-interior vertices may get worse within the
+//    relaxed range. A curve vertex with one quad spans 180 degrees (SICN near 0) and an interior
+//    vertex of valence 3 or 5 costs the same in Eq. 15, yet only the first is a bad quad.
 //  - Cavities: the quads of x; then those with every quad around their face-interior vertices
 //    added (Gmsh's implementation tries that larger patch first). A curve vertex with one quad has
 //    no replacement of that quad alone that gives it two.

@@ -176,7 +176,8 @@ int diagonal_neighbours(const cad::FaceGeometry& surface, std::span<const mesh::
     if (d_best >= 0.8 * spacing) continue;
     const Vec3 d = (all[best] - all[i]) / d_best;
     const auto cross = guide.at(pts[i - nb]).cross;
-    const double c0 = std::abs(dot(d, normalized(cross[0]))), c1 = std::abs(dot(d, normalized(cross[1])));
+    const double c0 = std::abs(dot(d, normalized(cross[0])));
+    const double c1 = std::abs(dot(d, normalized(cross[1])));
     if (c0 > 0.5 && c0 < 0.866 && c1 > 0.5 && c1 < 0.866) ++diagonal;
   }
   return diagonal;
