@@ -340,6 +340,19 @@ bool Work::try_cavity(LO x, std::vector<LO> cav, bool force) {  // cav by value:
   }
   for (LO q : ring) min_before = std::min(min_before, sicn(quads[q]));
   const int sign = orient >= 0 ? 1 : -1;
+  // Corners turning against the surface normal at their vertex. On a strongly curved surface a
+  // valid quad (SICN > 0 about its own normal) may have some already, e.g. quads wrapping a wing's
+  // leading edge: the replacement may not add any, but need not remove those of the ring.
+  const auto backward_corners = [&](const std::array<LO, 4>& q, const std::vector<Vec3>& p,
+                                    const std::vector<Vec2>& u) {
+    int backward = 0;
+    for (int k = 0; k < 4; ++k)  // at a pole (no normal) the quad's SICN alone decides
+      if (norm(surface.normal(u[q[k]])) > 0 && corner_turn(q, k, p, u) * sign <= 0) ++backward;
+    return backward;
+  };
+  int backward_before = 0;
+  for (LO q : cav) backward_before += backward_corners(quads[q], points, uv);
+  for (LO q : ring) backward_before += backward_corners(quads[q], points, uv);
 
   // The region as a face mesh of its own. Free: new vertices, and dim-2 vertices whose quads after
   // the change all lie in the region; the others are locked for smooth_face by classifying them as
@@ -370,13 +383,12 @@ bool Work::try_cavity(LO x, std::vector<LO> cav, bool force) {  // cav by value:
   const mesh::FaceMesh smoothed = smooth::smooth_face(sub, surface, options.smoothing);
 
   double min_after = 1.0;
+  int backward_after = 0;
   for (const auto& q : smoothed.quads) {
     min_after = std::min(min_after, sicn_of(q, smoothed.points));
-    for (int k = 0; k < 4; ++k)
-      if (norm(surface.normal(smoothed.uv[q[k]])) > 0 &&
-          corner_turn(q, k, smoothed.points, smoothed.uv) * sign <= 0)
-        min_after = -1.0;  // at a pole (no normal) the quad's SICN alone decides
+    backward_after += backward_corners(q, smoothed.points, smoothed.uv);
   }
+  if (backward_after > backward_before) min_after = -1.0;
   const bool good =
       min_after >= options.min_sicn || (options.accept_if_not_worse && min_after >= min_before);
   if (!(min_after > 0 && good)) {

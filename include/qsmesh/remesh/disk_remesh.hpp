@@ -108,9 +108,11 @@ struct DiskRemeshOptions {
   /// the built-in example 0.036 -> 0.140 and of mambo_s34 0.294 -> 0.468, for 10 and 5 more
   /// interior irregular vertices.
   double force_below_sicn = 0.3;
-  /// Geometry acceptance: every quad of the enlarged cavity must have SICN > 0 and turn with the
-  /// face normal at its four corners, and its minimum SICN must reach min_sicn or, when
-  /// accept_if_not_worse, the minimum of the same region before the change.
+  /// Geometry acceptance: every quad of the enlarged cavity must have SICN > 0, the region may not
+  /// have more corners turning against the surface normal at their vertex than before (on a
+  /// strongly curved surface valid quads can have some: coarse quads around a leading edge), and
+  /// its minimum SICN must reach min_sicn or, when accept_if_not_worse, the minimum of the same
+  /// region before the change.
   double min_sicn = 0.3;
   bool accept_if_not_worse = true;
   smooth::SmoothOptions smoothing{};  ///< on the enlarged cavity, its boundary locked
@@ -142,7 +144,7 @@ struct DiskRemeshStats {
 /// never a defect; on a cavity's boundary it keeps its valence. New interior vertices start at the
 /// harmonic (uniform Tutte) position in uv; the enlarged cavity (the new quads and every quad
 /// touching them) is smoothed with smooth::smooth_face with its boundary locked, then checked
-/// (DiskRemeshOptions::min_sicn): a transaction, the whole replacement is kept or nothing changes.
+/// (DiskRemeshOptions::min_sicn and the acceptance above it): a transaction, the whole replacement is kept or nothing changes.
 /// dim-0 and dim-1 vertices never move. Deterministic (fixed order, no threads).
 /// Returns the new mesh: surviving vertices in their order then the new ones; quads likewise.
 [[nodiscard]] mesh::FaceMesh remesh_disk_defects(const mesh::FaceMesh& mesh,
