@@ -250,8 +250,8 @@ TEST_F(Qsmesh, ExampleQuasiStructuredHasNoFlatQuad) {
   const std::string step = tmp("e2e_wing_body_qs.step");
   ASSERT_EQ(run("example wing-body -o " + step).code, 0);
   const std::string stats = tmp("e2e_wing_body_qs.json");
-  const ExeResult r =
-      run("mesh " + step + " -o " + tmp("e2e_wing_body_qs.msh") + " --threads 2 -q --stats " + stats);
+  const ExeResult r = run("mesh " + step + " -o " + tmp("e2e_wing_body_qs.msh") +
+                          " --threads 2 -q --stats " + stats);
   ASSERT_EQ(r.code, 0) << r.err;
   const std::string json = slurp(stats);
   EXPECT_EQ(json_number(json, "triangles"), 0);

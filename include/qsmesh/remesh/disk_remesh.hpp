@@ -144,7 +144,8 @@ struct DiskRemeshStats {
 /// never a defect; on a cavity's boundary it keeps its valence. New interior vertices start at the
 /// harmonic (uniform Tutte) position in uv; the enlarged cavity (the new quads and every quad
 /// touching them) is smoothed with smooth::smooth_face with its boundary locked, then checked
-/// (DiskRemeshOptions::min_sicn and the acceptance above it): a transaction, the whole replacement is kept or nothing changes.
+/// (DiskRemeshOptions::min_sicn and the acceptance there): a transaction, the whole replacement
+/// is kept or nothing changes.
 /// dim-0 and dim-1 vertices never move. Deterministic (fixed order, no threads).
 /// Returns the new mesh: surviving vertices in their order then the new ones; quads likewise.
 [[nodiscard]] mesh::FaceMesh remesh_disk_defects(const mesh::FaceMesh& mesh,
