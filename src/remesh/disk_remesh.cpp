@@ -342,7 +342,7 @@ bool Work::try_cavity(LO x, std::vector<LO> cav, bool force) {  // cav by value:
   const int sign = orient >= 0 ? 1 : -1;
   // Corners turning against the surface normal at their vertex. On a strongly curved surface a
   // valid quad (SICN > 0 about its own normal) may have some already, e.g. quads wrapping a wing's
-  // leading edge: the replacement may not add any, but need not remove those of the ring.
+  // leading edge: the region may not end with more of them than it had, instead of none.
   const auto backward_corners = [&](const std::array<LO, 4>& q, const std::vector<Vec3>& p,
                                     const std::vector<Vec2>& u) {
     int backward = 0;
