@@ -18,8 +18,12 @@ AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
   const fs::path p(path_);
   // Same folder as the target, so that rename() never crosses file systems; the pid keeps two
   // processes writing the same name apart.
-  const fs::path temp =
-      p.parent_path() / ("." + p.filename().string() + ".tmp." + std::to_string(::getpid()));
+  // Appended rather than "." + ...: GCC 12 reports a false -Wrestrict on that concatenation.
+  std::string name = ".";
+  name += p.filename().string();
+  name += ".tmp.";
+  name += std::to_string(::getpid());
+  const fs::path temp = p.parent_path() / name;
   temp_ = temp.string();
   std::error_code ec;
   fs::remove(temp, ec);
