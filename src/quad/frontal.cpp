@@ -222,16 +222,16 @@ class PointIndex {
 
   /// True when some point j lies closer to p than r x weight_j; with a frame (d1, d2: unit,
   /// orthogonal), when j lies in the square of half-width r x weight_j around p with sides along
-  /// d1 and d2 (its offset along the normal is not bounded).
+  /// d1 and d2 and within its circumscribed sphere (which bounds the offset along the normal).
   [[nodiscard]] bool crowded(const Vec3& p, double r, const Vec3* d1 = nullptr,
                              const Vec3* d2 = nullptr) const {
     const bool square = d1 != nullptr && d2 != nullptr;
-    if (square) r *= std::numbers::sqrt2;  // the search reaches the square's corners
+    const double reach = square ? r * std::numbers::sqrt2 : r;  // to the square's corners
     int l = 0;
-    while (l + 1 < levels_ && cell(l) < r) ++l;
+    while (l + 1 < levels_ && cell(l) < reach) ++l;
     const double c = cell(l);
     const std::int64_t x = coord(p.x, c), y = coord(p.y, c), z = coord(p.z, c);
-    const auto ring = static_cast<std::int64_t>(std::max(1.0, std::ceil(r / c)));
+    const auto ring = static_cast<std::int64_t>(std::max(1.0, std::ceil(reach / c)));
     const auto& grid = grids_[l];
     for (std::int64_t i = x - ring; i <= x + ring; ++i)
       for (std::int64_t j = y - ring; j <= y + ring; ++j)
@@ -239,11 +239,11 @@ class PointIndex {
           const auto it = grid.find(key(i, j, k));
           if (it == grid.end()) continue;
           for (LO id : it->second) {
-            const double rr = r * weight_[id];
+            const double rr = reach * weight_[id];
             const Vec3 d = pts_[id] - p;
             if (norm2(d) >= rr * rr) continue;
             if (!square) return true;
-            const double half = rr / std::numbers::sqrt2;
+            const double half = r * weight_[id];
             if (std::abs(dot(d, *d1)) < half && std::abs(dot(d, *d2)) < half) return true;
           }
         }
@@ -381,10 +381,9 @@ std::vector<Vec2> frontal_points(const cad::FaceGeometry& surface, std::span<con
         continue;
       }
       const double hy = spacing_at(uv);
-      const bool crowded = options.cross_aligned_exclusion
-                               ? index.crowded(ey.p, options.min_distance * hy, &d1, &d2)
-                               : index.crowded(ey.p, options.min_distance * hy);
-      if (crowded) {
+      const bool square = options.cross_aligned_exclusion;
+      if (index.crowded(ey.p, options.min_distance * hy, square ? &d1 : nullptr,
+                        square ? &d2 : nullptr)) {
         ++st.too_close;
         continue;
       }

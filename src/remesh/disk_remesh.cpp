@@ -5,7 +5,6 @@
 #include <map>
 #include <numbers>
 #include <set>
-#include <tuple>
 #include <utility>
 
 #include "qsmesh/core/error.hpp"
@@ -189,15 +188,17 @@ struct Work {
     return mesh::quad_sicn({p[q[0]], p[q[1]], p[q[2]], p[q[3]]});
   }
   [[nodiscard]] double sicn(const std::array<LO, 4>& q) const { return sicn_of(q, points); }
-  // Number of corners of q turning with the surface normal minus those turning against it.
-  [[nodiscard]] int orientation(const std::array<LO, 4>& q, const std::vector<Vec3>& p,
-                                const std::vector<Vec2>& u) const {
-    int s = 0;
+  // Corners of q turning with (first) and against (second) the surface normal at their vertex; a
+  // corner where the surface has no normal (a pole) counts for neither.
+  [[nodiscard]] std::pair<int, int> turns(const std::array<LO, 4>& q, const std::vector<Vec3>& p,
+                                          const std::vector<Vec2>& u) const {
+    std::pair<int, int> n{0, 0};
     for (int k = 0; k < 4; ++k) {
       const double t = corner_turn(q, k, p, u);
-      s += t > 0 ? 1 : t < 0 ? -1 : 0;  // 0: no normal there (a pole)
+      n.first += t > 0 ? 1 : 0;
+      n.second += t < 0 ? 1 : 0;
     }
-    return s;
+    return n;
   }
   [[nodiscard]] double corner_turn(const std::array<LO, 4>& q, int k, const std::vector<Vec3>& p,
                                    const std::vector<Vec2>& u) const {
@@ -226,13 +227,15 @@ bool Work::try_fix(LO x) {
   if (options.larger_cavity)
     for (LO q : small)
       for (LO v : quads[q])
-        if (vclass[v].dim == 2 && !pole[v]) grown.insert(v2q[v].begin(), v2q[v].end());
+        if (vclass[v].dim == 2) grown.insert(v2q[v].begin(), v2q[v].end());
   std::vector<std::vector<LO>> cavities{small};
   if (grown.size() > small.size()) cavities.emplace_back(grown.begin(), grown.end());
-  double worst = 1;
-  for (LO q : small) worst = std::min(worst, sicn(quads[q]));
-  const bool may_force = kind_of(vclass[x]) != VertexKind::interior &&
-                         valence(x) < ideal_valence(x) && worst < options.force_below_sicn;
+  bool may_force = kind_of(vclass[x]) != VertexKind::interior && valence(x) < ideal_valence(x);
+  if (may_force) {
+    double worst = 1;
+    for (LO q : small) worst = std::min(worst, sicn(quads[q]));
+    may_force = worst < options.force_below_sicn;
+  }
   for (int rule = 0; rule < (may_force ? 2 : 1); ++rule)
     for (const auto& cav : cavities)
       if (try_cavity(x, cav, rule == 1)) return true;
@@ -270,7 +273,7 @@ bool Work::try_cavity(LO x, std::vector<LO> cav, bool force) {  // cav by value:
       if (!on_cycle.count(v) && std::find(inner.begin(), inner.end(), v) == inner.end())
         inner.push_back(v);
   for (LO v : inner) {
-    bool inside = vclass[v].dim == 2 && !pole[v];
+    bool inside = vclass[v].dim == 2;
     for (LO q : v2q[v]) inside = inside && in_cavity.count(q) > 0;
     if (!inside) return refuse(stats.skipped);
   }
@@ -331,28 +334,25 @@ bool Work::try_cavity(LO x, std::vector<LO> cav, bool force) {  // cav by value:
       if (!in_cavity.count(q)) ring.insert(q);
   std::vector<std::array<LO, 4>> region(new_quads);
   for (LO q : ring) region.push_back(quads[q]);
-  // Before: the old cavity and the same ring.
+  // Before: the old cavity and the same ring. The orientation is the old cavity's majority (the
+  // mesh's own convention, counter-clockwise about the normal, normally). Corners turning against
+  // it: on a strongly curved surface a valid quad (SICN > 0 about its own normal) may have some,
+  // e.g. quads wrapping a wing's leading edge, so the region may not end with more of them than it
+  // had, instead of none.
   double min_before = 1.0;
-  int orient = 0;  // the mesh's own convention (counter-clockwise about the normal, normally)
-  for (LO q : cav) {
+  int orient = 0;
+  std::pair<int, int> turns_before{0, 0};
+  const auto count_before = [&](LO q) {
     min_before = std::min(min_before, sicn(quads[q]));
-    orient += orientation(quads[q], points, uv);
-  }
-  for (LO q : ring) min_before = std::min(min_before, sicn(quads[q]));
-  const int sign = orient >= 0 ? 1 : -1;
-  // Corners turning against the surface normal at their vertex. On a strongly curved surface a
-  // valid quad (SICN > 0 about its own normal) may have some already, e.g. quads wrapping a wing's
-  // leading edge: the region may not end with more of them than it had, instead of none.
-  const auto backward_corners = [&](const std::array<LO, 4>& q, const std::vector<Vec3>& p,
-                                    const std::vector<Vec2>& u) {
-    int backward = 0;
-    for (int k = 0; k < 4; ++k)  // at a pole (no normal) the quad's SICN alone decides
-      if (norm(surface.normal(u[q[k]])) > 0 && corner_turn(q, k, p, u) * sign <= 0) ++backward;
-    return backward;
+    const auto [with, against] = turns(quads[q], points, uv);
+    turns_before.first += with;
+    turns_before.second += against;
+    return with - against;
   };
-  int backward_before = 0;
-  for (LO q : cav) backward_before += backward_corners(quads[q], points, uv);
-  for (LO q : ring) backward_before += backward_corners(quads[q], points, uv);
+  for (LO q : cav) orient += count_before(q);
+  for (LO q : ring) count_before(q);
+  const bool ccw = orient >= 0;
+  const int backward_before = ccw ? turns_before.second : turns_before.first;
 
   // The region as a face mesh of its own. Free: new vertices, and dim-2 vertices whose quads after
   // the change all lie in the region; the others are locked for smooth_face by classifying them as
@@ -371,7 +371,7 @@ bool Work::try_cavity(LO x, std::vector<LO> cav, bool force) {  // cav by value:
       }
   for (const auto& [v, lv] : local) {
     bool free_vertex = v >= first_new;
-    if (!free_vertex && vclass[v].dim == 2 && !pole[v]) {
+    if (!free_vertex && vclass[v].dim == 2) {
       free_vertex = true;
       for (LO q : v2q[v])
         if (!in_cavity.count(q) && !ring.count(q)) free_vertex = false;
@@ -386,7 +386,8 @@ bool Work::try_cavity(LO x, std::vector<LO> cav, bool force) {  // cav by value:
   int backward_after = 0;
   for (const auto& q : smoothed.quads) {
     min_after = std::min(min_after, sicn_of(q, smoothed.points));
-    backward_after += backward_corners(q, smoothed.points, smoothed.uv);
+    const auto [with, against] = turns(q, smoothed.points, smoothed.uv);
+    backward_after += ccw ? against : with;
   }
   if (backward_after > backward_before) min_after = -1.0;
   const bool good =
@@ -431,9 +432,9 @@ bool Work::try_cavity(LO x, std::vector<LO> cav, bool force) {  // cav by value:
 
 LO count_defects(const mesh::FaceMesh& m, const DiskRemeshOptions& options) {
   const std::vector<int> ideal = corner_ideal_valences(m, options);
-  std::map<std::tuple<int, LO, LO>, int> uses;
+  std::map<LO, int> corner_uses;  // images of each CAD corner in the mesh
   for (const auto& c : m.vclass)
-    if (c.dim != 2) ++uses[{int(c.dim), c.entity, c.dim == 1 ? c.index : kNoIndex}];
+    if (c.dim == 0) ++corner_uses[c.entity];
   std::vector<int> val(m.num_vertices(), 0);
   for (const auto& q : m.quads)
     for (LO v : q) ++val[v];
@@ -443,7 +444,7 @@ LO count_defects(const mesh::FaceMesh& m, const DiskRemeshOptions& options) {
     if (val[v] == 0) continue;
     if (c.dim == 2) {
       defects += val[v] >= 6 ? 1 : 0;
-    } else if (c.dim == 1 || uses[{int(c.dim), c.entity, kNoIndex}] == 1) {
+    } else if (c.dim == 1 || corner_uses[c.entity] == 1) {
       // A seam image is a curve vertex of its side; a corner seen twice (a seam end, a pole) has
       // no ideal valence known here.
       defects += val[v] != (c.dim == 1 ? 2 : ideal[v]) ? 1 : 0;

@@ -64,6 +64,21 @@ bool nothing_written(const std::string& dir, const std::string& stem) {
   return true;
 }
 
+/// `qsmesh mesh MODEL -o NAME.msh OPTIONS -q --stats NAME.json` (files in the test folder): the
+/// run's result and its statistics JSON (empty when the run failed).
+struct MeshRun {
+  ExeResult exe;
+  std::string json;
+};
+MeshRun mesh_with_stats(const std::string& model, const std::string& options,
+                        const std::string& name) {
+  const std::string stats = tmp(name + ".json");
+  MeshRun m;
+  m.exe = run("mesh " + model + " -o " + tmp(name + ".msh") + " " + options + " -q --stats " + stats);
+  if (m.exe.code == 0) m.json = slurp(stats);
+  return m;
+}
+
 class Qsmesh : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
@@ -147,10 +162,8 @@ TEST_F(Qsmesh, UnstructuredValidOnSmallModels) {
   }
   for (const std::string& model : models) {
     SCOPED_TRACE(model);
-    const std::string stats = tmp("e2e_valid.json");
-    const ExeResult r = run("mesh " + model + " -o " + tmp("e2e_valid.msh") + " --until unstructured --threads 2 -q --stats " + stats);
+    const auto [r, json] = mesh_with_stats(model, "--until unstructured --threads 2", "e2e_valid");
     ASSERT_EQ(r.code, 0) << r.err;
-    const std::string json = slurp(stats);
     EXPECT_EQ(json_number(json, "triangles"), 0);
     EXPECT_GT(json_number(json, "quads"), 1000);
     EXPECT_EQ(json_number(json, "faces_failed"), 0) << r.err;
@@ -169,11 +182,9 @@ TEST_F(Qsmesh, UnstructuredValidOnSmallModels) {
 TEST_F(Qsmesh, FuselageKeepsFrontalPathAtCoarseSize) {
   const std::string path = std::string(QSMESH_SHARED_CAD_DIR) + "/wing_fuselage.step";
   if (!fs::exists(path)) GTEST_SKIP() << path << " not found";
-  const std::string stats = tmp("e2e_fuselage.json");
-  const ExeResult r = run("mesh " + path + " -o " + tmp("e2e_fuselage.msh") +
-                          " --size-factor 0.08298 --until unstructured --threads 2 -q --stats " + stats);
+  const auto [r, json] = mesh_with_stats(
+      path, "--size-factor 0.08298 --until unstructured --threads 2", "e2e_fuselage");
   ASSERT_EQ(r.code, 0) << r.err;
-  const std::string json = slurp(stats);
   EXPECT_EQ(json_number(json, "faces_fell_back"), 0);
   EXPECT_GT(json_number(json, "sicn_min"), 0);
 }
@@ -249,11 +260,8 @@ TEST_F(Qsmesh, ExampleWingBody) {
 TEST_F(Qsmesh, ExampleQuasiStructuredHasNoFlatQuad) {
   const std::string step = tmp("e2e_wing_body_qs.step");
   ASSERT_EQ(run("example wing-body -o " + step).code, 0);
-  const std::string stats = tmp("e2e_wing_body_qs.json");
-  const ExeResult r = run("mesh " + step + " -o " + tmp("e2e_wing_body_qs.msh") +
-                          " --threads 2 -q --stats " + stats);
+  const auto [r, json] = mesh_with_stats(step, "--threads 2", "e2e_wing_body_qs");
   ASSERT_EQ(r.code, 0) << r.err;
-  const std::string json = slurp(stats);
   EXPECT_EQ(json_number(json, "triangles"), 0);
   EXPECT_EQ(json_number(json, "faces_failed"), 0);
   EXPECT_GT(json_number(json, "sicn_min"), 0.2);

@@ -15,7 +15,7 @@
 #include <gp_Ax2.hxx>
 #include <gp_Circ.hxx>
 #include <gp_Pnt.hxx>
-#include <span>
+#include <memory>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -101,6 +101,24 @@ mesh::FaceMesh run_face(const cad::CadModel& model, const Prepared& p, Unstructu
   return mesh_face_unstructured(model, 0, p.halved, p.full, fields, options, &rep);
 }
 
+// What frontal_points needs on a disk of radius 3 with a uniform size map `size`. Not copyable:
+// the guide refers to the prepared fields.
+struct DiskFront {
+  explicit DiskFront(double size)
+      : model(disk(3)),
+        p(prepare(model, size)),
+        guide(p.background, p.cf, p.sizes),
+        surface(model.face_geometry(0)),
+        loops(background::face_boundary(model, 0, *surface, p.halved)) {}
+  DiskFront(const DiskFront&) = delete;
+  DiskFront& operator=(const DiskFront&) = delete;
+  cad::CadModel model;
+  Prepared p;
+  FaceGuide guide;
+  std::unique_ptr<cad::FaceGeometry> surface;
+  std::vector<mesh::BoundaryLoop> loops;
+};
+
 TEST(FaceGuide, InterpolatesTheSizeAndFindsTheCross) {
   const auto model = rectangle(4, 3);
   Prepared p = prepare(model, 0.5);
@@ -127,14 +145,13 @@ TEST(FaceGuide, InterpolatesTheSizeAndFindsTheCross) {
 }
 
 TEST(Frontal, PointsRespectTheMinimumSpacingAndAreDeterministic) {
-  const auto model = disk(3);
-  const Prepared p = prepare(model, 0.4);
-  const FaceGuide guide(p.background, p.cf, p.sizes);
-  const auto surface = model.face_geometry(0);
-  const auto loops = background::face_boundary(model, 0, *surface, p.halved);
+  const DiskFront f(0.4);
+  const cad::FaceGeometry& surface = *f.surface;
+  const auto& loops = f.loops;
+  const FaceGuide& guide = f.guide;
   FrontalOptions options;
   FrontalStats stats;
-  const std::vector<Vec2> pts = frontal_points(*surface, loops, guide, options, &stats);
+  const std::vector<Vec2> pts = frontal_points(surface, loops, guide, options, &stats);
   ASSERT_GT(pts.size(), 20U);
   EXPECT_EQ(stats.accepted, static_cast<std::int64_t>(pts.size()));
   EXPECT_GT(stats.too_close, 0);
@@ -144,7 +161,7 @@ TEST(Frontal, PointsRespectTheMinimumSpacingAndAreDeterministic) {
   const std::size_t nb = all.size();
   for (const Vec2& uv : pts) {
     EXPECT_LT(uv.u * uv.u + uv.v * uv.v, 9.0) << "point outside the disk";
-    all.push_back(surface->eval(uv).p);
+    all.push_back(surface.eval(uv).p);
   }
   const double spacing = options.spacing_factor * 0.4;
   double closest = 1e300;
@@ -154,28 +171,29 @@ TEST(Frontal, PointsRespectTheMinimumSpacingAndAreDeterministic) {
   // The disk is covered: about area / spacing^2 points.
   const double expected = 3.14159 * 9 / (spacing * spacing);
   EXPECT_GT(static_cast<double>(pts.size() + nb), 0.7 * expected);
-  EXPECT_EQ(pts, frontal_points(*surface, loops, guide, options));
+  EXPECT_EQ(pts, frontal_points(surface, loops, guide, options));
 }
 
-// Points of `pts` whose nearest other point (boundary points included) is closer than 0.8 x
+// Points of `pts` (frontal points of `f`) whose nearest other point (boundary points included) is closer than 0.8 x
 // spacing along a diagonal of the cross there (30 to 60 degrees from both branches): where two
 // fronts offset by half a spacing interleave into a lattice turned by 45 degrees.
-int diagonal_neighbours(const cad::FaceGeometry& surface, std::span<const mesh::BoundaryLoop> loops,
-                        const FaceGuide& guide, const std::vector<Vec2>& pts, double spacing) {
+int diagonal_neighbours(const DiskFront& f, const std::vector<Vec2>& pts, double spacing) {
   std::vector<Vec3> all;
-  for (const auto& L : loops)
+  for (const auto& L : f.loops)
     for (const auto& b : L.points) all.push_back(b.xyz);
   const std::size_t nb = all.size();
-  for (const Vec2& uv : pts) all.push_back(surface.eval(uv).p);
+  for (const Vec2& uv : pts) all.push_back(f.surface->eval(uv).p);
   int diagonal = 0;
   for (std::size_t i = nb; i < all.size(); ++i) {
     std::size_t best = i;
     double d_best = 1e300;
-    for (std::size_t j = 0; j < all.size(); ++j)
-      if (j != i && distance(all[i], all[j]) < d_best) d_best = distance(all[i], all[best = j]);
+    for (std::size_t j = 0; j < all.size(); ++j) {
+      const double d = j != i ? distance(all[i], all[j]) : d_best;
+      if (d < d_best) d_best = d, best = j;
+    }
     if (d_best >= 0.8 * spacing) continue;
     const Vec3 d = (all[best] - all[i]) / d_best;
-    const auto cross = guide.at(pts[i - nb]).cross;
+    const auto cross = f.guide.at(pts[i - nb]).cross;
     const double c0 = std::abs(dot(d, normalized(cross[0])));
     const double c1 = std::abs(dot(d, normalized(cross[1])));
     if (c0 > 0.5 && c0 < 0.866 && c1 > 0.5 && c1 < 0.866) ++diagonal;
@@ -188,20 +206,19 @@ TEST(Frontal, FrontsDoNotInterleaveAcrossTheCross) {
   // exclusion zone of radius 0.5 spacing a point half a spacing off diagonally passes (0.71), and
   // interleaved fronts form patches of a lattice turned by 45 degrees; the square zone along the
   // cross rejects it.
-  const auto model = disk(3);
-  const Prepared p = prepare(model, 0.2);
-  const FaceGuide guide(p.background, p.cf, p.sizes);
-  const auto surface = model.face_geometry(0);
-  const auto loops = background::face_boundary(model, 0, *surface, p.halved);
+  const DiskFront f(0.2);
+  const cad::FaceGeometry& surface = *f.surface;
+  const auto& loops = f.loops;
+  const FaceGuide& guide = f.guide;
   FrontalOptions square;
   ASSERT_TRUE(square.cross_aligned_exclusion);
   FrontalOptions round = square;
   round.cross_aligned_exclusion = false;
   const double spacing = square.spacing_factor * 0.2;
-  const std::vector<Vec2> a = frontal_points(*surface, loops, guide, square);
-  const std::vector<Vec2> b = frontal_points(*surface, loops, guide, round);
-  const int da = diagonal_neighbours(*surface, loops, guide, a, spacing);
-  const int db = diagonal_neighbours(*surface, loops, guide, b, spacing);
+  const std::vector<Vec2> a = frontal_points(surface, loops, guide, square);
+  const std::vector<Vec2> b = frontal_points(surface, loops, guide, round);
+  const int da = diagonal_neighbours(f, a, spacing);
+  const int db = diagonal_neighbours(f, b, spacing);
   std::printf("points %zu / %zu, with a diagonal nearest neighbour: square %d, disk %d\n", a.size(),
               b.size(), da, db);
   EXPECT_LT(da, static_cast<int>(a.size()) / 12);  // near the singularities some are natural
