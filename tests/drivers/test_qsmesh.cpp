@@ -74,7 +74,8 @@ MeshRun mesh_with_stats(const std::string& model, const std::string& options,
                         const std::string& name) {
   const std::string stats = tmp(name + ".json");
   MeshRun m;
-  m.exe = run("mesh " + model + " -o " + tmp(name + ".msh") + " " + options + " -q --stats " + stats);
+  m.exe =
+      run("mesh " + model + " -o " + tmp(name + ".msh") + " " + options + " -q --stats " + stats);
   if (m.exe.code == 0) m.json = slurp(stats);
   return m;
 }

@@ -174,9 +174,10 @@ TEST(Frontal, PointsRespectTheMinimumSpacingAndAreDeterministic) {
   EXPECT_EQ(pts, frontal_points(surface, loops, guide, options));
 }
 
-// Points of `pts` (frontal points of `f`) whose nearest other point (boundary points included) is closer than 0.8 x
-// spacing along a diagonal of the cross there (30 to 60 degrees from both branches): where two
-// fronts offset by half a spacing interleave into a lattice turned by 45 degrees.
+// Points of `pts` (frontal points of `f`) whose nearest other point (boundary points included)
+// is closer than 0.8 x spacing along a diagonal of the cross there (30 to 60 degrees from both
+// branches): where two fronts offset by half a spacing interleave into a lattice turned by 45
+// degrees.
 int diagonal_neighbours(const DiskFront& f, const std::vector<Vec2>& pts, double spacing) {
   std::vector<Vec3> all;
   for (const auto& L : f.loops)
