@@ -182,6 +182,7 @@ std::int64_t total_irregular_boundary(const parallel::PipelineResult& r) {
 /// Totals of the quasi-structured stage over the faces.
 struct QuasiTotals {
   std::int64_t by_pattern = 0;
+  std::int64_t by_comparison = 0;  // of by_pattern: kept after comparing with the unstructured mesh
   std::int64_t irregular_before = 0, irregular_after = 0;  // cavity remeshing (Sec. 6.2)
   std::array<std::int64_t, 4> cavities{};                  // remeshed, by step
   std::int64_t defects_before = 0, defects_after = 0, disk_replaced = 0;  // Sec. 6.3
@@ -192,6 +193,7 @@ QuasiTotals quasi_totals(const parallel::PipelineResult& r) {
   QuasiTotals t;
   for (const auto& q : r.quasi_reports) {
     t.by_pattern += q.by_pattern ? 1 : 0;
+    t.by_comparison += q.by_comparison ? 1 : 0;
     t.irregular_before += q.irregular_before;
     t.irregular_after += q.irregular_after;
     for (int k = 0; k < 4; ++k) t.cavities[k] += q.cavities[k];
@@ -226,6 +228,9 @@ std::string stats_json(const Arguments& args, const Session& session,
   if (!r.quasi_reports.empty()) {
     const QuasiTotals t = quasi_totals(r);
     j.value("faces_meshed_by_pattern", t.by_pattern);  // Sec. 6.1.2
+    // Of those, the faces whose pattern mesh the quality thresholds refused but which was no
+    // worse than the unstructured path's (PipelineOptions::pattern_compare_tolerance).
+    j.value("faces_meshed_by_pattern_after_comparison", t.by_comparison);
     // Sec. 6.2 on the other faces: interior irregular vertices of their unstructured meshes
     // before and after cavity remeshing, cavities remeshed by step.
     j.value("irregular_unstructured_before", t.irregular_before);
@@ -314,7 +319,11 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
   if (s.quads > 0) os << "  SICN min/avg: " << s.sicn_min << " / " << s.sicn_avg << "\n";
   if (!r.quasi_reports.empty()) {
     const QuasiTotals t = quasi_totals(r);
-    os << "  faces meshed by patterns: " << t.by_pattern << " of " << model.num_faces() << "\n"
+    os << "  faces meshed by patterns: " << t.by_pattern << " of " << model.num_faces();
+    if (t.by_comparison > 0)
+      os << " (" << t.by_comparison
+         << " of them as good as their unstructured mesh, below the pattern thresholds)";
+    os << "\n"
        << "  cavity remeshing (other faces): irregular interior vertices " << t.irregular_before
        << " -> " << t.irregular_after << "; cavities remeshed by step " << t.cavities[0] << ", "
        << t.cavities[1] << ", " << t.cavities[2] << ", " << t.cavities[3] << "\n"

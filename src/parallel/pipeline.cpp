@@ -195,6 +195,7 @@ void unpack(const std::vector<char>& in, std::size_t& pos, quad::UnstructuredRep
 
 void pack(const QuasiReport& r, std::vector<char>& out) {
   put<std::uint8_t>(out, r.by_pattern ? 1 : 0);
+  put<std::uint8_t>(out, r.by_comparison ? 1 : 0);
   put_vec(out, std::vector<char>(r.pattern.begin(), r.pattern.end()));
   put_vec(out, std::vector<char>(r.refusal.begin(), r.refusal.end()));
   put<std::int64_t>(out, r.irregular_before);
@@ -208,6 +209,7 @@ void pack(const QuasiReport& r, std::vector<char>& out) {
 
 void unpack(const std::vector<char>& in, std::size_t& pos, QuasiReport& r) {
   r.by_pattern = get<std::uint8_t>(in, pos) != 0;
+  r.by_comparison = get<std::uint8_t>(in, pos) != 0;
   std::vector<char> text;
   get_vec(in, pos, text);
   r.pattern.assign(text.begin(), text.end());
@@ -371,6 +373,10 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
   const std::vector<qstruct::Pattern> patterns =
       quasi ? qstruct::builtin_patterns() : std::vector<qstruct::Pattern>{};
   std::vector<mesh::FaceMesh> quad_meshes(quads ? mine.size() : 0);
+  // Valid pattern meshes refused on quality, with their pattern's name, for the comparison with
+  // the unstructured path's result (PipelineOptions::pattern_compare_tolerance).
+  std::vector<mesh::FaceMesh> refused_patterns(quasi ? mine.size() : 0);
+  std::vector<std::string> refused_names(quasi ? mine.size() : 0);
   std::vector<double> face_seconds(quads ? mine.size() : 0, 0.0);
   if (quasi) {
     // Simple CAD faces meshed directly by a pattern (paper 000 Sec. 6.1.2, pipeline step 4); the
@@ -395,6 +401,10 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
         quad_meshes[i] = std::move(m);
       } else {
         quasi_reports[i].refusal = qstruct::to_string(pr.refusal);
+        if (options.pattern_compare_tolerance >= 0 && !pr.refused_mesh.quads.empty()) {
+          refused_patterns[i] = std::move(pr.refused_mesh);
+          refused_names[i] = pr.pattern_name;
+        }
       }
       face_seconds[i] += face_clock.seconds();
       const std::int64_t n = ++p_done;
@@ -486,6 +496,32 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
                 [&](std::int64_t i, const cad::FaceGeometry& surface) {
                   return smooth::smooth_face(quad_meshes[i], surface, options.final_smooth);
                 });
+      // Second look at the pattern meshes refused on quality: where the unstructured path did no
+      // better, the pattern's fewer irregular vertices win (a small triangle face is often the
+      // same three quads either way).
+      const double tol = options.pattern_compare_tolerance;
+      tasks.parallel_for(total, [&](std::int64_t i) {
+        if (refused_patterns[i].quads.empty()) return;
+        const mesh::FaceQuadStats pat = mesh::face_quad_stats(refused_patterns[i]);
+        bool take = !quad_reports[i].ok || !quad_meshes[i].triangles.empty() ||
+                    quad_meshes[i].quads.empty();
+        if (!take) {
+          const mesh::FaceQuadStats uns = mesh::face_quad_stats(quad_meshes[i]);
+          take = pat.sicn_min >= uns.sicn_min - tol && pat.sicn_avg >= uns.sicn_avg - tol &&
+                 pat.irregular_interior <= uns.irregular_interior;
+        }
+        if (take) {
+          quad_meshes[i] = std::move(refused_patterns[i]);
+          quad_reports[i] = quad::UnstructuredReport{};
+          quad_reports[i].ok = true;
+          quad_reports[i].sicn_min = pat.sicn_min;
+          quad_reports[i].quads = pat.quads;
+          quasi_reports[i].by_pattern = true;
+          quasi_reports[i].by_comparison = true;
+          quasi_reports[i].pattern = refused_names[i];
+        }
+        refused_patterns[i] = mesh::FaceMesh{};
+      });
     }
     meshes = std::move(quad_meshes);
   }

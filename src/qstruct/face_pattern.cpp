@@ -187,6 +187,7 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
   std::stable_sort(cands.begin(), cands.end(), [](const Candidate& a, const Candidate& b) { return a.score < b.score; });
 
   mesh::FaceMesh best;
+  bool best_valid = false;
   const int tries = std::min<int>(std::max(1, options.max_candidates), static_cast<int>(cands.size()));
   for (int k = 0; k < tries; ++k) {
     const Candidate& c = cands[k];
@@ -206,6 +207,7 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
     ++rep.candidates;
     const bool good = q.invalid == 0 && q.sicn_min > options.min_sicn && q.sicn_avg > options.min_sicn_avg;
     if (good || k == 0 || q.sicn_min > rep.sicn_min) {
+      best_valid = q.invalid == 0 && q.sicn_min > 0;
       rep.pattern = c.match.pattern;
       rep.pattern_name = patterns[c.match.pattern].name;
       rep.start = c.match.start;
@@ -225,7 +227,13 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
   std::ostringstream os;
   os << rep.candidates << " candidate(s) tried, best " << rep.pattern_name << " with SICN min " << rep.sicn_min
      << " avg " << rep.sicn_avg << " (thresholds " << options.min_sicn << ", " << options.min_sicn_avg << ")";
-  return refuse(Refusal::Quality, os.str());
+  const std::int64_t best_quads = rep.quads;
+  refuse(Refusal::Quality, os.str());
+  if (best_valid) {
+    rep.quads = best_quads;
+    rep.refused_mesh = std::move(best);
+  }
+  return empty;
 }
 
 }  // namespace
@@ -318,7 +326,13 @@ mesh::FaceMesh mesh_face_pattern(const cad::CadModel& model, LO f, std::span<con
     PatternFaceReport second;
     out = try_sides(f, face, *surface, soft, patterns, options, second);
     // Report the attempt that got further (a quality refusal says more than no pattern).
-    if (second.ok || (rep.refusal != Refusal::Quality && second.refusal == Refusal::Quality)) rep = second;
+    // Between two quality refusals, the one whose valid candidate has the higher minimum.
+    const bool second_better =
+        second.ok || (rep.refusal != Refusal::Quality && second.refusal == Refusal::Quality) ||
+        (rep.refusal == Refusal::Quality && second.refusal == Refusal::Quality &&
+         !second.refused_mesh.quads.empty() &&
+         (rep.refused_mesh.quads.empty() || second.sicn_min > rep.sicn_min));
+    if (second_better) rep = std::move(second);
     return out;
   } catch (const Error& e) {
     rep.quads = 0;

@@ -13,6 +13,7 @@
 #include "qsmesh/parallel/pipeline.hpp"
 #include "shapes.hpp"
 
+#include <algorithm>
 #include <filesystem>
 #include <sstream>
 
@@ -209,6 +210,69 @@ TEST(Pipeline, QuadMeshDoesNotDependOnRanks) { check_quads_do_not_depend_on_rank
 
 TEST(Pipeline, QuasiStructuredMeshDoesNotDependOnRanks) {
   check_quads_do_not_depend_on_ranks(Stage::QuasiStructured, "pipe_quasi");
+}
+
+// Pattern meshes refused by (here impossibly strict) quality thresholds are compared with what the
+// unstructured path makes of the face, and kept where they are no worse. Returns the faces kept so.
+int check_refused_patterns_compared(const Comm& comm, const cad::CadModel& model) {
+  PipelineOptions options;
+  options.background.sizes.size = 0.7;
+  options.sizemap.size_max = 0.7;
+  options.until = Stage::QuasiStructured;
+  options.patterns.min_sicn = 0.999;
+  options.patterns.min_sicn_avg = 0.999;
+  std::ostringstream sink;
+  Logger log(sink, LogLevel::Quiet);
+  const PipelineResult compared = run_pipeline(comm, model, options, TaskArena(2), log);
+  options.pattern_compare_tolerance = -1;
+  const PipelineResult never = run_pipeline(comm, model, options, TaskArena(2), log);
+  if (comm.rank() != 0) return 0;
+  options.pattern_compare_tolerance = 0.01;
+  const PipelineResult serial = run_pipeline(Comm::self(), model, options, TaskArena(1), log);
+  const auto nf = static_cast<std::size_t>(model.num_faces());
+  EXPECT_EQ(compared.quasi_reports.size(), nf);
+  EXPECT_EQ(never.face_stats.size(), nf);
+  int taken = 0;
+  const std::size_t checked = std::min({nf, compared.quasi_reports.size(), never.face_stats.size()});
+  for (std::size_t f = 0; f < checked; ++f) {
+    const QuasiReport& q = compared.quasi_reports[f];
+    EXPECT_EQ(q.by_comparison, serial.quasi_reports[f].by_comparison) << "face " << f;
+    EXPECT_FALSE(never.quasi_reports[f].by_comparison) << "face " << f;
+    // Faces that pass even these thresholds (exact squares) are meshed by pattern either way.
+    if (never.quasi_reports[f].by_pattern) {
+      EXPECT_TRUE(q.by_pattern && !q.by_comparison) << "face " << f;
+    }
+    if (!q.by_comparison) continue;
+    ++taken;
+    EXPECT_TRUE(q.by_pattern);
+    EXPECT_EQ(q.refusal, "quality");
+    // The pattern mesh kept is no worse than the face's mesh without it.
+    const mesh::FaceQuadStats& mine = compared.face_stats[f];
+    const mesh::FaceQuadStats& other = never.face_stats[f];
+    EXPECT_GT(mine.sicn_min, 0);
+    EXPECT_GE(mine.sicn_min, other.sicn_min - 0.01) << "face " << f;
+    EXPECT_GE(mine.sicn_avg, other.sicn_avg - 0.01) << "face " << f;
+    EXPECT_LE(mine.irregular_interior, other.irregular_interior) << "face " << f;
+  }
+  const auto conformity = mesh::check_conformity(compared.mesh, model);
+  EXPECT_TRUE(conformity.ok()) << conformity.summary();
+  EXPECT_EQ(compared.mesh.quads, serial.mesh.quads);
+  return taken;
+}
+
+TEST(Pipeline, RefusedPatternKeptWhereTheUnstructuredMeshIsNoBetter) {
+  const Comm comm = Comm::world();
+  // The box's planar sides and fillets get their grids back.
+  const int box = check_refused_patterns_compared(comm, shared_model(comm, "pipe_compare"));
+  if (comm.rank() == 0) {
+    EXPECT_GT(box, 0);
+  }
+  // A right triangle with a 26.6 degree corner: the triangle pattern (SICN avg 0.74) loses to the
+  // unstructured mesh (about 0.9 with four irregular vertices), and the comparison says so.
+  const std::string path = tmp("pipe_compare_triangle_np" + std::to_string(comm.size()) + ".brep");
+  if (comm.rank() == 0) test::write_polygon_face({{0, 0}, {10, 0}, {2, 4}}, path);
+  comm.barrier();
+  EXPECT_EQ(check_refused_patterns_compared(comm, cad::load_cad(path)), 0);
 }
 
 TEST(Pipeline, SizeMapAndCurveMeshesDoNotDependOnRanks) {

@@ -74,6 +74,21 @@ int main(int argc, char** argv) {
         std::cout << "face " << f << " " << cad::to_string(model.faces()[f].type) << " sides [";
         for (std::size_t i = 0; i < rep.side_edges.size(); ++i) std::cout << (i ? "," : "") << rep.side_edges[i];
         std::cout << "] (" << face_seconds << " s) ";
+        if (model.faces()[f].loops.size() == 1) {
+          try {
+            const auto surf = model.face_geometry(f);
+            const auto fs = qstruct::face_sides(model, f, *surf, result.quantized_curves, fo);
+            int concave = 0;
+            double sharpest = 180;
+            for (std::size_t i = 0; i < fs.points.size(); ++i)
+              if (fs.points[i].vclass.dim == 0) {
+                if (fs.angle_deg[i] > 225) ++concave;
+                sharpest = std::min(sharpest, fs.angle_deg[i]);
+              }
+            std::cout << "concave " << concave << " sharpest " << sharpest << " ";
+          } catch (const std::exception&) {
+          }
+        }
         if (rep.ok)
           std::cout << "ok " << rep.pattern_name << " quads " << rep.quads << " sicn " << rep.sicn_min << "/"
                     << rep.sicn_avg << "\n";

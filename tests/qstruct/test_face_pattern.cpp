@@ -164,6 +164,17 @@ TEST(FacePattern, RectangleWithATransitionGetsOneValence3And5) {
   EXPECT_GE(rep.candidates, 1);
   EXPECT_TRUE(r.quads.empty());
   EXPECT_NE(rep.reason.find("face 0"), std::string::npos) << rep.reason;
+  // ... and the refused mesh is handed back for a comparison: the same fill as the one kept above.
+  EXPECT_EQ(rep.refused_mesh.quads.size(), m.quads.size());
+  EXPECT_EQ(rep.quads, static_cast<std::int64_t>(m.quads.size()));
+  PatternFaceReport as_kept = rep;  // check_face checks a kept mesh's report
+  as_kept.ok = true;
+  as_kept.refusal = Refusal::None;
+  const auto refused_check = check_face(pc.model, 0, pc.curves, rep.refused_mesh, as_kept);
+  EXPECT_EQ(refused_check.interior.count(3) ? refused_check.interior.at(3) : 0, 1);
+  const smooth::QualityReport q = smooth::measure(rep.refused_mesh);
+  EXPECT_EQ(q.invalid, 0);
+  EXPECT_NEAR(q.sicn_min, rep.sicn_min, 1e-12);
 }
 
 // PatternFaceOptions::lift_max_poor_fraction: the untangler only gets fills with few poor quads.

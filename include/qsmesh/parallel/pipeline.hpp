@@ -57,6 +57,15 @@ struct PipelineOptions {
   /// 11 faces below 1, 146 in 1-1.5, 141 in 1.5-2, 15 in 2-3 (fine boundaries make structured
   /// fills finer than the size map inside); wing_fuselage's two transition faces above 5.
   double pattern_max_quad_ratio = 3.0;
+  /// A face whose pattern mesh was refused on quality alone (valid, but at or below
+  /// patterns.min_sicn or patterns.min_sicn_avg) gets it after all when it is no worse than what
+  /// the unstructured path and the topological steps made of the face: SICN min and avg each at
+  /// least theirs minus this tolerance, and no more interior irregular vertices (paper 000 Sec.
+  /// 6.1.1 keeps a pattern mesh when its quality is better than the mesh it replaces). The
+  /// pattern mesh is also taken when the unstructured path gave no valid all-quad mesh. Negative:
+  /// never. On Block.stp the faces this takes are small triangles (three or seven quads) that
+  /// both paths mesh alike.
+  double pattern_compare_tolerance = 0.01;
   /// Stage::QuasiStructured: cavity remeshing of the unstructured faces (Sec. 6.2).
   qstruct::CavityOptions cavities;
   /// Stage::QuasiStructured: disk remeshing of the defects of the unstructured faces (Sec. 6.3).
@@ -75,6 +84,9 @@ struct QuasiReport {
   bool by_pattern = false;  ///< meshed by a pattern (Sec. 6.1.2); else by the unstructured path
   std::string pattern;      ///< the pattern's name when by_pattern
   std::string refusal;      ///< why no pattern was kept (qstruct::to_string of the refusal)
+  /// by_pattern, but only after the comparison of PipelineOptions::pattern_compare_tolerance
+  /// (`refusal` then says why the thresholds refused it first).
+  bool by_comparison = false;
   /// Cavity remeshing (unstructured faces only): interior irregular vertices before it (the
   /// unstructured mesh) and after it, cavities remeshed by step (Steps 1-4 of Sec. 6.2.2).
   std::int64_t irregular_before = 0, irregular_after = 0;

@@ -2,7 +2,8 @@
 // loop is split into sides at its convex corners, the side edge counts of the final (quantized)
 // curve meshes are matched with the coarse patterns (Sec. 6.1.1), the refined pattern is laid out
 // in the parameter plane and smoothed (Sec. 5.3), and kept only when its quality is good; else
-// the caller uses the unstructured path (Sec. 5).
+// the caller uses the unstructured path (Sec. 5), and may still compare a refused fill with that
+// path's mesh (PatternFaceReport::refused_mesh).
 #pragma once
 
 #include <cstdint>
@@ -83,6 +84,10 @@ struct PatternFaceReport {
   int lifts = 0;                 ///< candidates handed to the untangler (lift_poor_quads)
   double sicn_min = 0, sicn_avg = 0;  ///< of the mesh kept (or of the best refused one)
   std::int64_t quads = 0;
+  /// On a Quality refusal: the best candidate (highest minimum SICN) when it is valid (every quad
+  /// SICN > 0), else empty. Paper 000 Sec. 6.1.1 keeps a pattern mesh when its quality is better
+  /// than the mesh it replaces; a caller that has the face's other mesh can make that comparison.
+  mesh::FaceMesh refused_mesh;
 };
 
 /// The boundary of a face split at its convex corners.
@@ -127,7 +132,8 @@ struct FaceSides {
 ///  - Output: an all-quad FaceMesh whose boundary vertices are exactly those of
 ///    background::face_boundary (same uv, xyz, VertexClass: assembly merges them with the
 ///    neighbouring faces), interior vertices classified on f, quads oriented along the face
-///    normal. When the face is refused: an empty mesh (face id set) and the reason in the report.
+///    normal. When the face is refused: an empty mesh (face id set) and the reason in the report
+///    (with the best valid candidate in report->refused_mesh on a quality refusal).
 /// Never throws for a face-level failure. Deterministic.
 [[nodiscard]] mesh::FaceMesh mesh_face_pattern(const cad::CadModel& model, LO f,
                                                std::span<const mesh::CurveMesh> full_curves,
