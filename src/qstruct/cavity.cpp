@@ -1,6 +1,7 @@
 #include "qsmesh/qstruct/cavity.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <limits>
 #include <set>
@@ -104,6 +105,8 @@ class Grower {
     n_in_.assign(static_cast<std::size_t>(t.num_vertices()), 0);
     next_.assign(static_cast<std::size_t>(t.num_vertices()), kNoIndex);
     seed_point_ = m.points[seed];
+    for (const auto& p : o.patterns)
+      has_sides_[static_cast<std::size_t>(std::min<LO>(p.num_sides(), kMaxSides))] = 1;
   }
 
   GrowResult run() {
@@ -177,17 +180,29 @@ class Grower {
         res.stop = GrowResult::Stop::MaxQuads;
         break;
       }
+      // The nearest addable frontier quad (ties to the smaller id, so the scan order does not
+      // matter); quads the cavity took are dropped from the list on the way.
       LO best = kNoIndex;
       double best_d = std::numeric_limits<double>::max();
-      for (const LO q : frontier_) {
-        if (in_[q]) continue;
-        const double d = distance(centroid(m_, q), seed_point_);
+      std::size_t kept = 0;
+      for (std::size_t r = 0; r < frontier_.size(); ++r) {
+        const LO q = frontier_[r];
+        if (in_[q]) {
+          frontier_flag_[q] = 0;
+          continue;
+        }
+        const double d = frontier_d_[r];
+        frontier_[kept] = q;
+        frontier_d_[kept] = d;
+        ++kept;
         if (d < best_d || (d == best_d && q < best)) {
           if (!can_add(q)) continue;
           best = q;
           best_d = d;
         }
       }
+      frontier_.resize(kept);
+      frontier_d_.resize(kept);
       if (best == kNoIndex) {
         res.stop = GrowResult::Stop::NoFrontier;
         break;
@@ -236,7 +251,9 @@ class Grower {
     in_[q] = 1;
     quads_.push_back(q);
     for (const LO v : m_.quads[q]) {
+      if (n_in_[v] == 1) --corners_;
       ++n_in_[v];
+      if (n_in_[v] == 1) ++corners_;
       const LO val = t_.valence(v);
       if (n_in_[v] == val && !t_.on_boundary(v)) {
         interior_.push_back(v);
@@ -249,11 +266,15 @@ class Grower {
     }
     for (int k = 0; k < 4; ++k) {
       const LO nb = t_.neighbour(q, k);
-      if (nb != kNoIndex && !in_[nb] && !frontier_flag_[nb]) {
-        frontier_flag_[nb] = 1;
-        frontier_.push_back(nb);
-      }
+      if (nb != kNoIndex && !in_[nb] && !frontier_flag_[nb]) push_frontier(nb);
     }
+  }
+
+  // Centroids do not move during a growth: each quad's distance to the seed is computed once.
+  void push_frontier(LO q) {
+    frontier_flag_[q] = 1;
+    frontier_.push_back(q);
+    frontier_d_.push_back(distance(centroid(m_, q), seed_point_));
   }
 
   // Farthest vertex from the seed of the quads the growth looked at (added, undone or frontier).
@@ -273,6 +294,7 @@ class Grower {
     const LO q = quads_.back();
     quads_.pop_back();
     in_[q] = 0;
+    if (!frontier_flag_[q]) push_frontier(q);  // the frontier scan dropped it when it was taken
     for (int i = 3; i >= 0; --i) {
       const LO v = m_.quads[q][i];
       const LO val = t_.valence(v);
@@ -281,7 +303,9 @@ class Grower {
         interior_.pop_back();
         if (val != 4) --irregular_inside_;
       }
+      if (n_in_[v] == 1) --corners_;
       --n_in_[v];
+      if (n_in_[v] == 1) ++corners_;
       if (!t_.on_boundary(v) && n_in_[v] > 0 && val - n_in_[v] == 1)
         concave_.insert(v);
       else
@@ -291,6 +315,13 @@ class Grower {
 
   // Boundary, sides and matches of the current (convex) cavity; true when remeshable.
   bool evaluate(Cavity& c, GrowResult& res) {
+    // The corners are the vertices in one cavity quad (kept count of): when no pattern has that
+    // many sides, the boundary need not be walked (growths check often, and big cavities are
+    // mostly between two matching shapes).
+    if (!has_sides_[static_cast<std::size_t>(std::min<LO>(corners_, kMaxSides))]) {
+      ++res.no_pattern;
+      return false;
+    }
     std::vector<LO> starts;
     bool simple = true;
     for (const LO q : quads_)
@@ -401,6 +432,10 @@ class Grower {
   Vec3 seed_point_;
   std::vector<char> in_, frontier_flag_, forbidden_;
   std::vector<LO> n_in_, next_, quads_, frontier_, interior_;
+  std::vector<double> frontier_d_;  // distance from each frontier_ quad's centroid to the seed
+  LO corners_ = 0;                   // vertices in exactly one cavity quad
+  static constexpr LO kMaxSides = 16;
+  std::array<char, kMaxSides + 1> has_sides_{};  // a pattern has that many sides (last: or more)
   std::set<LO> concave_;
   int irregular_inside_ = 0, checked_irregular_ = 0;
 };

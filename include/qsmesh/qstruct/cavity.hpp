@@ -105,7 +105,8 @@ struct GrowResult {
   /// Why the growth stopped: a concave vertex could not be absorbed, GrowOptions::max_quads, no
   /// outside quad could be added, the seed fan is not a disk, or (minimal) a remeshable cavity.
   enum class Stop { Concave, MaxQuads, NoFrontier, Fan, Found } stop = Stop::NoFrontier;
-  /// Of the checks: no pattern with that many sides, no match (Eq. 14 unsolvable within the
+  /// Of the checks: no pattern with that many sides (told from the number of vertices in one
+  /// cavity quad, before the boundary is walked), no match (Eq. 14 unsolvable within the
   /// attempts), matches none of which is remeshable (irregularity not lowered, quad change,
   /// a flagged vertex or a CAD corner would change valence, Step 2's single irregular vertex).
   int no_pattern = 0, no_match = 0, not_better = 0;
