@@ -84,9 +84,9 @@ Arguments parse(const std::vector<std::string>& args) {
   else if (cmd == "example") a.command = Command::Example;
   else throw InputError("unknown command '" + cmd + "' (commands: info, mesh, crossfield, sizemap, example; see qsmesh --help)");
   const bool meshing = a.command == Command::Mesh || a.command == Command::CrossField || a.command == Command::SizeMap;
-  // Size-map options act from the sizemap command on; the mesh command takes them once its quad
-  // stages exist (until then they would change nothing).
-  const bool sizing = a.command == Command::SizeMap;
+  // Size-map options: the sizemap command and the mesh command (whose quad stages use the size
+  // map; with --until background they are refused, see below).
+  const bool sizing = a.command == Command::SizeMap || a.command == Command::Mesh;
 
   std::vector<std::string> positional;
   for (std::size_t i = 1; i < args.size(); ++i) {
@@ -109,7 +109,15 @@ Arguments parse(const std::vector<std::string>& args) {
       a.face_time_budget = parse_positive(opt, value());
     else if (opt == "--stats" && meshing) a.stats = value();
     else if (opt == "--check" && a.command == Command::CrossField) a.check = true;
-    else if (opt == "--sizemap" && sizing) {
+    else if (opt == "--curvature-edges" && sizing) {
+      const std::string& v = value();
+      char* end = nullptr;
+      const double n = std::strtod(v.c_str(), &end);
+      if (end == v.c_str() || *end != '\0' || !std::isfinite(n) || n < 0 || (n > 0 && n < 3))
+        throw InputError(opt + ": '" + v +
+                         "' is not 0 (no curvature sizes) or a number of edges per turn of at least 3");
+      a.curvature_edges = n;
+    } else if (opt == "--sizemap" && sizing) {
       a.sizemap = value();
       if (a.sizemap != "features" && a.sizemap != "crossfield")
         throw InputError("--sizemap: unknown method '" + a.sizemap + "' (features or crossfield)");
@@ -137,6 +145,14 @@ Arguments parse(const std::vector<std::string>& args) {
     else positional.push_back(opt);
   }
   if (a.size && a.size_factor) throw InputError("--size and --size-factor: give one, not both");
+  const bool sizing_given = a.sizemap != "crossfield" || a.quads > 0 || a.curvature_edges ||
+                            !a.curve_edges.empty() || !a.face_quads.empty() ||
+                            !a.corner_sizes.empty() || !a.curve_sizes.empty() ||
+                            !a.face_sizes.empty();
+  if (a.command == Command::Mesh && sizing_given && a.until == "background")
+    throw InputError(
+        "size-map options act on the quad mesh: with --until background only --size or "
+        "--size-factor applies");
 
   if (a.command == Command::Example) {
     if (positional.size() != 1)
@@ -187,6 +203,10 @@ std::string help(const std::string& topic) {
           "  --threads T           threads per rank (default: the cores of the machine divided\n"
           "                        among the ranks running on it)\n"
           "  --stats FILE.json     also write the run statistics as JSON\n"
+          "  --quads N, --curvature-edges N, --curve-edges C:N,.., --face-quads F:N,..,\n"
+          "  --corner-size K:H,.., --curve-size C:H,.., --face-size F:H,.., --sizemap METHOD\n"
+          "                        size-map controls, as for sizemap (see qsmesh sizemap --help);\n"
+          "                        they act on the quad mesh, not with --until background\n"
           "  --face-time-budget S  at most S seconds of cavity remeshing (paper 000 Sec. 6.2) per\n"
           "                        face; a face that reaches it keeps the mesh it has (valid) and is\n"
           "                        counted in the summary. Without it the work is bounded by\n"
@@ -219,6 +239,10 @@ std::string help(const std::string& topic) {
           "  --sizemap METHOD      features (small features and user sizes only) or crossfield\n"
           "                        (also the conformal scaling of the cross fields; default)\n"
           "  --quads N             target number of quads of the model (default: area / size^2)\n"
+          "  --curvature-edges N   edges per full turn on curved curves and faces: a radius R gets\n"
+          "                        edges of 2 pi R / N at most (default 16); 0 sizes by the cross\n"
+          "                        field and the small CAD features only (paper 000 Sec. 4), so the\n"
+          "                        mesh coarsens with --size on curved models too\n"
           "  --curve-edges C:N,..  prescribe the (even) number of edges of curves; kept exactly\n"
           "  --face-quads F:N,..   prescribe the number of quads of faces\n"
           "  --corner-size K:H,.., --curve-size C:H,.., --face-size F:H,..\n"

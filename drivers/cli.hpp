@@ -29,6 +29,9 @@ struct Arguments {
   bool check = false;              ///< crossfield --check
   std::string sizemap = "crossfield";  ///< --sizemap features|crossfield
   double quads = 0;                ///< --quads N: target quad count of the model (0: from the size)
+  /// --curvature-edges N: edges per full turn on curved curves and faces (0: no curvature sizes;
+  /// unset: sizemap::SizeMapOptions' default).
+  std::optional<double> curvature_edges;
   std::vector<std::pair<int, int>> curve_edges;       ///< --curve-edges C:N,...
   std::vector<std::pair<int, double>> face_quads;     ///< --face-quads F:N,...
   std::vector<std::pair<int, double>> corner_sizes;   ///< --corner-size K:H,...

@@ -414,6 +414,39 @@ Session::Session(const Arguments& args, const char* command)
                ranks, " rank(s) x ", threads, " thread(s)"));
 }
 
+namespace {
+
+/// Throws InputError unless every id of an ID:VALUE option names an entity of the model.
+template <class T>
+void check_ids(const char* option, const char* what, const std::vector<std::pair<int, T>>& items,
+               LO count) {
+  for (const auto& [id, value] : items)
+    if (id >= count)
+      throw InputError(cat(option, ": ", what, " ", id, " does not exist (the model has ", count,
+                           " ", what, "s)"));
+}
+
+}  // namespace
+
+void apply_size_options(const Arguments& args, const Session& s,
+                        parallel::PipelineOptions& options) {
+  check_ids("--curve-edges", "curve", args.curve_edges, s.model.num_curves());
+  check_ids("--curve-size", "curve", args.curve_sizes, s.model.num_curves());
+  check_ids("--corner-size", "corner", args.corner_sizes, s.model.num_corners());
+  check_ids("--face-quads", "face", args.face_quads, s.model.num_faces());
+  check_ids("--face-size", "face", args.face_sizes, s.model.num_faces());
+  sizemap::SizeMapOptions& so = options.sizemap;
+  so.method = args.sizemap == "features" ? sizemap::Method::Features : sizemap::Method::CrossField;
+  so.size_max = s.size;
+  so.target_quads = args.quads;
+  if (args.curvature_edges) so.edges_per_turn = *args.curvature_edges;
+  for (const auto& [id, v] : args.face_quads) so.face_quads.emplace_back(id, v);
+  for (const auto& [id, v] : args.corner_sizes) so.corner_sizes.emplace_back(id, v);
+  for (const auto& [id, v] : args.curve_sizes) so.curve_sizes.emplace_back(id, v);
+  for (const auto& [id, v] : args.face_sizes) so.face_sizes.emplace_back(id, v);
+  for (const auto& [id, n] : args.curve_edges) options.quantize.prescribed.emplace_back(id, n);
+}
+
 int run_mesh(const Arguments& args) {
   // Everything the user could get wrong is checked before any work.
   const parallel::Stage until = parallel::parse_stage(args.until);
@@ -423,7 +456,7 @@ int run_mesh(const Arguments& args) {
   Session s(args, "mesh");
   parallel::PipelineOptions options;
   options.background.sizes.size = s.size;
-  options.sizemap.size_max = s.size;
+  apply_size_options(args, s, options);
   options.until = until;
   options.cavities.time_budget_s = args.face_time_budget;
   parallel::PipelineResult result =

@@ -9,6 +9,7 @@
 #include "qsmesh/core/tasks.hpp"
 #include "qsmesh/core/timer.hpp"
 #include "qsmesh/parallel/comm.hpp"
+#include "qsmesh/parallel/pipeline.hpp"
 
 namespace qsmesh::cli {
 
@@ -44,6 +45,13 @@ int run_mesh(const Arguments& args);
 int run_crossfield(const Arguments& args);
 /// `qsmesh sizemap`: size map and curve quantization (paper 000 Sec. 4), written as VTU. Collective.
 int run_sizemap(const Arguments& args);
+
+/// The size-map options of the command line (--sizemap, --quads, --curvature-edges, --curve-edges,
+/// --face-quads, --corner-size, --curve-size, --face-size), checked against the model (InputError
+/// naming an id that does not exist), set in options.sizemap and options.quantize.prescribed;
+/// options.sizemap.size_max is the session's size.
+void apply_size_options(const Arguments& args, const Session& s,
+                        parallel::PipelineOptions& options);
 
 /// Writes `text` to `path` through a temporary file renamed at the end.
 void write_text_file_atomically(const std::string& path, const std::string& text);

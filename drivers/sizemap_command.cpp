@@ -16,14 +16,6 @@ namespace qsmesh::cli {
 
 namespace {
 
-/// Throws InputError unless every id of an ID:VALUE option names an entity of the model.
-template <class T>
-void check_ids(const char* option, const char* what, const std::vector<std::pair<int, T>>& items, LO count) {
-  for (const auto& [id, value] : items)
-    if (id >= count)
-      throw InputError(cat(option, ": ", what, " ", id, " does not exist (the model has ", count, " ", what, "s)"));
-}
-
 /// Point fields s, s_min, s_cf on the assembled background mesh (global numbering: corners, curve
 /// vertices, then the faces' interior vertices in face order), and the quantized curve vertices as
 /// markers with their curve id.
@@ -85,25 +77,11 @@ int run_sizemap(const Arguments& args) {
   if (!args.stats.empty()) check_writable("--stats", args.stats);
 
   Session s(args, "sizemap");
-  check_ids("--curve-edges", "curve", args.curve_edges, s.model.num_curves());
-  check_ids("--curve-size", "curve", args.curve_sizes, s.model.num_curves());
-  check_ids("--corner-size", "corner", args.corner_sizes, s.model.num_corners());
-  check_ids("--face-quads", "face", args.face_quads, s.model.num_faces());
-  check_ids("--face-size", "face", args.face_sizes, s.model.num_faces());
-
   linalg::PetscLane lane;
   parallel::PipelineOptions options;
   options.background.sizes.size = s.size;
   options.size_map = true;
-  sizemap::SizeMapOptions& so = options.sizemap;
-  so.method = args.sizemap == "features" ? sizemap::Method::Features : sizemap::Method::CrossField;
-  so.size_max = s.size;
-  so.target_quads = args.quads;
-  for (const auto& [id, v] : args.face_quads) so.face_quads.emplace_back(id, v);
-  for (const auto& [id, v] : args.corner_sizes) so.corner_sizes.emplace_back(id, v);
-  for (const auto& [id, v] : args.curve_sizes) so.curve_sizes.emplace_back(id, v);
-  for (const auto& [id, v] : args.face_sizes) so.face_sizes.emplace_back(id, v);
-  for (const auto& [id, n] : args.curve_edges) options.quantize.prescribed.emplace_back(id, n);
+  apply_size_options(args, s, options);
   const parallel::PipelineResult result = parallel::run_pipeline(s.comm, s.model, options, *s.tasks, s.log, &lane);
   for (const auto& [stage, sec] : result.times.entries()) s.times.add(stage, sec);
   if (s.rank != 0) return 0;

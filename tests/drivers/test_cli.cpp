@@ -77,8 +77,24 @@ TEST(Cli, SizeMapOptions) {
   EXPECT_NE(error_of({"sizemap", "m.step", "-o", "s.vtu", "--curve-edges", "3:4.5"}).find("integer"), std::string::npos);
   EXPECT_NE(error_of({"sizemap", "m.step", "-o", "s.vtu", "--curve-size", "3:-1"}).find("positive"), std::string::npos);
   EXPECT_NE(error_of({"sizemap", "m.step"}).find("missing -o"), std::string::npos);
-  // Not yet meaningful for mesh: refused rather than silently ignored.
-  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--curve-edges", "3:8"}).find("unknown option"), std::string::npos);
+  // The mesh command takes them too (its quad stages use the size map), but not with --until
+  // background, where they would change nothing: refused rather than silently ignored.
+  const Arguments m = p({"mesh", "m.step", "-o", "o.vtu", "--curve-edges", "3:8", "--curvature-edges", "0",
+                         "--curve-size", "4:1.5", "--quads", "5000"});
+  EXPECT_EQ(m.curve_edges, (std::vector<std::pair<int, int>>{{3, 8}}));
+  ASSERT_TRUE(m.curvature_edges.has_value());
+  EXPECT_DOUBLE_EQ(*m.curvature_edges, 0.0);
+  EXPECT_DOUBLE_EQ(*p({"sizemap", "m.step", "-o", "s.vtu", "--curvature-edges", "8"}).curvature_edges, 8.0);
+  EXPECT_FALSE(p({"mesh", "m.step", "-o", "o.vtu"}).curvature_edges.has_value());
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--until", "background", "--curve-size", "4:1"})
+                .find("--until background"),
+            std::string::npos);
+  for (const char* bad : {"2", "-1", "x", "8x", "inf"})
+    EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--curvature-edges", bad}).find("--curvature-edges"),
+              std::string::npos)
+        << bad;
+  EXPECT_NE(error_of({"crossfield", "m.step", "-o", "c.vtu", "--curve-size", "4:1"}).find("unknown option"),
+            std::string::npos);
 }
 
 TEST(Cli, MissingPiecesAndUnknowns) {

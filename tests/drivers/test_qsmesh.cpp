@@ -244,6 +244,34 @@ TEST_F(Qsmesh, SizeMapWritesFieldsAndHonoursPrescriptions) {
   EXPECT_NE(bad_id.err.find("curve 100000 does not exist"), std::string::npos) << bad_id.err;
 }
 
+// The size-map controls of `sizemap` act on `qsmesh mesh` too.
+TEST_F(Qsmesh, MeshHonoursSizeMapOptions) {
+  // Curve 0 of the filleted box gets about 10 edges at this size; 14 must be kept exactly.
+  const auto [r, json] = mesh_with_stats(model_, "--size 0.8 --curve-edges 0:14", "e2e_mesh_edges");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_GT(json_number(json, "sicn_min"), 0);
+  const std::string msh = slurp(tmp("e2e_mesh_edges.msh"));
+  // Element block of curve 0: "entityDim entityTag elementType count" = "1 1 1 count".
+  const auto block = msh.find("\n1 1 1 ", msh.find("$Elements"));
+  ASSERT_NE(block, std::string::npos);
+  EXPECT_EQ(std::stoi(msh.substr(block + 7)), 14);
+  // The fillets (radius 1) ask for edges of 2 pi / 16 = 0.39 by curvature; without the curvature
+  // sizes they follow --size 0.8 and the cross field: fewer vertices, still valid.
+  const auto [r16, j16] = mesh_with_stats(model_, "--size 0.8", "e2e_mesh_curv16");
+  const auto [r0, j0] = mesh_with_stats(model_, "--size 0.8 --curvature-edges 0", "e2e_mesh_curv0");
+  ASSERT_EQ(r16.code, 0) << r16.err;
+  ASSERT_EQ(r0.code, 0) << r0.err;
+  EXPECT_LT(json_number(j0, "vertices"), 0.8 * json_number(j16, "vertices"));
+  EXPECT_GT(json_number(j0, "sicn_min"), 0);
+  // An id the model does not have: one line, exit 2, nothing written.
+  const std::string bad_out = tmp("e2e_mesh_bad_id.msh");
+  const ExeResult bad = run("mesh " + model_ + " -o " + bad_out + " --curve-size 100000:1 -q");
+  EXPECT_EQ(bad.code, 2);
+  EXPECT_EQ(lines(bad.err), 1) << bad.err;
+  EXPECT_NE(bad.err.find("curve 100000 does not exist"), std::string::npos) << bad.err;
+  EXPECT_FALSE(fs::exists(bad_out));
+}
+
 TEST_F(Qsmesh, ExampleWingBody) {
   const std::string step = tmp("e2e_wing_body.step");
   const ExeResult r = run("example wing-body -o " + step);
