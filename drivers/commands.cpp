@@ -214,6 +214,7 @@ std::string stats_json(const Arguments& args, const Session& session,
   write_run_header(j, args, session);
   j.value("output", args.output);
   j.value("stage", args.until);
+  j.value("curvature_edges", curvature_edges(args));  // edges per full turn (0: none)
   j.value("corners", static_cast<std::int64_t>(model.num_corners()));
   j.value("curves", static_cast<std::int64_t>(model.num_curves()));
   j.value("faces", static_cast<std::int64_t>(model.num_faces()));
@@ -428,6 +429,10 @@ void check_ids(const char* option, const char* what, const std::vector<std::pair
 
 }  // namespace
 
+double curvature_edges(const Arguments& args) {
+  return args.curvature_edges.value_or(sizemap::SizeMapOptions{}.edges_per_turn);
+}
+
 void apply_size_options(const Arguments& args, const Session& s,
                         parallel::PipelineOptions& options) {
   check_ids("--curve-edges", "curve", args.curve_edges, s.model.num_curves());
@@ -439,7 +444,7 @@ void apply_size_options(const Arguments& args, const Session& s,
   so.method = args.sizemap == "features" ? sizemap::Method::Features : sizemap::Method::CrossField;
   so.size_max = s.size;
   so.target_quads = args.quads;
-  if (args.curvature_edges) so.edges_per_turn = *args.curvature_edges;
+  so.edges_per_turn = curvature_edges(args);
   for (const auto& [id, v] : args.face_quads) so.face_quads.emplace_back(id, v);
   for (const auto& [id, v] : args.corner_sizes) so.corner_sizes.emplace_back(id, v);
   for (const auto& [id, v] : args.curve_sizes) so.curve_sizes.emplace_back(id, v);

@@ -52,6 +52,8 @@ int run_sizemap(const Arguments& args);
 /// options.sizemap.size_max is the session's size.
 void apply_size_options(const Arguments& args, const Session& s,
                         parallel::PipelineOptions& options);
+/// The curvature edges per turn a run uses: --curvature-edges, or the size map's default.
+double curvature_edges(const Arguments& args);
 
 /// Writes `text` to `path` through a temporary file renamed at the end.
 void write_text_file_atomically(const std::string& path, const std::string& text);

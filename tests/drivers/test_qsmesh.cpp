@@ -262,6 +262,8 @@ TEST_F(Qsmesh, MeshHonoursSizeMapOptions) {
   ASSERT_EQ(r16.code, 0) << r16.err;
   ASSERT_EQ(r0.code, 0) << r0.err;
   EXPECT_LT(json_number(j0, "vertices"), 0.8 * json_number(j16, "vertices"));
+  EXPECT_EQ(json_number(j0, "curvature_edges"), 0);  // --stats says what the run used
+  EXPECT_EQ(json_number(j16, "curvature_edges"), 16);
   EXPECT_GT(json_number(j0, "sicn_min"), 0);
   // An id the model does not have: one line, exit 2, nothing written.
   const std::string bad_out = tmp("e2e_mesh_bad_id.msh");
