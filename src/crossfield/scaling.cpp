@@ -46,6 +46,15 @@ void compute_scaling(FaceCrossField& cf, const Geometry& g, const CrossFieldOpti
   cf.H.assign(static_cast<std::size_t>(nv), 0.0);
   cf.h.assign(static_cast<std::size_t>(nv), 1.0);
   if (nv < 2) return;
+  // At a cusp (two curves leaving a corner tangentially) the field turns by a right angle over a
+  // vanishing width: H goes to -infinity there with a coefficient no quantile clamp tames, and a
+  // clamped value still shrinks the sizes of every curve the face shares (t20_data's chamfer
+  // faces halved those of the hexagon flats beside them). Such a field says nothing about sizes;
+  // the face keeps a uniform scaling, and s_min still sees its small features.
+  for (LO v = 0; v < nv; ++v)
+    if (cf.vertex_dim[v] == 0 && g.boundary_vertex[v] &&
+        g.vertex_angle[v] * 180 / kPi < options.cusp_angle_deg)
+      return;
   // H is fixed to 0 at vertex 0 (then shifted to zero mean): unknown of vertex v is v - 1.
   std::vector<linalg::SparseMatrix::Triplet> trip;
   trip.reserve(static_cast<std::size_t>(nt) * 9);

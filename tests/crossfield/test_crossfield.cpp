@@ -7,6 +7,7 @@
 #include <BRepBuilderAPI_MakeWire.hxx>
 #include <BRepPrimAPI_MakeSphere.hxx>
 #include <BRepTools.hxx>
+#include <GC_MakeArcOfCircle.hxx>
 #include <TopoDS.hxx>
 #include <algorithm>
 #include <cmath>
@@ -288,6 +289,39 @@ TEST(CrossField, FullSphereHasEightSingularities) {
   EXPECT_EQ(plus, 8);
 }
 
+TEST(CrossField, CuspFaceGetsAUniformScaling) {
+  // The x axis from (0, 0) to (2, 0), up to (2, 1), back to (1, 1), then the quarter of the circle
+  // of centre (0, 1) and radius 1 down to (0, 0), where it is tangent to the axis: a 0-degree
+  // cusp, and three right angles.
+  const gp_Circ circle(gp_Ax2(gp_Pnt(0, 1, 0), gp_Dir(0, 0, 1)), 1.0);
+  const Handle(Geom_TrimmedCurve) arc =
+      GC_MakeArcOfCircle(circle, gp_Pnt(0, 0, 0), gp_Pnt(1, 1, 0), true).Value();
+  BRepBuilderAPI_MakeWire wire;
+  wire.Add(BRepBuilderAPI_MakeEdge(gp_Pnt(0, 0, 0), gp_Pnt(2, 0, 0)).Edge());
+  wire.Add(BRepBuilderAPI_MakeEdge(gp_Pnt(2, 0, 0), gp_Pnt(2, 1, 0)).Edge());
+  wire.Add(BRepBuilderAPI_MakeEdge(gp_Pnt(2, 1, 0), gp_Pnt(1, 1, 0)).Edge());
+  wire.Add(BRepBuilderAPI_MakeEdge(arc).Edge());
+  ASSERT_TRUE(wire.IsDone());
+  const auto model =
+      test::load_shape(BRepBuilderAPI_MakeFace(wire.Wire(), true).Face(), "cf_cusp.brep");
+  CrossFieldOptions raw;
+  raw.cusp_angle_deg = 0;
+  const auto a = run(model, 0, 0.05, "cusp-raw", raw);
+  const auto b = run(model, 0, 0.05, "cusp");
+  // Without the rule the scaling falls towards the cusp: even clamped to its 5% quantile, sizes
+  // there are about half the largest (exp(0.66) measured).
+  const auto [lo, hi] = std::minmax_element(a.cf.H.begin(), a.cf.H.end());
+  EXPECT_GT(*hi - *lo, 0.5);
+  // With it the face keeps h = 1; the cross field itself is the same.
+  for (std::size_t v = 0; v < b.cf.H.size(); ++v) {
+    EXPECT_EQ(b.cf.H[v], 0.0);
+    EXPECT_EQ(b.cf.h[v], 1.0);
+  }
+  ASSERT_EQ(a.cf.u.size(), b.cf.u.size());
+  for (std::size_t e = 0; e < a.cf.u.size(); ++e) EXPECT_EQ(a.cf.u[e].u, b.cf.u[e].u);
+  EXPECT_EQ(a.cf.singularities.size(), b.cf.singularities.size());
+}
+
 TEST(CrossField, AcuteCornerGetsAnArtificialSingularity) {
   // Right triangle with angles 90, 60 and 30 degrees.
   BRepBuilderAPI_MakePolygon poly(gp_Pnt(0, 0, 0), gp_Pnt(2, 0, 0),
@@ -306,6 +340,9 @@ TEST(CrossField, AcuteCornerGetsAnArtificialSingularity) {
     }
   EXPECT_EQ(acute, 1);
   EXPECT_TRUE(cf.euler.consistent);
+  // 30 degrees is sharp, not a cusp: the scaling is the computed one.
+  const auto [lo, hi] = std::minmax_element(cf.H.begin(), cf.H.end());
+  EXPECT_GT(*hi - *lo, 0.1);
 }
 
 TEST(CrossField, BoundaryExtensionPushesSingularitiesInwards) {

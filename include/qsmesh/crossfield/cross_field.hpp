@@ -26,6 +26,10 @@ struct CrossFieldOptions {
   /// left as they are, exp(H) shrinks to the size floor there and the faces around fill with
   /// slivers (docs/architecture.md, "Decisions worth knowing").
   double scaling_quantile = 0.05;
+  /// A face with a CAD corner sharper than this (degrees; a cusp, where two curves leave the
+  /// corner tangentially) gets a uniform scaling, H = 0: at a cusp H has a singularity the
+  /// quantile clamp does not tame. 0: never.
+  double cusp_angle_deg = 2;
   linalg::SolverOptions solver;
 };
 
