@@ -16,7 +16,10 @@ namespace {
 struct FaceSidesOfUses {
   int num_sides = 0;
   std::vector<std::pair<LO, int>> uses;  // (curve, side)
+  bool rectangle = false;  // four sides, opposite lengths within BalanceOptions::grid_length_ratio
 };
+
+bool is_grid(const std::vector<LO>& n) { return n.size() == 4 && n[0] == n[2] && n[1] == n[3]; }
 
 std::vector<LO> side_counts(const FaceSidesOfUses& f, const std::vector<int>& edges) {
   std::vector<LO> n(static_cast<std::size_t>(f.num_sides), 0);
@@ -93,8 +96,16 @@ std::vector<int> balance_curve_counts(const cad::CadModel& model,
     if (m < 2 || m > 6) continue;
     FaceSidesOfUses t;
     t.num_sides = m;
-    for (std::size_t u = 0; u < uses.size(); ++u)
+    std::vector<double> length(static_cast<std::size_t>(m), 0.0);
+    for (std::size_t u = 0; u < uses.size(); ++u) {
       t.uses.emplace_back(uses[u].curve, side_of(fs, fs.use_start[u]));
+      length[t.uses.back().second] += cads[uses[u].curve].length;
+    }
+    const auto close = [&](double a, double b) {
+      return options.grid_length_ratio >= 1 && a > 0 && b > 0 &&
+             std::max(a, b) <= options.grid_length_ratio * std::min(a, b);
+    };
+    t.rectangle = m == 4 && close(length[0], length[2]) && close(length[1], length[3]);
     targets.push_back(std::move(t));
   }
   rep.faces_considered = static_cast<LO>(targets.size());
@@ -108,6 +119,12 @@ std::vector<int> balance_curve_counts(const cad::CadModel& model,
   std::vector<char> fit(targets.size());
   for (std::size_t i = 0; i < targets.size(); ++i) fit[i] = fits(side_counts(targets[i], edges));
   rep.fitting_before = static_cast<LO>(std::count(fit.begin(), fit.end(), 1));
+  const auto count_grids = [&] {
+    LO g = 0;
+    for (const auto& t : targets) g += is_grid(side_counts(t, edges)) ? 1 : 0;
+    return g;
+  };
+  rep.grids_before = count_grids();
 
   const auto allowed = [&](LO c, int n) {
     const int lo = cads[c].corners[0] == cads[c].corners[1] ? 4 : 2;
@@ -209,6 +226,80 @@ std::vector<int> balance_curve_counts(const cad::CadModel& model,
     }
     if (!any) break;
   }
+  // Rectangles fitted only by a transition: their counts differ through the size map alone (the
+  // sides are as long as each other), and a transition fill shears its rows to absorb that. Equal
+  // counts give a grid. A move must not cost any face its fit or its grid, and must bring the
+  // rectangles' opposite counts closer in total.
+  const auto grid_misfit = [&](LO t) {
+    if (!targets[t].rectangle) return 0;
+    const auto n = side_counts(targets[t], edges);
+    return static_cast<int>(std::abs(n[0] - n[2]) + std::abs(n[1] - n[3]));
+  };
+  for (int pass = 0; pass < options.max_passes; ++pass) {
+    bool any = false;
+    for (std::size_t i = 0; i < targets.size(); ++i) {
+      const FaceSidesOfUses& t = targets[i];
+      if (!t.rectangle || !fit[i]) continue;
+      const auto n = side_counts(t, edges);
+      if (is_grid(n)) continue;
+      LO best_var = kNoIndex;
+      int best_delta = 0, best_gain = 0, best_dmis = 0;
+      double best_rel = 0;
+      for (int a = 0; a < 2; ++a) {
+        const int d = n[a] - n[a + 2];
+        if (d == 0) continue;
+        for (const auto& [side, delta] : {std::pair<int, int>{a, -d}, std::pair<int, int>{a + 2, d}})
+          for (const auto& [c, s] : t.uses) {
+            if (s != side || frozen[var_of(c)]) continue;
+            const LO var = var_of(c);
+            const std::vector<LO> mem = members(var);
+            if (!std::all_of(mem.begin(), mem.end(), [&](LO x) { return allowed(x, edges[x] + delta); }))
+              continue;
+            std::vector<LO> touched;
+            for (const LO x : mem)
+              touched.insert(touched.end(), curve2targets[x].begin(), curve2targets[x].end());
+            std::sort(touched.begin(), touched.end());
+            touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+            int dmis = 0, gain = 0;
+            bool loses = false;
+            std::vector<std::pair<LO, char>> before;
+            for (const LO tt : touched) {
+              dmis -= grid_misfit(tt);
+              before.emplace_back(tt, is_grid(side_counts(targets[tt], edges)) ? 1 : 0);
+            }
+            for (const LO x : mem) edges[x] += delta;
+            for (std::size_t k = 0; k < touched.size(); ++k) {
+              const LO tt = touched[k];
+              const auto nn = side_counts(targets[tt], edges);
+              const bool g = is_grid(nn);
+              if ((fit[tt] && !fits(nn)) || (before[k].second && !g)) loses = true;
+              gain += (g ? 1 : 0) - before[k].second;
+              dmis += grid_misfit(tt);
+            }
+            for (const LO x : mem) edges[x] -= delta;
+            if (loses || dmis >= 0) continue;
+            double ideal_sum = 0;
+            for (const LO x : mem) ideal_sum += std::max(1.0, q.ideal[x]);
+            const double rel = std::abs(delta) * static_cast<double>(mem.size()) / ideal_sum;
+            if (best_var == kNoIndex ||
+                std::make_tuple(-gain, dmis, rel, var) < std::make_tuple(-best_gain, best_dmis, best_rel, best_var)) {
+              best_var = var;
+              best_delta = delta;
+              best_gain = gain;
+              best_dmis = dmis;
+              best_rel = rel;
+            }
+          }
+      }
+      if (best_var == kNoIndex) continue;
+      for (const LO c : members(best_var)) edges[c] += best_delta;
+      for (const LO c : members(best_var))
+        for (const LO tt : curve2targets[c]) fit[tt] = fits(side_counts(targets[tt], edges)) ? 1 : 0;
+      any = true;
+    }
+    if (!any) break;
+  }
+  rep.grids_after = count_grids();
   rep.fitting_after = static_cast<LO>(std::count(fit.begin(), fit.end(), 1));
   for (LO c = 0; c < nc; ++c) rep.curves_changed += edges[c] != q.edges[c] ? 1 : 0;
   if (report != nullptr) *report = rep;

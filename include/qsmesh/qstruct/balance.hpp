@@ -27,6 +27,11 @@ struct BalanceOptions {
   double max_change = 0.35;
   /// Greedy passes over the faces (each stops early when nothing changed).
   int max_passes = 6;
+  /// Four-sided faces whose opposite sides have lengths within this ratio (both pairs) are
+  /// rectangles in all but their counts: after the passes above, such a face that a pattern fits
+  /// only with a size transition is steered to the grid (opposite counts made equal), when no face
+  /// loses its fit or its grid. Below 1: off.
+  double grid_length_ratio = 1.1;
   /// Corner detection as for the pattern meshing (corner_angle_deg) and the matching.
   PatternFaceOptions faces;
 };
@@ -35,6 +40,8 @@ struct BalanceReport {
   LO faces_considered = 0;   ///< faces with one loop, no pole and 2 to 6 sides
   LO fitting_before = 0;     ///< of those, faces some pattern fits before balancing
   LO fitting_after = 0;      ///< and after
+  LO grids_before = 0;       ///< four-sided faces with equal opposite counts, before balancing
+  LO grids_after = 0;        ///< and after
   LO curves_changed = 0;     ///< curves whose count changed
   int passes = 0;
 };
