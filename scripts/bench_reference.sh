@@ -15,7 +15,7 @@ export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 [ -x /usr/bin/time ] || { echo "bench_reference: /usr/bin/time missing (Debian package 'time')" >&2; exit 2; }
 declare -A factor=([Block.stp]=0.00524761 [A319.brep]=0.0809062
                    [wing_fuselage.step]=0.129588 [mambo_s34.step]=0.00495607
-                   [cube_filet.stp]=0.00434721 [t20_data.step]=0.00477212)
+                   [cube_filet.stp]=0.00434721 [t20_data.step]=0.0048345)
 models=(Block.stp A319.brep wing_fuselage.step mambo_s34.step cube_filet.stp t20_data.step)
 if [ $# -gt 0 ]; then
   models=()

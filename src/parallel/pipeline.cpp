@@ -352,7 +352,8 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
       result.quantization.edges = std::move(edges);
       log.info(cat("quantize: faces fitting a pattern ", result.balance.fitting_before, " -> ",
                    result.balance.fitting_after, " of ", result.balance.faces_considered,
-                   ", grids ", result.balance.grids_before, " -> ", result.balance.grids_after, " (",
+                   ", grids ", result.balance.grids_before, " -> ", result.balance.grids_after,
+                   " (",
                    result.balance.curves_changed, " curves changed)"));
     }
     result.quantized_curves =

@@ -1,6 +1,7 @@
 #include "qsmesh/qstruct/balance.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdlib>
 #include <map>
@@ -248,13 +249,14 @@ std::vector<int> balance_curve_counts(const cad::CadModel& model,
       for (int a = 0; a < 2; ++a) {
         const int d = n[a] - n[a + 2];
         if (d == 0) continue;
-        for (const auto& [side, delta] : {std::pair<int, int>{a, -d}, std::pair<int, int>{a + 2, d}})
+        const std::array<std::pair<int, int>, 2> side_moves{{{a, -d}, {a + 2, d}}};
+        for (const auto& [side, delta] : side_moves)
           for (const auto& [c, s] : t.uses) {
             if (s != side || frozen[var_of(c)]) continue;
             const LO var = var_of(c);
             const std::vector<LO> mem = members(var);
-            if (!std::all_of(mem.begin(), mem.end(), [&](LO x) { return allowed(x, edges[x] + delta); }))
-              continue;
+            const auto ok = [&](LO x) { return allowed(x, edges[x] + delta); };
+            if (!std::all_of(mem.begin(), mem.end(), ok)) continue;
             std::vector<LO> touched;
             for (const LO x : mem)
               touched.insert(touched.end(), curve2targets[x].begin(), curve2targets[x].end());
@@ -281,8 +283,9 @@ std::vector<int> balance_curve_counts(const cad::CadModel& model,
             double ideal_sum = 0;
             for (const LO x : mem) ideal_sum += std::max(1.0, q.ideal[x]);
             const double rel = std::abs(delta) * static_cast<double>(mem.size()) / ideal_sum;
+            const auto key = std::make_tuple(-gain, dmis, rel, var);
             if (best_var == kNoIndex ||
-                std::make_tuple(-gain, dmis, rel, var) < std::make_tuple(-best_gain, best_dmis, best_rel, best_var)) {
+                key < std::make_tuple(-best_gain, best_dmis, best_rel, best_var)) {
               best_var = var;
               best_delta = delta;
               best_gain = gain;
@@ -294,7 +297,8 @@ std::vector<int> balance_curve_counts(const cad::CadModel& model,
       if (best_var == kNoIndex) continue;
       for (const LO c : members(best_var)) edges[c] += best_delta;
       for (const LO c : members(best_var))
-        for (const LO tt : curve2targets[c]) fit[tt] = fits(side_counts(targets[tt], edges)) ? 1 : 0;
+        for (const LO tt : curve2targets[c])
+          fit[tt] = fits(side_counts(targets[tt], edges)) ? 1 : 0;
       any = true;
     }
     if (!any) break;

@@ -373,19 +373,21 @@ TEST(Balance, RectanglesFittedByATransitionBecomeGrids) {
     BalanceOptions o;
     o.grid_length_ratio = ratio;
     BalanceReport rep;
-    const std::vector<int> edges = balance_curve_counts(pc.model, pc.curves, q, patterns, {}, o, &rep);
+    const std::vector<int> edges =
+        balance_curve_counts(pc.model, pc.curves, q, patterns, {}, o, &rep);
     EXPECT_EQ(rep.fitting_before, 1);
     EXPECT_EQ(rep.fitting_after, 1);
     for (LO c = 0; c < 4; ++c)
       EXPECT_LE(std::abs(edges[c] - q.ideal[c]), std::max(2.0, 0.35 * q.ideal[c]) + 1e-9);
     return std::make_pair(edges, rep);
   };
-  const auto [rect, rect_rep] = run({{0, 0}, {10, 0}, {10, 4}, {0, 4}}, "qs_balance_rect.brep", 1.1);
+  const XY rectangle = {{0, 0}, {10, 0}, {10, 4}, {0, 4}};
+  const auto [rect, rect_rep] = run(rectangle, "qs_balance_rect.brep", 1.1);
   EXPECT_EQ(rect[0], rect[2]);  // bottom and top now equal: 10 and 10, or 12 and 12
   EXPECT_EQ(rect[1], rect[3]);
   EXPECT_EQ(rect_rep.grids_before, 0);
   EXPECT_EQ(rect_rep.grids_after, 1);
-  const auto [off, off_rep] = run({{0, 0}, {10, 0}, {10, 4}, {0, 4}}, "qs_balance_off.brep", 0);
+  const auto [off, off_rep] = run(rectangle, "qs_balance_off.brep", 0);
   EXPECT_EQ(off, (std::vector<int>{12, 4, 10, 4}));
   EXPECT_EQ(off_rep.grids_after, 0);
   const auto [trap, trap_rep] = run({{0, 0}, {10, 0}, {8, 4}, {2, 4}}, "qs_balance_trap.brep", 1.1);
