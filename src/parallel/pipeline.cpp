@@ -375,10 +375,13 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
   const std::vector<qstruct::Pattern> patterns =
       quasi ? qstruct::builtin_patterns() : std::vector<qstruct::Pattern>{};
   std::vector<mesh::FaceMesh> quad_meshes(quads ? mine.size() : 0);
-  // Valid pattern meshes refused on quality, with their pattern's name, for the comparison with
-  // the unstructured path's result (PipelineOptions::pattern_compare_tolerance).
-  std::vector<mesh::FaceMesh> refused_patterns(quasi ? mine.size() : 0);
-  std::vector<std::string> refused_names(quasi ? mine.size() : 0);
+  // Valid pattern meshes refused on quality, for the comparison with the unstructured path's
+  // result (PipelineOptions::pattern_compare_tolerance).
+  struct RefusedFill {
+    mesh::FaceMesh mesh;
+    std::string pattern;
+  };
+  std::vector<RefusedFill> refused(quasi ? mine.size() : 0);
   std::vector<double> face_seconds(quads ? mine.size() : 0, 0.0);
   if (quasi) {
     // Simple CAD faces meshed directly by a pattern (paper 000 Sec. 6.1.2, pipeline step 4); the
@@ -404,8 +407,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
       } else {
         quasi_reports[i].refusal = qstruct::to_string(pr.refusal);
         if (options.pattern_compare_tolerance >= 0 && !pr.refused_mesh.quads.empty()) {
-          refused_patterns[i] = std::move(pr.refused_mesh);
-          refused_names[i] = pr.pattern_name;
+          refused[i] = {std::move(pr.refused_mesh), pr.pattern_name};
         }
       }
       face_seconds[i] += face_clock.seconds();
@@ -503,8 +505,8 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
       // same three quads either way).
       const double tol = options.pattern_compare_tolerance;
       tasks.parallel_for(total, [&](std::int64_t i) {
-        if (refused_patterns[i].quads.empty()) return;
-        const mesh::FaceQuadStats pat = mesh::face_quad_stats(refused_patterns[i]);
+        if (refused[i].mesh.quads.empty()) return;
+        const mesh::FaceQuadStats pat = mesh::face_quad_stats(refused[i].mesh);
         bool take = !quad_reports[i].ok || !quad_meshes[i].triangles.empty() ||
                     quad_meshes[i].quads.empty();
         if (!take) {
@@ -513,16 +515,16 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
                  pat.irregular_interior <= uns.irregular_interior;
         }
         if (take) {
-          quad_meshes[i] = std::move(refused_patterns[i]);
+          quad_meshes[i] = std::move(refused[i].mesh);
           quad_reports[i] = quad::UnstructuredReport{};
           quad_reports[i].ok = true;
           quad_reports[i].sicn_min = pat.sicn_min;
           quad_reports[i].quads = pat.quads;
           quasi_reports[i].by_pattern = true;
           quasi_reports[i].by_comparison = true;
-          quasi_reports[i].pattern = refused_names[i];
+          quasi_reports[i].pattern = refused[i].pattern;
         }
-        refused_patterns[i] = mesh::FaceMesh{};
+        refused[i] = RefusedFill{};
       });
     }
     meshes = std::move(quad_meshes);

@@ -135,6 +135,40 @@ std::vector<int> balance_curve_counts(const cad::CadModel& model,
     return next <= std::max(2.0, options.max_change * ideal) + 1e-9 || next < now;
   };
 
+  // A move adds `delta` edges to every curve of one variable (its members).
+  const auto move_allowed = [&](const std::vector<LO>& mem, int delta) {
+    return std::all_of(mem.begin(), mem.end(), [&](LO c) { return allowed(c, edges[c] + delta); });
+  };
+  const auto relative_change = [&](const std::vector<LO>& mem, int delta) {
+    double ideal_sum = 0;
+    for (const LO c : mem) ideal_sum += std::max(1.0, q.ideal[c]);
+    return std::abs(delta) * static_cast<double>(mem.size()) / ideal_sum;
+  };
+  // The targets a move of these curves touches, each once, in increasing order.
+  const auto touched_by = [&](const std::vector<LO>& mem) {
+    std::vector<LO> touched;
+    for (const LO c : mem) touched.insert(touched.end(), curve2targets[c].begin(), curve2targets[c].end());
+    std::sort(touched.begin(), touched.end());
+    touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
+    return touched;
+  };
+  // Side counts of target t once the move is made.
+  const auto moved_counts = [&](LO t, const std::vector<LO>& mem, int delta) {
+    std::vector<LO> n = side_counts(targets[t], edges);
+    for (const auto& [c, s] : targets[t].uses)
+      if (std::find(mem.begin(), mem.end(), c) != mem.end()) n[s] += delta;
+    return n;
+  };
+  // The movable variables of a side of t, each once, in increasing order.
+  const auto side_vars = [&](const FaceSidesOfUses& t, int side) {
+    std::vector<LO> v;
+    for (const auto& [c, s] : t.uses)
+      if (s == side && !frozen[var_of(c)]) v.push_back(var_of(c));
+    std::sort(v.begin(), v.end());
+    v.erase(std::unique(v.begin(), v.end()), v.end());
+    return v;
+  };
+
   struct Eval {
     bool ok = false;
     int gain = 0;        // fitting faces gained
@@ -145,26 +179,15 @@ std::vector<int> balance_curve_counts(const cad::CadModel& model,
   const auto evaluate = [&](LO var, int delta) {
     Eval e;
     const std::vector<LO> mem = members(var);
-    double ideal_sum = 0;
-    for (const LO c : mem) {
-      if (!allowed(c, edges[c] + delta)) return e;
-      ideal_sum += std::max(1.0, q.ideal[c]);
-    }
-    std::vector<LO> touched;
-    for (const LO c : mem) touched.insert(touched.end(), curve2targets[c].begin(), curve2targets[c].end());
-    std::sort(touched.begin(), touched.end());
-    touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
-    for (const LO c : mem) edges[c] += delta;
-    for (const LO t : touched) {
-      const auto n = side_counts(targets[t], edges);
+    if (!move_allowed(mem, delta)) return e;
+    for (const LO t : touched_by(mem)) {
+      const auto n = moved_counts(t, mem, delta);
       const bool after = fits(n);
       e.fit_after.emplace_back(t, after ? 1 : 0);
       e.gain += (after ? 1 : 0) - fit[t];
-      e.dmisfit += misfit(n, after);
+      e.dmisfit += misfit(n, after) - misfit(side_counts(targets[t], edges), fit[t] != 0);
     }
-    for (const LO c : mem) edges[c] -= delta;
-    for (const LO t : touched) e.dmisfit -= misfit(side_counts(targets[t], edges), fit[t] != 0);
-    e.rel = std::abs(delta) * static_cast<double>(mem.size()) / ideal_sum;
+    e.rel = relative_change(mem, delta);
     e.ok = e.gain > 0 || (e.gain == 0 && e.dmisfit < 0);
     return e;
   };
@@ -178,17 +201,9 @@ std::vector<int> balance_curve_counts(const cad::CadModel& model,
       const auto n = side_counts(t, edges);
       // Candidate moves: (variable, delta) pairs that shrink the failing differences.
       std::vector<std::pair<LO, int>> moves;
-      const auto side_vars = [&](int side) {
-        std::vector<LO> v;
-        for (const auto& [c, s] : t.uses)
-          if (s == side && !frozen[var_of(c)]) v.push_back(var_of(c));
-        std::sort(v.begin(), v.end());
-        v.erase(std::unique(v.begin(), v.end()), v.end());
-        return v;
-      };
       const auto add = [&](int side, int delta) {
         if (delta == 0) return;
-        for (const LO v : side_vars(side)) moves.emplace_back(v, delta);
+        for (const LO v : side_vars(t, side)) moves.emplace_back(v, delta);
       };
       if (t.num_sides == 4) {
         for (int a = 0; a < 2; ++a) {
@@ -231,10 +246,8 @@ std::vector<int> balance_curve_counts(const cad::CadModel& model,
   // sides are as long as each other), and a transition fill shears its rows to absorb that. Equal
   // counts give a grid. A move must not cost any face its fit or its grid, and must bring the
   // rectangles' opposite counts closer in total.
-  const auto grid_misfit = [&](LO t) {
-    if (!targets[t].rectangle) return 0;
-    const auto n = side_counts(targets[t], edges);
-    return static_cast<int>(std::abs(n[0] - n[2]) + std::abs(n[1] - n[3]));
+  const auto grid_misfit = [](const FaceSidesOfUses& t, const std::vector<LO>& n) {
+    return t.rectangle ? static_cast<int>(std::abs(n[0] - n[2]) + std::abs(n[1] - n[3])) : 0;
   };
   for (int pass = 0; pass < options.max_passes; ++pass) {
     bool any = false;
@@ -251,38 +264,21 @@ std::vector<int> balance_curve_counts(const cad::CadModel& model,
         if (d == 0) continue;
         const std::array<std::pair<int, int>, 2> side_moves{{{a, -d}, {a + 2, d}}};
         for (const auto& [side, delta] : side_moves)
-          for (const auto& [c, s] : t.uses) {
-            if (s != side || frozen[var_of(c)]) continue;
-            const LO var = var_of(c);
+          for (const LO var : side_vars(t, side)) {
             const std::vector<LO> mem = members(var);
-            const auto ok = [&](LO x) { return allowed(x, edges[x] + delta); };
-            if (!std::all_of(mem.begin(), mem.end(), ok)) continue;
-            std::vector<LO> touched;
-            for (const LO x : mem)
-              touched.insert(touched.end(), curve2targets[x].begin(), curve2targets[x].end());
-            std::sort(touched.begin(), touched.end());
-            touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
-            int dmis = 0, gain = 0;
+            if (!move_allowed(mem, delta)) continue;
+            int gain = 0, dmis = 0;
             bool loses = false;
-            std::vector<std::pair<LO, char>> before;
-            for (const LO tt : touched) {
-              dmis -= grid_misfit(tt);
-              before.emplace_back(tt, is_grid(side_counts(targets[tt], edges)) ? 1 : 0);
+            for (const LO tt : touched_by(mem)) {
+              const auto before = side_counts(targets[tt], edges);
+              const auto after = moved_counts(tt, mem, delta);
+              const bool was = is_grid(before), is = is_grid(after);
+              loses = loses || (fit[tt] && !fits(after)) || (was && !is);
+              gain += (is ? 1 : 0) - (was ? 1 : 0);
+              dmis += grid_misfit(targets[tt], after) - grid_misfit(targets[tt], before);
             }
-            for (const LO x : mem) edges[x] += delta;
-            for (std::size_t k = 0; k < touched.size(); ++k) {
-              const LO tt = touched[k];
-              const auto nn = side_counts(targets[tt], edges);
-              const bool g = is_grid(nn);
-              if ((fit[tt] && !fits(nn)) || (before[k].second && !g)) loses = true;
-              gain += (g ? 1 : 0) - before[k].second;
-              dmis += grid_misfit(tt);
-            }
-            for (const LO x : mem) edges[x] -= delta;
             if (loses || dmis >= 0) continue;
-            double ideal_sum = 0;
-            for (const LO x : mem) ideal_sum += std::max(1.0, q.ideal[x]);
-            const double rel = std::abs(delta) * static_cast<double>(mem.size()) / ideal_sum;
+            const double rel = relative_change(mem, delta);
             const auto key = std::make_tuple(-gain, dmis, rel, var);
             if (best_var == kNoIndex ||
                 key < std::make_tuple(-best_gain, best_dmis, best_rel, best_var)) {
@@ -295,10 +291,9 @@ std::vector<int> balance_curve_counts(const cad::CadModel& model,
           }
       }
       if (best_var == kNoIndex) continue;
-      for (const LO c : members(best_var)) edges[c] += best_delta;
-      for (const LO c : members(best_var))
-        for (const LO tt : curve2targets[c])
-          fit[tt] = fits(side_counts(targets[tt], edges)) ? 1 : 0;
+      const std::vector<LO> mem = members(best_var);
+      for (const LO c : mem) edges[c] += best_delta;
+      for (const LO tt : touched_by(mem)) fit[tt] = fits(side_counts(targets[tt], edges)) ? 1 : 0;
       any = true;
     }
     if (!any) break;

@@ -227,10 +227,9 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
   std::ostringstream os;
   os << rep.candidates << " candidate(s) tried, best " << rep.pattern_name << " with SICN min " << rep.sicn_min
      << " avg " << rep.sicn_avg << " (thresholds " << options.min_sicn << ", " << options.min_sicn_avg << ")";
-  const std::int64_t best_quads = rep.quads;
   refuse(Refusal::Quality, os.str());
   if (best_valid) {
-    rep.quads = best_quads;
+    rep.quads = static_cast<std::int64_t>(best.quads.size());
     rep.refused_mesh = std::move(best);
   }
   return empty;

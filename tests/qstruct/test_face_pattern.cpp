@@ -310,6 +310,17 @@ TEST(FacePattern, PolesAndHolesAreRefused) {
 }
 
 
+// A quantization whose counts are the polygon's curve meshes, each its own ideal value, no chord.
+quantize::Quantization quantization_of(const PolygonCase& pc) {
+  quantize::Quantization q;
+  for (const auto& curve : pc.curves) {
+    q.edges.push_back(curve.num_edges());
+    q.ideal.push_back(static_cast<double>(q.edges.back()));
+  }
+  q.curve2chord.assign(pc.curves.size(), kNoIndex);
+  return q;
+}
+
 // Pattern-aware quantization: a long rectangle whose bottom side is two curves gets [14, 2, 10, 2]
 // from the per-curve rounding, which no pattern fits (a transition of 4 edges across a strip 2
 // edges wide); balancing moves one bottom curve or the top so that the opposite sides agree.
@@ -318,12 +329,7 @@ TEST(Balance, SidesOfSeveralCurvesAreMadeToFit) {
   const std::vector<LO> counts = {6, 8, 2, 10, 2};
   const auto pc = polygon(xy, counts, "qs_balance.brep");
   ASSERT_EQ(pc.model.num_curves(), 5);
-  quantize::Quantization q;
-  for (LO c = 0; c < 5; ++c) {
-    q.edges.push_back(pc.curves[c].num_edges());
-    q.ideal.push_back(static_cast<double>(q.edges.back()));
-  }
-  q.curve2chord.assign(5, kNoIndex);
+  const quantize::Quantization q = quantization_of(pc);
   const auto patterns = builtin_patterns();
   const auto fs = face_sides(pc.model, 0, *pc.model.face_geometry(0), pc.curves, PatternFaceOptions{});
   ASSERT_EQ(fs.corners.size(), 4u);  // the 180-degree vertex at (3, 0) is no corner
@@ -362,12 +368,7 @@ TEST(Balance, SidesOfSeveralCurvesAreMadeToFit) {
 TEST(Balance, RectanglesFittedByATransitionBecomeGrids) {
   const auto run = [](const XY& xy, const std::string& name, double ratio) {
     const auto pc = polygon(xy, {12, 4, 10, 4}, name);
-    quantize::Quantization q;
-    for (LO c = 0; c < 4; ++c) {
-      q.edges.push_back(pc.curves[c].num_edges());
-      q.ideal.push_back(static_cast<double>(q.edges.back()));
-    }
-    q.curve2chord.assign(4, kNoIndex);
+    const quantize::Quantization q = quantization_of(pc);
     const auto patterns = builtin_patterns();
     EXPECT_FALSE(match_patterns(patterns, std::vector<LO>{12, 4, 10, 4}).empty());  // transitions
     BalanceOptions o;

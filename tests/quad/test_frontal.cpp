@@ -112,6 +112,18 @@ struct DiskFront {
         loops(background::face_boundary(model, 0, *surface, p.halved)) {}
   DiskFront(const DiskFront&) = delete;
   DiskFront& operator=(const DiskFront&) = delete;
+  [[nodiscard]] std::vector<Vec2> points(const FrontalOptions& options,
+                                         FrontalStats* stats = nullptr) const {
+    return frontal_points(*surface, loops, guide, options, stats);
+  }
+  /// The boundary points, then those of `pts` on the surface.
+  [[nodiscard]] std::vector<Vec3> with_boundary(const std::vector<Vec2>& pts) const {
+    std::vector<Vec3> all;
+    for (const auto& L : loops)
+      for (const auto& b : L.points) all.push_back(b.xyz);
+    for (const Vec2& uv : pts) all.push_back(surface->eval(uv).p);
+    return all;
+  }
   cad::CadModel model;
   Prepared p;
   FaceGuide guide;
@@ -146,23 +158,15 @@ TEST(FaceGuide, InterpolatesTheSizeAndFindsTheCross) {
 
 TEST(Frontal, PointsRespectTheMinimumSpacingAndAreDeterministic) {
   const DiskFront f(0.4);
-  const cad::FaceGeometry& surface = *f.surface;
-  const auto& loops = f.loops;
-  const FaceGuide& guide = f.guide;
   FrontalOptions options;
   FrontalStats stats;
-  const std::vector<Vec2> pts = frontal_points(surface, loops, guide, options, &stats);
+  const std::vector<Vec2> pts = f.points(options, &stats);
   ASSERT_GT(pts.size(), 20U);
   EXPECT_EQ(stats.accepted, static_cast<std::int64_t>(pts.size()));
   EXPECT_GT(stats.too_close, 0);
-  std::vector<Vec3> all;
-  for (const auto& L : loops)
-    for (const auto& b : L.points) all.push_back(b.xyz);
-  const std::size_t nb = all.size();
-  for (const Vec2& uv : pts) {
-    EXPECT_LT(uv.u * uv.u + uv.v * uv.v, 9.0) << "point outside the disk";
-    all.push_back(surface.eval(uv).p);
-  }
+  const std::vector<Vec3> all = f.with_boundary(pts);
+  const std::size_t nb = all.size() - pts.size();
+  for (const Vec2& uv : pts) EXPECT_LT(uv.u * uv.u + uv.v * uv.v, 9.0) << "point outside the disk";
   const double spacing = options.spacing_factor * 0.4;
   double closest = 1e300;
   for (std::size_t i = nb; i < all.size(); ++i)
@@ -171,7 +175,7 @@ TEST(Frontal, PointsRespectTheMinimumSpacingAndAreDeterministic) {
   // The disk is covered: about area / spacing^2 points.
   const double expected = 3.14159 * 9 / (spacing * spacing);
   EXPECT_GT(static_cast<double>(pts.size() + nb), 0.7 * expected);
-  EXPECT_EQ(pts, frontal_points(surface, loops, guide, options));
+  EXPECT_EQ(pts, f.points(options));
 }
 
 // Points of `pts` (frontal points of `f`) whose nearest other point (boundary points included)
@@ -179,11 +183,8 @@ TEST(Frontal, PointsRespectTheMinimumSpacingAndAreDeterministic) {
 // branches): where two fronts offset by half a spacing interleave into a lattice turned by 45
 // degrees.
 int diagonal_neighbours(const DiskFront& f, const std::vector<Vec2>& pts, double spacing) {
-  std::vector<Vec3> all;
-  for (const auto& L : f.loops)
-    for (const auto& b : L.points) all.push_back(b.xyz);
-  const std::size_t nb = all.size();
-  for (const Vec2& uv : pts) all.push_back(f.surface->eval(uv).p);
+  const std::vector<Vec3> all = f.with_boundary(pts);
+  const std::size_t nb = all.size() - pts.size();
   int diagonal = 0;
   for (std::size_t i = nb; i < all.size(); ++i) {
     std::size_t best = i;
@@ -208,16 +209,13 @@ TEST(Frontal, FrontsDoNotInterleaveAcrossTheCross) {
   // interleaved fronts form patches of a lattice turned by 45 degrees; the square zone along the
   // cross rejects it.
   const DiskFront f(0.2);
-  const cad::FaceGeometry& surface = *f.surface;
-  const auto& loops = f.loops;
-  const FaceGuide& guide = f.guide;
   FrontalOptions square;
   ASSERT_TRUE(square.cross_aligned_exclusion);
   FrontalOptions round = square;
   round.cross_aligned_exclusion = false;
   const double spacing = square.spacing_factor * 0.2;
-  const std::vector<Vec2> a = frontal_points(surface, loops, guide, square);
-  const std::vector<Vec2> b = frontal_points(surface, loops, guide, round);
+  const std::vector<Vec2> a = f.points(square);
+  const std::vector<Vec2> b = f.points(round);
   const int da = diagonal_neighbours(f, a, spacing);
   const int db = diagonal_neighbours(f, b, spacing);
   std::printf("points %zu / %zu, with a diagonal nearest neighbour: square %d, disk %d\n", a.size(),
