@@ -358,7 +358,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     }
     result.quantized_curves =
         quantize::place_vertices(model, curves, result.curve_sizes.at, result.quantization,
-                                 /*halved=*/false, tasks);
+                                 /*halved=*/false, tasks, options.place);
     result.times.add("quantize", comm.allreduce_max(clock.seconds()));
     log.info(cat("quantize: ", model.num_curves(), " curves, ", result.quantization.num_chords,
                  " chords, ", result.quantization.total_edges, " edges"));
@@ -420,7 +420,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
   if (quads) {
     clock.reset();
     const std::vector<mesh::CurveMesh> halved = quantize::place_vertices(
-        model, curves, result.curve_sizes.at, result.quantization, /*halved=*/true, tasks);
+        model, curves, result.curve_sizes.at, result.quantization, /*halved=*/true, tasks, options.place);
     quad::UnstructuredOptions qo;
     qo.size = options.background.sizes.size;
     auto mesh_unstructured = [&](std::int64_t i) {

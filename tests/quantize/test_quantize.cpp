@@ -355,8 +355,10 @@ TEST(PlaceVertices, Eq11SpacingFollowsTheSize) {
   const auto ideal = ideal_edge_counts(bg, sizes);
   const Quantization q = quantize_curves(model, ideal, {});
   const TaskArena tasks(2);
+  PlaceOptions own;  // each curve by its own size integral (Eq. 11 as written)
+  own.align_chords = false;
   for (const bool halved : {false, true}) {
-    const auto meshes = place_vertices(model, bg, sizes, q, halved, tasks);
+    const auto meshes = place_vertices(model, bg, sizes, q, halved, tasks, own);
     ASSERT_EQ(static_cast<LO>(meshes.size()), model.num_curves());
     for (LO c = 0; c < model.num_curves(); ++c) {
       const auto& m = meshes[c];
@@ -386,6 +388,118 @@ TEST(PlaceVertices, Eq11SpacingFollowsTheSize) {
       }
       EXPECT_GT((x[n] - x[n - 1]) / (x[1] - x[0]), 3.0);
     }
+  }
+}
+
+// The rectangle's sides graded 3:1 each along its own direction: the top and bottom sides run in
+// opposite directions, so by Eq. 11 alone a grid fill would shear (bottom fine at x = 0, top
+// fine at x = 10).
+struct GradedRectangle {
+  std::vector<mesh::CurveMesh> bg;
+  std::vector<std::vector<double>> sizes;
+  GradedRectangle() {
+    for (LO c = 0; c < rectangle().num_curves(); ++c) {
+      bg.push_back(test::uniform_curve_mesh(rectangle(), c, 40));
+      std::vector<double> s;
+      for (const double x : arc_length(bg.back().points)) s.push_back(0.2 + 0.08 * x);
+      sizes.push_back(s);
+    }
+  }
+};
+
+// Edge lengths of the long sides (length 10) in increasing x, bottom first.
+std::vector<std::vector<double>> long_side_xs(const cad::CadModel& model,
+                                              const std::vector<mesh::CurveMesh>& meshes) {
+  std::vector<std::vector<double>> out;
+  for (LO c = 0; c < model.num_curves(); ++c) {
+    if (std::lround(model.curves()[c].length) != 10) continue;
+    std::vector<double> x;
+    for (const auto& p : meshes[c].points) x.push_back(p.x);
+    std::sort(x.begin(), x.end());
+    out.push_back(x);
+  }
+  return out;
+}
+
+TEST(PlaceVertices, OppositeSidesOfAGridFaceShareTheirSpacing) {
+  const auto& model = rectangle();
+  const GradedRectangle r;
+  const Quantization q = quantize_curves(model, ideal_edge_counts(r.bg, r.sizes), {});
+  const TaskArena tasks(2);
+  for (const bool halved : {false, true}) {
+    const auto xs = long_side_xs(model, place_vertices(model, r.bg, r.sizes, q, halved, tasks));
+    ASSERT_EQ(xs.size(), 2u);
+    ASSERT_EQ(xs[0].size(), xs[1].size());
+    const std::size_t n = xs[0].size() - 1;
+    EXPECT_EQ(n, halved ? 10u : 20u);
+    // Same x on both sides: the grid's columns are straight.
+    for (std::size_t i = 0; i <= n; ++i) EXPECT_NEAR(xs[0][i], xs[1][i], 1e-9) << "vertex " << i;
+    // The mean of a profile and its mirror image is symmetric: both ends get the same spacing,
+    // finer than the middle (1 / s is convex along the side).
+    const double first = xs[0][1] - xs[0][0], last = xs[0][n] - xs[0][n - 1];
+    const double middle = xs[0][n / 2 + 1] - xs[0][n / 2];
+    EXPECT_NEAR(first / last, 1.0, 1e-3);
+    EXPECT_LT(first, middle);
+  }
+  // The same curves placed each by its own integral: the two sides graded in opposite senses.
+  PlaceOptions own;
+  own.align_chords = false;
+  const auto xs = long_side_xs(model, place_vertices(model, r.bg, r.sizes, q, false, tasks, own));
+  EXPECT_GT(std::abs(xs[0][10] - xs[1][10]), 1.0);
+}
+
+TEST(PlaceVertices, FacesWithOneJoinedPairKeepTheirOwnSpacing) {
+  // The short sides out of their chord (as when their ideal counts differ beyond the chord ratio):
+  // only the long sides are joined, so the face is no grid and its sides keep the spacing their
+  // sizes ask for.
+  const auto& model = rectangle();
+  const GradedRectangle r;
+  std::vector<double> ideal = ideal_edge_counts(r.bg, r.sizes);
+  const Quantization joined = quantize_curves(model, ideal, {});
+  Quantization q = joined;
+  const auto loop = loop_curves(model);
+  for (std::size_t k = 0; k < loop.size(); ++k)
+    if (std::lround(model.curves()[loop[k]].length) == 4) q.curve2chord[loop[k]] = kNoIndex;
+  const TaskArena tasks(1);
+  const auto xs = long_side_xs(model, place_vertices(model, r.bg, r.sizes, q, false, tasks));
+  ASSERT_EQ(xs.size(), 2u);
+  EXPECT_GT(std::abs(xs[0][10] - xs[1][10]), 1.0);
+  PlaceOptions bad;
+  bad.profile_samples = 1;
+  EXPECT_THROW((void)place_vertices(model, r.bg, r.sizes, joined, false, tasks, bad), Error);
+}
+
+TEST(PlaceVertices, TaperedFacesKeepTheirOwnSpacing) {
+  // A trapezoid: bottom 10, top 4 (2.5:1, beyond PlaceOptions::align_length_ratio), legs 5 and 5.
+  // Both pairs are joined in chords; the legs share their spacing, the bottom and top do not.
+  const cad::CadModel model = polygon_face({{0, 0}, {10, 0}, {7, 4}, {3, 4}}, "q_trapezoid.brep");
+  std::vector<mesh::CurveMesh> bg;
+  std::vector<std::vector<double>> sizes;
+  for (LO c = 0; c < model.num_curves(); ++c) {
+    bg.push_back(test::uniform_curve_mesh(model, c, 40));
+    std::vector<double> s;
+    for (const double x : arc_length(bg.back().points)) s.push_back(0.2 + 0.08 * x);
+    sizes.push_back(s);
+  }
+  const Quantization q = quantize_curves(model, ideal_edge_counts(bg, sizes), {});
+  const auto loop = loop_curves(model);
+  ASSERT_EQ(loop.size(), 4u);
+  ASSERT_NE(q.curve2chord[loop[0]], kNoIndex);
+  ASSERT_EQ(q.curve2chord[loop[0]], q.curve2chord[loop[2]]);
+  ASSERT_NE(q.curve2chord[loop[1]], kNoIndex);
+  ASSERT_EQ(q.curve2chord[loop[1]], q.curve2chord[loop[3]]);
+  const auto meshes = place_vertices(model, bg, sizes, q, false, TaskArena(1));
+  // Each curve's first and last edge, along its own direction.
+  const auto ends = [&](LO c) {
+    const auto x = arc_length(meshes[c].points);
+    return std::pair{x[1] - x[0], x.back() - x[x.size() - 2]};
+  };
+  for (const LO c : loop) {
+    const auto [first, last] = ends(c);
+    if (std::lround(model.curves()[c].length) == 5)
+      EXPECT_NEAR(first / last, 1.0, 1e-3) << "leg " << c;  // the mean of mirrored profiles
+    else
+      EXPECT_GT(last / first, 1.5) << "curve " << c;  // its own grading, fine at its start
   }
 }
 

@@ -45,6 +45,8 @@ struct PipelineOptions {
   bool size_map = false;
   sizemap::SizeMapOptions sizemap;
   quantize::QuantizeOptions quantize;
+  /// Where the quantized curves' vertices go (quantize::place_vertices).
+  quantize::PlaceOptions place;
   /// Pattern-aware quantization (qstruct::balance_curve_counts) after Sec. 4.3: curve counts
   /// nudged so that more faces fit a coarse pattern (Sec. 6.1.2). Applies with the size map.
   bool balance_counts = true;

@@ -83,18 +83,42 @@ struct Quantization {
                                            std::span<const double> ideal,
                                            const QuantizeOptions& options);
 
+struct PlaceOptions {
+  /// Opposite curves of the four-sided faces whose two pairs of opposite sides are joined in
+  /// chords (the faces a grid or transition pattern fills) share one vertex distribution, so the
+  /// pattern's rows do not shear: the curves connected by such faces (oriented through them) are
+  /// placed by the mean of their normalised profiles (∫ dl / s over the curve, as a function of
+  /// the arc-length fraction) instead of each by its own. Measured at the reference vertex
+  /// counts (docs/benchmarks.md, with align_length_ratio 1.5): interior irregular vertices
+  /// Block.stp 3158 -> 3083, mambo 321 -> 318, t20 109 -> 103, but A319 1146 -> 1166 and
+  /// wing_fuselage 873 -> 882 (unstructured neighbours of the aligned faces); four 44 x 4 grids of
+  /// Block at size factor 0.0037 from SICN avg 0.62 (refused) to 0.93.
+  bool align_chords = true;
+  /// ... through the faces whose opposite sides differ in length by at most this ratio (>= 1).
+  /// Measured at the reference counts, against no bound: the built-in example SICN avg 0.878 ->
+  /// 0.895 (its wing root and tip, 2.35:1, no longer blended), the six shared models within 3%
+  /// in interior irregular vertices either way.
+  double align_length_ratio = 1.5;
+  /// Arc-length samples of the shared profile (>= 2).
+  int profile_samples = 256;
+};
+
 /// Paper 000 Eq. 11: the final curve meshes, one per curve, indexed by curve id. Curve c gets
 /// n = q.edges[c] edges (n = q.edges[c] / 2 when `halved`: the meshes the quad mesher uses before
 /// midpoint subdivision; q.edges[c] must then be even). Vertex i sits where the integral of dl / s
 /// (s linear along the background polyline curves[c], as in ideal_edge_counts) reaches i/n of the
 /// total; its parameter is interpolated linearly between the two background vertices around it and
-/// its point is evaluated on the CAD curve (model.curve_geometry(c)). The end vertices are the
+/// its point is evaluated on the CAD curve (model.curve_geometry(c)). With
+/// options.align_chords, the curves of a set of aligned opposite sides (see PlaceOptions) use the
+/// set's mean profile instead of their own, sampled at options.profile_samples + 1 arc-length
+/// fractions and interpolated linearly; their vertex i sits where that profile reaches i/n, at
+/// that fraction of the background polyline's length. The end vertices are the
 /// curve's corners exactly (t = the background's end parameters). Degenerate curves keep their
 /// background mesh (one edge). One task per curve on `tasks`; the result does not depend on the
 /// thread count. Throws qsmesh::Error on size mismatches or non-positive sizes.
 [[nodiscard]] std::vector<mesh::CurveMesh> place_vertices(
     const cad::CadModel& model, std::span<const mesh::CurveMesh> curves,
     std::span<const std::vector<double>> sizes, const Quantization& q, bool halved,
-    const TaskArena& tasks);
+    const TaskArena& tasks, const PlaceOptions& options = {});
 
 }  // namespace qsmesh::quantize
