@@ -97,11 +97,11 @@ mesh::FaceMesh build_mesh(LO f, const cad::Face& face, const cad::FaceGeometry& 
 
 // Whether the quads at or below min_sicn are few enough for the untangler to be worth a try
 // (PatternFaceOptions::lift_max_poor_fraction).
-bool few_poor_quads(const mesh::FaceMesh& m, const PatternFaceOptions& options) {
+bool few_poor_quads(const mesh::FaceMesh& m, const PatternFaceOptions& options, double min_sicn) {
   std::int64_t poor = 0;
   for (const auto& q : m.quads)
     if (mesh::quad_sicn({m.points[q[0]], m.points[q[1]], m.points[q[2]], m.points[q[3]]}) <=
-        options.min_sicn)
+        min_sicn)
       ++poor;
   const double bound =
       std::max(static_cast<double>(options.lift_min_poor_quads),
@@ -186,6 +186,15 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
   // matches come sorted by pattern order and energy; the valence fit goes first.
   std::stable_sort(cands.begin(), cands.end(), [](const Candidate& a, const Candidate& b) { return a.score < b.score; });
 
+  // The quad at a corner of angle a below 90 degrees reaches at best SICN sin(a) (equal edges):
+  // a threshold above that would refuse every mesh of the face, the unstructured one included.
+  double min_sicn = options.min_sicn;
+  for (const LO c : fs.corners) {
+    const double best = std::sin(fs.angle_deg[c] * std::numbers::pi / 180);
+    if (fs.angle_deg[c] < 90 && best <= options.min_sicn)
+      min_sicn = std::min(min_sicn, options.corner_sicn_factor * best);
+  }
+  rep.min_sicn = min_sicn;
   mesh::FaceMesh best;
   bool best_valid = false;
   const int tries = std::min<int>(std::max(1, options.max_candidates), static_cast<int>(cands.size()));
@@ -196,16 +205,16 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
     // A layout good on average but with a few poor quads (usually next to an irregular vertex of
     // the pattern, or a folded corner of a size transition) is worth lifting locally; the
     // smoothing kernels never lower the minimum, so they cannot get out of a fold.
-    if (options.lift_poor_quads && (q.invalid > 0 || q.sicn_min <= options.min_sicn) &&
-        q.sicn_avg > options.min_sicn_avg && few_poor_quads(mesh, options)) {
+    if (options.lift_poor_quads && (q.invalid > 0 || q.sicn_min <= min_sicn) &&
+        q.sicn_avg > options.min_sicn_avg && few_poor_quads(mesh, options, min_sicn)) {
       ++rep.lifts;
       smooth::UntangleOptions uo;
-      uo.target = options.min_sicn + 0.05;
+      uo.target = min_sicn + 0.05;
       mesh = smooth::untangle_face(mesh, surface, uo);
       q = smooth::measure(mesh);
     }
     ++rep.candidates;
-    const bool good = q.invalid == 0 && q.sicn_min > options.min_sicn && q.sicn_avg > options.min_sicn_avg;
+    const bool good = q.invalid == 0 && q.sicn_min > min_sicn && q.sicn_avg > options.min_sicn_avg;
     if (good || k == 0 || q.sicn_min > rep.sicn_min) {
       best_valid = q.invalid == 0 && q.sicn_min > 0;
       rep.pattern = c.match.pattern;
@@ -226,7 +235,7 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
   }
   std::ostringstream os;
   os << rep.candidates << " candidate(s) tried, best " << rep.pattern_name << " with SICN min " << rep.sicn_min
-     << " avg " << rep.sicn_avg << " (thresholds " << options.min_sicn << ", " << options.min_sicn_avg << ")";
+     << " avg " << rep.sicn_avg << " (thresholds " << min_sicn << ", " << options.min_sicn_avg << ")";
   refuse(Refusal::Quality, os.str());
   if (best_valid) {
     rep.quads = static_cast<std::int64_t>(best.quads.size());

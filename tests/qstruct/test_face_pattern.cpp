@@ -177,6 +177,29 @@ TEST(FacePattern, RectangleWithATransitionGetsOneValence3And5) {
   EXPECT_NEAR(q.sicn_min, rep.sicn_min, 1e-12);
 }
 
+// PatternFaceOptions::corner_sicn_factor: a quadrilateral with a 15-degree corner (the others
+// 110, 115, 120), sides [20, 2, 4, 18] fitted by a transition. No quad at that corner can reach
+// SICN 0.3 (sin 15 = 0.259), so the plain threshold would refuse every fill; the lowered one
+// (0.9 x 0.259) keeps it.
+TEST(FacePattern, SharpCornerLowersTheMinThresholdToWhatItAllows) {
+  const XY xy = {{0, 0}, {10, 0}, {10.342, 0.940}, {8.898, 2.384}};
+  const auto pc = polygon(xy, {20, 2, 4, 18}, "qs_sharp.brep");
+  const auto patterns = builtin_patterns();
+  PatternFaceReport rep;
+  const auto m = mesh_face_pattern(pc.model, 0, pc.curves, patterns, {}, &rep);
+  ASSERT_TRUE(rep.ok) << rep.reason;
+  (void)check_face(pc.model, 0, pc.curves, m, rep);
+  EXPECT_NEAR(rep.min_sicn, 0.9 * std::sin(15 * std::numbers::pi / 180), 0.01);
+  EXPECT_LT(rep.sicn_min, 0.3);
+  EXPECT_GT(rep.sicn_min, rep.min_sicn);
+  PatternFaceOptions plain;
+  plain.corner_sicn_factor = 1e9;  // never below min_sicn: the plain threshold
+  (void)mesh_face_pattern(pc.model, 0, pc.curves, patterns, plain, &rep);
+  EXPECT_FALSE(rep.ok);
+  EXPECT_EQ(rep.refusal, Refusal::Quality);
+  EXPECT_DOUBLE_EQ(rep.min_sicn, 0.3);
+}
+
 // PatternFaceOptions::lift_max_poor_fraction: the untangler only gets fills with few poor quads.
 // With min_sicn 0.95 most quads of the transition fill are "poor" (and the average bound is off),
 // so the default bound skips the untangler; without the bound it runs.
