@@ -1,6 +1,7 @@
 #include "qsmesh/qstruct/patterns.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <numeric>
 #include <utility>
@@ -208,6 +209,54 @@ RefinedPattern refine_pattern(const Pattern& pattern, std::span<const LO> chords
     for (LO t = 0; t < s; ++t) r.boundary.push_back(at(e, pattern.boundary[k], t));
   }
   return r;
+}
+
+std::vector<std::vector<LO>> chord_moves(const Pattern& pattern) {
+  const int rows = pattern.num_sides();
+  const int cols = static_cast<int>(pattern.num_chords);
+  // Reduced row echelon form of w in rationals (exact: w holds 0, 1, 2 and the patterns are
+  // small, so doubles carry the fractions without rounding trouble at this size).
+  std::vector<std::vector<double>> a(static_cast<std::size_t>(rows), std::vector<double>(cols));
+  for (int i = 0; i < rows; ++i)
+    for (int j = 0; j < cols; ++j) a[i][j] = pattern.weight(i, j);
+  std::vector<int> pivot_col;
+  int r = 0;
+  for (int j = 0; j < cols && r < rows; ++j) {
+    int p = r;
+    for (int i = r + 1; i < rows; ++i)
+      if (std::abs(a[i][j]) > std::abs(a[p][j])) p = i;
+    if (std::abs(a[p][j]) < 1e-9) continue;
+    std::swap(a[p], a[r]);
+    const double d = a[r][j];
+    for (double& x : a[r]) x /= d;
+    for (int i = 0; i < rows; ++i) {
+      if (i == r || std::abs(a[i][j]) < 1e-12) continue;
+      const double k = a[i][j];
+      for (int jj = 0; jj < cols; ++jj) a[i][jj] -= k * a[r][jj];
+    }
+    pivot_col.push_back(j);
+    ++r;
+  }
+  std::vector<char> is_pivot(static_cast<std::size_t>(cols), 0);
+  for (const int j : pivot_col) is_pivot[j] = 1;
+  std::vector<std::vector<LO>> out;
+  for (int f = 0; f < cols; ++f) {
+    if (is_pivot[f]) continue;
+    std::vector<double> x(static_cast<std::size_t>(cols), 0.0);
+    x[f] = 1;
+    for (int i = 0; i < static_cast<int>(pivot_col.size()); ++i) x[pivot_col[i]] = -a[i][f];
+    // Smallest multiplier making every entry an integer.
+    for (int m = 1; m <= 64; ++m) {
+      bool integral = true;
+      for (const double v : x) integral = integral && std::abs(v * m - std::round(v * m)) < 1e-6;
+      if (!integral) continue;
+      std::vector<LO> v(static_cast<std::size_t>(cols));
+      for (int j = 0; j < cols; ++j) v[j] = static_cast<LO>(std::lround(x[j] * m));
+      out.push_back(std::move(v));
+      break;
+    }
+  }
+  return out;
 }
 
 }  // namespace qsmesh::qstruct

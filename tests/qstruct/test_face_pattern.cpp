@@ -142,8 +142,10 @@ TEST(FacePattern, RectangleWithATransitionGetsOneValence3And5) {
   const XY xy = {{0, 0}, {10, 0}, {10, 5}, {0, 5}};
   const auto pc = polygon(xy, {11, 4, 9, 6}, "qs_trans.brep");
   const auto patterns = builtin_patterns();
+  PatternFaceOptions balanced;  // the matched chord subdivisions, not moved
+  balanced.move_evaluations = 0;
   PatternFaceReport rep;
-  const auto m = mesh_face_pattern(pc.model, 0, pc.curves, patterns, {}, &rep);
+  const auto m = mesh_face_pattern(pc.model, 0, pc.curves, patterns, balanced, &rep);
   const auto v = check_face(pc.model, 0, pc.curves, m, rep);
   EXPECT_EQ(rep.pattern_name, "transition_1");
   EXPECT_EQ(v.interior.count(3) ? v.interior.at(3) : 0, 1);
@@ -156,7 +158,7 @@ TEST(FacePattern, RectangleWithATransitionGetsOneValence3And5) {
     }
 
   // Thresholds are honoured: nothing is that good, so the face is refused with the reason.
-  PatternFaceOptions strict;
+  PatternFaceOptions strict = balanced;
   strict.min_sicn = 0.999;
   const auto r = mesh_face_pattern(pc.model, 0, pc.curves, patterns, strict, &rep);
   EXPECT_FALSE(rep.ok);
@@ -198,6 +200,39 @@ TEST(FacePattern, SharpCornerLowersTheMinThresholdToWhatItAllows) {
   EXPECT_FALSE(rep.ok);
   EXPECT_EQ(rep.refusal, Refusal::Quality);
   EXPECT_DOUBLE_EQ(rep.min_sicn, 0.3);
+}
+
+// PatternFaceOptions::move_evaluations: a strip 4 wide and 20 high that widens to 5.46 over its
+// top fifth (the right side bends by 20 degrees at y = 16, too little to be a corner). The
+// balanced chord subdivisions put the size transition halfway up, under rows of tall quads; the
+// moves keep the pattern, its irregular vertices and the side counts, and raise the mean SICN.
+TEST(FacePattern, MovesOfTheIrregularVerticesRaiseTheMeanSicn) {
+  const XY xy = {{0, 0}, {4, 0}, {4, 16}, {5.456, 20}, {0, 20}};
+  const auto pc = polygon(xy, {8, 32, 8, 12, 40}, "qs_flare.brep");
+  const auto patterns = builtin_patterns();
+  PatternFaceOptions fixed;
+  fixed.move_evaluations = 0;
+  PatternFaceReport before;
+  const auto m0 = mesh_face_pattern(pc.model, 0, pc.curves, patterns, fixed, &before);
+  ASSERT_TRUE(before.ok) << before.reason;
+  EXPECT_EQ(before.moves, 0);
+  PatternFaceReport after;
+  const auto m1 = mesh_face_pattern(pc.model, 0, pc.curves, patterns, {}, &after);
+  ASSERT_TRUE(after.ok) << after.reason;
+  const auto v0 = check_face(pc.model, 0, pc.curves, m0, before);
+  const auto v1 = check_face(pc.model, 0, pc.curves, m1, after);
+  EXPECT_EQ(after.pattern_name, before.pattern_name);
+  EXPECT_EQ(after.side_edges, before.side_edges);
+  // The same irregular vertices; only the number of regular ones may change.
+  auto irregular0 = v0.interior, irregular1 = v1.interior;
+  irregular0.erase(4);
+  irregular1.erase(4);
+  EXPECT_EQ(irregular1, irregular0);
+  EXPECT_FALSE(irregular1.empty());
+  EXPECT_NE(after.chords, before.chords);
+  EXPECT_GT(after.moves, 0);
+  EXPECT_GT(after.sicn_avg, before.sicn_avg + 0.01);
+  EXPECT_GT(after.sicn_min, after.min_sicn);
 }
 
 // PatternFaceOptions::lift_max_poor_fraction: the untangler only gets fills with few poor quads.

@@ -86,6 +86,32 @@ TEST(Patterns, ThirdPatternGivesThePapersSystem) {
   EXPECT_EQ(p.weight(0, 0) + p.weight(0, 1) + p.weight(0, 2), 3);
 }
 
+// chord_moves: the kernel of w, in integers. The grid has none (its sides fix both chords); the
+// paper's third pattern has two (a + b + c = N1, a + c = N3 and b + d + e = N4, d + e = N2 leave
+// a against c and d against e free); every pattern's moves keep all side counts.
+TEST(Patterns, ChordMovesKeepEverySideCount) {
+  const auto all = builtin_patterns();
+  EXPECT_TRUE(chord_moves(by_name(all, "grid")).empty());
+  EXPECT_EQ(chord_moves(by_name(all, "transition_1")).size(), 2u);
+  for (const auto& p : all) {
+    const auto moves = chord_moves(p);
+    for (const auto& v : moves) {
+      ASSERT_EQ(static_cast<LO>(v.size()), p.num_chords) << p.name;
+      bool nonzero = false;
+      for (const LO x : v) nonzero = nonzero || x != 0;
+      EXPECT_TRUE(nonzero) << p.name;
+      for (int i = 0; i < p.num_sides(); ++i) {
+        long sum = 0;
+        for (LO j = 0; j < p.num_chords; ++j) sum += static_cast<long>(p.weight(i, j)) * v[j];
+        EXPECT_EQ(sum, 0) << p.name << " side " << i;
+      }
+    }
+    // As many moves as free chords: a random positive solution plus any combination stays a
+    // solution, and the moves are independent (checked by their count against the rank).
+    EXPECT_LE(static_cast<LO>(moves.size()), p.num_chords - 1) << p.name;
+  }
+}
+
 TEST(Patterns, InvalidPatternsAreRejected) {
   // Two quads with inconsistent orientation.
   EXPECT_THROW((void)make_pattern("bad", {{0, 0}, {1, 0}, {1, 1}, {0, 1}, {2, 0}, {2, 1}}, {{0, 1, 2, 3}, {1, 2, 5, 4}}),

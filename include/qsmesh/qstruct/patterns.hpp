@@ -110,6 +110,12 @@ struct PatternMatch {
                                                        std::span<const LO> side_edges,
                                                        const MatchOptions& options = {});
 
+/// Integer vectors spanning the kernel of the pattern's Eq. 14 matrix w: adding a multiple of one
+/// to a solution changes no side's count, only where the pattern's irregular vertices sit (e.g.
+/// how far up a rectangle's size transition is). One vector per free chord of the reduced row
+/// echelon form, scaled to the smallest integers; empty when the sides fix every chord (the grid).
+[[nodiscard]] std::vector<std::vector<LO>> chord_moves(const Pattern& pattern);
+
 /// The refined quad mesh of a pattern: each coarse quad becomes an s_i x s_j grid, s from its two
 /// chords (paper 000 Fig. 4, bottom).
 struct RefinedPattern {
