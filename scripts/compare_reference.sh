@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Runs `qsmesh mesh --until STAGE` on each shared model at a size that gives the vertex count of the
 # Gmsh reference run of ../shared/cad/README.md (the size factor is searched, up to eight runs per
-# model, until the count is within 1%; the run closest to the reference count is reported), and prints qsmesh's numbers beside the reference's: vertices, interior irregular
-# vertices, SICN min / avg, wall time and peak memory (one thread, one rank). The reference numbers
+# model, until the count is within 1%; the run closest to the reference count is reported), and
+# prints qsmesh's numbers beside the reference's: vertices, interior irregular vertices, SICN
+# min / avg, wall time and peak memory (one thread, one rank). The reference numbers
 # are read from that README by scripts/gmsh_reference.py.
 # Usage: scripts/compare_reference.sh [STAGE] [MODEL...]   (after scripts/build.sh; default stage
 # quasi-structured, default models: all six)
