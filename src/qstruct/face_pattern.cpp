@@ -115,10 +115,12 @@ bool few_poor_quads(const mesh::FaceMesh& m, const PatternFaceOptions& options, 
 // widens near one end (mambo's [102, 20, 102, 32] strips: rows of tall quads above the
 // transition, SICN avg 0.93). Moves along the kernel of Eq. 14 keep every side's count and shift
 // the pattern's irregular vertices; a local search over them keeps the best mean SICN.
-mesh::FaceMesh move_irregular_vertices(LO f, const cad::Face& face, const cad::FaceGeometry& surface,
-                                       const FaceSides& fs, const Pattern& pattern, const Candidate& start,
-                                       mesh::FaceMesh mesh, smooth::QualityReport q, double min_sicn,
-                                       const PatternFaceOptions& options, PatternFaceReport& rep) {
+mesh::FaceMesh move_irregular_vertices(LO f, const cad::Face& face,
+                                       const cad::FaceGeometry& surface, const FaceSides& fs,
+                                       const Pattern& pattern, const Candidate& start,
+                                       mesh::FaceMesh mesh, smooth::QualityReport q,
+                                       double min_sicn, const PatternFaceOptions& options,
+                                       PatternFaceReport& rep) {
   const std::vector<std::vector<LO>> moves = chord_moves(pattern);
   if (moves.empty()) return mesh;
   Candidate best = start;
@@ -137,14 +139,17 @@ mesh::FaceMesh move_irregular_vertices(LO f, const cad::Face& face, const cad::F
       if (c.match.chords[j] < 1) return false;
     }
     c.refined = refine_pattern(pattern, c.match.chords);
-    if (options.max_quads > 0 && static_cast<std::int64_t>(c.refined.quads.size()) > options.max_quads)
+    if (options.max_quads > 0 &&
+        static_cast<std::int64_t>(c.refined.quads.size()) > options.max_quads)
       return false;
     ++evaluations;
-    mesh::FaceMesh m = smooth::smooth_face(build_mesh(f, face, surface, fs, c), surface, options.smooth);
+    mesh::FaceMesh m =
+        smooth::smooth_face(build_mesh(f, face, surface, fs, c), surface, options.smooth);
     const smooth::QualityReport mq = smooth::measure(m);
     if (mq.invalid != 0) return false;
     const bool good_new = mq.sicn_min > min_sicn && mq.sicn_avg > options.min_sicn_avg;
-    const bool good_old = q.invalid == 0 && q.sicn_min > min_sicn && q.sicn_avg > options.min_sicn_avg;
+    const bool good_old =
+        q.invalid == 0 && q.sicn_min > min_sicn && q.sicn_avg > options.min_sicn_avg;
     if (good_new != good_old ? !good_new : score(mq) <= score(q) + 1e-4) return false;
     best = std::move(c);
     mesh = std::move(m);
@@ -159,7 +164,8 @@ mesh::FaceMesh move_irregular_vertices(LO f, const cad::Face& face, const cad::F
       if (v[j] > 0) lo = std::max(lo, -((best.match.chords[j] - 1) / v[j]));
       if (v[j] < 0) hi = std::min(hi, (best.match.chords[j] - 1) / -v[j]);
     }
-    if (lo == std::numeric_limits<LO>::min() || hi == std::numeric_limits<LO>::max() || hi - lo < 1) continue;
+    if (lo == std::numeric_limits<LO>::min() || hi == std::numeric_limits<LO>::max() || hi - lo < 1)
+      continue;
     // Coarse: four points spread over the range; then halving steps around the best.
     const LO span = std::max<LO>(1, (hi - lo) / 5);
     LO at = 0;  // offset of `best` from where this vector's search started
@@ -272,10 +278,12 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
   bool best_valid = false;
   int best_k = 0;
   smooth::QualityReport best_q;
-  const int tries = std::min<int>(std::max(1, options.max_candidates), static_cast<int>(cands.size()));
+  const int tries =
+      std::min<int>(std::max(1, options.max_candidates), static_cast<int>(cands.size()));
   for (int k = 0; k < tries; ++k) {
     const Candidate& c = cands[k];
-    mesh::FaceMesh mesh = smooth::smooth_face(build_mesh(f, face, surface, fs, c), surface, options.smooth);
+    mesh::FaceMesh mesh =
+        smooth::smooth_face(build_mesh(f, face, surface, fs, c), surface, options.smooth);
     smooth::QualityReport q = smooth::measure(mesh);
     // A layout good on average but with a few poor quads (usually next to an irregular vertex of
     // the pattern, or a folded corner of a size transition) is worth lifting locally; the
@@ -317,8 +325,8 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
     // The best valid candidate below the thresholds may pass them with its irregular vertices
     // elsewhere (Block's half-disks [60, 78]: SICN avg 0.53 balanced, 0.84 moved).
     const Candidate& c = cands[best_k];
-    best = move_irregular_vertices(f, face, surface, fs, patterns[c.match.pattern], c, std::move(best),
-                                   best_q, min_sicn, options, rep);
+    best = move_irregular_vertices(f, face, surface, fs, patterns[c.match.pattern], c,
+                                   std::move(best), best_q, min_sicn, options, rep);
     if (rep.sicn_min > min_sicn && rep.sicn_avg > options.min_sicn_avg) {
       rep.ok = true;
       rep.refusal = Refusal::None;
@@ -326,8 +334,9 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
     }
   }
   std::ostringstream os;
-  os << rep.candidates << " candidate(s) tried, best " << rep.pattern_name << " with SICN min " << rep.sicn_min
-     << " avg " << rep.sicn_avg << " (thresholds " << min_sicn << ", " << options.min_sicn_avg << ")";
+  os << rep.candidates << " candidate(s) tried, best " << rep.pattern_name << " with SICN min "
+     << rep.sicn_min << " avg " << rep.sicn_avg << " (thresholds " << min_sicn << ", "
+     << options.min_sicn_avg << ")";
   refuse(Refusal::Quality, os.str());
   if (best_valid) {
     rep.quads = static_cast<std::int64_t>(best.quads.size());

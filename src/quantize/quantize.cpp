@@ -110,10 +110,10 @@ std::vector<double> normalised_profile(const mesh::CurveMesh& m, const std::vect
 // faces (opposite uses of a loop run in opposite directions); a set the faces orient
 // inconsistently (a twisted band) keeps its own profiles.
 std::vector<std::vector<double>> shared_profiles(const cad::CadModel& model,
-                                                std::span<const mesh::CurveMesh> curves,
-                                                std::span<const std::vector<double>> sizes,
-                                                const Quantization& q,
-                                                const PlaceOptions& options) {
+                                                 std::span<const mesh::CurveMesh> curves,
+                                                 std::span<const std::vector<double>> sizes,
+                                                 const Quantization& q,
+                                                 const PlaceOptions& options) {
   const int samples = options.profile_samples;
   const LO nc = model.num_curves();
   const auto cv = model.curves();
@@ -171,8 +171,7 @@ std::vector<std::vector<double>> shared_profiles(const cad::CadModel& model,
         consistent = false;
         break;
       }
-      for (int k = 0; k <= samples; ++k)
-        shared[k] += flip[c] != 0 ? 1 - g[samples - k] : g[k];
+      for (int k = 0; k <= samples; ++k) shared[k] += flip[c] != 0 ? 1 - g[samples - k] : g[k];
     }
     if (!consistent) continue;
     for (double& v : shared) v /= static_cast<double>(mem.size());
