@@ -230,7 +230,7 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
   const LO m = static_cast<LO>(fs.corners.size());
   std::vector<char> splits(nb, 0);
   for (const LO c : fs.corners) splits[c] = 1;
-  std::vector<Candidate> cands;
+  std::vector<Candidate> cands, oversize;
   std::int64_t fewest_quads = -1;
   for (const auto& match : matches) {
     Candidate c;
@@ -238,7 +238,6 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
     c.refined = refine_pattern(patterns[match.pattern], match.chords);
     const auto nq = static_cast<std::int64_t>(c.refined.quads.size());
     if (fewest_quads < 0 || nq < fewest_quads) fewest_quads = nq;
-    if (options.max_quads > 0 && nq > options.max_quads) continue;
     QSMESH_CHECK(static_cast<LO>(c.refined.boundary.size()) == nb,
                  "refined boundary has " << c.refined.boundary.size() << " vertices, the face " << nb);
     const LO first = match.reversed ? fs.corners[(match.start + 1) % m] : fs.corners[match.start];
@@ -254,16 +253,12 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
           fs.points[i].vclass.dim == 0 ? std::max(2, static_cast<int>(std::lround(fs.angle_deg[i] / 90.0))) : 2;
       c.score += std::abs(valence[c.refined.boundary[p]] - ideal);
     }
-    cands.push_back(std::move(c));
-  }
-  if (cands.empty()) {
-    std::ostringstream os;
-    os << "every fitting pattern needs at least " << fewest_quads << " quads, more than the "
-       << options.max_quads << " the size map allows";
-    return refuse(Refusal::TooManyQuads, os.str());
+    (options.max_quads > 0 && nq > options.max_quads ? oversize : cands).push_back(std::move(c));
   }
   // matches come sorted by pattern order and energy; the valence fit goes first.
-  std::stable_sort(cands.begin(), cands.end(), [](const Candidate& a, const Candidate& b) { return a.score < b.score; });
+  const auto by_score = [](const Candidate& a, const Candidate& b) { return a.score < b.score; };
+  std::stable_sort(cands.begin(), cands.end(), by_score);
+  std::stable_sort(oversize.begin(), oversize.end(), by_score);
 
   // The quad at a corner of angle a below 90 degrees reaches at best SICN sin(a) (equal edges):
   // a threshold above that would refuse every mesh of the face, the unstructured one included.
@@ -274,6 +269,45 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
       min_sicn = std::min(min_sicn, options.corner_sicn_factor * best);
   }
   rep.min_sicn = min_sicn;
+  if (cands.empty()) {
+    std::ostringstream os;
+    os << "every fitting pattern needs at least " << fewest_quads << " quads, more than the "
+       << options.max_quads << " the size map allows";
+    if (options.move_evaluations > 0) {
+      // The balanced subdivisions put a transition where it costs the most quads; moved, the
+      // same pattern may fit the bound (Block's half-disks [60, 78] at size factor 0.0037). The
+      // search starts from a worst-possible score and lays out only the moves within the bound.
+      const Candidate& c = oversize.front();
+      rep.pattern = c.match.pattern;
+      rep.pattern_name = patterns[c.match.pattern].name;
+      rep.start = c.match.start;
+      rep.reversed = c.match.reversed;
+      smooth::QualityReport none;
+      none.invalid = 1;
+      none.sicn_min = -1;
+      none.sicn_avg = -1;
+      mesh::FaceMesh moved =
+          move_irregular_vertices(f, face, surface, fs, patterns[c.match.pattern], c,
+                                  mesh::FaceMesh{}, none, min_sicn, options, rep);
+      if (rep.moves > 0) {
+        ++rep.candidates;
+        if (rep.sicn_min > min_sicn && rep.sicn_avg > options.min_sicn_avg) {
+          rep.ok = true;
+          rep.refusal = Refusal::None;
+          return moved;
+        }
+        refuse(Refusal::Quality, os.str() + "; moved, " + rep.pattern_name +
+                                     " fits with SICN min " + std::to_string(rep.sicn_min) +
+                                     " avg " + std::to_string(rep.sicn_avg));
+        if (rep.sicn_min > 0) {
+          rep.quads = static_cast<std::int64_t>(moved.quads.size());
+          rep.refused_mesh = std::move(moved);
+        }
+        return empty;
+      }
+    }
+    return refuse(Refusal::TooManyQuads, os.str());
+  }
   mesh::FaceMesh best;
   bool best_valid = false;
   int best_k = 0;

@@ -235,6 +235,32 @@ TEST(FacePattern, MovesOfTheIrregularVerticesRaiseTheMeanSicn) {
   EXPECT_GT(after.sicn_min, after.min_sicn);
 }
 
+// ... and a fill whose balanced subdivisions need more quads than max_quads may still fit the
+// bound once moved: the same strip with the bound one quad below the balanced fill's count.
+TEST(FacePattern, MovedFillsMayFitTheQuadBound) {
+  const XY xy = {{0, 0}, {4, 0}, {4, 16}, {5.456, 20}, {0, 20}};
+  const auto pc = polygon(xy, {8, 32, 8, 12, 40}, "qs_flare_bound.brep");
+  const auto patterns = builtin_patterns();
+  PatternFaceOptions fixed;
+  fixed.move_evaluations = 0;
+  PatternFaceReport rep;
+  (void)mesh_face_pattern(pc.model, 0, pc.curves, patterns, fixed, &rep);
+  ASSERT_TRUE(rep.ok) << rep.reason;
+  const std::int64_t balanced = rep.quads;
+  fixed.max_quads = balanced - 1;
+  (void)mesh_face_pattern(pc.model, 0, pc.curves, patterns, fixed, &rep);
+  EXPECT_FALSE(rep.ok);
+  EXPECT_EQ(rep.refusal, Refusal::TooManyQuads);
+  PatternFaceOptions bounded;
+  bounded.max_quads = balanced - 1;
+  const auto m = mesh_face_pattern(pc.model, 0, pc.curves, patterns, bounded, &rep);
+  ASSERT_TRUE(rep.ok) << rep.reason;
+  (void)check_face(pc.model, 0, pc.curves, m, rep);
+  EXPECT_GT(rep.moves, 0);
+  EXPECT_LE(static_cast<std::int64_t>(m.quads.size()), balanced - 1);
+  EXPECT_EQ(rep.quads, static_cast<std::int64_t>(m.quads.size()));
+}
+
 // PatternFaceOptions::lift_max_poor_fraction: the untangler only gets fills with few poor quads.
 // With min_sicn 0.95 most quads of the transition fill are "poor" (and the average bound is off),
 // so the default bound skips the untangler; without the bound it runs.

@@ -62,7 +62,10 @@ struct PatternFaceOptions {
   /// (chord_moves: the same pattern and side counts, other chord subdivisions): a local search
   /// from the matched solution, four points spread along each move then halving steps. A kept
   /// fill keeps the best mean SICN above the thresholds; a refused one climbs toward them (mean
-  /// less twice the minimum's shortfall) and is kept if it passes. 0: off. Measured with 40:
+  /// less twice the minimum's shortfall) and is kept if it passes. When every match needs more
+  /// than max_quads, the best one is searched the same way from its balanced solution, laying out
+  /// only moves within the bound (Block at 0.0037: six half-disks [60, 78], 396 -> 402 faces by
+  /// pattern). 0: off. Measured with 40:
   /// mambo's four [102, 20, 102, 32] transitions SICN avg 0.93 -> 0.97-0.99 (the model's 0.973
   /// -> 0.979 at its reference count), Block at size factor 0.0037 +6 faces by pattern (half-
   /// disks, avg 0.53 -> 0.80-0.84); the pattern stage 1.2-2.3 s longer on Block.
