@@ -104,6 +104,13 @@ PolygonCase polygon(const XY& xy, const std::vector<LO>& counts, const std::stri
   return c;
 }
 
+// The matched (balanced) chord subdivisions, not moved.
+PatternFaceOptions without_moves() {
+  PatternFaceOptions o;
+  o.move_evaluations = 0;
+  return o;
+}
+
 TEST(FacePattern, RectangleWithEqualOppositeSidesIsAGrid) {
   const XY xy = {{0, 0}, {10, 0}, {10, 4}, {0, 4}};
   const auto pc = polygon(xy, {10, 4, 10, 4}, "qs_rect.brep");
@@ -142,8 +149,7 @@ TEST(FacePattern, RectangleWithATransitionGetsOneValence3And5) {
   const XY xy = {{0, 0}, {10, 0}, {10, 5}, {0, 5}};
   const auto pc = polygon(xy, {11, 4, 9, 6}, "qs_trans.brep");
   const auto patterns = builtin_patterns();
-  PatternFaceOptions balanced;  // the matched chord subdivisions, not moved
-  balanced.move_evaluations = 0;
+  const PatternFaceOptions balanced = without_moves();
   PatternFaceReport rep;
   const auto m = mesh_face_pattern(pc.model, 0, pc.curves, patterns, balanced, &rep);
   const auto v = check_face(pc.model, 0, pc.curves, m, rep);
@@ -206,12 +212,14 @@ TEST(FacePattern, SharpCornerLowersTheMinThresholdToWhatItAllows) {
 // top fifth (the right side bends by 20 degrees at y = 16, too little to be a corner). The
 // balanced chord subdivisions put the size transition halfway up, under rows of tall quads; the
 // moves keep the pattern, its irregular vertices and the side counts, and raise the mean SICN.
+PolygonCase flared_strip(const std::string& name) {
+  return polygon({{0, 0}, {4, 0}, {4, 16}, {5.456, 20}, {0, 20}}, {8, 32, 8, 12, 40}, name);
+}
+
 TEST(FacePattern, MovesOfTheIrregularVerticesRaiseTheMeanSicn) {
-  const XY xy = {{0, 0}, {4, 0}, {4, 16}, {5.456, 20}, {0, 20}};
-  const auto pc = polygon(xy, {8, 32, 8, 12, 40}, "qs_flare.brep");
+  const auto pc = flared_strip("qs_flare.brep");
   const auto patterns = builtin_patterns();
-  PatternFaceOptions fixed;
-  fixed.move_evaluations = 0;
+  const PatternFaceOptions fixed = without_moves();
   PatternFaceReport before;
   const auto m0 = mesh_face_pattern(pc.model, 0, pc.curves, patterns, fixed, &before);
   ASSERT_TRUE(before.ok) << before.reason;
@@ -238,11 +246,9 @@ TEST(FacePattern, MovesOfTheIrregularVerticesRaiseTheMeanSicn) {
 // ... and a fill whose balanced subdivisions need more quads than max_quads may still fit the
 // bound once moved: the same strip with the bound one quad below the balanced fill's count.
 TEST(FacePattern, MovedFillsMayFitTheQuadBound) {
-  const XY xy = {{0, 0}, {4, 0}, {4, 16}, {5.456, 20}, {0, 20}};
-  const auto pc = polygon(xy, {8, 32, 8, 12, 40}, "qs_flare_bound.brep");
+  const auto pc = flared_strip("qs_flare_bound.brep");
   const auto patterns = builtin_patterns();
-  PatternFaceOptions fixed;
-  fixed.move_evaluations = 0;
+  PatternFaceOptions fixed = without_moves();
   PatternFaceReport rep;
   (void)mesh_face_pattern(pc.model, 0, pc.curves, patterns, fixed, &rep);
   ASSERT_TRUE(rep.ok) << rep.reason;
