@@ -110,6 +110,20 @@ bool few_poor_quads(const mesh::FaceMesh& m, const PatternFaceOptions& options, 
   return static_cast<double>(poor) <= bound;
 }
 
+// Whether a measured fill is kept: valid, its minimum above min_sicn (the face's threshold, see
+// try_sides) and its mean above options.min_sicn_avg.
+bool passes(const smooth::QualityReport& q, double min_sicn, const PatternFaceOptions& options) {
+  return q.invalid == 0 && q.sicn_min > min_sicn && q.sicn_avg > options.min_sicn_avg;
+}
+
+// The report's pattern and placement from a candidate.
+void report_pattern(PatternFaceReport& rep, std::span<const Pattern> patterns, const Candidate& c) {
+  rep.pattern = c.match.pattern;
+  rep.pattern_name = patterns[c.match.pattern].name;
+  rep.start = c.match.start;
+  rep.reversed = c.match.reversed;
+}
+
 // Paper 000 Sec. 6.1.1 picks the chord subdivisions closest to the balanced guess, blind to
 // the geometry: a size transition in a rectangle lands halfway along it even when the face
 // widens near one end (mambo's [102, 20, 102, 32] strips: rows of tall quads above the
@@ -147,9 +161,7 @@ mesh::FaceMesh move_irregular_vertices(LO f, const cad::Face& face,
         smooth::smooth_face(build_mesh(f, face, surface, fs, c), surface, options.smooth);
     const smooth::QualityReport mq = smooth::measure(m);
     if (mq.invalid != 0) return false;
-    const bool good_new = mq.sicn_min > min_sicn && mq.sicn_avg > options.min_sicn_avg;
-    const bool good_old =
-        q.invalid == 0 && q.sicn_min > min_sicn && q.sicn_avg > options.min_sicn_avg;
+    const bool good_new = passes(mq, min_sicn, options), good_old = passes(q, min_sicn, options);
     if (good_new != good_old ? !good_new : score(mq) <= score(q) + 1e-4) return false;
     best = std::move(c);
     mesh = std::move(m);
@@ -264,11 +276,16 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
   // a threshold above that would refuse every mesh of the face, the unstructured one included.
   double min_sicn = options.min_sicn;
   for (const LO c : fs.corners) {
-    const double best = std::sin(fs.angle_deg[c] * std::numbers::pi / 180);
-    if (fs.angle_deg[c] < 90 && best <= options.min_sicn)
-      min_sicn = std::min(min_sicn, options.corner_sicn_factor * best);
+    const double reachable = std::sin(fs.angle_deg[c] * std::numbers::pi / 180);
+    if (fs.angle_deg[c] < 90 && reachable <= options.min_sicn)
+      min_sicn = std::min(min_sicn, options.corner_sicn_factor * reachable);
   }
   rep.min_sicn = min_sicn;
+  const auto keep = [&](mesh::FaceMesh kept) {
+    rep.ok = true;
+    rep.refusal = Refusal::None;
+    return kept;
+  };
   if (cands.empty()) {
     std::ostringstream os;
     os << "every fitting pattern needs at least " << fewest_quads << " quads, more than the "
@@ -278,10 +295,7 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
       // same pattern may fit the bound (Block's half-disks [60, 78] at size factor 0.0037). The
       // search starts from a worst-possible score and lays out only the moves within the bound.
       const Candidate& c = oversize.front();
-      rep.pattern = c.match.pattern;
-      rep.pattern_name = patterns[c.match.pattern].name;
-      rep.start = c.match.start;
-      rep.reversed = c.match.reversed;
+      report_pattern(rep, patterns, c);
       smooth::QualityReport none;
       none.invalid = 1;
       none.sicn_min = -1;
@@ -291,18 +305,14 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
                                   mesh::FaceMesh{}, none, min_sicn, options, rep);
       if (rep.moves > 0) {
         ++rep.candidates;
-        if (rep.sicn_min > min_sicn && rep.sicn_avg > options.min_sicn_avg) {
-          rep.ok = true;
-          rep.refusal = Refusal::None;
-          return moved;
-        }
+        // A move is kept only when its fill is valid, so the moved fill is.
+        if (rep.sicn_min > min_sicn && rep.sicn_avg > options.min_sicn_avg)
+          return keep(std::move(moved));
         refuse(Refusal::Quality, os.str() + "; moved, " + rep.pattern_name +
                                      " fits with SICN min " + std::to_string(rep.sicn_min) +
                                      " avg " + std::to_string(rep.sicn_avg));
-        if (rep.sicn_min > 0) {
-          rep.quads = static_cast<std::int64_t>(moved.quads.size());
-          rep.refused_mesh = std::move(moved);
-        }
+        rep.quads = static_cast<std::int64_t>(moved.quads.size());
+        rep.refused_mesh = std::move(moved);
         return empty;
       }
     }
@@ -331,15 +341,12 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
       q = smooth::measure(mesh);
     }
     ++rep.candidates;
-    const bool good = q.invalid == 0 && q.sicn_min > min_sicn && q.sicn_avg > options.min_sicn_avg;
+    const bool good = passes(q, min_sicn, options);
     if (good || k == 0 || q.sicn_min > rep.sicn_min) {
       best_valid = q.invalid == 0 && q.sicn_min > 0;
       best_k = k;
       best_q = q;
-      rep.pattern = c.match.pattern;
-      rep.pattern_name = patterns[c.match.pattern].name;
-      rep.start = c.match.start;
-      rep.reversed = c.match.reversed;
+      report_pattern(rep, patterns, c);
       rep.chords = c.match.chords;
       rep.sicn_min = q.sicn_min;
       rep.sicn_avg = q.sicn_avg;
@@ -350,9 +357,7 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
       if (options.move_evaluations > 0 && q.sicn_avg < options.move_below_avg)
         best = move_irregular_vertices(f, face, surface, fs, patterns[c.match.pattern], c,
                                        std::move(best), q, min_sicn, options, rep);
-      rep.ok = true;
-      rep.refusal = Refusal::None;
-      return best;
+      return keep(std::move(best));
     }
   }
   if (best_valid && options.move_evaluations > 0) {
@@ -361,11 +366,8 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
     const Candidate& c = cands[best_k];
     best = move_irregular_vertices(f, face, surface, fs, patterns[c.match.pattern], c,
                                    std::move(best), best_q, min_sicn, options, rep);
-    if (rep.sicn_min > min_sicn && rep.sicn_avg > options.min_sicn_avg) {
-      rep.ok = true;
-      rep.refusal = Refusal::None;
-      return best;
-    }
+    if (rep.sicn_min > min_sicn && rep.sicn_avg > options.min_sicn_avg)
+      return keep(std::move(best));
   }
   std::ostringstream os;
   os << rep.candidates << " candidate(s) tried, best " << rep.pattern_name << " with SICN min "

@@ -71,14 +71,20 @@ struct UnionFind {
   }
 };
 
+// Arc length at the background vertices of one curve.
+std::vector<double> arc_lengths(const mesh::CurveMesh& m) {
+  std::vector<double> arc(m.points.size(), 0.0);
+  for (std::size_t i = 0; i + 1 < m.points.size(); ++i)
+    arc[i + 1] = arc[i] + distance(m.points[i], m.points[i + 1]);
+  return arc;
+}
+
 // Normalised ∫ dl / s of a curve (0 at its start, 1 at its end) at the arc-length fractions
 // k / samples, k = 0 .. samples. Empty when the curve has no length or no size integral.
 std::vector<double> normalised_profile(const mesh::CurveMesh& m, const std::vector<double>& s,
                                        int samples) {
   const std::vector<double> f = cumulative(m, s);
-  std::vector<double> arc(m.points.size(), 0.0);
-  for (std::size_t i = 0; i + 1 < m.points.size(); ++i)
-    arc[i + 1] = arc[i] + distance(m.points[i], m.points[i + 1]);
+  const std::vector<double> arc = arc_lengths(m);
   if (!(f.back() > 0) || !(arc.back() > 0)) return {};
   std::vector<double> g(static_cast<std::size_t>(samples) + 1);
   std::size_t j = 0;
@@ -106,9 +112,9 @@ std::vector<double> normalised_profile(const mesh::CurveMesh& m, const std::vect
 // went from 873 to 984 interior irregular vertices that way. Opposite sides of very different
 // lengths (the built-in example's wing root and tip, 4296 and 1828 long) bound a tapered face
 // that no pattern fills well anyway; blending them cost its unstructured mesh SICN avg 0.895 ->
-// 0.878. The curves of a set are oriented through the
-// faces (opposite uses of a loop run in opposite directions); a set the faces orient
-// inconsistently (a twisted band) keeps its own profiles.
+// 0.878. The curves of a set are oriented through the faces (opposite uses of a loop run in
+// opposite directions); a set the faces orient inconsistently (a twisted band) keeps its own
+// profiles.
 std::vector<std::vector<double>> shared_profiles(const cad::CadModel& model,
                                                  std::span<const mesh::CurveMesh> curves,
                                                  std::span<const std::vector<double>> sizes,
@@ -159,13 +165,10 @@ std::vector<std::vector<double>> shared_profiles(const cad::CadModel& model,
         }
       }
     }
-    if (mem.size() < 2) continue;
+    if (!consistent || mem.size() < 2) continue;
+    // Chords never hold degenerate curves (quantize_curves), so every member has a polyline.
     std::vector<double> shared(static_cast<std::size_t>(samples) + 1, 0.0);
     for (const LO c : mem) {
-      if (!consistent || cv[c].degenerate) {
-        consistent = false;
-        break;
-      }
       const std::vector<double> g = normalised_profile(curves[c], sizes[c], samples);
       if (g.empty()) {
         consistent = false;
@@ -375,7 +378,6 @@ std::vector<mesh::CurveMesh> place_vertices(const cad::CadModel& model,
       m.curve = c;
       return;
     }
-    check_sizes(c, bg, sizes[c]);
     const int total_edges = q.edges[c];
     QSMESH_CHECK(!halved || total_edges % 2 == 0,
                  "curve " << c << ": " << total_edges << " edges cannot be halved");
@@ -389,11 +391,9 @@ std::vector<mesh::CurveMesh> place_vertices(const cad::CadModel& model,
     m.t.front() = bg.t.front();
     m.t.back() = bg.t.back();
     if (!profiles.empty() && !profiles[c].empty()) {
-      // The chord's shared profile: vertex i where it reaches i/n, at that arc-length fraction.
+      // The shared profile: vertex i where it reaches i/n, at that arc-length fraction.
       const auto& g = profiles[c];
-      std::vector<double> arc(bg.points.size(), 0.0);
-      for (std::size_t k = 0; k + 1 < bg.points.size(); ++k)
-        arc[k + 1] = arc[k] + distance(bg.points[k], bg.points[k + 1]);
+      const std::vector<double> arc = arc_lengths(bg);
       std::size_t k = 0, j = 0;
       const std::size_t last_k = g.size() - 2, last_j = arc.size() - 2;
       for (int i = 1; i < n; ++i) {
