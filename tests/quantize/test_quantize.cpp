@@ -391,15 +391,15 @@ TEST(PlaceVertices, Eq11SpacingFollowsTheSize) {
   }
 }
 
-// The rectangle's sides graded 3:1 each along its own direction: the top and bottom sides run in
-// opposite directions, so by Eq. 11 alone a grid fill would shear (bottom fine at x = 0, top
-// fine at x = 10).
-struct GradedRectangle {
+// Every curve of the model graded along its own direction, s = 0.2 + 0.08 x (3:1 over the
+// rectangle's long sides): its top and bottom sides run in opposite directions, so by Eq. 11
+// alone a grid fill would shear (bottom fine at x = 0, top fine at x = 10).
+struct GradedCurves {
   std::vector<mesh::CurveMesh> bg;
   std::vector<std::vector<double>> sizes;
-  GradedRectangle() {
-    for (LO c = 0; c < rectangle().num_curves(); ++c) {
-      bg.push_back(test::uniform_curve_mesh(rectangle(), c, 40));
+  explicit GradedCurves(const cad::CadModel& model) {
+    for (LO c = 0; c < model.num_curves(); ++c) {
+      bg.push_back(test::uniform_curve_mesh(model, c, 40));
       std::vector<double> s;
       for (const double x : arc_length(bg.back().points)) s.push_back(0.2 + 0.08 * x);
       sizes.push_back(s);
@@ -423,7 +423,7 @@ std::vector<std::vector<double>> long_side_xs(const cad::CadModel& model,
 
 TEST(PlaceVertices, OppositeSidesOfAGridFaceShareTheirSpacing) {
   const auto& model = rectangle();
-  const GradedRectangle r;
+  const GradedCurves r(model);
   const Quantization q = quantize_curves(model, ideal_edge_counts(r.bg, r.sizes), {});
   const TaskArena tasks(2);
   for (const bool halved : {false, true}) {
@@ -453,7 +453,7 @@ TEST(PlaceVertices, FacesWithOneJoinedPairKeepTheirOwnSpacing) {
   // only the long sides are joined, so the face is no grid and its sides keep the spacing their
   // sizes ask for.
   const auto& model = rectangle();
-  const GradedRectangle r;
+  const GradedCurves r(model);
   std::vector<double> ideal = ideal_edge_counts(r.bg, r.sizes);
   const Quantization joined = quantize_curves(model, ideal, {});
   Quantization q = joined;
@@ -473,22 +473,15 @@ TEST(PlaceVertices, TaperedFacesKeepTheirOwnSpacing) {
   // A trapezoid: bottom 10, top 4 (2.5:1, beyond PlaceOptions::align_length_ratio), legs 5 and 5.
   // Both pairs are joined in chords; the legs share their spacing, the bottom and top do not.
   const cad::CadModel model = polygon_face({{0, 0}, {10, 0}, {7, 4}, {3, 4}}, "q_trapezoid.brep");
-  std::vector<mesh::CurveMesh> bg;
-  std::vector<std::vector<double>> sizes;
-  for (LO c = 0; c < model.num_curves(); ++c) {
-    bg.push_back(test::uniform_curve_mesh(model, c, 40));
-    std::vector<double> s;
-    for (const double x : arc_length(bg.back().points)) s.push_back(0.2 + 0.08 * x);
-    sizes.push_back(s);
-  }
-  const Quantization q = quantize_curves(model, ideal_edge_counts(bg, sizes), {});
+  const GradedCurves r(model);
+  const Quantization q = quantize_curves(model, ideal_edge_counts(r.bg, r.sizes), {});
   const auto loop = loop_curves(model);
   ASSERT_EQ(loop.size(), 4u);
   ASSERT_NE(q.curve2chord[loop[0]], kNoIndex);
   ASSERT_EQ(q.curve2chord[loop[0]], q.curve2chord[loop[2]]);
   ASSERT_NE(q.curve2chord[loop[1]], kNoIndex);
   ASSERT_EQ(q.curve2chord[loop[1]], q.curve2chord[loop[3]]);
-  const auto meshes = place_vertices(model, bg, sizes, q, false, TaskArena(1));
+  const auto meshes = place_vertices(model, r.bg, r.sizes, q, false, TaskArena(1));
   // Each curve's first and last edge, along its own direction.
   const auto ends = [&](LO c) {
     const auto x = arc_length(meshes[c].points);
