@@ -173,6 +173,13 @@ std::string quad_method(const parallel::PipelineResult& r, std::size_t f) {
   return f < r.quad_reports.size() && r.quad_reports[f].frontal ? "frontal" : "fallback";
 }
 
+/// Why face f was not meshed by a pattern (qstruct::Refusal as text); empty when it was, or when
+/// the run stopped before the quasi-structured stage.
+std::string pattern_refusal(const parallel::PipelineResult& r, std::size_t f) {
+  if (f >= r.quasi_reports.size() || r.quasi_reports[f].by_pattern) return {};
+  return r.quasi_reports[f].refusal;
+}
+
 std::int64_t total_irregular_boundary(const parallel::PipelineResult& r) {
   std::int64_t n = 0;
   for (const auto& st : r.face_stats) n += st.irregular_boundary;
@@ -285,6 +292,7 @@ std::string stats_json(const Arguments& args, const Session& session,
       j.begin_object()
           .value("face", static_cast<std::int64_t>(f))
           .value("method", quad_method(r, f))
+          .value("pattern_refusal", pattern_refusal(r, f))
           .value("vertices", st.vertices)
           .value("quads", st.quads)
           .value("triangles", st.triangles)
@@ -355,9 +363,12 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
           "/ avg, seconds\n";
     for (std::size_t f = 0; f < r.face_stats.size(); ++f) {
       const auto& st = r.face_stats[f];
-      os << "    face " << f << ": " << quad_method(r, f) << ", " << st.vertices << ", " << st.quads
-         << ", " << st.triangles << ", " << st.irregular_interior << " / " << st.irregular_boundary
-         << ", " << st.sicn_min << " / " << st.sicn_avg << ", " << r.face_seconds[f]
+      const std::string refusal = pattern_refusal(r, f);
+      os << "    face " << f << ": " << quad_method(r, f)
+         << (refusal.empty() ? "" : " (no pattern: " + refusal + ")") << ", " << st.vertices << ", "
+         << st.quads << ", " << st.triangles << ", " << st.irregular_interior << " / "
+         << st.irregular_boundary << ", " << st.sicn_min << " / " << st.sicn_avg << ", "
+         << r.face_seconds[f]
          << (!r.quasi_reports.empty() && r.quasi_reports[f].time_budget_hit
                  ? " (stopped by --face-time-budget)"
                  : "")

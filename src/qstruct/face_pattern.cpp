@@ -21,7 +21,6 @@ const char* to_string(Refusal r) {
     case Refusal::None: return "none";
     case Refusal::Loops: return "loops";
     case Refusal::Degenerate: return "degenerate";
-    case Refusal::NoCorner: return "no_corner";
     case Refusal::NoPattern: return "no_pattern";
     case Refusal::Quality: return "quality";
     case Refusal::TooManyQuads: return "too_many_quads";
@@ -110,10 +109,18 @@ bool few_poor_quads(const mesh::FaceMesh& m, const PatternFaceOptions& options, 
   return static_cast<double>(poor) <= bound;
 }
 
-// Whether a measured fill is kept: valid, its minimum above min_sicn (the face's threshold, see
-// try_sides) and its mean above options.min_sicn_avg.
+// Whether a valid fill with these SICN is kept: its minimum above min_sicn (the face's
+// threshold, see try_sides) and its mean above options.min_sicn_avg, or its minimum above
+// options.keep_sicn_min whatever its mean.
+bool passes_sicn(double sicn_min, double sicn_avg, double min_sicn,
+                 const PatternFaceOptions& options) {
+  return sicn_min > min_sicn &&
+         (sicn_avg > options.min_sicn_avg || sicn_min > options.keep_sicn_min);
+}
+
+// Whether a measured fill is kept: valid and passes_sicn.
 bool passes(const smooth::QualityReport& q, double min_sicn, const PatternFaceOptions& options) {
-  return q.invalid == 0 && q.sicn_min > min_sicn && q.sicn_avg > options.min_sicn_avg;
+  return q.invalid == 0 && passes_sicn(q.sicn_min, q.sicn_avg, min_sicn, options);
 }
 
 // The report's pattern and placement from a candidate.
@@ -176,8 +183,14 @@ mesh::FaceMesh move_irregular_vertices(LO f, const cad::Face& face,
       if (v[j] > 0) lo = std::max(lo, -((best.match.chords[j] - 1) / v[j]));
       if (v[j] < 0) hi = std::min(hi, (best.match.chords[j] - 1) / -v[j]);
     }
-    if (lo == std::numeric_limits<LO>::min() || hi == std::numeric_limits<LO>::max() || hi - lo < 1)
-      continue;
+    // A move that only adds (a closed chord's layers) has no bound from the sides: it may
+    // double the chords it adds to.
+    if (hi == std::numeric_limits<LO>::max()) {
+      hi = 0;
+      for (std::size_t j = 0; j < v.size(); ++j)
+        if (v[j] > 0) hi = std::max(hi, best.match.chords[j] / v[j]);
+    }
+    if (lo == std::numeric_limits<LO>::min() || hi - lo < 1) continue;
     // Coarse: four points spread over the range; then halving steps around the best.
     const LO span = std::max<LO>(1, (hi - lo) / 5);
     LO at = 0;  // offset of `best` from where this vector's search started
@@ -204,6 +217,7 @@ void set_side_edges(FaceSides& fs) {
   const LO n = static_cast<LO>(fs.points.size());
   const LO m = static_cast<LO>(fs.corners.size());
   fs.side_edges.clear();
+  if (m == 0) fs.side_edges.push_back(n);  // one smooth loop: one side closing on itself
   for (LO k = 0; k < m; ++k) {
     const LO a = fs.corners[k], b = k + 1 < m ? fs.corners[k + 1] : fs.corners[0] + n;
     fs.side_edges.push_back(b - a);
@@ -227,9 +241,8 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
     rep.quads = 0;
     return empty;
   };
-  if (fs.corners.size() < 2)
-    return refuse(Refusal::NoCorner, std::to_string(fs.corners.size()) + " convex corner(s)");
-  const std::vector<PatternMatch> matches = match_patterns(patterns, fs.side_edges, options.match);
+  const std::vector<PatternMatch> matches =
+      match_patterns(patterns, fs.side_edges, options.match, fs.corners.empty());
   if (matches.empty()) {
     std::ostringstream os;
     os << "no pattern fits the sides [";
@@ -240,6 +253,25 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
 
   const LO nb = static_cast<LO>(fs.points.size());
   const LO m = static_cast<LO>(fs.corners.size());
+  // A closed chord (the disk pattern's ring) is the layers between the centre quad and the side:
+  // about A / P wide (A the face's area, P its perimeter; R / 2 in a round disk of radius R
+  // whose centre quad has sides R, half the width of a long slot), in edges of the boundary's
+  // spacing P / N: A N / P^2 layers. A is the loop's vector area (exact on a plane, the
+  // projected area on a curved face); the move search adjusts the layers to the shape.
+  LO ring_layers = 1;
+  {
+    Vec3 twice_area{0, 0, 0};
+    double perimeter = 0;
+    for (LO i = 0; i < nb; ++i) {
+      const Vec3& a = fs.points[i].xyz;
+      const Vec3& b = fs.points[(i + 1) % nb].xyz;
+      twice_area = twice_area + cross(a - fs.points[0].xyz, b - fs.points[0].xyz);
+      perimeter += norm(b - a);
+    }
+    if (perimeter > 0)
+      ring_layers = std::max<LO>(
+          1, static_cast<LO>(std::lround(0.5 * norm(twice_area) * nb / (perimeter * perimeter))));
+  }
   std::vector<char> splits(nb, 0);
   for (const LO c : fs.corners) splits[c] = 1;
   std::vector<Candidate> cands, oversize;
@@ -247,12 +279,18 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
   for (const auto& match : matches) {
     Candidate c;
     c.match = match;
-    c.refined = refine_pattern(patterns[match.pattern], match.chords);
+    const Pattern& pat = patterns[match.pattern];
+    for (LO j = 0; j < pat.num_chords; ++j)
+      if (pat.closed_chord(j)) c.match.chords[j] = ring_layers;
+    c.refined = refine_pattern(pat, c.match.chords);
     const auto nq = static_cast<std::int64_t>(c.refined.quads.size());
     if (fewest_quads < 0 || nq < fewest_quads) fewest_quads = nq;
     QSMESH_CHECK(static_cast<LO>(c.refined.boundary.size()) == nb,
                  "refined boundary has " << c.refined.boundary.size() << " vertices, the face " << nb);
-    const LO first = match.reversed ? fs.corners[(match.start + 1) % m] : fs.corners[match.start];
+    // Without corner the loop's first point starts the single side.
+    const LO first = m == 0           ? 0
+                     : match.reversed ? fs.corners[(match.start + 1) % m]
+                                      : fs.corners[match.start];
     c.seq.resize(nb);
     for (LO p = 0; p < nb; ++p) c.seq[p] = (((match.reversed ? first - p : first + p) % nb) + nb) % nb;
     std::vector<int> valence(static_cast<std::size_t>(c.refined.num_vertices), 0);
@@ -306,7 +344,7 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
       if (rep.moves > 0) {
         ++rep.candidates;
         // A move is kept only when its fill is valid, so the moved fill is.
-        if (rep.sicn_min > min_sicn && rep.sicn_avg > options.min_sicn_avg)
+        if (passes_sicn(rep.sicn_min, rep.sicn_avg, min_sicn, options))
           return keep(std::move(moved));
         refuse(Refusal::Quality, os.str() + "; moved, " + rep.pattern_name +
                                      " fits with SICN min " + std::to_string(rep.sicn_min) +
@@ -366,8 +404,7 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
     const Candidate& c = cands[best_k];
     best = move_irregular_vertices(f, face, surface, fs, patterns[c.match.pattern], c,
                                    std::move(best), best_q, min_sicn, options, rep);
-    if (rep.sicn_min > min_sicn && rep.sicn_avg > options.min_sicn_avg)
-      return keep(std::move(best));
+    if (passes_sicn(rep.sicn_min, rep.sicn_avg, min_sicn, options)) return keep(std::move(best));
   }
   std::ostringstream os;
   os << rep.candidates << " candidate(s) tried, best " << rep.pattern_name << " with SICN min "

@@ -208,14 +208,15 @@ ChordSolution solve_chords(std::span<const int> w, int num_sides, LO num_chords,
   return out;
 }
 
-std::vector<PatternMatch> match_patterns(std::span<const Pattern> patterns, std::span<const LO> side_edges,
-                                         const MatchOptions& options) {
+std::vector<PatternMatch> match_patterns(std::span<const Pattern> patterns,
+                                         std::span<const LO> side_edges,
+                                         const MatchOptions& options, bool cornerless) {
   const int m = static_cast<int>(side_edges.size());
   std::vector<PatternMatch> out;
-  if (m == 0) return out;
+  if (m == 0 || (cornerless && m != 1)) return out;
   for (LO p = 0; p < static_cast<LO>(patterns.size()); ++p) {
     const Pattern& pat = patterns[p];
-    if (pat.num_sides() != m) continue;
+    if (pat.num_sides() != m || pat.cornerless() != cornerless) continue;
     // Subdivisions seen along each cavity side, in cavity order: equal ones give the same mesh.
     std::set<std::vector<std::vector<LO>>> seen;
     std::vector<PatternMatch> found;

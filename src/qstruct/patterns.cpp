@@ -82,7 +82,10 @@ Pattern make_pattern(std::string name, std::vector<Vec2> xy, std::vector<std::ar
   LO start = kNoIndex;
   for (LO v = 0; v < nv && start == kNoIndex; ++v)
     if (next[v] != kNoIndex && p.valence[v] == 1) start = v;
-  QSMESH_CHECK(start != kNoIndex, "pattern " << p.name << ": no corner (boundary vertex of one quad)");
+  // A pattern without corner (a disk bounded by one smooth loop) is one side starting anywhere.
+  for (LO v = 0; v < nv && start == kNoIndex; ++v)
+    if (next[v] != kNoIndex) start = v;
+  QSMESH_CHECK(start != kNoIndex, "pattern " << p.name << ": no boundary");
   for (LO v = start;;) {
     p.boundary.push_back(v);
     p.boundary_edge.push_back(next_edge[v]);
@@ -97,6 +100,7 @@ Pattern make_pattern(std::string name, std::vector<Vec2> xy, std::vector<std::ar
                           << boundary_edges << " edges)");
   for (LO k = 0; k < static_cast<LO>(p.boundary.size()); ++k)
     if (p.valence[p.boundary[k]] == 1) p.side_start.push_back(k);
+  if (p.side_start.empty()) p.side_start.push_back(0);
 
   // Chords: opposite edges of a quad belong to the same chord.
   std::vector<LO> parent(ne);
@@ -108,6 +112,8 @@ Pattern make_pattern(std::string name, std::vector<Vec2> xy, std::vector<std::ar
     }
   // Chords numbered in order of first appearance along the boundary, so that w reads like the
   // paper's systems (a, b, c, ... along side 1 first).
+  // Closed chords (rings that reach no side, e.g. around the centre quad of the disk pattern)
+  // come last: their columns of w are zero.
   std::vector<LO> root2chord(ne, kNoIndex);
   for (const LO e : p.boundary_edge) {
     const LO r = find_root(parent, e);
@@ -115,10 +121,9 @@ Pattern make_pattern(std::string name, std::vector<Vec2> xy, std::vector<std::ar
   }
   p.edge_chord.resize(ne);
   for (LO e = 0; e < ne; ++e) {
-    p.edge_chord[e] = root2chord[find_root(parent, e)];
-    QSMESH_CHECK(p.edge_chord[e] != kNoIndex,
-                 "pattern " << p.name << ": a chord through edge " << p.edges[e][0] << "-" << p.edges[e][1]
-                            << " never reaches the boundary (closed chord)");
+    const LO r = find_root(parent, e);
+    if (root2chord[r] == kNoIndex) root2chord[r] = p.num_chords++;
+    p.edge_chord[e] = root2chord[r];
   }
 
   const int m = p.num_sides();

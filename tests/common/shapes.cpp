@@ -1,20 +1,22 @@
 #include "shapes.hpp"
 
 #include <BRepAlgoAPI_Cut.hxx>
+#include <BRepBuilderAPI_MakeEdge.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepBuilderAPI_MakePolygon.hxx>
+#include <BRepBuilderAPI_MakeWire.hxx>
 #include <BRepFilletAPI_MakeFillet.hxx>
 #include <BRepPrimAPI_MakeBox.hxx>
 #include <BRepPrimAPI_MakeCylinder.hxx>
 #include <BRepPrimAPI_MakeSphere.hxx>
 #include <BRepTools.hxx>
+#include <GC_MakeArcOfCircle.hxx>
 #include <IFSelect_ReturnStatus.hxx>
 #include <STEPControl_Writer.hxx>
-
 #include <TopExp_Explorer.hxx>
 #include <TopoDS.hxx>
+#include <cmath>
 #include <gp_Ax2.hxx>
-
 #include <stdexcept>
 
 namespace qsmesh::test {
@@ -50,6 +52,20 @@ std::string write_polygon_face(const std::vector<std::pair<double, double>>& xy,
   poly.Close();
   BRepBuilderAPI_MakeFace face(poly.Wire(), /*OnlyPlane=*/true);
   if (!face.IsDone()) throw std::runtime_error("polygon face construction failed");
+  return write(face.Face(), path);
+}
+
+std::string write_teardrop(double radius, const std::string& path) {
+  // The tip (0, -r sqrt 2) sees the circle under 90 degrees; the tangent points close the arc.
+  const double r = radius, h = r / std::sqrt(2.0);
+  const gp_Pnt tip(0, -r * std::sqrt(2.0), 0), right(h, -h, 0), top(0, r, 0), left(-h, -h, 0);
+  BRepBuilderAPI_MakeWire wire;
+  wire.Add(BRepBuilderAPI_MakeEdge(tip, right).Edge());
+  wire.Add(BRepBuilderAPI_MakeEdge(GC_MakeArcOfCircle(right, top, left).Value()).Edge());
+  wire.Add(BRepBuilderAPI_MakeEdge(left, tip).Edge());
+  if (!wire.IsDone()) throw std::runtime_error("teardrop wire construction failed");
+  BRepBuilderAPI_MakeFace face(wire.Wire(), /*OnlyPlane=*/true);
+  if (!face.IsDone()) throw std::runtime_error("teardrop face construction failed");
   return write(face.Face(), path);
 }
 

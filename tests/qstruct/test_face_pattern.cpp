@@ -145,6 +145,26 @@ TEST(FacePattern, QuadCountBoundRefusesTooFineFills) {
   EXPECT_EQ(kept.quads.size(), 40u);
 }
 
+// Cells 2.5 x 1 have SICN 2 * 2.5 / (2.5^2 + 1) = 0.69 everywhere: below the mean threshold 0.7,
+// above keep_sicn_min 0.5, so the grid is kept; without that rule it is refused on quality.
+TEST(FacePattern, FillWithEveryQuadFairIsKeptWhateverItsMean) {
+  const XY xy = {{0, 0}, {10, 0}, {10, 4}, {0, 4}};
+  const auto pc = polygon(xy, {4, 4, 4, 4}, "qs_rect_fair.brep");
+  const auto patterns = builtin_patterns();
+  PatternFaceReport rep;
+  const auto m = mesh_face_pattern(pc.model, 0, pc.curves, patterns, {}, &rep);
+  (void)check_face(pc.model, 0, pc.curves, m, rep);
+  EXPECT_EQ(rep.pattern_name, "grid");
+  EXPECT_NEAR(rep.sicn_min, 5.0 / 7.25, 1e-6);
+  EXPECT_LT(rep.sicn_avg, PatternFaceOptions{}.min_sicn_avg);
+  PatternFaceOptions off;
+  off.keep_sicn_min = 2;
+  const auto refused = mesh_face_pattern(pc.model, 0, pc.curves, patterns, off, &rep);
+  EXPECT_FALSE(rep.ok);
+  EXPECT_EQ(rep.refusal, Refusal::Quality);
+  EXPECT_TRUE(refused.quads.empty());
+}
+
 TEST(FacePattern, RectangleWithATransitionGetsOneValence3And5) {
   const XY xy = {{0, 0}, {10, 0}, {10, 5}, {0, 5}};
   const auto pc = polygon(xy, {11, 4, 9, 6}, "qs_trans.brep");
@@ -358,6 +378,56 @@ TEST(FacePattern, CylinderSideIsAFourSidedDiskAcrossItsSeam) {
   int twice = 0;
   for (const auto& [k, n] : copies) twice += n == 2;
   EXPECT_EQ(twice, 4);
+}
+
+// A face bounded by one smooth loop has no corner: Euler (paper 000 Eq. 2) asks for four
+// valence-3 vertices inside, which the disk pattern has (a centre quad in a ring of four).
+TEST(FacePattern, DiskWithoutCornerGetsFourValence3Vertices) {
+  const auto model = cad::load_cad(test::write_cylinder(tmp("qs_cyl_caps.brep")));
+  std::vector<mesh::CurveMesh> curves;
+  for (LO c = 0; c < model.num_curves(); ++c)
+    curves.push_back(test::uniform_curve_mesh(
+        model, c, model.curves()[c].type == cad::CurveType::Circle ? 32 : 5));
+  const auto patterns = builtin_patterns();
+  int caps = 0;
+  for (LO f = 0; f < model.num_faces(); ++f) {
+    if (model.faces()[f].type != cad::SurfaceType::Plane) continue;
+    ++caps;
+    PatternFaceReport rep;
+    const auto m = mesh_face_pattern(model, f, curves, patterns, {}, &rep);
+    const auto v = check_face(model, f, curves, m, rep);
+    EXPECT_EQ(rep.pattern_name, "disk");
+    EXPECT_EQ(rep.side_edges, std::vector<LO>{32});
+    EXPECT_EQ(v.interior.at(3), 4);
+    EXPECT_EQ(v.interior.size(), 2u) << "only valences 3 and 4 inside";
+    // The ring has as many layers as the chords say: a x b centre quads, 2 (a + b) per layer.
+    ASSERT_EQ(rep.chords.size(), 3u);
+    EXPECT_EQ(rep.chords[0] + rep.chords[1], 16);
+    EXPECT_EQ(rep.quads,
+              static_cast<std::int64_t>(rep.chords[0]) * rep.chords[1] + 32 * rep.chords[2]);
+    EXPECT_GT(rep.sicn_avg, 0.8);
+  }
+  EXPECT_EQ(caps, 2);
+}
+
+// One corner: three valence-3 vertices inside (Eq. 2), the teardrop pattern.
+TEST(FacePattern, TeardropWithOneCornerGetsThreeValence3Vertices) {
+  const auto model = cad::load_cad(test::write_teardrop(2.0, tmp("qs_teardrop.brep")));
+  ASSERT_EQ(model.num_faces(), 1);
+  std::vector<mesh::CurveMesh> curves;
+  // About 0.25 apart: the tangents are 2 long, the arc 3 pi (270 degrees of radius 2).
+  for (LO c = 0; c < model.num_curves(); ++c)
+    curves.push_back(test::uniform_curve_mesh(
+        model, c, model.curves()[c].type == cad::CurveType::Circle ? 38 : 8));
+  const auto patterns = builtin_patterns();
+  PatternFaceReport rep;
+  const auto m = mesh_face_pattern(model, 0, curves, patterns, {}, &rep);
+  const auto v = check_face(model, 0, curves, m, rep);
+  EXPECT_EQ(rep.pattern_name, "one_corner");
+  EXPECT_EQ(rep.side_edges, std::vector<LO>{54});
+  EXPECT_EQ(v.interior.at(3), 3);
+  EXPECT_EQ(v.interior.size(), 2u) << "only valences 3 and 4 inside";
+  EXPECT_GT(rep.sicn_avg, 0.7);
 }
 
 TEST(FacePattern, PolesAndHolesAreRefused) {

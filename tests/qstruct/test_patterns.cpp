@@ -36,10 +36,17 @@ std::vector<std::vector<int>> columns(const std::vector<int>& w, int rows, int c
 TEST(Patterns, BuiltinPatternsAreValidDisks) {
   const auto all = builtin_patterns();
   // name -> {sides, chords, irregular vertices}
-  const std::map<std::string, std::array<int, 3>> expected = {
-      {"grid", {4, 2, 0}},     {"transition_1", {4, 5, 2}}, {"transition_2", {4, 7, 4}}, {"triangle", {3, 3, 1}},
-      {"transition_2_joined", {4, 6, 3}},
-      {"pentagon", {5, 5, 1}}, {"l_shape", {5, 4, 1}},      {"hexagon", {6, 6, 1}},      {"half_disk", {2, 3, 2}}};
+  const std::map<std::string, std::array<int, 3>> expected = {{"grid", {4, 2, 0}},
+                                                              {"transition_1", {4, 5, 2}},
+                                                              {"transition_2", {4, 7, 4}},
+                                                              {"triangle", {3, 3, 1}},
+                                                              {"transition_2_joined", {4, 6, 3}},
+                                                              {"pentagon", {5, 5, 1}},
+                                                              {"l_shape", {5, 4, 1}},
+                                                              {"hexagon", {6, 6, 1}},
+                                                              {"half_disk", {2, 3, 2}},
+                                                              {"one_corner", {1, 3, 3}},
+                                                              {"disk", {1, 3, 4}}};
   ASSERT_EQ(all.size(), expected.size());
   for (const auto& p : all) {
     SCOPED_TRACE(p.name);
@@ -55,7 +62,7 @@ TEST(Patterns, BuiltinPatternsAreValidDisks) {
       EXPECT_GT(area, 0);
     }
     // Every side count equals its chord weights; w entries are 0, 1 or 2; each chord reaches
-    // the boundary exactly twice.
+    // the boundary exactly twice, or never (a closed chord).
     std::vector<int> per_chord(p.num_chords, 0);
     for (int i = 0; i < p.num_sides(); ++i)
       for (LO j = 0; j < p.num_chords; ++j) {
@@ -63,9 +70,15 @@ TEST(Patterns, BuiltinPatternsAreValidDisks) {
         EXPECT_LE(p.weight(i, j), 2);
         per_chord[j] += p.weight(i, j);
       }
-    for (const int c : per_chord) EXPECT_EQ(c, 2);
-    EXPECT_EQ(p.valence[p.boundary[p.side_start[0]]], 1);
+    for (LO j = 0; j < p.num_chords; ++j) EXPECT_EQ(per_chord[j], p.closed_chord(j) ? 0 : 2);
+    // Sides start at a corner, except in the pattern without corner.
+    EXPECT_EQ(p.valence[p.boundary[p.side_start[0]]], p.name == "disk" ? 2 : 1);
+    EXPECT_EQ(p.cornerless(), p.name == "disk");
   }
+  // Only the disk's ring is closed; it is numbered last, after the chords reaching the side.
+  for (const auto& p : all)
+    for (LO j = 0; j < p.num_chords; ++j)
+      EXPECT_EQ(p.closed_chord(j), p.name == "disk" && j == p.num_chords - 1) << p.name << " " << j;
   // The half disk has chords turning inside a side (w = 2).
   const auto& hd = by_name(all, "half_disk");
   EXPECT_EQ(*std::max_element(hd.w.begin(), hd.w.end()), 2);
@@ -110,6 +123,32 @@ TEST(Patterns, ChordMovesKeepEverySideCount) {
     // solution, and the moves are independent (checked by their count against the rank).
     EXPECT_LE(static_cast<LO>(moves.size()), p.num_chords - 1) << p.name;
   }
+}
+
+// One side: 2 a + 2 b + 2 c = N1 for the teardrop, 2 a + 2 b = N1 for the disk. A face with one
+// corner fits only the first, a face without corner only the second, and only with an even count.
+TEST(Match, OneSidedPatternsFitByCorners) {
+  const auto all = builtin_patterns();
+  const std::vector<LO> n24 = {24};
+  const auto one = match_patterns(all, n24);
+  ASSERT_FALSE(one.empty());
+  for (const auto& m : one) EXPECT_EQ(all[m.pattern].name, "one_corner");
+  EXPECT_EQ(one.front().chords, (std::vector<LO>{4, 4, 4}));
+  const auto none = match_patterns(all, n24, {}, /*cornerless=*/true);
+  ASSERT_FALSE(none.empty());
+  for (const auto& m : none) EXPECT_EQ(all[m.pattern].name, "disk");
+  // The two crossing chords share the side; the ring is left to the caller (1 here).
+  EXPECT_EQ(none.front().chords, (std::vector<LO>{6, 6, 1}));
+  const std::vector<LO> n23 = {23};
+  EXPECT_TRUE(match_patterns(all, n23).empty());
+  EXPECT_TRUE(match_patterns(all, n23, {}, true).empty());
+  // A cavity with corners never takes the disk.
+  const std::vector<LO> n4 = {6, 6, 6, 6};
+  for (const auto& m : match_patterns(all, n4)) EXPECT_FALSE(all[m.pattern].cornerless());
+  EXPECT_TRUE(match_patterns(all, n4, {}, true).empty());
+  // The disk's ring layers are a move of their own (it changes no side).
+  const auto moves = chord_moves(by_name(all, "disk"));
+  EXPECT_NE(std::find(moves.begin(), moves.end(), std::vector<LO>{0, 0, 1}), moves.end());
 }
 
 TEST(Patterns, InvalidPatternsAreRejected) {

@@ -28,9 +28,11 @@ namespace qsmesh::qstruct {
 /// A coarse quad pattern (a small quad mesh of a disk) and what is derived from it.
 ///
 /// Terms (paper 000 Sec. 6): a corner is a boundary vertex with one quad (valence 1); the sides
-/// are the boundary split at the corners; a topological chord is a class of edges linked through
-/// opposite edges of quads (a dual chord); Eq. 14: sum_j w[i][j] s_j = N_i, where w[i][j] is the
-/// number of edges of side i in chord j (0, 1 or 2).
+/// are the boundary split at the corners (a pattern without corner has one side, closing on
+/// itself); a topological chord is a class of edges linked through opposite edges of quads (a
+/// dual chord); Eq. 14: sum_j w[i][j] s_j = N_i, where w[i][j] is the number of edges of side i
+/// in chord j (0, 1 or 2). A closed chord (a ring reaching no side) has a zero column: Eq. 14
+/// leaves its subdivision free.
 struct Pattern {
   std::string name;
   std::vector<Vec2> xy;                   ///< drawing coordinates from the data file
@@ -41,7 +43,8 @@ struct Pattern {
   std::vector<LO> edge_chord;             ///< chord of each edge
   LO num_chords = 0;
   /// Boundary vertices counter-clockwise (interior on the left), starting at the corner with the
-  /// smallest id; boundary edge k joins boundary[k] and boundary[k + 1] (cyclic).
+  /// smallest id (without corner: the boundary vertex with the smallest id); boundary edge k
+  /// joins boundary[k] and boundary[k + 1] (cyclic).
   std::vector<LO> boundary;
   std::vector<LO> boundary_edge;          ///< edge id of boundary edge k
   std::vector<LO> side_start;             ///< position in `boundary` where each side starts
@@ -53,12 +56,20 @@ struct Pattern {
   [[nodiscard]] LO num_vertices() const { return static_cast<LO>(xy.size()); }
   [[nodiscard]] int num_sides() const { return static_cast<int>(side_start.size()); }
   [[nodiscard]] int weight(int side, LO chord) const { return w[side * num_chords + chord]; }
+  /// No corner: the pattern fills a cavity bounded by one smooth loop (match_patterns).
+  [[nodiscard]] bool cornerless() const { return valence[boundary[side_start[0]]] != 1; }
+  /// Whether chord j reaches no side (a ring): Eq. 14 does not constrain it.
+  [[nodiscard]] bool closed_chord(LO chord) const {
+    for (int i = 0; i < num_sides(); ++i)
+      if (weight(i, chord) != 0) return false;
+    return true;
+  }
 };
 
 /// Derives boundary, sides, chords and w from a coarse quad mesh. Throws qsmesh::Error when the
 /// mesh is not a valid pattern: an index out of range, a repeated vertex in a quad, an edge used
 /// by more than two quads or twice in one direction (inconsistent orientation), a boundary that
-/// is not one closed loop (not a disk), no corner, or a chord that never reaches the boundary.
+/// is not one closed loop (not a disk).
 [[nodiscard]] Pattern make_pattern(std::string name, std::vector<Vec2> xy,
                                    std::vector<std::array<LO, 4>> quads);
 
@@ -86,7 +97,9 @@ struct ChordSolution {
 /// form, then a depth-first search from the bottom row up: free variables take values in order of
 /// distance to round(x_j), within bounds implied by the rows, pivots follow by back substitution
 /// (must be exact and >= 1). Among the solutions met within options.max_attempts trial values the
-/// one with the smallest E is kept (ties: the first met). Deterministic.
+/// one with the smallest E is kept (ties: the first met). A chord on no side (a zero column: a
+/// closed chord) is not constrained and gets 1; the caller sizes it from the geometry.
+/// Deterministic.
 [[nodiscard]] ChordSolution solve_chords(std::span<const int> w, int num_sides, LO num_chords,
                                          std::span<const LO> side_edges,
                                          const MatchOptions& options = {});
@@ -105,10 +118,13 @@ struct PatternMatch {
 /// Every pattern with N.size() sides, every rotation in both directions (paper 000 Sec. 6.1.1),
 /// solved with solve_chords. Matches giving the same subdivisions on every cavity side (symmetric
 /// duplicates, e.g. the 8 placements of the grid) are kept once. Sorted by pattern index, then
-/// energy, then (reversed, start). Empty when no pattern fits.
+/// energy, then (reversed, start). Empty when no pattern fits. `cornerless`: the cavity is
+/// bounded by one smooth loop (side_edges holds its one count); only the patterns without corner
+/// (Pattern::cornerless) fit it, and they fit nothing else.
 [[nodiscard]] std::vector<PatternMatch> match_patterns(std::span<const Pattern> patterns,
                                                        std::span<const LO> side_edges,
-                                                       const MatchOptions& options = {});
+                                                       const MatchOptions& options = {},
+                                                       bool cornerless = false);
 
 /// Integer vectors spanning the kernel of the pattern's Eq. 14 matrix w: adding a multiple of one
 /// to a solution changes no side's count, only where the pattern's irregular vertices sit (e.g.
