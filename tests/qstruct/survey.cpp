@@ -15,6 +15,7 @@
 #include "qsmesh/core/timer.hpp"
 #include "qsmesh/parallel/comm.hpp"
 #include "qsmesh/parallel/pipeline.hpp"
+#include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/qstruct/face_pattern.hpp"
 #include "survey_common.hpp"
 
@@ -91,9 +92,25 @@ int main(int argc, char** argv) {
         }
         if (rep.ok)
           std::cout << "ok " << rep.pattern_name << " quads " << rep.quads << " sicn " << rep.sicn_min << "/"
-                    << rep.sicn_avg << "\n";
+                    << rep.sicn_avg;
         else
-          std::cout << qstruct::to_string(rep.refusal) << ": " << rep.reason << "\n";
+          std::cout << qstruct::to_string(rep.refusal) << ": " << rep.reason;
+        // How far the geometric stage went: untangler calls, moves kept, and for a refused valid
+        // fill its quads at or below the min threshold.
+        if (rep.candidates > 0) {
+          std::cout << " [lifts " << rep.lifts << ", moves " << rep.moves;
+          if (!rep.refused_mesh.quads.empty()) {
+            int poor = 0;
+            const auto& rm = rep.refused_mesh;
+            for (const auto& q : rm.quads)
+              if (mesh::quad_sicn({rm.points[q[0]], rm.points[q[1]], rm.points[q[2]], rm.points[q[3]]}) <=
+                  rep.min_sicn)
+                ++poor;
+            std::cout << ", poor " << poor << " of " << rm.quads.size();
+          }
+          std::cout << "]";
+        }
+        std::cout << "\n";
       }
     }
     const double faces_s = clock.seconds();
