@@ -359,8 +359,8 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
     if (!o.ok || (o.fell_back && !o.error.empty()))
       os << "  face " << o.face << ": " << o.error << "\n";
   if (per_face && !r.face_stats.empty()) {
-    os << "  per face: method, vertices, quads, triangles, irregular interior / boundary, SICN min "
-          "/ avg, seconds\n";
+    os << "  per face: method (and why no pattern was kept), vertices, quads, triangles, irregular "
+          "interior / boundary, SICN min / avg, seconds\n";
     for (std::size_t f = 0; f < r.face_stats.size(); ++f) {
       const auto& st = r.face_stats[f];
       const std::string refusal = pattern_refusal(r, f);

@@ -82,7 +82,8 @@ Pattern make_pattern(std::string name, std::vector<Vec2> xy, std::vector<std::ar
   LO start = kNoIndex;
   for (LO v = 0; v < nv && start == kNoIndex; ++v)
     if (next[v] != kNoIndex && p.valence[v] == 1) start = v;
-  // A pattern without corner (a disk bounded by one smooth loop) is one side starting anywhere.
+  // A pattern without corner (a disk bounded by one smooth loop) is one side, starting at the
+  // boundary vertex with the smallest id.
   for (LO v = 0; v < nv && start == kNoIndex; ++v)
     if (next[v] != kNoIndex) start = v;
   QSMESH_CHECK(start != kNoIndex, "pattern " << p.name << ": no boundary");

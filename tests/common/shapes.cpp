@@ -18,6 +18,7 @@
 #include <cmath>
 #include <gp_Ax2.hxx>
 #include <stdexcept>
+#include <vector>
 
 namespace qsmesh::test {
 
@@ -66,6 +67,25 @@ std::string write_teardrop(double radius, const std::string& path) {
   if (!wire.IsDone()) throw std::runtime_error("teardrop wire construction failed");
   BRepBuilderAPI_MakeFace face(wire.Wire(), /*OnlyPlane=*/true);
   if (!face.IsDone()) throw std::runtime_error("teardrop face construction failed");
+  return write(face.Face(), path);
+}
+
+std::string write_stadium(double length, double radius, bool arc_first, const std::string& path) {
+  const double l = length, r = radius;
+  const gp_Pnt a(0, -r, 0), b(l, -r, 0), c(l, r, 0), d(0, r, 0);
+  const TopoDS_Edge bottom = BRepBuilderAPI_MakeEdge(a, b).Edge();
+  const TopoDS_Edge right =
+      BRepBuilderAPI_MakeEdge(GC_MakeArcOfCircle(b, gp_Pnt(l + r, 0, 0), c).Value()).Edge();
+  const TopoDS_Edge top = BRepBuilderAPI_MakeEdge(c, d).Edge();
+  const TopoDS_Edge left =
+      BRepBuilderAPI_MakeEdge(GC_MakeArcOfCircle(d, gp_Pnt(-r, 0, 0), a).Value()).Edge();
+  BRepBuilderAPI_MakeWire wire;
+  for (const TopoDS_Edge& e : arc_first ? std::vector<TopoDS_Edge>{right, top, left, bottom}
+                                        : std::vector<TopoDS_Edge>{bottom, right, top, left})
+    wire.Add(e);
+  if (!wire.IsDone()) throw std::runtime_error("stadium wire construction failed");
+  BRepBuilderAPI_MakeFace face(wire.Wire(), /*OnlyPlane=*/true);
+  if (!face.IsDone()) throw std::runtime_error("stadium face construction failed");
   return write(face.Face(), path);
 }
 

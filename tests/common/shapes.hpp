@@ -25,6 +25,10 @@ std::string write_polygon_face(const std::vector<std::pair<double, double>>& xy,
 /// Writes the planar teardrop made of a circle of this radius about the origin and the two
 /// tangents to it from the point (0, -radius sqrt 2): one corner (90 degrees), smooth elsewhere.
 std::string write_teardrop(double radius, const std::string& path);
+/// Writes the planar slot made of the segments y = -radius and y = radius for 0 <= x <= length and
+/// two half circles closing them: no corner. `arc_first`: the wire starts with the right half
+/// circle instead of the bottom segment (the same face, its loop starting elsewhere).
+std::string write_stadium(double length, double radius, bool arc_first, const std::string& path);
 /// Writes a box with filleted edges (radius 1), as STEP.
 std::string write_filleted_box(const std::string& path);
 

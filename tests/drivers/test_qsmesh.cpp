@@ -291,6 +291,14 @@ TEST_F(Qsmesh, ExampleQuasiStructuredHasNoFlatQuad) {
   EXPECT_GT(json_number(json, "sicn_min"), 0.2);
   EXPECT_GT(json_number(json, "sicn_avg"), 0.88);
   EXPECT_LT(json_number(json, "irregular_interior"), 0.06 * json_number(json, "vertices"));
+  // Every face says why it has no pattern; the faces meshed by one say nothing.
+  const auto count = [&](const std::string& what) {
+    std::size_t n = 0;
+    for (auto at = json.find(what); at != std::string::npos; at = json.find(what, at + 1)) ++n;
+    return static_cast<double>(n);
+  };
+  EXPECT_EQ(count("\"pattern_refusal\": "), json_number(json, "faces"));
+  EXPECT_EQ(count("\"pattern_refusal\": \"\""), json_number(json, "faces_meshed_by_pattern"));
 }
 
 // Bad input: one line on stderr naming the file or option, exit code 2, nothing written.

@@ -410,6 +410,35 @@ TEST(FacePattern, DiskWithoutCornerGetsFourValence3Vertices) {
   EXPECT_EQ(caps, 2);
 }
 
+// A long face without corner: the disk pattern's corners and chords must follow the shape,
+// wherever the CAD loop starts (eight starts over half the loop, each moved).
+TEST(FacePattern, SlotWithoutCornerIsADiskWhereverItsLoopStarts) {
+  const auto patterns = builtin_patterns();
+  std::vector<double> means;
+  for (const bool arc_first : {false, true}) {
+    const auto model = cad::load_cad(test::write_stadium(
+        8.0, 1.0, arc_first, tmp(arc_first ? "qs_slot_a.brep" : "qs_slot_b.brep")));
+    std::vector<mesh::CurveMesh> curves;
+    // Edges about 0.5 long: 16 on the segments, 6 on the half circles (pi long).
+    for (LO c = 0; c < model.num_curves(); ++c)
+      curves.push_back(test::uniform_curve_mesh(
+          model, c, model.curves()[c].type == cad::CurveType::Circle ? 6 : 16));
+    PatternFaceReport rep;
+    const auto m = mesh_face_pattern(model, 0, curves, patterns, {}, &rep);
+    const auto v = check_face(model, 0, curves, m, rep);
+    EXPECT_EQ(rep.pattern_name, "disk");
+    EXPECT_EQ(v.interior.at(3), 4);
+    EXPECT_EQ(v.interior.size(), 2u) << "only valences 3 and 4 inside";
+    // A ring of one or two layers around a long centre quad, not the balanced 11 x 11 square.
+    ASSERT_EQ(rep.chords.size(), 3u);
+    EXPECT_GE(std::max(rep.chords[0], rep.chords[1]), 4 * std::min(rep.chords[0], rep.chords[1]));
+    EXPECT_LE(rep.chords[2], 2);
+    EXPECT_GT(rep.sicn_avg, 0.9);
+    means.push_back(rep.sicn_avg);
+  }
+  EXPECT_NEAR(means[0], means[1], 0.02);
+}
+
 // One corner: three valence-3 vertices inside (Eq. 2), the teardrop pattern.
 TEST(FacePattern, TeardropWithOneCornerGetsThreeValence3Vertices) {
   const auto model = cad::load_cad(test::write_teardrop(2.0, tmp("qs_teardrop.brep")));

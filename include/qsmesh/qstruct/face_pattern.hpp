@@ -27,19 +27,22 @@ struct PatternFaceOptions {
   /// this (degrees) are taken as flat and matching is tried once more (blunt corners, e.g. 140
   /// degrees, fit one quad or two about as badly).
   double soft_corner_angle_deg = 120;
-  /// The pattern mesh is kept only when, after smoothing, every quad has SICN (Eq. 12) above
-  /// min_sicn and the mean SICN is above min_sicn_avg. SICN also measures stretching (a w x h
+  /// The pattern mesh is kept when, after smoothing, every quad has SICN (Eq. 12) above
+  /// min_sicn and the mean SICN is above min_sicn_avg (or every quad above keep_sicn_min,
+  /// below). SICN also measures stretching (a w x h
   /// rectangle has 2wh / (w^2 + h^2)), so these bounds trade faces meshed by patterns against
   /// quality. Measured on Block.stp at --size-factor 0.02 (--until quasi-structured): 0.2 / 0.45
   /// gives 354 faces by patterns, SICN avg 0.855; 0.3 / 0.7 gives 304 faces, SICN avg 0.887
   /// (the unstructured path alone: 0.895).
   double min_sicn = 0.3;
   double min_sicn_avg = 0.7;
-  /// A fill whose every quad has SICN above this is kept whatever its mean (the acceptance rule
-  /// of Gmsh's implementation of Sec. 6.1.2, which has no mean threshold). A319.brep at its
-  /// reference count: two 4 x 10 grids at SICN 0.57 / 0.699 kept, 24 -> 26 faces by pattern,
-  /// interior irregular 1233 -> 1226, SICN avg 0.890 -> 0.889; the other shared models
-  /// unchanged. Above 1: off.
+  /// A valid fill whose every quad has SICN above this (and above the face's min threshold) is
+  /// kept whatever its mean (the acceptance rule of Gmsh's implementation of Sec. 6.1.2, which
+  /// has no mean threshold). A319.brep at its reference count: two 4 x 10 grids at SICN 0.57 /
+  /// 0.699 kept, 24 -> 26 faces by pattern, interior irregular 1233 -> 1226, SICN avg 0.890 ->
+  /// 0.889; the other shared models unchanged. 1 or more: off. The untangler (lift_poor_quads)
+  /// is still offered only fills whose mean passes min_sicn_avg: it lifts to min_sicn + 0.05,
+  /// short of this bound.
   double keep_sicn_min = 0.5;
   /// The quad at a corner of angle a < 90 degrees reaches SICN sin(a) at best (equal edges): at a
   /// face with a side-splitting corner where sin(a) <= min_sicn, which min_sicn would refuse
@@ -100,7 +103,9 @@ struct PatternFaceReport {
   bool ok = false;
   Refusal refusal = Refusal::None;
   std::string reason;            ///< refusal details, with the face id
-  std::vector<LO> side_edges;    ///< edges of each side, from the side after the first corner
+  /// Edges of each side, from the side after the first corner; without corner one side, the
+  /// whole loop.
+  std::vector<LO> side_edges;
   LO pattern = kNoIndex;         ///< index in the pattern list of the mesh kept (or last tried)
   std::string pattern_name;
   int start = 0;                 ///< face side holding pattern side 0 (PatternMatch::start)
@@ -126,7 +131,9 @@ struct FaceSides {
   /// 180 elsewhere.
   std::vector<double> angle_deg;
   std::vector<LO> corners;  ///< positions in `points` of the convex corners, increasing
-  std::vector<LO> side_edges;  ///< side k runs from corners[k] to corners[k + 1] (cyclic)
+  /// Side k runs from corners[k] to corners[k + 1] (cyclic); without corner one side of all
+  /// points.size() edges, from point 0.
+  std::vector<LO> side_edges;
   /// Position in `points` where each use of the face's loop starts (loop order). Corners sit at
   /// use starts, so a use lies in one side: side_of(fs, use_start[u]).
   std::vector<LO> use_start;
@@ -152,12 +159,17 @@ struct FaceSides {
 ///  - The face must have one boundary loop (seams included: a cylinder's lateral face is a 4-sided
 ///    disk in its parameter plane, the seam used twice) and no degenerate curve.
 ///  - The boundary is split at the corners below options.corner_angle_deg; when that gives no
-///    mesh, once more at the corners below options.soft_corner_angle_deg only.
+///    mesh, once more at the corners below options.soft_corner_angle_deg only. A face with one
+///    corner takes the one-sided patterns with a corner (the teardrop), a face without corner
+///    the patterns without corner (the disk, Pattern::cornerless).
 ///  - Matches (match_patterns) are ranked by how well the refined pattern's boundary valences fit
 ///    the CAD corners that do not split sides (ideal valence max(2, round(angle / 90))), then by
 ///    pattern order and energy; up to options.max_candidates of them are laid out (interior
 ///    vertices by a uniform-weight Laplace solve in (u, v), the boundary fixed), smoothed with
-///    smooth::smooth_face and measured; the first above the thresholds is returned.
+///    smooth::smooth_face and measured; the first above the thresholds is returned. Without
+///    corner, eight starts spread over half the loop are laid out and each valid one moved
+///    (chord_moves, then turns of the pattern along the loop, up to a quarter of it each way);
+///    the best mean wins, the search stopping at the first at or above move_below_avg.
 ///  - Output: an all-quad FaceMesh whose boundary vertices are exactly those of
 ///    background::face_boundary (same uv, xyz, VertexClass: assembly merges them with the
 ///    neighbouring faces), interior vertices classified on f, quads oriented along the face
