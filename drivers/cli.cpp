@@ -213,8 +213,9 @@ std::string help(const std::string& topic) {
           "                        iteration counts only and the mesh does not depend on timing\n"
           "  --sew                 sew faces that arrive disconnected\n"
           "  -q, --quiet           print only warnings and errors\n"
-          "  -v, --verbose         print per-face details (with the quad stages: method, counts,\n"
-          "                        irregular vertices, SICN and time of every face)\n\n"
+          "  -v, --verbose         print per-face details (with the quad stages: method, why no\n"
+          "                        pattern was kept, counts, irregular vertices, SICN and time of\n"
+          "                        every face)\n\n"
           "Exit codes: 0 success, 2 bad input (one line on stderr says what to fix), 1 internal error.\n";
   } else if (topic == "crossfield") {
     os << "usage: [mpirun -np P] qsmesh crossfield MODEL [-o OUT.vtu] [--check] [options]\n\n"
