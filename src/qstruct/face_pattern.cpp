@@ -237,6 +237,28 @@ void set_side_edges(FaceSides& fs) {
   }
 }
 
+// A closed chord (the disk pattern's ring) is the layers between the centre quad and the side.
+// In a round disk of radius R whose centre quad has sides R the ring is R / 2 = A / P wide (A the
+// area, P the perimeter), A N / P^2 layers in edges of the boundary's spacing P / N. On a long
+// face this is too many (a 16 x 2 slot: 7 layers where 2 fit), and the move search of each start
+// brings it down; scaling it by the roundness 4 pi A / P^2 instead was no better (stadiums 2-16
+// long: better on some, worse on others; Block's slots 9 and 220: SICN avg 0.98 -> 0.93). A is
+// the loop's vector area (exact on a plane, the projected area on a curved face).
+LO ring_layers(const FaceSides& fs) {
+  const LO nb = static_cast<LO>(fs.points.size());
+  Vec3 twice_area{0, 0, 0};
+  double perimeter = 0;
+  for (LO i = 0; i < nb; ++i) {
+    const Vec3& a = fs.points[i].xyz;
+    const Vec3& b = fs.points[(i + 1) % nb].xyz;
+    twice_area = twice_area + cross(a - fs.points[0].xyz, b - fs.points[0].xyz);
+    perimeter += norm(b - a);
+  }
+  if (!(perimeter > 0)) return 1;
+  return std::max<LO>(
+      1, static_cast<LO>(std::lround(0.5 * norm(twice_area) * nb / (perimeter * perimeter))));
+}
+
 // Matching, ranking and geometric trials for one split of the boundary into sides. Fills `rep`
 // (ok, or the refusal and its reason) and returns the mesh kept, or an empty one.
 mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& surface, const FaceSides& fs,
@@ -266,28 +288,13 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
 
   const LO nb = static_cast<LO>(fs.points.size());
   const LO m = static_cast<LO>(fs.corners.size());
-  // A closed chord (the disk pattern's ring) is the layers between the centre quad and the side.
-  // In a round disk of radius R whose centre quad has sides R the ring is R / 2 = A / P wide (A
-  // the area, P the perimeter), A N / P^2 layers in edges of the boundary's spacing P / N. On a
-  // long face this is too many (a 16 x 2 slot: 7 layers where 2 fit), and the move search of
-  // each start brings it down; scaling it by the roundness 4 pi A / P^2 instead was no better
-  // (stadiums 2-16 long: better on some, worse on others; Block's slots 9 and 220: SICN avg
-  // 0.98 -> 0.93). A is the loop's vector area (exact on a plane, the projected area on a
-  // curved face).
-  LO ring_layers = 1;
-  {
-    Vec3 twice_area{0, 0, 0};
-    double perimeter = 0;
-    for (LO i = 0; i < nb; ++i) {
-      const Vec3& a = fs.points[i].xyz;
-      const Vec3& b = fs.points[(i + 1) % nb].xyz;
-      twice_area = twice_area + cross(a - fs.points[0].xyz, b - fs.points[0].xyz);
-      perimeter += norm(b - a);
-    }
-    if (perimeter > 0)
-      ring_layers = std::max<LO>(
-          1, static_cast<LO>(std::lround(0.5 * norm(twice_area) * nb / (perimeter * perimeter))));
+  // Only patterns with a closed chord (the disk) need the face's ring estimate.
+  bool rings = false;
+  for (const auto& match : matches) {
+    const Pattern& pat = patterns[match.pattern];
+    for (LO j = 0; j < pat.num_chords; ++j) rings = rings || pat.closed_chord(j);
   }
+  const LO layers = rings ? ring_layers(fs) : 1;
   std::vector<char> splits(nb, 0);
   for (const LO c : fs.corners) splits[c] = 1;
   std::vector<Candidate> cands, oversize;
@@ -309,7 +316,7 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
       c.match = match;
       const Pattern& pat = patterns[match.pattern];
       for (LO j = 0; j < pat.num_chords; ++j)
-        if (pat.closed_chord(j)) c.match.chords[j] = ring_layers;
+        if (pat.closed_chord(j)) c.match.chords[j] = layers;
       c.refined = refine_pattern(pat, c.match.chords);
       const auto nq = static_cast<std::int64_t>(c.refined.quads.size());
       if (fewest_quads < 0 || nq < fewest_quads) fewest_quads = nq;

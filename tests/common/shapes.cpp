@@ -15,6 +15,7 @@
 #include <STEPControl_Writer.hxx>
 #include <TopExp_Explorer.hxx>
 #include <TopoDS.hxx>
+#include <TopoDS_Wire.hxx>
 #include <cmath>
 #include <gp_Ax2.hxx>
 #include <stdexcept>
@@ -26,6 +27,13 @@ namespace {
 std::string write(const TopoDS_Shape& s, const std::string& path) {
   if (!BRepTools::Write(s, path.c_str())) throw std::runtime_error("cannot write " + path);
   return path;
+}
+
+// The planar face bounded by `wire`, written as BREP; `what` names the shape in errors.
+std::string write_planar_face(const TopoDS_Wire& wire, const char* what, const std::string& path) {
+  BRepBuilderAPI_MakeFace face(wire, /*OnlyPlane=*/true);
+  if (!face.IsDone()) throw std::runtime_error(std::string(what) + " face construction failed");
+  return write(face.Face(), path);
 }
 }  // namespace
 
@@ -51,9 +59,7 @@ std::string write_polygon_face(const std::vector<std::pair<double, double>>& xy,
   BRepBuilderAPI_MakePolygon poly;
   for (const auto& [x, y] : xy) poly.Add(gp_Pnt(x, y, 0));
   poly.Close();
-  BRepBuilderAPI_MakeFace face(poly.Wire(), /*OnlyPlane=*/true);
-  if (!face.IsDone()) throw std::runtime_error("polygon face construction failed");
-  return write(face.Face(), path);
+  return write_planar_face(poly.Wire(), "polygon", path);
 }
 
 std::string write_teardrop(double radius, const std::string& path) {
@@ -65,9 +71,7 @@ std::string write_teardrop(double radius, const std::string& path) {
   wire.Add(BRepBuilderAPI_MakeEdge(GC_MakeArcOfCircle(right, top, left).Value()).Edge());
   wire.Add(BRepBuilderAPI_MakeEdge(left, tip).Edge());
   if (!wire.IsDone()) throw std::runtime_error("teardrop wire construction failed");
-  BRepBuilderAPI_MakeFace face(wire.Wire(), /*OnlyPlane=*/true);
-  if (!face.IsDone()) throw std::runtime_error("teardrop face construction failed");
-  return write(face.Face(), path);
+  return write_planar_face(wire.Wire(), "teardrop", path);
 }
 
 std::string write_stadium(double length, double radius, bool arc_first, const std::string& path) {
@@ -84,9 +88,7 @@ std::string write_stadium(double length, double radius, bool arc_first, const st
                                         : std::vector<TopoDS_Edge>{bottom, right, top, left})
     wire.Add(e);
   if (!wire.IsDone()) throw std::runtime_error("stadium wire construction failed");
-  BRepBuilderAPI_MakeFace face(wire.Wire(), /*OnlyPlane=*/true);
-  if (!face.IsDone()) throw std::runtime_error("stadium face construction failed");
-  return write(face.Face(), path);
+  return write_planar_face(wire.Wire(), "stadium", path);
 }
 
 std::string write_filleted_box(const std::string& path) {

@@ -113,7 +113,7 @@ struct PatternFaceReport {
   std::vector<LO> chords;        ///< chord subdivisions of that match
   int candidates = 0;            ///< matches tried geometrically
   int lifts = 0;                 ///< candidates handed to the untangler (lift_poor_quads)
-  int moves = 0;                 ///< improving moves of the kept fill's irregular vertices
+  int moves = 0;  ///< improving moves made by the search (over every start without corner)
   double sicn_min = 0, sicn_avg = 0;  ///< of the mesh kept (or of the best refused one)
   /// The min threshold applied (options.min_sicn, lowered at sharp corners: corner_sicn_factor).
   double min_sicn = 0;
