@@ -1,9 +1,11 @@
-// qstruct_survey MODEL [--size-factor F] [--threads T] [--faces] [--face F] [--min-sicn A]
-// [--min-sicn-avg B] [--smooth-iterations N]
+// qstruct_survey MODEL [--size-factor F] [--threads T] [--faces] [--face F [--dump OBJ]]
+// [--min-sicn A] [--min-sicn-avg B] [--smooth-iterations N]
 // How many faces of MODEL the pattern path (paper 000 Sec. 6.1.2) meshes on the curve meshes the
 // pipeline quantizes (size map, crossfield method, as `qsmesh sizemap`), and why the others are
-// refused. Serial (MPI_COMM_SELF); --faces prints one line per face (with its pattern time).
+// refused. Serial (MPI_COMM_SELF); --faces prints one line per face (with its pattern time);
+// --dump writes face F's mesh (kept, or the best valid fill refused) as a Wavefront OBJ.
 #include <cstdlib>
+#include <fstream>
 #include <iostream>
 #include <map>
 #include <string>
@@ -13,9 +15,9 @@
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/core/log.hpp"
 #include "qsmesh/core/timer.hpp"
+#include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/parallel/comm.hpp"
 #include "qsmesh/parallel/pipeline.hpp"
-#include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/qstruct/face_pattern.hpp"
 #include "survey_common.hpp"
 
@@ -25,16 +27,26 @@ int main(int argc, char** argv) {
   parallel::MpiSession mpi(&argc, &argv);
   test::SurveyArgs args;
   LO detail = kNoIndex;
+  std::string dump;  // --dump: OBJ file of the detail face's mesh (kept, or the refused fill)
   qstruct::PatternFaceOptions fo;
   const bool ok = test::parse_survey_args(
-      argc, argv, "usage: qstruct_survey MODEL [--size-factor F] [--threads T] [--faces] [--face F] [--min-sicn A] [--min-sicn-avg B] [--smooth-iterations N]", args,
-      [&](const std::string& a, int& i) {
+      argc, argv,
+      "usage: qstruct_survey MODEL [--size-factor F] [--threads T] [--faces] [--face F [--dump "
+      "OBJ]] [--min-sicn A] [--min-sicn-avg B] [--smooth-iterations N]",
+      args, [&](const std::string& a, int& i) {
         if (i + 1 >= argc) return false;
-        if (a == "--face") detail = std::atoi(argv[++i]);
-        else if (a == "--min-sicn") fo.min_sicn = std::atof(argv[++i]);
-        else if (a == "--min-sicn-avg") fo.min_sicn_avg = std::atof(argv[++i]);
-        else if (a == "--smooth-iterations") fo.smooth.iterations = std::atoi(argv[++i]);
-        else return false;
+        if (a == "--face")
+          detail = std::atoi(argv[++i]);
+        else if (a == "--dump")
+          dump = argv[++i];
+        else if (a == "--min-sicn")
+          fo.min_sicn = std::atof(argv[++i]);
+        else if (a == "--min-sicn-avg")
+          fo.min_sicn_avg = std::atof(argv[++i]);
+        else if (a == "--smooth-iterations")
+          fo.smooth.iterations = std::atoi(argv[++i]);
+        else
+          return false;
         return true;
       });
   if (!ok) return 2;
@@ -59,6 +71,15 @@ int main(int argc, char** argv) {
       const Stopwatch face_clock;
       const auto m = qstruct::mesh_face_pattern(model, f, result.quantized_curves, patterns, fo, &rep);
       const double face_seconds = face_clock.seconds();
+      if (f == detail && !dump.empty()) {
+        const mesh::FaceMesh& out = rep.ok ? m : rep.refused_mesh;
+        std::ofstream obj(dump);
+        for (const auto& p : out.points) obj << "v " << p.x << " " << p.y << " " << p.z << "\n";
+        for (const auto& q : out.quads)
+          obj << "f " << q[0] + 1 << " " << q[1] + 1 << " " << q[2] + 1 << " " << q[3] + 1 << "\n";
+        std::cout << "face " << f << ": " << out.quads.size() << " quads written to " << dump
+                  << "\n";
+      }
       std::string sides = std::to_string(rep.side_edges.size());
       if (rep.ok) {
         ++meshed;

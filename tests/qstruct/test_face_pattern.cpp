@@ -205,6 +205,27 @@ TEST(FacePattern, RectangleWithATransitionGetsOneValence3And5) {
   EXPECT_NEAR(q.sicn_min, rep.sicn_min, 1e-12);
 }
 
+// An 8 x 2 rectangle with sides [10, 2, 6, 2]: its short sides leave no room for two turning
+// chords, and the U-turn pattern (a chord leaving the long side and coming back to it) is the one
+// that fits: two valence-3 and two valence-5 vertices, nothing else irregular.
+TEST(FacePattern, StripWithShortSidesGetsAUTurn) {
+  const XY xy = {{0, 0}, {8, 0}, {8, 2}, {0, 2}};
+  const auto pc = polygon(xy, {10, 2, 6, 2}, "qs_uturn.brep");
+  const auto patterns = builtin_patterns();
+  PatternFaceReport rep;
+  const auto m = mesh_face_pattern(pc.model, 0, pc.curves, patterns, {}, &rep);
+  const auto v = check_face(pc.model, 0, pc.curves, m, rep);
+  EXPECT_EQ(rep.pattern_name, "chord_uturn");
+  EXPECT_EQ(v.interior.count(3) ? v.interior.at(3) : 0, 2);
+  EXPECT_EQ(v.interior.count(5) ? v.interior.at(5) : 0, 2);
+  EXPECT_EQ(v.interior.size(), 3u);  // valences 3, 4, 5 only
+  for (LO i = 0; i < m.num_vertices(); ++i)
+    if (m.vclass[i].dim == 1) {
+      EXPECT_EQ(v.of[i], 2);
+    }
+  EXPECT_GT(rep.sicn_min, 0.3);
+}
+
 // PatternFaceOptions::corner_sicn_factor: a quadrilateral with a 15-degree corner (the others
 // 110, 115, 120), sides [20, 2, 4, 18] fitted by a transition. No quad at that corner can reach
 // SICN 0.3 (sin 15 = 0.259), so the plain threshold would refuse every fill; the lowered one
@@ -510,12 +531,12 @@ quantize::Quantization quantization_of(const PolygonCase& pc) {
   return q;
 }
 
-// Pattern-aware quantization: a long rectangle whose bottom side is two curves gets [14, 2, 10, 2]
-// from the per-curve rounding, which no pattern fits (a transition of 4 edges across a strip 2
-// edges wide); balancing moves one bottom curve or the top so that the opposite sides agree.
+// Pattern-aware quantization: a long rectangle whose bottom side is two curves gets [14, 2, 10, 4]
+// from the per-curve rounding, which no pattern fits (the ends differ by 2 edges, the long sides
+// by 4, across a strip 2 to 4 edges wide); balancing moves curves so that a pattern fits.
 TEST(Balance, SidesOfSeveralCurvesAreMadeToFit) {
   const XY xy = {{0, 0}, {3, 0}, {10, 0}, {10, 1}, {0, 1}};
-  const std::vector<LO> counts = {6, 8, 2, 10, 2};
+  const std::vector<LO> counts = {6, 8, 2, 10, 4};
   const auto pc = polygon(xy, counts, "qs_balance.brep");
   ASSERT_EQ(pc.model.num_curves(), 5);
   const quantize::Quantization q = quantization_of(pc);
@@ -543,11 +564,16 @@ TEST(Balance, SidesOfSeveralCurvesAreMadeToFit) {
     EXPECT_LE(std::abs(edges[c] - q.ideal[c]), std::max(2.0, 0.35 * q.ideal[c]) + 1e-9) << "curve " << c;
   }
 
-  // With the bottom and top curves prescribed nothing may move, and nothing does.
-  std::vector<LO> fixed;
-  for (LO c = 0; c < 5; ++c)
-    if (q.edges[c] != 2) fixed.push_back(c);
-  EXPECT_EQ(balance_curve_counts(pc.model, pc.curves, q, patterns, fixed, BalanceOptions{}), q.edges);
+  // With the bottom and top curves prescribed (user sizes) only the ends may move, and the fit
+  // comes from them.
+  const std::vector<LO> fixed = {0, 1, 3};
+  const std::vector<int> ends =
+      balance_curve_counts(pc.model, pc.curves, q, patterns, fixed, BalanceOptions{});
+  for (const LO c : fixed) EXPECT_EQ(ends[c], q.edges[c]);
+  EXPECT_FALSE(match_patterns(patterns, sides(ends)).empty());
+  // With every curve prescribed nothing moves.
+  const std::vector<LO> all = {0, 1, 2, 3, 4};
+  EXPECT_EQ(balance_curve_counts(pc.model, pc.curves, q, patterns, all, BalanceOptions{}), q.edges);
 }
 
 // A rectangle that a transition fits only because the size map gave its bottom two more edges than

@@ -41,6 +41,8 @@ TEST(Patterns, BuiltinPatternsAreValidDisks) {
                                                               {"transition_2", {4, 7, 4}},
                                                               {"triangle", {3, 3, 1}},
                                                               {"transition_2_joined", {4, 6, 3}},
+                                                              {"transition_aligned", {4, 6, 2}},
+                                                              {"chord_uturn", {4, 6, 4}},
                                                               {"pentagon", {5, 5, 1}},
                                                               {"l_shape", {5, 4, 1}},
                                                               {"hexagon", {6, 6, 1}},
@@ -291,6 +293,62 @@ TEST(Match, TwoPairTransitionTakesUnequalDifferences) {
   const auto matches = match_patterns(all, n);
   ASSERT_FALSE(matches.empty());
   EXPECT_EQ(all[matches[0].pattern].name, "transition_2");
+}
+
+// Sums of the chord subdivisions of match m over each side of pattern p equal the cavity's counts
+// (Eq. 14 on the rotated sides).
+void expect_solves_eq14(const Pattern& p, const PatternMatch& m, const std::vector<LO>& n) {
+  const int ns = p.num_sides();
+  for (int i = 0; i < ns; ++i) {
+    const LO side = ((m.reversed ? m.start - i : m.start + i) % ns + ns) % ns;
+    LO sum = 0;
+    for (LO j = 0; j < p.num_chords; ++j) sum += p.weight(i, j) * m.chords[j];
+    EXPECT_EQ(sum, n[side]) << p.name << " side " << i;
+  }
+}
+
+// The two four-sided patterns of Gmsh's implementation beside the paper's third one: a chord
+// making a U-turn (w = 2 on one side) and a valence-3 / valence-5 pair side by side.
+TEST(Match, UTurnAndAlignedPairGiveTheirSystems) {
+  const auto all = builtin_patterns();
+  const Pattern& u = by_name(all, "chord_uturn");
+  // a + b + c = N1, d + e = N2, a + b + c + 2 f = N3, d + e = N4
+  EXPECT_EQ(
+      columns(u.w, 4, u.num_chords),
+      (std::vector<std::vector<int>>{
+          {0, 0, 2, 0}, {0, 1, 0, 1}, {0, 1, 0, 1}, {1, 0, 1, 0}, {1, 0, 1, 0}, {1, 0, 1, 0}}));
+  EXPECT_EQ(u.irregular, 4);
+  const Pattern& a = by_name(all, "transition_aligned");
+  // a + b + c = N1, b + d + e + f = N2, a + c + e = N3, d + f = N4
+  EXPECT_EQ(
+      columns(a.w, 4, a.num_chords),
+      (std::vector<std::vector<int>>{
+          {0, 1, 0, 1}, {0, 1, 0, 1}, {0, 1, 1, 0}, {1, 0, 1, 0}, {1, 0, 1, 0}, {1, 1, 0, 0}}));
+  EXPECT_EQ(a.irregular, 2);
+
+  // [10, 2, 6, 2]: the sides between the unequal ones hold two edges, too few for two turning
+  // chords (transition_2, transition_2_joined); only the U-turn fits, turning f = 2.
+  const std::vector<LO> n = {10, 2, 6, 2};
+  const auto matches = match_patterns(all, n);
+  ASSERT_FALSE(matches.empty());
+  for (const auto& m : matches) {
+    EXPECT_EQ(all[m.pattern].name, "chord_uturn");
+    expect_solves_eq14(all[m.pattern], m, n);
+    for (LO j = 0; j < u.num_chords; ++j)
+      if (u.weight(2, j) == 2) {
+        EXPECT_EQ(m.chords[j], 2);
+      }
+  }
+  // [12, 12, 12, 2]: N2 - N4 = b + e = 10, N1 - N3 = b - e = 0 fits the aligned pair, b = e = 5.
+  const std::vector<LO> n2 = {12, 12, 12, 2};
+  bool aligned = false;
+  for (const auto& m : match_patterns(all, n2)) {
+    EXPECT_NE(all[m.pattern].name, "grid");
+    if (m.pattern != index_of(all, "transition_aligned")) continue;
+    aligned = true;
+    expect_solves_eq14(a, m, n2);
+  }
+  EXPECT_TRUE(aligned);
 }
 
 TEST(Refine, GridAndTransitionTopology) {
