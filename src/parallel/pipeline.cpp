@@ -393,8 +393,10 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
       qstruct::PatternFaceReport pr;
       qstruct::PatternFaceOptions po = options.patterns;
       if (options.pattern_max_quad_ratio > 0 && !sizes.empty())
-        po.max_quads = static_cast<std::int64_t>(std::ceil(
-            options.pattern_max_quad_ratio * sizemap::expected_quads(meshes[i], sizes[i].s)));
+        po.max_quads = std::max<std::int64_t>(
+            options.pattern_min_quad_bound,
+            static_cast<std::int64_t>(std::ceil(options.pattern_max_quad_ratio *
+                                                sizemap::expected_quads(meshes[i], sizes[i].s))));
       mesh::FaceMesh m =
           qstruct::mesh_face_pattern(model, mine[i], result.quantized_curves, patterns, po, &pr);
       if (pr.ok) {
@@ -500,6 +502,26 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
                 [&](std::int64_t i, const cad::FaceGeometry& surface) {
                   return smooth::smooth_face(quad_meshes[i], surface, options.final_smooth);
                 });
+      // Last resort for a face that the unstructured path could not mesh validly (its fallback
+      // folded a quad too: t20's chamfer slivers with a 0-degree cusp at size factor 0.01): the
+      // pattern fill that the size map's quad bound refused, if it is valid. Poor quads beat
+      // folded ones, and only failed faces pay for this layout.
+      if (options.pattern_compare_tolerance >= 0)
+        tasks.parallel_for(total, [&](std::int64_t i) {
+          if (quasi_reports[i].by_pattern || quad_reports[i].ok || !refused[i].mesh.quads.empty())
+            return;
+          const Stopwatch face_clock;
+          qstruct::PatternFaceOptions po = options.patterns;
+          po.max_quads = 0;
+          qstruct::PatternFaceReport pr;
+          mesh::FaceMesh m = qstruct::mesh_face_pattern(model, mine[i], result.quantized_curves,
+                                                        patterns, po, &pr);
+          if (pr.ok)
+            refused[i] = {std::move(m), pr.pattern_name};
+          else if (!pr.refused_mesh.quads.empty())
+            refused[i] = {std::move(pr.refused_mesh), pr.pattern_name};
+          face_seconds[i] += face_clock.seconds();
+        });
       // Second look at the pattern meshes refused on quality: where the unstructured path did no
       // better, the pattern's fewer irregular vertices win (a small triangle face is often the
       // same three quads either way).

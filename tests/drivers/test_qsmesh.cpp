@@ -190,6 +190,21 @@ TEST_F(Qsmesh, FuselageKeepsFrontalPathAtCoarseSize) {
   EXPECT_GT(json_number(json, "sicn_min"), 0);
 }
 
+// t20_data.step at size factor 0.01: its chamfer slivers 12 and 13 (a 0-degree cusp) folded a
+// quad on the frontal path and on its fallback, and the run reported two failed faces. The
+// pattern fill that the size map's quad bound had refused is valid there (poor, SICN avg 0.13-0.17,
+// but no fold) and is taken.
+TEST_F(Qsmesh, CuspSliversGetAValidFillWhereTheFallbackFolds) {
+  const std::string path = std::string(QSMESH_SHARED_CAD_DIR) + "/t20_data.step";
+  if (!fs::exists(path)) GTEST_SKIP() << path << " not found";
+  const auto [r, json] = mesh_with_stats(path, "--size-factor 0.01 --threads 2", "e2e_cusp");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(json_number(json, "faces_failed"), 0) << r.err;
+  EXPECT_EQ(json_number(json, "triangles"), 0);
+  EXPECT_GT(json_number(json, "sicn_min"), 0);
+  EXPECT_NE(json.find("\"conforming\": true"), std::string::npos);
+}
+
 TEST_F(Qsmesh, SameFileWhateverTheThreads) {
   const std::string a = tmp("e2e_t1.msh"), b = tmp("e2e_t2.msh");
   ASSERT_EQ(run("mesh " + model_ + " -o " + a + " --size 0.7 --threads 1 -q").code, 0);

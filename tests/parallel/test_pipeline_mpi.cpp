@@ -275,6 +275,44 @@ TEST(Pipeline, RefusedPatternKeptWhereTheUnstructuredMeshIsNoBetter) {
   EXPECT_EQ(check_refused_patterns_compared(comm, cad::load_cad(path)), 0);
 }
 
+// PipelineOptions::pattern_min_quad_bound: the size map's bound on a fill's quads never goes below
+// it. With a ratio so small that every bound is the floor, a floor of 1 refuses every fill on its
+// count and a floor above any fill lets the pattern path mesh what it meshes without a bound.
+TEST(Pipeline, PatternQuadBoundHasAFloor) {
+  const Comm comm = Comm::world();
+  const cad::CadModel model = shared_model(comm, "pipe_floor");
+  PipelineOptions options;
+  options.background.sizes.size = 0.7;
+  options.sizemap.size_max = 0.7;
+  options.until = Stage::QuasiStructured;
+  std::ostringstream sink;
+  Logger log(sink, LogLevel::Quiet);
+  const auto by_pattern = [&](const PipelineResult& r, const char* refusal) {
+    int n = 0, refused = 0;
+    for (const QuasiReport& q : r.quasi_reports) {
+      n += q.by_pattern ? 1 : 0;
+      refused += q.refusal == refusal ? 1 : 0;
+    }
+    return std::make_pair(n, refused);
+  };
+  options.pattern_max_quad_ratio = 0;
+  const PipelineResult unbounded = run_pipeline(comm, model, options, TaskArena(2), log);
+  options.pattern_max_quad_ratio = 1e-9;
+  options.pattern_min_quad_bound = 1;
+  const PipelineResult tight = run_pipeline(comm, model, options, TaskArena(2), log);
+  options.pattern_min_quad_bound = 1000000;
+  const PipelineResult floor = run_pipeline(comm, model, options, TaskArena(2), log);
+  if (comm.rank() != 0) return;
+  const auto [all, none] = by_pattern(unbounded, "too_many_quads");
+  EXPECT_GT(all, 0);
+  EXPECT_EQ(none, 0);
+  const auto [tight_n, tight_refused] = by_pattern(tight, "too_many_quads");
+  EXPECT_EQ(tight_n, 0);
+  EXPECT_GE(tight_refused, all);  // and the faces refused on quality without a bound
+  EXPECT_EQ(by_pattern(floor, "too_many_quads"), std::make_pair(all, 0));
+  EXPECT_EQ(floor.mesh.quads, unbounded.mesh.quads);
+}
+
 TEST(Pipeline, SizeMapAndCurveMeshesDoNotDependOnRanks) {
   const Comm comm = Comm::world();
   check_size_map(comm, shared_model(comm, "pipe_sm"), 0.6);

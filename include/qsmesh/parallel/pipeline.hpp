@@ -59,6 +59,10 @@ struct PipelineOptions {
   /// 11 faces below 1, 146 in 1-1.5, 141 in 1.5-2, 15 in 2-3 (fine boundaries make structured
   /// fills finer than the size map inside); wing_fuselage's two transition faces above 5.
   double pattern_max_quad_ratio = 3.0;
+  /// ... but never below this many quads: on a face the size map gives a handful of quads the
+  /// ratio means nothing (Block's triangles 215 and 307 ask for about 2 quads, and their 7-quad
+  /// triangle fill, the same mesh as the unstructured path's, was refused on count).
+  std::int64_t pattern_min_quad_bound = 64;
   /// A face whose pattern mesh was refused on quality alone (valid, but at or below
   /// patterns.min_sicn or patterns.min_sicn_avg) gets it after all when it is no worse than what
   /// the unstructured path and the topological steps made of the face: SICN min and avg each at
