@@ -212,6 +212,8 @@ Quantization quantize_curves(const cad::CadModel& model, std::span<const double>
                  "curve " << c << ": ideal edge count " << ideal[c]);
   QSMESH_CHECK(options.chord_ratio_limit >= 1,
                "chord_ratio_limit " << options.chord_ratio_limit << " is below 1");
+  QSMESH_CHECK(options.chord_length_ratio_limit >= 1,
+               "chord_length_ratio_limit " << options.chord_length_ratio_limit << " is below 1");
 
   Quantization q;
   q.ideal.assign(ideal.begin(), ideal.end());
@@ -252,6 +254,9 @@ Quantization quantize_curves(const cad::CadModel& model, std::span<const double>
       if (curves[a].degenerate || curves[b].degenerate) continue;
       const double lo = std::min(ideal[a], ideal[b]), hi = std::max(ideal[a], ideal[b]);
       if (hi > options.chord_ratio_limit * lo) continue;
+      const double short_side = std::min(curves[a].length, curves[b].length);
+      const double long_side = std::max(curves[a].length, curves[b].length);
+      if (long_side > options.chord_length_ratio_limit * short_side) continue;
       uf.join(a, b);
       in_chord[a] = in_chord[b] = true;
     }

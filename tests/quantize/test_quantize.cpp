@@ -260,6 +260,29 @@ TEST(Quantize, RatioLimitKeepsVeryDifferentSidesApart) {
   EXPECT_EQ(j.num_chords, 2);
 }
 
+// A trapezoid whose bases differ 2.5 times in length: a size map finer at the short base gives
+// ideal counts only 1.5 times apart, within chord_ratio_limit, but a grid would have cells 2.5
+// times wider at one end than at the other; the bases stay apart. Its legs, as long as each
+// other, are joined.
+TEST(Quantize, LengthLimitKeepsBasesOfATaperedFaceApart) {
+  const cad::CadModel model =
+      polygon_face({{0, 0}, {10, 0}, {7, 4}, {3, 4}}, "q_taper.brep");  // bases 10 and 4
+  const auto ideal = ideal_by_use(model, {12, 5, 8, 5});
+  const auto loop = loop_curves(model);
+  const Quantization q = quantize_curves(model, ideal, {});
+  EXPECT_EQ(q.curve2chord[loop[0]], kNoIndex);
+  EXPECT_EQ(q.curve2chord[loop[2]], kNoIndex);
+  EXPECT_EQ(edges_by_use(model, q), (std::vector<int>{12, 6, 8, 6}));
+  EXPECT_EQ(q.num_chords, 1);
+  // Without the length limit the ideal counts alone join them: average 10 for both bases.
+  QuantizeOptions by_counts;
+  by_counts.chord_length_ratio_limit = 100;
+  const Quantization j = quantize_curves(model, ideal, by_counts);
+  EXPECT_EQ(q.curve2chord[loop[1]], q.curve2chord[loop[3]]);
+  EXPECT_EQ(edges_by_use(model, j), (std::vector<int>{10, 6, 10, 6}));
+  EXPECT_EQ(j.num_chords, 2);
+}
+
 TEST(Quantize, ClosedAndDegenerateCurves) {
   const cad::CadModel cyl = cad::load_cad(test::write_cylinder(tmp("q_cyl.brep")));
   std::vector<double> ideal(static_cast<std::size_t>(cyl.num_curves()), 1.0);
@@ -471,10 +494,13 @@ TEST(PlaceVertices, FacesWithOneJoinedPairKeepTheirOwnSpacing) {
 
 TEST(PlaceVertices, TaperedFacesKeepTheirOwnSpacing) {
   // A trapezoid: bottom 10, top 4 (2.5:1, beyond PlaceOptions::align_length_ratio), legs 5 and 5.
-  // Both pairs are joined in chords; the legs share their spacing, the bottom and top do not.
+  // Both pairs are joined in chords (the bases by a length limit looser than the default's 2);
+  // the legs share their spacing, the bottom and top do not.
   const cad::CadModel model = polygon_face({{0, 0}, {10, 0}, {7, 4}, {3, 4}}, "q_trapezoid.brep");
   const GradedCurves r(model);
-  const Quantization q = quantize_curves(model, ideal_edge_counts(r.bg, r.sizes), {});
+  QuantizeOptions joined;
+  joined.chord_length_ratio_limit = 3;
+  const Quantization q = quantize_curves(model, ideal_edge_counts(r.bg, r.sizes), joined);
   const auto loop = loop_curves(model);
   ASSERT_EQ(loop.size(), 4u);
   ASSERT_NE(q.curve2chord[loop[0]], kNoIndex);

@@ -25,6 +25,11 @@ struct QuantizeOptions {
   /// Opposite sides of a four-sided face are forced equal (joined in one chord) unless their ideal
   /// counts differ by more than this ratio (max / min > chord_ratio_limit). Must be >= 1.
   double chord_ratio_limit = 2.0;
+  /// ... nor when their lengths differ by more than this ratio (max / min). A grid across a face
+  /// whose ends differ more than that in length has cells that much wider at one end, whatever
+  /// the size map asks (mambo_s34's fillets [62, 6, 62, 6]: arcs 1.51 long, ideal 4.0 edges, got
+  /// 6 through a tapered face from arcs 3.14 long, ideal 6.3, and cells 0.5 x 0.25). Must be >= 1.
+  double chord_length_ratio_limit = 2.0;
   /// Final counts even: all-quad meshing by midpoint subdivision (paper 000 Sec. 5.2) halves them
   /// before the quad mesher and subdivides afterwards.
   bool even = true;
@@ -65,7 +70,8 @@ struct Quantization {
 ///  - Chords: for every face with one loop of exactly four curve uses (a conformal four-sided
 ///  face),
 ///    uses 0-2 and 1-3 are opposite; each opposite pair of non-degenerate curves is joined
-///    (union-find over curves) unless max/min of their ideal values > chord_ratio_limit. A curve
+///    (union-find over curves) unless max/min of their ideal values > chord_ratio_limit or of
+///    their lengths > chord_length_ratio_limit. A curve
 ///    is in a chord when it is a side of at least one joined pair (a seam opposite itself, as on a
 ///    cylinder, makes a chord of one curve). All curves of a chord get the average of the chord's
 ///    ideal values (each curve counted once), then rounded.
