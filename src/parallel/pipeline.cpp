@@ -505,10 +505,13 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
       // Last resort for a face that the unstructured path could not mesh validly (its fallback
       // folded a quad too: t20's chamfer slivers with a 0-degree cusp at size factor 0.01): the
       // pattern fill that the size map's quad bound refused, if it is valid. Poor quads beat
-      // folded ones, and only failed faces pay for this layout.
+      // folded ones, and only failed faces pay for this layout. Other refusals would give the
+      // same answer again.
+      const std::string over_bound = qstruct::to_string(qstruct::Refusal::TooManyQuads);
       if (options.pattern_compare_tolerance >= 0)
         tasks.parallel_for(total, [&](std::int64_t i) {
-          if (quasi_reports[i].by_pattern || quad_reports[i].ok || !refused[i].mesh.quads.empty())
+          if (quasi_reports[i].by_pattern || quad_reports[i].ok || !refused[i].mesh.quads.empty() ||
+              quasi_reports[i].refusal != over_bound)
             return;
           const Stopwatch face_clock;
           qstruct::PatternFaceOptions po = options.patterns;

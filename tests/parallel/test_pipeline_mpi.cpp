@@ -285,6 +285,7 @@ TEST(Pipeline, PatternQuadBoundHasAFloor) {
   options.background.sizes.size = 0.7;
   options.sizemap.size_max = 0.7;
   options.until = Stage::QuasiStructured;
+  options.pattern_compare_tolerance = -1;  // the bound alone decides (no fill taken afterwards)
   std::ostringstream sink;
   Logger log(sink, LogLevel::Quiet);
   const auto by_pattern = [&](const PipelineResult& r, const char* refusal) {

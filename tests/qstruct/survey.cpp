@@ -6,8 +6,10 @@
 // --dump writes face F's mesh (kept, or the best valid fill refused) as a Wavefront OBJ.
 #include <cstdlib>
 #include <fstream>
+#include <iomanip>
 #include <iostream>
 #include <map>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -50,6 +52,10 @@ int main(int argc, char** argv) {
         return true;
       });
   if (!ok) return 2;
+  if (!dump.empty() && detail == kNoIndex) {
+    std::cerr << "qstruct_survey: --dump needs --face F\n";
+    return 2;
+  }
   const std::string& path = args.path;
   const double size_factor = args.size_factor;
   const bool per_face = args.per_face;
@@ -74,6 +80,8 @@ int main(int argc, char** argv) {
       if (f == detail && !dump.empty()) {
         const mesh::FaceMesh& out = rep.ok ? m : rep.refused_mesh;
         std::ofstream obj(dump);
+        if (!obj) throw std::runtime_error("cannot write " + dump);
+        obj << std::setprecision(17);
         for (const auto& p : out.points) obj << "v " << p.x << " " << p.y << " " << p.z << "\n";
         for (const auto& q : out.quads)
           obj << "f " << q[0] + 1 << " " << q[1] + 1 << " " << q[2] + 1 << " " << q[3] + 1 << "\n";

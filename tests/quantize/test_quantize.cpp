@@ -272,13 +272,16 @@ TEST(Quantize, LengthLimitKeepsBasesOfATaperedFaceApart) {
   const Quantization q = quantize_curves(model, ideal, {});
   EXPECT_EQ(q.curve2chord[loop[0]], kNoIndex);
   EXPECT_EQ(q.curve2chord[loop[2]], kNoIndex);
+  EXPECT_NE(q.curve2chord[loop[1]], kNoIndex);
+  EXPECT_EQ(q.curve2chord[loop[1]], q.curve2chord[loop[3]]);
   EXPECT_EQ(edges_by_use(model, q), (std::vector<int>{12, 6, 8, 6}));
   EXPECT_EQ(q.num_chords, 1);
   // Without the length limit the ideal counts alone join them: average 10 for both bases.
   QuantizeOptions by_counts;
   by_counts.chord_length_ratio_limit = 100;
   const Quantization j = quantize_curves(model, ideal, by_counts);
-  EXPECT_EQ(q.curve2chord[loop[1]], q.curve2chord[loop[3]]);
+  EXPECT_NE(j.curve2chord[loop[0]], kNoIndex);
+  EXPECT_EQ(j.curve2chord[loop[0]], j.curve2chord[loop[2]]);
   EXPECT_EQ(edges_by_use(model, j), (std::vector<int>{10, 6, 10, 6}));
   EXPECT_EQ(j.num_chords, 2);
 }

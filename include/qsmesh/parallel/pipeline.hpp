@@ -68,7 +68,9 @@ struct PipelineOptions {
   /// the unstructured path and the topological steps made of the face: SICN min and avg each at
   /// least theirs minus this tolerance, and no more interior irregular vertices (paper 000 Sec.
   /// 6.1.1 keeps a pattern mesh when its quality is better than the mesh it replaces). The
-  /// pattern mesh is also taken when the unstructured path gave no valid all-quad mesh. Negative:
+  /// pattern mesh is also taken when the unstructured path gave no valid all-quad mesh; a face
+  /// refused only on the quad bound then gets its fill laid out without the bound and taken when
+  /// valid (t20_data's cusp slivers at size factor 0.01). Both count in by_comparison. Negative:
   /// never. On Block.stp the faces this takes are small triangles (three or seven quads) that
   /// both paths mesh alike.
   double pattern_compare_tolerance = 0.01;
