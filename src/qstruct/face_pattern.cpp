@@ -288,18 +288,28 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
 
   const LO nb = static_cast<LO>(fs.points.size());
   const LO m = static_cast<LO>(fs.corners.size());
-  // Only patterns with a closed chord (the disk) need the face's ring estimate.
-  bool rings = false;
-  for (const auto& match : matches) {
-    const Pattern& pat = patterns[match.pattern];
-    for (LO j = 0; j < pat.num_chords; ++j) rings = rings || pat.closed_chord(j);
-  }
-  const LO layers = rings ? ring_layers(fs) : 1;
+  LO layers = 0;  // ring_layers(fs), computed for the first pattern with a closed chord
   std::vector<char> splits(nb, 0);
   for (const LO c : fs.corners) splits[c] = 1;
   std::vector<Candidate> cands, oversize;
   std::int64_t fewest_quads = -1;
   for (const auto& match : matches) {
+    const Pattern& pat = patterns[match.pattern];
+    PatternMatch sized = match;
+    for (LO j = 0; j < pat.num_chords; ++j)
+      if (pat.closed_chord(j)) {
+        if (layers == 0) layers = ring_layers(fs);
+        sized.chords[j] = layers;
+      }
+    const RefinedPattern refined = refine_pattern(pat, sized.chords);
+    const auto nq = static_cast<std::int64_t>(refined.quads.size());
+    if (fewest_quads < 0 || nq < fewest_quads) fewest_quads = nq;
+    QSMESH_CHECK(
+        static_cast<LO>(refined.boundary.size()) == nb,
+        "refined boundary has " << refined.boundary.size() << " vertices, the face " << nb);
+    std::vector<int> valence(static_cast<std::size_t>(refined.num_vertices), 0);
+    for (const auto& q : refined.quads)
+      for (const LO v : q) ++valence[v];
     // Without corner any loop point may start the single side, and where the pattern's corners
     // land matters as soon as the face is not round (an ellipse 3:1 with 32 edges: SICN avg 0.83
     // from one start, 0.66 from another). The disk pattern is the same after a half turn, so
@@ -313,29 +323,18 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
     }
     for (const LO first : firsts) {
       Candidate c;
-      c.match = match;
-      const Pattern& pat = patterns[match.pattern];
-      for (LO j = 0; j < pat.num_chords; ++j)
-        if (pat.closed_chord(j)) c.match.chords[j] = layers;
-      c.refined = refine_pattern(pat, c.match.chords);
-      const auto nq = static_cast<std::int64_t>(c.refined.quads.size());
-      if (fewest_quads < 0 || nq < fewest_quads) fewest_quads = nq;
-      QSMESH_CHECK(
-          static_cast<LO>(c.refined.boundary.size()) == nb,
-          "refined boundary has " << c.refined.boundary.size() << " vertices, the face " << nb);
+      c.match = sized;
+      c.refined = refined;
       c.seq.resize(nb);
       for (LO p = 0; p < nb; ++p)
         c.seq[p] = (((match.reversed ? first - p : first + p) % nb) + nb) % nb;
-      std::vector<int> valence(static_cast<std::size_t>(c.refined.num_vertices), 0);
-      for (const auto& q : c.refined.quads)
-        for (const LO v : q) ++valence[v];
       for (LO p = 0; p < nb; ++p) {
         const LO i = c.seq[p];
         if (splits[i]) continue;
         const int ideal = fs.points[i].vclass.dim == 0
                               ? std::max(2, static_cast<int>(std::lround(fs.angle_deg[i] / 90.0)))
                               : 2;
-        c.score += std::abs(valence[c.refined.boundary[p]] - ideal);
+        c.score += std::abs(valence[refined.boundary[p]] - ideal);
       }
       (options.max_quads > 0 && nq > options.max_quads ? oversize : cands).push_back(std::move(c));
     }

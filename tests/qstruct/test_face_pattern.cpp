@@ -104,6 +104,18 @@ PolygonCase polygon(const XY& xy, const std::vector<LO>& counts, const std::stri
   return c;
 }
 
+// A size transition's valences: interior vertices of valence 3, 4 and 5 only, n3 and n5 of the
+// irregular ones, and every curve vertex of m (off the corners) in two quads.
+void expect_transition_valences(const Valences& v, const mesh::FaceMesh& m, int n3, int n5) {
+  EXPECT_EQ(v.interior.count(3) ? v.interior.at(3) : 0, n3);
+  EXPECT_EQ(v.interior.count(5) ? v.interior.at(5) : 0, n5);
+  EXPECT_EQ(v.interior.size(), 3u);
+  for (LO i = 0; i < m.num_vertices(); ++i)
+    if (m.vclass[i].dim == 1) {
+      EXPECT_EQ(v.of[i], 2) << "curve vertex " << i;
+    }
+}
+
 // The matched (balanced) chord subdivisions, not moved.
 PatternFaceOptions without_moves() {
   PatternFaceOptions o;
@@ -174,14 +186,7 @@ TEST(FacePattern, RectangleWithATransitionGetsOneValence3And5) {
   const auto m = mesh_face_pattern(pc.model, 0, pc.curves, patterns, balanced, &rep);
   const auto v = check_face(pc.model, 0, pc.curves, m, rep);
   EXPECT_EQ(rep.pattern_name, "transition_1");
-  EXPECT_EQ(v.interior.count(3) ? v.interior.at(3) : 0, 1);
-  EXPECT_EQ(v.interior.count(5) ? v.interior.at(5) : 0, 1);
-  EXPECT_EQ(v.interior.size(), 3u);  // valences 3, 4, 5 only
-  // Boundary vertices off the corners have two quads.
-  for (LO i = 0; i < m.num_vertices(); ++i)
-    if (m.vclass[i].dim == 1) {
-      EXPECT_EQ(v.of[i], 2);
-    }
+  expect_transition_valences(v, m, 1, 1);
 
   // Thresholds are honoured: nothing is that good, so the face is refused with the reason.
   PatternFaceOptions strict = balanced;
@@ -216,13 +221,7 @@ TEST(FacePattern, StripWithShortSidesGetsAUTurn) {
   const auto m = mesh_face_pattern(pc.model, 0, pc.curves, patterns, {}, &rep);
   const auto v = check_face(pc.model, 0, pc.curves, m, rep);
   EXPECT_EQ(rep.pattern_name, "chord_uturn");
-  EXPECT_EQ(v.interior.count(3) ? v.interior.at(3) : 0, 2);
-  EXPECT_EQ(v.interior.count(5) ? v.interior.at(5) : 0, 2);
-  EXPECT_EQ(v.interior.size(), 3u);  // valences 3, 4, 5 only
-  for (LO i = 0; i < m.num_vertices(); ++i)
-    if (m.vclass[i].dim == 1) {
-      EXPECT_EQ(v.of[i], 2);
-    }
+  expect_transition_valences(v, m, 2, 2);
   EXPECT_GT(rep.sicn_min, 0.3);
 }
 
