@@ -479,9 +479,57 @@ TEST(FacePattern, TeardropWithOneCornerGetsThreeValence3Vertices) {
   EXPECT_GT(rep.sicn_avg, 0.7);
 }
 
-TEST(FacePattern, PolesAndHolesAreRefused) {
+// A pole is a corner where the curves on either side meet (paper 000 Sec. 6.1.2 on a face whose
+// loop holds a degenerate curve): the sphere octant is a triangle with 90-degree corners, the
+// triangle pattern's one valence-3 vertex inside, the pole one vertex.
+TEST(FacePattern, PoleOfASphereOctantIsACornerOfATriangle) {
+  const auto model = cad::load_cad(test::write_sphere_octant(tmp("qs_octant.brep")));
+  LO f = kNoIndex;
+  for (LO g = 0; g < model.num_faces(); ++g)
+    if (model.faces()[g].type == cad::SurfaceType::Sphere) f = g;
+  ASSERT_NE(f, kNoIndex);
+  LO pole = kNoIndex;
+  for (const auto& use : model.faces()[f].loops[0].uses)
+    if (model.curves()[use.curve].degenerate) pole = model.curves()[use.curve].corners[0];
+  ASSERT_NE(pole, kNoIndex) << "the octant's loop has its degenerate curve";
+  std::vector<mesh::CurveMesh> curves;
+  for (LO c = 0; c < model.num_curves(); ++c)
+    curves.push_back(test::uniform_curve_mesh(model, c, model.curves()[c].degenerate ? 1 : 8));
+  const auto patterns = builtin_patterns();
+  const auto surface = model.face_geometry(f);
+  const FaceSides fs = face_sides(model, f, *surface, curves, PatternFaceOptions{});
+  EXPECT_EQ(fs.side_edges, (std::vector<LO>{8, 8, 8}));
+  for (const LO c : fs.corners) EXPECT_NEAR(fs.angle_deg[c], 90.0, 1.0);
+  PatternFaceReport rep;
+  const auto m = mesh_face_pattern(model, f, curves, patterns, {}, &rep);
+  ASSERT_TRUE(rep.ok) << rep.reason;
+  EXPECT_EQ(rep.pattern_name, "triangle");
+  EXPECT_EQ(m.quads.size(), 48u);  // three 4 x 4 blocks
+  const auto v = valences(m);
+  EXPECT_EQ(v.interior, (std::map<int, int>{{3, 1}, {4, 36}}));
+  int at_pole = 0;
+  for (LO i = 0; i < m.num_vertices(); ++i)
+    if (m.vclass[i].dim == 0 && m.vclass[i].entity == pole) {
+      ++at_pole;
+      EXPECT_EQ(v.of[i], 1) << "a 90-degree corner is in one quad";
+    }
+  EXPECT_EQ(at_pole, 1);
+  for (const auto& q : m.quads) {
+    const std::array<Vec3, 4> p{m.points[q[0]], m.points[q[1]], m.points[q[2]], m.points[q[3]]};
+    EXPECT_GT(mesh::quad_sicn(p), 0.5);
+    // Outward like the sphere: the quad's normal along its centre's position.
+    EXPECT_GT(dot(cross(p[1] - p[0], p[3] - p[0]) + cross(p[3] - p[2], p[1] - p[2]),
+                  p[0] + p[1] + p[2] + p[3]),
+              0);
+  }
+  for (LO i = 0; i < m.num_vertices(); ++i) EXPECT_NEAR(norm(m.points[i]), 3.0, 1e-9);
+  EXPECT_GT(rep.sicn_avg, 0.8);
+}
+
+TEST(FacePattern, PolesInsideAndHolesAreRefused) {
   const auto patterns = builtin_patterns();
   {
+    // The whole sphere: its poles lie between the two uses of the seam, inside the face.
     const auto model = cad::load_cad(test::write_sphere(tmp("qs_sphere.brep")));
     std::vector<mesh::CurveMesh> curves;
     for (LO c = 0; c < model.num_curves(); ++c)
@@ -517,7 +565,6 @@ TEST(FacePattern, PolesAndHolesAreRefused) {
     EXPECT_GE(meshed, 4);  // the four box sides without the hole, all 4 x 4 grids
   }
 }
-
 
 // A quantization whose counts are the polygon's curve meshes, each its own ideal value, no chord.
 quantize::Quantization quantization_of(const PolygonCase& pc) {

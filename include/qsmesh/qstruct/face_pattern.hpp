@@ -138,11 +138,17 @@ struct FaceSides {
   /// use starts, so a use lies in one side: side_of(fs, use_start[u]).
   std::vector<LO> use_start;
   double uv_area = 0;       ///< signed area of the loop in the parameter plane (> 0: CCW)
+  std::vector<LO> poles;    ///< positions in `points` of the poles (merged degenerate curves)
 };
 
 /// Splits the boundary of face f (one loop) into sides. `curves`: the final curve meshes of all
-/// curves, by curve id. Throws qsmesh::Error when the face does not have exactly one closed loop,
-/// uses a degenerate curve, or has a corner where a tangent or the surface normal vanishes.
+/// curves, by curve id. A degenerate curve (pole) gives no edge: its copies of the pole become
+/// one point, at their mean (u, v), the corner where the curves on either side meet (its angle
+/// measured in the plane normal to the mean surface normal of its two loop neighbours, exact at
+/// a smooth pole, an approximation at a cone's apex). Throws qsmesh::Error when the face does
+/// not have exactly one closed loop, has only degenerate curves, a pole between the two uses of
+/// a seam (inside the face: a whole sphere or cone), or a corner where a tangent or the surface
+/// normal vanishes.
 [[nodiscard]] FaceSides face_sides(const cad::CadModel& model, LO f,
                                    const cad::FaceGeometry& surface,
                                    std::span<const mesh::CurveMesh> curves,
@@ -157,7 +163,8 @@ struct FaceSides {
 ///  - Input: the model, the final curve meshes of all curves (`full_curves`, by curve id, as
 ///    quad::subdivide uses them), the pattern list (builtin_patterns()) and options.
 ///  - The face must have one boundary loop (seams included: a cylinder's lateral face is a 4-sided
-///    disk in its parameter plane, the seam used twice) and no degenerate curve.
+///    disk in its parameter plane, the seam used twice). A pole (degenerate curve) is a corner of
+///    that loop (face_sides): a cone sector or a fuselage's nose cap is a triangle.
 ///  - The boundary is split at the corners below options.corner_angle_deg; when that gives no
 ///    mesh, once more at the corners below options.soft_corner_angle_deg only. A face with one
 ///    corner takes the one-sided patterns with a corner (the teardrop), a face without corner
@@ -172,9 +179,10 @@ struct FaceSides {
 ///    the best mean wins, the search stopping at the first at or above move_below_avg.
 ///  - Output: an all-quad FaceMesh whose boundary vertices are exactly those of
 ///    background::face_boundary (same uv, xyz, VertexClass: assembly merges them with the
-///    neighbouring faces), interior vertices classified on f, quads oriented along the face
-///    normal. When the face is refused: an empty mesh (face id set) and the reason in the report
-///    (with the best valid candidate in report->refused_mesh on a quality refusal).
+///    neighbouring faces; a pole's copies are one vertex, at their mean uv), interior vertices
+///    classified on f, quads oriented along the face normal. When the face is refused: an empty
+///    mesh (face id set) and the reason in the report (with the best valid candidate in
+///    report->refused_mesh on a quality refusal).
 /// Never throws for a face-level failure. Deterministic.
 [[nodiscard]] mesh::FaceMesh mesh_face_pattern(const cad::CadModel& model, LO f,
                                                std::span<const mesh::CurveMesh> full_curves,
