@@ -117,6 +117,8 @@ Arguments parse(const std::vector<std::string>& args) {
         throw InputError(opt + ": '" + v +
                          "' is not 0 (no curvature sizes) or a number of edges per turn of at least 3");
       a.curvature_edges = n;
+    } else if (opt == "--face-curvature" && sizing) {
+      a.face_curvature = true;
     } else if (opt == "--sizemap" && sizing) {
       a.sizemap = value();
       if (a.sizemap != "features" && a.sizemap != "crossfield")
@@ -146,7 +148,7 @@ Arguments parse(const std::vector<std::string>& args) {
   }
   if (a.size && a.size_factor) throw InputError("--size and --size-factor: give one, not both");
   const bool sizing_given = a.sizemap != "crossfield" || a.quads > 0 || a.curvature_edges ||
-                            !a.curve_edges.empty() || !a.face_quads.empty() ||
+                            a.face_curvature || !a.curve_edges.empty() || !a.face_quads.empty() ||
                             !a.corner_sizes.empty() || !a.curve_sizes.empty() ||
                             !a.face_sizes.empty();
   if (a.command == Command::Mesh && sizing_given && a.until == "background")
@@ -203,7 +205,8 @@ std::string help(const std::string& topic) {
           "  --threads T           threads per rank (default: the cores of the machine divided\n"
           "                        among the ranks running on it)\n"
           "  --stats FILE.json     also write the run statistics as JSON\n"
-          "  --quads N, --curvature-edges N, --curve-edges C:N,.., --face-quads F:N,..,\n"
+          "  --quads N, --curvature-edges N, --face-curvature, --curve-edges C:N,..,\n"
+          "  --face-quads F:N,..,\n"
           "  --corner-size K:H,.., --curve-size C:H,.., --face-size F:H,.., --sizemap METHOD\n"
           "                        size-map controls, as for sizemap (see qsmesh sizemap --help);\n"
           "                        they act on the quad mesh, not with --until background\n"
@@ -240,10 +243,12 @@ std::string help(const std::string& topic) {
           "  --sizemap METHOD      features (small features and user sizes only) or crossfield\n"
           "                        (also the conformal scaling of the cross fields; default)\n"
           "  --quads N             target number of quads of the model (default: area / size^2)\n"
-          "  --curvature-edges N   edges per full turn on curved curves and faces: a radius R gets\n"
-          "                        edges of 2 pi R / N at most (default 16); 0 sizes by the cross\n"
-          "                        field and the small CAD features only (paper 000 Sec. 4), so the\n"
-          "                        mesh coarsens with --size on curved models too\n"
+          "  --curvature-edges N   edges per full turn on curved curves: a radius R gets edges of\n"
+          "                        2 pi R / N at most (default 16); 0 sizes by the cross field and\n"
+          "                        the small CAD features only (paper 000 Sec. 4)\n"
+          "  --face-curvature      the same bound from the faces' curvature along their curves\n"
+          "                        (finer on curved faces, e.g. a wing's leading edge, but the\n"
+          "                        isotropic sizes then make the counts of opposite sides unequal)\n"
           "  --curve-edges C:N,..  prescribe the (even) number of edges of curves; kept exactly\n"
           "  --face-quads F:N,..   prescribe the number of quads of faces\n"
           "  --corner-size K:H,.., --curve-size C:H,.., --face-size F:H,..\n"

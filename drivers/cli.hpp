@@ -32,6 +32,9 @@ struct Arguments {
   /// --curvature-edges N: edges per full turn on curved curves and faces (0: no curvature sizes;
   /// unset: sizemap::SizeMapOptions' default).
   std::optional<double> curvature_edges;
+  /// --face-curvature: the curvature sizes also from the faces' principal curvatures
+  /// (sizemap::SizeMapOptions::face_curvature).
+  bool face_curvature = false;
   std::vector<std::pair<int, int>> curve_edges;       ///< --curve-edges C:N,...
   std::vector<std::pair<int, double>> face_quads;     ///< --face-quads F:N,...
   std::vector<std::pair<int, double>> corner_sizes;   ///< --corner-size K:H,...

@@ -222,6 +222,7 @@ std::string stats_json(const Arguments& args, const Session& session,
   j.value("output", args.output);
   j.value("stage", args.until);
   j.value("curvature_edges", curvature_edges(args));  // edges per full turn (0: none)
+  j.value("face_curvature", args.face_curvature);
   j.value("corners", static_cast<std::int64_t>(model.num_corners()));
   j.value("curves", static_cast<std::int64_t>(model.num_curves()));
   j.value("faces", static_cast<std::int64_t>(model.num_faces()));
@@ -456,6 +457,7 @@ void apply_size_options(const Arguments& args, const Session& s,
   so.size_max = s.size;
   so.target_quads = args.quads;
   so.edges_per_turn = curvature_edges(args);
+  so.face_curvature = args.face_curvature;
   for (const auto& [id, v] : args.face_quads) so.face_quads.emplace_back(id, v);
   for (const auto& [id, v] : args.corner_sizes) so.corner_sizes.emplace_back(id, v);
   for (const auto& [id, v] : args.curve_sizes) so.curve_sizes.emplace_back(id, v);

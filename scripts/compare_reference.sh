@@ -6,7 +6,9 @@
 # min / avg, wall time and peak memory (one thread, one rank). The reference numbers
 # are read from that README by scripts/gmsh_reference.py.
 # Usage: scripts/compare_reference.sh [STAGE] [MODEL...]   (after scripts/build.sh; default stage
-# quasi-structured, default models: all six)
+# quasi-structured, default models: all six). QSMESH_ARGS adds options to every run, e.g.
+# QSMESH_ARGS="--curvature-edges 0" for the reference's sizing (Gmsh's quasi-structured algorithm
+# sizes by the cross field and the CAD features, not by the curvature).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 stage=${1:-quasi-structured}
@@ -21,7 +23,7 @@ echo "|---|---|---|---|---|---|---|---|"
 for m in "${models[@]}"; do
   [ -f "../shared/cad/$m" ] || continue
   python3 - "$m" "$stage" "$out" <<'PY'
-import json, math, subprocess, sys
+import json, math, os, subprocess, sys
 sys.path.insert(0, "scripts")
 import gmsh_reference
 model, stage, out = sys.argv[1], sys.argv[2], sys.argv[3]
@@ -30,6 +32,7 @@ target = ref.vertices
 def run(f):
     cmd = ["/usr/bin/time", "-f", "%M", "-o", f"{out}/mem", "./build/drivers/qsmesh", "mesh", f"../shared/cad/{model}",
            "-o", f"{out}/m.vtu", "--size-factor", f"{f:.6g}", "--until", stage, "--threads", "1", "-q", "--stats", f"{out}/s.json"]
+    cmd += os.environ.get("QSMESH_ARGS", "").split()
     subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL)
     d = json.load(open(f"{out}/s.json"))
     d["peak_mb"] = int(open(f"{out}/mem").read().split()[-1]) / 1024

@@ -174,8 +174,8 @@ CurveSizes initial_curve_sizes(const cad::CadModel& model, std::span<const mesh:
   };
   for (const auto& [c, v] : options.curve_sizes) cap_curve(c, v);
 
-  // (0) Curvature: 2 pi R / n along the curve and across its faces, as for the background mesh;
-  //     without it a half circle may get two edges and its faces fold.
+  // (0) Curvature: 2 pi R / n along the curve (without it a half circle may get two edges and its
+  //     faces fold), and across its faces with face_curvature.
   if (options.edges_per_turn > 0) {
     background::SizeOptions curvature;
     curvature.size = options.size_max;
@@ -185,7 +185,11 @@ CurveSizes initial_curve_sizes(const cad::CadModel& model, std::span<const mesh:
     tasks.parallel_for(nc, [&](std::int64_t i) {
       const auto c = static_cast<LO>(i);
       if (model.curves()[c].degenerate) return;
-      const background::CurveCurvatureSize size(model, c, uses[c], curvature);
+      const background::CurveCurvatureSize size(
+          model, c,
+          options.face_curvature ? std::span<const background::CurveUseRef>(uses[c])
+                                 : std::span<const background::CurveUseRef>(),
+          curvature);
       for (std::size_t k = 0; k < curves[c].t.size(); ++k) out.at[c][k] = std::min(out.at[c][k], size(curves[c].t[k]));
     });
   }

@@ -86,6 +86,11 @@ TEST(Cli, SizeMapOptions) {
   EXPECT_DOUBLE_EQ(*m.curvature_edges, 0.0);
   EXPECT_DOUBLE_EQ(*p({"sizemap", "m.step", "-o", "s.vtu", "--curvature-edges", "8"}).curvature_edges, 8.0);
   EXPECT_FALSE(p({"mesh", "m.step", "-o", "o.vtu"}).curvature_edges.has_value());
+  EXPECT_FALSE(p({"mesh", "m.step", "-o", "o.vtu"}).face_curvature);
+  EXPECT_TRUE(p({"sizemap", "m.step", "-o", "s.vtu", "--face-curvature"}).face_curvature);
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--until", "background", "--face-curvature"})
+                .find("--until background"),
+            std::string::npos);
   EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--until", "background", "--curve-size", "4:1"})
                 .find("--until background"),
             std::string::npos);

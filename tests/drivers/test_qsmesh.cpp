@@ -295,7 +295,9 @@ TEST_F(Qsmesh, ExampleWingBody) {
 // quad spanning 180 degrees at a seam vertex of the nose (SICN 0.036; disk remeshing skipped
 // seams), then a quad flattened next to a valence-6 vertex of the wing whose disk replacements
 // were all refused because quads around them, already valid, had corners turning against the
-// surface normal at their vertex on the leading edge (SICN 0.051).
+// surface normal at their vertex on the leading edge (SICN 0.051). Since the faces' curvature no
+// longer sizes the curves by default, one quad of this coarse mesh (2.3k vertices) bends over the
+// wing's leading edge at SICN 0.19: poor, not flat (0.21 with --face-curvature).
 TEST_F(Qsmesh, ExampleQuasiStructuredHasNoFlatQuad) {
   const std::string step = tmp("e2e_wing_body_qs.step");
   ASSERT_EQ(run("example wing-body -o " + step).code, 0);
@@ -303,7 +305,7 @@ TEST_F(Qsmesh, ExampleQuasiStructuredHasNoFlatQuad) {
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(json_number(json, "triangles"), 0);
   EXPECT_EQ(json_number(json, "faces_failed"), 0);
-  EXPECT_GT(json_number(json, "sicn_min"), 0.2);
+  EXPECT_GT(json_number(json, "sicn_min"), 0.15);
   EXPECT_GT(json_number(json, "sicn_avg"), 0.88);
   EXPECT_LT(json_number(json, "irregular_interior"), 0.06 * json_number(json, "vertices"));
   // Every face says why it has no pattern; the faces meshed by one say nothing.

@@ -462,5 +462,32 @@ TEST(SizeMap, CurvatureBoundsTheSizeOnCurvedCurves) {
   EXPECT_GT(checked, 0);
 }
 
+TEST(SizeMap, FaceCurvatureBoundsStraightCurvesOnlyWhenAskedFor) {
+  // A cylinder of radius 2: its seam is straight, its side face curved across it. By default the
+  // seam grows from the circles' 2 pi 2 / 16 at its ends by the gradation (paper 000's size map
+  // has no curvature term); with face_curvature the face holds it at 2 pi 2 / 16 all along.
+  const Model m = prepare(cad::load_cad(test::write_cylinder(tmp("sm_cyl.brep"))), 0.5, false);
+  SizeMapOptions o;
+  o.size_max = 2.0;
+  o.method = Method::Features;
+  const CurveSizes plain = initial_curve_sizes(m.cad, m.curves, o, TaskArena(1));
+  o.face_curvature = true;
+  const CurveSizes curved = initial_curve_sizes(m.cad, m.curves, o, TaskArena(1));
+  const double across = 2 * std::numbers::pi * 2 / 16;
+  int seams = 0;
+  for (LO c = 0; c < m.cad.num_curves(); ++c) {
+    if (m.cad.curves()[c].type != cad::CurveType::Line) continue;
+    ++seams;
+    double largest = 0;
+    for (std::size_t i = 0; i < plain.at[c].size(); ++i) {
+      largest = std::max(largest, plain.at[c][i]);
+      EXPECT_NEAR(curved.at[c][i], across, 1e-6);
+    }
+    EXPECT_GT(largest, across + 0.2 * 2.0);  // halfway up the seam, 2.5 from either end
+    EXPECT_LE(largest, 2.0);
+  }
+  EXPECT_EQ(seams, 1);
+}
+
 }  // namespace
 }  // namespace qsmesh::sizemap

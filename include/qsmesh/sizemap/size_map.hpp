@@ -40,9 +40,16 @@ struct SizeMapOptions {
   double size_min = 0;
   /// g_max of Eq. 10: largest growth of the size per unit distance (0.2: progression ratio 1.2).
   double gradation = 0.2;
-  /// Edges per full turn on curved curves and faces (a radius R gives 2 pi R / n on the curves);
-  /// 0 switches the curvature sizes off.
+  /// Edges per full turn on curved curves (a radius R gives 2 pi R / n on the curves); 0 switches
+  /// the curvature sizes off.
   double edges_per_turn = 16;
+  /// Also 2 pi R / n from the largest principal curvature of the faces along their curves. Off by
+  /// default: paper 000's size map has no curvature term, and a face's curvature across it (a
+  /// wing's leading edge) then sets isotropic sizes along it as well, so that its opposite sides
+  /// get unequal counts and no pattern fits. Measured at the reference vertex counts
+  /// (docs/benchmarks.md, tenth session): A319 interior irregular 3.13% -> 1.66%, SICN avg 0.886 ->
+  /// 0.891, 45 -> 56 faces by pattern; Block 1.29% -> 1.27%, 0.912 -> 0.929, 393 -> 403.
+  bool face_curvature = false;
   /// N, the target number of quads of the whole model; 0: total area / size_max^2.
   double target_quads = 0;
   /// (face id, quad count) fixed by the user: that face gets this N_i instead of its area share.
