@@ -551,10 +551,20 @@ FaceSides face_sides(const cad::CadModel& model, LO f, const cad::FaceGeometry& 
 
   fs.angle_deg.assign(n, 180.0);
   const double orient = fs.uv_area > 0 ? 1.0 : -1.0;
-  const auto unit_normal = [&](LO i) {
-    const auto ev = surface.eval(fs.points[static_cast<std::size_t>((i % n + n) % n)].uv);
+  const auto point_uv = [&](LO i) {
+    return fs.points[static_cast<std::size_t>((i % n + n) % n)].uv;
+  };
+  const auto unit_normal_at = [&](const Vec2& uv) {
+    const auto ev = surface.eval(uv);
     const Vec3 c = cross(ev.du, ev.dv);
     return norm(c) > 0 ? normalized(c) : c;
+  };
+  const auto unit_normal = [&](LO i) { return unit_normal_at(point_uv(i)); };
+  // Just off a pole towards loop point i: the normal there tends to the pole's own on a smooth
+  // surface (a fuselage nose), to the side's at a cone's apex; the loop point itself if singular.
+  const auto normal_off_pole = [&](LO pole, LO i) {
+    const Vec3 near = unit_normal_at(point_uv(pole) + (point_uv(i) - point_uv(pole)) * 1e-3);
+    return norm(near) > 0 ? near : unit_normal(i);
   };
   LO prev = nu - 1;  // the last regular use before u
   while (degenerate(prev)) --prev;
@@ -567,9 +577,9 @@ FaceSides face_sides(const cad::CadModel& model, LO f, const cad::FaceGeometry& 
                  "pole between the two uses of seam curve " << uses[u].curve);
     const Vec3 t_in = use_tangent(model, uses[prev], curves[uses[prev].curve], true);
     const Vec3 t_out = use_tangent(model, uses[u], curves[uses[u].curve], false);
-    // At a pole du x dv vanishes: the normal there is the mean of its neighbours' on the loop.
-    Vec3 normal =
-        pole_copies[u] > 0 ? unit_normal(pos - 1) + unit_normal(pos + 1) : unit_normal(pos);
+    // At a pole du x dv vanishes: the mean of the normals just off it towards its two neighbours.
+    Vec3 normal = pole_copies[u] > 0 ? normal_off_pole(pos, pos - 1) + normal_off_pole(pos, pos + 1)
+                                     : unit_normal(pos);
     QSMESH_CHECK(norm(normal) > 0 && norm(t_in) > 0 && norm(t_out) > 0,
                  "singular surface or curve at the corner of curve " << uses[u].curve);
     // With the normal du x dv flipped for a clockwise (u, v) loop, the interior lies on the left.

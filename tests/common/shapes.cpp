@@ -60,6 +60,11 @@ std::string write_sphere_octant(const std::string& path) {
   return write(BRepPrimAPI_MakeSphere(3.0, 0.0, quarter, quarter).Shape(), path);
 }
 
+std::string write_sphere_lune(const std::string& path) {
+  const double quarter = std::acos(0.0);
+  return write(BRepPrimAPI_MakeSphere(3.0, -quarter, quarter, quarter).Shape(), path);
+}
+
 std::string write_polygon_face(const std::vector<std::pair<double, double>>& xy, const std::string& path) {
   BRepBuilderAPI_MakePolygon poly;
   for (const auto& [x, y] : xy) poly.Add(gp_Pnt(x, y, 0));

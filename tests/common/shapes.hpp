@@ -23,6 +23,9 @@ std::string write_sphere(const std::string& path);
 /// Writes the octant of a sphere of radius 3 (longitude and latitude 0 to 90 degrees): a spherical
 /// triangle whose corner at the north pole ends in a degenerate curve, and three quarter disks.
 std::string write_sphere_octant(const std::string& path);
+/// Writes a lune of a sphere of radius 3 (a quarter of its longitudes, pole to pole): a face whose
+/// loop holds both poles, between two half meridians, and two half disks.
+std::string write_sphere_lune(const std::string& path);
 /// Writes the planar face (z = 0) bounded by the polygon through `xy`, as BREP; returns path.
 std::string write_polygon_face(const std::vector<std::pair<double, double>>& xy, const std::string& path);
 /// Writes the planar teardrop made of a circle of this radius about the origin and the two

@@ -526,6 +526,38 @@ TEST(FacePattern, PoleOfASphereOctantIsACornerOfATriangle) {
   EXPECT_GT(rep.sicn_avg, 0.8);
 }
 
+// Two poles in one loop (a lune between two half meridians): two corners of 90 degrees, a
+// two-sided face; whatever fills it must be valid, with each pole one vertex.
+TEST(FacePattern, LuneWithTwoPolesHasTwoCorners) {
+  const auto model = cad::load_cad(test::write_sphere_lune(tmp("qs_lune.brep")));
+  LO f = kNoIndex;
+  for (LO g = 0; g < model.num_faces(); ++g)
+    if (model.faces()[g].type == cad::SurfaceType::Sphere) f = g;
+  ASSERT_NE(f, kNoIndex);
+  std::vector<mesh::CurveMesh> curves;
+  for (LO c = 0; c < model.num_curves(); ++c)
+    curves.push_back(test::uniform_curve_mesh(model, c, model.curves()[c].degenerate ? 1 : 12));
+  const FaceSides fs = face_sides(model, f, *model.face_geometry(f), curves, PatternFaceOptions{});
+  EXPECT_EQ(fs.poles.size(), 2u);
+  EXPECT_EQ(fs.side_edges, (std::vector<LO>{12, 12}));
+  for (const LO c : fs.corners) EXPECT_NEAR(fs.angle_deg[c], 90.0, 1.0);
+  PatternFaceReport rep;
+  const auto m = mesh_face_pattern(model, f, curves, builtin_patterns(), {}, &rep);
+  if (rep.ok || !rep.refused_mesh.quads.empty()) {
+    const auto& mm = rep.ok ? m : rep.refused_mesh;
+    std::map<LO, int> poles;
+    for (LO i = 0; i < mm.num_vertices(); ++i)
+      if (mm.vclass[i].dim == 0) ++poles[mm.vclass[i].entity];
+    EXPECT_EQ(poles.size(), 2u);
+    for (const auto& [corner, n] : poles) EXPECT_EQ(n, 1) << "corner " << corner;
+    for (const auto& q : mm.quads)
+      EXPECT_GT(
+          mesh::quad_sicn({mm.points[q[0]], mm.points[q[1]], mm.points[q[2]], mm.points[q[3]]}), 0);
+  }
+  EXPECT_TRUE(rep.ok) << rep.reason;
+  EXPECT_EQ(rep.pattern_name, "half_disk");
+}
+
 TEST(FacePattern, PolesInsideAndHolesAreRefused) {
   const auto patterns = builtin_patterns();
   {

@@ -144,11 +144,11 @@ struct FaceSides {
 /// Splits the boundary of face f (one loop) into sides. `curves`: the final curve meshes of all
 /// curves, by curve id. A degenerate curve (pole) gives no edge: its copies of the pole become
 /// one point, at their mean (u, v), the corner where the curves on either side meet (its angle
-/// measured in the plane normal to the mean surface normal of its two loop neighbours, exact at
-/// a smooth pole, an approximation at a cone's apex). Throws qsmesh::Error when the face does
-/// not have exactly one closed loop, has only degenerate curves, a pole between the two uses of
-/// a seam (inside the face: a whole sphere or cone), or a corner where a tangent or the surface
-/// normal vanishes.
+/// measured in the plane normal to the mean of the surface normals just off the pole towards its
+/// two loop neighbours: the surface's normal at a smooth pole, an approximation at a cone's apex).
+/// Throws qsmesh::Error when the face does not have exactly one closed loop, has only degenerate
+/// curves, a pole between the two uses of a seam (inside the face: a whole sphere or cone), or a
+/// corner where a tangent or the surface normal vanishes.
 [[nodiscard]] FaceSides face_sides(const cad::CadModel& model, LO f,
                                    const cad::FaceGeometry& surface,
                                    std::span<const mesh::CurveMesh> curves,
