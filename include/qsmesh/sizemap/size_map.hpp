@@ -47,8 +47,8 @@ struct SizeMapOptions {
   /// default: paper 000's size map has no curvature term, and a face's curvature across it (a
   /// wing's leading edge) then sets isotropic sizes along it as well, so that its opposite sides
   /// get unequal counts and no pattern fits. Measured at the reference vertex counts
-  /// (docs/benchmarks.md, tenth session): A319 interior irregular 3.13% -> 1.66%, SICN avg 0.886 ->
-  /// 0.891, 45 -> 56 faces by pattern; Block 1.29% -> 1.27%, 0.912 -> 0.929, 393 -> 403.
+  /// (docs/benchmarks.md, tenth session): A319 interior irregular 3.13% -> 1.54%, SICN avg 0.886 ->
+  /// 0.889, 45 -> 56 faces by pattern; Block 1.29% -> 1.28%, 0.912 -> 0.928, 393 -> 398.
   bool face_curvature = false;
   /// N, the target number of quads of the whole model; 0: total area / size_max^2.
   double target_quads = 0;
