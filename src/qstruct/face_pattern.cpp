@@ -499,9 +499,15 @@ FaceSides face_sides(const cad::CadModel& model, LO f, const cad::FaceGeometry& 
   const auto& uses = face.loops[0].uses;
   const LO nu = static_cast<LO>(uses.size());
   const auto degenerate = [&](LO u) { return model.curves()[uses[u].curve].degenerate; };
-  LO regular = 0;
-  for (LO u = 0; u < nu; ++u) regular += degenerate(u) ? 0 : 1;
-  QSMESH_CHECK(regular > 0, "the boundary loop has only degenerate curves");
+  QSMESH_CHECK(
+      std::any_of(uses.begin(), uses.end(),
+                  [&](const cad::CurveUse& x) { return !model.curves()[x.curve].degenerate; }),
+      "the boundary loop has only degenerate curves");
+  const auto next_regular = [&](LO u) {
+    do u = (u + 1) % nu;
+    while (degenerate(u));
+    return u;
+  };
   FaceSides fs;
   const auto loops = background::face_boundary(model, f, surface, curves);
   const auto& raw = loops[0].points;
@@ -510,26 +516,20 @@ FaceSides face_sides(const cad::CadModel& model, LO f, const cad::FaceGeometry& 
   // first point of the next use, at their mean (u, v), so the pole is one corner where the curves
   // on either side meet and a cone sector is a triangle. The mean keeps the (u, v) loop simple for
   // the Laplace layout; the smoothing works on the surface and leaves boundary points in place.
-  std::vector<LO> pole_copies(static_cast<std::size_t>(nu), 0);  // merged into use u's start
-  Vec2 pending{0, 0};
-  LO npending = 0;
+  // pole_copies[u], pole_uv[u]: the copies merged into regular use u's first point, their sum.
+  std::vector<LO> pole_copies(static_cast<std::size_t>(nu), 0);
+  std::vector<Vec2> pole_uv(static_cast<std::size_t>(nu), Vec2{0, 0});
   LO rpos = 0;
   for (LO u = 0; u < nu; ++u) {
     const LO ne = curves[uses[u].curve].num_edges();
+    fs.use_start.push_back(static_cast<LO>(fs.points.size()));
     if (degenerate(u)) {
-      for (LO i = 0; i < ne; ++i) pending = pending + raw[static_cast<std::size_t>(rpos + i)].uv;
-      npending += ne;
-      fs.use_start.push_back(static_cast<LO>(fs.points.size()));
+      const LO to = next_regular(u);
+      for (LO i = 0; i < ne; ++i)
+        pole_uv[to] = pole_uv[to] + raw[static_cast<std::size_t>(rpos + i)].uv;
+      pole_copies[to] += ne;
     } else {
-      fs.use_start.push_back(static_cast<LO>(fs.points.size()));
       for (LO i = 0; i < ne; ++i) fs.points.push_back(raw[static_cast<std::size_t>(rpos + i)]);
-      if (npending > 0) {
-        auto& p = fs.points[static_cast<std::size_t>(fs.use_start.back())];
-        p.uv = (p.uv + pending) * (1.0 / static_cast<double>(npending + 1));
-        pole_copies[u] = npending;
-      }
-      pending = {0, 0};
-      npending = 0;
     }
     rpos += ne;
   }
@@ -537,15 +537,11 @@ FaceSides face_sides(const cad::CadModel& model, LO f, const cad::FaceGeometry& 
                "the boundary loop does not match the curve meshes");
   const LO n = static_cast<LO>(fs.points.size());
   for (LO& s : fs.use_start) s %= n;  // trailing degenerate uses end where the loop starts
-  LO first_regular = 0;
-  while (degenerate(first_regular)) ++first_regular;
-  if (npending > 0) {  // degenerate uses at the end of the loop: their pole is point 0
-    auto& p = fs.points[0];
-    const LO copies = npending + pole_copies[first_regular];
-    p.uv = (p.uv * static_cast<double>(pole_copies[first_regular] + 1) + pending) *
-           (1.0 / static_cast<double>(copies + 1));
-    pole_copies[first_regular] = copies;
-  }
+  for (LO u = 0; u < nu; ++u)
+    if (pole_copies[u] > 0) {
+      auto& p = fs.points[static_cast<std::size_t>(fs.use_start[u])];
+      p.uv = (p.uv + pole_uv[u]) * (1.0 / static_cast<double>(pole_copies[u] + 1));
+    }
   for (LO i = 0; i < n; ++i) fs.uv_area += 0.5 * cross(fs.points[i].uv, fs.points[(i + 1) % n].uv);
   QSMESH_CHECK(fs.uv_area != 0, "the boundary loop has no area in the parameter plane");
 
@@ -591,7 +587,6 @@ FaceSides face_sides(const cad::CadModel& model, LO f, const cad::FaceGeometry& 
     if (pole_copies[u] > 0) fs.poles.push_back(pos);
     prev = u;
   }
-  std::sort(fs.corners.begin(), fs.corners.end());
   set_side_edges(fs);
   return fs;
 }

@@ -479,22 +479,33 @@ TEST(FacePattern, TeardropWithOneCornerGetsThreeValence3Vertices) {
   EXPECT_GT(rep.sicn_avg, 0.7);
 }
 
+// The spherical face of a model made by test::write_sphere_*, kNoIndex when there is none.
+LO sphere_face(const cad::CadModel& model) {
+  for (LO f = 0; f < model.num_faces(); ++f)
+    if (model.faces()[f].type == cad::SurfaceType::Sphere) return f;
+  return kNoIndex;
+}
+
+// n edges on every curve, one on the degenerate ones (poles).
+std::vector<mesh::CurveMesh> curves_with_poles(const cad::CadModel& model, LO n) {
+  std::vector<mesh::CurveMesh> curves;
+  for (LO c = 0; c < model.num_curves(); ++c)
+    curves.push_back(test::uniform_curve_mesh(model, c, model.curves()[c].degenerate ? 1 : n));
+  return curves;
+}
+
 // A pole is a corner where the curves on either side meet (paper 000 Sec. 6.1.2 on a face whose
 // loop holds a degenerate curve): the sphere octant is a triangle with 90-degree corners, the
 // triangle pattern's one valence-3 vertex inside, the pole one vertex.
 TEST(FacePattern, PoleOfASphereOctantIsACornerOfATriangle) {
   const auto model = cad::load_cad(test::write_sphere_octant(tmp("qs_octant.brep")));
-  LO f = kNoIndex;
-  for (LO g = 0; g < model.num_faces(); ++g)
-    if (model.faces()[g].type == cad::SurfaceType::Sphere) f = g;
+  const LO f = sphere_face(model);
   ASSERT_NE(f, kNoIndex);
   LO pole = kNoIndex;
   for (const auto& use : model.faces()[f].loops[0].uses)
     if (model.curves()[use.curve].degenerate) pole = model.curves()[use.curve].corners[0];
   ASSERT_NE(pole, kNoIndex) << "the octant's loop has its degenerate curve";
-  std::vector<mesh::CurveMesh> curves;
-  for (LO c = 0; c < model.num_curves(); ++c)
-    curves.push_back(test::uniform_curve_mesh(model, c, model.curves()[c].degenerate ? 1 : 8));
+  const auto curves = curves_with_poles(model, 8);
   const auto patterns = builtin_patterns();
   const auto surface = model.face_geometry(f);
   const FaceSides fs = face_sides(model, f, *surface, curves, PatternFaceOptions{});
@@ -530,13 +541,9 @@ TEST(FacePattern, PoleOfASphereOctantIsACornerOfATriangle) {
 // two-sided face; whatever fills it must be valid, with each pole one vertex.
 TEST(FacePattern, LuneWithTwoPolesHasTwoCorners) {
   const auto model = cad::load_cad(test::write_sphere_lune(tmp("qs_lune.brep")));
-  LO f = kNoIndex;
-  for (LO g = 0; g < model.num_faces(); ++g)
-    if (model.faces()[g].type == cad::SurfaceType::Sphere) f = g;
+  const LO f = sphere_face(model);
   ASSERT_NE(f, kNoIndex);
-  std::vector<mesh::CurveMesh> curves;
-  for (LO c = 0; c < model.num_curves(); ++c)
-    curves.push_back(test::uniform_curve_mesh(model, c, model.curves()[c].degenerate ? 1 : 12));
+  const auto curves = curves_with_poles(model, 12);
   const FaceSides fs = face_sides(model, f, *model.face_geometry(f), curves, PatternFaceOptions{});
   EXPECT_EQ(fs.poles.size(), 2u);
   EXPECT_EQ(fs.side_edges, (std::vector<LO>{12, 12}));
@@ -563,9 +570,7 @@ TEST(FacePattern, PolesInsideAndHolesAreRefused) {
   {
     // The whole sphere: its poles lie between the two uses of the seam, inside the face.
     const auto model = cad::load_cad(test::write_sphere(tmp("qs_sphere.brep")));
-    std::vector<mesh::CurveMesh> curves;
-    for (LO c = 0; c < model.num_curves(); ++c)
-      curves.push_back(test::uniform_curve_mesh(model, c, model.curves()[c].degenerate ? 1 : 8));
+    const auto curves = curves_with_poles(model, 8);
     PatternFaceReport rep;
     const auto m = mesh_face_pattern(model, 0, curves, patterns, {}, &rep);
     EXPECT_FALSE(rep.ok);
