@@ -119,6 +119,13 @@ Arguments parse(const std::vector<std::string>& args) {
       a.curvature_edges = n;
     } else if (opt == "--face-curvature" && sizing) {
       a.face_curvature = true;
+    } else if (opt == "--feature-ratio" && sizing) {
+      const std::string& v = value();
+      char* end = nullptr;
+      const double r = std::strtod(v.c_str(), &end);
+      if (end == v.c_str() || *end != '\0' || !(r >= 0 && r <= 1))
+        throw InputError(opt + ": '" + v + "' is not a number in [0, 1]");
+      a.feature_ratio = r;
     } else if (opt == "--sizemap" && sizing) {
       a.sizemap = value();
       if (a.sizemap != "features" && a.sizemap != "crossfield")
@@ -148,9 +155,9 @@ Arguments parse(const std::vector<std::string>& args) {
   }
   if (a.size && a.size_factor) throw InputError("--size and --size-factor: give one, not both");
   const bool sizing_given = a.sizemap != "crossfield" || a.quads > 0 || a.curvature_edges ||
-                            a.face_curvature || !a.curve_edges.empty() || !a.face_quads.empty() ||
-                            !a.corner_sizes.empty() || !a.curve_sizes.empty() ||
-                            !a.face_sizes.empty();
+                            a.face_curvature || a.feature_ratio || !a.curve_edges.empty() ||
+                            !a.face_quads.empty() || !a.corner_sizes.empty() ||
+                            !a.curve_sizes.empty() || !a.face_sizes.empty();
   if (a.command == Command::Mesh && sizing_given && a.until == "background")
     throw InputError(
         "size-map options act on the quad mesh: with --until background only --size or "
@@ -205,8 +212,8 @@ std::string help(const std::string& topic) {
           "  --threads T           threads per rank (default: the cores of the machine divided\n"
           "                        among the ranks running on it)\n"
           "  --stats FILE.json     also write the run statistics as JSON\n"
-          "  --quads N, --curvature-edges N, --face-curvature, --curve-edges C:N,..,\n"
-          "  --face-quads F:N,..,\n"
+          "  --quads N, --curvature-edges N, --face-curvature, --feature-ratio R,\n"
+          "  --curve-edges C:N,.., --face-quads F:N,..,\n"
           "  --corner-size K:H,.., --curve-size C:H,.., --face-size F:H,.., --sizemap METHOD\n"
           "                        size-map controls, as for sizemap (see qsmesh sizemap --help);\n"
           "                        they act on the quad mesh, not with --until background\n"
@@ -249,6 +256,10 @@ std::string help(const std::string& topic) {
           "  --face-curvature      the same bound from the faces' curvature along their curves\n"
           "                        (finer on curved faces, e.g. a wing's leading edge, but the\n"
           "                        isotropic sizes then make the counts of opposite sides unequal)\n"
+          "  --feature-ratio R     small CAD features (curves closer than the size) refine the\n"
+          "                        size to no less than R times what it is without them (default\n"
+          "                        0.75); 0 resolves every feature, at the price of more irregular\n"
+          "                        vertices along thin strips and slots\n"
           "  --curve-edges C:N,..  prescribe the (even) number of edges of curves; kept exactly\n"
           "  --face-quads F:N,..   prescribe the number of quads of faces\n"
           "  --corner-size K:H,.., --curve-size C:H,.., --face-size F:H,..\n"

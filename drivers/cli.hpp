@@ -35,6 +35,9 @@ struct Arguments {
   /// --face-curvature: the curvature sizes also from the faces' principal curvatures
   /// (sizemap::SizeMapOptions::face_curvature).
   bool face_curvature = false;
+  /// --feature-ratio R: how far small features refine (sizemap::SizeMapOptions::feature_ratio;
+  /// unset: its default).
+  std::optional<double> feature_ratio;
   std::vector<std::pair<int, int>> curve_edges;       ///< --curve-edges C:N,...
   std::vector<std::pair<int, double>> face_quads;     ///< --face-quads F:N,...
   std::vector<std::pair<int, double>> corner_sizes;   ///< --corner-size K:H,...

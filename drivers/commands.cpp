@@ -223,6 +223,7 @@ std::string stats_json(const Arguments& args, const Session& session,
   j.value("stage", args.until);
   j.value("curvature_edges", curvature_edges(args));  // edges per full turn (0: none)
   j.value("face_curvature", args.face_curvature);
+  j.value("feature_ratio", feature_ratio(args));
   j.value("corners", static_cast<std::int64_t>(model.num_corners()));
   j.value("curves", static_cast<std::int64_t>(model.num_curves()));
   j.value("faces", static_cast<std::int64_t>(model.num_faces()));
@@ -445,6 +446,10 @@ double curvature_edges(const Arguments& args) {
   return args.curvature_edges.value_or(sizemap::SizeMapOptions{}.edges_per_turn);
 }
 
+double feature_ratio(const Arguments& args) {
+  return args.feature_ratio.value_or(sizemap::SizeMapOptions{}.feature_ratio);
+}
+
 void apply_size_options(const Arguments& args, const Session& s,
                         parallel::PipelineOptions& options) {
   check_ids("--curve-edges", "curve", args.curve_edges, s.model.num_curves());
@@ -458,6 +463,7 @@ void apply_size_options(const Arguments& args, const Session& s,
   so.target_quads = args.quads;
   so.edges_per_turn = curvature_edges(args);
   so.face_curvature = args.face_curvature;
+  so.feature_ratio = feature_ratio(args);
   for (const auto& [id, v] : args.face_quads) so.face_quads.emplace_back(id, v);
   for (const auto& [id, v] : args.corner_sizes) so.corner_sizes.emplace_back(id, v);
   for (const auto& [id, v] : args.curve_sizes) so.curve_sizes.emplace_back(id, v);

@@ -54,6 +54,8 @@ void apply_size_options(const Arguments& args, const Session& s,
                         parallel::PipelineOptions& options);
 /// The curvature edges per turn a run uses: --curvature-edges, or the size map's default.
 double curvature_edges(const Arguments& args);
+/// The feature ratio a run uses: --feature-ratio, or the size map's default.
+double feature_ratio(const Arguments& args);
 
 /// Writes `text` to `path` through a temporary file renamed at the end.
 void write_text_file_atomically(const std::string& path, const std::string& text);

@@ -42,6 +42,8 @@ void validate(const cad::CadModel& model, const SizeMapOptions& options) {
   (void)effective_size_min(options);
   if (!(options.gradation >= 0) || !std::isfinite(options.gradation))
     input_error("gradation must be >= 0");
+  if (!(options.feature_ratio >= 0 && options.feature_ratio <= 1))
+    input_error("the feature ratio must be in [0, 1]");
   check_entities(options.corner_sizes, model.num_corners(), "corner");
   check_entities(options.curve_sizes, model.num_curves(), "curve");
   check_entities(options.face_sizes, model.num_faces(), "face");
@@ -236,9 +238,12 @@ CurveSizes initial_curve_sizes(const cad::CadModel& model, std::span<const mesh:
       // Gaps narrower than a tenth of the floor are curves touching or lying on top of each other
       // (unsewn or sloppy models), not features a mesh could resolve.
       background::limit_by_feature_distance(model, dense, h, 0.1 * floor, floor, cell, tasks);
+      const double ratio = options.feature_ratio;
       for (LO c = 0; c < nc; ++c)
-        for (std::size_t i = 0; i < original[c].size(); ++i)
-          out.at[c][i] = std::min(out.at[c][i], h[c][original[c][i]]);
+        for (std::size_t i = 0; i < original[c].size(); ++i) {
+          double& s = out.at[c][i];
+          s = std::min(s, std::max(h[c][original[c][i]], ratio * s));
+        }
     }
   }
 

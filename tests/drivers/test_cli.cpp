@@ -88,6 +88,16 @@ TEST(Cli, SizeMapOptions) {
   EXPECT_FALSE(p({"mesh", "m.step", "-o", "o.vtu"}).curvature_edges.has_value());
   EXPECT_FALSE(p({"mesh", "m.step", "-o", "o.vtu"}).face_curvature);
   EXPECT_TRUE(p({"sizemap", "m.step", "-o", "s.vtu", "--face-curvature"}).face_curvature);
+  EXPECT_FALSE(p({"mesh", "m.step", "-o", "o.vtu"}).feature_ratio.has_value());
+  EXPECT_DOUBLE_EQ(*p({"mesh", "m.step", "-o", "o.vtu", "--feature-ratio", "0"}).feature_ratio,
+                   0.0);
+  EXPECT_DOUBLE_EQ(*p({"sizemap", "m.step", "-o", "s.vtu", "--feature-ratio", "0.5"}).feature_ratio,
+                   0.5);
+  for (const char* bad : {"-0.1", "1.5", "x", "nan"})
+    EXPECT_NE(
+        error_of({"mesh", "m.step", "-o", "o.vtu", "--feature-ratio", bad}).find("--feature-ratio"),
+        std::string::npos)
+        << bad;
   EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--until", "background", "--face-curvature"})
                 .find("--until background"),
             std::string::npos);

@@ -142,6 +142,7 @@ TEST(SizeMap, NarrowSlotGetsSmallSizesAndGradesOut) {
     SizeMapOptions o;
     o.method = method;
     o.size_max = 1.0;
+    o.feature_ratio = 0;  // every feature resolved, as Sec. 4.1 reads
     const TaskArena tasks(2);
     const CurveSizes cs = initial_curve_sizes(m.cad, m.curves, o, tasks);
     const auto n = face_quad_targets(m.cad, o);
@@ -179,6 +180,33 @@ TEST(SizeMap, NarrowSlotGetsSmallSizesAndGradesOut) {
       }
     }
   }
+}
+
+TEST(SizeMap, FeatureRatioBoundsHowFarTheSlotRefinesItsSides) {
+  // The slot's sides are 0.2 apart: rule (ii) asks for 0.2 there, the ratio keeps at least
+  // ratio x 1 (the size without the rule). Near the slot's bottom (0.2 long, rule (i)) the sides
+  // grade up from 0.2 whatever the ratio, so only their upper part is looked at.
+  const Model m = prepare(slot_plate(), 1.0, false);
+  SizeMapOptions o;
+  o.method = Method::Features;
+  o.size_max = 1.0;
+  for (const double ratio : {0.0, 0.5, 1.0}) {
+    o.feature_ratio = ratio;
+    const CurveSizes cs = initial_curve_sizes(m.cad, m.curves, o, TaskArena(2));
+    int seen = 0;
+    for (LO c = 0; c < m.cad.num_curves(); ++c)
+      for (std::size_t i = 0; i < cs.at[c].size(); ++i) {
+        const Vec3& p = m.curves[c].points[i];
+        const bool side = std::abs(p.x - 4.9) < 1e-9 || std::abs(p.x - 5.1) < 1e-9;
+        if (!side || p.y < 8.0 || p.y > 9.5) continue;
+        ++seen;
+        EXPECT_NEAR(cs.at[c][i], std::max(0.2, ratio), 1e-6) << "ratio " << ratio << " y " << p.y;
+      }
+    EXPECT_GT(seen, 2);
+    EXPECT_LE(curve_gradation_excess(m, cs, o.gradation), 1e-9);
+  }
+  o.feature_ratio = 1.5;
+  EXPECT_THROW((void)initial_curve_sizes(m.cad, m.curves, o, TaskArena(1)), InputError);
 }
 
 TEST(SizeMap, SlotWithWrongGradationFailsTheBound) {

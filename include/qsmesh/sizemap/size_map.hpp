@@ -50,6 +50,16 @@ struct SizeMapOptions {
   /// (docs/benchmarks.md, tenth session): A319 interior irregular 3.13% -> 1.54%, SICN avg 0.886 ->
   /// 0.889, 45 -> 56 faces by pattern; Block 1.29% -> 1.28%, 0.912 -> 0.928, 393 -> 398.
   bool face_curvature = false;
+  /// How far a small feature may refine: rule (ii) (the distance to the nearest curve sharing no
+  /// corner) lowers a curve's size to no less than this fraction of the size it has without that
+  /// rule, in [0, 1]; 0 resolves every feature down to the floor, as Sec. 4.1 reads. Gmsh's
+  /// implementation clamps the same way, by the edges of its background triangulation, which is
+  /// about as fine as the target mesh. Without the clamp a thin strip (a wing's blunt trailing
+  /// edge, a slot) sizes its long curves by its width, and the faces along them carry the
+  /// transition back to the target size with irregular vertices. Measured at the reference vertex
+  /// counts (docs/benchmarks.md, eleventh session), 0 -> 0.75: interior irregular Block 1.28% ->
+  /// 0.96%, wing_fuselage 2.60% -> 0.82%, A319 1.54% -> 1.50%.
+  double feature_ratio = 0.75;
   /// N, the target number of quads of the whole model; 0: total area / size_max^2.
   double target_quads = 0;
   /// (face id, quad count) fixed by the user: that face gets this N_i instead of its area share.
