@@ -128,18 +128,19 @@ bool few_poor_quads(const mesh::FaceMesh& m, const PatternFaceOptions& options, 
   return static_cast<double>(poor) <= bound;
 }
 
-// Whether a valid fill with these SICN is kept: its minimum above min_sicn (the face's
-// threshold, see try_sides) and its mean above options.min_sicn_avg, or its minimum above
-// options.keep_sicn_min whatever its mean.
-bool passes_sicn(double sicn_min, double sicn_avg, double min_sicn,
+// Whether a valid fill of `quads` quads with these SICN is kept: its minimum above min_sicn (the
+// face's threshold, see try_sides) and its mean above options.min_sicn_avg, or its minimum above
+// options.keep_sicn_min whatever its mean, or a small fill (options.small_fill_quads).
+bool passes_sicn(double sicn_min, double sicn_avg, std::int64_t quads, double min_sicn,
                  const PatternFaceOptions& options) {
   return sicn_min > min_sicn &&
-         (sicn_avg > options.min_sicn_avg || sicn_min > options.keep_sicn_min);
+         (sicn_avg > options.min_sicn_avg || sicn_min > options.keep_sicn_min ||
+          quads <= options.small_fill_quads);
 }
 
 // Whether a measured fill is kept: valid and passes_sicn.
 bool passes(const smooth::QualityReport& q, double min_sicn, const PatternFaceOptions& options) {
-  return q.invalid == 0 && passes_sicn(q.sicn_min, q.sicn_avg, min_sicn, options);
+  return q.invalid == 0 && passes_sicn(q.sicn_min, q.sicn_avg, q.quads, min_sicn, options);
 }
 
 // The report's pattern and placement from a candidate.
@@ -393,7 +394,8 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
       if (rep.moves > 0) {
         ++rep.candidates;
         // A move is kept only when its fill is valid, so the moved fill is.
-        if (passes_sicn(rep.sicn_min, rep.sicn_avg, min_sicn, options))
+        if (passes_sicn(rep.sicn_min, rep.sicn_avg, static_cast<std::int64_t>(moved.quads.size()),
+                        min_sicn, options))
           return keep(std::move(moved));
         refuse(Refusal::Quality, os.str() + "; moved, " + rep.pattern_name +
                                      " fits with SICN min " + std::to_string(rep.sicn_min) +
@@ -475,7 +477,9 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
     const Candidate& c = cands[best_k];
     best = move_irregular_vertices(f, face, surface, fs, patterns[c.match.pattern], c,
                                    std::move(best), best_q, min_sicn, options, rep);
-    if (passes_sicn(rep.sicn_min, rep.sicn_avg, min_sicn, options)) return keep(std::move(best));
+    if (passes_sicn(rep.sicn_min, rep.sicn_avg, static_cast<std::int64_t>(best.quads.size()),
+                    min_sicn, options))
+      return keep(std::move(best));
   }
   std::ostringstream os;
   os << rep.candidates << " candidate(s) tried, best " << rep.pattern_name << " with SICN min "

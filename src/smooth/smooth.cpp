@@ -32,7 +32,8 @@ QualityReport measure(const mesh::FaceMesh& mesh) {
     sum += s;
     if (s <= 0) ++r.invalid;
   }
-  r.sicn_avg = sum / static_cast<double>(mesh.quads.size());
+  r.quads = static_cast<std::int64_t>(mesh.quads.size());
+  r.sicn_avg = sum / static_cast<double>(r.quads);
   return r;
 }
 

@@ -171,7 +171,30 @@ TEST(FacePattern, FillWithEveryQuadFairIsKeptWhateverItsMean) {
   EXPECT_LT(rep.sicn_avg, PatternFaceOptions{}.min_sicn_avg);
   PatternFaceOptions off;
   off.keep_sicn_min = 2;
+  off.small_fill_quads = 0;  // 16 quads: small, kept on its minimum too
   const auto refused = mesh_face_pattern(pc.model, 0, pc.curves, patterns, off, &rep);
+  EXPECT_FALSE(rep.ok);
+  EXPECT_EQ(rep.refusal, Refusal::Quality);
+  EXPECT_TRUE(refused.quads.empty());
+}
+
+// Cells 4.5 x 1: SICN 9 / 21.25 = 0.42 everywhere, above min_sicn 0.3 but below the mean
+// threshold and keep_sicn_min. The 16-quad grid is small: kept on its minimum alone, and refused
+// once small fills are fewer than 16 quads.
+TEST(FacePattern, SmallFillIsKeptOnItsMinimumAlone) {
+  const XY xy = {{0, 0}, {18, 0}, {18, 4}, {0, 4}};
+  const auto pc = polygon(xy, {4, 4, 4, 4}, "qs_rect_small.brep");
+  const auto patterns = builtin_patterns();
+  PatternFaceReport rep;
+  const auto m = mesh_face_pattern(pc.model, 0, pc.curves, patterns, {}, &rep);
+  (void)check_face(pc.model, 0, pc.curves, m, rep);
+  EXPECT_EQ(rep.pattern_name, "grid");
+  EXPECT_EQ(m.quads.size(), 16u);
+  EXPECT_NEAR(rep.sicn_min, 9.0 / 21.25, 1e-6);
+  EXPECT_LT(rep.sicn_min, PatternFaceOptions{}.keep_sicn_min);
+  PatternFaceOptions fewer;
+  fewer.small_fill_quads = 15;
+  const auto refused = mesh_face_pattern(pc.model, 0, pc.curves, patterns, fewer, &rep);
   EXPECT_FALSE(rep.ok);
   EXPECT_EQ(rep.refusal, Refusal::Quality);
   EXPECT_TRUE(refused.quads.empty());

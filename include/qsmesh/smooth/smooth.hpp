@@ -14,6 +14,7 @@ namespace qsmesh::smooth {
 struct QualityReport {
   double sicn_min = 0, sicn_avg = 0;  ///< 0 when the mesh has no quad
   std::int64_t invalid = 0;           ///< quads with SICN <= 0
+  std::int64_t quads = 0;             ///< quads measured
 };
 
 /// SICN (paper 000 Eq. 12, mesh::quad_sicn, on the 3D points) of every quad of the mesh.
