@@ -279,6 +279,7 @@ TEST_F(Qsmesh, MeshHonoursSizeMapOptions) {
   EXPECT_LT(json_number(j0, "vertices"), 0.8 * json_number(j16, "vertices"));
   EXPECT_EQ(json_number(j0, "curvature_edges"), 0);  // --stats says what the run used
   EXPECT_EQ(json_number(j16, "curvature_edges"), 16);
+  EXPECT_DOUBLE_EQ(json_number(j16, "feature_ratio"), 0.75);
   EXPECT_GT(json_number(j0, "sicn_min"), 0);
 }
 
