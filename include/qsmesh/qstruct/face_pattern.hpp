@@ -45,11 +45,12 @@ struct PatternFaceOptions {
   /// short of this bound.
   double keep_sicn_min = 0.5;
   /// A valid fill of at most this many quads is kept on its minimum alone (above the face's min
-  /// threshold): its mean is that of a few corner quads and says little more than the minimum,
-  /// and the unstructured mesh of so small a face holds about as many irregular vertices as
-  /// quads next to them. Block.stp at size factor 0.0036: its [4, 10, 8] triangles get the
-  /// triangle pattern (31 quads, 1 irregular vertex, SICN avg 0.60-0.67) instead of 19-23
-  /// unstructured quads with 3 irregular vertices (avg 0.77-0.80). 0: off.
+  /// threshold): its mean is that of a few corner quads and says little more than the minimum.
+  /// Block.stp at size factor 0.0036: its [4, 10, 8] triangles get the triangle pattern (31
+  /// quads, 1 irregular vertex, SICN avg 0.60-0.67) instead of 19-23 unstructured quads with 3
+  /// irregular vertices (avg 0.77-0.80), 416 -> 423 faces by pattern. The price shows on A319's
+  /// faces 44 and 79: 22-quad half-disks at SICN avg 0.52 where 14 unstructured quads had 0.74,
+  /// with the same 2 irregular vertices. 0: off.
   std::int64_t small_fill_quads = 40;
   /// The quad at a corner of angle a < 90 degrees reaches SICN sin(a) at best (equal edges): at a
   /// face with a side-splitting corner where sin(a) <= min_sicn, which min_sicn would refuse

@@ -96,7 +96,8 @@ struct CurveSizes {
 /// user face sizes on the face's boundary curves; for both methods the small-feature limits: no
 /// larger than (i) the curve's length and (ii) the distance to the nearest curve sharing no corner
 /// (background::limit_by_feature_distance on the curve-mesh polylines, densified so that a segment
-/// is no longer than half the local size); floored by effective_size_min (so (i) and (ii) hold for
+/// is no longer than half the local size), (ii) lowering a size to no less than feature_ratio x
+/// its value before (ii); floored by effective_size_min (so (i) and (ii) hold for
 /// features larger than the floor); then user corner sizes, and grade_curves (corners = min over
 /// their curves, Eq. 10 along the curve edges and through corners). `curves` indexed by curve id,
 /// as background::mesh_curves returns them. Deterministic whatever the thread count of `tasks`.
