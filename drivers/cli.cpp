@@ -2,6 +2,7 @@
 
 #include <cmath>
 #include <cstdlib>
+#include <optional>
 #include <sstream>
 
 #include "qsmesh/core/error.hpp"
@@ -20,6 +21,14 @@ double parse_positive(const std::string& option, const std::string& text) {
   }
   if (used != text.size()) throw InputError(option + ": '" + text + "' is not a number");
   if (!std::isfinite(v) || v <= 0) throw InputError(option + ": must be positive, got '" + text + "'");
+  return v;
+}
+
+// The whole of `text` as a number (strtod's syntax: inf and nan included), or nothing.
+std::optional<double> parse_double(const std::string& text) {
+  char* end = nullptr;
+  const double v = std::strtod(text.c_str(), &end);
+  if (end == text.c_str() || *end != '\0') return std::nullopt;
   return v;
 }
 
@@ -111,21 +120,18 @@ Arguments parse(const std::vector<std::string>& args) {
     else if (opt == "--check" && a.command == Command::CrossField) a.check = true;
     else if (opt == "--curvature-edges" && sizing) {
       const std::string& v = value();
-      char* end = nullptr;
-      const double n = std::strtod(v.c_str(), &end);
-      if (end == v.c_str() || *end != '\0' || !std::isfinite(n) || n < 0 || (n > 0 && n < 3))
+      const auto n = parse_double(v);
+      if (!n || !std::isfinite(*n) || *n < 0 || (*n > 0 && *n < 3))
         throw InputError(opt + ": '" + v +
                          "' is not 0 (no curvature sizes) or a number of edges per turn of at least 3");
-      a.curvature_edges = n;
+      a.curvature_edges = *n;
     } else if (opt == "--face-curvature" && sizing) {
       a.face_curvature = true;
     } else if (opt == "--feature-ratio" && sizing) {
       const std::string& v = value();
-      char* end = nullptr;
-      const double r = std::strtod(v.c_str(), &end);
-      if (end == v.c_str() || *end != '\0' || !(r >= 0 && r <= 1))
-        throw InputError(opt + ": '" + v + "' is not a number in [0, 1]");
-      a.feature_ratio = r;
+      const auto r = parse_double(v);
+      if (!r || !(*r >= 0 && *r <= 1)) throw InputError(opt + ": '" + v + "' is not a number in [0, 1]");
+      a.feature_ratio = *r;
     } else if (opt == "--sizemap" && sizing) {
       a.sizemap = value();
       if (a.sizemap != "features" && a.sizemap != "crossfield")

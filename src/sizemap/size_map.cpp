@@ -183,14 +183,16 @@ CurveSizes initial_curve_sizes(const cad::CadModel& model, std::span<const mesh:
     curvature.size = options.size_max;
     curvature.min_size = floor;
     curvature.edges_per_turn = options.edges_per_turn;
-    const auto uses = background::curve_uses(model);
+    // The faces' uses of each curve, needed only when their curvature counts.
+    const auto uses = options.face_curvature ? background::curve_uses(model)
+                                             : std::vector<std::vector<background::CurveUseRef>>{};
     tasks.parallel_for(nc, [&](std::int64_t i) {
       const auto c = static_cast<LO>(i);
       if (model.curves()[c].degenerate) return;
       const background::CurveCurvatureSize size(
           model, c,
-          options.face_curvature ? std::span<const background::CurveUseRef>(uses[c])
-                                 : std::span<const background::CurveUseRef>(),
+          uses.empty() ? std::span<const background::CurveUseRef>()
+                       : std::span<const background::CurveUseRef>(uses[c]),
           curvature);
       for (std::size_t k = 0; k < curves[c].t.size(); ++k) out.at[c][k] = std::min(out.at[c][k], size(curves[c].t[k]));
     });
@@ -238,11 +240,11 @@ CurveSizes initial_curve_sizes(const cad::CadModel& model, std::span<const mesh:
       // Gaps narrower than a tenth of the floor are curves touching or lying on top of each other
       // (unsewn or sloppy models), not features a mesh could resolve.
       background::limit_by_feature_distance(model, dense, h, 0.1 * floor, floor, cell, tasks);
-      const double ratio = options.feature_ratio;
+      // h only ever lowers the sizes it started from, and the ratio is at most 1.
       for (LO c = 0; c < nc; ++c)
         for (std::size_t i = 0; i < original[c].size(); ++i) {
           double& s = out.at[c][i];
-          s = std::min(s, std::max(h[c][original[c][i]], ratio * s));
+          s = std::max(h[c][original[c][i]], options.feature_ratio * s);
         }
     }
   }

@@ -157,47 +157,45 @@ TEST(FacePattern, QuadCountBoundRefusesTooFineFills) {
   EXPECT_EQ(kept.quads.size(), 40u);
 }
 
-// Cells 2.5 x 1 have SICN 2 * 2.5 / (2.5^2 + 1) = 0.69 everywhere: below the mean threshold 0.7,
-// above keep_sicn_min 0.5, so the grid is kept; without that rule it is refused on quality.
-TEST(FacePattern, FillWithEveryQuadFairIsKeptWhateverItsMean) {
-  const XY xy = {{0, 0}, {10, 0}, {10, 4}, {0, 4}};
-  const auto pc = polygon(xy, {4, 4, 4, 4}, "qs_rect_fair.brep");
+// A w x 4 rectangle with 4 edges on every side: a 16-quad grid of (w / 4) x 1 cells, each of SICN
+// `sicn`. Checks that the default options keep it and that `refusing` refuses it on quality;
+// returns the report of the kept fill.
+PatternFaceReport grid_kept_then_refused(double w, const std::string& name, double sicn,
+                                         const PatternFaceOptions& refusing) {
+  const auto pc = polygon({{0, 0}, {w, 0}, {w, 4}, {0, 4}}, {4, 4, 4, 4}, name);
   const auto patterns = builtin_patterns();
+  PatternFaceReport kept;
+  const auto m = mesh_face_pattern(pc.model, 0, pc.curves, patterns, {}, &kept);
+  (void)check_face(pc.model, 0, pc.curves, m, kept);
+  EXPECT_EQ(kept.pattern_name, "grid");
+  EXPECT_EQ(m.quads.size(), 16u);
+  EXPECT_NEAR(kept.sicn_min, sicn, 1e-6);
   PatternFaceReport rep;
-  const auto m = mesh_face_pattern(pc.model, 0, pc.curves, patterns, {}, &rep);
-  (void)check_face(pc.model, 0, pc.curves, m, rep);
-  EXPECT_EQ(rep.pattern_name, "grid");
-  EXPECT_NEAR(rep.sicn_min, 5.0 / 7.25, 1e-6);
-  EXPECT_LT(rep.sicn_avg, PatternFaceOptions{}.min_sicn_avg);
-  PatternFaceOptions off;
-  off.keep_sicn_min = 2;
-  off.small_fill_quads = 0;  // 16 quads: small, kept on its minimum too
-  const auto refused = mesh_face_pattern(pc.model, 0, pc.curves, patterns, off, &rep);
+  const auto refused = mesh_face_pattern(pc.model, 0, pc.curves, patterns, refusing, &rep);
   EXPECT_FALSE(rep.ok);
   EXPECT_EQ(rep.refusal, Refusal::Quality);
   EXPECT_TRUE(refused.quads.empty());
+  return kept;
+}
+
+// Cells 2.5 x 1 have SICN 2 * 2.5 / (2.5^2 + 1) = 0.69 everywhere: below the mean threshold 0.7,
+// above keep_sicn_min 0.5, so the grid is kept; without that rule it is refused on quality.
+TEST(FacePattern, FillWithEveryQuadFairIsKeptWhateverItsMean) {
+  PatternFaceOptions off;
+  off.keep_sicn_min = 2;
+  off.small_fill_quads = 0;  // 16 quads: small, kept on its minimum too
+  const auto kept = grid_kept_then_refused(10, "qs_rect_fair.brep", 5.0 / 7.25, off);
+  EXPECT_LT(kept.sicn_avg, PatternFaceOptions{}.min_sicn_avg);
 }
 
 // Cells 4.5 x 1: SICN 9 / 21.25 = 0.42 everywhere, above min_sicn 0.3 but below the mean
 // threshold and keep_sicn_min. The 16-quad grid is small: kept on its minimum alone, and refused
 // once small fills are fewer than 16 quads.
 TEST(FacePattern, SmallFillIsKeptOnItsMinimumAlone) {
-  const XY xy = {{0, 0}, {18, 0}, {18, 4}, {0, 4}};
-  const auto pc = polygon(xy, {4, 4, 4, 4}, "qs_rect_small.brep");
-  const auto patterns = builtin_patterns();
-  PatternFaceReport rep;
-  const auto m = mesh_face_pattern(pc.model, 0, pc.curves, patterns, {}, &rep);
-  (void)check_face(pc.model, 0, pc.curves, m, rep);
-  EXPECT_EQ(rep.pattern_name, "grid");
-  EXPECT_EQ(m.quads.size(), 16u);
-  EXPECT_NEAR(rep.sicn_min, 9.0 / 21.25, 1e-6);
-  EXPECT_LT(rep.sicn_min, PatternFaceOptions{}.keep_sicn_min);
   PatternFaceOptions fewer;
   fewer.small_fill_quads = 15;
-  const auto refused = mesh_face_pattern(pc.model, 0, pc.curves, patterns, fewer, &rep);
-  EXPECT_FALSE(rep.ok);
-  EXPECT_EQ(rep.refusal, Refusal::Quality);
-  EXPECT_TRUE(refused.quads.empty());
+  const auto kept = grid_kept_then_refused(18, "qs_rect_small.brep", 9.0 / 21.25, fewer);
+  EXPECT_LT(kept.sicn_min, PatternFaceOptions{}.keep_sicn_min);
 }
 
 TEST(FacePattern, RectangleWithATransitionGetsOneValence3And5) {
