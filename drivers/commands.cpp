@@ -50,6 +50,15 @@ void write_text_file_atomically(const std::string& path, const std::string& text
   file.commit();
 }
 
+namespace {
+// Curves whose range the loader trimmed where they run past a corner (cad::Curve::t0).
+std::int64_t trimmed_curves(const cad::CadModel& model) {
+  std::int64_t n = 0;
+  for (const auto& c : model.curves()) n += c.trimmed[0] || c.trimmed[1] ? 1 : 0;
+  return n;
+}
+}  // namespace
+
 int run_info(const Arguments& args) {
   const cad::CadModel model = cad::load_cad(args.model, cad::LoadOptions{args.sew, 0});
   if (args.json) {
@@ -62,6 +71,7 @@ int run_info(const Arguments& args) {
     std::int64_t degenerate = 0;
     for (const auto& c : model.curves()) degenerate += c.degenerate ? 1 : 0;
     j.value("degenerate_curves", degenerate);
+    j.value("curves_trimmed_at_corners", trimmed_curves(model));
     j.value("diagonal", model.diagonal());
     j.begin_array("box")
         .begin_object()
@@ -102,6 +112,7 @@ int run_info(const Arguments& args) {
   std::int64_t degenerate = 0;
   for (const auto& c : model.curves()) degenerate += c.degenerate ? 1 : 0;
   std::cout << "degenerate curves: " << degenerate << "\n"
+            << "curves trimmed at corners (running past them): " << trimmed_curves(model) << "\n"
             << "bounding box: (" << model.box().lo.x << ", " << model.box().lo.y << ", "
             << model.box().lo.z << ") - (" << model.box().hi.x << ", " << model.box().hi.y << ", "
             << model.box().hi.z << "), diagonal " << model.diagonal() << "\n\n";

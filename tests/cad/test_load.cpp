@@ -3,11 +3,16 @@
 
 #include <BRepAlgoAPI_Cut.hxx>
 #include <BRepBuilderAPI_Copy.hxx>
+#include <BRepBuilderAPI_MakeFace.hxx>
+#include <BRepBuilderAPI_MakePolygon.hxx>
 #include <BRepPrimAPI_MakeBox.hxx>
 #include <BRepPrimAPI_MakeCylinder.hxx>
 #include <BRepPrimAPI_MakeSphere.hxx>
 #include <BRep_Builder.hxx>
+#include <BRep_Tool.hxx>
+#include <TopExp.hxx>
 #include <TopExp_Explorer.hxx>
+#include <TopoDS.hxx>
 #include <TopoDS_Compound.hxx>
 #include <cmath>
 #include <fstream>
@@ -16,6 +21,7 @@
 #include <string>
 
 #include "helpers.hpp"
+#include "load_shape.hpp"
 #include "qsmesh/cad/model.hpp"
 #include "qsmesh/core/error.hpp"
 
@@ -109,6 +115,49 @@ void expect_input_error(const std::string& path, const std::string& word) {
     EXPECT_NE(what.find(word), std::string::npos) << what;
     EXPECT_EQ(what.find('\n'), std::string::npos) << what;
   }
+}
+
+// Sloppy CAD (A319.brep has 18 such curves): the line of one edge of a 10 x 10 square runs 1.5
+// past its corner, inside the corner's tolerance. The loader trims that end of the range to the
+// point nearest the corner, so curve meshes stay between their corners; the other ends and
+// edges keep their ranges.
+TEST(CadLoad, CurveRunningPastItsCornerIsTrimmed) {
+  BRepBuilderAPI_MakePolygon poly(gp_Pnt(0, 0, 0), gp_Pnt(10, 0, 0), gp_Pnt(10, 10, 0),
+                                  gp_Pnt(0, 10, 0), true);
+  const TopoDS_Face face = BRepBuilderAPI_MakeFace(poly.Wire(), true).Face();
+  BRep_Builder b;
+  bool extended = false;
+  for (TopExp_Explorer ex(face, TopAbs_EDGE); ex.More() && !extended; ex.Next()) {
+    const TopoDS_Edge e = TopoDS::Edge(ex.Current());
+    TopoDS_Vertex v0, v1;
+    TopExp::Vertices(e, v0, v1);
+    if (BRep_Tool::Pnt(v0).Distance(gp_Pnt(0, 0, 0)) > 1e-9 ||
+        BRep_Tool::Pnt(v1).Distance(gp_Pnt(10, 0, 0)) > 1e-9)
+      continue;
+    double t0 = 0, t1 = 0;
+    BRep_Tool::Range(e, t0, t1);
+    b.Range(e, t0, t1 + 1.5);  // the line goes on to x = 11.5
+    b.UpdateVertex(v1, 2.0);
+    extended = true;
+  }
+  ASSERT_TRUE(extended);
+  const CadModel m = qsmesh::test::load_shape(face, "overshoot.brep");
+  ASSERT_EQ(m.num_curves(), 4);
+  int trimmed = 0;
+  for (LO c = 0; c < m.num_curves(); ++c) {
+    const Curve& curve = m.curves()[c];
+    EXPECT_NEAR(curve.length, 10.0, 1e-6) << "curve " << c;
+    const auto g = m.curve_geometry(c);
+    for (int end = 0; end < 2; ++end) {
+      const Vec3 p = g->point(end == 0 ? curve.t0 : curve.t1);
+      EXPECT_LT(distance(p, m.corners()[curve.corners[end]].point), 1e-6) << "curve " << c;
+      trimmed += curve.trimmed[end] ? 1 : 0;
+    }
+    // No point of the curve's range lies beyond x = 10.
+    for (int k = 0; k <= 20; ++k)
+      EXPECT_LE(g->point(curve.t0 + (curve.t1 - curve.t0) * k / 20).x, 10 + 1e-6);
+  }
+  EXPECT_EQ(trimmed, 1);
 }
 
 TEST(CadLoad, BadInput) {

@@ -33,8 +33,15 @@ struct Corner {
 /// A CAD edge.
 struct Curve {
   std::array<LO, 2> corners{kNoIndex, kNoIndex};  ///< corner at t0, corner at t1 (equal when closed)
-  double t0 = 0, t1 = 0;                           ///< parameter range, t0 < t1
-  double length = 0;                               ///< 3D arc length (0 when degenerate)
+  /// Parameter range, t0 < t1: the edge's range, trimmed at an end where the curve runs past its
+  /// corner (sloppy CAD: the curve passes within the corner's tolerance of it, goes on and comes
+  /// back no closer) to the parameter of the curve's point nearest the corner. Without the trim,
+  /// curve vertices placed on the overshoot lie beyond the corner, outside the faces
+  /// (A319.brep: 0.66 past corner 100, a folded quad at size factor 0.002).
+  double t0 = 0, t1 = 0;
+  double length = 0;  ///< 3D arc length over [t0, t1] (0 when degenerate)
+  /// Whether the range was trimmed at the start and at the end (see t0, t1).
+  std::array<bool, 2> trimmed{false, false};
   bool degenerate = false;  ///< collapses to one point (pole of a sphere or cone)
   CurveType type = CurveType::Other;
 };
