@@ -102,9 +102,13 @@ TEST_F(Qsmesh, InfoAndJson) {
   const ExeResult r = run("info " + model_);
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_NE(r.out.find("faces:     26"), std::string::npos) << r.out;
+  // A clean OpenCASCADE model: no curve runs past its corners (CadLoad tests the trimming).
+  EXPECT_NE(r.out.find("curves trimmed at corners (running past them): 0"), std::string::npos)
+      << r.out;
   const ExeResult j = run("info --json " + model_);
   ASSERT_EQ(j.code, 0) << j.err;
   EXPECT_NE(j.out.find("\"faces\": 26"), std::string::npos) << j.out;
+  EXPECT_NE(j.out.find("\"curves_trimmed_at_corners\": 0"), std::string::npos) << j.out;
   EXPECT_NE(j.out.find("\"corners\": "), std::string::npos);
   EXPECT_NE(j.out.find("\"curves\": "), std::string::npos);
 }
