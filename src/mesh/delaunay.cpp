@@ -848,4 +848,102 @@ FaceMesh triangulate_face(const cad::FaceGeometry& surface, bool face_reversed,
   return mesher.run(face_reversed);
 }
 
+namespace {
+
+// The face's surface seen through the parameters (u su, v sv): S'(u', v') = S(u' / su, v' / sv).
+class ScaledSurface final : public cad::FaceGeometry {
+ public:
+  ScaledSurface(const cad::FaceGeometry& s, Vec2 scale) : s_(s), su_(scale.u), sv_(scale.v) {}
+  [[nodiscard]] Vec2 to_original(const Vec2& x) const { return {x.u / su_, x.v / sv_}; }
+  [[nodiscard]] Vec2 to_scaled(const Vec2& x) const { return {x.u * su_, x.v * sv_}; }
+  [[nodiscard]] cad::SurfaceEval eval(const Vec2& uv) const override {
+    cad::SurfaceEval e = s_.eval(to_original(uv));
+    e.du = e.du * (1 / su_);
+    e.dv = e.dv * (1 / sv_);
+    return e;
+  }
+  [[nodiscard]] cad::SurfaceEval2 eval2(const Vec2& uv) const override {
+    cad::SurfaceEval2 e = s_.eval2(to_original(uv));
+    e.du = e.du * (1 / su_);
+    e.dv = e.dv * (1 / sv_);
+    e.duu = e.duu * (1 / (su_ * su_));
+    e.duv = e.duv * (1 / (su_ * sv_));
+    e.dvv = e.dvv * (1 / (sv_ * sv_));
+    return e;
+  }
+  [[nodiscard]] Vec3 normal(const Vec2& uv) const override { return s_.normal(to_original(uv)); }
+  [[nodiscard]] Vec2 project(const Vec3& p, const Vec2& guess, Vec3* foot) const override {
+    return to_scaled(s_.project(p, to_original(guess), foot));
+  }
+  [[nodiscard]] Vec2 boundary_uv(LO loop, LO use, double t) const override {
+    return to_scaled(s_.boundary_uv(loop, use, t));
+  }
+  [[nodiscard]] bool contains(const Vec2& uv) const override {
+    return s_.contains(to_original(uv));
+  }
+
+ private:
+  const cad::FaceGeometry& s_;
+  double su_, sv_;
+};
+
+}  // namespace
+
+bool has_flat_boundary_triangle(const FaceMesh& tri, double flat_ratio) {
+  for (const auto& t : tri.triangles) {
+    if (tri.vclass[t[0]].dim > 1 || tri.vclass[t[1]].dim > 1 || tri.vclass[t[2]].dim > 1) continue;
+    double longest = 0;
+    for (int k = 0; k < 3; ++k) {
+      const Vec2 d = tri.uv[t[(k + 1) % 3]] - tri.uv[t[k]];
+      longest = std::max(longest, dot(d, d));
+    }
+    const double area =
+        0.5 * std::abs(cross(tri.uv[t[1]] - tri.uv[t[0]], tri.uv[t[2]] - tri.uv[t[0]]));
+    if (area < flat_ratio * longest) return true;
+  }
+  return false;
+}
+
+Vec2 mean_boundary_speeds(const cad::FaceGeometry& surface, std::span<const BoundaryLoop> loops) {
+  double su = 0, sv = 0;
+  std::int64_t n = 0;
+  for (const auto& loop : loops)
+    for (const auto& p : loop.points) {
+      const cad::SurfaceEval e = surface.eval(p.uv);
+      su += norm(e.du);
+      sv += norm(e.dv);
+      ++n;
+    }
+  const auto mean = [&](double sum) {
+    const double m = n > 0 ? sum / static_cast<double>(n) : 0.0;
+    return std::isfinite(m) && m > 0 ? m : 1.0;
+  };
+  return {mean(su), mean(sv)};
+}
+
+FaceMesh triangulate_face_scaled(const cad::FaceGeometry& surface, bool face_reversed,
+                                 std::span<const BoundaryLoop> loops, const SizeFunction& size,
+                                 const TriangulateOptions& options, Vec2 scale,
+                                 TriangulateStats* stats) {
+  QSMESH_CHECK(std::isfinite(scale.u) && std::isfinite(scale.v) && scale.u > 0 && scale.v > 0,
+               "triangulate_face_scaled: scale (" << scale.u << ", " << scale.v << ")");
+  const ScaledSurface scaled(surface, scale);
+  std::vector<BoundaryLoop> scaled_loops(loops.begin(), loops.end());
+  for (auto& loop : scaled_loops)
+    for (auto& p : loop.points) p.uv = scaled.to_scaled(p.uv);
+  std::vector<Vec2> points(options.interior_points.begin(), options.interior_points.end());
+  for (Vec2& x : points) x = scaled.to_scaled(x);
+  TriangulateOptions o = options;
+  o.interior_points = points;
+  const SizeFunction scaled_size = [&](const Vec2& uv, const Vec3& xyz) {
+    return size(scaled.to_original(uv), xyz);
+  };
+  FaceMesh fm = triangulate_face(scaled, face_reversed, scaled_loops, scaled_size, o, stats);
+  for (std::size_t v = 0; v < fm.uv.size(); ++v) {
+    fm.uv[v] = scaled.to_original(fm.uv[v]);
+    if (fm.vclass[v].dim == 2) fm.vclass[v].param = {fm.uv[v].u, fm.uv[v].v};
+  }
+  return fm;
+}
+
 }  // namespace qsmesh::mesh

@@ -88,6 +88,19 @@ mesh::FaceMesh frontal_quads(const cad::CadModel& model, LO f, const cad::FaceGe
     to.refine = true;
     tri = mesh::triangulate_face(surface, model.faces()[f].reversed, loops, size, to);
   }
+  // The kernel's Delaunay steps work in (u, v). Where the parametrisation is much finer one way
+  // than the other, a strip narrower than the spacing (which holds no frontal point) looks wide
+  // there and gets flat triangles along its curves, whose subdivision folds quads on the curve:
+  // Block.stp at size factor 0.008, a torus fillet 0.78 wide and 24 times finer across than
+  // along in (u, v) (face 82), fell back to the uniform path with 133 irregular vertices. Such a
+  // face is triangulated again in parameters scaled to its 3D proportions, kept when that is
+  // free of them; the other faces keep their triangulation (and mesh) as it was.
+  if (mesh::has_flat_boundary_triangle(tri)) {
+    mesh::FaceMesh again =
+        mesh::triangulate_face_scaled(surface, model.faces()[f].reversed, loops, size, to,
+                                      mesh::mean_boundary_speeds(surface, loops));
+    if (!mesh::has_flat_boundary_triangle(again)) tri = std::move(again);
+  }
   tri.face = f;
   for (auto& vc : tri.vclass)
     if (vc.dim == 2) vc.entity = f;

@@ -223,16 +223,21 @@ TEST(Delaunay, LShape) {
   expect_quality(r);
 }
 
-TEST(Delaunay, CylinderPatchAnisotropicUV) {
-  const Cylinder cyl(10, kProjection);
-  const double h = 0.8;
-  // u in [0, 1.2] rad (12 mm of arc), v in [0, 6] mm.
+// A patch of a cylinder of radius 10: u in [0, 1.2] rad (12 mm of arc), v in [0, 6] mm; sides of
+// about h.
+BoundaryLoop cylinder_patch(const Cylinder& cyl, double h) {
   BoundaryLoop loop;
   add_side(loop, cyl, {0, 0}, {1.2, 0}, segs(12, h), 0);
   add_side(loop, cyl, {1.2, 0}, {1.2, 6}, segs(6, h), 1);
   add_side(loop, cyl, {1.2, 6}, {0, 6}, segs(12, h), 2);
   add_side(loop, cyl, {0, 6}, {0, 0}, segs(6, h), 3);
-  std::vector<BoundaryLoop> loops{loop};
+  return loop;
+}
+
+TEST(Delaunay, CylinderPatchAnisotropicUV) {
+  const Cylinder cyl(10, kProjection);
+  const double h = 0.8;
+  std::vector<BoundaryLoop> loops{cylinder_patch(cyl, h)};
   SizeFunction size = [&](const Vec2&, const Vec3&) { return h; };
   const FaceMesh fm = triangulate_face(cyl, false, loops, size);
   const Report r = check_mesh("cylinder-patch", fm, loops, false, size);
@@ -447,3 +452,73 @@ TEST(Delaunay, AnisotropicAndMismatchedBoundary) {
   }
 }
 }  // namespace
+
+// Flat boundary triangles: three boundary vertices (corner or curve) and a (u, v) area below
+// the ratio times the squared longest edge; a triangle with an interior vertex never counts.
+TEST(Delaunay, FlatBoundaryTriangleIsDetected) {
+  FaceMesh m;
+  const auto add = [&](Vec2 uv, int dim) {
+    m.uv.push_back(uv);
+    m.points.push_back({uv.u, uv.v, 0});
+    VertexClass c;
+    c.dim = static_cast<std::uint8_t>(dim);
+    m.vclass.push_back(c);
+  };
+  add({0, 0}, 0);      // 0: corner
+  add({1, 0.001}, 1);  // 1: curve vertex, 0.001 off the chord 0-2
+  add({2, 0}, 1);      // 2: curve vertex
+  add({1, 1}, 2);      // 3: interior
+  add({1, 0.5}, 1);    // 4: curve vertex of another curve, well off the chord
+  m.triangles = {{0, 2, 3}};
+  EXPECT_FALSE(has_flat_boundary_triangle(m));
+  m.triangles.push_back({0, 2, 4});  // boundary-only but not flat (area 0.5, longest 2)
+  EXPECT_FALSE(has_flat_boundary_triangle(m));
+  m.triangles.push_back({0, 2, 1});  // flat: area 0.001 < 1e-3 * 4
+  EXPECT_TRUE(has_flat_boundary_triangle(m));
+  EXPECT_FALSE(has_flat_boundary_triangle(m, 1e-4));
+  m.triangles = {{0, 1, 3}};  // flat enough but with an interior vertex
+  m.uv[3] = {0.5, 0.0005};
+  EXPECT_FALSE(has_flat_boundary_triangle(m));
+}
+
+// A strip of a cylinder of radius 10, 30 long around it and 0.8 wide along its axis: (u, v) =
+// (angle, axial position) make it 6 spacings wide in the parameter plane against 0.6 in 3D.
+// Triangulated in parameters scaled by the boundary's mean speeds (10 and 1), it is valid and
+// maps back to the face's own (u, v), with the boundary points first and in order.
+TEST(Delaunay, ScaledParametersMapBack) {
+  const Cylinder cyl(10, kProjection);
+  BoundaryLoop loop;
+  add_side(loop, cyl, {0, 0}, {3, 0}, 23, 0);
+  add_side(loop, cyl, {3, 0}, {3, 0.8}, 1, 1);
+  add_side(loop, cyl, {3, 0.8}, {0, 0.8}, 23, 2);
+  add_side(loop, cyl, {0, 0.8}, {0, 0}, 1, 3);
+  const std::vector<BoundaryLoop> loops{loop};
+  const SizeFunction size = [](const Vec2&, const Vec3&) { return 1.3; };
+  const Vec2 speeds = mean_boundary_speeds(cyl, loops);
+  EXPECT_NEAR(speeds.u, 10.0, 1e-9);
+  EXPECT_NEAR(speeds.v, 1.0, 1e-9);
+  const FaceMesh fm = triangulate_face_scaled(cyl, false, loops, size, {}, speeds);
+  const Report r = check_mesh("cylinder-strip-scaled", fm, loops, false, size);
+  EXPECT_NEAR(r.uv_area, 2.4, 1e-9);
+  EXPECT_FALSE(has_flat_boundary_triangle(fm));
+  for (std::size_t i = 0; i < loop.points.size(); ++i)
+    EXPECT_LT(norm(fm.uv[i] - loop.points[i].uv), 1e-12);
+  for (std::size_t v = 0; v < fm.points.size(); ++v) {
+    EXPECT_LT(distance(fm.points[v], cyl.eval(fm.uv[v]).p), 1e-9);
+    if (fm.vclass[v].dim == 2) {
+      EXPECT_EQ(fm.vclass[v].param[0], fm.uv[v].u);
+    }
+  }
+}
+
+TEST(Delaunay, UnitScaleIsTheSameTriangulation) {
+  const Cylinder cyl(10, kProjection);
+  const double h = 0.8;
+  const std::vector<BoundaryLoop> loops{cylinder_patch(cyl, h)};
+  const SizeFunction size = [&](const Vec2&, const Vec3&) { return h; };
+  const FaceMesh a = triangulate_face(cyl, false, loops, size);
+  const FaceMesh b = triangulate_face_scaled(cyl, false, loops, size, {}, {1, 1});
+  EXPECT_EQ(a.triangles, b.triangles);
+  EXPECT_EQ(a.uv, b.uv);
+  EXPECT_THROW((void)triangulate_face_scaled(cyl, false, loops, size, {}, {0, 1}), Error);
+}

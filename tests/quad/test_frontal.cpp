@@ -6,21 +6,32 @@
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepBuilderAPI_MakePolygon.hxx>
 #include <BRepBuilderAPI_MakeWire.hxx>
+#include <BRepLib.hxx>
 #include <BRepTools.hxx>
+#include <Geom2d_BezierCurve.hxx>
+#include <Geom2d_Line.hxx>
+#include <Geom_ToroidalSurface.hxx>
+#include <TColgp_Array1OfPnt2d.hxx>
+#include <TopoDS_Edge.hxx>
+#include <TopoDS_Face.hxx>
 #include <TopoDS_Shape.hxx>
 #include <TopoDS_Wire.hxx>
-#include <TopoDS_Face.hxx>
 #include <cmath>
 #include <cstdio>
 #include <gp_Ax2.hxx>
+#include <gp_Ax3.hxx>
 #include <gp_Circ.hxx>
+#include <gp_Dir2d.hxx>
 #include <gp_Pnt.hxx>
+#include <gp_Pnt2d.hxx>
 #include <memory>
+#include <numbers>
 #include <stdexcept>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "load_shape.hpp"
 #include "qsmesh/background/curve_mesh.hpp"
 #include "qsmesh/background/face_mesh.hpp"
 #include "qsmesh/crossfield/cross_field.hpp"
@@ -29,7 +40,6 @@
 #include "qsmesh/quad/unstructured.hpp"
 #include "qsmesh/quantize/quantize.hpp"
 #include "quantized_curves.hpp"
-#include "load_shape.hpp"
 #include "tmp_dir.hpp"
 
 namespace qsmesh::quad {
@@ -50,6 +60,36 @@ cad::CadModel disk(double r) {
   const gp_Circ c(gp_Ax2(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), r);
   const TopoDS_Wire w = BRepBuilderAPI_MakeWire(BRepBuilderAPI_MakeEdge(c).Edge()).Wire();
   return test::load_shape(BRepBuilderAPI_MakeFace(w).Face(), "fr_disk.brep");
+}
+
+// A strip of a torus (major radius 12, minor 0.5) over half a turn of u and a quarter turn of v,
+// as a fillet along a round edge: about 0.8 wide and 38 long, 24 times finer across than along in
+// (u, v). Its top side bulges out of the strip by 1% of the width in the parameter plane, as the
+// approximated pcurves of such fillets do (Block.stp's face 82), so that three consecutive
+// vertices of it make a strictly convex, nearly flat triangle there.
+cad::CadModel thin_torus_fillet() {
+  const double pi = std::numbers::pi;
+  const Handle(Geom_ToroidalSurface) s =
+      new Geom_ToroidalSurface(gp_Ax3(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), 12, 0.5);
+  TColgp_Array1OfPnt2d top(1, 3);
+  top(1) = gp_Pnt2d(pi, pi / 2);
+  top(2) = gp_Pnt2d(pi / 2, pi / 2 + 0.03);
+  top(3) = gp_Pnt2d(0, pi / 2);
+  const Handle(Geom2d_Curve)
+      pcurves[4] = {new Geom2d_Line(gp_Pnt2d(0, 0), gp_Dir2d(1, 0)),
+                    new Geom2d_Line(gp_Pnt2d(pi, 0), gp_Dir2d(0, 1)), new Geom2d_BezierCurve(top),
+                    new Geom2d_Line(gp_Pnt2d(0, pi / 2), gp_Dir2d(0, -1))};
+  const double ranges[4][2] = {{0, pi}, {0, pi / 2}, {0, 1}, {0, pi / 2}};
+  BRepBuilderAPI_MakeWire wire;
+  for (int k = 0; k < 4; ++k) {
+    TopoDS_Edge e = BRepBuilderAPI_MakeEdge(pcurves[k], s, ranges[k][0], ranges[k][1]).Edge();
+    BRepLib::BuildCurves3d(e);
+    wire.Add(e);
+  }
+  if (!wire.IsDone()) throw std::runtime_error("wire construction failed");
+  BRepBuilderAPI_MakeFace face(s, wire.Wire(), true);
+  if (!face.IsDone()) throw std::runtime_error("face construction failed");
+  return test::load_shape(face.Shape(), "fr_thin_torus_fillet.brep");
 }
 
 // What the pipeline hands the quad stage for face 0 with a uniform size map `size`: the curve
@@ -277,6 +317,23 @@ TEST(Unstructured, DiskHasIrregularVerticesAtTheSingularitiesAndFewerThanWithout
   std::printf("[frontal] disk without cross field: %zu quads, %zu irregular interior vertices\n", plain.quads.size(),
               plain_irr.size());
   EXPECT_LT(static_cast<double>(irr.size()), 0.8 * static_cast<double>(plain_irr.size()));
+}
+
+// A strip narrower than the spacing holds no frontal point, and in (u, v) it is 24 times wider
+// than in 3D: the kind of face where flat triangles along a curve made Block.stp's face 82 fall
+// back to the uniform path at size factor 0.008 (this analytic fillet does not get them; the
+// kernel-level tests cover the scaled triangulation). The frontal path holds at four sizes.
+TEST(Unstructured, ThinTorusFilletKeepsTheFrontalPath) {
+  const auto model = thin_torus_fillet();
+  for (const double size : {0.5, 0.65, 0.8, 1.0}) {
+    const Prepared p = prepare(model, size);
+    UnstructuredReport rep;
+    const mesh::FaceMesh m = run_face(model, p, rep);
+    EXPECT_TRUE(rep.ok) << "size " << size << ": " << rep.error;
+    EXPECT_TRUE(rep.frontal) << "size " << size << ": " << rep.error;
+    EXPECT_FALSE(rep.fell_back) << "size " << size;
+    EXPECT_GT(sicn_min(m), 0.1) << "size " << size;
+  }
 }
 
 TEST(Unstructured, WithoutCrossFieldFallsBackToTheUniformPath) {

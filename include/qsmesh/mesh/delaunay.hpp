@@ -74,4 +74,31 @@ struct TriangulateStats {
                                         const TriangulateOptions& options = {},
                                         TriangulateStats* stats = nullptr);
 
+/// Whether `tri` has a flat triangle along its boundary: its three vertices are boundary vertices
+/// (vclass.dim 0 or 1) and its (u, v) area is below flat_ratio times the square of its longest
+/// (u, v) edge. triangulate_face leaves such triangles where a strip narrower than the spacing
+/// (no interior point fits in it) is much wider in (u, v) than in 3D, e.g. a thin torus fillet
+/// along a round edge: consecutive vertices of one curve become neighbours, and a midpoint
+/// subdivision of the triangles puts inner vertices on the curve itself (folded quads).
+[[nodiscard]] bool has_flat_boundary_triangle(const FaceMesh& tri, double flat_ratio = 1e-3);
+
+/// Mean of |dS/du| and of |dS/dv| over the points of `loops` (model units per parameter unit):
+/// the scale that gives the face's parameters their 3D proportions along its boundary, on average.
+/// A component is 1 when its mean is not positive and finite.
+[[nodiscard]] Vec2 mean_boundary_speeds(const cad::FaceGeometry& surface,
+                                        std::span<const BoundaryLoop> loops);
+
+/// triangulate_face in the scaled parameters (u scale.u, v scale.v): the Delaunay steps of the
+/// kernel, which work in the parameter plane, then see the face with other proportions (with
+/// mean_boundary_speeds: about its 3D ones). Inputs and output as for triangulate_face, all in
+/// the face's own (u, v): loops, options.interior_points and the size function's argument; the
+/// output's uv (boundary points: their input (u, v) up to the rounding of the scaling; their 3D
+/// points exactly) and the params of its interior vertices. Preconditions: scale.u, scale.v > 0 and
+/// finite (else qsmesh::Error).
+[[nodiscard]] FaceMesh triangulate_face_scaled(const cad::FaceGeometry& surface, bool face_reversed,
+                                               std::span<const BoundaryLoop> loops,
+                                               const SizeFunction& size,
+                                               const TriangulateOptions& options, Vec2 scale,
+                                               TriangulateStats* stats = nullptr);
+
 }  // namespace qsmesh::mesh
