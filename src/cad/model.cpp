@@ -147,6 +147,7 @@ double nearest_parameter(const BRepAdaptor_Curve& ac, const Vec3& corner, double
 void trim_overshoots(const BRepAdaptor_Curve& ac, const std::vector<Corner>& corners, Curve& c) {
   const double mid = (c.t0 + c.t1) / 2;
   const double eps = 1e-6 * c.length;
+  const Curve before = c;
   for (int end = 0; end < 2; ++end) {
     if (c.corners[end] == kNoIndex) continue;
     const Vec3& p = corners[c.corners[end]].point;
@@ -159,6 +160,9 @@ void trim_overshoots(const BRepAdaptor_Curve& ac, const std::vector<Corner>& cor
       c.trimmed[end] = true;
     }
   }
+  // Both ends trimmed to about the middle: no curve between the corners to speak of; the range is
+  // left as the CAD kernel gave it rather than made degenerate.
+  if (!(c.t1 - c.t0 > 1e-3 * (before.t1 - before.t0))) c = before;
 }
 
 CurveType curve_type(GeomAbs_CurveType t) {
