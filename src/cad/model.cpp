@@ -17,7 +17,6 @@
 #include <TopoDS_Vertex.hxx>
 #include <TopoDS_Wire.hxx>
 #include <algorithm>
-#include <cmath>
 #include <utility>
 
 #include "impl.hpp"
@@ -100,62 +99,26 @@ namespace {
 
 Vec3 to_vec(const gp_Pnt& p) { return {p.X(), p.Y(), p.Z()}; }
 
-// The parameter in [lo, hi] of the curve's point nearest to `corner`: the best of evenly spaced
-// samples, refined by golden-section search between its two neighbours. Distance to one point
-// along a curve is not unimodal in general; the samples find the right basin for the short
-// overshoots this serves.
-double nearest_parameter(const BRepAdaptor_Curve& ac, const Vec3& corner, double lo, double hi) {
-  constexpr int kSamples = 64;
-  const auto dist = [&](double t) { return distance(to_vec(ac.Value(t)), corner); };
-  int best = 0;
-  double best_d = dist(lo);
-  for (int k = 1; k <= kSamples; ++k) {
-    const double d = dist(lo + (hi - lo) * k / kSamples);
-    if (d < best_d) {
-      best_d = d;
-      best = k;
-    }
-  }
-  double a = lo + (hi - lo) * std::max(best - 1, 0) / kSamples;
-  double b = lo + (hi - lo) * std::min(best + 1, kSamples) / kSamples;
-  const double g = (std::sqrt(5.0) - 1) / 2;
-  double x1 = b - g * (b - a), x2 = a + g * (b - a);
-  double f1 = dist(x1), f2 = dist(x2);
-  for (int it = 0; it < 60 && b - a > 1e-12 * (std::abs(a) + std::abs(b) + 1); ++it) {
-    if (f1 < f2) {
-      b = x2;
-      x2 = x1;
-      f2 = f1;
-      x1 = b - g * (b - a);
-      f1 = dist(x1);
-    } else {
-      a = x1;
-      x1 = x2;
-      f1 = f2;
-      x2 = a + g * (b - a);
-      f2 = dist(x2);
-    }
-  }
-  const double t = (a + b) / 2;
-  return dist(t) < best_d ? t : lo + (hi - lo) * best / kSamples;
-}
-
-// Trims the ends of c's range where the curve runs past its corner (see Curve::t0). Only the half
-// of the range at each end is searched, so a closed curve keeps one corner per end. An end is
-// trimmed when a point inside is nearer the corner than the end point by more than a millionth
-// of the curve's length (below that, the gap is noise of the CAD kernel).
-void trim_overshoots(const BRepAdaptor_Curve& ac, const std::vector<Corner>& corners, Curve& c) {
+// Trims the ends of curve i's range where it runs past its corner (see Curve::t0): the curve's
+// own projection (CurveGeometry::project, Newton from the end, then a global search) of the
+// corner onto the half of the range at that end, so a closed curve keeps one corner per end. An
+// end is trimmed when that point is nearer the corner than the end point by more than a
+// millionth of the curve's length (below that, the gap is noise of the CAD kernel).
+void trim_overshoots(const CadModel::Impl& impl, const std::vector<Corner>& corners, LO i,
+                     Curve& c) {
   const double mid = (c.t0 + c.t1) / 2;
   const double eps = 1e-6 * c.length;
   const Curve before = c;
   for (int end = 0; end < 2; ++end) {
     if (c.corners[end] == kNoIndex) continue;
     const Vec3& p = corners[c.corners[end]].point;
-    const double t_end = end == 0 ? c.t0 : c.t1;
-    const double t =
-        end == 0 ? nearest_parameter(ac, p, c.t0, mid) : nearest_parameter(ac, p, mid, c.t1);
-    if (distance(to_vec(ac.Value(t)), p) < distance(to_vec(ac.Value(t_end)), p) - eps &&
-        t != t_end) {
+    Curve half = before;
+    (end == 0 ? half.t1 : half.t0) = mid;
+    const auto g = make_curve_geometry(impl, half, p, i);
+    const double t_end = end == 0 ? before.t0 : before.t1;
+    Vec3 foot;
+    const double t = g->project(p, t_end, &foot);
+    if (t != t_end && distance(foot, p) < distance(g->point(t_end), p) - eps) {
       (end == 0 ? c.t0 : c.t1) = t;
       c.trimmed[end] = true;
     }
@@ -293,7 +256,7 @@ CadModel ModelBuilder::build(const TopoDS_Shape& shape, std::string source) {
       BRepAdaptor_Curve ac(e);
       c.type = curve_type(ac.GetType());
       c.length = GCPnts_AbscissaPoint::Length(ac, c.t0, c.t1);
-      trim_overshoots(ac, m.corners_, c);
+      trim_overshoots(im, m.corners_, i, c);
       if (c.trimmed[0] || c.trimmed[1]) c.length = GCPnts_AbscissaPoint::Length(ac, c.t0, c.t1);
     } catch (const Standard_Failure&) {
       // An edge without usable geometry keeps length 0 and type Other.
