@@ -382,6 +382,9 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     std::string pattern;
   };
   std::vector<RefusedFill> refused(quasi ? mine.size() : 0);
+  // The quad bound each face's fills had (0: none), for the second look after the unstructured
+  // path below.
+  std::vector<std::int64_t> fill_bound(quasi ? mine.size() : 0, 0);
   std::vector<double> face_seconds(quads ? mine.size() : 0, 0.0);
   if (quasi) {
     // Simple CAD faces meshed directly by a pattern (paper 000 Sec. 6.1.2, pipeline step 4); the
@@ -397,6 +400,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
             options.pattern_min_quad_bound,
             static_cast<std::int64_t>(std::ceil(options.pattern_max_quad_ratio *
                                                 sizemap::expected_quads(meshes[i], sizes[i].s))));
+      fill_bound[i] = po.max_quads;
       mesh::FaceMesh m =
           qstruct::mesh_face_pattern(model, mine[i], result.quantized_curves, patterns, po, &pr);
       if (pr.ok) {
@@ -502,20 +506,30 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
                 [&](std::int64_t i, const cad::FaceGeometry& surface) {
                   return smooth::smooth_face(quad_meshes[i], surface, options.final_smooth);
                 });
-      // Last resort for a face that the unstructured path could not mesh validly (its fallback
-      // folded a quad too: t20's chamfer slivers with a 0-degree cusp at size factor 0.01): the
-      // pattern fill that the size map's quad bound refused, if it is valid. Poor quads beat
-      // folded ones, and only failed faces pay for this layout. Other refusals would give the
-      // same answer again.
+      // Second chance for the fills that the size map's quad bound refused (other refusals would
+      // give the same answer again):
+      //  - a face that the unstructured path could not mesh validly (its fallback folded a quad
+      //    too: t20's chamfer slivers with a 0-degree cusp at size factor 0.01) takes the fill
+      //    whatever its size, if it is valid: poor quads beat folded ones;
+      //  - a face whose unstructured mesh came out with more quads than the bound lays out the
+      //    fills of at most that many quads. The bound keeps fills from carrying a size
+      //    transition across a whole face; here the curve counts forced the unstructured mesh to
+      //    the same size (wing_fuselage's blunt trailing edges at size factor 0.02: strips
+      //    [2, 48, 2, 48] sized for one quad, 101 unstructured quads with 3 irregular vertices
+      //    inside a strip two quads wide). The comparison below then decides.
       const std::string over_bound = qstruct::to_string(qstruct::Refusal::TooManyQuads);
       if (options.pattern_compare_tolerance >= 0)
         tasks.parallel_for(total, [&](std::int64_t i) {
-          if (quasi_reports[i].by_pattern || quad_reports[i].ok || !refused[i].mesh.quads.empty() ||
+          if (quasi_reports[i].by_pattern || !refused[i].mesh.quads.empty() ||
               quasi_reports[i].refusal != over_bound)
             return;
+          const bool failed = !quad_reports[i].ok || !quad_meshes[i].triangles.empty() ||
+                              quad_meshes[i].quads.empty();
+          const auto unstructured_quads = static_cast<std::int64_t>(quad_meshes[i].quads.size());
+          if (!failed && (fill_bound[i] <= 0 || unstructured_quads <= fill_bound[i])) return;
           const Stopwatch face_clock;
           qstruct::PatternFaceOptions po = options.patterns;
-          po.max_quads = 0;
+          po.max_quads = failed ? 0 : unstructured_quads;
           qstruct::PatternFaceReport pr;
           mesh::FaceMesh m = qstruct::mesh_face_pattern(model, mine[i], result.quantized_curves,
                                                         patterns, po, &pr);

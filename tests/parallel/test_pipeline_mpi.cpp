@@ -314,6 +314,50 @@ TEST(Pipeline, PatternQuadBoundHasAFloor) {
   EXPECT_EQ(floor.mesh.quads, unbounded.mesh.quads);
 }
 
+// A fill refused on the size map's quad bound gets a second look when the unstructured path had
+// to make at least as many quads of the face: a strip two edges wide (its short curves cannot get
+// fewer) sized for a few quads. Bound 1 refuses every fill on its count; the grid, no larger
+// than the unstructured mesh and no worse, is kept after the comparison, the same on every rank.
+TEST(Pipeline, FillRefusedOnCountIsComparedWhenTheUnstructuredMeshIsAsLarge) {
+  const Comm comm = Comm::world();
+  const std::string path = tmp("pipe_strip_np" + std::to_string(comm.size()) + ".brep");
+  if (comm.rank() == 0) test::write_polygon_face({{0, 0}, {30, 0}, {30, 0.6}, {0, 0.6}}, path);
+  comm.barrier();
+  const cad::CadModel model = cad::load_cad(path);
+  PipelineOptions options;
+  options.background.sizes.size = 3;
+  options.sizemap.size_max = 3;
+  options.until = Stage::QuasiStructured;
+  options.pattern_max_quad_ratio = 1e-9;
+  options.pattern_min_quad_bound = 1;
+  std::ostringstream sink;
+  Logger log(sink, LogLevel::Quiet);
+  const PipelineResult compared = run_pipeline(comm, model, options, TaskArena(2), log);
+  options.pattern_compare_tolerance = -1;
+  const PipelineResult never = run_pipeline(comm, model, options, TaskArena(2), log);
+  if (comm.rank() != 0) return;
+  options.pattern_compare_tolerance = 0.01;
+  const PipelineResult serial = run_pipeline(Comm::self(), model, options, TaskArena(1), log);
+  ASSERT_EQ(compared.quasi_reports.size(), 1U);
+  ASSERT_EQ(never.quasi_reports.size(), 1U);
+  EXPECT_EQ(never.quasi_reports[0].refusal, "too_many_quads");
+  EXPECT_FALSE(never.quasi_reports[0].by_pattern);
+  const QuasiReport& q = compared.quasi_reports[0];
+  EXPECT_EQ(q.refusal, "too_many_quads");
+  EXPECT_TRUE(q.by_pattern);
+  EXPECT_TRUE(q.by_comparison);
+  EXPECT_EQ(q.pattern, "grid");
+  const mesh::FaceQuadStats& mine = compared.face_stats[0];
+  const mesh::FaceQuadStats& other = never.face_stats[0];
+  EXPECT_EQ(mine.irregular_interior, 0);
+  EXPECT_LE(mine.quads, other.quads);
+  EXPECT_GE(mine.sicn_min, other.sicn_min - 0.01);
+  EXPECT_GE(mine.sicn_avg, other.sicn_avg - 0.01);
+  EXPECT_EQ(compared.mesh.quads, serial.mesh.quads);
+  const auto conformity = mesh::check_conformity(compared.mesh, model);
+  EXPECT_TRUE(conformity.ok()) << conformity.summary();
+}
+
 TEST(Pipeline, SizeMapAndCurveMeshesDoNotDependOnRanks) {
   const Comm comm = Comm::world();
   check_size_map(comm, shared_model(comm, "pipe_sm"), 0.6);

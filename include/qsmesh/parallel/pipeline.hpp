@@ -70,8 +70,11 @@ struct PipelineOptions {
   /// 6.1.1 keeps a pattern mesh when its quality is better than the mesh it replaces). The
   /// pattern mesh is also taken when the unstructured path gave no valid all-quad mesh; a face
   /// refused only on the quad bound then gets its fill laid out without the bound and taken when
-  /// valid (t20_data's cusp slivers at size factor 0.01). Both count in by_comparison. Negative:
-  /// never. On Block.stp the faces this takes are small triangles (three or seven quads) that
+  /// valid (t20_data's cusp slivers at size factor 0.01). A face refused on the quad bound whose
+  /// unstructured mesh has more quads than the bound gets its fills of at most that many quads
+  /// laid out, compared as above (wing_fuselage's blunt trailing edges at size factor 0.02: grids
+  /// [2, 48, 2, 48] instead of 101 quads with 3 irregular vertices). All count in by_comparison.
+  /// Negative: never. On Block.stp the faces this takes are small triangles (three or seven quads) that
   /// both paths mesh alike.
   double pattern_compare_tolerance = 0.01;
   /// Stage::QuasiStructured: cavity remeshing of the unstructured faces (Sec. 6.2).
