@@ -132,6 +132,8 @@ Arguments parse(const std::vector<std::string>& args) {
       const auto r = parse_double(v);
       if (!r || !(*r >= 0 && *r <= 1)) throw InputError(opt + ": '" + v + "' is not a number in [0, 1]");
       a.feature_ratio = *r;
+    } else if (opt == "--size-min" && sizing) {
+      a.size_min = parse_positive(opt, value());
     } else if (opt == "--sizemap" && sizing) {
       a.sizemap = value();
       if (a.sizemap != "features" && a.sizemap != "crossfield")
@@ -161,7 +163,8 @@ Arguments parse(const std::vector<std::string>& args) {
   }
   if (a.size && a.size_factor) throw InputError("--size and --size-factor: give one, not both");
   const bool sizing_given = a.sizemap != "crossfield" || a.quads > 0 || a.curvature_edges ||
-                            a.face_curvature || a.feature_ratio || !a.curve_edges.empty() ||
+                            a.face_curvature || a.feature_ratio || a.size_min ||
+                            !a.curve_edges.empty() ||
                             !a.face_quads.empty() || !a.corner_sizes.empty() ||
                             !a.curve_sizes.empty() || !a.face_sizes.empty();
   if (a.command == Command::Mesh && sizing_given && a.until == "background")
@@ -218,7 +221,7 @@ std::string help(const std::string& topic) {
           "  --threads T           threads per rank (default: the cores of the machine divided\n"
           "                        among the ranks running on it)\n"
           "  --stats FILE.json     also write the run statistics as JSON\n"
-          "  --quads N, --curvature-edges N, --face-curvature, --feature-ratio R,\n"
+          "  --quads N, --curvature-edges N, --face-curvature, --feature-ratio R, --size-min H,\n"
           "  --curve-edges C:N,.., --face-quads F:N,..,\n"
           "  --corner-size K:H,.., --curve-size C:H,.., --face-size F:H,.., --sizemap METHOD\n"
           "                        size-map controls, as for sizemap (see qsmesh sizemap --help);\n"
@@ -266,6 +269,10 @@ std::string help(const std::string& topic) {
           "                        size to no less than R times what it is without them (default\n"
           "                        0.75); 0 resolves every feature, at the price of more irregular\n"
           "                        vertices along thin strips and slots\n"
+          "  --size-min H          smallest size the size map may ask for (model units; default\n"
+          "                        the size cap / 100); given, it also stops curves shorter than\n"
+          "                        H (sliver edges of the CAD) from refining the mesh around them\n"
+          "                        (they keep their 2 edges)\n"
           "  --curve-edges C:N,..  prescribe the (even) number of edges of curves; kept exactly\n"
           "  --face-quads F:N,..   prescribe the number of quads of faces\n"
           "  --corner-size K:H,.., --curve-size C:H,.., --face-size F:H,..\n"

@@ -38,6 +38,9 @@ struct Arguments {
   /// --feature-ratio R: how far small features refine (sizemap::SizeMapOptions::feature_ratio;
   /// unset: its default).
   std::optional<double> feature_ratio;
+  /// --size-min H: floor of the automatic sizes, model units (sizemap::SizeMapOptions::size_min;
+  /// unset: the size cap / 100, which curves shorter than it still go below).
+  std::optional<double> size_min;
   std::vector<std::pair<int, int>> curve_edges;       ///< --curve-edges C:N,...
   std::vector<std::pair<int, double>> face_quads;     ///< --face-quads F:N,...
   std::vector<std::pair<int, double>> corner_sizes;   ///< --corner-size K:H,...

@@ -201,11 +201,15 @@ CurveSizes initial_curve_sizes(const cad::CadModel& model, std::span<const mesh:
     for (const auto& loop : model.faces()[f].loops)
       for (const auto& use : loop.uses) cap_curve(use.curve, v);
 
-  // (i) no larger than the curve's length, even below the floor: a curve gets at least one edge,
-  //     and the faces around a very short curve grade out from it.
+  // (i) no larger than the curve's length, even below the default floor (the paper's rule): a
+  //     curve gets at least one edge, and the faces around a very short curve grade out from it.
+  //     A floor the user gave is a statement about the smallest elements wanted, so it holds here
+  //     too: a sliver edge of the CAD still gets its edges (the quantization's minimum), and its
+  //     surroundings stay at the floor.
+  const double length_floor = options.size_min > 0 ? floor : 0.0;
   for (LO c = 0; c < nc; ++c) {
     const auto& cc = model.curves()[c];
-    if (!cc.degenerate) cap_curve(c, cc.length);
+    if (!cc.degenerate) cap_curve(c, std::max(cc.length, length_floor));
   }
 
   // (ii) no larger than the distance to the nearest curve sharing no corner. The search only finds

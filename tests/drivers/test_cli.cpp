@@ -98,6 +98,15 @@ TEST(Cli, SizeMapOptions) {
         error_of({"mesh", "m.step", "-o", "o.vtu", "--feature-ratio", bad}).find("--feature-ratio"),
         std::string::npos)
         << bad;
+  EXPECT_FALSE(p({"mesh", "m.step", "-o", "o.vtu"}).size_min.has_value());
+  EXPECT_DOUBLE_EQ(*p({"sizemap", "m.step", "-o", "s.vtu", "--size-min", "0.25"}).size_min, 0.25);
+  for (const char* bad : {"0", "-1", "x"})
+    EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--size-min", bad}).find("--size-min"),
+              std::string::npos)
+        << bad;
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--until", "background", "--size-min", "1"})
+                .find("--until background"),
+            std::string::npos);
   EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--until", "background", "--face-curvature"})
                 .find("--until background"),
             std::string::npos);

@@ -209,6 +209,36 @@ TEST(SizeMap, FeatureRatioBoundsHowFarTheSlotRefinesItsSides) {
   EXPECT_THROW((void)initial_curve_sizes(m.cad, m.curves, o, TaskArena(1)), InputError);
 }
 
+TEST(SizeMap, GivenFloorStopsSliverCurvesFromRefining) {
+  // A 10 x 10 square with one corner cut by a sliver edge 0.005 long. Rule (i) sizes the sliver
+  // by its length, below the default floor (size cap / 100); a floor the user gives holds there
+  // too, and everywhere else.
+  const Model m = prepare(
+      polygon_face({{0, 0}, {10, 0}, {10, 10}, {0.003, 10}, {0, 9.996}}, "sliver_corner.brep"), 1.0,
+      false);
+  LO sliver = kNoIndex;
+  for (LO c = 0; c < m.cad.num_curves(); ++c)
+    if (m.cad.curves()[c].length < 0.1) sliver = c;
+  ASSERT_NE(sliver, kNoIndex);
+  const double length = m.cad.curves()[sliver].length;
+  SizeMapOptions o;
+  o.method = Method::Features;
+  o.size_max = 1.0;
+  EXPECT_LT(length, effective_size_min(o));
+  const CurveSizes paper = initial_curve_sizes(m.cad, m.curves, o, TaskArena(1));
+  for (const double s : paper.at[sliver]) EXPECT_LE(s, length + 1e-12);
+  o.size_min = 0.2;
+  const CurveSizes floored = initial_curve_sizes(m.cad, m.curves, o, TaskArena(1));
+  for (LO c = 0; c < m.cad.num_curves(); ++c)
+    for (const double s : floored.at[c]) EXPECT_GE(s, 0.2 - 1e-12) << "curve " << c;
+  for (const double s : floored.corner) EXPECT_GE(s, 0.2 - 1e-12);
+  EXPECT_LE(curve_gradation_excess(m, floored, o.gradation), 1e-9);
+  // A user size below the floor still wins (the floor drops to it).
+  o.curve_sizes = {{sliver, 0.05}};
+  const CurveSizes user = initial_curve_sizes(m.cad, m.curves, o, TaskArena(1));
+  for (const double s : user.at[sliver]) EXPECT_LE(s, 0.05 + 1e-12);
+}
+
 TEST(SizeMap, SlotWithWrongGradationFailsTheBound) {
   // The check above can fail: a field graded at 0.5 violates the 0.2 bound somewhere.
   const Model m = prepare(slot_plate(), 1.0, false);
