@@ -51,6 +51,13 @@ void write_text_file_atomically(const std::string& path, const std::string& text
 }
 
 namespace {
+// Curves that collapse to a point (poles).
+std::int64_t degenerate_curves(const cad::CadModel& model) {
+  std::int64_t n = 0;
+  for (const auto& c : model.curves()) n += c.degenerate ? 1 : 0;
+  return n;
+}
+
 // Curves whose range the loader trimmed where they run past a corner (cad::Curve::t0).
 std::int64_t trimmed_curves(const cad::CadModel& model) {
   std::int64_t n = 0;
@@ -68,9 +75,7 @@ int run_info(const Arguments& args) {
     j.value("corners", static_cast<std::int64_t>(model.num_corners()));
     j.value("curves", static_cast<std::int64_t>(model.num_curves()));
     j.value("faces", static_cast<std::int64_t>(model.num_faces()));
-    std::int64_t degenerate = 0;
-    for (const auto& c : model.curves()) degenerate += c.degenerate ? 1 : 0;
-    j.value("degenerate_curves", degenerate);
+    j.value("degenerate_curves", degenerate_curves(model));
     j.value("curves_trimmed_at_corners", trimmed_curves(model));
     j.value("diagonal", model.diagonal());
     j.begin_array("box")
@@ -109,9 +114,7 @@ int run_info(const Arguments& args) {
             << "corners:   " << model.num_corners() << "\n"
             << "curves:    " << model.num_curves() << "\n"
             << "faces:     " << model.num_faces() << "\n";
-  std::int64_t degenerate = 0;
-  for (const auto& c : model.curves()) degenerate += c.degenerate ? 1 : 0;
-  std::cout << "degenerate curves: " << degenerate << "\n"
+  std::cout << "degenerate curves: " << degenerate_curves(model) << "\n"
             << "curves trimmed at corners (running past them): " << trimmed_curves(model) << "\n"
             << "bounding box: (" << model.box().lo.x << ", " << model.box().lo.y << ", "
             << model.box().lo.z << ") - (" << model.box().hi.x << ", " << model.box().hi.y << ", "

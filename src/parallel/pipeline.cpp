@@ -517,14 +517,18 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
       //    the same size (wing_fuselage's blunt trailing edges at size factor 0.02: strips
       //    [2, 48, 2, 48] sized for one quad, 101 unstructured quads with 3 irregular vertices
       //    inside a strip two quads wide). The comparison below then decides.
+      // The unstructured path left the face without a valid all-quad mesh.
+      const auto no_valid_quads = [&](std::int64_t i) {
+        return !quad_reports[i].ok || !quad_meshes[i].triangles.empty() ||
+               quad_meshes[i].quads.empty();
+      };
       const std::string over_bound = qstruct::to_string(qstruct::Refusal::TooManyQuads);
       if (options.pattern_compare_tolerance >= 0)
         tasks.parallel_for(total, [&](std::int64_t i) {
           if (quasi_reports[i].by_pattern || !refused[i].mesh.quads.empty() ||
               quasi_reports[i].refusal != over_bound)
             return;
-          const bool failed = !quad_reports[i].ok || !quad_meshes[i].triangles.empty() ||
-                              quad_meshes[i].quads.empty();
+          const bool failed = no_valid_quads(i);
           const auto unstructured_quads = static_cast<std::int64_t>(quad_meshes[i].quads.size());
           if (!failed && (fill_bound[i] <= 0 || unstructured_quads <= fill_bound[i])) return;
           const Stopwatch face_clock;
@@ -546,8 +550,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
       tasks.parallel_for(total, [&](std::int64_t i) {
         if (refused[i].mesh.quads.empty()) return;
         const mesh::FaceQuadStats pat = mesh::face_quad_stats(refused[i].mesh);
-        bool take = !quad_reports[i].ok || !quad_meshes[i].triangles.empty() ||
-                    quad_meshes[i].quads.empty();
+        bool take = no_valid_quads(i);
         if (!take) {
           const mesh::FaceQuadStats uns = mesh::face_quad_stats(quad_meshes[i]);
           take = pat.sicn_min >= uns.sicn_min - tol && pat.sicn_avg >= uns.sicn_avg - tol &&
