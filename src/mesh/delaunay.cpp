@@ -702,6 +702,7 @@ class FaceMesher {
   }
 
   void optimize() {
+    if (opt_.shorten_ratio > 0) flip_shorter(opt_.shorten_ratio);
     flip_for_angles();
     // Vertices the front placed badly (where fronts met, next to much finer boundary edges)
     // leave thin triangles that no flip removes; moving them helps, and new flips may follow.
@@ -777,6 +778,31 @@ class FaceMesher {
       moved += accepted ? 1 : 0;
     }
     return moved;
+  }
+
+  /// TriangulateOptions::shorten_ratio.
+  void flip_shorter(double ratio) {
+    for (int sweep = 0; sweep < 100; ++sweep) {
+      std::int64_t flips = 0;
+      for (LO t = 0; t < static_cast<LO>(tr_.tris.size()); ++t) {
+        for (int i = 0; i < 3; ++i) {
+          const Tri& T = tr_.tris[t];
+          if (!T.alive) break;
+          const LO u = T.n[i];
+          if (u == kNoIndex || T.is_locked(i)) continue;
+          const LO a = T.v[i], b = T.v[next3(i)], c = T.v[prev3(i)];
+          const LO d = tr_.tris[u].v[tr_.edge_to(u, t)];
+          if (std::min({a, b, c, d}) < first_real_) continue;
+          const double length = distance(xyz_[b], xyz_[c]);
+          if (length <= 2 * std::min(h_[b], h_[c]) || distance(xyz_[a], xyz_[d]) >= ratio * length)
+            continue;
+          const double before = std::min(tri_min_angle(a, b, c), tri_min_angle(d, c, b));
+          const double after = std::min(tri_min_angle(a, b, d), tri_min_angle(d, c, a));
+          if (after >= before && tr_.flip(t, i)) ++flips;
+        }
+      }
+      if (flips == 0) break;
+    }
   }
 
   void flip_for_angles() {

@@ -194,6 +194,21 @@ TEST_F(Qsmesh, FuselageKeepsFrontalPathAtCoarseSize) {
   EXPECT_GT(json_number(json, "sicn_min"), 0);
 }
 
+// wing_fuselage.step at size factor 0.005: the fairing sliver (face 12) has a parametrisation
+// stretched unevenly toward its tip, and the (u, v) Delaunay steps spanned its narrow part with a
+// fan of triangles 60 long across a strip 8 wide. The recombined quads folded and the face fell
+// back to subdividing every triangle (42 interior irregular vertices). The retry with the
+// length-reducing flips (UnstructuredOptions::retry_shorten_ratio) keeps the frontal path.
+TEST_F(Qsmesh, FairingSliverKeepsFrontalPath) {
+  const std::string path = std::string(QSMESH_SHARED_CAD_DIR) + "/wing_fuselage.step";
+  if (!fs::exists(path)) GTEST_SKIP() << path << " not found";
+  const auto [r, json] =
+      mesh_with_stats(path, "--size-factor 0.005 --until unstructured --threads 2", "e2e_fairing");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(json_number(json, "faces_fell_back"), 0);
+  EXPECT_GT(json_number(json, "sicn_min"), 0.1);
+}
+
 // t20_data.step at size factor 0.01: its chamfer slivers 12 and 13 (a 0-degree cusp) folded a
 // quad on the frontal path and on its fallback, and the run reported two failed faces. The
 // pattern fill that the size map's quad bound had refused is valid there (poor, SICN avg 0.13-0.17,

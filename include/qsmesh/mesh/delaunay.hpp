@@ -47,6 +47,14 @@ struct TriangulateOptions {
   /// points and only the final quality clean-up (flips on 3D angles, moves of badly placed interior
   /// vertices). The size function then only sets the spacing tests and the pole fans.
   bool refine = true;
+  /// Before the flips on 3D angles, flip every interior edge longer than twice the size at both
+  /// ends whose other diagonal is shorter than shorten_ratio times it in 3D, when the flip is valid
+  /// in (u, v) and the smaller 3D angle of the two triangles does not drop (0: off). Each flip
+  /// shortens the total edge length, so the pass ends. It zips fans that the (u, v) Delaunay steps
+  /// leave in strips narrower than the spacing where the parametrisation is stretched unevenly:
+  /// the angle flips alone cannot undo them, since each zipping flip barely changes the smallest
+  /// angle and the flips that would are invalid in (u, v).
+  double shorten_ratio = 0;
 };
 
 /// Statistics of a triangulation run.
