@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdio>
 #include <filesystem>
@@ -194,6 +195,17 @@ std::string pattern_refusal(const parallel::PipelineResult& r, std::size_t f) {
   return r.quasi_reports[f].refusal;
 }
 
+// Largest over mean of the ranks' busy times (1 when balanced or on one rank).
+double load_imbalance(const std::vector<double>& busy) {
+  if (busy.empty()) return 1.0;
+  double sum = 0, most = 0;
+  for (double b : busy) {
+    sum += b;
+    most = std::max(most, b);
+  }
+  return sum > 0 ? most * static_cast<double>(busy.size()) / sum : 1.0;
+}
+
 std::int64_t total_irregular_boundary(const parallel::PipelineResult& r) {
   std::int64_t n = 0;
   for (const auto& st : r.face_stats) n += st.irregular_boundary;
@@ -290,6 +302,12 @@ std::string stats_json(const Arguments& args, const Session& session,
   j.value("conforming", checks.conformity.ok());
   j.value("max_distance_to_cad", checks.max_distance_to_cad);
   write_times(j, session.times);
+  if (!r.rank_busy_seconds.empty()) {
+    j.begin_array("rank_busy_seconds");
+    for (double b : r.rank_busy_seconds) j.value("", b);
+    j.end_array();
+    j.value("load_imbalance", load_imbalance(r.rank_busy_seconds));
+  }
   j.begin_array("face_reports");
   for (const auto& o : outcomes(r)) {
     if (o.ok && !o.fell_back) continue;
@@ -308,6 +326,7 @@ std::string stats_json(const Arguments& args, const Session& session,
       const auto& st = r.face_stats[f];
       j.begin_object()
           .value("face", static_cast<std::int64_t>(f))
+          .value("rank", f < r.face_rank.size() ? r.face_rank[f] : 0)
           .value("method", quad_method(r, f))
           .value("pattern_refusal", pattern_refusal(r, f))
           .value("vertices", st.vertices)
@@ -372,6 +391,12 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
      << "; largest vertex distance to its CAD entity: " << checks.max_distance_to_cad
      << " of the diagonal\n";
   os << "  time (s):" << times_line(times) << "\n";
+  if (r.rank_busy_seconds.size() > 1) {
+    const auto [lo, hi] =
+        std::minmax_element(r.rank_busy_seconds.begin(), r.rank_busy_seconds.end());
+    os << "  ranks' time in the per-face stages (s): min " << *lo << ", max " << *hi
+       << "; load imbalance (max / mean) " << load_imbalance(r.rank_busy_seconds) << "\n";
+  }
   for (const auto& o : outcomes(r))
     if (!o.ok || (o.fell_back && !o.error.empty()))
       os << "  face " << o.face << ": " << o.error << "\n";

@@ -234,11 +234,20 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
 
   // Curves: every rank computes the same meshes (cheap next to the faces, and no communication).
   Stopwatch clock;
+  // Each stage ends with the slowest rank's time; the stages split by faces also add this rank's
+  // own time to `busy` (PipelineResult::rank_busy_seconds). The clock is read before the
+  // reduction, so a rank's time is its work, not its wait for the others.
+  double busy = 0;
+  const auto end_stage = [&](const char* stage, bool by_faces) {
+    const double seconds = clock.seconds();
+    if (by_faces) busy += seconds;
+    result.times.add(stage, comm.allreduce_max(seconds));
+  };
   const std::vector<mesh::CurveMesh> curves =
       background::mesh_curves(model, options.background.sizes, tasks);
   std::int64_t curve_edges = 0;
   for (const auto& c : curves) curve_edges += c.num_edges();
-  result.times.add("curves", comm.allreduce_max(clock.seconds()));
+  end_stage("curves", false);
   log.info(cat("curves: ", model.num_curves(), " curves meshed, ", curve_edges, " edges (",
                result.times.get("curves"), " s)"));
 
@@ -249,7 +258,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
   std::vector<LO> mine;
   for (LO f = 0; f < nfaces; ++f)
     if (result.face_rank[f] == rank) mine.push_back(f);
-  result.times.add("partition", comm.allreduce_max(clock.seconds()));
+  end_stage("partition", false);
   if (nranks > 1) {
     std::vector<std::int64_t> per_rank(static_cast<std::size_t>(nranks), 0);
     per_rank[rank] = static_cast<std::int64_t>(mine.size());
@@ -273,7 +282,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     if (n * 10 / total != (n - 1) * 10 / total)  // every tenth of the faces
       log.info(cat("background: ", n, "/", mine.size(), " faces on rank ", rank));
   });
-  result.times.add("background", comm.allreduce_max(clock.seconds()));
+  end_stage("background", true);
 
   // Cross fields (paper 000 Sec. 3) on the same faces, one task per face. The size map (it needs H
   // at every vertex) and the frontal insertion (the crosses) keep the whole fields; the drivers
@@ -305,7 +314,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
       if (n * 10 / total != (n - 1) * 10 / total)
         log.info(cat("crossfield: ", n, "/", mine.size(), " faces on rank ", rank));
     });
-    result.times.add("crossfield", comm.allreduce_max(clock.seconds()));
+    end_stage("crossfield", true);
   }
 
   // Size map (paper 000 Sec. 4.1-4.2): curve sizes known to every rank, face fields on the faces'
@@ -335,7 +344,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     sizemap::grade_curves(model, curves, so.gradation, united);
     face_pass(united);  // faces now agree on their shared curves
     result.curve_sizes = std::move(united);
-    result.times.add("sizemap", comm.allreduce_max(clock.seconds()));
+    end_stage("sizemap", true);
 
     clock.reset();
     const std::vector<double> ideal = quantize::ideal_edge_counts(curves, result.curve_sizes.at);
@@ -359,7 +368,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     result.quantized_curves =
         quantize::place_vertices(model, curves, result.curve_sizes.at, result.quantization,
                                  /*halved=*/false, tasks, options.place);
-    result.times.add("quantize", comm.allreduce_max(clock.seconds()));
+    end_stage("quantize", false);
     log.info(cat("quantize: ", model.num_curves(), " curves, ", result.quantization.num_chords,
                  " chords, ", result.quantization.total_edges, " edges"));
   }
@@ -421,7 +430,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
       if (n * 10 / total != (n - 1) * 10 / total)
         log.info(cat("patterns: ", n, "/", mine.size(), " faces on rank ", rank));
     });
-    result.times.add("patterns", comm.allreduce_max(clock.seconds()));
+    end_stage("patterns", true);
   }
   if (quads) {
     clock.reset();
@@ -448,7 +457,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
       if (n * 10 / total != (n - 1) * 10 / total)
         log.info(cat("unstructured: ", n, "/", mine.size(), " faces on rank ", rank));
     });
-    result.times.add("unstructured", comm.allreduce_max(clock.seconds()));
+    end_stage("unstructured", true);
     if (quasi) {
       // Topological improvement of the faces the unstructured path meshed with quads only. A step
       // that throws leaves the face's valid mesh as it was; each step is timed as its own stage.
@@ -469,7 +478,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
           }
           face_seconds[i] += face_clock.seconds();
         });
-        result.times.add(stage, comm.allreduce_max(clock.seconds()));
+        end_stage(stage, true);
       };
       // Cavity remeshing (Sec. 6.2): irregular vertices that the cross field does not ask for are
       // removed by remeshing convex cavities with patterns.
@@ -522,6 +531,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
         return !quad_reports[i].ok || !quad_meshes[i].triangles.empty() ||
                quad_meshes[i].quads.empty();
       };
+      clock.reset();
       const std::string over_bound = qstruct::to_string(qstruct::Refusal::TooManyQuads);
       if (options.pattern_compare_tolerance >= 0)
         tasks.parallel_for(total, [&](std::int64_t i) {
@@ -568,6 +578,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
         }
         refused[i] = RefusedFill{};
       });
+      end_stage("pattern_compare", true);
     }
     meshes = std::move(quad_meshes);
   }
@@ -636,7 +647,10 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
                                  all);
     if (size_map && !quads) result.background = std::move(all);
   }
-  result.times.add("assemble", comm.allreduce_max(clock.seconds()));
+  end_stage("assemble", false);
+  result.rank_busy_seconds.assign(static_cast<std::size_t>(nranks), 0.0);
+  result.rank_busy_seconds[static_cast<std::size_t>(rank)] = busy;
+  comm.allreduce_sum(result.rank_busy_seconds);
   return result;
 }
 

@@ -336,6 +336,11 @@ TEST_F(Qsmesh, ExampleQuasiStructuredHasNoFlatQuad) {
   };
   EXPECT_EQ(count("\"pattern_refusal\": "), json_number(json, "faces"));
   EXPECT_EQ(count("\"pattern_refusal\": \"\""), json_number(json, "faces_meshed_by_pattern"));
+  // Load balance for scaling studies: every face says which rank meshed it (one rank here), and
+  // the one rank's time in the per-face stages gives an imbalance of 1.
+  EXPECT_EQ(count("\"rank\": 0"), json_number(json, "faces"));
+  EXPECT_NE(json.find("\"rank_busy_seconds\": ["), std::string::npos);
+  EXPECT_EQ(json_number(json, "load_imbalance"), 1.0);
 }
 
 // Bad input: one line on stderr naming the file or option, exit code 2, nothing written.

@@ -69,6 +69,15 @@ TEST(Pipeline, DistributedEqualsSerial) {
   ASSERT_EQ(static_cast<LO>(result.face_rank.size()), model.num_faces());
   for (int r : result.face_rank) EXPECT_TRUE(r >= 0 && r < comm.size());
   EXPECT_GT(result.times.get("background"), 0.0);
+  // Every rank has every rank's own time in the per-face stages; here the background stage alone,
+  // whose recorded time is the slowest rank's.
+  ASSERT_EQ(static_cast<int>(result.rank_busy_seconds.size()), comm.size());
+  std::vector<int> faces_of(static_cast<std::size_t>(comm.size()), 0);
+  for (int r : result.face_rank) ++faces_of[static_cast<std::size_t>(r)];
+  for (int r = 0; r < comm.size(); ++r)
+    if (faces_of[static_cast<std::size_t>(r)] > 0) EXPECT_GT(result.rank_busy_seconds[r], 0.0) << r;
+  EXPECT_EQ(*std::max_element(result.rank_busy_seconds.begin(), result.rank_busy_seconds.end()),
+            result.times.get("background"));
 
   if (comm.rank() != 0) return;
   // The serial reference: the same stage functions, no MPI, one thread.

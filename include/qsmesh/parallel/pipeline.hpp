@@ -141,6 +141,10 @@ struct PipelineResult {
   std::vector<mesh::FaceQuadStats> face_stats;
   std::vector<double> face_seconds;
   std::vector<int> face_rank;                   ///< rank that meshed each face (every rank)
+  /// Wall time (s) each rank spent in the stages split by faces (background to the comparison of
+  /// refused pattern fills), its own work without its waits for the others (every rank). Their
+  /// spread is the load imbalance of the METIS partition (max / mean, 1 on one rank).
+  std::vector<double> rank_busy_seconds;
   StageTimes times;                             ///< wall time per stage (max over ranks)
 };
 

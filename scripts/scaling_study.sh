@@ -1,0 +1,125 @@
+#!/usr/bin/env bash
+# Strong-scaling study of `qsmesh mesh` on one model: the same run at several rank x thread
+# counts, each repeated, with the median wall time, the speedup and parallel efficiency against the
+# first configuration, the main stages' times, the load imbalance of the face partition (the
+# ranks' time in the per-face stages, max / mean, from --stats), the peak memory of one process,
+# and whether the mesh is byte-identical to the first configuration's (it must be: the mesh does
+# not depend on the numbers of ranks and threads). Prints a markdown table; --csv also writes the
+# rows as CSV.
+# Usage: scripts/scaling_study.sh MODEL [--size-factor F] [--until STAGE] [--configs "PxT ..."]
+#                                 [--repeat N] [--csv FILE]   (after scripts/build.sh)
+#   defaults: --size-factor 0.02, --until quasi-structured, --configs "1x1 1x2 2x1" (and 2x2, 4x1,
+#   4x2, 8x1, 8x2, 16x1 where the machine has that many cores), --repeat 3.
+# Wall time is that of the whole command (mpiexec, loading and writing included). Configurations
+# with more processes x threads than cores are run but marked: their times say nothing of scaling.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+usage() { sed -n '9,12p' "$0" | sed 's/^# \{0,1\}//' >&2; exit 2; }
+[ $# -ge 1 ] || usage
+model=$1; shift
+[ -f "$model" ] || { echo "scaling_study: no such model file: $model" >&2; exit 2; }
+factor=0.02
+until=quasi-structured
+repeat=3
+csv=
+cores=$(nproc)
+configs=
+while [ $# -gt 0 ]; do
+  case "$1" in
+    --size-factor) factor=$2; shift 2 ;;
+    --until) until=$2; shift 2 ;;
+    --configs) configs=$2; shift 2 ;;
+    --repeat) repeat=$2; shift 2 ;;
+    --csv) csv=$2; shift 2 ;;
+    *) echo "scaling_study: unknown option $1" >&2; usage ;;
+  esac
+done
+if [ -z "$configs" ]; then
+  configs="1x1 1x2 2x1"
+  for c in 2x2 4x1 4x2 8x1 8x2 16x1; do
+    p=${c%x*}; t=${c#*x}
+    [ $((p * t)) -le "$cores" ] && configs="$configs $c"
+  done
+fi
+[[ "$repeat" =~ ^[1-9][0-9]*$ ]] || { echo "scaling_study: --repeat must be a positive integer" >&2; exit 2; }
+for c in $configs; do
+  [[ "$c" =~ ^[1-9][0-9]*x[1-9][0-9]*$ ]] || { echo "scaling_study: configuration '$c' is not PxT (ranks x threads)" >&2; exit 2; }
+done
+exe=./build/drivers/qsmesh
+[ -x "$exe" ] || { echo "scaling_study: $exe missing; run scripts/build.sh first" >&2; exit 2; }
+[ -x /usr/bin/time ] || { echo "scaling_study: /usr/bin/time missing (Debian package 'time'; scripts/setup.sh installs it)" >&2; exit 2; }
+export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+out=$(mktemp -d)
+trap 'rm -rf "$out"' EXIT
+
+# Runs: one line per run, "config repeat wall_s peak_kb stats.json mesh.msh".
+runs=$out/runs.txt
+: > "$runs"
+for c in $configs; do
+  p=${c%x*}; t=${c#*x}
+  for k in $(seq 1 "$repeat"); do
+    /usr/bin/time -f "%e %M" -o "$out/time" mpiexec --oversubscribe --bind-to none -n "$p" "$exe" mesh "$model" \
+      -o "$out/$c.$k.msh" --size-factor "$factor" --until "$until" --threads "$t" -q \
+      --stats "$out/$c.$k.json" >/dev/null
+    read -r wall kb < <(tail -n1 "$out/time")
+    echo "$c $k $wall $kb $out/$c.$k.json $out/$c.$k.msh" >> "$runs"
+    # Only the first repeat's mesh is compared; drop the others to keep the folder small.
+    [ "$k" -eq 1 ] || rm -f "$out/$c.$k.msh"
+  done
+done
+
+python3 - "$runs" "$model" "$factor" "$until" "$cores" "$repeat" "$csv" <<'PY'
+import csv, filecmp, json, statistics, sys
+runs_path, model, factor, until, cores, repeat, csv_path = sys.argv[1:8]
+cores = int(cores)
+runs = {}
+order = []
+for line in open(runs_path):
+    c, k, wall, kb, stats, mesh = line.split()
+    if c not in runs:
+        runs[c] = []
+        order.append(c)
+    runs[c].append({"wall": float(wall), "kb": int(kb), "stats": json.load(open(stats)), "mesh": mesh})
+
+def median_run(rs):
+    # The run whose wall time is the median (the lower middle for an even count).
+    return sorted(rs, key=lambda r: r["wall"])[(len(rs) - 1) // 2]
+
+base = order[0]
+base_cores = int(base.split("x")[0]) * int(base.split("x")[1])
+base_wall = median_run(runs[base])["wall"]
+base_mesh = runs[base][0]["mesh"]
+header = ["ranks x threads", "cores", "wall s (median)", "wall s (min-max)", "speedup", "efficiency",
+          "crossfield s", "unstructured s", "cavities s", "load imbalance", "peak MB / process",
+          "vertices", "same mesh as " + base]
+rows = []
+for c in order:
+    rs = runs[c]
+    m = median_run(rs)
+    p, t = (int(x) for x in c.split("x"))
+    n = p * t
+    walls = [r["wall"] for r in rs]
+    speedup = base_wall / m["wall"] if m["wall"] > 0 else float("nan")
+    eff = speedup * base_cores / n
+    s = m["stats"]["seconds"]
+    same = filecmp.cmp(base_mesh, rs[0]["mesh"], shallow=False)
+    label = c + (" (oversubscribed)" if n > cores else "")
+    rows.append([label, n, f"{m['wall']:.2f}", f"{min(walls):.2f}-{max(walls):.2f}", f"{speedup:.2f}",
+                 f"{eff:.2f}", f"{s.get('crossfield', 0):.2f}", f"{s.get('unstructured', 0):.2f}",
+                 f"{s.get('cavities', 0):.2f}", f"{m['stats'].get('load_imbalance', 1.0):.2f}",
+                 f"{max(r['kb'] for r in rs) / 1024:.0f}", m["stats"]["vertices"], "yes" if same else "NO"])
+print(f"model: {model}, --size-factor {factor}, --until {until}, {cores} cores, {repeat} run(s) per configuration")
+print()
+print("| " + " | ".join(header) + " |")
+print("|" + "---|" * len(header))
+for r in rows:
+    print("| " + " | ".join(str(x) for x in r) + " |")
+if csv_path:
+    with open(csv_path, "w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(header)
+        w.writerows(rows)
+if any(r[-1] == "NO" for r in rows):
+    print("\nscaling_study: the mesh differs between configurations", file=sys.stderr)
+    sys.exit(1)
+PY
