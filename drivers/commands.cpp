@@ -308,6 +308,14 @@ std::string stats_json(const Arguments& args, const Session& session,
     j.end_array();
     j.value("load_imbalance", load_imbalance(r.rank_busy_seconds));
   }
+  if (!r.quasi_reports.empty()) {
+    // The improvement stage runs its three steps face by face; their time summed over the faces.
+    j.begin_object("improvement_face_seconds")
+        .value("cavities", r.improvement_seconds[0])
+        .value("disk_remesh", r.improvement_seconds[1])
+        .value("final_smoothing", r.improvement_seconds[2])
+        .end_object();
+  }
   j.begin_array("face_reports");
   for (const auto& o : outcomes(r)) {
     if (o.ok && !o.fell_back) continue;

@@ -26,14 +26,14 @@ def t(k): return f"{s[k]:.2f}" if k in s else "-"
 nv = d["vertices"]
 irr = f"{100.0 * d['irregular_interior'] / nv:.1f}%" if nv else "-"
 quality = f"{d['sicn_min']:.3f} / {d['sicn_avg']:.3f}" if d["quads"] else f"{d['min_angle_deg']:.1f} deg"
-stages = " | ".join(t(k) for k in ["curves", "background", "crossfield", "sizemap", "quantize", "patterns", "unstructured", "cavities", "disk_remesh", "final_smoothing", "write"])
+stages = " | ".join(t(k) for k in ["curves", "background", "crossfield", "sizemap", "quantize", "patterns", "unstructured", "improvement", "write"])
 print(f"| {sys.argv[2]} | {nv} | {d['quads']} | {irr} | {quality} | {stages} | {s['total']:.2f} | {int(sys.argv[3]) / 1024:.0f} |")
 PY
 }
 echo "model: $model, --size-factor $factor, --until $stage, $(nproc) cores"
 echo
-echo "| run | vertices | quads | interior irregular | SICN min / avg | curves | background | crossfield | sizemap | quantize | patterns | unstructured | cavities | disk remesh | final smoothing | write | total (s) | peak MB |"
-echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+echo "| run | vertices | quads | interior irregular | SICN min / avg | curves | background | crossfield | sizemap | quantize | patterns | unstructured | improvement | write | total (s) | peak MB |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
 row "1 rank x 1 thread" 1 1
 row "1 rank x 2 threads" 1 2
 row "2 ranks x 1 thread" 2 1

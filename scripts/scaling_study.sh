@@ -90,7 +90,7 @@ base_cores = int(base.split("x")[0]) * int(base.split("x")[1])
 base_wall = median_run(runs[base])["wall"]
 base_mesh = runs[base][0]["mesh"]
 header = ["ranks x threads", "cores", "wall s (median)", "wall s (min-max)", "speedup", "efficiency",
-          "crossfield s", "unstructured s", "cavities s", "load imbalance", "peak MB / process",
+          "crossfield s", "patterns s", "improvement s", "load imbalance", "peak MB / process",
           "vertices", "same mesh as " + base]
 rows = []
 for c in order:
@@ -105,8 +105,8 @@ for c in order:
     same = filecmp.cmp(base_mesh, rs[0]["mesh"], shallow=False)
     label = c + (" (oversubscribed)" if n > cores else "")
     rows.append([label, n, f"{m['wall']:.2f}", f"{min(walls):.2f}-{max(walls):.2f}", f"{speedup:.2f}",
-                 f"{eff:.2f}", f"{s.get('crossfield', 0):.2f}", f"{s.get('unstructured', 0):.2f}",
-                 f"{s.get('cavities', 0):.2f}", f"{m['stats'].get('load_imbalance', 1.0):.2f}",
+                 f"{eff:.2f}", f"{s.get('crossfield', 0):.2f}", f"{s.get('patterns', 0):.2f}",
+                 f"{s.get('improvement', 0):.2f}", f"{m['stats'].get('load_imbalance', 1.0):.2f}",
                  f"{max(r['kb'] for r in rs) / 1024:.0f}", m["stats"]["vertices"], "yes" if same else "NO"])
 print(f"model: {model}, --size-factor {factor}, --until {until}, {cores} cores, {repeat} run(s) per configuration")
 print()

@@ -2,7 +2,9 @@
 
 #include <mpi.h>
 
+#include <atomic>
 #include <limits>
+#include <mutex>
 
 #include "qsmesh/core/error.hpp"
 
@@ -154,6 +156,55 @@ void Comm::broadcast_bytes(std::vector<char>& bytes, int root) const {
     const int count = static_cast<int>(std::min(kChunk, n - off));
     check_mpi(MPI_Bcast(bytes.data() + off, count, MPI_CHAR, root, impl_->comm), "MPI_Bcast");
   }
+}
+
+struct SharedCounter::Impl {
+  MPI_Comm comm = MPI_COMM_NULL;
+  bool distributed = false;
+  MPI_Win win = MPI_WIN_NULL;
+  std::int64_t value = 0;              // the counter itself, on rank 0 (exposed in `win`)
+  std::atomic<std::int64_t> local{0};  // one rank
+  std::mutex lock;                     // MPI_THREAD_SERIALIZED
+};
+
+SharedCounter::SharedCounter(const Comm& comm) : impl_(std::make_unique<Impl>()) {
+  impl_->comm = comm.impl_->comm;
+  impl_->distributed = comm.size() > 1;
+  if (!impl_->distributed) return;
+  const bool owner = comm.rank() == 0;
+  // Memory allocated by MPI (not MPI_Win_create on our own): on one node Open MPI then shares it
+  // and does the fetch-and-add itself. With a window over user memory it fell back to messages
+  // that rank 0 serves only when it calls MPI, so the other ranks waited for its faces to end
+  // (Block at its reference count, 2 ranks: improvement 9.3 s against 10.4 s on one).
+  std::int64_t* base = nullptr;
+  check_mpi(MPI_Win_allocate(owner ? static_cast<MPI_Aint>(sizeof(std::int64_t)) : 0,
+                             static_cast<int>(sizeof(std::int64_t)), MPI_INFO_NULL, impl_->comm,
+                             &base, &impl_->win),
+            "MPI_Win_allocate");
+  check_mpi(MPI_Win_set_errhandler(impl_->win, MPI_ERRORS_RETURN), "MPI_Win_set_errhandler");
+  if (owner) {
+    check_mpi(MPI_Win_lock(MPI_LOCK_EXCLUSIVE, 0, 0, impl_->win), "MPI_Win_lock");
+    *base = 0;
+    check_mpi(MPI_Win_unlock(0, impl_->win), "MPI_Win_unlock");
+  }
+  check_mpi(MPI_Barrier(impl_->comm), "MPI_Barrier");
+}
+
+SharedCounter::~SharedCounter() {
+  // Collective; an error here cannot be thrown from a destructor and would end the run anyway.
+  if (impl_->win != MPI_WIN_NULL) MPI_Win_free(&impl_->win);
+}
+
+std::int64_t SharedCounter::next() {
+  if (!impl_->distributed) return impl_->local.fetch_add(1);
+  const std::lock_guard<std::mutex> guard(impl_->lock);
+  const std::int64_t one = 1;
+  std::int64_t old = 0;
+  check_mpi(MPI_Win_lock(MPI_LOCK_SHARED, 0, 0, impl_->win), "MPI_Win_lock");
+  check_mpi(MPI_Fetch_and_op(&one, &old, MPI_INT64_T, 0, 0, MPI_SUM, impl_->win),
+            "MPI_Fetch_and_op");
+  check_mpi(MPI_Win_unlock(0, impl_->win), "MPI_Win_unlock");
+  return old;
 }
 
 }  // namespace qsmesh::parallel

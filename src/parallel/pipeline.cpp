@@ -7,10 +7,12 @@
 #include <limits>
 #include <memory>
 
+#include "improve.hpp"
 #include "qsmesh/background/curve_mesh.hpp"
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/mesh/assemble.hpp"
 #include "qsmesh/parallel/partition.hpp"
+#include "serialize.hpp"
 
 namespace qsmesh::parallel {
 
@@ -41,45 +43,8 @@ std::vector<double> estimate_face_costs(const cad::CadModel& model, double size)
   return cost;
 }
 
-namespace {
-
-template <class T>
-void put(std::vector<char>& out, const T& v) {
-  const auto* p = reinterpret_cast<const char*>(&v);
-  out.insert(out.end(), p, p + sizeof(T));
-}
-template <class T>
-void put_vec(std::vector<char>& out, const std::vector<T>& v) {
-  put<std::int64_t>(out, static_cast<std::int64_t>(v.size()));
-  const auto* p = reinterpret_cast<const char*>(v.data());
-  out.insert(out.end(), p, p + v.size() * sizeof(T));
-}
-template <class T>
-T get(const std::vector<char>& in, std::size_t& pos) {
-  QSMESH_CHECK(pos + sizeof(T) <= in.size(), "truncated face record");
-  T v;
-  std::memcpy(&v, in.data() + pos, sizeof(T));
-  pos += sizeof(T);
-  return v;
-}
-template <class T>
-void get_vec(const std::vector<char>& in, std::size_t& pos, std::vector<T>& v) {
-  const auto n = static_cast<std::size_t>(get<std::int64_t>(in, pos));
-  QSMESH_CHECK(pos + n * sizeof(T) <= in.size(), "truncated face record");
-  v.resize(n);
-  std::memcpy(v.data(), in.data() + pos, n * sizeof(T));
-  pos += n * sizeof(T);
-}
-
-}  // namespace
-
 void pack(const mesh::FaceMesh& m, const background::FaceReport& r, std::vector<char>& out) {
-  put<LO>(out, m.face);
-  put_vec(out, m.points);
-  put_vec(out, m.uv);
-  put_vec(out, m.vclass);
-  put_vec(out, m.triangles);
-  put_vec(out, m.quads);
+  pack_mesh(m, out);
   put<LO>(out, r.face);
   put<std::uint8_t>(out, r.ok ? 1 : 0);
   put<std::uint8_t>(out, r.fell_back ? 1 : 0);
@@ -89,12 +54,7 @@ void pack(const mesh::FaceMesh& m, const background::FaceReport& r, std::vector<
 
 void unpack(const std::vector<char>& in, std::size_t& pos, mesh::FaceMesh& m,
             background::FaceReport& r) {
-  m.face = get<LO>(in, pos);
-  get_vec(in, pos, m.points);
-  get_vec(in, pos, m.uv);
-  get_vec(in, pos, m.vclass);
-  get_vec(in, pos, m.triangles);
-  get_vec(in, pos, m.quads);
+  unpack_mesh(in, pos, m);
   r.face = get<LO>(in, pos);
   r.ok = get<std::uint8_t>(in, pos) != 0;
   r.fell_back = get<std::uint8_t>(in, pos) != 0;
@@ -459,62 +419,31 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     });
     end_stage("unstructured", true);
     if (quasi) {
-      // Topological improvement of the faces the unstructured path meshed with quads only. A step
-      // that throws leaves the face's valid mesh as it was; each step is timed as its own stage.
-      auto improve = [&](const char* stage, const char* what, const auto& step) {
-        clock.reset();
-        tasks.parallel_for(total, [&](std::int64_t i) {
-          if (quasi_reports[i].by_pattern || !quad_reports[i].ok ||
-              !quad_meshes[i].triangles.empty())
-            return;
-          const Stopwatch face_clock;
-          try {
-            const auto surface = model.face_geometry(mine[i]);
-            mesh::FaceMesh out = step(i, *surface);
-            out.face = mine[i];
-            quad_meshes[i] = std::move(out);
-          } catch (const std::exception& e) {
-            log.warn(Error(e.what(), ErrorContext{what, 2, mine[i]}).what());
-          }
-          face_seconds[i] += face_clock.seconds();
-        });
-        end_stage(stage, true);
-      };
-      // Cavity remeshing (Sec. 6.2): irregular vertices that the cross field does not ask for are
-      // removed by remeshing convex cavities with patterns.
-      improve("cavities", "cavity remeshing",
-              [&](std::int64_t i, const cad::FaceGeometry& surface) {
-                const std::span<const crossfield::Singularity> singular =
-                    full[i] != nullptr
-                        ? std::span<const crossfield::Singularity>(full[i]->singularities)
-                        : std::span<const crossfield::Singularity>();
-                qstruct::CavityReport cr;
-                mesh::FaceMesh out = qstruct::remesh_cavities(quad_meshes[i], surface, singular,
-                                                              patterns, options.cavities, &cr);
-                quasi_reports[i].irregular_before = cr.irregular_before;
-                quasi_reports[i].irregular_after = cr.irregular_after;
-                quasi_reports[i].cavities = cr.remeshed;
-                quasi_reports[i].time_budget_hit = cr.time_budget_hit;
-                return out;
-              });
-      // Local clean-up (Sec. 6.3): defects remeshed with the best disk quadrangulation, each
-      // replacement a transaction.
+      // Topological improvement of the faces the unstructured path meshed with quads only (Sec.
+      // 6.2-6.3, then the final smoothing), dealt out over ranks and threads as faces finish.
+      clock.reset();
+      std::vector<ImproveFace> to_improve;
+      for (std::int64_t i = 0; i < total; ++i) {
+        if (quasi_reports[i].by_pattern || !quad_reports[i].ok || !quad_meshes[i].triangles.empty())
+          continue;
+        ImproveFace f;
+        f.face = mine[i];
+        f.mesh = &quad_meshes[i];
+        if (full[i] != nullptr) f.singularities = full[i]->singularities;
+        f.report = &quasi_reports[i];
+        f.seconds = &face_seconds[i];
+        to_improve.push_back(f);
+      }
       const remesh::DiskQuadTable table = remesh::DiskQuadTable::builtin();
-      improve("disk_remesh", "disk remeshing",
-              [&](std::int64_t i, const cad::FaceGeometry& surface) {
-                remesh::DiskRemeshStats ds;
-                mesh::FaceMesh out =
-                    remesh::remesh_disk_defects(quad_meshes[i], surface, table, options.disk, &ds);
-                quasi_reports[i].defects_before = ds.defects_before;
-                quasi_reports[i].defects_after = ds.defects_after;
-                quasi_reports[i].disk_replaced = ds.replaced;
-                return out;
-              });
-      if (options.final_smoothing)
-        improve("final_smoothing", "final smoothing",
-                [&](std::int64_t i, const cad::FaceGeometry& surface) {
-                  return smooth::smooth_face(quad_meshes[i], surface, options.final_smooth);
-                });
+      ImproveSettings settings;
+      settings.patterns = patterns;
+      settings.table = &table;
+      settings.cavities = options.cavities;
+      settings.disk = options.disk;
+      settings.final_smoothing = options.final_smoothing;
+      settings.final_smooth = options.final_smooth;
+      result.improvement_seconds = improve_faces(comm, model, to_improve, settings, tasks, log);
+      end_stage("improvement", true);
       // Second chance for the fills that the size map's quad bound refused (other refusals would
       // give the same answer again):
       //  - a face that the unstructured path could not mesh validly (its fallback folded a quad

@@ -55,6 +55,23 @@ TEST(Comm, ReductionsAndGather) {
   EXPECT_EQ(b, (std::vector<char>{'x', 'y', 'z'}));
 }
 
+// The counter that deals out the improvement stage: every value below the total goes to exactly
+// one caller, over all ranks and two threads each.
+TEST(Comm, SharedCounterHandsOutEachValueOnce) {
+  const Comm comm = Comm::world();
+  constexpr std::int64_t kTotal = 200;
+  std::vector<std::int64_t> hits(kTotal, 0);
+  {
+    SharedCounter counter(comm);
+    const TaskArena two(2);
+    two.parallel_for(2, [&](std::int64_t) {
+      for (std::int64_t k = counter.next(); k < kTotal; k = counter.next()) ++hits[k];
+    });
+  }
+  comm.allreduce_sum(hits);
+  for (std::int64_t k = 0; k < kTotal; ++k) EXPECT_EQ(hits[k], 1) << k;
+}
+
 TEST(Pipeline, DistributedEqualsSerial) {
   const Comm comm = Comm::world();
   const cad::CadModel model = shared_model(comm, "pipe_fillet");

@@ -9,8 +9,9 @@
 
 namespace qsmesh::parallel {
 
-/// Initialises MPI (thread level SERIALIZED: MPI itself is called from the main thread only, but
-/// PETSc solves run on worker threads, one at a time through linalg::PetscLane) and finalises it on
+/// Initialises MPI (thread level SERIALIZED: MPI is called from the main thread, except PETSc
+/// solves, which run on worker threads one at a time through linalg::PetscLane, and SharedCounter,
+/// whose calls are serialised by its own lock in stages without PETSc) and finalises it on
 /// destruction. Exactly one per process, created by the driver's main().
 class MpiSession {
  public:
@@ -58,6 +59,29 @@ class Comm {
   struct Impl;
   explicit Comm(std::shared_ptr<Impl> impl);
   std::shared_ptr<Impl> impl_;
+  friend class SharedCounter;
+};
+
+/// A counter shared by every rank and thread of a communicator, for dealing out work dynamically:
+/// next() returns 0, 1, 2, ... each value once over all callers together, in no fixed order across
+/// callers. Several ranks: one 64-bit integer in an MPI window on rank 0, advanced by
+/// MPI_Fetch_and_op under a passive-target lock (rank 0 need not take part: on one node Open MPI's
+/// shared-memory window does the atomic itself; a transport without remote atomics may make a call
+/// wait for rank 0's next MPI call); one rank: an atomic.
+/// Construction and destruction are collective. next() is thread-safe: its MPI calls are
+/// serialised by a lock, as MPI_THREAD_SERIALIZED requires, so it must not run while another
+/// thread of the rank is inside MPI (no PETSc solve in the same stage).
+class SharedCounter {
+ public:
+  explicit SharedCounter(const Comm& comm);
+  ~SharedCounter();
+  SharedCounter(const SharedCounter&) = delete;
+  SharedCounter& operator=(const SharedCounter&) = delete;
+  [[nodiscard]] std::int64_t next();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
 };
 
 }  // namespace qsmesh::parallel

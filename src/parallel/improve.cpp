@@ -1,0 +1,259 @@
+#include "improve.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <cstdint>
+#include <exception>
+#include <numeric>
+#include <string>
+
+#include "qsmesh/core/error.hpp"
+#include "qsmesh/core/timer.hpp"
+#include "qsmesh/qstruct/cavity.hpp"
+#include "qsmesh/remesh/disk_remesh.hpp"
+#include "qsmesh/smooth/smooth.hpp"
+#include "serialize.hpp"
+
+namespace qsmesh::parallel {
+
+namespace {
+
+// A face of any rank, as this rank sees it.
+struct Work {
+  LO face = kNoIndex;
+  int owner = 0;
+  std::size_t local = 0;  // index in `mine` when owner is this rank
+  mesh::FaceMesh mesh;    // the copy of another rank's face
+  std::vector<crossfield::Singularity> singularities;
+  std::int64_t quads = 0;
+};
+
+// What improving one face gives, wherever it ran.
+struct Result {
+  bool done = false;
+  mesh::FaceMesh mesh;
+  QuasiReport fields;  // the cavity and disk fields only
+  double seconds = 0;
+  std::array<double, 3> steps{};
+};
+
+Result improve_one(const cad::CadModel& model, LO face, mesh::FaceMesh mesh,
+                   std::span<const crossfield::Singularity> singularities,
+                   const ImproveSettings& settings, Logger& log) {
+  Result r;
+  r.done = true;
+  const Stopwatch total;
+  std::unique_ptr<cad::FaceGeometry> surface;
+  try {
+    surface = model.face_geometry(face);
+  } catch (const std::exception& e) {
+    log.warn(Error(e.what(), ErrorContext{"topological improvement", 2, face}).what());
+  }
+  // A step that throws leaves the face's valid mesh as it was.
+  const auto step = [&](int k, const char* what, const auto& run) {
+    if (surface == nullptr) return;
+    const Stopwatch clock;
+    try {
+      mesh::FaceMesh out = run(*surface);
+      out.face = face;
+      mesh = std::move(out);
+    } catch (const std::exception& e) {
+      log.warn(Error(e.what(), ErrorContext{what, 2, face}).what());
+    }
+    r.steps[static_cast<std::size_t>(k)] = clock.seconds();
+  };
+  // Cavity remeshing (Sec. 6.2): irregular vertices that the cross field does not ask for are
+  // removed by remeshing convex cavities with patterns.
+  step(0, "cavity remeshing", [&](const cad::FaceGeometry& s) {
+    qstruct::CavityReport cr;
+    mesh::FaceMesh out =
+        qstruct::remesh_cavities(mesh, s, singularities, settings.patterns, settings.cavities, &cr);
+    r.fields.irregular_before = cr.irregular_before;
+    r.fields.irregular_after = cr.irregular_after;
+    r.fields.cavities = cr.remeshed;
+    r.fields.time_budget_hit = cr.time_budget_hit;
+    return out;
+  });
+  // Local clean-up (Sec. 6.3): defects remeshed with the best disk quadrangulation, each
+  // replacement a transaction.
+  step(1, "disk remeshing", [&](const cad::FaceGeometry& s) {
+    remesh::DiskRemeshStats ds;
+    mesh::FaceMesh out = remesh::remesh_disk_defects(mesh, s, *settings.table, settings.disk, &ds);
+    r.fields.defects_before = ds.defects_before;
+    r.fields.defects_after = ds.defects_after;
+    r.fields.disk_replaced = ds.replaced;
+    return out;
+  });
+  if (settings.final_smoothing)
+    step(2, "final smoothing", [&](const cad::FaceGeometry& s) {
+      return smooth::smooth_face(mesh, s, settings.final_smooth);
+    });
+  r.mesh = std::move(mesh);
+  r.seconds = total.seconds();
+  return r;
+}
+
+void copy_fields(const QuasiReport& from, QuasiReport& to) {
+  to.irregular_before = from.irregular_before;
+  to.irregular_after = from.irregular_after;
+  to.cavities = from.cavities;
+  to.time_budget_hit = from.time_budget_hit;
+  to.defects_before = from.defects_before;
+  to.defects_after = from.defects_after;
+  to.disk_replaced = from.disk_replaced;
+}
+
+void apply(Result&& r, ImproveFace& f) {
+  *f.mesh = std::move(r.mesh);
+  copy_fields(r.fields, *f.report);
+  *f.seconds += r.seconds;
+}
+
+void pack_result(LO face, const Result& r, std::vector<char>& out) {
+  put<LO>(out, face);
+  pack_mesh(r.mesh, out);
+  const QuasiReport& q = r.fields;
+  for (std::int64_t x :
+       {q.irregular_before, q.irregular_after, q.defects_before, q.defects_after, q.disk_replaced})
+    put<std::int64_t>(out, x);
+  put(out, q.cavities);
+  put<std::uint8_t>(out, q.time_budget_hit ? 1 : 0);
+  put<double>(out, r.seconds);
+}
+
+LO unpack_result(const std::vector<char>& in, std::size_t& pos, Result& r) {
+  const auto face = get<LO>(in, pos);
+  unpack_mesh(in, pos, r.mesh);
+  QuasiReport& q = r.fields;
+  for (std::int64_t* x : {&q.irregular_before, &q.irregular_after, &q.defects_before,
+                          &q.defects_after, &q.disk_replaced})
+    *x = get<std::int64_t>(in, pos);
+  q.cavities = get<std::array<std::int64_t, 4>>(in, pos);
+  q.time_budget_hit = get<std::uint8_t>(in, pos) != 0;
+  r.seconds = get<double>(in, pos);
+  r.done = true;
+  return face;
+}
+
+// Every rank's buffer on every rank: rank 0 gathers and broadcasts (a record per rank: its size,
+// then its bytes).
+std::vector<std::vector<char>> allgather_bytes(const Comm& comm, const std::vector<char>& mine) {
+  const auto gathered = comm.gather_bytes(mine, 0);
+  std::vector<char> all;
+  if (comm.rank() == 0)
+    for (const auto& b : gathered) put_vec(all, b);
+  comm.broadcast_bytes(all, 0);
+  std::vector<std::vector<char>> out(static_cast<std::size_t>(comm.size()));
+  std::size_t pos = 0;
+  for (auto& b : out) get_vec(all, pos, b);
+  QSMESH_CHECK(pos == all.size(), "improvement: " << all.size() - pos << " bytes left over");
+  return out;
+}
+
+}  // namespace
+
+std::array<double, 3> improve_faces(const Comm& comm, const cad::CadModel& model,
+                                    std::span<ImproveFace> mine, const ImproveSettings& settings,
+                                    const TaskArena& tasks, Logger& log) {
+  QSMESH_CHECK(settings.table != nullptr, "improvement: no disk quadrangulation table");
+  const int rank = comm.rank();
+  const int nranks = comm.size();
+
+  // Every rank's faces, this rank's read in place and the others' copied in.
+  std::vector<Work> work;
+  if (nranks == 1) {
+    for (std::size_t i = 0; i < mine.size(); ++i)
+      work.push_back(
+          {mine[i].face, 0, i, {}, {}, static_cast<std::int64_t>(mine[i].mesh->quads.size())});
+  } else {
+    std::vector<char> buffer;
+    for (const ImproveFace& f : mine) {
+      pack_mesh(*f.mesh, buffer);
+      put_vec(buffer,
+              std::vector<crossfield::Singularity>(f.singularities.begin(), f.singularities.end()));
+    }
+    const auto all = allgather_bytes(comm, buffer);
+    for (int r = 0; r < nranks; ++r) {
+      const std::vector<char>& bytes = all[static_cast<std::size_t>(r)];
+      std::size_t pos = 0;
+      for (std::size_t i = 0; pos < bytes.size(); ++i) {
+        Work w;
+        w.owner = r;
+        w.local = i;
+        unpack_mesh(bytes, pos, w.mesh);
+        get_vec(bytes, pos, w.singularities);
+        w.face = w.mesh.face;
+        w.quads = static_cast<std::int64_t>(w.mesh.quads.size());
+        if (r == rank) {  // read in place
+          QSMESH_CHECK(i < mine.size() && mine[i].face == w.face,
+                       "improvement: face record " << w.face << " out of order");
+          w.mesh = mesh::FaceMesh{};
+          w.singularities.clear();
+        }
+        work.push_back(std::move(w));
+      }
+    }
+  }
+
+  // Largest first, so that the last faces dealt out are short.
+  std::vector<std::size_t> order(work.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return work[a].quads != work[b].quads ? work[a].quads > work[b].quads
+                                          : work[a].face < work[b].face;
+  });
+  const auto n = static_cast<std::int64_t>(work.size());
+  std::vector<Result> results(work.size());
+  {
+    SharedCounter counter(comm);
+    tasks.parallel_for(tasks.threads(), [&](std::int64_t) {
+      for (std::int64_t k = counter.next(); k < n; k = counter.next()) {
+        const std::size_t w_at = order[static_cast<std::size_t>(k)];
+        Work& w = work[w_at];
+        const bool local = w.owner == rank;
+        mesh::FaceMesh in = local ? std::move(*mine[w.local].mesh) : std::move(w.mesh);
+        const std::span<const crossfield::Singularity> singular =
+            local ? mine[w.local].singularities
+                  : std::span<const crossfield::Singularity>(w.singularities);
+        results[w_at] = improve_one(model, w.face, std::move(in), singular, settings, log);
+        if ((k + 1) * 10 / n != k * 10 / n)
+          log.info(cat("improvement: ", k + 1, "/", n, " faces (all ranks)"));
+      }
+    });
+  }
+
+  // Results to their owners; the time of each step summed over the faces of all ranks.
+  std::vector<double> steps(3, 0.0);
+  std::vector<char> outgoing;
+  for (std::size_t i = 0; i < work.size(); ++i) {
+    Result& r = results[i];
+    if (!r.done) continue;
+    for (std::size_t k = 0; k < 3; ++k) steps[k] += r.steps[k];
+    if (work[i].owner == rank)
+      apply(std::move(r), mine[work[i].local]);
+    else
+      pack_result(work[i].face, r, outgoing);
+  }
+  if (nranks > 1) {
+    std::vector<std::size_t> local_of_face;  // face -> index in mine + 1 (0: not this rank's)
+    for (std::size_t i = 0; i < mine.size(); ++i) {
+      const auto f = static_cast<std::size_t>(mine[i].face);
+      if (local_of_face.size() <= f) local_of_face.resize(f + 1, 0);
+      local_of_face[f] = i + 1;
+    }
+    const auto all = allgather_bytes(comm, outgoing);
+    for (const auto& bytes : all) {
+      std::size_t pos = 0;
+      while (pos < bytes.size()) {
+        Result r;
+        const auto f = static_cast<std::size_t>(unpack_result(bytes, pos, r));
+        if (f < local_of_face.size() && local_of_face[f] != 0)
+          apply(std::move(r), mine[local_of_face[f] - 1]);
+      }
+    }
+    comm.allreduce_sum(steps);
+  }
+  return {steps[0], steps[1], steps[2]};
+}
+
+}  // namespace qsmesh::parallel

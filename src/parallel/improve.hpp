@@ -1,0 +1,55 @@
+// The topological improvement of the unstructured faces (paper 000 Sec. 6.2-6.3 and the final
+// smoothing), dealt out across ranks and threads as faces finish (src/parallel only).
+#pragma once
+
+#include <array>
+#include <span>
+#include <vector>
+
+#include "qsmesh/cad/model.hpp"
+#include "qsmesh/core/log.hpp"
+#include "qsmesh/core/tasks.hpp"
+#include "qsmesh/crossfield/cross_field.hpp"
+#include "qsmesh/mesh/surface_mesh.hpp"
+#include "qsmesh/parallel/comm.hpp"
+#include "qsmesh/parallel/pipeline.hpp"
+#include "qsmesh/qstruct/patterns.hpp"
+#include "qsmesh/remesh/disk_table.hpp"
+
+namespace qsmesh::parallel {
+
+/// One face of this rank to improve.
+struct ImproveFace {
+  LO face = kNoIndex;
+  mesh::FaceMesh* mesh = nullptr;  ///< in: the valid all-quad unstructured mesh; out: improved
+  std::span<const crossfield::Singularity> singularities;  ///< of the face's cross field
+  QuasiReport* report = nullptr;                           ///< out: the cavity and disk fields
+  double* seconds = nullptr;                               ///< out: += wall time spent on the face
+};
+
+/// What the steps take.
+struct ImproveSettings {
+  std::span<const qstruct::Pattern> patterns;
+  const remesh::DiskQuadTable* table = nullptr;
+  qstruct::CavityOptions cavities;
+  remesh::DiskRemeshOptions disk;
+  bool final_smoothing = true;
+  smooth::SmoothOptions final_smooth;
+};
+
+/// Per face, in order: cavity remeshing (Sec. 6.2), disk remeshing of the defects (Sec. 6.3), the
+/// final smoothing (when settings.final_smoothing). A step that throws leaves the face's valid
+/// mesh as it was (the warning names the face and the step).
+///
+/// Collective over `comm`. A face's cost is not known before (a few faces of a model take most of
+/// the time, whatever their size), so no partition fixed in advance balances it: every rank
+/// receives every rank's faces (mesh and singularities), the faces are taken largest first (quad
+/// count, then face id) from a SharedCounter by whichever thread of whichever rank is free, and
+/// each result goes back to the rank that owns the face. A face's result depends only on the
+/// face, so the mesh is the same whatever the numbers of ranks and threads. One rank: no copies.
+/// Returns the wall time of the three steps summed over the faces of all ranks (every rank).
+std::array<double, 3> improve_faces(const Comm& comm, const cad::CadModel& model,
+                                    std::span<ImproveFace> mine, const ImproveSettings& settings,
+                                    const TaskArena& tasks, Logger& log);
+
+}  // namespace qsmesh::parallel
