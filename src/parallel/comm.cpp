@@ -3,6 +3,7 @@
 #include <mpi.h>
 
 #include <atomic>
+#include <cstring>
 #include <limits>
 #include <mutex>
 
@@ -156,6 +157,35 @@ void Comm::broadcast_bytes(std::vector<char>& bytes, int root) const {
     const int count = static_cast<int>(std::min(kChunk, n - off));
     check_mpi(MPI_Bcast(bytes.data() + off, count, MPI_CHAR, root, impl_->comm), "MPI_Bcast");
   }
+}
+
+std::vector<std::vector<char>> Comm::allgather_bytes(const std::vector<char>& mine) const {
+  const auto gathered = gather_bytes(mine, 0);
+  // One buffer: each rank's size (64-bit) then its bytes.
+  std::vector<char> all;
+  if (rank() == 0)
+    for (const auto& b : gathered) {
+      const auto n = static_cast<std::int64_t>(b.size());
+      const auto* p = reinterpret_cast<const char*>(&n);
+      all.insert(all.end(), p, p + sizeof n);
+      all.insert(all.end(), b.begin(), b.end());
+    }
+  broadcast_bytes(all, 0);
+  std::vector<std::vector<char>> out(static_cast<std::size_t>(size()));
+  std::size_t pos = 0;
+  for (auto& b : out) {
+    std::int64_t n = 0;
+    QSMESH_CHECK(pos + sizeof n <= all.size(), "allgather_bytes: truncated buffer");
+    std::memcpy(&n, all.data() + pos, sizeof n);
+    pos += sizeof n;
+    QSMESH_CHECK(n >= 0 && pos + static_cast<std::size_t>(n) <= all.size(),
+                 "allgather_bytes: truncated buffer");
+    b.assign(all.begin() + static_cast<std::ptrdiff_t>(pos),
+             all.begin() + static_cast<std::ptrdiff_t>(pos + static_cast<std::size_t>(n)));
+    pos += static_cast<std::size_t>(n);
+  }
+  QSMESH_CHECK(pos == all.size(), "allgather_bytes: " << all.size() - pos << " bytes left over");
+  return out;
 }
 
 struct SharedCounter::Impl {

@@ -135,22 +135,15 @@ LO unpack_result(const std::vector<char>& in, std::size_t& pos, Result& r) {
   return face;
 }
 
-// Every rank's buffer on every rank: rank 0 gathers and broadcasts (a record per rank: its size,
-// then its bytes).
-std::vector<std::vector<char>> allgather_bytes(const Comm& comm, const std::vector<char>& mine) {
-  const auto gathered = comm.gather_bytes(mine, 0);
-  std::vector<char> all;
-  if (comm.rank() == 0)
-    for (const auto& b : gathered) put_vec(all, b);
-  comm.broadcast_bytes(all, 0);
-  std::vector<std::vector<char>> out(static_cast<std::size_t>(comm.size()));
-  std::size_t pos = 0;
-  for (auto& b : out) get_vec(all, pos, b);
-  QSMESH_CHECK(pos == all.size(), "improvement: " << all.size() - pos << " bytes left over");
-  return out;
-}
-
 }  // namespace
+
+void deal_out(const Comm& comm, std::int64_t n, const TaskArena& tasks,
+              const std::function<void(std::int64_t)>& body) {
+  SharedCounter counter(comm);
+  tasks.parallel_for(tasks.threads(), [&](std::int64_t) {
+    for (std::int64_t k = counter.next(); k < n; k = counter.next()) body(k);
+  });
+}
 
 std::array<double, 3> improve_faces(const Comm& comm, const cad::CadModel& model,
                                     std::span<ImproveFace> mine, const ImproveSettings& settings,
@@ -172,7 +165,7 @@ std::array<double, 3> improve_faces(const Comm& comm, const cad::CadModel& model
       put_vec(buffer,
               std::vector<crossfield::Singularity>(f.singularities.begin(), f.singularities.end()));
     }
-    const auto all = allgather_bytes(comm, buffer);
+    const auto all = comm.allgather_bytes(buffer);
     for (int r = 0; r < nranks; ++r) {
       const std::vector<char>& bytes = all[static_cast<std::size_t>(r)];
       std::size_t pos = 0;
@@ -204,23 +197,18 @@ std::array<double, 3> improve_faces(const Comm& comm, const cad::CadModel& model
   });
   const auto n = static_cast<std::int64_t>(work.size());
   std::vector<Result> results(work.size());
-  {
-    SharedCounter counter(comm);
-    tasks.parallel_for(tasks.threads(), [&](std::int64_t) {
-      for (std::int64_t k = counter.next(); k < n; k = counter.next()) {
-        const std::size_t w_at = order[static_cast<std::size_t>(k)];
-        Work& w = work[w_at];
-        const bool local = w.owner == rank;
-        mesh::FaceMesh in = local ? std::move(*mine[w.local].mesh) : std::move(w.mesh);
-        const std::span<const crossfield::Singularity> singular =
-            local ? mine[w.local].singularities
-                  : std::span<const crossfield::Singularity>(w.singularities);
-        results[w_at] = improve_one(model, w.face, std::move(in), singular, settings, log);
-        if ((k + 1) * 10 / n != k * 10 / n)
-          log.info(cat("improvement: ", k + 1, "/", n, " faces (all ranks)"));
-      }
-    });
-  }
+  deal_out(comm, n, tasks, [&](std::int64_t k) {
+    const std::size_t w_at = order[static_cast<std::size_t>(k)];
+    Work& w = work[w_at];
+    const bool local = w.owner == rank;
+    mesh::FaceMesh in = local ? std::move(*mine[w.local].mesh) : std::move(w.mesh);
+    const std::span<const crossfield::Singularity> singular =
+        local ? mine[w.local].singularities
+              : std::span<const crossfield::Singularity>(w.singularities);
+    results[w_at] = improve_one(model, w.face, std::move(in), singular, settings, log);
+    if ((k + 1) * 10 / n != k * 10 / n)
+      log.info(cat("improvement: ", k + 1, "/", n, " faces (all ranks)"));
+  });
 
   // Results to their owners; the time of each step summed over the faces of all ranks.
   std::vector<double> steps(3, 0.0);
@@ -241,7 +229,7 @@ std::array<double, 3> improve_faces(const Comm& comm, const cad::CadModel& model
       if (local_of_face.size() <= f) local_of_face.resize(f + 1, 0);
       local_of_face[f] = i + 1;
     }
-    const auto all = allgather_bytes(comm, outgoing);
+    const auto all = comm.allgather_bytes(outgoing);
     for (const auto& bytes : all) {
       std::size_t pos = 0;
       while (pos < bytes.size()) {

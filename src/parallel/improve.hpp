@@ -3,6 +3,7 @@
 #pragma once
 
 #include <array>
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -17,6 +18,13 @@
 #include "qsmesh/remesh/disk_table.hpp"
 
 namespace qsmesh::parallel {
+
+/// Calls body(k) once for each k in [0, n), over the threads of every rank together: each free
+/// thread takes the next k from a SharedCounter (collective; no other MPI call may run meanwhile,
+/// so body must not call MPI). Which rank runs which k depends on timing; the caller keeps
+/// results keyed by k and sends them where they belong.
+void deal_out(const Comm& comm, std::int64_t n, const TaskArena& tasks,
+              const std::function<void(std::int64_t)>& body);
 
 /// One face of this rank to improve.
 struct ImproveFace {

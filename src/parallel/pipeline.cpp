@@ -6,6 +6,7 @@
 #include <cstring>
 #include <limits>
 #include <memory>
+#include <numeric>
 
 #include "improve.hpp"
 #include "qsmesh/background/curve_mesh.hpp"
@@ -357,39 +358,111 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
   std::vector<double> face_seconds(quads ? mine.size() : 0, 0.0);
   if (quasi) {
     // Simple CAD faces meshed directly by a pattern (paper 000 Sec. 6.1.2, pipeline step 4); the
-    // others go through the unstructured path below.
+    // others go through the unstructured path below. A fill needs only the model, the curve meshes
+    // (every rank has them) and the face's quad bound, which its owner computes from its size map
+    // and shares; the faces are then dealt out over all ranks (deal_out), largest bound first: a
+    // few faces whose fills are refused and searched take most of the stage.
     clock.reset();
-    std::atomic<std::int64_t> p_done{0};
+    std::vector<std::int64_t> bound_of(static_cast<std::size_t>(nfaces), 0);
     tasks.parallel_for(total, [&](std::int64_t i) {
-      const Stopwatch face_clock;
-      qstruct::PatternFaceReport pr;
-      qstruct::PatternFaceOptions po = options.patterns;
       if (options.pattern_max_quad_ratio > 0 && !sizes.empty())
-        po.max_quads = std::max<std::int64_t>(
+        fill_bound[i] = std::max<std::int64_t>(
             options.pattern_min_quad_bound,
             static_cast<std::int64_t>(std::ceil(options.pattern_max_quad_ratio *
                                                 sizemap::expected_quads(meshes[i], sizes[i].s))));
-      fill_bound[i] = po.max_quads;
-      mesh::FaceMesh m =
-          qstruct::mesh_face_pattern(model, mine[i], result.quantized_curves, patterns, po, &pr);
+      bound_of[static_cast<std::size_t>(mine[i])] = fill_bound[i];
+    });
+    comm.allreduce_sum(bound_of);  // each face's entry is set by its owner alone
+    std::vector<LO> order(static_cast<std::size_t>(nfaces));
+    std::iota(order.begin(), order.end(), LO{0});
+    std::sort(order.begin(), order.end(), [&](LO a, LO b) {
+      return bound_of[a] != bound_of[b] ? bound_of[a] > bound_of[b] : a < b;
+    });
+    struct Fill {
+      bool done = false;
+      qstruct::PatternFaceReport report;  // refused_mesh kept only for the comparison
+      mesh::FaceMesh mesh;
+      double seconds = 0;
+    };
+    std::vector<Fill> fills(static_cast<std::size_t>(nfaces));
+    std::atomic<std::int64_t> p_done{0};
+    deal_out(comm, nfaces, tasks, [&](std::int64_t k) {
+      const LO f = order[static_cast<std::size_t>(k)];
+      const Stopwatch face_clock;
+      Fill& fill = fills[static_cast<std::size_t>(f)];
+      qstruct::PatternFaceOptions po = options.patterns;
+      po.max_quads = bound_of[static_cast<std::size_t>(f)];
+      fill.mesh =
+          qstruct::mesh_face_pattern(model, f, result.quantized_curves, patterns, po, &fill.report);
+      if (fill.report.ok || options.pattern_compare_tolerance < 0)
+        fill.report.refused_mesh = mesh::FaceMesh{};
+      fill.seconds = face_clock.seconds();
+      fill.done = true;
+      const std::int64_t n = ++p_done;
+      if (n * 10 / nfaces != (n - 1) * 10 / nfaces)
+        log.info(cat("patterns: ", n, " faces on rank ", rank));
+    });
+    // Fills to their owners.
+    const auto take = [&](std::int64_t i, Fill&& fill) {
+      const qstruct::PatternFaceReport& pr = fill.report;
       if (pr.ok) {
         quasi_reports[i].by_pattern = true;
         quasi_reports[i].pattern = pr.pattern_name;
         quad_reports[i].ok = true;
         quad_reports[i].sicn_min = pr.sicn_min;
         quad_reports[i].quads = pr.quads;
-        quad_meshes[i] = std::move(m);
+        quad_meshes[i] = std::move(fill.mesh);
       } else {
         quasi_reports[i].refusal = qstruct::to_string(pr.refusal);
-        if (options.pattern_compare_tolerance >= 0 && !pr.refused_mesh.quads.empty()) {
-          refused[i] = {std::move(pr.refused_mesh), pr.pattern_name};
+        if (!fill.report.refused_mesh.quads.empty())
+          refused[i] = {std::move(fill.report.refused_mesh), pr.pattern_name};
+      }
+      face_seconds[i] += fill.seconds;
+    };
+    std::vector<std::int64_t> local_of(static_cast<std::size_t>(nfaces), -1);
+    for (std::int64_t i = 0; i < total; ++i) local_of[static_cast<std::size_t>(mine[i])] = i;
+    std::vector<char> outgoing;
+    for (LO f = 0; f < nfaces; ++f) {
+      Fill& fill = fills[static_cast<std::size_t>(f)];
+      if (!fill.done) continue;
+      if (local_of[static_cast<std::size_t>(f)] >= 0) {
+        take(local_of[static_cast<std::size_t>(f)], std::move(fill));
+      } else {
+        const qstruct::PatternFaceReport& pr = fill.report;
+        put<LO>(outgoing, f);
+        put<std::uint8_t>(outgoing, pr.ok ? 1 : 0);
+        put<qstruct::Refusal>(outgoing, pr.refusal);
+        put_vec(outgoing, std::vector<char>(pr.pattern_name.begin(), pr.pattern_name.end()));
+        put<double>(outgoing, pr.sicn_min);
+        put<std::int64_t>(outgoing, pr.quads);
+        pack_mesh(fill.mesh, outgoing);
+        pack_mesh(pr.refused_mesh, outgoing);
+        put<double>(outgoing, fill.seconds);
+      }
+      fill = Fill{};
+    }
+    if (nranks > 1)
+      for (const auto& bytes : comm.allgather_bytes(outgoing)) {
+        std::size_t pos = 0;
+        while (pos < bytes.size()) {
+          const auto f = get<LO>(bytes, pos);
+          Fill fill;
+          qstruct::PatternFaceReport& pr = fill.report;
+          pr.ok = get<std::uint8_t>(bytes, pos) != 0;
+          pr.refusal = get<qstruct::Refusal>(bytes, pos);
+          std::vector<char> name;
+          get_vec(bytes, pos, name);
+          pr.pattern_name.assign(name.begin(), name.end());
+          pr.sicn_min = get<double>(bytes, pos);
+          pr.quads = get<std::int64_t>(bytes, pos);
+          unpack_mesh(bytes, pos, fill.mesh);
+          unpack_mesh(bytes, pos, pr.refused_mesh);
+          fill.seconds = get<double>(bytes, pos);
+          QSMESH_CHECK(f >= 0 && f < nfaces, "pattern fill for unknown face " << f);
+          if (local_of[static_cast<std::size_t>(f)] >= 0)
+            take(local_of[static_cast<std::size_t>(f)], std::move(fill));
         }
       }
-      face_seconds[i] += face_clock.seconds();
-      const std::int64_t n = ++p_done;
-      if (n * 10 / total != (n - 1) * 10 / total)
-        log.info(cat("patterns: ", n, "/", mine.size(), " faces on rank ", rank));
-    });
     end_stage("patterns", true);
   }
   if (quads) {

@@ -54,6 +54,8 @@ class Comm {
                                                             int root = 0) const;
   /// Broadcasts a byte buffer from `root` (resized on the receivers).
   void broadcast_bytes(std::vector<char>& bytes, int root = 0) const;
+  /// Every rank's byte buffer on every rank, in rank order (gathered on rank 0, then broadcast).
+  [[nodiscard]] std::vector<std::vector<char>> allgather_bytes(const std::vector<char>& mine) const;
 
  private:
   struct Impl;
