@@ -91,8 +91,11 @@ TEST(Pipeline, DistributedEqualsSerial) {
   ASSERT_EQ(static_cast<int>(result.rank_busy_seconds.size()), comm.size());
   std::vector<int> faces_of(static_cast<std::size_t>(comm.size()), 0);
   for (int r : result.face_rank) ++faces_of[static_cast<std::size_t>(r)];
-  for (int r = 0; r < comm.size(); ++r)
-    if (faces_of[static_cast<std::size_t>(r)] > 0) EXPECT_GT(result.rank_busy_seconds[r], 0.0) << r;
+  for (int r = 0; r < comm.size(); ++r) {
+    if (faces_of[static_cast<std::size_t>(r)] > 0) {
+      EXPECT_GT(result.rank_busy_seconds[r], 0.0) << r;
+    }
+  }
   EXPECT_EQ(*std::max_element(result.rank_busy_seconds.begin(), result.rank_busy_seconds.end()),
             result.times.get("background"));
 
