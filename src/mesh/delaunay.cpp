@@ -780,9 +780,12 @@ class FaceMesher {
     return moved;
   }
 
-  /// TriangulateOptions::shorten_ratio.
-  void flip_shorter(double ratio) {
-    for (int sweep = 0; sweep < 100; ++sweep) {
+  /// Sweeps over the interior edges (at most max_sweeps, until one flips nothing), flipping each
+  /// edge (b, c) between triangles (a, b, c) and (d, c, b) for which flip(a, b, c, d) holds and
+  /// the flip is valid in (u, v).
+  template <class Rule>
+  void flip_sweeps(int max_sweeps, const Rule& flip) {
+    for (int sweep = 0; sweep < max_sweeps; ++sweep) {
       std::int64_t flips = 0;
       for (LO t = 0; t < static_cast<LO>(tr_.tris.size()); ++t) {
         for (int i = 0; i < 3; ++i) {
@@ -792,38 +795,38 @@ class FaceMesher {
           if (u == kNoIndex || T.is_locked(i)) continue;
           const LO a = T.v[i], b = T.v[next3(i)], c = T.v[prev3(i)];
           const LO d = tr_.tris[u].v[tr_.edge_to(u, t)];
-          if (std::min({a, b, c, d}) < first_real_) continue;
-          const double length = distance(xyz_[b], xyz_[c]);
-          if (length <= 2 * std::min(h_[b], h_[c]) || distance(xyz_[a], xyz_[d]) >= ratio * length)
-            continue;
-          const double before = std::min(tri_min_angle(a, b, c), tri_min_angle(d, c, b));
-          const double after = std::min(tri_min_angle(a, b, d), tri_min_angle(d, c, a));
-          if (after >= before && tr_.flip(t, i)) ++flips;
+          if (flip(a, b, c, d) && tr_.flip(t, i)) ++flips;
         }
       }
       if (flips == 0) break;
     }
   }
 
+  /// The smaller 3D angle of the two triangles on each side of edge (b, c): as they are, and
+  /// after the flip to (a, d).
+  std::pair<double, double> angles_before_after(LO a, LO b, LO c, LO d) const {
+    return {std::min(tri_min_angle(a, b, c), tri_min_angle(d, c, b)),
+            std::min(tri_min_angle(a, b, d), tri_min_angle(d, c, a))};
+  }
+
+  /// TriangulateOptions::shorten_ratio.
+  void flip_shorter(double ratio) {
+    flip_sweeps(100, [&](LO a, LO b, LO c, LO d) {
+      if (std::min({a, b, c, d}) < first_real_) return false;
+      const double length = distance(xyz_[b], xyz_[c]);
+      if (length <= 2 * std::min(h_[b], h_[c]) || distance(xyz_[a], xyz_[d]) >= ratio * length)
+        return false;
+      const auto [before, after] = angles_before_after(a, b, c, d);
+      return after >= before;
+    });
+  }
+
   void flip_for_angles() {
     constexpr double kGain = 1e-3;  // radians
-    for (int sweep = 0; sweep < 6; ++sweep) {
-      std::int64_t flips = 0;
-      for (LO t = 0; t < static_cast<LO>(tr_.tris.size()); ++t) {
-        for (int i = 0; i < 3; ++i) {
-          const Tri& T = tr_.tris[t];
-          if (!T.alive) break;
-          const LO u = T.n[i];
-          if (u == kNoIndex || T.is_locked(i)) continue;
-          const LO a = T.v[i], b = T.v[next3(i)], c = T.v[prev3(i)];
-          const LO d = tr_.tris[u].v[tr_.edge_to(u, t)];
-          const double before = std::min(tri_min_angle(a, b, c), tri_min_angle(d, c, b));
-          const double after = std::min(tri_min_angle(a, b, d), tri_min_angle(d, c, a));
-          if (after > before + kGain && tr_.flip(t, i)) ++flips;
-        }
-      }
-      if (flips == 0) break;
-    }
+    flip_sweeps(6, [&](LO a, LO b, LO c, LO d) {
+      const auto [before, after] = angles_before_after(a, b, c, d);
+      return after > before + kGain;
+    });
   }
 
   // ---------------------------------------------------------------- output

@@ -50,7 +50,7 @@ void pack(const mesh::FaceMesh& m, const background::FaceReport& r, std::vector<
   put<std::uint8_t>(out, r.ok ? 1 : 0);
   put<std::uint8_t>(out, r.fell_back ? 1 : 0);
   put<double>(out, r.seconds);
-  put_vec(out, std::vector<char>(r.error.begin(), r.error.end()));
+  put_string(out, r.error);
 }
 
 void unpack(const std::vector<char>& in, std::size_t& pos, mesh::FaceMesh& m,
@@ -60,9 +60,7 @@ void unpack(const std::vector<char>& in, std::size_t& pos, mesh::FaceMesh& m,
   r.ok = get<std::uint8_t>(in, pos) != 0;
   r.fell_back = get<std::uint8_t>(in, pos) != 0;
   r.seconds = get<double>(in, pos);
-  std::vector<char> err;
-  get_vec(in, pos, err);
-  r.error.assign(err.begin(), err.end());
+  r.error = get_string(in, pos);
 }
 
 CrossFieldOutput summarize(const crossfield::FaceCrossField& cf) {
@@ -92,7 +90,7 @@ CrossFieldOutput summarize(const crossfield::FaceCrossField& cf) {
 
 void pack(const CrossFieldOutput& c, std::vector<char>& out) {
   put<std::uint8_t>(out, c.ok ? 1 : 0);
-  put_vec(out, std::vector<char>(c.error.begin(), c.error.end()));
+  put_string(out, c.error);
   put_vec(out, c.directions);
   put_vec(out, c.u_norm);
   put_vec(out, c.H);
@@ -106,9 +104,7 @@ void pack(const CrossFieldOutput& c, std::vector<char>& out) {
 
 void unpack(const std::vector<char>& in, std::size_t& pos, CrossFieldOutput& c) {
   c.ok = get<std::uint8_t>(in, pos) != 0;
-  std::vector<char> err;
-  get_vec(in, pos, err);
-  c.error.assign(err.begin(), err.end());
+  c.error = get_string(in, pos);
   get_vec(in, pos, c.directions);
   get_vec(in, pos, c.u_norm);
   get_vec(in, pos, c.H);
@@ -137,7 +133,7 @@ void pack(const quad::UnstructuredReport& r, std::vector<char>& out) {
   put<std::uint8_t>(out, r.fell_back ? 1 : 0);
   put<std::uint8_t>(out, r.frontal ? 1 : 0);
   put<std::int64_t>(out, r.frontal_points);
-  put_vec(out, std::vector<char>(r.error.begin(), r.error.end()));
+  put_string(out, r.error);
   put<double>(out, r.sicn_min);
   put<std::int64_t>(out, r.quads);
 }
@@ -147,9 +143,7 @@ void unpack(const std::vector<char>& in, std::size_t& pos, quad::UnstructuredRep
   r.fell_back = get<std::uint8_t>(in, pos) != 0;
   r.frontal = get<std::uint8_t>(in, pos) != 0;
   r.frontal_points = get<std::int64_t>(in, pos);
-  std::vector<char> err;
-  get_vec(in, pos, err);
-  r.error.assign(err.begin(), err.end());
+  r.error = get_string(in, pos);
   r.sicn_min = get<double>(in, pos);
   r.quads = get<std::int64_t>(in, pos);
 }
@@ -157,8 +151,8 @@ void unpack(const std::vector<char>& in, std::size_t& pos, quad::UnstructuredRep
 void pack(const QuasiReport& r, std::vector<char>& out) {
   put<std::uint8_t>(out, r.by_pattern ? 1 : 0);
   put<std::uint8_t>(out, r.by_comparison ? 1 : 0);
-  put_vec(out, std::vector<char>(r.pattern.begin(), r.pattern.end()));
-  put_vec(out, std::vector<char>(r.refusal.begin(), r.refusal.end()));
+  put_string(out, r.pattern);
+  put_string(out, r.refusal);
   put<std::int64_t>(out, r.irregular_before);
   put<std::int64_t>(out, r.irregular_after);
   for (auto c : r.cavities) put<std::int64_t>(out, c);
@@ -171,11 +165,8 @@ void pack(const QuasiReport& r, std::vector<char>& out) {
 void unpack(const std::vector<char>& in, std::size_t& pos, QuasiReport& r) {
   r.by_pattern = get<std::uint8_t>(in, pos) != 0;
   r.by_comparison = get<std::uint8_t>(in, pos) != 0;
-  std::vector<char> text;
-  get_vec(in, pos, text);
-  r.pattern.assign(text.begin(), text.end());
-  get_vec(in, pos, text);
-  r.refusal.assign(text.begin(), text.end());
+  r.pattern = get_string(in, pos);
+  r.refusal = get_string(in, pos);
   r.irregular_before = get<std::int64_t>(in, pos);
   r.irregular_after = get<std::int64_t>(in, pos);
   for (auto& c : r.cavities) c = get<std::int64_t>(in, pos);
@@ -432,7 +423,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
         put<LO>(outgoing, f);
         put<std::uint8_t>(outgoing, pr.ok ? 1 : 0);
         put<qstruct::Refusal>(outgoing, pr.refusal);
-        put_vec(outgoing, std::vector<char>(pr.pattern_name.begin(), pr.pattern_name.end()));
+        put_string(outgoing, pr.pattern_name);
         put<double>(outgoing, pr.sicn_min);
         put<std::int64_t>(outgoing, pr.quads);
         pack_mesh(fill.mesh, outgoing);
@@ -450,9 +441,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
           qstruct::PatternFaceReport& pr = fill.report;
           pr.ok = get<std::uint8_t>(bytes, pos) != 0;
           pr.refusal = get<qstruct::Refusal>(bytes, pos);
-          std::vector<char> name;
-          get_vec(bytes, pos, name);
-          pr.pattern_name.assign(name.begin(), name.end());
+          pr.pattern_name = get_string(bytes, pos);
           pr.sicn_min = get<double>(bytes, pos);
           pr.quads = get<std::int64_t>(bytes, pos);
           unpack_mesh(bytes, pos, fill.mesh);

@@ -4,6 +4,7 @@
 
 #include <cstdint>
 #include <cstring>
+#include <string>
 #include <vector>
 
 #include "qsmesh/core/error.hpp"
@@ -37,6 +38,16 @@ void get_vec(const std::vector<char>& in, std::size_t& pos, std::vector<T>& v) {
   v.resize(n);
   std::memcpy(v.data(), in.data() + pos, n * sizeof(T));
   pos += n * sizeof(T);
+}
+
+inline void put_string(std::vector<char>& out, const std::string& text) {
+  put_vec(out, std::vector<char>(text.begin(), text.end()));
+}
+
+inline std::string get_string(const std::vector<char>& in, std::size_t& pos) {
+  std::vector<char> text;
+  get_vec(in, pos, text);
+  return {text.begin(), text.end()};
 }
 
 inline void pack_mesh(const mesh::FaceMesh& m, std::vector<char>& out) {
