@@ -137,6 +137,14 @@ LO unpack_result(const std::vector<char>& in, std::size_t& pos, Result& r) {
 
 }  // namespace
 
+void DealProgress::done() {
+  const std::int64_t d = ++done_;
+  if (n_ <= 0 || d * 10 / n_ == (d - 1) * 10 / n_) return;
+  log_.info(ranks_ == 1
+                ? cat(stage_, ": ", d, "/", n_, " faces")
+                : cat(stage_, ": ", d, " faces on rank ", rank_, " (", n_, " on all ranks)"));
+}
+
 void deal_out(const Comm& comm, std::int64_t n, const TaskArena& tasks,
               const std::function<void(std::int64_t)>& body) {
   SharedCounter counter(comm);
@@ -197,6 +205,7 @@ std::array<double, 3> improve_faces(const Comm& comm, const cad::CadModel& model
   });
   const auto n = static_cast<std::int64_t>(work.size());
   std::vector<Result> results(work.size());
+  DealProgress progress("improvement", n, comm, log);
   deal_out(comm, n, tasks, [&](std::int64_t k) {
     const std::size_t w_at = order[static_cast<std::size_t>(k)];
     Work& w = work[w_at];
@@ -206,8 +215,7 @@ std::array<double, 3> improve_faces(const Comm& comm, const cad::CadModel& model
         local ? mine[w.local].singularities
               : std::span<const crossfield::Singularity>(w.singularities);
     results[w_at] = improve_one(model, w.face, std::move(in), singular, settings, log);
-    if ((k + 1) * 10 / n != k * 10 / n)
-      log.info(cat("improvement: ", k + 1, "/", n, " faces (all ranks)"));
+    progress.done();
   });
 
   // Results to their owners; the time of each step summed over the faces of all ranks.

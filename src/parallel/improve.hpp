@@ -3,6 +3,7 @@
 #pragma once
 
 #include <array>
+#include <atomic>
 #include <functional>
 #include <span>
 #include <vector>
@@ -25,6 +26,23 @@ namespace qsmesh::parallel {
 /// results keyed by k and sends them where they belong.
 void deal_out(const Comm& comm, std::int64_t n, const TaskArena& tasks,
               const std::function<void(std::int64_t)>& body);
+
+/// Progress of a dealt-out stage as this rank sees it: done() after each item it finished logs
+/// "STAGE: d/n faces" on one rank, "STAGE: d faces on rank r (n on all ranks)" on several, at
+/// every tenth of n. Thread-safe.
+class DealProgress {
+ public:
+  DealProgress(const char* stage, std::int64_t n, const Comm& comm, Logger& log)
+      : stage_(stage), n_(n), rank_(comm.rank()), ranks_(comm.size()), log_(log) {}
+  void done();
+
+ private:
+  const char* stage_;
+  std::int64_t n_;
+  int rank_, ranks_;
+  Logger& log_;
+  std::atomic<std::int64_t> done_{0};
+};
 
 /// One face of this rank to improve.
 struct ImproveFace {

@@ -376,7 +376,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
       double seconds = 0;
     };
     std::vector<Fill> fills(static_cast<std::size_t>(nfaces));
-    std::atomic<std::int64_t> p_done{0};
+    DealProgress progress("patterns", nfaces, comm, log);
     deal_out(comm, nfaces, tasks, [&](std::int64_t k) {
       const LO f = order[static_cast<std::size_t>(k)];
       const Stopwatch face_clock;
@@ -389,9 +389,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
         fill.report.refused_mesh = mesh::FaceMesh{};
       fill.seconds = face_clock.seconds();
       fill.done = true;
-      const std::int64_t n = ++p_done;
-      if (n * 10 / nfaces != (n - 1) * 10 / nfaces)
-        log.info(cat("patterns: ", n, " faces on rank ", rank));
+      progress.done();
     });
     // Fills to their owners.
     const auto take = [&](std::int64_t i, Fill&& fill) {
