@@ -218,6 +218,12 @@ std::array<double, 3> improve_faces(const Comm& comm, const cad::CadModel& model
     progress.done();
   });
 
+  // The copies of the other ranks' faces are done with (those taken here were moved out).
+  for (Work& w : work) {
+    w.mesh = mesh::FaceMesh{};
+    w.singularities = {};
+  }
+
   // Results to their owners; the time of each step summed over the faces of all ranks.
   std::vector<double> steps(3, 0.0);
   std::vector<char> outgoing;
