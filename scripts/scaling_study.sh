@@ -10,8 +10,10 @@
 #                                 [--repeat N] [--csv FILE]   (after scripts/build.sh)
 #   defaults: --size-factor 0.02, --until quasi-structured, --configs "1x1 1x2 2x1" (and 2x2, 4x1,
 #   4x2, 8x1, 8x2, 16x1 where the machine has that many cores), --repeat 3.
-# Wall time is that of the whole command (mpiexec, loading and writing included). Configurations
-# with more processes x threads than cores are run but marked: their times say nothing of scaling.
+# Wall time is that of the whole command (mpiexec, loading and writing included); the median of an
+# even number of runs is the lower middle one, and the stage times shown are that run's.
+# Configurations with more processes x threads than cores are run but marked: their times say
+# nothing of scaling.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 usage() { sed -n '9,12p' "$0" | sed 's/^# \{0,1\}//' >&2; exit 2; }
