@@ -343,9 +343,9 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     std::string pattern;
   };
   std::vector<RefusedFill> refused(quasi ? mine.size() : 0);
-  // The quad bound each face's fills had (0: none), for the second look after the unstructured
-  // path below.
-  std::vector<std::int64_t> fill_bound(quasi ? mine.size() : 0, 0);
+  // The quad bound of each face's fills (0: none), by face id: computed by the face's owner,
+  // known to every rank (the fills are dealt out), read again by the second look below.
+  std::vector<std::int64_t> fill_bound(quasi ? static_cast<std::size_t>(nfaces) : 0, 0);
   std::vector<double> face_seconds(quads ? mine.size() : 0, 0.0);
   if (quasi) {
     // Simple CAD faces meshed directly by a pattern (paper 000 Sec. 6.1.2, pipeline step 4); the
@@ -354,20 +354,18 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     // and shares; the faces are then dealt out over all ranks (deal_out), largest bound first: a
     // few faces whose fills are refused and searched take most of the stage.
     clock.reset();
-    std::vector<std::int64_t> bound_of(static_cast<std::size_t>(nfaces), 0);
     tasks.parallel_for(total, [&](std::int64_t i) {
       if (options.pattern_max_quad_ratio > 0 && !sizes.empty())
-        fill_bound[i] = std::max<std::int64_t>(
+        fill_bound[static_cast<std::size_t>(mine[i])] = std::max<std::int64_t>(
             options.pattern_min_quad_bound,
             static_cast<std::int64_t>(std::ceil(options.pattern_max_quad_ratio *
                                                 sizemap::expected_quads(meshes[i], sizes[i].s))));
-      bound_of[static_cast<std::size_t>(mine[i])] = fill_bound[i];
     });
-    comm.allreduce_sum(bound_of);  // each face's entry is set by its owner alone
+    comm.allreduce_sum(fill_bound);  // each face's entry is set by its owner alone
     std::vector<LO> order(static_cast<std::size_t>(nfaces));
     std::iota(order.begin(), order.end(), LO{0});
     std::sort(order.begin(), order.end(), [&](LO a, LO b) {
-      return bound_of[a] != bound_of[b] ? bound_of[a] > bound_of[b] : a < b;
+      return fill_bound[a] != fill_bound[b] ? fill_bound[a] > fill_bound[b] : a < b;
     });
     struct Fill {
       bool done = false;
@@ -382,7 +380,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
       const Stopwatch face_clock;
       Fill& fill = fills[static_cast<std::size_t>(f)];
       qstruct::PatternFaceOptions po = options.patterns;
-      po.max_quads = bound_of[static_cast<std::size_t>(f)];
+      po.max_quads = fill_bound[static_cast<std::size_t>(f)];
       fill.mesh =
           qstruct::mesh_face_pattern(model, f, result.quantized_curves, patterns, po, &fill.report);
       if (fill.report.ok || options.pattern_compare_tolerance < 0)
@@ -529,7 +527,8 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
             return;
           const bool failed = no_valid_quads(i);
           const auto unstructured_quads = static_cast<std::int64_t>(quad_meshes[i].quads.size());
-          if (!failed && (fill_bound[i] <= 0 || unstructured_quads <= fill_bound[i])) return;
+          const std::int64_t bound = fill_bound[static_cast<std::size_t>(mine[i])];
+          if (!failed && (bound <= 0 || unstructured_quads <= bound)) return;
           const Stopwatch face_clock;
           qstruct::PatternFaceOptions po = options.patterns;
           po.max_quads = failed ? 0 : unstructured_quads;

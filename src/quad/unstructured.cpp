@@ -101,33 +101,33 @@ mesh::FaceMesh frontal_quads(const cad::CadModel& model, LO f, const cad::FaceGe
                                       mesh::mean_boundary_speeds(surface, loops));
     if (!mesh::has_flat_boundary_triangle(again)) tri = std::move(again);
   }
-  const auto to_quads = [&](mesh::FaceMesh t, bool& fell_back) {
+  const auto to_quads = [&](mesh::FaceMesh& t, bool& fell_back) {
     t.face = f;
     for (auto& vc : t.vclass)
       if (vc.dim == 2) vc.entity = f;
     // Moving badly placed points (where fronts met) before pairing: thin triangles there have no
     // good partner and become lone triangles, each a valence-3 vertex after subdivision. Measured
     // on Block.stp at 258k vertices: interior irregular vertices 6.01% -> 5.62%.
-    t = mesh::improve_small_angles(t, surface, model.faces()[f].reversed,
-                                   options.improve_triangles);
+    const mesh::FaceMesh moved = mesh::improve_small_angles(t, surface, model.faces()[f].reversed,
+                                                            options.improve_triangles);
     std::vector<std::array<Vec3, 2>> directions;
-    directions.reserve(t.triangles.size());
-    for (const auto& tr : t.triangles)
-      directions.push_back(guide.at((t.uv[tr[0]] + t.uv[tr[1]] + t.uv[tr[2]]) / 3.0).cross);
-    return quads_from(t, directions, surface, full, options, fell_back);
+    directions.reserve(moved.triangles.size());
+    for (const auto& tr : moved.triangles)
+      directions.push_back(
+          guide.at((moved.uv[tr[0]] + moved.uv[tr[1]] + moved.uv[tr[2]]) / 3.0).cross);
+    return quads_from(moved, directions, surface, full, options, fell_back);
   };
-  const bool long_edges = options.retry_shorten_ratio > 0 && options.refill_edge_ratio > 0 &&
-                          has_long_edge(tri, size, options.refill_edge_ratio);
   bool fell_back = false;
-  mesh::FaceMesh out = to_quads(std::move(tri), fell_back);
+  mesh::FaceMesh out = to_quads(tri, fell_back);
   // Long edges left after the refill are fans across strips too narrow for points
-  // (UnstructuredOptions::retry_shorten_ratio); only where they folded a quad.
-  if (long_edges && (fell_back || !valid(out))) {
+  // (UnstructuredOptions::retry_shorten_ratio); looked for only where they may have folded a quad.
+  if ((fell_back || !valid(out)) && options.retry_shorten_ratio > 0 &&
+      options.refill_edge_ratio > 0 && has_long_edge(tri, size, options.refill_edge_ratio)) {
     to.shorten_ratio = options.retry_shorten_ratio;
     bool again_fell_back = false;
-    mesh::FaceMesh again =
-        to_quads(mesh::triangulate_face(surface, model.faces()[f].reversed, loops, size, to),
-                 again_fell_back);
+    mesh::FaceMesh retry =
+        mesh::triangulate_face(surface, model.faces()[f].reversed, loops, size, to);
+    mesh::FaceMesh again = to_quads(retry, again_fell_back);
     if (valid(again) && (!valid(out) || min_sicn(again) > min_sicn(out))) {
       out = std::move(again);
       fell_back = again_fell_back;
