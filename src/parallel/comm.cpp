@@ -2,6 +2,7 @@
 
 #include <mpi.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cstring>
 #include <limits>
@@ -41,6 +42,9 @@ void MpiSession::abort(int code) {
 
 struct Comm::Impl {
   MPI_Comm comm = MPI_COMM_WORLD;
+  // Serialises the MPI calls that worker threads make (SharedCounter, SharedBytes): MPI runs at
+  // MPI_THREAD_SERIALIZED.
+  std::mutex lane;
 };
 
 Comm::Comm(std::shared_ptr<Impl> impl) : impl_(std::move(impl)) {}
@@ -188,16 +192,58 @@ std::vector<std::vector<char>> Comm::allgather_bytes(const std::vector<char>& mi
   return out;
 }
 
+std::vector<std::vector<char>> Comm::alltoall_bytes(
+    const std::vector<std::vector<char>>& to_each) const {
+  const int n = size();
+  const int me = rank();
+  QSMESH_CHECK(to_each.size() == static_cast<std::size_t>(n),
+               "alltoall_bytes: " << to_each.size() << " buffers for " << n << " ranks");
+  std::vector<std::int64_t> send_sizes(static_cast<std::size_t>(n)), recv_sizes(send_sizes.size());
+  for (int r = 0; r < n; ++r) send_sizes[r] = static_cast<std::int64_t>(to_each[r].size());
+  check_mpi(MPI_Alltoall(send_sizes.data(), 1, MPI_INT64_T, recv_sizes.data(), 1, MPI_INT64_T,
+                         impl_->comm),
+            "MPI_Alltoall");
+  constexpr std::int64_t kChunk = std::int64_t{1} << 30;
+  std::vector<std::vector<char>> out(static_cast<std::size_t>(n));
+  std::vector<MPI_Request> requests;
+  // Pieces between two ranks share a tag: MPI keeps their order.
+  const auto pieces = [&](std::int64_t bytes, const auto& post) {
+    for (std::int64_t off = 0; off < bytes; off += kChunk) {
+      MPI_Request q = MPI_REQUEST_NULL;
+      post(off, static_cast<int>(std::min(kChunk, bytes - off)), &q);
+      requests.push_back(q);
+    }
+  };
+  for (int r = 0; r < n; ++r) {
+    if (r == me) continue;
+    out[r].resize(static_cast<std::size_t>(recv_sizes[r]));
+    pieces(recv_sizes[r], [&](std::int64_t off, int count, MPI_Request* q) {
+      check_mpi(MPI_Irecv(out[r].data() + off, count, MPI_CHAR, r, 8, impl_->comm, q), "MPI_Irecv");
+    });
+  }
+  for (int r = 0; r < n; ++r) {
+    if (r == me) continue;
+    pieces(send_sizes[r], [&](std::int64_t off, int count, MPI_Request* q) {
+      check_mpi(MPI_Isend(to_each[r].data() + off, count, MPI_CHAR, r, 8, impl_->comm, q),
+                "MPI_Isend");
+    });
+  }
+  out[me] = to_each[me];
+  check_mpi(MPI_Waitall(static_cast<int>(requests.size()), requests.data(), MPI_STATUSES_IGNORE),
+            "MPI_Waitall");
+  return out;
+}
+
 struct SharedCounter::Impl {
+  std::shared_ptr<Comm::Impl> owner;   // its communicator and lane
   MPI_Comm comm = MPI_COMM_NULL;
   bool distributed = false;
   MPI_Win win = MPI_WIN_NULL;
-  std::int64_t value = 0;              // the counter itself, on rank 0 (exposed in `win`)
   std::atomic<std::int64_t> local{0};  // one rank
-  std::mutex lock;                     // MPI_THREAD_SERIALIZED
 };
 
 SharedCounter::SharedCounter(const Comm& comm) : impl_(std::make_unique<Impl>()) {
+  impl_->owner = comm.impl_;
   impl_->comm = comm.impl_->comm;
   impl_->distributed = comm.size() > 1;
   if (!impl_->distributed) return;
@@ -227,7 +273,7 @@ SharedCounter::~SharedCounter() {
 
 std::int64_t SharedCounter::next() {
   if (!impl_->distributed) return impl_->local.fetch_add(1);
-  const std::lock_guard<std::mutex> guard(impl_->lock);
+  const std::lock_guard<std::mutex> guard(impl_->owner->lane);
   const std::int64_t one = 1;
   std::int64_t old = 0;
   check_mpi(MPI_Win_lock(MPI_LOCK_SHARED, 0, 0, impl_->win), "MPI_Win_lock");
@@ -235,6 +281,77 @@ std::int64_t SharedCounter::next() {
             "MPI_Fetch_and_op");
   check_mpi(MPI_Win_unlock(0, impl_->win), "MPI_Win_unlock");
   return old;
+}
+
+struct SharedBytes::Impl {
+  std::shared_ptr<Comm::Impl> owner;  // its communicator and lane
+  bool distributed = false;
+  MPI_Win win = MPI_WIN_NULL;
+  char* base = nullptr;                // this rank's bytes (in the window on several ranks)
+  std::vector<char> local;             // one rank: the bytes themselves
+  std::vector<std::int64_t> sizes;     // every rank's byte count
+};
+
+SharedBytes::SharedBytes(const Comm& comm, const std::vector<char>& mine)
+    : impl_(std::make_unique<Impl>()) {
+  impl_->owner = comm.impl_;
+  const MPI_Comm c = comm.impl_->comm;
+  const int n = comm.size();
+  impl_->distributed = n > 1;
+  const auto my_size = static_cast<std::int64_t>(mine.size());
+  if (!impl_->distributed) {
+    impl_->local = mine;
+    impl_->base = impl_->local.data();
+    impl_->sizes = {my_size};
+    return;
+  }
+  impl_->sizes.resize(static_cast<std::size_t>(n));
+  check_mpi(MPI_Allgather(&my_size, 1, MPI_INT64_T, impl_->sizes.data(), 1, MPI_INT64_T, c),
+            "MPI_Allgather");
+  // Allocated by MPI, as SharedCounter's: reads then need nothing from the owner.
+  check_mpi(MPI_Win_allocate(static_cast<MPI_Aint>(my_size), 1, MPI_INFO_NULL, c, &impl_->base,
+                             &impl_->win),
+            "MPI_Win_allocate");
+  check_mpi(MPI_Win_set_errhandler(impl_->win, MPI_ERRORS_RETURN), "MPI_Win_set_errhandler");
+  const int me = comm.rank();
+  check_mpi(MPI_Win_lock(MPI_LOCK_EXCLUSIVE, me, 0, impl_->win), "MPI_Win_lock");
+  if (my_size > 0) std::memcpy(impl_->base, mine.data(), mine.size());
+  check_mpi(MPI_Win_unlock(me, impl_->win), "MPI_Win_unlock");
+  // Nobody reads before every owner has written.
+  check_mpi(MPI_Barrier(c), "MPI_Barrier");
+}
+
+SharedBytes::~SharedBytes() {
+  // Collective; an error here cannot be thrown from a destructor and would end the run anyway.
+  if (impl_->win != MPI_WIN_NULL) MPI_Win_free(&impl_->win);
+}
+
+std::vector<char> SharedBytes::read(int owner, std::int64_t offset, std::int64_t length) const {
+  QSMESH_CHECK(owner >= 0 && owner < static_cast<int>(impl_->sizes.size()),
+               "SharedBytes: no rank " << owner);
+  QSMESH_CHECK(offset >= 0 && length >= 0 && offset + length <= impl_->sizes[owner],
+               "SharedBytes: bytes [" << offset << ", " << offset + length << ") of rank " << owner
+                                      << ", which has " << impl_->sizes[owner]);
+  std::vector<char> out(static_cast<std::size_t>(length));
+  if (length == 0) return out;
+  if (!impl_->distributed) {
+    std::memcpy(out.data(), impl_->base + offset, out.size());
+    return out;
+  }
+  constexpr std::int64_t kChunk = std::int64_t{1} << 30;
+  const std::lock_guard<std::mutex> guard(impl_->owner->lane);
+  check_mpi(MPI_Win_lock(MPI_LOCK_SHARED, owner, 0, impl_->win), "MPI_Win_lock");
+  for (std::int64_t off = 0; off < length; off += kChunk) {
+    const int count = static_cast<int>(std::min(kChunk, length - off));
+    const int code = MPI_Get(out.data() + off, count, MPI_CHAR, owner,
+                             static_cast<MPI_Aint>(offset + off), count, MPI_CHAR, impl_->win);
+    if (code != MPI_SUCCESS) {
+      MPI_Win_unlock(owner, impl_->win);
+      check_mpi(code, "MPI_Get");
+    }
+  }
+  check_mpi(MPI_Win_unlock(owner, impl_->win), "MPI_Win_unlock");
+  return out;
 }
 
 }  // namespace qsmesh::parallel

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <exception>
 #include <numeric>
+#include <optional>
 #include <string>
 
 #include "qsmesh/core/error.hpp"
@@ -22,9 +23,9 @@ namespace {
 struct Work {
   LO face = kNoIndex;
   int owner = 0;
-  std::size_t local = 0;  // index in `mine` when owner is this rank
-  mesh::FaceMesh mesh;    // the copy of another rank's face
-  std::vector<crossfield::Singularity> singularities;
+  std::size_t local = 0;    // index in the owner's `mine`
+  std::int64_t offset = 0;  // the face's bytes in the owner's SharedBytes (several ranks)
+  std::int64_t length = 0;
   std::int64_t quads = 0;
 };
 
@@ -160,20 +161,32 @@ std::array<double, 3> improve_faces(const Comm& comm, const cad::CadModel& model
   const int rank = comm.rank();
   const int nranks = comm.size();
 
-  // Every rank's faces, this rank's read in place and the others' copied in.
+  // Every rank's faces as records (owner, where its bytes lie); this rank's are read in place,
+  // another rank's are fetched by whichever rank takes the face, when it takes it.
   std::vector<Work> work;
-  if (nranks == 1) {
-    for (std::size_t i = 0; i < mine.size(); ++i)
-      work.push_back(
-          {mine[i].face, 0, i, {}, {}, static_cast<std::int64_t>(mine[i].mesh->quads.size())});
-  } else {
-    std::vector<char> buffer;
-    for (const ImproveFace& f : mine) {
-      pack_mesh(*f.mesh, buffer);
-      put_vec(buffer,
-              std::vector<crossfield::Singularity>(f.singularities.begin(), f.singularities.end()));
+  std::vector<char> buffer;  // this rank's faces, packed (several ranks)
+  for (std::size_t i = 0; i < mine.size(); ++i) {
+    Work w{mine[i].face, rank, i, 0, 0, static_cast<std::int64_t>(mine[i].mesh->quads.size())};
+    if (nranks > 1) {
+      w.offset = static_cast<std::int64_t>(buffer.size());
+      pack_mesh(*mine[i].mesh, buffer);
+      put_vec(buffer, std::vector<crossfield::Singularity>(mine[i].singularities.begin(),
+                                                           mine[i].singularities.end()));
+      w.length = static_cast<std::int64_t>(buffer.size()) - w.offset;
     }
-    const auto all = comm.allgather_bytes(buffer);
+    work.push_back(w);
+  }
+  std::optional<SharedBytes> shared;
+  if (nranks > 1) {
+    std::vector<char> records;
+    for (const Work& w : work) {
+      put<LO>(records, w.face);
+      put<std::int64_t>(records, w.quads);
+      put<std::int64_t>(records, w.offset);
+      put<std::int64_t>(records, w.length);
+    }
+    const auto all = comm.allgather_bytes(records);
+    work.clear();
     for (int r = 0; r < nranks; ++r) {
       const std::vector<char>& bytes = all[static_cast<std::size_t>(r)];
       std::size_t pos = 0;
@@ -181,19 +194,17 @@ std::array<double, 3> improve_faces(const Comm& comm, const cad::CadModel& model
         Work w;
         w.owner = r;
         w.local = i;
-        unpack_mesh(bytes, pos, w.mesh);
-        get_vec(bytes, pos, w.singularities);
-        w.face = w.mesh.face;
-        w.quads = static_cast<std::int64_t>(w.mesh.quads.size());
-        if (r == rank) {  // read in place
-          QSMESH_CHECK(i < mine.size() && mine[i].face == w.face,
-                       "improvement: face record " << w.face << " out of order");
-          w.mesh = mesh::FaceMesh{};
-          w.singularities.clear();
-        }
-        work.push_back(std::move(w));
+        w.face = get<LO>(bytes, pos);
+        w.quads = get<std::int64_t>(bytes, pos);
+        w.offset = get<std::int64_t>(bytes, pos);
+        w.length = get<std::int64_t>(bytes, pos);
+        QSMESH_CHECK(r != rank || (i < mine.size() && mine[i].face == w.face),
+                     "improvement: face record " << w.face << " out of order");
+        work.push_back(w);
       }
     }
+    shared.emplace(comm, buffer);
+    std::vector<char>().swap(buffer);  // the window holds the copy now
   }
 
   // Largest first, so that the last faces dealt out are short.
@@ -208,33 +219,39 @@ std::array<double, 3> improve_faces(const Comm& comm, const cad::CadModel& model
   DealProgress progress("improvement", n, comm, log);
   deal_out(comm, n, tasks, [&](std::int64_t k) {
     const std::size_t w_at = order[static_cast<std::size_t>(k)];
-    Work& w = work[w_at];
-    const bool local = w.owner == rank;
-    mesh::FaceMesh in = local ? std::move(*mine[w.local].mesh) : std::move(w.mesh);
-    const std::span<const crossfield::Singularity> singular =
-        local ? mine[w.local].singularities
-              : std::span<const crossfield::Singularity>(w.singularities);
-    results[w_at] = improve_one(model, w.face, std::move(in), singular, settings, log);
+    const Work& w = work[w_at];
+    if (w.owner == rank) {
+      ImproveFace& f = mine[w.local];
+      results[w_at] =
+          improve_one(model, w.face, std::move(*f.mesh), f.singularities, settings, log);
+    } else {
+      const std::vector<char> bytes = shared->read(w.owner, w.offset, w.length);
+      std::size_t pos = 0;
+      mesh::FaceMesh in;
+      std::vector<crossfield::Singularity> singularities;
+      unpack_mesh(bytes, pos, in);
+      get_vec(bytes, pos, singularities);
+      QSMESH_CHECK(in.face == w.face, "improvement: rank " << w.owner << " sent face " << in.face
+                                                           << " for face " << w.face);
+      results[w_at] = improve_one(model, w.face, std::move(in), singularities, settings, log);
+    }
     progress.done();
   });
+  shared.reset();  // collective: every rank is past its last read
 
-  // The copies of the other ranks' faces are done with (those taken here were moved out).
-  for (Work& w : work) {
-    w.mesh = mesh::FaceMesh{};
-    w.singularities = {};
-  }
-
-  // Results to their owners; the time of each step summed over the faces of all ranks.
+  // Results to their owners only; the time of each step summed over the faces of all ranks.
   std::vector<double> steps(3, 0.0);
-  std::vector<char> outgoing;
+  std::vector<std::vector<char>> outgoing(static_cast<std::size_t>(nranks));
   for (std::size_t i = 0; i < work.size(); ++i) {
     Result& r = results[i];
     if (!r.done) continue;
     for (std::size_t k = 0; k < 3; ++k) steps[k] += r.steps[k];
-    if (work[i].owner == rank)
+    if (work[i].owner == rank) {
       apply(std::move(r), mine[work[i].local]);
-    else
-      pack_result(work[i].face, r, outgoing);
+    } else {
+      pack_result(work[i].face, r, outgoing[static_cast<std::size_t>(work[i].owner)]);
+      r = Result{};
+    }
   }
   if (nranks > 1) {
     std::vector<std::size_t> local_of_face;  // face -> index in mine + 1 (0: not this rank's)
@@ -243,14 +260,16 @@ std::array<double, 3> improve_faces(const Comm& comm, const cad::CadModel& model
       if (local_of_face.size() <= f) local_of_face.resize(f + 1, 0);
       local_of_face[f] = i + 1;
     }
-    const auto all = comm.allgather_bytes(outgoing);
-    for (const auto& bytes : all) {
+    const auto incoming = comm.alltoall_bytes(outgoing);
+    outgoing = {};
+    for (const auto& bytes : incoming) {
       std::size_t pos = 0;
       while (pos < bytes.size()) {
         Result r;
         const auto f = static_cast<std::size_t>(unpack_result(bytes, pos, r));
-        if (f < local_of_face.size() && local_of_face[f] != 0)
-          apply(std::move(r), mine[local_of_face[f] - 1]);
+        QSMESH_CHECK(f < local_of_face.size() && local_of_face[f] != 0,
+                     "improvement: the result of face " << f << " came to a rank not owning it");
+        apply(std::move(r), mine[local_of_face[f] - 1]);
       }
     }
     comm.allreduce_sum(steps);

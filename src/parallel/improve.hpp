@@ -21,9 +21,9 @@
 namespace qsmesh::parallel {
 
 /// Calls body(k) once for each k in [0, n), over the threads of every rank together: each free
-/// thread takes the next k from a SharedCounter (collective; no other MPI call may run meanwhile,
-/// so body must not call MPI). Which rank runs which k depends on timing; the caller keeps
-/// results keyed by k and sends them where they belong.
+/// thread takes the next k from a SharedCounter (collective; body may call MPI only through
+/// objects that take `comm`'s lock, such as SharedBytes::read). Which rank runs which k depends on
+/// timing; the caller keeps results keyed by k and sends them where they belong.
 void deal_out(const Comm& comm, std::int64_t n, const TaskArena& tasks,
               const std::function<void(std::int64_t)>& body);
 
@@ -69,10 +69,12 @@ struct ImproveSettings {
 ///
 /// Collective over `comm`. A face's cost is not known before (a few faces of a model take most of
 /// the time, whatever their size), so no partition fixed in advance balances it: every rank
-/// receives every rank's faces (mesh and singularities), the faces are taken largest first (quad
-/// count, then face id) from a SharedCounter by whichever thread of whichever rank is free, and
-/// each result goes back to the rank that owns the face. A face's result depends only on the
-/// face, so the mesh is the same whatever the numbers of ranks and threads. One rank: no copies.
+/// learns every face's record (id, quads, owner), the faces are taken largest first (quad count,
+/// then face id) from a SharedCounter by whichever thread of whichever rank is free, a face taken
+/// away from its owner is read from the owner's SharedBytes (its mesh and singularities, that face
+/// alone), and each result goes back to the owner alone (Comm::alltoall_bytes). A rank thus holds
+/// its own faces plus those it works on, not the model. A face's result depends only on the face,
+/// so the mesh is the same whatever the numbers of ranks and threads. One rank: no copies.
 /// Returns the wall time of the three steps summed over the faces of all ranks (every rank).
 std::array<double, 3> improve_faces(const Comm& comm, const cad::CadModel& model,
                                     std::span<ImproveFace> mine, const ImproveSettings& settings,

@@ -9,11 +9,13 @@
 #include "qsmesh/sizemap/size_map.hpp"
 #include "qsmesh/mesh/assemble.hpp"
 #include "qsmesh/mesh/validate.hpp"
+#include "qsmesh/core/error.hpp"
 #include "qsmesh/parallel/comm.hpp"
 #include "qsmesh/parallel/pipeline.hpp"
 #include "shapes.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <filesystem>
 #include <sstream>
 
@@ -70,6 +72,67 @@ TEST(Comm, SharedCounterHandsOutEachValueOnce) {
   }
   comm.allreduce_sum(hits);
   for (std::int64_t k = 0; k < kTotal; ++k) EXPECT_EQ(hits[k], 1) << k;
+}
+
+// Rank r's byte i is (r * 31 + i) mod 251: a wrong owner or offset reads other values.
+char byte_of(int rank, std::int64_t i) { return static_cast<char>((rank * 31 + i) % 251); }
+
+TEST(Comm, SharedBytesReadsAnyRanksBytesWhileCounterRuns) {
+  const Comm comm = Comm::world();
+  const int n = comm.size();
+  // Ranks hold different amounts, one of them none at all.
+  const std::int64_t mine_size = comm.rank() == 1 ? 0 : 1000 + 37 * comm.rank();
+  std::vector<char> mine(static_cast<std::size_t>(mine_size));
+  for (std::int64_t i = 0; i < mine_size; ++i) mine[i] = byte_of(comm.rank(), i);
+  constexpr std::int64_t kReads = 120;
+  std::vector<std::int64_t> bad(1, 0), done(1, 0);
+  {
+    SharedBytes shared(comm, mine);
+    SharedCounter counter(comm);
+    const TaskArena two(2);
+    std::atomic<std::int64_t> wrong{0}, count{0};
+    // Two threads per rank mix counter calls and reads, as the improvement stage does.
+    two.parallel_for(2, [&](std::int64_t) {
+      for (std::int64_t k = counter.next(); k < kReads; k = counter.next()) {
+        const int owner = static_cast<int>(k % n);
+        const std::int64_t size = owner == 1 ? 0 : 1000 + 37 * owner;
+        const std::int64_t offset = size == 0 ? 0 : (k * 97) % size;
+        const std::int64_t length = std::min<std::int64_t>(size - offset, 1 + k % 300);
+        const std::vector<char> got = shared.read(owner, offset, length);
+        if (static_cast<std::int64_t>(got.size()) != length) ++wrong;
+        for (std::int64_t i = 0; i < static_cast<std::int64_t>(got.size()); ++i)
+          if (got[i] != byte_of(owner, offset + i)) ++wrong;
+        ++count;
+      }
+    });
+    bad[0] = wrong;
+    done[0] = count;
+    // A range past the owner's bytes is refused, not read.
+    EXPECT_THROW((void)shared.read(0, 0, 1001), qsmesh::Error);
+    EXPECT_THROW((void)shared.read(n, 0, 1), qsmesh::Error);
+  }
+  comm.allreduce_sum(bad);
+  comm.allreduce_sum(done);
+  EXPECT_EQ(bad[0], 0);
+  EXPECT_EQ(done[0], kReads);
+}
+
+TEST(Comm, AlltoallBytesDeliversEachBufferToItsRank) {
+  const Comm comm = Comm::world();
+  const int n = comm.size(), me = comm.rank();
+  // Rank s sends rank r (s + 1) * (r + 2) bytes of value s * 10 + r (nothing from 0 to 1).
+  std::vector<std::vector<char>> to_each(static_cast<std::size_t>(n));
+  for (int r = 0; r < n; ++r)
+    if (!(me == 0 && r == 1))
+      to_each[r].assign(static_cast<std::size_t>((me + 1) * (r + 2)), static_cast<char>(me * 10 + r));
+  const auto got = comm.alltoall_bytes(to_each);
+  ASSERT_EQ(static_cast<int>(got.size()), n);
+  for (int s = 0; s < n; ++s) {
+    const std::size_t expected = s == 0 && me == 1 ? 0 : static_cast<std::size_t>((s + 1) * (me + 2));
+    EXPECT_EQ(got[s].size(), expected) << "from " << s;
+    for (char c : got[s]) EXPECT_EQ(c, static_cast<char>(s * 10 + me)) << "from " << s;
+  }
+  EXPECT_THROW((void)comm.alltoall_bytes(std::vector<std::vector<char>>(n + 1)), qsmesh::Error);
 }
 
 TEST(Pipeline, DistributedEqualsSerial) {

@@ -10,8 +10,9 @@
 namespace qsmesh::parallel {
 
 /// Initialises MPI (thread level SERIALIZED: MPI is called from the main thread, except PETSc
-/// solves, which run on worker threads one at a time through linalg::PetscLane, and SharedCounter,
-/// whose calls are serialised by its own lock in stages without PETSc) and finalises it on
+/// solves, which run on worker threads one at a time through linalg::PetscLane, and SharedCounter
+/// and SharedBytes, whose calls are serialised by their communicator's lock in stages without
+/// PETSc) and finalises it on
 /// destruction. Exactly one per process, created by the driver's main().
 class MpiSession {
  public:
@@ -56,12 +57,19 @@ class Comm {
   void broadcast_bytes(std::vector<char>& bytes, int root = 0) const;
   /// Every rank's byte buffer on every rank, in rank order (gathered on rank 0, then broadcast).
   [[nodiscard]] std::vector<std::vector<char>> allgather_bytes(const std::vector<char>& mine) const;
+  /// Personalised exchange: to_each[r] (one buffer per rank, this rank's own included) goes to rank
+  /// r; returns what every rank sent here, indexed by sender. Sizes are 64-bit and the payloads
+  /// travel in pieces under the int range, each pair of ranks directly (no rank holds more than
+  /// what it sends and receives).
+  [[nodiscard]] std::vector<std::vector<char>> alltoall_bytes(
+      const std::vector<std::vector<char>>& to_each) const;
 
  private:
   struct Impl;
   explicit Comm(std::shared_ptr<Impl> impl);
   std::shared_ptr<Impl> impl_;
   friend class SharedCounter;
+  friend class SharedBytes;
 };
 
 /// A counter shared by every rank and thread of a communicator, for dealing out work dynamically:
@@ -71,8 +79,9 @@ class Comm {
 /// shared-memory window does the atomic itself; a transport without remote atomics may make a call
 /// wait for rank 0's next MPI call); one rank: an atomic.
 /// Construction and destruction are collective. next() is thread-safe: its MPI calls are
-/// serialised by a lock, as MPI_THREAD_SERIALIZED requires, so it must not run while another
-/// thread of the rank is inside MPI (no PETSc solve in the same stage).
+/// serialised by the communicator's lock (shared by the Comm's copies, and with SharedBytes::read),
+/// as MPI_THREAD_SERIALIZED requires, so it must not run while another thread of the rank is inside
+/// MPI by another path (no PETSc solve in the same stage).
 class SharedCounter {
  public:
   explicit SharedCounter(const Comm& comm);
@@ -80,6 +89,29 @@ class SharedCounter {
   SharedCounter(const SharedCounter&) = delete;
   SharedCounter& operator=(const SharedCounter&) = delete;
   [[nodiscard]] std::int64_t next();
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Every rank's byte buffer, readable by every rank and thread without its owner taking part: for
+/// work dealt out as it goes (SharedCounter), where a rank learns which item it takes only when it
+/// takes it, and fetches that item alone instead of receiving every rank's items beforehand.
+/// Several ranks: the bytes are copied into an MPI window allocated by MPI (on one node Open MPI
+/// serves reads from shared memory; see SharedCounter), read with MPI_Get under a shared
+/// passive-target lock; one rank: read in place.
+/// Construction and destruction are collective. read() is thread-safe; its MPI calls take the
+/// communicator's lock, the one SharedCounter::next() takes.
+class SharedBytes {
+ public:
+  SharedBytes(const Comm& comm, const std::vector<char>& mine);
+  ~SharedBytes();
+  SharedBytes(const SharedBytes&) = delete;
+  SharedBytes& operator=(const SharedBytes&) = delete;
+  /// Bytes [offset, offset + length) of rank `owner`'s buffer. Precondition: the range lies in
+  /// that buffer (checked against its size; throws qsmesh::Error otherwise).
+  [[nodiscard]] std::vector<char> read(int owner, std::int64_t offset, std::int64_t length) const;
 
  private:
   struct Impl;
