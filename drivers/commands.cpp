@@ -250,7 +250,7 @@ std::string stats_json(const Arguments& args, const Session& session,
   j.value("curvature_edges", curvature_edges(args));  // edges per full turn (0: none)
   j.value("face_curvature", args.face_curvature);
   j.value("feature_ratio", feature_ratio(args));
-  j.value("size_min", args.size_min.value_or(0.0));  // model units (0: the size cap / 100)
+  j.value("size_min", given_size_min(args, session.size));  // model units (0: the size cap / 100)
   j.value("corners", static_cast<std::int64_t>(model.num_corners()));
   j.value("curves", static_cast<std::int64_t>(model.num_curves()));
   j.value("faces", static_cast<std::int64_t>(model.num_faces()));
@@ -498,6 +498,11 @@ double feature_ratio(const Arguments& args) {
   return args.feature_ratio.value_or(sizemap::SizeMapOptions{}.feature_ratio);
 }
 
+double given_size_min(const Arguments& args, double size) {
+  if (args.size_min_ratio) return *args.size_min_ratio * size;
+  return args.size_min.value_or(0.0);
+}
+
 void apply_size_options(const Arguments& args, const Session& s,
                         parallel::PipelineOptions& options) {
   check_ids("--curve-edges", "curve", args.curve_edges, s.model.num_curves());
@@ -512,15 +517,13 @@ void apply_size_options(const Arguments& args, const Session& s,
   so.edges_per_turn = curvature_edges(args);
   so.face_curvature = args.face_curvature;
   so.feature_ratio = feature_ratio(args);
-  if (args.size_min) {
-    if (*args.size_min > s.size) {
-      std::ostringstream os;
-      os << "--size-min " << *args.size_min << " is larger than the size cap " << s.size
-         << " (--size / --size-factor)";
-      throw InputError(os.str());
-    }
-    so.size_min = *args.size_min;
+  if (args.size_min && *args.size_min > s.size) {
+    std::ostringstream os;
+    os << "--size-min " << *args.size_min << " is larger than the size cap " << s.size
+       << " (--size / --size-factor)";
+    throw InputError(os.str());
   }
+  so.size_min = given_size_min(args, s.size);
   for (const auto& [id, v] : args.face_quads) so.face_quads.emplace_back(id, v);
   for (const auto& [id, v] : args.corner_sizes) so.corner_sizes.emplace_back(id, v);
   for (const auto& [id, v] : args.curve_sizes) so.curve_sizes.emplace_back(id, v);

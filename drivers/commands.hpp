@@ -56,6 +56,9 @@ void apply_size_options(const Arguments& args, const Session& s,
 double curvature_edges(const Arguments& args);
 /// The feature ratio a run uses: --feature-ratio, or the size map's default.
 double feature_ratio(const Arguments& args);
+/// The floor of the automatic sizes the user gave, in model units: --size-min, or --size-min-ratio
+/// times `size` (the size cap); 0 when neither is given (the size map's default floor).
+double given_size_min(const Arguments& args, double size);
 
 /// Writes `text` to `path` through a temporary file renamed at the end.
 void write_text_file_atomically(const std::string& path, const std::string& text);

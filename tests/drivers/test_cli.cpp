@@ -104,6 +104,17 @@ TEST(Cli, SizeMapOptions) {
     EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--size-min", bad}).find("--size-min"),
               std::string::npos)
         << bad;
+  EXPECT_FALSE(p({"mesh", "m.step", "-o", "o.vtu"}).size_min_ratio.has_value());
+  EXPECT_DOUBLE_EQ(
+      *p({"mesh", "m.step", "-o", "o.vtu", "--size-min-ratio", "0.17"}).size_min_ratio, 0.17);
+  for (const char* bad : {"0", "-0.1", "1.5", "x"})
+    EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--size-min-ratio", bad})
+                  .find("--size-min-ratio"),
+              std::string::npos)
+        << bad;
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--size-min", "1", "--size-min-ratio", "0.2"})
+                .find("give one, not both"),
+            std::string::npos);
   EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--until", "background", "--size-min", "1"})
                 .find("--until background"),
             std::string::npos);

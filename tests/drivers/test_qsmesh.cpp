@@ -300,6 +300,15 @@ TEST_F(Qsmesh, MeshHonoursSizeMapOptions) {
   EXPECT_EQ(json_number(j16, "curvature_edges"), 16);
   EXPECT_DOUBLE_EQ(json_number(j16, "feature_ratio"), 0.75);
   EXPECT_GT(json_number(j0, "sicn_min"), 0);
+  // A floor of 0.6 x 0.8 = 0.48 overrides the fillets' curvature sizes (0.39) as --size-min 0.48
+  // does, and --stats gives it in model units.
+  const auto [rr, jr] = mesh_with_stats(model_, "--size 0.8 --size-min-ratio 0.6", "e2e_mesh_ratio");
+  const auto [ra, ja] = mesh_with_stats(model_, "--size 0.8 --size-min 0.48", "e2e_mesh_abs");
+  ASSERT_EQ(rr.code, 0) << rr.err;
+  ASSERT_EQ(ra.code, 0) << ra.err;
+  EXPECT_DOUBLE_EQ(json_number(jr, "size_min"), 0.6 * 0.8);
+  EXPECT_EQ(json_number(jr, "vertices"), json_number(ja, "vertices"));
+  EXPECT_LT(json_number(jr, "vertices"), json_number(j16, "vertices"));
 }
 
 TEST_F(Qsmesh, ExampleWingBody) {
