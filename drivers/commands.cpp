@@ -257,6 +257,9 @@ std::string stats_json(const Arguments& args, const Session& session,
   const auto [failed, fell_back] = count_failures(r);
   j.value("faces_failed", failed);
   j.value("faces_fell_back", fell_back);
+  std::int64_t refined = 0;  // curves refined because a face boundary crossed itself (all rounds)
+  for (const LO n : r.curves_refined_for_crossings) refined += n;
+  j.value("curves_refined_for_crossings", refined);
   if (!r.quad_reports.empty()) {
     std::int64_t frontal = 0;
     for (const auto& q : r.quad_reports) frontal += q.frontal ? 1 : 0;

@@ -317,6 +317,41 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
                    " (",
                    result.balance.curves_changed, " curves changed)"));
     }
+    // Boundary repair: a face whose boundary crosses itself in its parameter plane cannot be
+    // triangulated. Each rank checks its own faces; the flags are summed, so every rank refines
+    // the same curves and keeps the same quantization.
+    std::vector<LO> fixed;
+    for (const auto& [c, n] : options.quantize.prescribed) fixed.push_back(c);
+    for (int round = 0; round < options.boundary_repair_rounds; ++round) {
+      std::vector<std::int64_t> flags(static_cast<std::size_t>(model.num_curves()), 0);
+      std::vector<std::vector<LO>> found(mine.size());
+      for (const bool halved : {true, false}) {
+        const std::vector<mesh::CurveMesh> placed = quantize::place_vertices(
+            model, curves, result.curve_sizes.at, result.quantization, halved, tasks, options.place);
+        tasks.parallel_for(static_cast<std::int64_t>(mine.size()), [&](std::int64_t i) {
+          try {
+            const auto c = quantize::crossing_curves(model, mine[i], placed);
+            found[i].insert(found[i].end(), c.begin(), c.end());
+          } catch (const std::exception& e) {
+            // The face's own stages report its geometry errors; this check only looks for crossings.
+            log.debug(Error(e.what(), ErrorContext{"quantize", 2, mine[i]}).what());
+          }
+        });
+      }
+      for (const auto& list : found)
+        for (const LO c : list) flags[c] = 1;
+      comm.allreduce_sum(flags);
+      std::vector<LO> flagged;
+      for (LO c = 0; c < model.num_curves(); ++c)
+        if (flags[c] > 0) flagged.push_back(c);
+      if (flagged.empty()) break;
+      const std::int64_t before = result.quantization.total_edges;
+      quantize::refine_curves(result.quantization, flagged, fixed);
+      if (result.quantization.total_edges == before) break;  // only fixed curves are involved
+      result.curves_refined_for_crossings.push_back(static_cast<LO>(flagged.size()));
+      log.info(cat("quantize: ", flagged.size(),
+                   " curves refined where face boundaries crossed themselves in the parameter plane"));
+    }
     result.quantized_curves =
         quantize::place_vertices(model, curves, result.curve_sizes.at, result.quantization,
                                  /*halved=*/false, tasks, options.place);

@@ -6,7 +6,9 @@
 #include <numeric>
 #include <sstream>
 
+#include "qsmesh/background/face_mesh.hpp"
 #include "qsmesh/core/error.hpp"
+#include "qsmesh/mesh/predicates.hpp"
 
 namespace qsmesh::quantize {
 
@@ -437,6 +439,107 @@ std::vector<mesh::CurveMesh> place_vertices(const cad::CadModel& model,
     }
   });
   return out;
+}
+
+std::vector<LO> crossing_curves(const cad::CadModel& model, LO f,
+                                std::span<const mesh::CurveMesh> curves) {
+  const auto surface = model.face_geometry(f);
+  const auto loops = background::face_boundary(model, f, *surface, curves);
+  // Segments of every loop, with their curve (face_boundary gives each use its curve mesh's
+  // edges in order) and their loop position (neighbours share a vertex and are not tested).
+  struct Segment {
+    Vec2 a, b;
+    LO curve;
+    LO loop, index, loop_size;
+  };
+  std::vector<Segment> segments;
+  const cad::Face& face = model.faces()[f];
+  for (LO l = 0; l < static_cast<LO>(loops.size()); ++l) {
+    const auto& pts = loops[l].points;
+    const auto n = static_cast<LO>(pts.size());
+    LO k = 0;
+    for (const cad::CurveUse& use : face.loops[l].uses)
+      for (LO e = 0; e < curves[use.curve].num_edges() && k < n; ++e, ++k)
+        segments.push_back({pts[k].uv, pts[(k + 1) % n].uv, use.curve, l, k, n});
+  }
+  if (segments.size() < 2) return {};
+  // A uniform grid over the loops' box, about one segment per cell, keeps this near-linear.
+  Vec2 lo = segments[0].a, hi = segments[0].a;
+  for (const Segment& s : segments)
+    for (const Vec2& p : {s.a, s.b}) {
+      lo = {std::min(lo.u, p.u), std::min(lo.v, p.v)};
+      hi = {std::max(hi.u, p.u), std::max(hi.v, p.v)};
+    }
+  const int cells = std::max(1, static_cast<int>(std::sqrt(static_cast<double>(segments.size()))));
+  const double wu = std::max(hi.u - lo.u, 1e-300) / cells, wv = std::max(hi.v - lo.v, 1e-300) / cells;
+  const auto cell_u = [&](double u) { return std::clamp(static_cast<int>((u - lo.u) / wu), 0, cells - 1); };
+  const auto cell_v = [&](double v) { return std::clamp(static_cast<int>((v - lo.v) / wv), 0, cells - 1); };
+  std::vector<std::vector<std::size_t>> grid(static_cast<std::size_t>(cells) * cells);
+  for (std::size_t i = 0; i < segments.size(); ++i) {
+    const Segment& s = segments[i];
+    for (int cu = cell_u(std::min(s.a.u, s.b.u)); cu <= cell_u(std::max(s.a.u, s.b.u)); ++cu)
+      for (int cv = cell_v(std::min(s.a.v, s.b.v)); cv <= cell_v(std::max(s.a.v, s.b.v)); ++cv)
+        grid[static_cast<std::size_t>(cu) * cells + cv].push_back(i);
+  }
+  const auto neighbours = [](const Segment& x, const Segment& y) {
+    if (x.loop != y.loop) return false;
+    const LO d = std::abs(x.index - y.index);
+    return d <= 1 || d == x.loop_size - 1;
+  };
+  const auto sign = [](double x) { return (x > 0) - (x < 0); };
+  std::vector<LO> out;
+  for (const auto& cell : grid)
+    for (std::size_t i = 0; i < cell.size(); ++i)
+      for (std::size_t j = i + 1; j < cell.size(); ++j) {
+        const Segment& x = segments[cell[i]];
+        const Segment& y = segments[cell[j]];
+        if (neighbours(x, y)) continue;
+        if (sign(mesh::orient2d(x.a, x.b, y.a)) * sign(mesh::orient2d(x.a, x.b, y.b)) < 0 &&
+            sign(mesh::orient2d(y.a, y.b, x.a)) * sign(mesh::orient2d(y.a, y.b, x.b)) < 0) {
+          out.push_back(x.curve);
+          out.push_back(y.curve);
+        }
+      }
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+  return out;
+}
+
+void refine_curves(Quantization& q, std::span<const LO> curves, std::span<const LO> fixed) {
+  const auto nc = static_cast<LO>(q.edges.size());
+  const bool chords = q.curve2chord.size() == q.edges.size();
+  std::vector<char> frozen(q.edges.size(), 0);
+  std::vector<char> frozen_chord(static_cast<std::size_t>(std::max<LO>(q.num_chords, 0)), 0);
+  for (const LO c : fixed) {
+    if (c < 0 || c >= nc) continue;
+    frozen[c] = 1;
+    if (chords && q.curve2chord[c] >= 0 && q.curve2chord[c] < q.num_chords)
+      frozen_chord[q.curve2chord[c]] = 1;
+  }
+  std::vector<int> target(q.edges.size(), 0);
+  std::map<LO, int> chord_target;  // chord -> largest doubled count among its flagged curves
+  for (const LO c : curves) {
+    if (c < 0 || c >= nc || q.edges[c] <= 0 || frozen[c] != 0) continue;
+    if (chords && q.curve2chord[c] >= 0 && q.curve2chord[c] < q.num_chords &&
+        frozen_chord[q.curve2chord[c]] != 0)
+      continue;
+    const int doubled = 2 * q.edges[c];
+    target[c] = std::max(target[c], doubled);
+    if (chords && q.curve2chord[c] != kNoIndex) {
+      int& t = chord_target[q.curve2chord[c]];
+      t = std::max(t, doubled);
+    }
+  }
+  q.total_edges = 0;
+  for (LO c = 0; c < nc; ++c) {
+    int e = std::max(q.edges[c], target[c]);
+    if (chords && q.curve2chord[c] != kNoIndex) {
+      const auto it = chord_target.find(q.curve2chord[c]);
+      if (it != chord_target.end() && q.edges[c] > 0) e = std::max(e, it->second);
+    }
+    q.edges[c] = e;
+    q.total_edges += e;
+  }
 }
 
 }  // namespace qsmesh::quantize

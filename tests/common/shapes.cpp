@@ -101,6 +101,21 @@ std::string write_stadium(double length, double radius, bool arc_first, const st
   return write_planar_face(wire.Wire(), "stadium", path);
 }
 
+std::string write_half_annulus(double inner, double outer, const std::string& path) {
+  const double r = inner, R = outer;
+  BRepBuilderAPI_MakeWire wire;
+  wire.Add(BRepBuilderAPI_MakeEdge(
+               GC_MakeArcOfCircle(gp_Pnt(R, 0, 0), gp_Pnt(0, R, 0), gp_Pnt(-R, 0, 0)).Value())
+               .Edge());
+  wire.Add(BRepBuilderAPI_MakeEdge(gp_Pnt(-R, 0, 0), gp_Pnt(-r, 0, 0)).Edge());
+  wire.Add(BRepBuilderAPI_MakeEdge(
+               GC_MakeArcOfCircle(gp_Pnt(-r, 0, 0), gp_Pnt(0, r, 0), gp_Pnt(r, 0, 0)).Value())
+               .Edge());
+  wire.Add(BRepBuilderAPI_MakeEdge(gp_Pnt(r, 0, 0), gp_Pnt(R, 0, 0)).Edge());
+  if (!wire.IsDone()) throw std::runtime_error("half annulus wire construction failed");
+  return write_planar_face(wire.Wire(), "half annulus", path);
+}
+
 std::string write_filleted_box(const std::string& path) {
   const TopoDS_Shape box = BRepPrimAPI_MakeBox(8.0, 6.0, 4.0).Shape();
   BRepFilletAPI_MakeFillet fillet(box);

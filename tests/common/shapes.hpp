@@ -35,6 +35,9 @@ std::string write_teardrop(double radius, const std::string& path);
 /// two half circles closing them: no corner. `arc_first`: the wire starts with the right half
 /// circle instead of the bottom segment (the same face, its loop starting elsewhere).
 std::string write_stadium(double length, double radius, bool arc_first, const std::string& path);
+/// Writes the planar half annulus between the circles of radii `inner` < `outer` about the origin,
+/// y >= 0: outer arc, radial segment, inner arc, radial segment (four corners).
+std::string write_half_annulus(double inner, double outer, const std::string& path);
 /// Writes a box with filleted edges (radius 1), as STEP.
 std::string write_filleted_box(const std::string& path);
 

@@ -209,6 +209,22 @@ TEST_F(Qsmesh, FairingSliverKeepsFrontalPath) {
   EXPECT_GT(json_number(json, "sicn_min"), 0.1);
 }
 
+// Block.stp at size factor 0.05 without curvature sizes: two faces got curve meshes so coarse
+// that their boundaries crossed themselves in the parameter plane (a small fillet's chord across
+// a neighbouring curve), could not be triangulated and were missing from the output. The crossing
+// curves (and their chords) are now refined after the quantization.
+TEST_F(Qsmesh, CrossingBoundariesAreRefinedNotDropped) {
+  const std::string path = std::string(QSMESH_SHARED_CAD_DIR) + "/Block.stp";
+  if (!fs::exists(path)) GTEST_SKIP() << path << " not found";
+  const auto [r, json] = mesh_with_stats(
+      path, "--size-factor 0.05 --curvature-edges 0 --threads 2", "e2e_crossing");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(json_number(json, "faces_failed"), 0) << r.err;
+  EXPECT_GT(json_number(json, "curves_refined_for_crossings"), 0);
+  EXPECT_GT(json_number(json, "sicn_min"), 0);
+  EXPECT_NE(json.find("\"conforming\": true"), std::string::npos);
+}
+
 // t20_data.step at size factor 0.01: its chamfer slivers 12 and 13 (a 0-degree cusp) folded a
 // quad on the frontal path and on its fallback, and the run reported two failed faces. The
 // pattern fill that the size map's quad bound had refused is valid there (poor, SICN avg 0.13-0.17,

@@ -286,6 +286,48 @@ TEST(Quantize, LengthLimitKeepsBasesOfATaperedFaceApart) {
   EXPECT_EQ(j.num_chords, 2);
 }
 
+TEST(Quantize, CoarseArcCuttingItsNeighbourIsFound) {
+  // Half annulus of radii 9 and 10: the outer arc with 2 edges is the chord from (10, 0) to
+  // (0, 10) and on to (-10, 0), 7.07 from the centre, across the inner arc (radius 9).
+  const cad::CadModel model = cad::load_cad(test::write_half_annulus(9.0, 10.0, tmp("q_annulus.brep")));
+  ASSERT_EQ(model.num_faces(), 1);
+  const auto loop = loop_curves(model);
+  ASSERT_EQ(loop.size(), 4u);
+  LO outer = kNoIndex, inner = kNoIndex;
+  for (const LO c : loop) {
+    const double len = model.curves()[c].length;
+    if (std::abs(len - 10 * M_PI) < 1e-6) outer = c;
+    if (std::abs(len - 9 * M_PI) < 1e-6) inner = c;
+  }
+  ASSERT_NE(outer, kNoIndex);
+  ASSERT_NE(inner, kNoIndex);
+  const auto meshes = [&](LO outer_edges, LO inner_edges) {
+    std::vector<mesh::CurveMesh> m;
+    for (LO c = 0; c < model.num_curves(); ++c)
+      m.push_back(test::uniform_curve_mesh(model, c, c == outer ? outer_edges : c == inner ? inner_edges : 2));
+    return m;
+  };
+  EXPECT_EQ(crossing_curves(model, 0, meshes(2, 8)), (std::vector<LO>{std::min(outer, inner), std::max(outer, inner)}));
+  // Equal counts give similar polygons, which do not cross; nor does a fine outer arc.
+  EXPECT_TRUE(crossing_curves(model, 0, meshes(2, 2)).empty());
+  EXPECT_TRUE(crossing_curves(model, 0, meshes(16, 8)).empty());
+}
+
+TEST(Quantize, RefinedCurvesTakeTheirChordAlong) {
+  Quantization q;
+  q.edges = {4, 4, 6, 2, 2, 0};
+  q.curve2chord = {0, 0, kNoIndex, 1, 1, kNoIndex};
+  q.num_chords = 2;
+  refine_curves(q, std::vector<LO>{0, 2, 5});
+  EXPECT_EQ(q.edges, (std::vector<int>{8, 8, 12, 2, 2, 0}));  // 5 is degenerate (no edges)
+  EXPECT_EQ(q.total_edges, 32);
+  // A chord holding a prescribed curve keeps its counts.
+  refine_curves(q, std::vector<LO>{3}, std::vector<LO>{4});
+  EXPECT_EQ(q.edges, (std::vector<int>{8, 8, 12, 2, 2, 0}));
+  refine_curves(q, std::vector<LO>{4});
+  EXPECT_EQ(q.edges, (std::vector<int>{8, 8, 12, 4, 4, 0}));
+}
+
 TEST(Quantize, ClosedAndDegenerateCurves) {
   const cad::CadModel cyl = cad::load_cad(test::write_cylinder(tmp("q_cyl.brep")));
   std::vector<double> ideal(static_cast<std::size_t>(cyl.num_curves()), 1.0);

@@ -52,6 +52,13 @@ struct PipelineOptions {
   /// nudged so that more faces fit a coarse pattern (Sec. 6.1.2). Applies with the size map.
   bool balance_counts = true;
   qstruct::BalanceOptions balance;
+  /// Rounds of boundary repair after the quantization: the curves of a face boundary that crosses
+  /// itself in the face's parameter plane (halved or final curve meshes, quantize::crossing_curves)
+  /// get twice their edges (their chords too), until no boundary crosses. Without it such a face
+  /// cannot be meshed and is missing from the output: a tight curve with too few edges, which the
+  /// curvature sizes prevent by default, but not --curvature-edges 0 or a raised --size-min at
+  /// coarse sizes (Block.stp at size factor 0.05: 2 faces). 0: off.
+  int boundary_repair_rounds = 4;
   /// Stage::QuasiStructured: pattern meshing of simple CAD faces (Sec. 6.1.2).
   qstruct::PatternFaceOptions patterns;
   /// A pattern mesh of a face may have at most this many times the quads the size map asks for
@@ -134,6 +141,8 @@ struct PipelineResult {
   sizemap::CurveSizes curve_sizes;              ///< size map on the background curve meshes (every rank)
   quantize::Quantization quantization;          ///< curve edge counts (every rank)
   qstruct::BalanceReport balance;               ///< pattern-aware balancing of those counts (every rank)
+  /// Curves refined because a face boundary crossed itself (boundary_repair_rounds), by round.
+  std::vector<LO> curves_refined_for_crossings;
   std::vector<mesh::CurveMesh> quantized_curves;  ///< final curve meshes (every rank)
   std::vector<quad::UnstructuredReport> quad_reports;  ///< by face, Stage::Unstructured (rank 0)
   std::vector<QuasiReport> quasi_reports;  ///< by face, Stage::QuasiStructured (rank 0)

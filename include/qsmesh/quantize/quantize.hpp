@@ -127,4 +127,19 @@ struct PlaceOptions {
     std::span<const std::vector<double>> sizes, const Quantization& q, bool halved,
     const TaskArena& tasks, const PlaceOptions& options = {});
 
+/// The curves whose meshes make the boundary of face f cross itself in the face's parameter
+/// plane: two segments of its loops (background::face_boundary on `curves`) that cross properly
+/// (exact orientation tests, segments sharing a loop vertex excepted). The Delaunay kernel cannot
+/// recover such a boundary, so the face could not be meshed at all: a tight curve (a small fillet,
+/// a slot's end) with too few edges cuts a corner across a neighbouring curve. Sorted, each curve
+/// once; empty when the boundary is simple. Throws what face_geometry / face_boundary throw.
+[[nodiscard]] std::vector<LO> crossing_curves(const cad::CadModel& model, LO f,
+                                              std::span<const mesh::CurveMesh> curves);
+
+/// Doubles the count of each curve in `curves` and gives every curve of its chord at least that
+/// count (so chords stay equal), keeping counts even; updates total_edges. Curves without edges
+/// (degenerate), unknown ids and the chords of the curves in `fixed` (user prescriptions, kept
+/// exactly) are left alone.
+void refine_curves(Quantization& q, std::span<const LO> curves, std::span<const LO> fixed = {});
+
 }  // namespace qsmesh::quantize
