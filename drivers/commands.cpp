@@ -373,6 +373,11 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
     os << "  boundary vertices away from their ideal valence (per face): "
        << total_irregular_boundary(r) << "\n";
   if (s.quads > 0) os << "  SICN min/avg: " << s.sicn_min << " / " << s.sicn_avg << "\n";
+  if (!r.curves_refined_for_crossings.empty()) {
+    LO refined = 0;
+    for (const LO n : r.curves_refined_for_crossings) refined += n;
+    os << "  curves refined because a face boundary crossed itself: " << refined << "\n";
+  }
   if (!r.quasi_reports.empty()) {
     const QuasiTotals t = quasi_totals(r);
     os << "  faces meshed by patterns: " << t.by_pattern << " of " << model.num_faces();
