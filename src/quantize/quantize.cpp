@@ -462,7 +462,20 @@ std::vector<LO> crossing_curves(const cad::CadModel& model, LO f,
       for (LO e = 0; e < curves[use.curve].num_edges() && k < n; ++e, ++k)
         segments.push_back({pts[k].uv, pts[(k + 1) % n].uv, use.curve, l, k, n});
   }
-  if (segments.size() < 2) return {};
+  std::vector<LO> out;
+  // A loop of one or two segments encloses nothing (two curves joining the same corners, one
+  // edge each on the halved meshes).
+  for (LO l = 0; l < static_cast<LO>(loops.size()); ++l) {
+    std::vector<LO> of_loop;
+    for (const Segment& s : segments)
+      if (s.loop == l) of_loop.push_back(s.curve);
+    if (!of_loop.empty() && of_loop.size() < 3) out.insert(out.end(), of_loop.begin(), of_loop.end());
+  }
+  if (segments.size() < 2) {
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
+  }
   // A uniform grid over the loops' box, about one segment per cell, keeps this near-linear.
   Vec2 lo = segments[0].a, hi = segments[0].a;
   for (const Segment& s : segments)
@@ -487,15 +500,26 @@ std::vector<LO> crossing_curves(const cad::CadModel& model, LO f,
     return d <= 1 || d == x.loop_size - 1;
   };
   const auto sign = [](double x) { return (x > 0) - (x < 0); };
-  std::vector<LO> out;
+  // Collinear segments overlapping over a length: the boundary runs back over itself.
+  const auto overlap = [](const Segment& x, const Segment& y) {
+    const Vec2 d = x.b - x.a;
+    const double len2 = d.u * d.u + d.v * d.v;
+    if (!(len2 > 0)) return false;
+    const auto at = [&](const Vec2& p) { return ((p.u - x.a.u) * d.u + (p.v - x.a.v) * d.v) / len2; };
+    const double lo = std::max(0.0, std::min(at(y.a), at(y.b)));
+    const double hi = std::min(1.0, std::max(at(y.a), at(y.b)));
+    return hi - lo > 1e-12;
+  };
   for (const auto& cell : grid)
     for (std::size_t i = 0; i < cell.size(); ++i)
       for (std::size_t j = i + 1; j < cell.size(); ++j) {
         const Segment& x = segments[cell[i]];
         const Segment& y = segments[cell[j]];
-        if (neighbours(x, y)) continue;
-        if (sign(mesh::orient2d(x.a, x.b, y.a)) * sign(mesh::orient2d(x.a, x.b, y.b)) < 0 &&
-            sign(mesh::orient2d(y.a, y.b, x.a)) * sign(mesh::orient2d(y.a, y.b, x.b)) < 0) {
+        const int o1 = sign(mesh::orient2d(x.a, x.b, y.a)), o2 = sign(mesh::orient2d(x.a, x.b, y.b));
+        const int o3 = sign(mesh::orient2d(y.a, y.b, x.a)), o4 = sign(mesh::orient2d(y.a, y.b, x.b));
+        const bool crossing = !neighbours(x, y) && o1 * o2 < 0 && o3 * o4 < 0;
+        const bool folded = o1 == 0 && o2 == 0 && o3 == 0 && o4 == 0 && overlap(x, y);
+        if (crossing || folded) {
           out.push_back(x.curve);
           out.push_back(y.curve);
         }

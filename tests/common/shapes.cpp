@@ -116,6 +116,17 @@ std::string write_half_annulus(double inner, double outer, const std::string& pa
   return write_planar_face(wire.Wire(), "half annulus", path);
 }
 
+std::string write_half_disk(double radius, const std::string& path) {
+  const double r = radius;
+  BRepBuilderAPI_MakeWire wire;
+  wire.Add(BRepBuilderAPI_MakeEdge(
+               GC_MakeArcOfCircle(gp_Pnt(r, 0, 0), gp_Pnt(0, r, 0), gp_Pnt(-r, 0, 0)).Value())
+               .Edge());
+  wire.Add(BRepBuilderAPI_MakeEdge(gp_Pnt(-r, 0, 0), gp_Pnt(r, 0, 0)).Edge());
+  if (!wire.IsDone()) throw std::runtime_error("half disk wire construction failed");
+  return write_planar_face(wire.Wire(), "half disk", path);
+}
+
 std::string write_filleted_box(const std::string& path) {
   const TopoDS_Shape box = BRepPrimAPI_MakeBox(8.0, 6.0, 4.0).Shape();
   BRepFilletAPI_MakeFillet fillet(box);

@@ -38,6 +38,9 @@ std::string write_stadium(double length, double radius, bool arc_first, const st
 /// Writes the planar half annulus between the circles of radii `inner` < `outer` about the origin,
 /// y >= 0: outer arc, radial segment, inner arc, radial segment (four corners).
 std::string write_half_annulus(double inner, double outer, const std::string& path);
+/// Writes the planar half disk of this radius about the origin, y >= 0: two curves (the arc and
+/// the diameter) joining the same two corners.
+std::string write_half_disk(double radius, const std::string& path);
 /// Writes a box with filleted edges (radius 1), as STEP.
 std::string write_filleted_box(const std::string& path);
 

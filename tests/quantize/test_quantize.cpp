@@ -313,6 +313,21 @@ TEST(Quantize, CoarseArcCuttingItsNeighbourIsFound) {
   EXPECT_TRUE(crossing_curves(model, 0, meshes(16, 8)).empty());
 }
 
+TEST(Quantize, LoopOfTwoSegmentsIsFound) {
+  // A half disk: arc and diameter join the same two corners. With one edge each (halved meshes
+  // of 2-edge curves) the loop encloses nothing; with two each it is a triangle.
+  const cad::CadModel model = cad::load_cad(test::write_half_disk(5.0, tmp("q_half_disk.brep")));
+  ASSERT_EQ(model.num_faces(), 1);
+  ASSERT_EQ(model.num_curves(), 2);
+  const auto meshes = [&](LO n) {
+    std::vector<mesh::CurveMesh> m;
+    for (LO c = 0; c < model.num_curves(); ++c) m.push_back(test::uniform_curve_mesh(model, c, n));
+    return m;
+  };
+  EXPECT_EQ(crossing_curves(model, 0, meshes(1)), (std::vector<LO>{0, 1}));
+  EXPECT_TRUE(crossing_curves(model, 0, meshes(2)).empty());
+}
+
 TEST(Quantize, RefinedCurvesTakeTheirChordAlong) {
   Quantization q;
   q.edges = {4, 4, 6, 2, 2, 0};

@@ -129,10 +129,12 @@ struct PlaceOptions {
 
 /// The curves whose meshes make the boundary of face f cross itself in the face's parameter
 /// plane: two segments of its loops (background::face_boundary on `curves`) that cross properly
-/// (exact orientation tests, segments sharing a loop vertex excepted). The Delaunay kernel cannot
-/// recover such a boundary, so the face could not be meshed at all: a tight curve (a small fillet,
-/// a slot's end) with too few edges cuts a corner across a neighbouring curve. Sorted, each curve
-/// once; empty when the boundary is simple. Throws what face_geometry / face_boundary throw.
+/// (exact orientation tests, segments sharing a loop vertex excepted) or lie on one line over a
+/// common length (the boundary runs back over itself), and the curves of a loop of fewer than
+/// three segments (two curves joining the same corners with one edge each). The Delaunay kernel
+/// cannot triangulate such a boundary, so the face could not be meshed at all: a tight curve (a
+/// small fillet, a slot's end) with too few edges cuts a corner across a neighbouring curve.
+/// Sorted, each curve once; empty when the boundary is simple. Throws what face_geometry / face_boundary throw.
 [[nodiscard]] std::vector<LO> crossing_curves(const cad::CadModel& model, LO f,
                                               std::span<const mesh::CurveMesh> curves);
 
