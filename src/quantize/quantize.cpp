@@ -506,9 +506,9 @@ std::vector<LO> crossing_curves(const cad::CadModel& model, LO f,
     const double len2 = d.u * d.u + d.v * d.v;
     if (!(len2 > 0)) return false;
     const auto at = [&](const Vec2& p) { return ((p.u - x.a.u) * d.u + (p.v - x.a.v) * d.v) / len2; };
-    const double lo = std::max(0.0, std::min(at(y.a), at(y.b)));
-    const double hi = std::min(1.0, std::max(at(y.a), at(y.b)));
-    return hi - lo > 1e-12;
+    const double from = std::max(0.0, std::min(at(y.a), at(y.b)));
+    const double to = std::min(1.0, std::max(at(y.a), at(y.b)));
+    return to - from > 1e-12;
   };
   for (const auto& cell : grid)
     for (std::size_t i = 0; i < cell.size(); ++i)
