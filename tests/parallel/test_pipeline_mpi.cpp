@@ -298,6 +298,40 @@ void check_quads_do_not_depend_on_ranks(Stage until, const std::string& name) {
   }
 }
 
+// A half disk sized far coarser than itself, without curvature sizes: arc and diameter get 2 edges
+// each, 1 each on the halved meshes, a loop enclosing nothing. The repair refines both on every
+// rank alike (one rank owns the face, all take part in the sum of the flags).
+TEST(Pipeline, CrossingBoundaryIsRepairedAlikeOnEveryRank) {
+  const Comm comm = Comm::world();
+  const std::string path = tmp("pipe_half_disk_np" + std::to_string(comm.size()) + ".brep");
+  if (comm.rank() == 0) test::write_half_disk(5.0, path);
+  comm.barrier();
+  const cad::CadModel model = cad::load_cad(path);
+  PipelineOptions options;
+  options.background.sizes.size = 1.0;
+  options.sizemap.size_max = 40.0;
+  options.sizemap.edges_per_turn = 0;
+  options.until = Stage::QuasiStructured;
+  std::ostringstream sink;
+  Logger log(sink, LogLevel::Quiet);
+  const PipelineResult dist = run_pipeline(comm, model, options, TaskArena(2), log);
+  EXPECT_FALSE(dist.curves_refined_for_crossings.empty());  // every rank knows
+  options.boundary_repair_rounds = 0;
+  const PipelineResult unrepaired = run_pipeline(comm, model, options, TaskArena(2), log);
+  if (comm.rank() != 0) return;
+  ASSERT_EQ(dist.quad_reports.size(), 1u);
+  EXPECT_TRUE(dist.quad_reports[0].ok) << dist.quad_reports[0].error;
+  EXPECT_GT(dist.face_stats[0].sicn_min, 0);
+  ASSERT_EQ(unrepaired.quad_reports.size(), 1u);
+  EXPECT_FALSE(unrepaired.quad_reports[0].ok);  // the face was missing without the repair
+  options.boundary_repair_rounds = 4;
+  const PipelineResult serial = run_pipeline(Comm::self(), model, options, TaskArena(1), log);
+  EXPECT_EQ(dist.quantization.edges, serial.quantization.edges);
+  EXPECT_EQ(dist.mesh.quads, serial.mesh.quads);
+  ASSERT_EQ(dist.mesh.points.size(), serial.mesh.points.size());
+  for (std::size_t i = 0; i < serial.mesh.points.size(); ++i) ASSERT_EQ(dist.mesh.points[i], serial.mesh.points[i]);
+}
+
 TEST(Pipeline, QuadMeshDoesNotDependOnRanks) { check_quads_do_not_depend_on_ranks(Stage::Unstructured, "pipe_quads"); }
 
 TEST(Pipeline, QuasiStructuredMeshDoesNotDependOnRanks) {
