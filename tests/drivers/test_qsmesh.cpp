@@ -209,6 +209,21 @@ TEST_F(Qsmesh, FairingSliverKeepsFrontalPath) {
   EXPECT_GT(json_number(json, "sicn_min"), 0.1);
 }
 
+// A curve shorter than the size floor (here 0.004 against --size 1, floor 0.01) refines the faces
+// around it (rule (i) of Sec. 4.1): the run says so, with the remedy; a given floor silences it.
+TEST_F(Qsmesh, SliverCurveIsPointedOut) {
+  const std::string path = qsmesh::test::write_polygon_face(
+      {{0, 0}, {10, 0}, {10, 5}, {9.996, 5}, {0, 5}}, tmp("e2e_sliver.brep"));
+  const ExeResult r = run("mesh " + path + " -o " + tmp("e2e_sliver.msh") + " --size 1");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("1 curve is shorter than the size floor 0.01"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--size-min"), std::string::npos);
+  const ExeResult quiet =
+      run("mesh " + path + " -o " + tmp("e2e_sliver2.msh") + " --size 1 --size-min 0.2");
+  ASSERT_EQ(quiet.code, 0) << quiet.err;
+  EXPECT_EQ(quiet.err.find("shorter than the size floor"), std::string::npos) << quiet.err;
+}
+
 // Block.stp at size factor 0.05 without curvature sizes: two faces got curve meshes so coarse
 // that their boundaries crossed themselves in the parameter plane (a small fillet's chord across
 // a neighbouring curve), could not be triangulated and were missing from the output. The crossing
