@@ -322,11 +322,12 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     // the same curves and keeps the same quantization.
     std::vector<LO> fixed;
     for (const auto& [c, n] : options.quantize.prescribed) fixed.push_back(c);
+    bool placed_final = false;  // result.quantized_curves holds the final quantization's meshes
     for (int round = 0; round < options.boundary_repair_rounds; ++round) {
       std::vector<std::int64_t> flags(static_cast<std::size_t>(model.num_curves()), 0);
       std::vector<std::vector<LO>> found(mine.size());
       for (const bool halved : {true, false}) {
-        const std::vector<mesh::CurveMesh> placed = quantize::place_vertices(
+        std::vector<mesh::CurveMesh> placed = quantize::place_vertices(
             model, curves, result.curve_sizes.at, result.quantization, halved, tasks, options.place);
         tasks.parallel_for(static_cast<std::int64_t>(mine.size()), [&](std::int64_t i) {
           try {
@@ -337,7 +338,9 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
             log.debug(Error(e.what(), ErrorContext{"quantize", 2, mine[i]}).what());
           }
         });
+        if (!halved) result.quantized_curves = std::move(placed);
       }
+      placed_final = true;
       for (const auto& list : found)
         for (const LO c : list) flags[c] = 1;
       comm.allreduce_sum(flags);
@@ -348,13 +351,15 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
       const std::int64_t before = result.quantization.total_edges;
       quantize::refine_curves(result.quantization, flagged, fixed);
       if (result.quantization.total_edges == before) break;  // only fixed curves are involved
+      placed_final = false;
       result.curves_refined_for_crossings.push_back(static_cast<LO>(flagged.size()));
       log.info(cat("quantize: ", flagged.size(),
                    " curves refined where face boundaries crossed themselves in the parameter plane"));
     }
-    result.quantized_curves =
-        quantize::place_vertices(model, curves, result.curve_sizes.at, result.quantization,
-                                 /*halved=*/false, tasks, options.place);
+    if (!placed_final)
+      result.quantized_curves =
+          quantize::place_vertices(model, curves, result.curve_sizes.at, result.quantization,
+                                   /*halved=*/false, tasks, options.place);
     end_stage("quantize", false);
     log.info(cat("quantize: ", model.num_curves(), " curves, ", result.quantization.num_chords,
                  " chords, ", result.quantization.total_edges, " edges"));
