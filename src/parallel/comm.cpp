@@ -235,7 +235,7 @@ std::vector<std::vector<char>> Comm::alltoall_bytes(
 }
 
 struct SharedCounter::Impl {
-  std::shared_ptr<Comm::Impl> owner;   // its communicator and lane
+  std::shared_ptr<Comm::Impl> owner;  // its communicator and lane
   MPI_Comm comm = MPI_COMM_NULL;
   bool distributed = false;
   MPI_Win win = MPI_WIN_NULL;
@@ -287,9 +287,9 @@ struct SharedBytes::Impl {
   std::shared_ptr<Comm::Impl> owner;  // its communicator and lane
   bool distributed = false;
   MPI_Win win = MPI_WIN_NULL;
-  char* base = nullptr;                // this rank's bytes (in the window on several ranks)
-  std::vector<char> local;             // one rank: the bytes themselves
-  std::vector<std::int64_t> sizes;     // every rank's byte count
+  char* base = nullptr;             // this rank's bytes (in the window on several ranks)
+  std::vector<char> local;          // one rank: the bytes themselves
+  std::vector<std::int64_t> sizes;  // every rank's byte count
 };
 
 SharedBytes::SharedBytes(const Comm& comm, const std::vector<char>& mine)

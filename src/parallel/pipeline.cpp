@@ -327,14 +327,16 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
       std::vector<std::int64_t> flags(static_cast<std::size_t>(model.num_curves()), 0);
       std::vector<std::vector<LO>> found(mine.size());
       for (const bool halved : {true, false}) {
-        std::vector<mesh::CurveMesh> placed = quantize::place_vertices(
-            model, curves, result.curve_sizes.at, result.quantization, halved, tasks, options.place);
+        std::vector<mesh::CurveMesh> placed =
+            quantize::place_vertices(model, curves, result.curve_sizes.at, result.quantization,
+                                     halved, tasks, options.place);
         tasks.parallel_for(static_cast<std::int64_t>(mine.size()), [&](std::int64_t i) {
           try {
             const auto c = quantize::crossing_curves(model, mine[i], placed);
             found[i].insert(found[i].end(), c.begin(), c.end());
           } catch (const std::exception& e) {
-            // The face's own stages report its geometry errors; this check only looks for crossings.
+            // The face's own stages report its geometry errors; this check only looks for
+            // crossings.
             log.debug(Error(e.what(), ErrorContext{"quantize", 2, mine[i]}).what());
           }
         });
@@ -353,8 +355,9 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
       if (result.quantization.total_edges == before) break;  // only fixed curves are involved
       placed_final = false;
       result.curves_refined_for_crossings.push_back(static_cast<LO>(flagged.size()));
-      log.info(cat("quantize: ", flagged.size(),
-                   " curves refined where face boundaries crossed themselves in the parameter plane"));
+      log.info(
+          cat("quantize: ", flagged.size(),
+              " curves refined where face boundaries crossed themselves in the parameter plane"));
     }
     if (!placed_final)
       result.quantized_curves =

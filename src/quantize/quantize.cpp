@@ -469,7 +469,8 @@ std::vector<LO> crossing_curves(const cad::CadModel& model, LO f,
     std::vector<LO> of_loop;
     for (const Segment& s : segments)
       if (s.loop == l) of_loop.push_back(s.curve);
-    if (!of_loop.empty() && of_loop.size() < 3) out.insert(out.end(), of_loop.begin(), of_loop.end());
+    if (!of_loop.empty() && of_loop.size() < 3)
+      out.insert(out.end(), of_loop.begin(), of_loop.end());
   }
   if (segments.size() < 2) {
     std::sort(out.begin(), out.end());
@@ -484,9 +485,14 @@ std::vector<LO> crossing_curves(const cad::CadModel& model, LO f,
       hi = {std::max(hi.u, p.u), std::max(hi.v, p.v)};
     }
   const int cells = std::max(1, static_cast<int>(std::sqrt(static_cast<double>(segments.size()))));
-  const double wu = std::max(hi.u - lo.u, 1e-300) / cells, wv = std::max(hi.v - lo.v, 1e-300) / cells;
-  const auto cell_u = [&](double u) { return std::clamp(static_cast<int>((u - lo.u) / wu), 0, cells - 1); };
-  const auto cell_v = [&](double v) { return std::clamp(static_cast<int>((v - lo.v) / wv), 0, cells - 1); };
+  const double wu = std::max(hi.u - lo.u, 1e-300) / cells,
+               wv = std::max(hi.v - lo.v, 1e-300) / cells;
+  const auto cell_u = [&](double u) {
+    return std::clamp(static_cast<int>((u - lo.u) / wu), 0, cells - 1);
+  };
+  const auto cell_v = [&](double v) {
+    return std::clamp(static_cast<int>((v - lo.v) / wv), 0, cells - 1);
+  };
   std::vector<std::vector<std::size_t>> grid(static_cast<std::size_t>(cells) * cells);
   for (std::size_t i = 0; i < segments.size(); ++i) {
     const Segment& s = segments[i];
@@ -505,7 +511,9 @@ std::vector<LO> crossing_curves(const cad::CadModel& model, LO f,
     const Vec2 d = x.b - x.a;
     const double len2 = d.u * d.u + d.v * d.v;
     if (!(len2 > 0)) return false;
-    const auto at = [&](const Vec2& p) { return ((p.u - x.a.u) * d.u + (p.v - x.a.v) * d.v) / len2; };
+    const auto at = [&](const Vec2& p) {
+      return ((p.u - x.a.u) * d.u + (p.v - x.a.v) * d.v) / len2;
+    };
     const double from = std::max(0.0, std::min(at(y.a), at(y.b)));
     const double to = std::min(1.0, std::max(at(y.a), at(y.b)));
     return to - from > 1e-12;
@@ -515,8 +523,10 @@ std::vector<LO> crossing_curves(const cad::CadModel& model, LO f,
       for (std::size_t j = i + 1; j < cell.size(); ++j) {
         const Segment& x = segments[cell[i]];
         const Segment& y = segments[cell[j]];
-        const int o1 = sign(mesh::orient2d(x.a, x.b, y.a)), o2 = sign(mesh::orient2d(x.a, x.b, y.b));
-        const int o3 = sign(mesh::orient2d(y.a, y.b, x.a)), o4 = sign(mesh::orient2d(y.a, y.b, x.b));
+        const int o1 = sign(mesh::orient2d(x.a, x.b, y.a)),
+                  o2 = sign(mesh::orient2d(x.a, x.b, y.b));
+        const int o3 = sign(mesh::orient2d(y.a, y.b, x.a)),
+                  o4 = sign(mesh::orient2d(y.a, y.b, x.b));
         const bool crossing = !neighbours(x, y) && o1 * o2 < 0 && o3 * o4 < 0;
         const bool folded = o1 == 0 && o2 == 0 && o3 == 0 && o4 == 0 && overlap(x, y);
         if (crossing || folded) {

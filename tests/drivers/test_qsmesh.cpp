@@ -231,8 +231,8 @@ TEST_F(Qsmesh, SliverCurveIsPointedOut) {
 TEST_F(Qsmesh, CrossingBoundariesAreRefinedNotDropped) {
   const std::string path = std::string(QSMESH_SHARED_CAD_DIR) + "/Block.stp";
   if (!fs::exists(path)) GTEST_SKIP() << path << " not found";
-  const auto [r, json] = mesh_with_stats(
-      path, "--size-factor 0.05 --curvature-edges 0 --threads 2", "e2e_crossing");
+  const auto [r, json] =
+      mesh_with_stats(path, "--size-factor 0.05 --curvature-edges 0 --threads 2", "e2e_crossing");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(json_number(json, "faces_failed"), 0) << r.err;
   EXPECT_GT(json_number(json, "curves_refined_for_crossings"), 0);
@@ -333,7 +333,8 @@ TEST_F(Qsmesh, MeshHonoursSizeMapOptions) {
   EXPECT_GT(json_number(j0, "sicn_min"), 0);
   // A floor of 0.6 x 0.8 = 0.48 overrides the fillets' curvature sizes (0.39) as --size-min 0.48
   // does, and --stats gives it in model units.
-  const auto [rr, jr] = mesh_with_stats(model_, "--size 0.8 --size-min-ratio 0.6", "e2e_mesh_ratio");
+  const auto [rr, jr] =
+      mesh_with_stats(model_, "--size 0.8 --size-min-ratio 0.6", "e2e_mesh_ratio");
   const auto [ra, ja] = mesh_with_stats(model_, "--size 0.8 --size-min 0.48", "e2e_mesh_abs");
   ASSERT_EQ(rr.code, 0) << rr.err;
   ASSERT_EQ(ra.code, 0) << ra.err;

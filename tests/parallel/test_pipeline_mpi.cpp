@@ -3,21 +3,21 @@
 #include <gtest/gtest.h>
 #include <mpi.h>
 
-#include "qsmesh/background/curve_mesh.hpp"
-#include "qsmesh/crossfield/cross_field.hpp"
-#include "qsmesh/quantize/quantize.hpp"
-#include "qsmesh/sizemap/size_map.hpp"
-#include "qsmesh/mesh/assemble.hpp"
-#include "qsmesh/mesh/validate.hpp"
-#include "qsmesh/core/error.hpp"
-#include "qsmesh/parallel/comm.hpp"
-#include "qsmesh/parallel/pipeline.hpp"
-#include "shapes.hpp"
-
 #include <algorithm>
 #include <atomic>
 #include <filesystem>
 #include <sstream>
+
+#include "qsmesh/background/curve_mesh.hpp"
+#include "qsmesh/core/error.hpp"
+#include "qsmesh/crossfield/cross_field.hpp"
+#include "qsmesh/mesh/assemble.hpp"
+#include "qsmesh/mesh/validate.hpp"
+#include "qsmesh/parallel/comm.hpp"
+#include "qsmesh/parallel/pipeline.hpp"
+#include "qsmesh/quantize/quantize.hpp"
+#include "qsmesh/sizemap/size_map.hpp"
+#include "shapes.hpp"
 
 namespace qsmesh::parallel {
 namespace {
@@ -124,11 +124,13 @@ TEST(Comm, AlltoallBytesDeliversEachBufferToItsRank) {
   std::vector<std::vector<char>> to_each(static_cast<std::size_t>(n));
   for (int r = 0; r < n; ++r)
     if (!(me == 0 && r == 1))
-      to_each[r].assign(static_cast<std::size_t>((me + 1) * (r + 2)), static_cast<char>(me * 10 + r));
+      to_each[r].assign(static_cast<std::size_t>((me + 1) * (r + 2)),
+                        static_cast<char>(me * 10 + r));
   const auto got = comm.alltoall_bytes(to_each);
   ASSERT_EQ(static_cast<int>(got.size()), n);
   for (int s = 0; s < n; ++s) {
-    const std::size_t expected = s == 0 && me == 1 ? 0 : static_cast<std::size_t>((s + 1) * (me + 2));
+    const std::size_t expected =
+        s == 0 && me == 1 ? 0 : static_cast<std::size_t>((s + 1) * (me + 2));
     EXPECT_EQ(got[s].size(), expected) << "from " << s;
     for (char c : got[s]) EXPECT_EQ(c, static_cast<char>(s * 10 + me)) << "from " << s;
   }
@@ -329,7 +331,8 @@ TEST(Pipeline, CrossingBoundaryIsRepairedAlikeOnEveryRank) {
   EXPECT_EQ(dist.quantization.edges, serial.quantization.edges);
   EXPECT_EQ(dist.mesh.quads, serial.mesh.quads);
   ASSERT_EQ(dist.mesh.points.size(), serial.mesh.points.size());
-  for (std::size_t i = 0; i < serial.mesh.points.size(); ++i) ASSERT_EQ(dist.mesh.points[i], serial.mesh.points[i]);
+  for (std::size_t i = 0; i < serial.mesh.points.size(); ++i)
+    ASSERT_EQ(dist.mesh.points[i], serial.mesh.points[i]);
 }
 
 TEST(Pipeline, QuadMeshDoesNotDependOnRanks) { check_quads_do_not_depend_on_ranks(Stage::Unstructured, "pipe_quads"); }

@@ -289,7 +289,8 @@ TEST(Quantize, LengthLimitKeepsBasesOfATaperedFaceApart) {
 TEST(Quantize, CoarseArcCuttingItsNeighbourIsFound) {
   // Half annulus of radii 9 and 10: the outer arc with 2 edges is the chord from (10, 0) to
   // (0, 10) and on to (-10, 0), 7.07 from the centre, across the inner arc (radius 9).
-  const cad::CadModel model = cad::load_cad(test::write_half_annulus(9.0, 10.0, tmp("q_annulus.brep")));
+  const cad::CadModel model =
+      cad::load_cad(test::write_half_annulus(9.0, 10.0, tmp("q_annulus.brep")));
   ASSERT_EQ(model.num_faces(), 1);
   const auto loop = loop_curves(model);
   ASSERT_EQ(loop.size(), 4u);
@@ -304,10 +305,14 @@ TEST(Quantize, CoarseArcCuttingItsNeighbourIsFound) {
   const auto meshes = [&](LO outer_edges, LO inner_edges) {
     std::vector<mesh::CurveMesh> m;
     for (LO c = 0; c < model.num_curves(); ++c)
-      m.push_back(test::uniform_curve_mesh(model, c, c == outer ? outer_edges : c == inner ? inner_edges : 2));
+      m.push_back(test::uniform_curve_mesh(model, c,
+                                           c == outer   ? outer_edges
+                                           : c == inner ? inner_edges
+                                                        : 2));
     return m;
   };
-  EXPECT_EQ(crossing_curves(model, 0, meshes(2, 8)), (std::vector<LO>{std::min(outer, inner), std::max(outer, inner)}));
+  EXPECT_EQ(crossing_curves(model, 0, meshes(2, 8)),
+            (std::vector<LO>{std::min(outer, inner), std::max(outer, inner)}));
   // Equal counts give similar polygons, which do not cross; nor does a fine outer arc.
   EXPECT_TRUE(crossing_curves(model, 0, meshes(2, 2)).empty());
   EXPECT_TRUE(crossing_curves(model, 0, meshes(16, 8)).empty());

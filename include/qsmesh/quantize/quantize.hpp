@@ -134,7 +134,8 @@ struct PlaceOptions {
 /// three segments (two curves joining the same corners with one edge each). The Delaunay kernel
 /// cannot triangulate such a boundary, so the face could not be meshed at all: a tight curve (a
 /// small fillet, a slot's end) with too few edges cuts a corner across a neighbouring curve.
-/// Sorted, each curve once; empty when the boundary is simple. Throws what face_geometry / face_boundary throw.
+/// Sorted, each curve once; empty when the boundary is simple. Throws what face_geometry /
+/// face_boundary throw.
 [[nodiscard]] std::vector<LO> crossing_curves(const cad::CadModel& model, LO f,
                                               std::span<const mesh::CurveMesh> curves);
 
