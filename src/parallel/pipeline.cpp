@@ -273,6 +273,9 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
   // ranks, their union on shared curves by an MPI min-reduction, then quantization (Sec. 4.3)
   // computed identically on every rank.
   std::vector<sizemap::FaceSizes> sizes(size_map ? mine.size() : 0);
+  // The halved curve meshes of the final quantization (paper 000 Sec. 5.2), when the boundary
+  // check already placed them; else the unstructured stage places them.
+  std::vector<mesh::CurveMesh> halved_curves;
   if (size_map) {
     clock.reset();
     const sizemap::SizeMapOptions& so = options.sizemap;
@@ -340,7 +343,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
             log.debug(Error(e.what(), ErrorContext{"quantize", 2, mine[i]}).what());
           }
         });
-        if (!halved) result.quantized_curves = std::move(placed);
+        (halved ? halved_curves : result.quantized_curves) = std::move(placed);
       }
       placed_final = true;
       for (const auto& list : found)
@@ -354,6 +357,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
       quantize::refine_curves(result.quantization, flagged, fixed);
       if (result.quantization.total_edges == before) break;  // only fixed curves are involved
       placed_final = false;
+      halved_curves.clear();
       result.curves_refined_for_crossings.push_back(static_cast<LO>(flagged.size()));
       log.info(
           cat("quantize: ", flagged.size(),
@@ -451,7 +455,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     };
     std::vector<std::int64_t> local_of(static_cast<std::size_t>(nfaces), -1);
     for (std::int64_t i = 0; i < total; ++i) local_of[static_cast<std::size_t>(mine[i])] = i;
-    std::vector<char> outgoing;
+    std::vector<std::vector<char>> to_owner(static_cast<std::size_t>(nranks));
     for (LO f = 0; f < nfaces; ++f) {
       Fill& fill = fills[static_cast<std::size_t>(f)];
       if (!fill.done) continue;
@@ -459,6 +463,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
         take(local_of[static_cast<std::size_t>(f)], std::move(fill));
       } else {
         const qstruct::PatternFaceReport& pr = fill.report;
+        std::vector<char>& outgoing = to_owner[static_cast<std::size_t>(result.face_rank[f])];
         put<LO>(outgoing, f);
         put<std::uint8_t>(outgoing, pr.ok ? 1 : 0);
         put<qstruct::Refusal>(outgoing, pr.refusal);
@@ -472,7 +477,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
       fill = Fill{};
     }
     if (nranks > 1)
-      for (const auto& bytes : comm.allgather_bytes(outgoing)) {
+      for (const auto& bytes : comm.alltoall_bytes(to_owner)) {
         std::size_t pos = 0;
         while (pos < bytes.size()) {
           const auto f = get<LO>(bytes, pos);
@@ -486,17 +491,21 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
           unpack_mesh(bytes, pos, fill.mesh);
           unpack_mesh(bytes, pos, pr.refused_mesh);
           fill.seconds = get<double>(bytes, pos);
-          QSMESH_CHECK(f >= 0 && f < nfaces, "pattern fill for unknown face " << f);
-          if (local_of[static_cast<std::size_t>(f)] >= 0)
-            take(local_of[static_cast<std::size_t>(f)], std::move(fill));
+          QSMESH_CHECK(f >= 0 && f < nfaces && local_of[static_cast<std::size_t>(f)] >= 0,
+                       "pattern fill of face " << f << " sent to rank " << rank
+                                               << ", which does not own it");
+          take(local_of[static_cast<std::size_t>(f)], std::move(fill));
         }
       }
     end_stage("patterns", true);
   }
   if (quads) {
     clock.reset();
-    const std::vector<mesh::CurveMesh> halved = quantize::place_vertices(
-        model, curves, result.curve_sizes.at, result.quantization, /*halved=*/true, tasks, options.place);
+    const std::vector<mesh::CurveMesh> halved =
+        !halved_curves.empty()
+            ? std::move(halved_curves)
+            : quantize::place_vertices(model, curves, result.curve_sizes.at, result.quantization,
+                                       /*halved=*/true, tasks, options.place);
     quad::UnstructuredOptions qo;
     qo.size = options.background.sizes.size;
     auto mesh_unstructured = [&](std::int64_t i) {
