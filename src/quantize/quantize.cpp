@@ -465,18 +465,15 @@ std::vector<LO> crossing_curves(const cad::CadModel& model, LO f,
   std::vector<LO> out;
   // A loop of one or two segments encloses nothing (two curves joining the same corners, one
   // edge each on the halved meshes).
-  for (LO l = 0; l < static_cast<LO>(loops.size()); ++l) {
-    std::vector<LO> of_loop;
-    for (const Segment& s : segments)
-      if (s.loop == l) of_loop.push_back(s.curve);
-    if (!of_loop.empty() && of_loop.size() < 3)
-      out.insert(out.end(), of_loop.begin(), of_loop.end());
-  }
-  if (segments.size() < 2) {
+  for (std::size_t l = 0; l < loops.size(); ++l)
+    if (!loops[l].points.empty() && loops[l].points.size() < 3)
+      for (const cad::CurveUse& use : face.loops[l].uses) out.push_back(use.curve);
+  const auto sorted_once = [&] {
     std::sort(out.begin(), out.end());
     out.erase(std::unique(out.begin(), out.end()), out.end());
     return out;
-  }
+  };
+  if (segments.size() < 2) return sorted_once();
   // A uniform grid over the loops' box, about one segment per cell, keeps this near-linear.
   Vec2 lo = segments[0].a, hi = segments[0].a;
   for (const Segment& s : segments)
@@ -534,9 +531,7 @@ std::vector<LO> crossing_curves(const cad::CadModel& model, LO f,
           out.push_back(y.curve);
         }
       }
-  std::sort(out.begin(), out.end());
-  out.erase(std::unique(out.begin(), out.end()), out.end());
-  return out;
+  return sorted_once();
 }
 
 void refine_curves(Quantization& q, std::span<const LO> curves, std::span<const LO> fixed) {
