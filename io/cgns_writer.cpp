@@ -3,14 +3,16 @@
 #include <cgns_io.h>
 #include <cgnslib.h>
 
+#include <algorithm>
 #include <array>
 #include <bit>
 #include <cerrno>
-#include <cstdio>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
 #include <limits>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "detail.hpp"
@@ -112,40 +114,71 @@ std::uint32_t lookup3(const unsigned char* k, std::size_t length) {
 // HDF5 (through cgnslib, which offers no switch) stores access/modification/change/birth times in
 // every version-2 object header, so two writes of the same mesh differ. This zeroes those times and
 // rewrites the header checksums. A candidate "OHDR" is only patched when its stored checksum
-// verifies, so bytes in raw data that happen to read "OHDR" are left alone.
+// verifies, so bytes in raw data that happen to read "OHDR" are left alone. The file is scanned in
+// blocks and each header read alone: the whole file in memory was the largest allocation of a run
+// on the writing rank (50 MB of heap for a 17.5 MB file; docs/benchmarks.md).
 void strip_hdf5_times(const std::string& file) {
   std::FILE* f = std::fopen(file.c_str(), "r+b");
   if (f == nullptr) throw Error("cannot reopen " + file + ": " + std::strerror(errno));
-  std::string data;
-  char buf[1 << 16];
-  for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, f)) > 0;) data.append(buf, n);
-  bool ok = std::ferror(f) == 0;
-  auto* bytes = reinterpret_cast<unsigned char*>(data.data());
-  std::size_t pos = 0;
-  while (ok && (pos = data.find("OHDR", pos)) != std::string::npos) {
-    const std::size_t start = pos;
-    pos += 4;
-    if (start + 6 > data.size() || bytes[start + 4] != 2 || (bytes[start + 5] & 0x20) == 0) continue;
-    const unsigned flags = bytes[start + 5];
-    std::size_t p = start + 6 + 16 + ((flags & 0x10) != 0 ? 4 : 0);
-    const std::size_t width = std::size_t{1} << (flags & 3);
-    if (p + width > data.size()) continue;
-    std::uint64_t chunk = 0;
-    for (std::size_t i = 0; i < width; ++i) chunk |= std::uint64_t{bytes[p + i]} << (8 * i);
-    p += width;
-    if (chunk > data.size() - p || p + chunk + 4 > data.size()) continue;
-    const std::size_t sum_at = p + chunk;
-    std::uint32_t stored = 0;
-    std::memcpy(&stored, bytes + sum_at, 4);  // little-endian file, little-endian host
-    if (lookup3(bytes + start, sum_at - start) != stored) continue;
-    std::memset(bytes + start + 6, 0, 16);
-    const std::uint32_t sum = lookup3(bytes + start, sum_at - start);
-    ok = std::fseek(f, static_cast<long>(start + 6), SEEK_SET) == 0 &&
-         std::fwrite(bytes + start + 6, 1, 16, f) == 16 &&
-         std::fseek(f, static_cast<long>(sum_at), SEEK_SET) == 0 && std::fwrite(&sum, 1, 4, f) == 4;
-    pos = sum_at + 4;
+  const auto fail = [&](const char* what) {
+    const std::string reason = std::strerror(errno);
+    std::fclose(f);
+    throw Error("cannot " + std::string(what) + " " + file + ": " + reason);
+  };
+  const auto read_at = [&](std::uint64_t at, unsigned char* to, std::size_t n) {
+    if (std::fseek(f, static_cast<long>(at), SEEK_SET) != 0 || std::fread(to, 1, n, f) != n)
+      fail("read back");
+  };
+  const auto write_at = [&](std::uint64_t at, const void* from, std::size_t n) {
+    if (std::fseek(f, static_cast<long>(at), SEEK_SET) != 0 || std::fwrite(from, 1, n, f) != n)
+      fail("rewrite");
+  };
+  if (std::fseek(f, 0, SEEK_END) != 0) fail("read back");
+  const long end = std::ftell(f);
+  if (end < 0) fail("read back");
+  const auto size = static_cast<std::uint64_t>(end);
+
+  constexpr std::uint64_t kBlock = std::uint64_t{1} << 20;
+  std::vector<unsigned char> block;
+  std::vector<unsigned char> header;
+  std::uint64_t next = 0;  // a header may start here or later (not inside one already patched)
+  for (std::uint64_t base = 0; base < size; base += kBlock) {
+    // 3 bytes past the block, so that a tag across the border is seen from this block.
+    block.resize(static_cast<std::size_t>(std::min(kBlock + 3, size - base)));
+    read_at(base, block.data(), block.size());
+    const std::string_view view(reinterpret_cast<const char*>(block.data()), block.size());
+    for (std::size_t i = view.find("OHDR"); i != std::string_view::npos && i < kBlock;
+         i = view.find("OHDR", i + 1)) {
+      const std::uint64_t start = base + i;
+      if (start < next || start + 6 > size) continue;
+      unsigned char prefix[6 + 16 + 4 + 8];
+      const std::size_t have =
+          static_cast<std::size_t>(std::min<std::uint64_t>(sizeof prefix, size - start));
+      read_at(start, prefix, have);
+      if (prefix[4] != 2 || (prefix[5] & 0x20) == 0) continue;
+      const unsigned flags = prefix[5];
+      const std::size_t p = 6 + 16 + ((flags & 0x10) != 0 ? 4 : 0);
+      const std::size_t width = std::size_t{1} << (flags & 3);
+      if (p + width > have) continue;
+      std::uint64_t chunk = 0;
+      for (std::size_t k = 0; k < width; ++k) chunk |= std::uint64_t{prefix[p + k]} << (8 * k);
+      const std::uint64_t body = start + p + width;  // the chunk's first byte
+      if (chunk > size - body || body + chunk + 4 > size) continue;
+      const std::uint64_t sum_at = body + chunk;
+      header.resize(static_cast<std::size_t>(sum_at + 4 - start));
+      read_at(start, header.data(), header.size());
+      const std::size_t covered = header.size() - 4;
+      std::uint32_t stored = 0;
+      std::memcpy(&stored, header.data() + covered, 4);  // little-endian file, little-endian host
+      if (lookup3(header.data(), covered) != stored) continue;
+      std::memset(header.data() + 6, 0, 16);
+      const std::uint32_t sum = lookup3(header.data(), covered);
+      write_at(start + 6, header.data() + 6, 16);
+      write_at(sum_at, &sum, 4);
+      next = sum_at + 4;
+    }
   }
-  if (std::fclose(f) != 0 || !ok) throw Error("cannot rewrite " + file + ": " + std::strerror(errno));
+  if (std::fclose(f) != 0) throw Error("cannot rewrite " + file + ": " + std::strerror(errno));
 }
 static_assert(std::endian::native == std::endian::little, "strip_hdf5_times assumes little endian");
 

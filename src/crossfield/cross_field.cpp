@@ -21,4 +21,20 @@ FaceCrossField compute_face_cross_field(const mesh::FaceMesh& background,
   return cf;
 }
 
+void shrink_cross_field(FaceCrossField& cf, CrossFieldUse use) {
+  // Swaps with empty vectors: clear() would keep the capacity.
+  std::vector<std::int8_t>().swap(cf.vertex_dim);
+  std::vector<std::array<LO, 3>>().swap(cf.tri2edges);
+  std::vector<std::uint8_t>().swap(cf.boundary_edge);
+  std::vector<std::uint8_t>().swap(cf.fixed_edge);
+  std::vector<Vec2>().swap(cf.u);
+  std::vector<double>().swap(cf.u_norm);
+  if (use == CrossFieldUse::Guide) {
+    std::vector<Vec3>().swap(cf.points);
+    std::vector<std::array<LO, 2>>().swap(cf.edges);
+    std::vector<double>().swap(cf.H);
+    std::vector<double>().swap(cf.h);
+  }
+}
+
 }  // namespace qsmesh::crossfield

@@ -6,42 +6,78 @@
 
 namespace qsmesh::mesh {
 
-SurfaceMesh assemble(const cad::CadModel& model, std::span<const CurveMesh> curves,
-                     std::span<const FaceMesh> faces) {
+namespace {
+
+// Two vertices of one face mesh are one vertex of the assembled mesh when they are the same
+// corner or the same vertex of the same curve (several uv images: seams, poles); interior
+// vertices are always distinct.
+bool same_vertex(const VertexClass& a, const VertexClass& b) {
+  if (a.dim != b.dim || a.dim == 2) return false;
+  return a.entity == b.entity && (a.dim == 0 || a.index == b.index);
+}
+
+bool collapsed(const FaceMesh& fm, const std::array<LO, 3>& t) {
+  return same_vertex(fm.vclass[t[0]], fm.vclass[t[1]]) ||
+         same_vertex(fm.vclass[t[1]], fm.vclass[t[2]]) ||
+         same_vertex(fm.vclass[t[0]], fm.vclass[t[2]]);
+}
+
+}  // namespace
+
+FaceContribution face_contribution(const FaceMesh& face) {
+  FaceContribution c;
+  for (const VertexClass& vc : face.vclass) c.interior_vertices += vc.dim == 2 ? 1 : 0;
+  for (const auto& t : face.triangles) c.triangles += collapsed(face, t) ? 0 : 1;
+  c.quads = static_cast<GO>(face.quads.size());
+  return c;
+}
+
+MeshAssembler::MeshAssembler(const cad::CadModel& model, std::span<const CurveMesh> curves,
+                             std::span<const FaceContribution> contributions)
+    : model_(model), curves_(curves) {
   const LO nc = model.num_corners();
   const LO ncurves = model.num_curves();
   const LO nfaces = model.num_faces();
   QSMESH_CHECK(static_cast<LO>(curves.size()) == ncurves, "one curve mesh per curve expected");
-  QSMESH_CHECK(static_cast<LO>(faces.size()) == nfaces, "one face mesh slot per face expected");
+  QSMESH_CHECK(static_cast<LO>(contributions.size()) == nfaces,
+               "one face contribution per face expected");
+  out_.num_cad_corners = nc;
+  out_.num_cad_curves = ncurves;
+  out_.num_cad_faces = nfaces;
 
-  SurfaceMesh out;
-  out.num_cad_corners = nc;
-  out.num_cad_curves = ncurves;
-  out.num_cad_faces = nfaces;
-
-  std::vector<GO> curve_offset(static_cast<std::size_t>(ncurves) + 1, nc);
+  curve_offset_.assign(static_cast<std::size_t>(ncurves) + 1, nc);
   for (LO c = 0; c < ncurves; ++c)
-    curve_offset[c + 1] = curve_offset[c] + std::max<LO>(0, curves[c].num_edges() - 1);
-  std::vector<GO> face_offset(static_cast<std::size_t>(nfaces) + 1, curve_offset[ncurves]);
+    curve_offset_[c + 1] = curve_offset_[c] + std::max<LO>(0, curves[c].num_edges() - 1);
+  face_offset_.assign(static_cast<std::size_t>(nfaces) + 1, curve_offset_[ncurves]);
+  triangle_offset_.assign(static_cast<std::size_t>(nfaces) + 1, 0);
+  quad_offset_.assign(static_cast<std::size_t>(nfaces) + 1, 0);
   for (LO f = 0; f < nfaces; ++f) {
-    GO interior = 0;
-    for (const VertexClass& vc : faces[f].vclass) interior += vc.dim == 2 ? 1 : 0;
-    face_offset[f + 1] = face_offset[f] + interior;
+    const FaceContribution& c = contributions[f];
+    QSMESH_CHECK(c.interior_vertices >= 0 && c.triangles >= 0 && c.quads >= 0,
+                 "face " << f << ": negative contribution");
+    face_offset_[f + 1] = face_offset_[f] + c.interior_vertices;
+    triangle_offset_[f + 1] = triangle_offset_[f] + c.triangles;
+    quad_offset_[f + 1] = quad_offset_[f] + c.quads;
   }
+  added_.assign(static_cast<std::size_t>(nfaces), 0);
 
-  const GO nv = face_offset[nfaces];
-  out.points.resize(static_cast<std::size_t>(nv));
-  out.vclass.resize(static_cast<std::size_t>(nv));
+  const GO nv = face_offset_[nfaces];
+  out_.points.resize(static_cast<std::size_t>(nv));
+  out_.vclass.resize(static_cast<std::size_t>(nv));
+  out_.triangles.resize(static_cast<std::size_t>(triangle_offset_[nfaces]));
+  out_.triangle_face.resize(out_.triangles.size());
+  out_.quads.resize(static_cast<std::size_t>(quad_offset_[nfaces]));
+  out_.quad_face.resize(out_.quads.size());
   for (LO i = 0; i < nc; ++i) {
-    out.points[i] = model.corners()[i].point;
-    out.vclass[i] = VertexClass{0, i, kNoIndex, {0, 0}};
+    out_.points[i] = model.corners()[i].point;
+    out_.vclass[i] = VertexClass{0, i, kNoIndex, {0, 0}};
   }
   for (LO c = 0; c < ncurves; ++c) {
     const CurveMesh& cm = curves[c];
     for (LO i = 1; i < cm.num_edges(); ++i) {
-      const GO g = curve_offset[c] + i - 1;
-      out.points[g] = cm.points[i];
-      out.vclass[g] = VertexClass{1, c, i, {cm.t[i], 0}};
+      const GO g = curve_offset_[c] + i - 1;
+      out_.points[g] = cm.points[i];
+      out_.vclass[g] = VertexClass{1, c, i, {cm.t[i], 0}};
     }
   }
 
@@ -53,68 +89,101 @@ SurfaceMesh assemble(const cad::CadModel& model, std::span<const CurveMesh> curv
     auto id = [&](LO i) -> GO {
       if (i == 0) return cc.corners[0];
       if (i == cm.num_edges()) return cc.corners[1];
-      return curve_offset[c] + i - 1;
+      return curve_offset_[c] + i - 1;
     };
     for (LO i = 0; i < cm.num_edges(); ++i) {
-      out.bars.push_back({id(i), id(i + 1)});
-      out.bar_curve.push_back(c);
+      out_.bars.push_back({id(i), id(i + 1)});
+      out_.bar_curve.push_back(c);
     }
   }
+}
 
-  // Faces in increasing id; local -> global through the classification.
-  std::vector<GO> local2global;
-  for (LO f = 0; f < nfaces; ++f) {
-    const FaceMesh& fm = faces[f];
-    local2global.assign(fm.vclass.size(), -1);
-    GO next_interior = face_offset[f];
-    for (std::size_t i = 0; i < fm.vclass.size(); ++i) {
-      const VertexClass& vc = fm.vclass[i];
-      GO g = -1;
-      if (vc.dim == 0) {
-        QSMESH_CHECK(vc.entity >= 0 && vc.entity < nc, "face " << f << ": bad corner id " << vc.entity);
-        g = vc.entity;
-      } else if (vc.dim == 1) {
-        QSMESH_CHECK(vc.entity >= 0 && vc.entity < ncurves, "face " << f << ": bad curve id " << vc.entity);
-        const CurveMesh& cm = curves[vc.entity];
-        QSMESH_CHECK(vc.index >= 1 && vc.index < cm.num_edges(),
-                     "face " << f << ": vertex index " << vc.index << " outside curve " << vc.entity);
-        g = curve_offset[vc.entity] + vc.index - 1;
-      } else {
-        g = next_interior++;
-        out.points[g] = fm.points[i];
-        out.vclass[g] = vc;
-        out.vclass[g].entity = f;
-        out.vclass[g].index = kNoIndex;
-      }
-      local2global[i] = g;
+void MeshAssembler::add_face(LO f, const FaceMesh& fm) {
+  const LO nc = model_.num_corners();
+  const LO ncurves = model_.num_curves();
+  QSMESH_CHECK(f >= 0 && f < model_.num_faces(), "assembly: no face " << f);
+  QSMESH_CHECK(!added_[f], "assembly: face " << f << " added twice");
+  added_[f] = 1;
+  const FaceContribution c = face_contribution(fm);
+  QSMESH_CHECK(c.interior_vertices == face_offset_[f + 1] - face_offset_[f] &&
+                   c.triangles == triangle_offset_[f + 1] - triangle_offset_[f] &&
+                   c.quads == quad_offset_[f + 1] - quad_offset_[f],
+               "assembly: face " << f << " has " << c.interior_vertices << " interior vertices, "
+                                 << c.triangles << " triangles and " << c.quads
+                                 << " quads, not the counts announced");
+  std::vector<GO> local2global(fm.vclass.size(), -1);
+  GO next_interior = face_offset_[f];
+  for (std::size_t i = 0; i < fm.vclass.size(); ++i) {
+    const VertexClass& vc = fm.vclass[i];
+    GO g = -1;
+    if (vc.dim == 0) {
+      QSMESH_CHECK(vc.entity >= 0 && vc.entity < nc,
+                   "face " << f << ": bad corner id " << vc.entity);
+      g = vc.entity;
+    } else if (vc.dim == 1) {
+      QSMESH_CHECK(vc.entity >= 0 && vc.entity < ncurves,
+                   "face " << f << ": bad curve id " << vc.entity);
+      const CurveMesh& cm = curves_[vc.entity];
+      QSMESH_CHECK(vc.index >= 1 && vc.index < cm.num_edges(),
+                   "face " << f << ": vertex index " << vc.index << " outside curve " << vc.entity);
+      g = curve_offset_[vc.entity] + vc.index - 1;
+    } else {
+      g = next_interior++;
+      out_.points[g] = fm.points[i];
+      out_.vclass[g] = vc;
+      out_.vclass[g].entity = f;
+      out_.vclass[g].index = kNoIndex;
     }
-    for (const auto& t : fm.triangles) {
-      const std::array<GO, 3> gt{local2global[t[0]], local2global[t[1]], local2global[t[2]]};
-      // Two uv images of one vertex (pole) collapse a triangle: it carries no area, drop it.
-      if (gt[0] == gt[1] || gt[1] == gt[2] || gt[0] == gt[2]) continue;
-      out.triangles.push_back(gt);
-      out.triangle_face.push_back(f);
-    }
-    for (const auto& q : fm.quads) {
-      out.quads.push_back({local2global[q[0]], local2global[q[1]], local2global[q[2]], local2global[q[3]]});
-      out.quad_face.push_back(f);
-    }
+    local2global[i] = g;
   }
+  GO t_out = triangle_offset_[f];
+  for (const auto& t : fm.triangles) {
+    // Two uv images of one vertex (pole) collapse a triangle: it carries no area, drop it.
+    if (collapsed(fm, t)) continue;
+    out_.triangles[t_out] = {local2global[t[0]], local2global[t[1]], local2global[t[2]]};
+    out_.triangle_face[t_out++] = f;
+  }
+  GO q_out = quad_offset_[f];
+  for (const auto& q : fm.quads) {
+    out_.quads[q_out] = {local2global[q[0]], local2global[q[1]], local2global[q[2]],
+                         local2global[q[3]]};
+    out_.quad_face[q_out++] = f;
+  }
+}
 
+SurfaceMesh MeshAssembler::finish() {
+  const LO nfaces = model_.num_faces();
+  for (LO f = 0; f < nfaces; ++f)
+    QSMESH_CHECK(added_[f] || (face_offset_[f + 1] == face_offset_[f] &&
+                               triangle_offset_[f + 1] == triangle_offset_[f] &&
+                               quad_offset_[f + 1] == quad_offset_[f]),
+                 "assembly: face " << f << " announced but never added");
   // Topology for the writers.
-  out.curve_corners.resize(static_cast<std::size_t>(ncurves));
-  for (LO c = 0; c < ncurves; ++c) out.curve_corners[c] = model.curves()[c].corners;
+  const LO ncurves = model_.num_curves();
+  out_.curve_corners.resize(static_cast<std::size_t>(ncurves));
+  for (LO c = 0; c < ncurves; ++c) out_.curve_corners[c] = model_.curves()[c].corners;
   std::vector<std::pair<LO, LO>> pairs;
   for (LO f = 0; f < nfaces; ++f) {
     std::vector<LO> cs;
-    for (const auto& loop : model.faces()[f].loops)
+    for (const auto& loop : model_.faces()[f].loops)
       for (const auto& use : loop.uses) cs.push_back(use.curve);
     std::sort(cs.begin(), cs.end());
     cs.erase(std::unique(cs.begin(), cs.end()), cs.end());
     for (LO c : cs) pairs.emplace_back(f, c);
   }
-  out.face2curves = Adjacency::from_pairs(nfaces, std::move(pairs));
-  return out;
+  out_.face2curves = Adjacency::from_pairs(nfaces, std::move(pairs));
+  return std::move(out_);
+}
+
+SurfaceMesh assemble(const cad::CadModel& model, std::span<const CurveMesh> curves,
+                     std::span<const FaceMesh> faces) {
+  QSMESH_CHECK(static_cast<LO>(faces.size()) == model.num_faces(),
+               "one face mesh slot per face expected");
+  std::vector<FaceContribution> counts(faces.size());
+  for (std::size_t f = 0; f < faces.size(); ++f) counts[f] = face_contribution(faces[f]);
+  MeshAssembler assembler(model, curves, counts);
+  for (LO f = 0; f < model.num_faces(); ++f) assembler.add_face(f, faces[f]);
+  return assembler.finish();
 }
 
 }  // namespace qsmesh::mesh

@@ -152,6 +152,41 @@ std::vector<std::vector<char>> Comm::gather_bytes(const std::vector<char>& mine,
   return out;
 }
 
+void Comm::gather_bytes_each(
+    std::vector<char>&& mine, int root,
+    const std::function<void(int rank, std::vector<char>& bytes)>& use) const {
+  const int n = size();
+  const int me = rank();
+  std::int64_t my_size = static_cast<std::int64_t>(mine.size());
+  std::vector<std::int64_t> sizes(static_cast<std::size_t>(n), 0);
+  check_mpi(MPI_Gather(&my_size, 1, MPI_INT64_T, sizes.data(), 1, MPI_INT64_T, root, impl_->comm),
+            "MPI_Gather");
+  constexpr std::int64_t kChunk = std::int64_t{1} << 30;
+  if (me == root) {
+    std::vector<char> bytes;
+    for (int r = 0; r < n; ++r) {
+      if (r == root) {
+        std::vector<char> own = std::move(mine);
+        use(r, own);
+        continue;
+      }
+      bytes.resize(static_cast<std::size_t>(sizes[r]));
+      for (std::int64_t off = 0; off < sizes[r]; off += kChunk) {
+        const int count = static_cast<int>(std::min(kChunk, sizes[r] - off));
+        check_mpi(
+            MPI_Recv(bytes.data() + off, count, MPI_CHAR, r, 9, impl_->comm, MPI_STATUS_IGNORE),
+            "MPI_Recv");
+      }
+      use(r, bytes);
+    }
+  } else {
+    for (std::int64_t off = 0; off < my_size; off += kChunk) {
+      const int count = static_cast<int>(std::min(kChunk, my_size - off));
+      check_mpi(MPI_Send(mine.data() + off, count, MPI_CHAR, root, 9, impl_->comm), "MPI_Send");
+    }
+  }
+}
+
 void Comm::broadcast_bytes(std::vector<char>& bytes, int root) const {
   std::int64_t n = static_cast<std::int64_t>(bytes.size());
   check_mpi(MPI_Bcast(&n, 1, MPI_INT64_T, root, impl_->comm), "MPI_Bcast");

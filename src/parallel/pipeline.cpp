@@ -7,6 +7,7 @@
 #include <limits>
 #include <memory>
 #include <numeric>
+#include <optional>
 
 #include "improve.hpp"
 #include "qsmesh/background/curve_mesh.hpp"
@@ -238,7 +239,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
 
   // Cross fields (paper 000 Sec. 3) on the same faces, one task per face. The size map (it needs H
   // at every vertex) and the frontal insertion (the crosses) keep the whole fields; the drivers
-  // get summaries.
+  // that asked for them (options.cross_fields) get summaries.
   const bool quads = options.until >= Stage::Unstructured;
   const bool size_map = options.size_map || quads;
   const bool cf_sizes = size_map && options.sizemap.method == sizemap::Method::CrossField;
@@ -254,7 +255,10 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
       try {
         auto cf = std::make_unique<crossfield::FaceCrossField>(
             crossfield::compute_face_cross_field(meshes[i], options.crossfield, lane));
-        fields[i] = summarize(*cf);
+        if (options.cross_fields)
+          fields[i] = summarize(*cf);
+        else
+          crossfield::shrink_cross_field(*cf, crossfield::CrossFieldUse::SizeMapAndGuide);
         if (keep_fields) full[i] = std::move(cf);
       } catch (const std::exception& e) {
         // A face without a cross field keeps its background mesh; later stages fall back to
@@ -298,6 +302,12 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     united.unpack(flat);
     sizemap::grade_curves(model, curves, so.gradation, united);
     face_pass(united);  // faces now agree on their shared curves
+    // The frontal insertion reads only the crosses of each field; the rest was for the size map.
+    if (!options.cross_fields)
+      tasks.parallel_for(total, [&](std::int64_t i) {
+        if (full[i] != nullptr)
+          crossfield::shrink_cross_field(*full[i], crossfield::CrossFieldUse::Guide);
+      });
     result.curve_sizes = std::move(united);
     end_stage("sizemap", true);
 
@@ -520,9 +530,20 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
                                                     face_fields, qo, &quad_reports[i]);
       face_seconds[i] += face_clock.seconds();
     };
+    // Of a face's cross field, the later steps need only its singularities; the field, the
+    // background mesh and the size map (the largest per-face data) go as soon as the face's
+    // unstructured mesh is made, so that they are not held through the improvement and the output
+    // (Block.stp at its reference count, one rank: peak heap 131 -> 101 MB, and 74 MB with
+    // crossfield::shrink_cross_field; docs/benchmarks.md).
+    std::vector<std::vector<crossfield::Singularity>> singularities(
+        quasi ? static_cast<std::size_t>(total) : 0);
     std::atomic<std::int64_t> q_done{0};
     tasks.parallel_for(total, [&](std::int64_t i) {
       if (!(quasi && quasi_reports[i].by_pattern)) mesh_unstructured(i);
+      if (full[i] != nullptr && quasi) singularities[i] = std::move(full[i]->singularities);
+      full[i].reset();
+      meshes[i] = mesh::FaceMesh{};
+      if (!options.size_map) sizes[i] = sizemap::FaceSizes{};
       const std::int64_t n = ++q_done;
       if (n * 10 / total != (n - 1) * 10 / total)
         log.info(cat("unstructured: ", n, "/", mine.size(), " faces on rank ", rank));
@@ -539,7 +560,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
         ImproveFace f;
         f.face = mine[i];
         f.mesh = &quad_meshes[i];
-        if (full[i] != nullptr) f.singularities = full[i]->singularities;
+        f.singularities = singularities[i];
         f.report = &quasi_reports[i];
         f.seconds = &face_seconds[i];
         to_improve.push_back(f);
@@ -623,13 +644,27 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     meshes = std::move(quad_meshes);
   }
 
-  // Gather on rank 0 and assemble in face order.
+  // Gather on rank 0 and assemble. The assembled mesh is sized first from every face's counts;
+  // the faces then arrive one rank at a time and each is written in place and dropped, so that
+  // rank 0 holds the assembled mesh and one rank's faces, not every face twice over.
   clock.reset();
+  const std::span<const mesh::CurveMesh> final_curves =
+      quads ? std::span<const mesh::CurveMesh>(result.quantized_curves)
+            : std::span<const mesh::CurveMesh>(curves);
+  std::vector<std::int64_t> counts(3 * static_cast<std::size_t>(nfaces), 0);
+  for (std::size_t i = 0; i < mine.size(); ++i) {
+    const mesh::FaceContribution c = mesh::face_contribution(meshes[i]);
+    const auto at = 3 * static_cast<std::size_t>(mine[i]);
+    counts[at] = c.interior_vertices;
+    counts[at + 1] = c.triangles;
+    counts[at + 2] = c.quads;
+  }
+  comm.allreduce_sum(counts);  // each face's entries are set by its owner alone
   std::vector<char> buffer;
   for (std::size_t i = 0; i < mine.size(); ++i) {
     pack(meshes[i], reports[i], buffer);
     if (options.cross_fields) pack(fields[i], buffer);
-    if (size_map) pack(sizes[i], buffer);
+    if (options.size_map) pack(sizes[i], buffer);
     if (quads) pack(quad_reports[i], buffer);
     if (quasi) pack(quasi_reports[i], buffer);
     if (quads) {
@@ -643,49 +678,58 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     }
   }
   meshes.clear();
-  const auto gathered = comm.gather_bytes(buffer, 0);
+  std::optional<mesh::MeshAssembler> assembler;
+  const bool keep_background = size_map && !quads;  // the size map's output draws them
   if (rank == 0) {
-    std::vector<mesh::FaceMesh> all(static_cast<std::size_t>(nfaces));
+    std::vector<mesh::FaceContribution> contributions(static_cast<std::size_t>(nfaces));
+    for (LO f = 0; f < nfaces; ++f) {
+      const auto at = 3 * static_cast<std::size_t>(f);
+      contributions[f] = {counts[at], counts[at + 1], counts[at + 2]};
+    }
+    assembler.emplace(model, final_curves, contributions);
     result.reports.resize(static_cast<std::size_t>(nfaces));
     if (options.cross_fields) result.cross_fields.resize(static_cast<std::size_t>(nfaces));
-    if (size_map) result.face_sizes.resize(static_cast<std::size_t>(nfaces));
+    if (options.size_map) result.face_sizes.resize(static_cast<std::size_t>(nfaces));
     if (quads) result.quad_reports.resize(static_cast<std::size_t>(nfaces));
     if (quasi) result.quasi_reports.resize(static_cast<std::size_t>(nfaces));
     if (quads) {
       result.face_stats.resize(static_cast<std::size_t>(nfaces));
       result.face_seconds.resize(static_cast<std::size_t>(nfaces));
     }
-    for (const auto& bytes : gathered) {
-      std::size_t pos = 0;
-      while (pos < bytes.size()) {
-        mesh::FaceMesh m;
-        background::FaceReport r;
-        unpack(bytes, pos, m, r);
-        const LO f = r.face;
-        QSMESH_CHECK(f >= 0 && f < nfaces, "gathered report for unknown face " << f);
-        result.reports[f] = std::move(r);
-        all[f] = std::move(m);
-        if (options.cross_fields) unpack(bytes, pos, result.cross_fields[f]);
-        if (size_map) unpack(bytes, pos, result.face_sizes[f]);
-        if (quads) unpack(bytes, pos, result.quad_reports[f]);
-        if (quasi) unpack(bytes, pos, result.quasi_reports[f]);
-        if (quads) {
-          mesh::FaceQuadStats& st = result.face_stats[f];
-          for (std::int64_t* x : {&st.vertices, &st.quads, &st.triangles, &st.irregular_interior,
-                                  &st.irregular_boundary})
-            *x = get<std::int64_t>(bytes, pos);
-          st.sicn_min = get<double>(bytes, pos);
-          st.sicn_avg = get<double>(bytes, pos);
-          result.face_seconds[f] = get<double>(bytes, pos);
-        }
+    if (keep_background) result.background.resize(static_cast<std::size_t>(nfaces));
+  }
+  comm.gather_bytes_each(std::move(buffer), 0, [&](int, std::vector<char>& bytes) {
+    std::size_t pos = 0;
+    while (pos < bytes.size()) {
+      mesh::FaceMesh m;
+      background::FaceReport r;
+      unpack(bytes, pos, m, r);
+      const LO f = r.face;
+      QSMESH_CHECK(f >= 0 && f < nfaces, "gathered report for unknown face " << f);
+      result.reports[f] = std::move(r);
+      m.face = f;
+      assembler->add_face(f, m);
+      if (keep_background) result.background[f] = std::move(m);
+      if (options.cross_fields) unpack(bytes, pos, result.cross_fields[f]);
+      if (options.size_map) unpack(bytes, pos, result.face_sizes[f]);
+      if (quads) unpack(bytes, pos, result.quad_reports[f]);
+      if (quasi) unpack(bytes, pos, result.quasi_reports[f]);
+      if (quads) {
+        mesh::FaceQuadStats& st = result.face_stats[f];
+        for (std::int64_t* x : {&st.vertices, &st.quads, &st.triangles, &st.irregular_interior,
+                                &st.irregular_boundary})
+          *x = get<std::int64_t>(bytes, pos);
+        st.sicn_min = get<double>(bytes, pos);
+        st.sicn_avg = get<double>(bytes, pos);
+        result.face_seconds[f] = get<double>(bytes, pos);
       }
     }
-    for (LO f = 0; f < nfaces; ++f) all[f].face = f;
-    result.mesh = mesh::assemble(model,
-                                 quads ? std::span<const mesh::CurveMesh>(result.quantized_curves)
-                                       : std::span<const mesh::CurveMesh>(curves),
-                                 all);
-    if (size_map && !quads) result.background = std::move(all);
+    std::vector<char>().swap(bytes);
+  });
+  if (rank == 0) {
+    result.mesh = assembler->finish();
+    for (LO f = 0; f < static_cast<LO>(result.background.size()); ++f)
+      result.background[f].face = f;
   }
   end_stage("assemble", false);
   result.rank_busy_seconds.assign(static_cast<std::size_t>(nranks), 0.0);

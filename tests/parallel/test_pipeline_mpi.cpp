@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <atomic>
 #include <filesystem>
+#include <numeric>
 #include <sstream>
 
 #include "qsmesh/background/curve_mesh.hpp"
@@ -135,6 +136,31 @@ TEST(Comm, AlltoallBytesDeliversEachBufferToItsRank) {
     for (char c : got[s]) EXPECT_EQ(c, static_cast<char>(s * 10 + me)) << "from " << s;
   }
   EXPECT_THROW((void)comm.alltoall_bytes(std::vector<std::vector<char>>(n + 1)), qsmesh::Error);
+}
+
+TEST(Comm, GatherBytesEachHandsOverOneRankAtATime) {
+  const Comm comm = Comm::world();
+  const int n = comm.size(), me = comm.rank();
+  // Rank r sends 3 * r + 1 bytes of value r; the root sees them in rank order, its own moved in.
+  std::vector<char> mine(static_cast<std::size_t>(3 * me + 1), static_cast<char>(me));
+  const char* own_data = mine.data();
+  std::vector<int> seen;
+  comm.gather_bytes_each(std::move(mine), 0, [&](int r, std::vector<char>& bytes) {
+    seen.push_back(r);
+    EXPECT_EQ(bytes.size(), static_cast<std::size_t>(3 * r + 1)) << "from " << r;
+    for (char c : bytes) EXPECT_EQ(c, static_cast<char>(r)) << "from " << r;
+    if (r == 0) {
+      EXPECT_EQ(bytes.data(), own_data);  // moved, not copied
+    }
+    bytes.clear();  // the callee may take or drop the buffer
+  });
+  if (me == 0) {
+    std::vector<int> expected(static_cast<std::size_t>(n));
+    std::iota(expected.begin(), expected.end(), 0);
+    EXPECT_EQ(seen, expected);
+  } else {
+    EXPECT_TRUE(seen.empty());
+  }
 }
 
 TEST(Pipeline, DistributedEqualsSerial) {

@@ -323,6 +323,34 @@ TEST(Unstructured, DiskHasIrregularVerticesAtTheSingularitiesAndFewerThanWithout
 // than in 3D: the kind of face where flat triangles along a curve made Block.stp's face 82 fall
 // back to the uniform path at size factor 0.008 (this analytic fillet does not get them; the
 // kernel-level tests cover the scaled triangulation). The frontal path holds at four sizes.
+// The pipeline keeps only the crosses of a field once the size map is built
+// (crossfield::shrink_cross_field): the frontal path must read nothing else.
+TEST(Unstructured, CrossFieldShrunkToTheGuideGivesTheSameMesh) {
+  const auto model = disk(3);
+  const Prepared whole = prepare(model, 0.4);
+  Prepared shrunk = whole;
+  crossfield::shrink_cross_field(shrunk.cf, crossfield::CrossFieldUse::Guide);
+  EXPECT_TRUE(shrunk.cf.points.empty() && shrunk.cf.edges.empty() && shrunk.cf.u.empty() &&
+              shrunk.cf.H.empty() && shrunk.cf.tri2edges.empty());
+  EXPECT_EQ(shrunk.cf.directions.size(), whole.cf.directions.size());
+  EXPECT_EQ(shrunk.cf.singularities.size(), whole.cf.singularities.size());
+  UnstructuredReport a, b;
+  const mesh::FaceMesh from_whole = run_face(model, whole, a);
+  const mesh::FaceMesh from_shrunk = run_face(model, shrunk, b);
+  EXPECT_TRUE(a.frontal && b.frontal);
+  EXPECT_GT(from_whole.quads.size(), 50u);
+  EXPECT_EQ(from_whole.quads, from_shrunk.quads);
+  EXPECT_EQ(from_whole.points, from_shrunk.points);
+
+  // The size map's part stays with SizeMapAndGuide.
+  Prepared sizing = whole;
+  crossfield::shrink_cross_field(sizing.cf, crossfield::CrossFieldUse::SizeMapAndGuide);
+  EXPECT_EQ(sizing.cf.points.size(), whole.cf.points.size());
+  EXPECT_EQ(sizing.cf.edges.size(), whole.cf.edges.size());
+  EXPECT_EQ(sizing.cf.H, whole.cf.H);
+  EXPECT_TRUE(sizing.cf.u.empty() && sizing.cf.u_norm.empty() && sizing.cf.tri2edges.empty());
+}
+
 TEST(Unstructured, ThinTorusFilletKeepsTheFrontalPath) {
   const auto model = thin_torus_fillet();
   for (const double size : {0.5, 0.65, 0.8, 1.0}) {

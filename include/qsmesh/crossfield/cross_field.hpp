@@ -108,6 +108,23 @@ struct FaceCrossField {
 /// The size map is then h(x) = exp(H(x) + C) (model units).
 [[nodiscard]] double scaling_constant(const FaceCrossField& cf, double n_quads);
 
+/// What a caller still reads of a FaceCrossField (shrink_cross_field).
+enum class CrossFieldUse {
+  /// sizemap::face_sizes, scaling_constant and the guide below: glued points, triangles,
+  /// input2glued, edges, H, h, directions, singularities.
+  SizeMapAndGuide,
+  /// The frontal point insertion (quad::FaceGuide: triangles, input2glued, directions) and the
+  /// cavity remeshing (singularities).
+  Guide,
+};
+
+/// Frees (capacity included) the arrays of `cf` that `use` does not read; euler and stats stay.
+/// For a pipeline that holds every face's field from the cross-field stage to its unstructured
+/// mesh: the edge unknowns (u, u_norm, tri2edges, flags) go once the field is made, the glued
+/// geometry and the scaling once the size map is built. Block.stp at its reference count, one
+/// rank: peak heap 101 -> 74 MB (docs/benchmarks.md).
+void shrink_cross_field(FaceCrossField& cf, CrossFieldUse use);
+
 // Stages of compute_face_cross_field, exposed for tests and tools.
 
 /// Fills points, triangles, input2glued, vertex_dim, edges, tri2edges, boundary_edge of `cf`.

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -53,6 +54,13 @@ class Comm {
   /// Gathers every rank's byte buffer on `root`, in rank order (empty vector on other ranks).
   [[nodiscard]] std::vector<std::vector<char>> gather_bytes(const std::vector<char>& mine,
                                                             int root = 0) const;
+  /// The same gather, handed over one rank at a time: on `root`, use(r, bytes) runs for r = 0, 1,
+  /// ... with rank r's buffer (its own is `mine`, moved, not copied), each received only after the
+  /// previous call returned, so that the root never holds more than one rank's buffer besides what
+  /// `use` keeps. `use` may move from or clear the buffer. Other ranks send theirs and return.
+  /// Collective.
+  void gather_bytes_each(std::vector<char>&& mine, int root,
+                         const std::function<void(int rank, std::vector<char>& bytes)>& use) const;
   /// Broadcasts a byte buffer from `root` (resized on the receivers).
   void broadcast_bytes(std::vector<char>& bytes, int root = 0) const;
   /// Every rank's byte buffer on every rank, in rank order (gathered on rank 0, then broadcast).
