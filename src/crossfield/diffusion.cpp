@@ -24,7 +24,9 @@ std::vector<Triplet> assemble_stiffness(const FaceCrossField& cf, const Geometry
                                         const std::vector<LO>& edge2unk,
                                         std::vector<double>& coupling) {
   std::vector<Triplet> trip;
-  trip.reserve(cf.triangles.size() * 36);
+  // 36 entries a triangle, and room for the diagonal the callers add (two per unknown edge), so
+  // that those additions do not double the capacity.
+  trip.reserve(cf.triangles.size() * 36 + 2 * cf.edges.size());
   for (std::size_t t = 0; t < cf.triangles.size(); ++t) {
     if (!use[t]) continue;
     // Edge k of the triangle joins vertices k and k+1: it is opposite vertex k+2. The CR basis
@@ -163,12 +165,15 @@ void diffuse(FaceCrossField& cf, const Geometry& g, const CrossFieldOptions& opt
   if (n == 0) return;  // every edge is fixed: nothing to diffuse
 
   std::vector<double> coupling(static_cast<std::size_t>(n), 0.0);
-  const std::vector<std::uint8_t> all(nt, 1);
-  auto trip = assemble_stiffness(cf, g, all, edge2unk, coupling);
-  for (std::size_t e = 0; e < ne; ++e)
-    if (edge2unk[e] != kNoIndex)
-      for (int a = 0; a < 2; ++a) trip.push_back({edge2unk[e] + a, edge2unk[e] + a, 0.0});
-  const linalg::SparseMatrix K(n, trip);
+  // The triplets (36 a triangle) go once K is built: held through the solves they were the
+  // largest allocation of the cross-field stage (t20_data's largest face, docs/benchmarks.md).
+  const linalg::SparseMatrix K = [&] {
+    auto trip = assemble_stiffness(cf, g, std::vector<std::uint8_t>(nt, 1), edge2unk, coupling);
+    for (std::size_t e = 0; e < ne; ++e)
+      if (edge2unk[e] != kNoIndex)
+        for (int a = 0; a < 2; ++a) trip.push_back({edge2unk[e] + a, edge2unk[e] + a, 0.0});
+    return linalg::SparseMatrix(n, trip);
+  }();
   std::vector<double> mfree(static_cast<std::size_t>(n));
   std::vector<std::int64_t> diag(static_cast<std::size_t>(n));
   for (std::size_t e = 0; e < ne; ++e)
