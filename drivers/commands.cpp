@@ -149,6 +149,9 @@ namespace {
 struct Checks {
   mesh::ConformityReport conformity;
   double max_distance_to_cad = 0;  ///< relative to the model diagonal
+  /// Peak resident memory of each rank (MB): the others' at the end of the pipeline, rank 0's
+  /// after writing the output.
+  std::vector<double> rank_peak_mb;
 };
 
 /// How one face ended at the last stage run.
@@ -312,6 +315,11 @@ std::string stats_json(const Arguments& args, const Session& session,
     j.end_array();
     j.value("load_imbalance", load_imbalance(r.rank_busy_seconds));
   }
+  if (!checks.rank_peak_mb.empty()) {
+    j.begin_array("rank_peak_memory_mb");
+    for (double m : checks.rank_peak_mb) j.value("", m);
+    j.end_array();
+  }
   if (!r.quasi_reports.empty()) {
     // The improvement stage runs its three steps face by face; their time summed over the faces.
     j.begin_object("improvement_face_seconds")
@@ -413,6 +421,17 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
         std::minmax_element(r.rank_busy_seconds.begin(), r.rank_busy_seconds.end());
     os << "  ranks' time in the per-face stages (s): min " << *lo << ", max " << *hi
        << "; load imbalance (max / mean) " << load_imbalance(r.rank_busy_seconds) << "\n";
+  }
+  if (!checks.rank_peak_mb.empty()) {
+    const std::vector<double>& mb = checks.rank_peak_mb;
+    os << "  peak memory (MB): " << std::lround(mb.front()) << " on rank 0";
+    if (mb.size() == 2) {
+      os << ", " << std::lround(mb[1]) << " on rank 1";
+    } else if (mb.size() > 2) {
+      const auto [lo, hi] = std::minmax_element(mb.begin() + 1, mb.end());
+      os << ", " << std::lround(*lo) << " to " << std::lround(*hi) << " on the other ranks";
+    }
+    os << "\n";
   }
   for (const auto& o : outcomes(r))
     if (!o.ok || (o.fell_back && !o.error.empty()))
@@ -580,6 +599,10 @@ int run_mesh(const Arguments& args) {
   parallel::PipelineResult result =
       parallel::run_pipeline(s.comm, s.model, options, *s.tasks, s.log);
   for (const auto& [stage, sec] : result.times.entries()) s.times.add(stage, sec);
+  // Before rank 0 works alone: a collective after its writing would hang the others if it failed.
+  std::vector<double> peak_mb(static_cast<std::size_t>(s.ranks), 0.0);
+  peak_mb[static_cast<std::size_t>(s.rank)] = peak_resident_mb();
+  s.comm.allreduce_sum(peak_mb);
 
   if (s.rank == 0) {
     Stopwatch clock;
@@ -593,6 +616,8 @@ int run_mesh(const Arguments& args) {
     io::write_mesh(result.mesh, args.output);
     s.times.add("write", clock.seconds());
     s.log.info(cat("wrote ", args.output));
+    peak_mb.front() = peak_resident_mb();
+    checks.rank_peak_mb = std::move(peak_mb);
     if (!args.quiet)
       print_summary(std::cout, s.model, result, stats, checks, s.times, args.verbose);
     if (!args.stats.empty())

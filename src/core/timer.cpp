@@ -1,6 +1,14 @@
 #include "qsmesh/core/timer.hpp"
 
+#include <sys/resource.h>
+
 namespace qsmesh {
+
+double peak_resident_mb() {
+  rusage usage{};
+  if (getrusage(RUSAGE_SELF, &usage) != 0) return 0;
+  return static_cast<double>(usage.ru_maxrss) / 1024.0;  // Linux: kilobytes
+}
 
 void StageTimes::add(const std::string& stage, double seconds) {
   for (auto& [name, s] : entries_) {

@@ -382,6 +382,13 @@ TEST_F(Qsmesh, ExampleQuasiStructuredHasNoFlatQuad) {
   EXPECT_EQ(count("\"rank\": 0"), json_number(json, "faces"));
   EXPECT_NE(json.find("\"rank_busy_seconds\": ["), std::string::npos);
   EXPECT_EQ(json_number(json, "load_imbalance"), 1.0);
+  // One rank's peak memory: at least what the libraries take, less than the machine has.
+  const auto mem = json.find("\"rank_peak_memory_mb\": [");
+  ASSERT_NE(mem, std::string::npos);
+  const double mb = std::stod(json.substr(json.find('[', mem) + 1));
+  EXPECT_GT(mb, 20.0);
+  EXPECT_LT(mb, 4096.0);
+  EXPECT_EQ(json.find(',', json.find('[', mem)) > json.find(']', mem), true) << "one rank, one value";
 }
 
 // Bad input: one line on stderr naming the file or option, exit code 2, nothing written.

@@ -1,4 +1,4 @@
-// Wall-clock timing of pipeline stages.
+// Wall-clock timing of pipeline stages, and the process's peak memory.
 #pragma once
 
 #include <chrono>
@@ -20,6 +20,10 @@ class Stopwatch {
  private:
   std::chrono::steady_clock::time_point start_;
 };
+
+/// Peak resident set size of this process so far, in megabytes (2^20 bytes; getrusage's
+/// ru_maxrss). 0 when the system does not report it.
+[[nodiscard]] double peak_resident_mb();
 
 /// Ordered list of (stage name, seconds); adding to an existing stage accumulates.
 class StageTimes {
