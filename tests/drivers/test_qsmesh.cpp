@@ -388,7 +388,7 @@ TEST_F(Qsmesh, ExampleQuasiStructuredHasNoFlatQuad) {
   const double mb = std::stod(json.substr(json.find('[', mem) + 1));
   EXPECT_GT(mb, 20.0);
   EXPECT_LT(mb, 4096.0);
-  EXPECT_EQ(json.find(',', json.find('[', mem)) > json.find(']', mem), true) << "one rank, one value";
+  EXPECT_GT(json.find(',', json.find('[', mem)), json.find(']', mem)) << "one rank, one value";
 }
 
 // Bad input: one line on stderr naming the file or option, exit code 2, nothing written.
