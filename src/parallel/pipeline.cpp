@@ -407,22 +407,27 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
   if (quasi) {
     // Simple CAD faces meshed directly by a pattern (paper 000 Sec. 6.1.2, pipeline step 4); the
     // others go through the unstructured path below. A fill needs only the model, the curve meshes
-    // (every rank has them) and the face's quad bound, which its owner computes from its size map
-    // and shares; the faces are then dealt out over all ranks (deal_out), largest bound first: a
-    // few faces whose fills are refused and searched take most of the stage.
+    // (every rank has them) and the face's quad bound (if any), which its owner computes from its
+    // size map and shares with the quads the size map asks for; the faces are then dealt out over
+    // all ranks (deal_out), those asking for the most quads first: a few faces whose fills are
+    // refused and searched take most of the stage.
     clock.reset();
-    tasks.parallel_for(total, [&](std::int64_t i) {
-      if (options.pattern_max_quad_ratio > 0 && !sizes.empty())
-        fill_bound[static_cast<std::size_t>(mine[i])] = std::max<std::int64_t>(
+    std::vector<double> expected(static_cast<std::size_t>(nfaces), 0.0);
+    if (!sizes.empty())
+      tasks.parallel_for(total, [&](std::int64_t i) {
+        expected[static_cast<std::size_t>(mine[i])] =
+            sizemap::expected_quads(meshes[i], sizes[i].s);
+      });
+    comm.allreduce_sum(expected);  // each face's entry is set by its owner alone
+    if (options.pattern_max_quad_ratio > 0)
+      for (LO f = 0; f < nfaces; ++f)
+        fill_bound[f] = std::max<std::int64_t>(
             options.pattern_min_quad_bound,
-            static_cast<std::int64_t>(std::ceil(options.pattern_max_quad_ratio *
-                                                sizemap::expected_quads(meshes[i], sizes[i].s))));
-    });
-    comm.allreduce_sum(fill_bound);  // each face's entry is set by its owner alone
+            static_cast<std::int64_t>(std::ceil(options.pattern_max_quad_ratio * expected[f])));
     std::vector<LO> order(static_cast<std::size_t>(nfaces));
     std::iota(order.begin(), order.end(), LO{0});
     std::sort(order.begin(), order.end(), [&](LO a, LO b) {
-      return fill_bound[a] != fill_bound[b] ? fill_bound[a] > fill_bound[b] : a < b;
+      return expected[a] != expected[b] ? expected[a] > expected[b] : a < b;
     });
     struct Fill {
       bool done = false;

@@ -513,6 +513,40 @@ TEST(Pipeline, FillRefusedOnCountIsComparedWhenTheUnstructuredMeshIsAsLarge) {
   EXPECT_TRUE(conformity.ok()) << conformity.summary();
 }
 
+// By default a fill is kept on its quality alone, whatever its quad count (paper 000 Sec. 6.1.2):
+// a square sized for about 100 quads whose four sides are prescribed 40 edges is a 40 x 40 grid,
+// 16 times what the size map asks for, kept directly; with a bound of 3 it is refused on its count.
+TEST(Pipeline, PatternFillsAreNotBoundedByTheSizeMapByDefault) {
+  const Comm comm = Comm::world();
+  const std::string path = tmp("pipe_fine_square_np" + std::to_string(comm.size()) + ".brep");
+  if (comm.rank() == 0) test::write_polygon_face({{0, 0}, {10, 0}, {10, 10}, {0, 10}}, path);
+  comm.barrier();
+  const cad::CadModel model = cad::load_cad(path);
+  ASSERT_EQ(model.num_curves(), 4);
+  PipelineOptions options;
+  options.background.sizes.size = 1;
+  options.sizemap.size_max = 1;
+  options.until = Stage::QuasiStructured;
+  for (LO c = 0; c < 4; ++c) options.quantize.prescribed.emplace_back(c, 40);
+  std::ostringstream sink;
+  Logger log(sink, LogLevel::Quiet);
+  const PipelineResult plain = run_pipeline(comm, model, options, TaskArena(2), log);
+  options.pattern_max_quad_ratio = 3;
+  options.pattern_compare_tolerance = -1;
+  const PipelineResult bounded = run_pipeline(comm, model, options, TaskArena(2), log);
+  if (comm.rank() != 0) return;
+  ASSERT_EQ(plain.quasi_reports.size(), 1U);
+  const QuasiReport& q = plain.quasi_reports[0];
+  EXPECT_TRUE(q.by_pattern);
+  EXPECT_FALSE(q.by_comparison);
+  EXPECT_EQ(q.refusal, "");
+  EXPECT_EQ(q.pattern, "grid");
+  EXPECT_EQ(plain.face_stats[0].quads, 1600);
+  EXPECT_EQ(plain.face_stats[0].irregular_interior, 0);
+  EXPECT_EQ(bounded.quasi_reports[0].refusal, "too_many_quads");
+  EXPECT_FALSE(bounded.quasi_reports[0].by_pattern);
+}
+
 TEST(Pipeline, SizeMapAndCurveMeshesDoNotDependOnRanks) {
   const Comm comm = Comm::world();
   check_size_map(comm, shared_model(comm, "pipe_sm"), 0.6);

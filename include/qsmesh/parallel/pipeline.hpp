@@ -63,10 +63,15 @@ struct PipelineOptions {
   qstruct::PatternFaceOptions patterns;
   /// A pattern mesh of a face may have at most this many times the quads the size map asks for
   /// (the sum over the background triangles of area / s^2); patterns.max_quads is set from it per
-  /// face (0: no bound). Measured ratios of the pattern meshes kept at size factor 0.02: Block
-  /// 11 faces below 1, 146 in 1-1.5, 141 in 1.5-2, 15 in 2-3 (fine boundaries make structured
-  /// fills finer than the size map inside); wing_fuselage's two transition faces above 5.
-  double pattern_max_quad_ratio = 3.0;
+  /// face. 0 (the default): no bound, as in paper 000 Sec. 6.1.2 and Gmsh, which keep a fill on
+  /// its quality alone. Measured ratios of the pattern meshes kept at size factor 0.02: Block 11
+  /// faces below 1, 146 in 1-1.5, 141 in 1.5-2, 15 in 2-3 (fine boundaries make structured fills
+  /// finer than the size map inside). A bound of 3 (the default until the sixteenth session) kept
+  /// A319's trailing-edge strips and one-corner leaves on the unstructured path at fine sizes (72
+  /// of 83 faces by patterns at size factor 0.0007, 75 without); at the reference vertex counts,
+  /// 0.01 and 0.02 the six shared models give the same numbers either way, within 2 faces and
+  /// 0.3% of the vertices (docs/benchmarks.md).
+  double pattern_max_quad_ratio = 0.0;
   /// ... but never below this many quads: on a face the size map gives a handful of quads the
   /// ratio means nothing (Block's triangles 215 and 307 ask for about 2 quads, and their 7-quad
   /// triangle fill, the same mesh as the unstructured path's, was refused on count).
