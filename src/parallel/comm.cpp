@@ -119,42 +119,17 @@ bool Comm::allreduce_and(bool value) const {
 }
 
 std::vector<std::vector<char>> Comm::gather_bytes(const std::vector<char>& mine, int root) const {
-  // Sizes first (64-bit), then the payload rank by rank with point-to-point messages, so that no
-  // single MPI count exceeds the int range even when the assembled mesh is large.
-  const int n = size();
-  const int me = rank();
-  std::int64_t my_size = static_cast<std::int64_t>(mine.size());
-  std::vector<std::int64_t> sizes(static_cast<std::size_t>(n), 0);
-  check_mpi(MPI_Gather(&my_size, 1, MPI_INT64_T, sizes.data(), 1, MPI_INT64_T, root, impl_->comm),
-            "MPI_Gather");
-  constexpr std::int64_t kChunk = std::int64_t{1} << 30;
-  std::vector<std::vector<char>> out;
-  if (me == root) {
-    out.resize(static_cast<std::size_t>(n));
-    for (int r = 0; r < n; ++r) {
-      out[r].resize(static_cast<std::size_t>(sizes[r]));
-      if (r == root) {
-        out[r] = mine;
-        continue;
-      }
-      for (std::int64_t off = 0; off < sizes[r]; off += kChunk) {
-        const int count = static_cast<int>(std::min(kChunk, sizes[r] - off));
-        check_mpi(MPI_Recv(out[r].data() + off, count, MPI_CHAR, r, 7, impl_->comm, MPI_STATUS_IGNORE),
-                  "MPI_Recv");
-      }
-    }
-  } else {
-    for (std::int64_t off = 0; off < my_size; off += kChunk) {
-      const int count = static_cast<int>(std::min(kChunk, my_size - off));
-      check_mpi(MPI_Send(mine.data() + off, count, MPI_CHAR, root, 7, impl_->comm), "MPI_Send");
-    }
-  }
+  std::vector<std::vector<char>> out(rank() == root ? static_cast<std::size_t>(size()) : 0);
+  gather_bytes_each(std::vector<char>(mine), root,
+                    [&](int r, std::vector<char>& bytes) { out[r] = std::move(bytes); });
   return out;
 }
 
 void Comm::gather_bytes_each(
     std::vector<char>&& mine, int root,
     const std::function<void(int rank, std::vector<char>& bytes)>& use) const {
+  // Sizes first (64-bit), then the payload rank by rank with point-to-point messages, so that no
+  // single MPI count exceeds the int range even when the assembled mesh is large.
   const int n = size();
   const int me = rank();
   std::int64_t my_size = static_cast<std::int64_t>(mine.size());
