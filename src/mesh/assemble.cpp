@@ -1,6 +1,7 @@
 #include "qsmesh/mesh/assemble.hpp"
 
 #include <algorithm>
+#include <sstream>
 
 #include "qsmesh/core/error.hpp"
 
@@ -41,27 +42,28 @@ MeshAssembler::MeshAssembler(const cad::CadModel& model, std::span<const CurveMe
   QSMESH_CHECK(static_cast<LO>(curves.size()) == ncurves, "one curve mesh per curve expected");
   QSMESH_CHECK(static_cast<LO>(contributions.size()) == nfaces,
                "one face contribution per face expected");
+  numbering_.num_corners = nc;
   out_.num_cad_corners = nc;
   out_.num_cad_curves = ncurves;
   out_.num_cad_faces = nfaces;
 
-  curve_offset_.assign(static_cast<std::size_t>(ncurves) + 1, nc);
+  numbering_.curve_offset.assign(static_cast<std::size_t>(ncurves) + 1, nc);
   for (LO c = 0; c < ncurves; ++c)
-    curve_offset_[c + 1] = curve_offset_[c] + std::max<LO>(0, curves[c].num_edges() - 1);
-  face_offset_.assign(static_cast<std::size_t>(nfaces) + 1, curve_offset_[ncurves]);
+    numbering_.curve_offset[c + 1] = numbering_.curve_offset[c] + std::max<LO>(0, curves[c].num_edges() - 1);
+  numbering_.face_offset.assign(static_cast<std::size_t>(nfaces) + 1, numbering_.curve_offset[ncurves]);
   triangle_offset_.assign(static_cast<std::size_t>(nfaces) + 1, 0);
   quad_offset_.assign(static_cast<std::size_t>(nfaces) + 1, 0);
   for (LO f = 0; f < nfaces; ++f) {
     const FaceContribution& c = contributions[f];
     QSMESH_CHECK(c.interior_vertices >= 0 && c.triangles >= 0 && c.quads >= 0,
                  "face " << f << ": negative contribution");
-    face_offset_[f + 1] = face_offset_[f] + c.interior_vertices;
+    numbering_.face_offset[f + 1] = numbering_.face_offset[f] + c.interior_vertices;
     triangle_offset_[f + 1] = triangle_offset_[f] + c.triangles;
     quad_offset_[f + 1] = quad_offset_[f] + c.quads;
   }
   added_.assign(static_cast<std::size_t>(nfaces), 0);
 
-  const GO nv = face_offset_[nfaces];
+  const GO nv = numbering_.face_offset[nfaces];
   out_.points.resize(static_cast<std::size_t>(nv));
   out_.vclass.resize(static_cast<std::size_t>(nv));
   out_.triangles.resize(static_cast<std::size_t>(triangle_offset_[nfaces]));
@@ -75,7 +77,7 @@ MeshAssembler::MeshAssembler(const cad::CadModel& model, std::span<const CurveMe
   for (LO c = 0; c < ncurves; ++c) {
     const CurveMesh& cm = curves[c];
     for (LO i = 1; i < cm.num_edges(); ++i) {
-      const GO g = curve_offset_[c] + i - 1;
+      const GO g = numbering_.curve_offset[c] + i - 1;
       out_.points[g] = cm.points[i];
       out_.vclass[g] = VertexClass{1, c, i, {cm.t[i], 0}};
     }
@@ -89,7 +91,7 @@ MeshAssembler::MeshAssembler(const cad::CadModel& model, std::span<const CurveMe
     auto id = [&](LO i) -> GO {
       if (i == 0) return cc.corners[0];
       if (i == cm.num_edges()) return cc.corners[1];
-      return curve_offset_[c] + i - 1;
+      return numbering_.curve_offset[c] + i - 1;
     };
     for (LO i = 0; i < cm.num_edges(); ++i) {
       out_.bars.push_back({id(i), id(i + 1)});
@@ -104,15 +106,16 @@ void MeshAssembler::add_face(LO f, const FaceMesh& fm) {
   QSMESH_CHECK(f >= 0 && f < model_.num_faces(), "assembly: no face " << f);
   QSMESH_CHECK(!added_[f], "assembly: face " << f << " added twice");
   added_[f] = 1;
-  const FaceContribution c = face_contribution(fm);
-  QSMESH_CHECK(c.interior_vertices == face_offset_[f + 1] - face_offset_[f] &&
-                   c.triangles == triangle_offset_[f + 1] - triangle_offset_[f] &&
-                   c.quads == quad_offset_[f + 1] - quad_offset_[f],
-               "assembly: face " << f << " has " << c.interior_vertices << " interior vertices, "
-                                 << c.triangles << " triangles and " << c.quads
-                                 << " quads, not the counts announced");
+  // The face must bring what was announced for it: its slots are checked while it is written.
+  const auto mismatch = [&](const char* what) {
+    std::ostringstream os;
+    os << "assembly: face " << f << " has other " << what << " counts than announced";
+    return os.str();
+  };
+  const GO quads_announced = quad_offset_[f + 1] - quad_offset_[f];
+  QSMESH_CHECK(static_cast<GO>(fm.quads.size()) == quads_announced, mismatch("quad"));
   std::vector<GO> local2global(fm.vclass.size(), -1);
-  GO next_interior = face_offset_[f];
+  GO next_interior = numbering_.face_offset[f];
   for (std::size_t i = 0; i < fm.vclass.size(); ++i) {
     const VertexClass& vc = fm.vclass[i];
     GO g = -1;
@@ -126,8 +129,9 @@ void MeshAssembler::add_face(LO f, const FaceMesh& fm) {
       const CurveMesh& cm = curves_[vc.entity];
       QSMESH_CHECK(vc.index >= 1 && vc.index < cm.num_edges(),
                    "face " << f << ": vertex index " << vc.index << " outside curve " << vc.entity);
-      g = curve_offset_[vc.entity] + vc.index - 1;
+      g = numbering_.curve_offset[vc.entity] + vc.index - 1;
     } else {
+      QSMESH_CHECK(next_interior < numbering_.face_offset[f + 1], mismatch("interior vertex"));
       g = next_interior++;
       out_.points[g] = fm.points[i];
       out_.vclass[g] = vc;
@@ -136,13 +140,16 @@ void MeshAssembler::add_face(LO f, const FaceMesh& fm) {
     }
     local2global[i] = g;
   }
+  QSMESH_CHECK(next_interior == numbering_.face_offset[f + 1], mismatch("interior vertex"));
   GO t_out = triangle_offset_[f];
   for (const auto& t : fm.triangles) {
     // Two uv images of one vertex (pole) collapse a triangle: it carries no area, drop it.
     if (collapsed(fm, t)) continue;
+    QSMESH_CHECK(t_out < triangle_offset_[f + 1], mismatch("triangle"));
     out_.triangles[t_out] = {local2global[t[0]], local2global[t[1]], local2global[t[2]]};
     out_.triangle_face[t_out++] = f;
   }
+  QSMESH_CHECK(t_out == triangle_offset_[f + 1], mismatch("triangle"));
   GO q_out = quad_offset_[f];
   for (const auto& q : fm.quads) {
     out_.quads[q_out] = {local2global[q[0]], local2global[q[1]], local2global[q[2]],
@@ -154,7 +161,7 @@ void MeshAssembler::add_face(LO f, const FaceMesh& fm) {
 SurfaceMesh MeshAssembler::finish() {
   const LO nfaces = model_.num_faces();
   for (LO f = 0; f < nfaces; ++f)
-    QSMESH_CHECK(added_[f] || (face_offset_[f + 1] == face_offset_[f] &&
+    QSMESH_CHECK(added_[f] || (numbering_.face_offset[f + 1] == numbering_.face_offset[f] &&
                                triangle_offset_[f + 1] == triangle_offset_[f] &&
                                quad_offset_[f + 1] == quad_offset_[f]),
                  "assembly: face " << f << " announced but never added");

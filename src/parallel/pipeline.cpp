@@ -731,11 +731,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     }
     std::vector<char>().swap(bytes);
   });
-  if (rank == 0) {
-    result.mesh = assembler->finish();
-    for (LO f = 0; f < static_cast<LO>(result.background.size()); ++f)
-      result.background[f].face = f;
-  }
+  if (rank == 0) result.mesh = assembler->finish();
   end_stage("assemble", false);
   result.rank_busy_seconds.assign(static_cast<std::size_t>(nranks), 0.0);
   result.rank_busy_seconds[static_cast<std::size_t>(rank)] = busy;

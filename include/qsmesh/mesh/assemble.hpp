@@ -49,7 +49,8 @@ class MeshAssembler {
  private:
   const cad::CadModel& model_;
   std::span<const CurveMesh> curves_;
-  std::vector<GO> curve_offset_, face_offset_, triangle_offset_, quad_offset_;
+  GlobalNumbering numbering_;
+  std::vector<GO> triangle_offset_, quad_offset_;  ///< by face, size num_faces + 1
   std::vector<char> added_;
   SurfaceMesh out_;
 };
