@@ -49,8 +49,10 @@ MeshAssembler::MeshAssembler(const cad::CadModel& model, std::span<const CurveMe
 
   numbering_.curve_offset.assign(static_cast<std::size_t>(ncurves) + 1, nc);
   for (LO c = 0; c < ncurves; ++c)
-    numbering_.curve_offset[c + 1] = numbering_.curve_offset[c] + std::max<LO>(0, curves[c].num_edges() - 1);
-  numbering_.face_offset.assign(static_cast<std::size_t>(nfaces) + 1, numbering_.curve_offset[ncurves]);
+    numbering_.curve_offset[c + 1] =
+        numbering_.curve_offset[c] + std::max<LO>(0, curves[c].num_edges() - 1);
+  numbering_.face_offset.assign(static_cast<std::size_t>(nfaces) + 1,
+                                numbering_.curve_offset[ncurves]);
   triangle_offset_.assign(static_cast<std::size_t>(nfaces) + 1, 0);
   quad_offset_.assign(static_cast<std::size_t>(nfaces) + 1, 0);
   for (LO f = 0; f < nfaces; ++f) {
