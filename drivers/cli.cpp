@@ -191,7 +191,7 @@ Arguments parse(const std::vector<std::string>& args) {
     if (positional.size() > 1) throw InputError(cmd + ": unexpected argument '" + positional[1] + "'");
     a.model = positional[0];
     if (a.command == Command::Mesh && a.output.empty())
-      throw InputError("mesh: missing -o OUT (.cgns, .vtu or .msh)");
+      throw InputError("mesh: missing -o OUT (.cgns, .vtu, .msh or .h5)");
     if (a.command == Command::CrossField && a.output.empty() && !a.check)
       throw InputError("crossfield: missing -o OUT.vtu (or --check)");
     if (a.command == Command::SizeMap && a.output.empty())
@@ -213,7 +213,9 @@ std::string help(const std::string& topic) {
     os << "usage: [mpirun -np P] qsmesh mesh MODEL -o OUT [options]\n\n"
           "Meshes every face of a CAD model and writes the surface mesh to OUT; the extension picks\n"
           "the format: .cgns (CGNS, unstructured zone, one section and family per CAD face and curve),\n"
-          ".vtu (VTK XML, opens in ParaView; cell data cad_face), .msh (Gmsh 4.1 with entities).\n"
+          ".vtu (VTK XML, opens in ParaView; cell data cad_face), .msh (Gmsh 4.1 with entities),\n"
+          ".h5 (HDF5 datasets for solvers: coordinates, quads, CAD ids and parameters of every\n"
+          "vertex; an XDMF file of the same name, .xdmf, is written beside it to open in ParaView).\n"
           "Faces are distributed over the MPI ranks (METIS) and over threads inside a rank; the mesh\n"
           "is the same whatever the numbers of ranks and threads.\n\n"
           "  -o, --output OUT      output file (written under a temporary name, renamed at the end)\n"
@@ -300,7 +302,7 @@ std::string help(const std::string& topic) {
           "usage: qsmesh COMMAND [options]\n\n"
           "commands:\n"
           "  info MODEL            print the CAD topology (corners, curves, faces)\n"
-          "  mesh MODEL -o OUT     mesh the model and write OUT (.cgns, .vtu, .msh)\n"
+          "  mesh MODEL -o OUT     mesh the model and write OUT (.cgns, .vtu, .msh, .h5)\n"
           "  crossfield MODEL -o OUT.vtu\n"
           "                        cross fields, singularities and scaling of every face\n"
           "  sizemap MODEL -o OUT.vtu\n"

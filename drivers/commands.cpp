@@ -615,7 +615,11 @@ int run_mesh(const Arguments& args) {
     clock.reset();
     io::write_mesh(result.mesh, args.output);
     s.times.add("write", clock.seconds());
-    s.log.info(cat("wrote ", args.output));
+    const bool h5 = std::filesystem::path(args.output).extension() == ".h5" ||
+                    std::filesystem::path(args.output).extension() == ".H5";
+    s.log.info(h5 ? cat("wrote ", args.output, " and ", io::xdmf_path_for(args.output),
+                        " (open it in ParaView)")
+                  : cat("wrote ", args.output));
     peak_mb.front() = peak_resident_mb();
     checks.rank_peak_mb = std::move(peak_mb);
     if (!args.quiet)

@@ -16,7 +16,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-enum class Format { kNone, kCgns, kVtu, kMsh };
+enum class Format { kNone, kCgns, kVtu, kMsh, kHdf5 };
 
 Format format_of(const std::string& path) {
   std::string ext = fs::path(path).extension().string();
@@ -25,6 +25,7 @@ Format format_of(const std::string& path) {
   if (ext == ".cgns") return Format::kCgns;
   if (ext == ".vtu") return Format::kVtu;
   if (ext == ".msh") return Format::kMsh;
+  if (ext == ".h5") return Format::kHdf5;
   return Format::kNone;
 }
 
@@ -37,9 +38,10 @@ bool is_supported_output(const std::string& path) {
 void check_output_path(const std::string& path) {
   if (!is_supported_output(path)) {
     throw InputError("output '" + path +
-                     "': unsupported format (the extension must be .cgns, .vtu or .msh)");
+                     "': unsupported format (the extension must be .cgns, .vtu, .msh or .h5)");
   }
   detail::check_output_folder(path);
+  if (format_of(path) == Format::kHdf5) detail::check_output_folder(xdmf_path_for(path));
 }
 
 namespace detail {
@@ -125,6 +127,9 @@ void write_mesh(const mesh::SurfaceMesh& mesh, const std::string& path, const Wr
     case Format::kCgns: write_cgns(mesh, path, options); return;
     case Format::kVtu: write_vtu(mesh, path, options); return;
     case Format::kMsh: write_msh(mesh, path, options); return;
+    case Format::kHdf5:
+      write_hdf5(mesh, path, options);
+      return;
     case Format::kNone: break;
   }
   QSMESH_CHECK(false, "unreachable: unsupported output " << path);

@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # Checks the foundation on every shared CAD model and the built-in example:
 #  - `qsmesh info` counts against ../shared/cad/README.md;
-#  - the background triangulation written as CGNS, VTU and MSH at 1, 2 and 4 ranks, files compared
+#  - the mesh written as CGNS, VTU, MSH and HDF5 at 1, 2 and 4 ranks, files compared
 #    byte for byte across rank counts, cgnscheck output scanned for warnings and errors;
 #  - statistics (vertices, triangles, smallest angles, time) from --stats; with --until unstructured
 #    the quad statistics instead (quads, interior irregular vertices, SICN min/avg, failed faces);
@@ -38,10 +38,10 @@ done
 $exe example wing-body -o "$out/wing_body.step" >/dev/null && models+=("$out/wing_body.step")
 
 if [ "$until" != background ]; then
-  printf "| model | corners/curves/faces | ranks 1/2/4 identical (cgns, vtu, msh) | cgnscheck | vertices | quads | triangles | interior irregular (%% of vertices) | SICN min / avg | conforming | faces failed / fell back | faces by pattern | time 1 rank (s) |\n"
+  printf "| model | corners/curves/faces | ranks 1/2/4 identical (cgns, vtu, msh, h5) | cgnscheck | vertices | quads | triangles | interior irregular (%% of vertices) | SICN min / avg | conforming | faces failed / fell back | faces by pattern | time 1 rank (s) |\n"
   printf "|---|---|---|---|---|---|---|---|---|---|---|---|---|\n"
 else
-  printf "| model | corners/curves/faces | ranks 1/2/4 identical (cgns, vtu, msh) | cgnscheck | vertices | triangles | min angle | tris < 10 deg (at sharp corners) | faces failed / fell back | time 1 rank (s) |\n"
+  printf "| model | corners/curves/faces | ranks 1/2/4 identical (cgns, vtu, msh, h5) | cgnscheck | vertices | triangles | min angle | tris < 10 deg (at sharp corners) | faces failed / fell back | time 1 rank (s) |\n"
   printf "|---|---|---|---|---|---|---|---|---|---|\n"
 fi
 for model in "${models[@]}"; do
@@ -51,7 +51,7 @@ for model in "${models[@]}"; do
     counts="$counts (expected ${expected[$name]})"; status=1
   fi
   same=yes
-  for ext in cgns vtu msh; do
+  for ext in cgns vtu msh h5; do
     for np in 1 2 4; do
       mpiexec --oversubscribe --bind-to none -n $np $exe mesh "$model" -o "$out/m_$np.$ext" --size-factor "$factor" \
         --until "$until" --threads "$threads" -q --stats "$out/s_$np.json" >/dev/null 2>"$out/err_$np" || { same="FAILED (np $np)"; status=1; }

@@ -114,7 +114,7 @@ TEST_F(Qsmesh, InfoAndJson) {
 }
 
 TEST_F(Qsmesh, MeshWritesEveryFormatAndStats) {
-  for (const std::string ext : {"cgns", "vtu", "msh"}) {
+  for (const std::string ext : {"cgns", "vtu", "msh", "h5"}) {
     const std::string out = tmp("e2e_mesh." + ext);
     const std::string stats = tmp("e2e_stats_" + ext + ".json");
     fs::remove(out);
@@ -122,6 +122,9 @@ TEST_F(Qsmesh, MeshWritesEveryFormatAndStats) {
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_TRUE(fs::exists(out));
     EXPECT_GT(fs::file_size(out), 1000u);
+    if (ext == "h5") {
+      EXPECT_GT(fs::file_size(tmp("e2e_mesh.xdmf")), 500u);
+    }
     EXPECT_NE(r.out.find("summary"), std::string::npos);
     const std::string json = slurp(stats);
     for (const char* key : {"\"vertices\"", "\"quads\"", "\"triangles\"", "\"irregular_interior\"", "\"sicn_min\"",

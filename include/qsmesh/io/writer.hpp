@@ -1,4 +1,5 @@
-// Mesh output: CGNS (cgnslib), VTK XML UnstructuredGrid (.vtu) and Gmsh MSH 4.1 ASCII (.msh).
+// Mesh output: CGNS (cgnslib), VTK XML UnstructuredGrid (.vtu), Gmsh MSH 4.1 ASCII (.msh) and plain
+// HDF5 datasets for solvers (.h5, with an XDMF description beside it for ParaView).
 //
 // Every writer writes to a temporary file in the destination folder and renames it to the requested
 // name only once the file is complete (io/atomic_file.hpp): a failed write leaves nothing under the
@@ -53,7 +54,7 @@ struct WriteOptions {
   bool msh_corner_elements = true;         ///< write one point element (type 15) per meshed corner
 };
 
-/// Writes `mesh` to `path`, the format chosen from the extension (.cgns, .vtu, .msh; any case).
+/// Writes `mesh` to `path`, the format chosen from the extension (.cgns .vtu .msh .h5, any case).
 /// Throws InputError (one line naming the path) when the extension is not supported or the folder
 /// does not exist or is not writable, before any work; qsmesh::Error when the mesh is inconsistent
 /// (check_mesh_for_output) or writing fails.
@@ -81,6 +82,32 @@ void write_cgns(const mesh::SurfaceMesh& mesh, const std::string& path, const Wr
 /// "cad_face" (and "cad_curve" with bars; -1 where not applicable), point data Int32 "cad_dim" and
 /// "cad_entity" (the vertex classification), plus options.point_fields / cell_fields.
 void write_vtu(const mesh::SurfaceMesh& mesh, const std::string& path, const WriteOptions& options = {});
+
+/// HDF5 (format_version 1) for solvers, plus the XDMF 3 file xdmf_path_for(path) describing it
+/// (open that one in ParaView: one block each for the quads, the triangles and the curve bars, with
+/// cell data cad_face / cad_curve and point data cad_dim / cad_entity). Both are written under
+/// temporary names; the XDMF file is renamed first and removed again if the HDF5 file fails.
+/// Root attributes: format ("qsmesh surface mesh"), format_version (1), length_unit,
+/// num_cad_corners, num_cad_curves, num_cad_faces. Datasets (little-endian, ids 0-based, elements
+/// in mesh order):
+///   coordinates         float64 [n_vertices, 3]
+///   vertex_cad_dim      int32 [n_vertices]: 0 corner, 1 curve, 2 face (VertexClass::dim)
+///   vertex_cad_entity   int32 [n_vertices]: corner / curve / face id
+///   vertex_cad_param    float64 [n_vertices, 2]: (t, 0) on a curve, (u, v) in a face
+///   quads               int64 [n_quads, 4], counter-clockwise about the face normal
+///   quad_cad_face       int32 [n_quads]
+///   triangles           int64 [n_triangles, 3]; triangle_cad_face int32 [n_triangles]
+///   bars                int64 [n_bars, 2]; bar_cad_curve int32 [n_bars]
+///   curve_corners       int32 [n_curves, 2]: end corners of each curve (-1: none)
+///   face_curve_offsets  int64 [n_faces + 1]; face_curves int32: the curves bounding face f are
+///                       face_curves[face_curve_offsets[f] .. face_curve_offsets[f + 1])
+/// Empty element kinds are zero-row datasets. Objects carry no timestamps: the same mesh gives the
+/// same bytes. Throws qsmesh::Error on an inconsistent mesh or a failed HDF5 call.
+void write_hdf5(const mesh::SurfaceMesh& mesh, const std::string& path,
+                const WriteOptions& options = {});
+
+/// The XDMF file written beside the HDF5 file `h5_path`: the same name with the extension .xdmf.
+[[nodiscard]] std::string xdmf_path_for(const std::string& h5_path);
 
 /// Gmsh MSH 4.1 ASCII: $Entities (corners, curves with their end corners, faces with their bounding
 /// curves), $Nodes and $Elements grouped by CAD entity (parametric 0).

@@ -1,0 +1,275 @@
+// HDF5 output through the HDF5 C API (Debian: the serial library cgnslib also uses), with an XDMF 3
+// description beside it. Its own handles only: nothing here touches cgnslib's files.
+#include <hdf5.h>
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cstdint>
+#include <filesystem>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "detail.hpp"
+#include "qsmesh/core/error.hpp"
+#include "qsmesh/io/atomic_file.hpp"
+#include "qsmesh/io/writer.hpp"
+
+namespace qsmesh::io {
+
+namespace fs = std::filesystem;
+
+namespace {
+
+static_assert(std::endian::native == std::endian::little,
+              "the HDF5 writer hands little-endian file types its native arrays");
+
+// HDF5 calls return a negative value on failure; every one goes through here.
+template <typename T>
+T h5_check(T rc, const char* call, const std::string& path) {
+  if (rc < 0) throw Error("HDF5 " + std::string(call) + " failed for " + path);
+  return rc;
+}
+#define QSMESH_H5(call) h5_check((call), #call, path)
+
+// Closes an HDF5 identifier on the error path; the success path calls close() to check the result.
+class H5Handle {
+ public:
+  using Closer = herr_t (*)(hid_t);
+  H5Handle(hid_t id, Closer closer) : id_(id), closer_(closer) {}
+  H5Handle(const H5Handle&) = delete;
+  H5Handle& operator=(const H5Handle&) = delete;
+  ~H5Handle() {
+    if (id_ >= 0) closer_(id_);
+  }
+  [[nodiscard]] hid_t get() const { return id_; }
+  herr_t close() {
+    const herr_t rc = closer_(id_);
+    id_ = -1;
+    return rc;
+  }
+
+ private:
+  hid_t id_;
+  Closer closer_;
+};
+
+// One file, every object created without timestamps, so that the same mesh gives the same bytes.
+class H5Writer {
+ public:
+  H5Writer(const std::string& temp_path, std::string name)
+      : path_(std::move(name)),
+        file_(H5Fcreate(temp_path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose),
+        dcpl_(H5Pcreate(H5P_DATASET_CREATE), H5Pclose) {
+    const std::string& path = path_;
+    QSMESH_H5(file_.get());
+    QSMESH_H5(dcpl_.get());
+    QSMESH_H5(H5Pset_obj_track_times(dcpl_.get(), 0));
+  }
+
+  // A dataset of rows x cols values (cols 0: one dimension), written from `data` (row-major).
+  template <typename T>
+  void dataset(const char* name, hid_t type, std::int64_t rows, int cols, const T* data) {
+    const std::string& path = path_;
+    const std::array<hsize_t, 2> dims{static_cast<hsize_t>(rows), static_cast<hsize_t>(cols)};
+    H5Handle space(H5Screate_simple(cols > 0 ? 2 : 1, dims.data(), nullptr), H5Sclose);
+    QSMESH_H5(space.get());
+    H5Handle set(
+        H5Dcreate2(file_.get(), name, type, space.get(), H5P_DEFAULT, dcpl_.get(), H5P_DEFAULT),
+        H5Dclose);
+    QSMESH_H5(set.get());
+    if (rows > 0) QSMESH_H5(H5Dwrite(set.get(), type, H5S_ALL, H5S_ALL, H5P_DEFAULT, data));
+    QSMESH_H5(set.close());
+    QSMESH_H5(space.close());
+  }
+
+  // An attribute of the root group.
+  void attribute(const char* name, std::int64_t value) {
+    const std::string& path = path_;
+    H5Handle space(H5Screate(H5S_SCALAR), H5Sclose);
+    QSMESH_H5(space.get());
+    H5Handle attr(
+        H5Acreate2(file_.get(), name, H5T_STD_I64LE, space.get(), H5P_DEFAULT, H5P_DEFAULT),
+        H5Aclose);
+    QSMESH_H5(attr.get());
+    QSMESH_H5(H5Awrite(attr.get(), H5T_NATIVE_INT64, &value));
+    QSMESH_H5(attr.close());
+    QSMESH_H5(space.close());
+  }
+  void attribute(const char* name, const std::string& value) {
+    const std::string& path = path_;
+    H5Handle type(H5Tcopy(H5T_C_S1), H5Tclose);
+    QSMESH_H5(type.get());
+    QSMESH_H5(H5Tset_size(type.get(), std::max<std::size_t>(1, value.size())));
+    QSMESH_H5(H5Tset_strpad(type.get(), H5T_STR_NULLPAD));
+    H5Handle space(H5Screate(H5S_SCALAR), H5Sclose);
+    QSMESH_H5(space.get());
+    H5Handle attr(H5Acreate2(file_.get(), name, type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT),
+                  H5Aclose);
+    QSMESH_H5(attr.get());
+    const std::string padded = value.empty() ? std::string(1, '\0') : value;
+    QSMESH_H5(H5Awrite(attr.get(), type.get(), padded.data()));
+    QSMESH_H5(attr.close());
+    QSMESH_H5(space.close());
+    QSMESH_H5(type.close());
+  }
+
+  void close() {
+    const std::string& path = path_;
+    QSMESH_H5(dcpl_.close());
+    QSMESH_H5(file_.close());
+  }
+
+ private:
+  std::string path_;
+  H5Handle file_;
+  H5Handle dcpl_;
+};
+
+// The XDMF DataItem of an HDF5 dataset.
+std::string data_item(const std::string& h5_name, const char* dataset, std::int64_t rows, int cols,
+                      const char* number_type, int precision) {
+  std::ostringstream os;
+  os << "<DataItem Dimensions=\"" << rows;
+  if (cols > 0) os << ' ' << cols;
+  os << "\" NumberType=\"" << number_type << "\" Precision=\"" << precision << "\" Format=\"HDF\">"
+     << h5_name << ":/" << dataset << "</DataItem>";
+  return os.str();
+}
+
+// XML-escapes a file name (the only free text in the XDMF file).
+std::string xml_escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string xdmf_path_for(const std::string& h5_path) {
+  return fs::path(h5_path).replace_extension(".xdmf").string();
+}
+
+void write_hdf5(const mesh::SurfaceMesh& mesh, const std::string& path,
+                const WriteOptions& options) {
+  (void)options;
+  check_mesh_for_output(mesh);
+  const GO nv = mesh.num_vertices();
+  const auto nt = static_cast<std::int64_t>(mesh.triangles.size());
+  const auto nq = static_cast<std::int64_t>(mesh.quads.size());
+  const auto nb = static_cast<std::int64_t>(mesh.bars.size());
+  const auto nc = static_cast<std::int64_t>(mesh.curve_corners.size());
+  static_assert(sizeof(std::array<GO, 4>) == 4 * sizeof(std::int64_t) && sizeof(GO) == 8,
+                "elements are written as rows of 64-bit ids");
+  static_assert(sizeof(Vec3) == 3 * sizeof(double), "points are written as rows of 3 doubles");
+
+  const std::string xdmf = xdmf_path_for(path);
+  AtomicFile h5_out(path);
+  AtomicFile xdmf_out(xdmf);
+  {
+    H5Writer h5(h5_out.temp_path(), path);
+    h5.attribute("format", std::string("qsmesh surface mesh"));
+    h5.attribute("format_version", std::int64_t{1});
+    h5.attribute("length_unit", mesh.length_unit);
+    h5.attribute("num_cad_corners", std::int64_t{mesh.num_cad_corners});
+    h5.attribute("num_cad_curves", std::int64_t{mesh.num_cad_curves});
+    h5.attribute("num_cad_faces", std::int64_t{mesh.num_cad_faces});
+
+    h5.dataset("coordinates", H5T_IEEE_F64LE, nv, 3, mesh.points.data());
+    {
+      std::vector<std::int32_t> dim(static_cast<std::size_t>(nv)), entity(dim.size());
+      std::vector<double> param(2 * dim.size());
+      for (std::size_t v = 0; v < dim.size(); ++v) {
+        dim[v] = mesh.vclass[v].dim;
+        entity[v] = mesh.vclass[v].entity;
+        param[2 * v] = mesh.vclass[v].param[0];
+        param[2 * v + 1] = mesh.vclass[v].param[1];
+      }
+      h5.dataset("vertex_cad_dim", H5T_STD_I32LE, nv, 0, dim.data());
+      h5.dataset("vertex_cad_entity", H5T_STD_I32LE, nv, 0, entity.data());
+      h5.dataset("vertex_cad_param", H5T_IEEE_F64LE, nv, 2, param.data());
+    }
+    h5.dataset("quads", H5T_STD_I64LE, nq, 4, mesh.quads.data());
+    h5.dataset("quad_cad_face", H5T_STD_I32LE, nq, 0, mesh.quad_face.data());
+    h5.dataset("triangles", H5T_STD_I64LE, nt, 3, mesh.triangles.data());
+    h5.dataset("triangle_cad_face", H5T_STD_I32LE, nt, 0, mesh.triangle_face.data());
+    h5.dataset("bars", H5T_STD_I64LE, nb, 2, mesh.bars.data());
+    h5.dataset("bar_cad_curve", H5T_STD_I32LE, nb, 0, mesh.bar_curve.data());
+    h5.dataset("curve_corners", H5T_STD_I32LE, nc, 2, mesh.curve_corners.data());
+    {
+      std::vector<std::int64_t> offsets(mesh.face2curves.offsets.begin(),
+                                        mesh.face2curves.offsets.end());
+      if (offsets.empty()) offsets.push_back(0);
+      h5.dataset("face_curve_offsets", H5T_STD_I64LE, static_cast<std::int64_t>(offsets.size()), 0,
+                 offsets.data());
+      h5.dataset("face_curves", H5T_STD_I32LE,
+                 static_cast<std::int64_t>(mesh.face2curves.targets.size()), 0,
+                 mesh.face2curves.targets.data());
+    }
+    h5.close();
+  }
+
+  // XDMF: a spatial collection of one grid per element kind, all on the same points; ParaView shows
+  // each as a block with cell data cad_face (or cad_curve) and point data cad_dim / cad_entity.
+  {
+    const std::string h5_name = xml_escape(fs::path(path).filename().string());
+    OutputFile x(xdmf_out.temp_path());
+    x << "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n <Domain>\n"
+      << "  <Grid Name=\"qsmesh\" GridType=\"Collection\" CollectionType=\"Spatial\">\n";
+    auto grid = [&](const char* name, const char* topology, int nodes, std::int64_t n,
+                    const char* conn, const char* cad_name, const char* cad_dataset) {
+      if (n == 0) return;
+      x << "   <Grid Name=\"" << name << "\" GridType=\"Uniform\">\n";
+      x << "    <Topology TopologyType=\"" << topology << "\" NumberOfElements=\""
+        << static_cast<long long>(n) << "\"";
+      if (std::string(topology) == "Polyline") x << " NodesPerElement=\"" << nodes << "\"";
+      x << ">\n     " << data_item(h5_name, conn, n, nodes, "Int", 8) << "\n    </Topology>\n";
+      x << "    <Geometry GeometryType=\"XYZ\">\n     "
+        << data_item(h5_name, "coordinates", nv, 3, "Float", 8) << "\n    </Geometry>\n";
+      x << "    <Attribute Name=\"" << cad_name
+        << "\" AttributeType=\"Scalar\" Center=\"Cell\">\n     "
+        << data_item(h5_name, cad_dataset, n, 0, "Int", 4) << "\n    </Attribute>\n";
+      for (const char* a : {"cad_dim", "cad_entity"}) {
+        const std::string set = std::string("vertex_") + a;
+        x << "    <Attribute Name=\"" << a << "\" AttributeType=\"Scalar\" Center=\"Node\">\n     "
+          << data_item(h5_name, set.c_str(), nv, 0, "Int", 4) << "\n    </Attribute>\n";
+      }
+      x << "   </Grid>\n";
+    };
+    grid("quads", "Quadrilateral", 4, nq, "quads", "cad_face", "quad_cad_face");
+    grid("triangles", "Triangle", 3, nt, "triangles", "cad_face", "triangle_cad_face");
+    grid("curves", "Polyline", 2, nb, "bars", "cad_curve", "bar_cad_curve");
+    x << "  </Grid>\n </Domain>\n</Xdmf>\n";
+    x.close();
+  }
+  // The description is committed first: if the data then fails to land, it is removed again, so
+  // that no description points at a file that is not there.
+  xdmf_out.commit();
+  try {
+    h5_out.commit();
+  } catch (...) {
+    std::error_code ec;
+    fs::remove(xdmf, ec);
+    throw;
+  }
+}
+
+}  // namespace qsmesh::io

@@ -1,0 +1,216 @@
+// HDF5 output read back through the HDF5 C API, and its XDMF description.
+#include <gtest/gtest.h>
+#include <hdf5.h>
+
+#include <chrono>
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "io_test_mesh.hpp"
+#include "qsmesh/core/error.hpp"
+#include "qsmesh/io/writer.hpp"
+
+namespace qsmesh::io {
+namespace {
+
+namespace fs = std::filesystem;
+using test::dir_entries;
+using test::fresh_dir;
+using test::make_test_mesh;
+using test::read_all;
+
+// A dataset read back: its dimensions and values converted to T by HDF5.
+template <typename T>
+struct Data {
+  std::vector<hsize_t> dims;
+  std::vector<T> values;
+};
+
+template <typename T>
+Data<T> read_dataset(hid_t file, const char* name, hid_t mem_type) {
+  Data<T> d;
+  const hid_t set = H5Dopen2(file, name, H5P_DEFAULT);
+  EXPECT_GE(set, 0) << name;
+  if (set < 0) return d;
+  const hid_t space = H5Dget_space(set);
+  const int rank = H5Sget_simple_extent_ndims(space);
+  d.dims.resize(static_cast<std::size_t>(rank));
+  H5Sget_simple_extent_dims(space, d.dims.data(), nullptr);
+  hsize_t n = 1;
+  for (hsize_t x : d.dims) n *= x;
+  d.values.resize(n);
+  if (n > 0) {
+    EXPECT_GE(H5Dread(set, mem_type, H5S_ALL, H5S_ALL, H5P_DEFAULT, d.values.data()), 0) << name;
+  }
+  H5Sclose(space);
+  H5Dclose(set);
+  return d;
+}
+
+std::int64_t read_int_attribute(hid_t file, const char* name) {
+  std::int64_t v = -12345;
+  const hid_t a = H5Aopen(file, name, H5P_DEFAULT);
+  EXPECT_GE(a, 0) << name;
+  if (a < 0) return v;
+  EXPECT_GE(H5Aread(a, H5T_NATIVE_INT64, &v), 0) << name;
+  H5Aclose(a);
+  return v;
+}
+
+std::string read_string_attribute(hid_t file, const char* name) {
+  const hid_t a = H5Aopen(file, name, H5P_DEFAULT);
+  EXPECT_GE(a, 0) << name;
+  if (a < 0) return {};
+  const hid_t type = H5Aget_type(a);
+  std::string s(H5Tget_size(type), '\0');
+  EXPECT_GE(H5Aread(a, type, s.data()), 0) << name;
+  H5Tclose(type);
+  H5Aclose(a);
+  return s.substr(0, s.find('\0'));
+}
+
+std::vector<hsize_t> dims(std::initializer_list<hsize_t> d) { return d; }
+
+TEST(Hdf5, ReadBack) {
+  const fs::path dir = fresh_dir("hdf5_read");
+  const mesh::SurfaceMesh m = make_test_mesh();
+  const std::string path = (dir / "m.h5").string();
+  write_mesh(m, path);
+  EXPECT_EQ(dir_entries(dir), (std::vector<std::string>{"m.h5", "m.xdmf"}));
+
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(file, 0);
+  EXPECT_EQ(read_string_attribute(file, "format"), "qsmesh surface mesh");
+  EXPECT_EQ(read_int_attribute(file, "format_version"), 1);
+  EXPECT_EQ(read_string_attribute(file, "length_unit"), "mm");
+  EXPECT_EQ(read_int_attribute(file, "num_cad_corners"), 7);
+  EXPECT_EQ(read_int_attribute(file, "num_cad_curves"), 10);
+  EXPECT_EQ(read_int_attribute(file, "num_cad_faces"), 4);
+
+  const auto xyz = read_dataset<double>(file, "coordinates", H5T_NATIVE_DOUBLE);
+  EXPECT_EQ(xyz.dims, dims({12, 3}));
+  ASSERT_EQ(xyz.values.size(), 36u);
+  for (std::size_t v = 0; v < 12; ++v)
+    for (int d = 0; d < 3; ++d) EXPECT_EQ(xyz.values[3 * v + d], m.points[v][d]) << v;
+
+  const auto dim = read_dataset<std::int32_t>(file, "vertex_cad_dim", H5T_NATIVE_INT32);
+  const auto entity = read_dataset<std::int32_t>(file, "vertex_cad_entity", H5T_NATIVE_INT32);
+  const auto param = read_dataset<double>(file, "vertex_cad_param", H5T_NATIVE_DOUBLE);
+  EXPECT_EQ(dim.dims, dims({12}));
+  EXPECT_EQ(param.dims, dims({12, 2}));
+  ASSERT_EQ(entity.values.size(), 12u);
+  ASSERT_EQ(param.values.size(), 24u);
+  for (std::size_t v = 0; v < 12; ++v) {
+    EXPECT_EQ(dim.values[v], m.vclass[v].dim) << v;
+    EXPECT_EQ(entity.values[v], m.vclass[v].entity) << v;
+    EXPECT_EQ(param.values[2 * v], m.vclass[v].param[0]) << v;
+    EXPECT_EQ(param.values[2 * v + 1], m.vclass[v].param[1]) << v;
+  }
+
+  // Elements in mesh order, 0-based, with their CAD entity.
+  const auto quads = read_dataset<std::int64_t>(file, "quads", H5T_NATIVE_INT64);
+  const auto qface = read_dataset<std::int32_t>(file, "quad_cad_face", H5T_NATIVE_INT32);
+  EXPECT_EQ(quads.dims, dims({3, 4}));
+  ASSERT_EQ(quads.values.size(), 12u);
+  for (std::size_t q = 0; q < 3; ++q) {
+    for (int k = 0; k < 4; ++k) EXPECT_EQ(quads.values[4 * q + k], m.quads[q][k]);
+    EXPECT_EQ(qface.values.at(q), m.quad_face[q]);
+  }
+  const auto tris = read_dataset<std::int64_t>(file, "triangles", H5T_NATIVE_INT64);
+  const auto tface = read_dataset<std::int32_t>(file, "triangle_cad_face", H5T_NATIVE_INT32);
+  EXPECT_EQ(tris.dims, dims({6, 3}));
+  ASSERT_EQ(tris.values.size(), 18u);
+  for (std::size_t t = 0; t < 6; ++t) {
+    for (int k = 0; k < 3; ++k) EXPECT_EQ(tris.values[3 * t + k], m.triangles[t][k]);
+    EXPECT_EQ(tface.values.at(t), m.triangle_face[t]);
+  }
+  const auto bars = read_dataset<std::int64_t>(file, "bars", H5T_NATIVE_INT64);
+  const auto bcurve = read_dataset<std::int32_t>(file, "bar_cad_curve", H5T_NATIVE_INT32);
+  EXPECT_EQ(bars.dims, dims({13, 2}));
+  ASSERT_EQ(bars.values.size(), 26u);
+  for (std::size_t b = 0; b < 13; ++b) {
+    EXPECT_EQ(bars.values[2 * b], m.bars[b][0]);
+    EXPECT_EQ(bars.values[2 * b + 1], m.bars[b][1]);
+    EXPECT_EQ(bcurve.values.at(b), m.bar_curve[b]);
+  }
+
+  // CAD topology.
+  const auto cc = read_dataset<std::int32_t>(file, "curve_corners", H5T_NATIVE_INT32);
+  EXPECT_EQ(cc.dims, dims({10, 2}));
+  ASSERT_EQ(cc.values.size(), 20u);
+  for (std::size_t c = 0; c < 10; ++c) {
+    EXPECT_EQ(cc.values[2 * c], m.curve_corners[c][0]);
+    EXPECT_EQ(cc.values[2 * c + 1], m.curve_corners[c][1]);
+  }
+  const auto off = read_dataset<std::int64_t>(file, "face_curve_offsets", H5T_NATIVE_INT64);
+  const auto fc = read_dataset<std::int32_t>(file, "face_curves", H5T_NATIVE_INT32);
+  ASSERT_EQ(off.values.size(), m.face2curves.offsets.size());
+  for (std::size_t i = 0; i < off.values.size(); ++i)
+    EXPECT_EQ(off.values[i], m.face2curves.offsets[i]);
+  EXPECT_EQ(fc.values, m.face2curves.targets);
+  H5Fclose(file);
+
+  // The XDMF description names the datasets with their shapes, one grid per element kind.
+  const std::string x = read_all(dir / "m.xdmf");
+  EXPECT_EQ(x.rfind("<?xml", 0), 0u);
+  for (const char* s :
+       {"TopologyType=\"Quadrilateral\" NumberOfElements=\"3\"",
+        "Dimensions=\"3 4\" NumberType=\"Int\" Precision=\"8\" Format=\"HDF\">m.h5:/quads<",
+        "TopologyType=\"Triangle\" NumberOfElements=\"6\"",
+        "Dimensions=\"6 3\" NumberType=\"Int\" Precision=\"8\" Format=\"HDF\">m.h5:/triangles<",
+        "TopologyType=\"Polyline\" NumberOfElements=\"13\" NodesPerElement=\"2\"",
+        "Dimensions=\"12 3\" NumberType=\"Float\" Precision=\"8\" "
+        "Format=\"HDF\">m.h5:/coordinates<",
+        ">m.h5:/quad_cad_face<", ">m.h5:/bar_cad_curve<", "Name=\"cad_entity\"", "</Xdmf>"})
+    EXPECT_NE(x.find(s), std::string::npos) << s;
+}
+
+TEST(Hdf5, EmptyKindsAreZeroRowsAndNoGrid) {
+  const fs::path dir = fresh_dir("hdf5_empty");
+  mesh::SurfaceMesh m = make_test_mesh();
+  m.triangles.clear();
+  m.triangle_face.clear();
+  const std::string path = (dir / "q.h5").string();
+  write_hdf5(m, path);
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(file, 0);
+  EXPECT_EQ(read_dataset<std::int64_t>(file, "triangles", H5T_NATIVE_INT64).dims, dims({0, 3}));
+  EXPECT_EQ(read_dataset<std::int32_t>(file, "triangle_cad_face", H5T_NATIVE_INT32).dims,
+            dims({0}));
+  EXPECT_EQ(read_dataset<std::int64_t>(file, "quads", H5T_NATIVE_INT64).dims, dims({3, 4}));
+  H5Fclose(file);
+  const std::string x = read_all(dir / "q.xdmf");
+  EXPECT_EQ(x.find("Triangle"), std::string::npos);
+  EXPECT_NE(x.find("Quadrilateral"), std::string::npos);
+}
+
+TEST(Hdf5, NoClockInTheBytes) {
+  // Two writes more than a second apart (HDF5 object times have one-second resolution).
+  const fs::path dir = fresh_dir("hdf5_clock");
+  write_mesh(make_test_mesh(), (dir / "a.h5").string());
+  std::this_thread::sleep_for(std::chrono::milliseconds(1100));
+  write_mesh(make_test_mesh(), (dir / "b.h5").string());
+  const std::string a = read_all(dir / "a.h5");
+  EXPECT_GT(a.size(), 1000u);
+  EXPECT_TRUE(a == read_all(dir / "b.h5"));
+}
+
+TEST(Hdf5, FailuresLeaveNothing) {
+  const fs::path dir = fresh_dir("hdf5_fail");
+  // The description's name is taken by a folder: refused before any work.
+  fs::create_directories(dir / "m.xdmf");
+  EXPECT_THROW(check_output_path((dir / "m.h5").string()), InputError);
+  EXPECT_THROW(write_mesh(make_test_mesh(), (dir / "m.h5").string()), InputError);
+  EXPECT_EQ(dir_entries(dir), std::vector<std::string>{"m.xdmf"});
+  // An inconsistent mesh: Error, and neither file nor temporary.
+  mesh::SurfaceMesh bad = make_test_mesh();
+  bad.quads[0][2] = 99;
+  EXPECT_THROW(write_hdf5(bad, (dir / "n.h5").string()), Error);
+  EXPECT_EQ(dir_entries(dir), std::vector<std::string>{"m.xdmf"});
+}
+
+}  // namespace
+}  // namespace qsmesh::io
