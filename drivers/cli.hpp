@@ -25,6 +25,9 @@ struct Arguments {
   /// paper 000 Sec. 6.2) may spend on one face (0: no bound; the result is then reproducible).
   double face_time_budget = 0;
   std::string stats;               ///< --stats FILE.json
+  /// --block-structured: write the CGNS file as structured blocks of the quad layout
+  /// (layout::extract_quad_layout, io::write_cgns_blocks) instead of one unstructured zone.
+  bool block_structured = false;
   bool json = false;               ///< info --json
   bool check = false;              ///< crossfield --check
   std::string sizemap = "crossfield";  ///< --sizemap features|crossfield

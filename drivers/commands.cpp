@@ -9,6 +9,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <optional>
 #include <sstream>
 #include <string_view>
 #include <thread>
@@ -21,6 +22,7 @@
 #include "qsmesh/core/timer.hpp"
 #include "qsmesh/io/atomic_file.hpp"
 #include "qsmesh/io/writer.hpp"
+#include "qsmesh/layout/quad_layout.hpp"
 #include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/mesh/validate.hpp"
 #include "qsmesh/parallel/comm.hpp"
@@ -152,6 +154,12 @@ struct Checks {
   /// Peak resident memory of each rank (MB): the others' at the end of the pipeline, rank 0's
   /// after writing the output.
   std::vector<double> rank_peak_mb;
+  /// With --block-structured: the quad layout written.
+  struct Blocks {
+    std::int64_t blocks = 0, quads = 0, largest = 0;
+    LO unblocked_faces = 0, extended_faces = 0;
+  };
+  std::optional<Blocks> blocks;
 };
 
 /// How one face ended at the last stage run.
@@ -315,6 +323,16 @@ std::string stats_json(const Arguments& args, const Session& session,
     j.end_array();
     j.value("load_imbalance", load_imbalance(r.rank_busy_seconds));
   }
+  if (checks.blocks) {
+    j.value("blocks", checks.blocks->blocks);
+    j.value("block_quads_mean", checks.blocks->blocks > 0
+                                    ? static_cast<double>(checks.blocks->quads) /
+                                          static_cast<double>(checks.blocks->blocks)
+                                    : 0.0);
+    j.value("block_quads_largest", checks.blocks->largest);
+    j.value("faces_not_in_blocks", static_cast<std::int64_t>(checks.blocks->unblocked_faces));
+    j.value("faces_with_extended_traces", static_cast<std::int64_t>(checks.blocks->extended_faces));
+  }
   if (!checks.rank_peak_mb.empty()) {
     j.begin_array("rank_peak_memory_mb");
     for (double m : checks.rank_peak_mb) j.value("", m);
@@ -421,6 +439,14 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
         std::minmax_element(r.rank_busy_seconds.begin(), r.rank_busy_seconds.end());
     os << "  ranks' time in the per-face stages (s): min " << *lo << ", max " << *hi
        << "; load imbalance (max / mean) " << load_imbalance(r.rank_busy_seconds) << "\n";
+  }
+  if (checks.blocks) {
+    const Checks::Blocks& b = *checks.blocks;
+    os << "  blocks (structured zones): " << b.blocks << ", "
+       << (b.blocks > 0 ? static_cast<double>(b.quads) / static_cast<double>(b.blocks) : 0.0)
+       << " quads each on average, largest " << b.largest << "; faces not in blocks "
+       << b.unblocked_faces << "; faces traced again with extended traces " << b.extended_faces
+       << "\n";
   }
   if (!checks.rank_peak_mb.empty()) {
     const std::vector<double>& mb = checks.rank_peak_mb;
@@ -613,7 +639,24 @@ int run_mesh(const Arguments& args) {
         mesh::max_distance_to_cad(result.mesh, s.model) / s.model.diagonal();
     s.times.add("statistics", clock.seconds());
     clock.reset();
-    io::write_mesh(result.mesh, args.output);
+    if (args.block_structured) {
+      const layout::QuadLayout lay = layout::extract_quad_layout(result.mesh);
+      Checks::Blocks b;
+      b.blocks = static_cast<std::int64_t>(lay.blocks.size());
+      for (const layout::Block& k : lay.blocks) {
+        const std::int64_t n = static_cast<std::int64_t>(k.ni) * k.nj;
+        b.quads += n;
+        b.largest = std::max(b.largest, n);
+      }
+      b.unblocked_faces = static_cast<LO>(lay.unblocked_faces.size());
+      b.extended_faces = lay.faces_with_extended_traces;
+      checks.blocks = b;
+      s.times.add("layout", clock.seconds());
+      clock.reset();
+      io::write_cgns_blocks(result.mesh, lay, args.output);
+    } else {
+      io::write_mesh(result.mesh, args.output);
+    }
     s.times.add("write", clock.seconds());
     const bool h5 = std::filesystem::path(args.output).extension() == ".h5" ||
                     std::filesystem::path(args.output).extension() == ".H5";

@@ -11,14 +11,18 @@
 #include <cstdio>
 #include <cstring>
 #include <limits>
+#include <map>
 #include <string>
 #include <string_view>
+#include <tuple>
+#include <unordered_map>
 #include <vector>
 
 #include "detail.hpp"
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/io/atomic_file.hpp"
 #include "qsmesh/io/writer.hpp"
+#include "qsmesh/layout/quad_layout.hpp"
 
 namespace qsmesh::io {
 
@@ -317,6 +321,308 @@ void write_cgns(const mesh::SurfaceMesh& mesh, const std::string& path, const Wr
     }
     QSMESH_CG(cg_goto(fn, base, "Zone_t", zone, "ZoneBC_t", 1, "BC_t", bc, "end"));
     QSMESH_CG(cg_famname_write(r.name.c_str()));
+  }
+
+  file.fn = -1;
+  QSMESH_CG(cg_close(fn));
+  strip_hdf5_times(out.temp_path());
+  out.commit();
+}
+
+namespace {
+
+// One side of a block: its vertices in order, and where it lies in the block's index space.
+struct Side {
+  int tangent;  // index (0: i, 1: j) that runs along the side
+  bool at_max;  // the side is at the largest value of the other index
+};
+constexpr std::array<Side, 4> kSides{
+    {{0, false}, {1, true}, {0, true}, {1, false}}};  // jmin imax jmax imin
+
+// The 1-based (i, j) of position p on side s of block b.
+std::array<cgsize_t, 2> side_index(const layout::Block& b, int s, LO p) {
+  const Side& side = kSides[static_cast<std::size_t>(s)];
+  std::array<cgsize_t, 2> ij{};
+  ij[static_cast<std::size_t>(side.tangent)] = p + 1;
+  const LO n = side.tangent == 0 ? b.nj : b.ni;  // the other index's cell count
+  ij[static_cast<std::size_t>(1 - side.tangent)] = side.at_max ? n + 1 : 1;
+  return ij;
+}
+
+GO side_vertex(const layout::Block& b, int s, LO p, const std::vector<GO>& vertices) {
+  const auto ij = side_index(b, s, p);
+  return b.vertex(static_cast<LO>(ij[0] - 1), static_cast<LO>(ij[1] - 1), vertices);
+}
+
+LO side_edges(const layout::Block& b, int s) {
+  return kSides[static_cast<std::size_t>(s)].tangent == 0 ? b.ni : b.nj;
+}
+
+}  // namespace
+
+void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& layout,
+                       const std::string& path, const WriteOptions& options) {
+  check_mesh_for_output(mesh);
+  const auto unit = length_unit(mesh.length_unit);
+  const auto nb = static_cast<GO>(layout.blocks.size());
+  for (const layout::Block& b : layout.blocks) {
+    QSMESH_CHECK(b.ni > 0 && b.nj > 0 && b.face >= 0 && b.face < mesh.num_cad_faces &&
+                     b.first >= 0 &&
+                     b.first + static_cast<std::int64_t>(b.ni + 1) * (b.nj + 1) <=
+                         static_cast<std::int64_t>(layout.vertices.size()),
+                 "CGNS block output " << path << ": a block does not fit the layout's arrays");
+  }
+  for (GO v : layout.vertices)
+    QSMESH_CHECK(v >= 0 && v < mesh.num_vertices(),
+                 "CGNS block output " << path << ": vertex " << v << " out of range");
+
+  // Block sides sharing a mesh edge: edge -> (block, side, position along the side).
+  struct Use {
+    GO block;
+    int side;
+    LO p;
+  };
+  std::unordered_map<std::uint64_t, std::vector<Use>> edge_uses;
+  const auto nv = static_cast<std::uint64_t>(mesh.num_vertices());
+  auto key = [nv](GO a, GO b) {
+    if (a > b) std::swap(a, b);
+    return static_cast<std::uint64_t>(a) * nv + static_cast<std::uint64_t>(b);
+  };
+  for (GO k = 0; k < nb; ++k) {
+    const layout::Block& b = layout.blocks[static_cast<std::size_t>(k)];
+    for (int s = 0; s < 4; ++s)
+      for (LO p = 0; p < side_edges(b, s); ++p)
+        edge_uses[key(side_vertex(b, s, p, layout.vertices),
+                      side_vertex(b, s, p + 1, layout.vertices))]
+            .push_back({k, s, p});
+  }
+
+  AtomicFile out(path);
+  CgFile file;
+  QSMESH_CG(cg_set_file_type(CG_FILE_HDF5));
+  QSMESH_CG(cg_open(out.temp_path().c_str(), CG_MODE_WRITE, &file.fn));
+  const int fn = file.fn;
+  int base = 0;
+  QSMESH_CG(cg_base_write(fn, options.cgns_base_name.c_str(), 2, 3, &base));
+  QSMESH_CG(cg_goto(fn, base, "end"));
+  QSMESH_CG(cg_dataclass_write(CGNS_ENUMV(Dimensional)));
+  QSMESH_CG(cg_units_write(CGNS_ENUMV(Kilogram), unit, CGNS_ENUMV(Second), CGNS_ENUMV(Kelvin),
+                           CGNS_ENUMV(Degree)));
+  {
+    std::vector<char> has(static_cast<std::size_t>(mesh.num_cad_faces), 0);
+    for (const layout::Block& b : layout.blocks) has[static_cast<std::size_t>(b.face)] = 1;
+    for (LO f : layout.unblocked_faces) has[static_cast<std::size_t>(f)] = 1;
+    for (LO f = 0; f < mesh.num_cad_faces; ++f) {
+      if (!has[static_cast<std::size_t>(f)]) continue;
+      int family = 0;
+      QSMESH_CG(cg_family_write(fn, base, ("Face_" + std::to_string(f)).c_str(), &family));
+    }
+  }
+
+  int cgio = 0;
+  double root = 0;
+  QSMESH_CG(cg_get_cgio(fn, &cgio));
+  QSMESH_CG(cg_root_id(fn, &root));
+  // Zero-padded, so that the zones sort by name (cgnslib's order) as the blocks do.
+  const int width = std::max<int>(
+      6, static_cast<int>(std::to_string(std::max<GO>(nb, mesh.num_cad_faces)).size()));
+  auto padded = [width](GO x) {
+    std::string t = std::to_string(x);
+    return std::string(
+               static_cast<std::size_t>(std::max<int>(0, width - static_cast<int>(t.size()))),
+               '0') +
+           t;
+  };
+  auto zone_name = [&](GO k) {
+    return "Block_" + padded(k) + "_Face_" +
+           padded(layout.blocks[static_cast<std::size_t>(k)].face);
+  };
+  std::vector<double> coord;
+  for (GO k = 0; k < nb; ++k) {
+    const layout::Block& b = layout.blocks[static_cast<std::size_t>(k)];
+    const std::string name = zone_name(k);
+    QSMESH_CHECK(name.size() <= 32,
+                 "CGNS block output " << path << ": zone name " << name << " too long");
+    cgsize_t size[6] = {b.ni + 1, b.nj + 1, b.ni, b.nj, 0, 0};
+    int zone = 0;
+    QSMESH_CG(cg_zone_write(fn, base, name.c_str(), size, CGNS_ENUMV(Structured), &zone));
+    const auto n = static_cast<std::size_t>(b.ni + 1) * static_cast<std::size_t>(b.nj + 1);
+    coord.resize(n);
+    const char* names[3] = {"CoordinateX", "CoordinateY", "CoordinateZ"};
+    for (int d = 0; d < 3; ++d) {
+      for (std::size_t i = 0; i < n; ++i)
+        coord[i] = mesh.points[static_cast<std::size_t>(
+            layout.vertices[static_cast<std::size_t>(b.first) + i])][d];
+      int c = 0;
+      QSMESH_CG(cg_coord_write(fn, base, zone, CGNS_ENUMV(RealDouble), names[d], coord.data(), &c));
+      QSMESH_CG(cg_goto(fn, base, "Zone_t", zone, "GridCoordinates_t", 1, "DataArray_t", c, "end"));
+      const float exponents[5] = {0, 1, 0, 0, 0};
+      QSMESH_CG(cg_exponents_write(CGNS_ENUMV(RealSingle), exponents));
+    }
+    QSMESH_CG(cg_goto(fn, base, "Zone_t", zone, "end"));
+    QSMESH_CG(cg_famname_write(("Face_" + std::to_string(b.face)).c_str()));
+
+    // 1-to-1 interfaces: maximal runs of side edges shared with the same side of the same block,
+    // the donor positions moving by one edge per edge.
+    int connections = 0;
+    double zgc_id = 0;  // the zone's ZoneGridConnectivity node, made with its first interface
+    for (int s = 0; s < 4; ++s) {
+      struct Run {
+        GO block;
+        int side;
+        LO p0, p1;  // this side's edges p0..p1
+        LO d0, d1;  // the donor side's edges matching p0 and p1
+      };
+      std::vector<Run> open, done;
+      for (LO p = 0; p < side_edges(b, s); ++p) {
+        const GO a = side_vertex(b, s, p, layout.vertices),
+                 c = side_vertex(b, s, p + 1, layout.vertices);
+        std::vector<Run> next;
+        for (const Use& u : edge_uses.at(key(a, c))) {
+          if (u.block == k && u.side == s) continue;
+          auto it = std::find_if(open.begin(), open.end(), [&](const Run& r) {
+            if (r.block != u.block || r.side != u.side || r.p1 != p - 1) return false;
+            const LO step = r.p1 > r.p0 ? (r.d1 - r.d0) / (r.p1 - r.p0) : u.p - r.d1;
+            return (step == 1 || step == -1) && u.p == r.d1 + step;
+          });
+          if (it != open.end()) {
+            Run r = *it;
+            r.p1 = p;
+            r.d1 = u.p;
+            open.erase(it);
+            next.push_back(r);
+          } else {
+            next.push_back({u.block, u.side, p, p, u.p, u.p});
+          }
+        }
+        for (const Run& r : open) done.push_back(r);
+        open.swap(next);
+      }
+      for (const Run& r : open) done.push_back(r);
+      std::sort(done.begin(), done.end(), [](const Run& x, const Run& y) {
+        return std::tie(x.p0, x.block, x.side) < std::tie(y.p0, y.block, y.side);
+      });
+      for (const Run& r : done) {
+        const layout::Block& d = layout.blocks[static_cast<std::size_t>(r.block)];
+        // Vertex ends: this side's p0 and p1 + 1; the donor's are whichever end of its matching
+        // edges carries the same vertex.
+        const GO first_vertex = side_vertex(b, s, r.p0, layout.vertices);
+        const LO dir =
+            r.p1 > r.p0 ? (r.d1 - r.d0) / (r.p1 - r.p0)
+                        : (side_vertex(d, r.side, r.d0, layout.vertices) == first_vertex ? 1 : -1);
+        const LO dv0 = dir > 0 ? r.d0 : r.d0 + 1;
+        const LO dv1 = dir > 0 ? r.d1 + 1 : r.d1;
+        QSMESH_CHECK(side_vertex(d, r.side, dv0, layout.vertices) == first_vertex &&
+                         side_vertex(d, r.side, dv1, layout.vertices) ==
+                             side_vertex(b, s, r.p1 + 1, layout.vertices),
+                     "CGNS block output " << path << ": blocks " << k << " and " << r.block
+                                          << " do not match along their interface");
+        const auto i0 = side_index(b, s, r.p0), i1 = side_index(b, s, r.p1 + 1);
+        const auto j0 = side_index(d, r.side, dv0), j1 = side_index(d, r.side, dv1);
+        cgsize_t range[4] = {i0[0], i0[1], i1[0], i1[1]};
+        cgsize_t donor[4] = {j0[0], j0[1], j1[0], j1[1]};
+        const Side& me = kSides[static_cast<std::size_t>(s)];
+        const Side& them = kSides[static_cast<std::size_t>(r.side)];
+        int transform[2] = {0, 0};
+        transform[me.tangent] = dir * (them.tangent + 1);
+        // Leaving this block across the side is entering the donor across its side.
+        const int normal = 1 - me.tangent, donor_normal = 1 - them.tangent;
+        transform[normal] = (me.at_max == them.at_max ? -1 : 1) * (donor_normal + 1);
+        std::string cname(1, 'C');
+        cname += std::to_string(++connections);
+        if (zgc_id == 0) {
+          double zone_id = 0;
+          QSMESH_CGIO(cgio_get_node_id(
+              cgio, root, ("/" + options.cgns_base_name + "/" + name).c_str(), &zone_id));
+          QSMESH_CGIO(cgio_new_node(cgio, zone_id, "ZoneGridConnectivity", "ZoneGridConnectivity_t",
+                                    "MT", 0, nullptr, nullptr, &zgc_id));
+        }
+        const std::string donor_name = zone_name(r.block);
+        const cgsize_t name_size[1] = {static_cast<cgsize_t>(donor_name.size())};
+        double conn_id = 0, child = 0;
+        QSMESH_CGIO(cgio_new_node(cgio, zgc_id, cname.c_str(), "GridConnectivity1to1_t", "C1", 1,
+                                  name_size, donor_name.data(), &conn_id));
+        const cgsize_t range_dims[2] = {2, 2}, transform_dims[1] = {2};
+        QSMESH_CGIO(cgio_new_node(cgio, conn_id, "Transform", "\"int[IndexDimension]\"", "I4", 1,
+                                  transform_dims, transform, &child));
+        QSMESH_CGIO(cgio_new_node(cgio, conn_id, "PointRange", "IndexRange_t", "I4", 2, range_dims,
+                                  range, &child));
+        QSMESH_CGIO(cgio_new_node(cgio, conn_id, "PointRangeDonor", "IndexRange_t", "I4", 2,
+                                  range_dims, donor, &child));
+      }
+    }
+  }
+
+  // Faces the layout could not cut into blocks: one unstructured zone with a section per face.
+  if (!layout.unblocked_faces.empty()) {
+    std::vector<char> unblocked(static_cast<std::size_t>(mesh.num_cad_faces), 0);
+    for (LO f : layout.unblocked_faces) unblocked[static_cast<std::size_t>(f)] = 1;
+    const detail::ElementGroups groups = detail::group_elements(mesh);
+    std::vector<GO> local(static_cast<std::size_t>(mesh.num_vertices()), -1);
+    std::vector<GO> used;
+    auto use = [&](GO v) {
+      if (local[static_cast<std::size_t>(v)] < 0) {
+        local[static_cast<std::size_t>(v)] = static_cast<GO>(used.size());
+        used.push_back(v);
+      }
+    };
+    GO ncells = 0;
+    for (LO f : layout.unblocked_faces) {
+      for (GO t : groups.face2tris[static_cast<std::size_t>(f)])
+        for (GO v : mesh.triangles[static_cast<std::size_t>(t)]) use(v);
+      for (GO q : groups.face2quads[static_cast<std::size_t>(f)])
+        for (GO v : mesh.quads[static_cast<std::size_t>(q)]) use(v);
+      ncells += static_cast<GO>(groups.face2tris[static_cast<std::size_t>(f)].size() +
+                                groups.face2quads[static_cast<std::size_t>(f)].size());
+    }
+    cgsize_t size[3] = {to_cg(static_cast<GO>(used.size()), path), to_cg(ncells, path), 0};
+    int zone = 0;
+    QSMESH_CG(cg_zone_write(fn, base, "Unstructured", size, CGNS_ENUMV(Unstructured), &zone));
+    const char* names[3] = {"CoordinateX", "CoordinateY", "CoordinateZ"};
+    coord.resize(used.size());
+    for (int d = 0; d < 3; ++d) {
+      for (std::size_t i = 0; i < used.size(); ++i)
+        coord[i] = mesh.points[static_cast<std::size_t>(used[i])][d];
+      int c = 0;
+      QSMESH_CG(cg_coord_write(fn, base, zone, CGNS_ENUMV(RealDouble), names[d], coord.data(), &c));
+      QSMESH_CG(cg_goto(fn, base, "Zone_t", zone, "GridCoordinates_t", 1, "DataArray_t", c, "end"));
+      const float exponents[5] = {0, 1, 0, 0, 0};
+      QSMESH_CG(cg_exponents_write(CGNS_ENUMV(RealSingle), exponents));
+    }
+    cgsize_t next = 1;
+    std::vector<cgsize_t> conn, offsets;
+    for (LO f : layout.unblocked_faces) {
+      const auto& tris = groups.face2tris[static_cast<std::size_t>(f)];
+      const auto& quads = groups.face2quads[static_cast<std::size_t>(f)];
+      const auto n = static_cast<cgsize_t>(tris.size() + quads.size());
+      if (n == 0) continue;
+      const std::string name = "Face_" + std::to_string(f);
+      const bool mixed = !tris.empty() && !quads.empty();
+      conn.clear();
+      offsets.assign(1, 0);
+      for (GO t : tris) {
+        if (mixed) conn.push_back(CGNS_ENUMV(TRI_3));
+        for (GO v : mesh.triangles[static_cast<std::size_t>(t)])
+          conn.push_back(static_cast<cgsize_t>(local[static_cast<std::size_t>(v)] + 1));
+        offsets.push_back(static_cast<cgsize_t>(conn.size()));
+      }
+      for (GO q : quads) {
+        if (mixed) conn.push_back(CGNS_ENUMV(QUAD_4));
+        for (GO v : mesh.quads[static_cast<std::size_t>(q)])
+          conn.push_back(static_cast<cgsize_t>(local[static_cast<std::size_t>(v)] + 1));
+        offsets.push_back(static_cast<cgsize_t>(conn.size()));
+      }
+      int section = 0;
+      if (mixed) {
+        QSMESH_CG(cg_poly_section_write(fn, base, zone, name.c_str(), CGNS_ENUMV(MIXED), next,
+                                        next + n - 1, 0, conn.data(), offsets.data(), &section));
+      } else {
+        QSMESH_CG(cg_section_write(fn, base, zone, name.c_str(),
+                                   tris.empty() ? CGNS_ENUMV(QUAD_4) : CGNS_ENUMV(TRI_3), next,
+                                   next + n - 1, 0, conn.data(), &section));
+      }
+      next += n;
+    }
   }
 
   file.fn = -1;

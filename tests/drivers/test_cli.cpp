@@ -39,6 +39,21 @@ TEST(Cli, MeshOptions) {
   EXPECT_NE(help("mesh").find("--face-time-budget"), std::string::npos);
 }
 
+TEST(Cli, BlockStructuredNeedsCgnsAndQuads) {
+  EXPECT_TRUE(p({"mesh", "m.step", "-o", "o.cgns", "--block-structured"}).block_structured);
+  EXPECT_FALSE(p({"mesh", "m.step", "-o", "o.cgns"}).block_structured);
+  EXPECT_TRUE(p({"mesh", "m.step", "-o", "o.CGNS", "--block-structured"}).block_structured);
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--block-structured"}).find("-o FILE.cgns"),
+            std::string::npos);
+  EXPECT_NE(
+      error_of({"mesh", "m.step", "-o", "o.cgns", "--block-structured", "--until", "background"})
+          .find("quad mesh"),
+      std::string::npos);
+  EXPECT_NE(
+      error_of({"sizemap", "m.step", "-o", "s.vtu", "--block-structured"}).find("unknown option"),
+      std::string::npos);
+}
+
 TEST(Cli, HelpEverywhere) {
   EXPECT_EQ(p({}).command, Command::Help);
   EXPECT_EQ(p({"--help"}).command, Command::Help);

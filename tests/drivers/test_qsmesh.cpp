@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "cgns_blocks_check.hpp"
 #include "shapes.hpp"
 
 namespace {
@@ -159,6 +160,32 @@ double json_number(const std::string& json, const std::string& key) {
 
 // Issue "valid all-quad meshes": on the small shared models and the built-in example, at the
 // default size: no triangle, every quad valid, conforming, every vertex on its CAD entity.
+TEST_F(Qsmesh, BlockStructuredCgnsJoinsItsBlocks) {
+  // The quad layout as structured zones: every quad in a block, every 1-to-1 interface joining
+  // the same points, the same file at 1 and 2 threads.
+  std::string first;
+  for (const char* threads : {"1", "2"}) {
+    const std::string out = tmp(std::string("e2e_blocks_") + threads + ".cgns");
+    const std::string stats = tmp(std::string("e2e_blocks_") + threads + ".json");
+    const ExeResult r =
+        run("mesh " + model_ + " -o " + out + " --block-structured --size 0.8 -q --threads " +
+            threads + " --stats " + stats);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const std::string json = slurp(stats);
+    EXPECT_GT(json_number(json, "blocks"), 4);
+    EXPECT_EQ(json_number(json, "faces_not_in_blocks"), 0);
+    const qsmesh::test::BlockFileSummary s = qsmesh::test::check_block_file(out);
+    EXPECT_EQ(s.error, "");
+    EXPECT_EQ(s.structured_zones, static_cast<int>(json_number(json, "blocks")));
+    EXPECT_EQ(s.unstructured_zones, 0);
+    EXPECT_EQ(static_cast<double>(s.block_quads), json_number(json, "quads"));
+    EXPECT_GT(s.interfaces, s.structured_zones);
+    const std::string bytes = slurp(out);
+    if (first.empty()) first = bytes;
+    EXPECT_TRUE(bytes == first) << "the block file depends on the thread count";
+  }
+}
+
 TEST_F(Qsmesh, UnstructuredValidOnSmallModels) {
   std::vector<std::string> models;
   const std::string example = tmp("e2e_wing_body.step");

@@ -20,6 +20,7 @@
 #include <string>
 #include <vector>
 
+#include "qsmesh/layout/quad_layout.hpp"
 #include "qsmesh/mesh/surface_mesh.hpp"
 
 namespace qsmesh::io {
@@ -77,6 +78,17 @@ void check_mesh_for_output(const mesh::SurfaceMesh& mesh);
 /// a BAR_2 section, a family and an EdgeCenter BC (FamilySpecified) per CAD curve.
 /// Limit: Debian's cgnslib uses 32-bit ids; larger meshes throw Error.
 void write_cgns(const mesh::SurfaceMesh& mesh, const std::string& path, const WriteOptions& options = {});
+
+/// Block-structured CGNS/HDF5 (paper 002's block-structured output, from the layout as it is): one
+/// base (CellDimension 2, PhysicalDimension 3, units as write_cgns), one structured zone
+/// "Block_<k>_Face_<f>" (k and f zero-padded to 6 digits or more) of (ni + 1) x (nj + 1) vertices per block of `layout` (its vertex grid, i
+/// fastest) with FamilyName "Face_<f>", and a GridConnectivity1to1 for every maximal stretch of a
+/// block side shared with one side of another block (or of itself, across a seam), within a face
+/// or across a CAD curve: point ranges, donor ranges and the transform relating the index spaces.
+/// The faces in layout.unblocked_faces go into one unstructured zone "Unstructured" (a section per
+/// face), without connectivity to the blocks. `layout` must come from extract_quad_layout(mesh).
+void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& layout,
+                       const std::string& path, const WriteOptions& options = {});
 
 /// VTK XML UnstructuredGrid: triangles (VTK type 5), quads (9), optionally bars (3); cell data Int32
 /// "cad_face" (and "cad_curve" with bars; -1 where not applicable), point data Int32 "cad_dim" and

@@ -1,0 +1,394 @@
+#include "qsmesh/layout/quad_layout.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <numeric>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include "qsmesh/core/error.hpp"
+
+namespace qsmesh::layout {
+
+namespace {
+
+struct EdgeInfo {
+  std::array<GO, 2> quads{-1, -1};
+  int count = 0;     // quads using the edge (2 inside a face; 1 on a free boundary)
+  bool bar = false;  // on a CAD curve
+  bool traced = false;
+};
+
+class Layouter {
+ public:
+  explicit Layouter(const mesh::SurfaceMesh& m) : m_(m), nv_(m.num_vertices()) {
+    const auto nq = static_cast<GO>(m.quads.size());
+    face_unblocked_.assign(static_cast<std::size_t>(std::max<LO>(m.num_cad_faces, 0)), 0);
+    for (LO f : m.triangle_face) face_unblocked_[static_cast<std::size_t>(f)] = 1;
+    // vertex -> quads (CSR)
+    v2q_offsets_.assign(static_cast<std::size_t>(nv_) + 1, 0);
+    for (const auto& q : m.quads)
+      for (GO v : q) ++v2q_offsets_[static_cast<std::size_t>(v) + 1];
+    std::partial_sum(v2q_offsets_.begin(), v2q_offsets_.end(), v2q_offsets_.begin());
+    v2q_.resize(static_cast<std::size_t>(v2q_offsets_.back()));
+    std::vector<GO> fill(v2q_offsets_.begin(), v2q_offsets_.end() - 1);
+    for (GO q = 0; q < nq; ++q)
+      for (GO v : m.quads[static_cast<std::size_t>(q)])
+        v2q_[static_cast<std::size_t>(fill[v]++)] = q;
+    edges_.reserve(static_cast<std::size_t>(2 * nq + m.bars.size()));
+    for (GO q = 0; q < nq; ++q) {
+      const auto& quad = m.quads[static_cast<std::size_t>(q)];
+      for (int k = 0; k < 4; ++k) {
+        EdgeInfo& e = edges_[key(quad[k], quad[(k + 1) % 4])];
+        if (e.count < 2) e.quads[static_cast<std::size_t>(e.count)] = q;
+        ++e.count;
+      }
+    }
+    for (const auto& b : m.bars) {
+      auto it = edges_.find(key(b[0], b[1]));
+      if (it != edges_.end()) it->second.bar = true;
+    }
+  }
+
+  [[nodiscard]] bool blocked_quad(GO q) const {
+    return face_unblocked_[static_cast<std::size_t>(m_.quad_face[static_cast<std::size_t>(q)])] ==
+           0;
+  }
+
+  // An edge inside a face that a trace may follow and a patch may be crossed through.
+  [[nodiscard]] bool interior(const EdgeInfo& e) const {
+    return !e.bar && e.count == 2 && blocked_quad(e.quads[0]) && blocked_quad(e.quads[1]);
+  }
+
+  [[nodiscard]] bool regular_interior(GO v) const {
+    return m_.vclass[static_cast<std::size_t>(v)].dim == 2 &&
+           v2q_offsets_[static_cast<std::size_t>(v) + 1] -
+                   v2q_offsets_[static_cast<std::size_t>(v)] ==
+               4;
+  }
+
+  // Trace starts (v, w): the edges leaving irregular interior vertices, CAD corners and curve
+  // vertices with a side of other than two quads. Restricted to the faces in `faces` when given.
+  [[nodiscard]] std::vector<std::pair<GO, GO>> starts(const std::vector<char>* faces) const {
+    std::vector<std::pair<GO, GO>> out;
+    std::vector<GO> quads, parent;
+    for (GO v = 0; v < nv_; ++v) {
+      const auto& c = m_.vclass[static_cast<std::size_t>(v)];
+      quads.assign(v2q_.begin() + v2q_offsets_[static_cast<std::size_t>(v)],
+                   v2q_.begin() + v2q_offsets_[static_cast<std::size_t>(v) + 1]);
+      if (quads.empty() || (c.dim == 2 && quads.size() == 4)) continue;
+      // Sides of a boundary vertex: its quads joined through interior edges at v.
+      parent.resize(quads.size());
+      std::iota(parent.begin(), parent.end(), 0);
+      auto find = [&](GO i) {
+        while (parent[static_cast<std::size_t>(i)] != i) i = parent[static_cast<std::size_t>(i)];
+        return i;
+      };
+      std::vector<std::pair<GO, std::size_t>> interior_edges;  // (w, quad index)
+      for (std::size_t a = 0; a < quads.size(); ++a) {
+        for (GO w : neighbours_in_quad(quads[a], v)) {
+          const EdgeInfo& e = edges_.at(key(v, w));
+          if (!interior(e)) continue;
+          interior_edges.emplace_back(w, a);
+          const GO other = e.quads[0] == quads[a] ? e.quads[1] : e.quads[0];
+          const auto b = static_cast<std::size_t>(std::find(quads.begin(), quads.end(), other) -
+                                                  quads.begin());
+          parent[static_cast<std::size_t>(find(static_cast<GO>(a)))] = find(static_cast<GO>(b));
+        }
+      }
+      std::vector<int> side_size(quads.size(), 0);
+      for (std::size_t a = 0; a < quads.size(); ++a)
+        ++side_size[static_cast<std::size_t>(find(static_cast<GO>(a)))];
+      for (const auto& [w, a] : interior_edges) {
+        const bool irregular_side =
+            side_size[static_cast<std::size_t>(find(static_cast<GO>(a)))] != 2;
+        if (c.dim == 0 || c.dim == 2 || irregular_side) {
+          if (faces != nullptr && (*faces)[static_cast<std::size_t>(
+                                      m_.quad_face[static_cast<std::size_t>(quads[a])])] == 0)
+            continue;
+          out.emplace_back(v, w);
+        }
+      }
+    }
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
+  }
+
+  // Runs the traces from `from`, all advancing one edge per round in order (see the header).
+  void trace(const std::vector<std::pair<GO, GO>>& from, bool motorcycle) {
+    std::vector<char> reached(static_cast<std::size_t>(nv_), 0);
+    struct State {
+      GO prev, cur;
+    };
+    std::vector<State> live;
+    for (const auto& [v, w] : from) {
+      EdgeInfo& e = edges_.at(key(v, w));
+      if (motorcycle && e.traced) continue;
+      e.traced = true;
+      reached[static_cast<std::size_t>(v)] = 1;
+      live.push_back({v, w});
+    }
+    std::vector<State> next;
+    while (!live.empty()) {
+      next.clear();
+      for (State s : live) {
+        if (!regular_interior(s.cur)) continue;
+        if (motorcycle && reached[static_cast<std::size_t>(s.cur)]) continue;
+        reached[static_cast<std::size_t>(s.cur)] = 1;
+        const GO after = straight_on(s.cur, s.prev);
+        EdgeInfo& e = edges_.at(key(s.cur, after));
+        if (!motorcycle && e.traced) continue;  // the rest of this line is traced already
+        e.traced = true;
+        next.push_back({s.cur, after});
+      }
+      live.swap(next);
+    }
+  }
+
+  void clear_traces(const std::vector<char>& faces) {
+    for (auto& [k, e] : edges_)
+      if (e.count >= 1 &&
+          faces[static_cast<std::size_t>(m_.quad_face[static_cast<std::size_t>(e.quads[0])])])
+        e.traced = false;
+  }
+
+  // Patches of the quads of the faces in `faces`, as grids: appends the blocks to `out`; returns
+  // the faces with a patch that is not a grid.
+  std::vector<LO> patches(const std::vector<char>& faces, QuadLayout& out) const {
+    const auto nq = static_cast<GO>(m_.quads.size());
+    std::vector<GO> patch(static_cast<std::size_t>(nq), -1);
+    std::vector<LO> failed;
+    std::vector<GO> members, stack;
+    for (GO seed = 0; seed < nq; ++seed) {
+      const LO f = m_.quad_face[static_cast<std::size_t>(seed)];
+      if (patch[static_cast<std::size_t>(seed)] >= 0 || !faces[static_cast<std::size_t>(f)])
+        continue;
+      members.clear();
+      stack.assign(1, seed);
+      patch[static_cast<std::size_t>(seed)] = seed;
+      while (!stack.empty()) {
+        const GO q = stack.back();
+        stack.pop_back();
+        members.push_back(q);
+        const auto& quad = m_.quads[static_cast<std::size_t>(q)];
+        for (int k = 0; k < 4; ++k) {
+          const EdgeInfo& e = edges_.at(key(quad[k], quad[(k + 1) % 4]));
+          if (!crossable(e)) continue;
+          const GO other = e.quads[0] == q ? e.quads[1] : e.quads[0];
+          if (patch[static_cast<std::size_t>(other)] >= 0) continue;
+          patch[static_cast<std::size_t>(other)] = seed;
+          stack.push_back(other);
+        }
+      }
+      std::sort(members.begin(), members.end());
+      if (!grid(members, f, out)) failed.push_back(f);
+    }
+    std::sort(failed.begin(), failed.end());
+    failed.erase(std::unique(failed.begin(), failed.end()), failed.end());
+    return failed;
+  }
+
+ private:
+  [[nodiscard]] std::uint64_t key(GO a, GO b) const {
+    if (a > b) std::swap(a, b);
+    return static_cast<std::uint64_t>(a) * static_cast<std::uint64_t>(nv_) +
+           static_cast<std::uint64_t>(b);
+  }
+
+  [[nodiscard]] bool crossable(const EdgeInfo& e) const { return interior(e) && !e.traced; }
+
+  [[nodiscard]] std::array<GO, 2> neighbours_in_quad(GO q, GO v) const {
+    const auto& quad = m_.quads[static_cast<std::size_t>(q)];
+    for (int k = 0; k < 4; ++k)
+      if (quad[k] == v) return {quad[(k + 1) % 4], quad[(k + 3) % 4]};
+    QSMESH_CHECK(false, "layout: vertex " << v << " not in quad " << q);
+    return {};
+  }
+
+  // At a valence-4 vertex c reached from prev: the vertex across c on the same grid line.
+  [[nodiscard]] GO straight_on(GO c, GO prev) const {
+    const EdgeInfo& e = edges_.at(key(c, prev));
+    std::array<GO, 3> side{prev, -1, -1};
+    for (int s = 0; s < 2; ++s) {
+      const auto n = neighbours_in_quad(e.quads[static_cast<std::size_t>(s)], c);
+      side[static_cast<std::size_t>(s) + 1] = n[0] == prev ? n[1] : n[0];
+    }
+    for (std::size_t i = v2q_offsets_[static_cast<std::size_t>(c)];
+         i < static_cast<std::size_t>(v2q_offsets_[static_cast<std::size_t>(c) + 1]); ++i)
+      for (GO w : neighbours_in_quad(v2q_[i], c))
+        if (std::find(side.begin(), side.end(), w) == side.end()) return w;
+    QSMESH_CHECK(false, "layout: no straight continuation at vertex " << c);
+    return -1;
+  }
+
+  // Position of v in quad q.
+  [[nodiscard]] int position(GO q, GO v) const {
+    const auto& quad = m_.quads[static_cast<std::size_t>(q)];
+    for (int k = 0; k < 4; ++k)
+      if (quad[k] == v) return k;
+    return -1;
+  }
+
+  // The patch `members` (sorted quad ids) as an ni x nj grid; false when it is not one.
+  bool grid(const std::vector<GO>& members, LO face, QuadLayout& out) const {
+    auto in_patch = [&](GO q) { return std::binary_search(members.begin(), members.end(), q); };
+    auto across = [&](GO q, GO a, GO b) -> GO {  // the patch quad across edge (a, b) of q, or -1
+      const EdgeInfo& e = edges_.at(key(a, b));
+      if (!crossable(e)) return -1;
+      const GO other = e.quads[0] == q ? e.quads[1] : e.quads[0];
+      return in_patch(other) ? other : -1;
+    };
+    // An oriented quad: local corners (0,0), (1,0), (1,1), (0,1) are quad[k], [k+1], [k+2], [k+3].
+    struct Oriented {
+      GO q;
+      int k;
+    };
+    auto corner = [&](Oriented o, int c) {
+      return m_.quads[static_cast<std::size_t>(o.q)][(o.k + c) % 4];
+    };
+    // The first quad with a patch corner: both its edges at that vertex bound the patch.
+    Oriented start{-1, 0};
+    for (GO q : members) {
+      for (int k = 0; k < 4 && start.q < 0; ++k) {
+        const auto& quad = m_.quads[static_cast<std::size_t>(q)];
+        if (across(q, quad[k], quad[(k + 1) % 4]) < 0 && across(q, quad[(k + 3) % 4], quad[k]) < 0)
+          start = {q, k};
+      }
+      if (start.q >= 0) break;
+    }
+    if (start.q < 0) return false;
+    auto step_i = [&](Oriented o) -> Oriented {
+      const GO b = corner(o, 1), c = corner(o, 2);
+      const GO n = across(o.q, b, c);
+      return n < 0 ? Oriented{-1, 0} : Oriented{n, position(n, b)};
+    };
+    auto step_j = [&](Oriented o) -> Oriented {
+      const GO d = corner(o, 3), c = corner(o, 2);
+      const GO n = across(o.q, d, c);
+      return n < 0 ? Oriented{-1, 0} : Oriented{n, position(n, d)};
+    };
+    LO ni = 0;
+    for (Oriented o = start; o.q >= 0; o = step_i(o)) {
+      if (++ni > static_cast<LO>(members.size())) return false;
+    }
+    std::vector<GO> grid_vertices;
+    std::vector<GO> seen;
+    LO nj = 0;
+    for (Oriented row = start; row.q >= 0; row = step_j(row)) {
+      if (static_cast<GO>(nj + 1) * ni > static_cast<GO>(members.size())) return false;
+      grid_vertices.resize(static_cast<std::size_t>(ni + 1) * static_cast<std::size_t>(nj + 2), -1);
+      Oriented o = row;
+      for (LO i = 0; i < ni; ++i) {
+        if (o.q < 0) return false;
+        seen.push_back(o.q);
+        const std::array<std::pair<LO, LO>, 4> at{
+            {{i, nj}, {i + 1, nj}, {i + 1, nj + 1}, {i, nj + 1}}};
+        for (int c = 0; c < 4; ++c) {
+          GO& slot = grid_vertices[static_cast<std::size_t>(at[c].second) *
+                                       static_cast<std::size_t>(ni + 1) +
+                                   static_cast<std::size_t>(at[c].first)];
+          if (slot >= 0 && slot != corner(o, c)) return false;
+          slot = corner(o, c);
+        }
+        o = step_i(o);
+      }
+      if (o.q >= 0) return false;  // a longer row: not a grid
+      ++nj;
+    }
+    std::sort(seen.begin(), seen.end());
+    if (seen != members) return false;
+    Block b;
+    b.face = face;
+    b.ni = ni;
+    b.nj = nj;
+    b.first = static_cast<std::int64_t>(out.vertices.size());
+    out.vertices.insert(out.vertices.end(), grid_vertices.begin(), grid_vertices.end());
+    out.blocks.push_back(b);
+    for (GO q : members)
+      out.quad2block[static_cast<std::size_t>(q)] = static_cast<GO>(out.blocks.size()) - 1;
+    return true;
+  }
+
+  const mesh::SurfaceMesh& m_;
+  GO nv_;
+  std::vector<char> face_unblocked_;
+  std::vector<GO> v2q_offsets_, v2q_;
+  std::unordered_map<std::uint64_t, EdgeInfo> edges_;
+
+ public:
+  [[nodiscard]] const std::vector<char>& face_unblocked() const { return face_unblocked_; }
+};
+
+}  // namespace
+
+QuadLayout extract_quad_layout(const mesh::SurfaceMesh& mesh, const LayoutOptions& options) {
+  QSMESH_CHECK(
+      mesh.quad_face.size() == mesh.quads.size() && mesh.vclass.size() == mesh.points.size(),
+      "layout: inconsistent mesh arrays");
+  QuadLayout out;
+  out.quad2block.assign(mesh.quads.size(), -1);
+  const auto nf = static_cast<std::size_t>(std::max<LO>(mesh.num_cad_faces, 0));
+  Layouter layouter(mesh);
+  std::vector<char> faces(nf, 0);
+  for (std::size_t f = 0; f < nf; ++f) faces[f] = layouter.face_unblocked()[f] == 0 ? 1 : 0;
+
+  layouter.trace(layouter.starts(nullptr), options.motorcycle);
+  QuadLayout first;
+  first.quad2block.assign(mesh.quads.size(), -1);
+  std::vector<LO> failed = layouter.patches(faces, first);
+  std::vector<char> again(nf, 0);
+  for (LO f : failed) again[static_cast<std::size_t>(f)] = 1;
+
+  QuadLayout second;
+  second.quad2block.assign(mesh.quads.size(), -1);
+  std::vector<LO> still_failed;
+  if (!failed.empty() && options.motorcycle) {
+    layouter.clear_traces(again);
+    layouter.trace(layouter.starts(&again), false);
+    still_failed = layouter.patches(again, second);
+    out.faces_with_extended_traces = static_cast<LO>(failed.size());
+  } else {
+    still_failed = failed;
+  }
+  std::vector<char> bad(nf, 0);
+  for (std::size_t f = 0; f < nf; ++f) bad[f] = layouter.face_unblocked()[f];
+  for (LO f : still_failed) bad[static_cast<std::size_t>(f)] = 1;
+
+  // Blocks by face: those of the first pass for the faces that passed, of the second for the faces
+  // traced again; faces failing both keep no block.
+  std::vector<std::vector<std::pair<const QuadLayout*, GO>>> by_face(nf);
+  for (const QuadLayout* from : {&first, &second})
+    for (std::size_t k = 0; k < from->blocks.size(); ++k) {
+      const auto f = static_cast<std::size_t>(from->blocks[k].face);
+      const bool use = from == &first ? (faces[f] && !again[f]) : again[f] != 0;
+      if (use && !bad[f]) by_face[f].emplace_back(from, static_cast<GO>(k));
+    }
+  std::vector<GO> remap_first(first.blocks.size(), -1), remap_second(second.blocks.size(), -1);
+  for (std::size_t f = 0; f < nf; ++f)
+    for (const auto& [from, k] : by_face[f]) {
+      const Block& b = from->blocks[static_cast<std::size_t>(k)];
+      Block c = b;
+      c.first = static_cast<std::int64_t>(out.vertices.size());
+      const auto n = static_cast<std::int64_t>(b.ni + 1) * static_cast<std::int64_t>(b.nj + 1);
+      out.vertices.insert(out.vertices.end(), from->vertices.begin() + b.first,
+                          from->vertices.begin() + b.first + n);
+      (from == &first ? remap_first : remap_second)[static_cast<std::size_t>(k)] =
+          static_cast<GO>(out.blocks.size());
+      out.blocks.push_back(c);
+    }
+  for (std::size_t q = 0; q < mesh.quads.size(); ++q) {
+    if (first.quad2block[q] >= 0 && remap_first[static_cast<std::size_t>(first.quad2block[q])] >= 0)
+      out.quad2block[q] = remap_first[static_cast<std::size_t>(first.quad2block[q])];
+    if (second.quad2block[q] >= 0 &&
+        remap_second[static_cast<std::size_t>(second.quad2block[q])] >= 0)
+      out.quad2block[q] = remap_second[static_cast<std::size_t>(second.quad2block[q])];
+  }
+  for (std::size_t f = 0; f < nf; ++f)
+    if (bad[f]) out.unblocked_faces.push_back(static_cast<LO>(f));
+  return out;
+}
+
+}  // namespace qsmesh::layout

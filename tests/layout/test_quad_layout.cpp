@@ -1,0 +1,216 @@
+// Quad layouts of hand-built meshes, and their block-structured CGNS output read back.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <filesystem>
+#include <map>
+#include <string>
+#include <vector>
+
+#include "cgns_blocks_check.hpp"
+#include "qsmesh/io/writer.hpp"
+#include "qsmesh/layout/quad_layout.hpp"
+#include "tmp_dir.hpp"
+
+namespace qsmesh::layout {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Two rectangular faces side by side on the lattice [0, a + b] x [0, n] (unit spacing, z = 0):
+// face 0 = [0, a] x [0, n], face 1 = [a, a + b] x [0, n], sharing the curve x = a. Corners at the
+// six rectangle corners; curves: 0 bottom of face 0, 1 bottom of face 1, 2 top of face 0, 3 top
+// of face 1, 4 x = 0, 5 x = a, 6 x = a + b. Quads counter-clockwise seen from +z.
+mesh::SurfaceMesh two_faces(int a, int b, int n) {
+  mesh::SurfaceMesh m;
+  m.num_cad_faces = 2;
+  m.num_cad_curves = 7;
+  m.num_cad_corners = 6;
+  const int nx = a + b;
+  std::vector<GO> id(static_cast<std::size_t>((nx + 1) * (n + 1)));
+  auto at = [&](int x, int y) -> GO& { return id[static_cast<std::size_t>(y * (nx + 1) + x)]; };
+  auto corner_of = [&](int x, int y) {
+    const int col = x == 0 ? 0 : (x == a ? 1 : 2);
+    return (y == 0 ? 0 : 3) + col;
+  };
+  std::map<int, int> next_on_curve;
+  for (int y = 0; y <= n; ++y) {
+    for (int x = 0; x <= nx; ++x) {
+      mesh::VertexClass c;
+      const bool vertical = x == 0 || x == a || x == nx, horizontal = y == 0 || y == n;
+      if (vertical && horizontal) {
+        c.dim = 0;
+        c.entity = corner_of(x, y);
+      } else if (vertical || horizontal) {
+        c.dim = 1;
+        c.entity = vertical ? (x == 0 ? 4 : (x == a ? 5 : 6)) : (y == 0 ? 0 : 2) + (x > a ? 1 : 0);
+        c.index = ++next_on_curve[c.entity];
+      } else {
+        c.dim = 2;
+        c.entity = x < a ? 0 : 1;
+      }
+      at(x, y) = static_cast<GO>(m.points.size());
+      m.points.push_back({static_cast<double>(x), static_cast<double>(y), 0.0});
+      m.vclass.push_back(c);
+    }
+  }
+  for (int y = 0; y < n; ++y)
+    for (int x = 0; x < nx; ++x) {
+      m.quads.push_back({at(x, y), at(x + 1, y), at(x + 1, y + 1), at(x, y + 1)});
+      m.quad_face.push_back(x < a ? 0 : 1);
+    }
+  auto bar = [&](GO p, GO q, LO curve) {
+    m.bars.push_back({p, q});
+    m.bar_curve.push_back(curve);
+  };
+  for (int x = 0; x < nx; ++x) {
+    bar(at(x, 0), at(x + 1, 0), x < a ? 0 : 1);
+    bar(at(x, n), at(x + 1, n), x < a ? 2 : 3);
+  }
+  for (int y = 0; y < n; ++y) {
+    bar(at(0, y), at(0, y + 1), 4);
+    bar(at(a, y), at(a, y + 1), 5);
+    bar(at(nx, y), at(nx, y + 1), 6);
+  }
+  m.curve_corners = {{0, 1}, {1, 2}, {3, 4}, {4, 5}, {0, 3}, {1, 4}, {2, 5}};
+  m.face2curves =
+      Adjacency::from_pairs(2, {{0, 0}, {0, 2}, {0, 4}, {0, 5}, {1, 1}, {1, 3}, {1, 5}, {1, 6}});
+  return m;
+}
+
+// A triangular face of three quads around a valence-3 vertex O: corners A, B, C; the midpoints of
+// its three curves; the triangle pattern of paper 000 Fig. 4.
+mesh::SurfaceMesh triangle_face() {
+  mesh::SurfaceMesh m;
+  m.num_cad_faces = 1;
+  m.num_cad_curves = 3;
+  m.num_cad_corners = 3;
+  m.points = {{0, 0, 0},      {2, 0, 0},      {1, 1.7, 0}, {1, 0, 0},
+              {1.5, 0.85, 0}, {0.5, 0.85, 0}, {1, 0.6, 0}};
+  m.vclass = {{0, 0, kNoIndex, {0, 0}},    {0, 1, kNoIndex, {0, 0}}, {0, 2, kNoIndex, {0, 0}},
+              {1, 0, 1, {0.5, 0}},         {1, 1, 1, {0.5, 0}},      {1, 2, 1, {0.5, 0}},
+              {2, 0, kNoIndex, {0.5, 0.3}}};
+  m.quads = {{0, 3, 6, 5}, {3, 1, 4, 6}, {6, 4, 2, 5}};
+  m.quad_face = {0, 0, 0};
+  m.bars = {{0, 3}, {3, 1}, {1, 4}, {4, 2}, {2, 5}, {5, 0}};
+  m.bar_curve = {0, 0, 1, 1, 2, 2};
+  m.curve_corners = {{0, 1}, {1, 2}, {2, 0}};
+  m.face2curves = Adjacency::from_pairs(1, {{0, 0}, {0, 1}, {0, 2}});
+  return m;
+}
+
+// Every block cell is a mesh quad (same vertices, same turning sense), every quad in one block.
+void expect_blocks_cover_the_quads(const mesh::SurfaceMesh& m, const QuadLayout& l) {
+  std::map<std::array<GO, 4>, GO> quad_of;  // the quad's vertices rotated to start at the smallest
+  auto canonical = [](std::array<GO, 4> q) {
+    std::rotate(q.begin(), std::min_element(q.begin(), q.end()), q.end());
+    return q;
+  };
+  for (std::size_t q = 0; q < m.quads.size(); ++q)
+    quad_of[canonical(m.quads[q])] = static_cast<GO>(q);
+  std::vector<int> covered(m.quads.size(), 0);
+  ASSERT_EQ(l.quad2block.size(), m.quads.size());
+  for (std::size_t k = 0; k < l.blocks.size(); ++k) {
+    const Block& b = l.blocks[k];
+    for (LO j = 0; j < b.nj; ++j)
+      for (LO i = 0; i < b.ni; ++i) {
+        const std::array<GO, 4> cell{b.vertex(i, j, l.vertices), b.vertex(i + 1, j, l.vertices),
+                                     b.vertex(i + 1, j + 1, l.vertices),
+                                     b.vertex(i, j + 1, l.vertices)};
+        const auto it = quad_of.find(canonical(cell));
+        ASSERT_NE(it, quad_of.end()) << "block " << k << " cell " << i << "," << j;
+        ++covered[static_cast<std::size_t>(it->second)];
+        EXPECT_EQ(l.quad2block[static_cast<std::size_t>(it->second)], static_cast<GO>(k));
+        EXPECT_EQ(m.quad_face[static_cast<std::size_t>(it->second)], b.face);
+      }
+  }
+  for (std::size_t q = 0; q < covered.size(); ++q) EXPECT_EQ(covered[q], 1) << "quad " << q;
+}
+
+TEST(QuadLayout, RegularFacesAreOneBlockEach) {
+  const mesh::SurfaceMesh m = two_faces(4, 2, 3);
+  const QuadLayout l = extract_quad_layout(m);
+  ASSERT_EQ(l.blocks.size(), 2u);
+  EXPECT_TRUE(l.unblocked_faces.empty());
+  EXPECT_EQ(l.blocks[0].face, 0);
+  EXPECT_EQ(l.blocks[1].face, 1);
+  // The grid starts at the corner of smallest vertex id, i along the first edge of its quad.
+  EXPECT_EQ(l.blocks[0].ni * l.blocks[0].nj, 12);
+  EXPECT_EQ(l.blocks[1].ni * l.blocks[1].nj, 6);
+  EXPECT_EQ(l.blocks[0].vertex(0, 0, l.vertices), 0);
+  EXPECT_EQ(l.blocks[0].ni, 4);
+  EXPECT_EQ(l.blocks[0].nj, 3);
+  expect_blocks_cover_the_quads(m, l);
+}
+
+TEST(QuadLayout, TracesFromAnIrregularVertexCutTheFace) {
+  const mesh::SurfaceMesh m = triangle_face();
+  const QuadLayout l = extract_quad_layout(m);
+  ASSERT_EQ(l.blocks.size(), 3u);
+  for (const Block& b : l.blocks) {
+    EXPECT_EQ(b.ni, 1);
+    EXPECT_EQ(b.nj, 1);
+  }
+  expect_blocks_cover_the_quads(m, l);
+}
+
+TEST(QuadLayout, FacesWithTrianglesAreLeftOut) {
+  mesh::SurfaceMesh m = two_faces(2, 2, 2);
+  // Split the last quad of face 1 into two triangles.
+  const auto q = m.quads.back();
+  m.quads.pop_back();
+  m.quad_face.pop_back();
+  m.triangles = {{q[0], q[1], q[2]}, {q[0], q[2], q[3]}};
+  m.triangle_face = {1, 1};
+  const QuadLayout l = extract_quad_layout(m);
+  ASSERT_EQ(l.blocks.size(), 1u);
+  EXPECT_EQ(l.blocks[0].face, 0);
+  EXPECT_EQ(l.unblocked_faces, std::vector<LO>{1});
+  for (std::size_t k = 0; k < m.quads.size(); ++k)
+    EXPECT_EQ(l.quad2block[k], m.quad_face[k] == 1 ? -1 : 0);
+}
+
+TEST(CgnsBlocks, InterfacesJoinTheSamePoints) {
+  const fs::path dir = fs::path(qsmesh::test::tmp_dir()) / "cgns_blocks";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  for (const bool triangle : {false, true}) {
+    const mesh::SurfaceMesh m = triangle ? triangle_face() : two_faces(4, 2, 3);
+    const QuadLayout l = extract_quad_layout(m);
+    const std::string path = (dir / (triangle ? "tri.cgns" : "two.cgns")).string();
+    io::write_cgns_blocks(m, l, path);
+    const qsmesh::test::BlockFileSummary s = qsmesh::test::check_block_file(path);
+    EXPECT_EQ(s.error, "");
+    EXPECT_EQ(s.structured_zones, static_cast<int>(l.blocks.size()));
+    EXPECT_EQ(s.unstructured_zones, 0);
+    EXPECT_EQ(s.block_quads, static_cast<std::int64_t>(m.quads.size()));
+    // Two faces: one interface each way along the shared curve (3 edges, 4 points). Triangle: each
+    // pair of its three blocks shares one edge, both ways.
+    EXPECT_EQ(s.interfaces, triangle ? 6 : 2);
+    EXPECT_EQ(s.interface_points, triangle ? 12 : 8);
+  }
+}
+
+TEST(CgnsBlocks, UnblockedFacesGoToAnUnstructuredZone) {
+  const fs::path dir = fs::path(qsmesh::test::tmp_dir()) / "cgns_blocks_mixed";
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  mesh::SurfaceMesh m = two_faces(2, 2, 2);
+  const auto q = m.quads.back();
+  m.quads.pop_back();
+  m.quad_face.pop_back();
+  m.triangles = {{q[0], q[1], q[2]}, {q[0], q[2], q[3]}};
+  m.triangle_face = {1, 1};
+  const QuadLayout l = extract_quad_layout(m);
+  const std::string path = (dir / "mixed.cgns").string();
+  io::write_cgns_blocks(m, l, path);
+  const qsmesh::test::BlockFileSummary s = qsmesh::test::check_block_file(path);
+  EXPECT_EQ(s.error, "");
+  EXPECT_EQ(s.structured_zones, 1);
+  EXPECT_EQ(s.unstructured_zones, 1);
+  EXPECT_EQ(s.block_quads, 4);
+}
+
+}  // namespace
+}  // namespace qsmesh::layout
