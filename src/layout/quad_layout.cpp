@@ -69,8 +69,9 @@ class Layouter {
                4;
   }
 
-  // Trace starts (v, w): the edges leaving irregular interior vertices, CAD corners and curve
-  // vertices with a side of other than two quads. Restricted to the faces in `faces` when given.
+  // Trace starts (v, w): the edges leaving irregular interior vertices, and the interior edges of
+  // the sides of other than two quads of CAD corners and curve vertices (poles included: their fan
+  // is one side). Restricted to the faces in `faces` when given.
   [[nodiscard]] std::vector<std::pair<GO, GO>> starts(const std::vector<char>* faces) const {
     std::vector<std::pair<GO, GO>> out;
     std::vector<GO> quads, parent;
@@ -104,7 +105,7 @@ class Layouter {
       for (const auto& [w, a] : interior_edges) {
         const bool irregular_side =
             side_size[static_cast<std::size_t>(find(static_cast<GO>(a)))] != 2;
-        if (c.dim == 0 || c.dim == 2 || irregular_side) {
+        if (c.dim == 2 || irregular_side) {
           if (faces != nullptr && (*faces)[static_cast<std::size_t>(
                                       m_.quad_face[static_cast<std::size_t>(quads[a])])] == 0)
             continue;

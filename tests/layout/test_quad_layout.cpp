@@ -144,6 +144,30 @@ TEST(QuadLayout, RegularFacesAreOneBlockEach) {
   expect_blocks_cover_the_quads(m, l);
 }
 
+TEST(QuadLayout, FlatCornersDoNotCutTheFace) {
+  // One face [0, 4] x [0, 2] whose bottom and top sides are two curves each, meeting at flat
+  // corners (two quads on their side): one block, the corners on its sides.
+  mesh::SurfaceMesh m = two_faces(2, 2, 2);
+  m.num_cad_faces = 1;
+  for (LO& f : m.quad_face) f = 0;
+  std::vector<std::array<GO, 2>> bars;
+  std::vector<LO> bar_curve;
+  for (std::size_t k = 0; k < m.bars.size(); ++k) {
+    if (m.bar_curve[k] == 5) continue;  // the curve between the two faces is gone
+    bars.push_back(m.bars[k]);
+    bar_curve.push_back(m.bar_curve[k]);
+  }
+  m.bars = bars;
+  m.bar_curve = bar_curve;
+  for (auto& c : m.vclass)
+    if (c.dim == 1 && c.entity == 5) c = {2, 0, kNoIndex, {0, 0}};
+  m.face2curves = Adjacency::from_pairs(1, {{0, 0}, {0, 1}, {0, 2}, {0, 3}, {0, 4}, {0, 6}});
+  const QuadLayout l = extract_quad_layout(m);
+  ASSERT_EQ(l.blocks.size(), 1u);
+  EXPECT_EQ(l.blocks[0].ni * l.blocks[0].nj, 8);
+  expect_blocks_cover_the_quads(m, l);
+}
+
 TEST(QuadLayout, TracesFromAnIrregularVertexCutTheFace) {
   const mesh::SurfaceMesh m = triangle_face();
   const QuadLayout l = extract_quad_layout(m);

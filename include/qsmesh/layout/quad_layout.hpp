@@ -2,14 +2,16 @@
 // II-III.A), for block-structured output (structured zones with 1-to-1 connectivity).
 //
 // Traces (separatrices) leave every irregular interior vertex along each of its edges, and every
-// CAD corner and every curve vertex away from its regular valence along each edge into the face. A
-// trace runs straight through regular vertices (valence 4) and stops at a CAD curve, at an
-// irregular vertex or, as in the motorcycle graph of paper 002 Sec. III.A, at a vertex another
-// trace has already reached (a T-junction). All traces advance one edge per round in a fixed order,
-// so the layout depends on the mesh only. The quads are then grouped into patches bounded by traces
-// and CAD curves; each patch is a grid of ni x nj quads, a block. Paper 002 goes on to simplify
-// this layout (ILP quantization, Sec. III.B-C); that is not done here, so the blocks are those of
-// the quasi-structured mesh as it is.
+// CAD corner or curve vertex with a side of other than two quads (a side: the quads between two
+// consecutive curve edges at the vertex) along that side's interior edges; a corner with two quads
+// on its side lies on a block side, a convex one with one quad is a block corner. A trace runs
+// straight through regular vertices (valence 4) and stops at a CAD curve, at an irregular vertex
+// or, as in the motorcycle graph of paper 002 Sec. III.A, at a vertex another trace has already
+// reached (a T-junction). All traces advance one edge per round in a fixed order, so the layout
+// depends on the mesh only. The quads are then grouped into patches bounded by traces and CAD
+// curves; each patch is a grid of ni x nj quads, a block. Paper 002 goes on to simplify this layout
+// (ILP quantization, Sec. III.B-C); that is not done here, so the blocks are those of the
+// quasi-structured mesh as it is.
 #pragma once
 
 #include <cstdint>
