@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <map>
 #include <numeric>
 #include <unordered_map>
 #include <utility>
@@ -325,6 +326,130 @@ class Layouter {
 
 }  // namespace
 
+namespace {
+
+// A block as its own vertex grid, for merging.
+struct Grid {
+  LO face = kNoIndex;
+  LO ni = 0, nj = 0;
+  std::vector<GO> v;  // (ni + 1) x (nj + 1), i fastest
+  [[nodiscard]] GO at(LO i, LO j) const {
+    return v[static_cast<std::size_t>(j) * static_cast<std::size_t>(ni + 1) +
+             static_cast<std::size_t>(i)];
+  }
+  // Boundary vertices of side s, counter-clockwise around the block: 0 = j min (i up), 1 = i max
+  // (j up), 2 = j max (i down), 3 = i min (j down).
+  [[nodiscard]] std::vector<GO> side(int s) const {
+    std::vector<GO> out;
+    if (s == 0)
+      for (LO i = 0; i <= ni; ++i) out.push_back(at(i, 0));
+    if (s == 1)
+      for (LO j = 0; j <= nj; ++j) out.push_back(at(ni, j));
+    if (s == 2)
+      for (LO i = ni; i >= 0; --i) out.push_back(at(i, nj));
+    if (s == 3)
+      for (LO j = nj; j >= 0; --j) out.push_back(at(0, j));
+    return out;
+  }
+  // Turns the index axes a quarter turn, keeping i x j (side s becomes side (s + 3) % 4).
+  void rotate() {
+    Grid r;
+    r.face = face;
+    r.ni = nj;
+    r.nj = ni;
+    r.v.resize(v.size());
+    for (LO jr = 0; jr <= r.nj; ++jr)
+      for (LO ir = 0; ir <= r.ni; ++ir)
+        r.v[static_cast<std::size_t>(jr) * static_cast<std::size_t>(r.ni + 1) +
+            static_cast<std::size_t>(ir)] = at(ni - jr, ir);
+    *this = std::move(r);
+  }
+};
+
+// Merges blocks of one face that share a whole side, not along a CAD curve, while any do: the
+// union of two such grids is a grid. Blocks are visited in order and each merge keeps the lower
+// index, so the result depends on the layout only. merged_into[k]: the block block k ended in.
+void merge_blocks(std::vector<Grid>& grids, const std::vector<std::array<GO, 2>>& bars, GO nv,
+                  std::vector<GO>& merged_into) {
+  std::unordered_map<std::uint64_t, char> bar_set;
+  auto ekey = [nv](GO a, GO b) {
+    if (a > b) std::swap(a, b);
+    return static_cast<std::uint64_t>(a) * static_cast<std::uint64_t>(nv) +
+           static_cast<std::uint64_t>(b);
+  };
+  for (const auto& b : bars) bar_set[ekey(b[0], b[1])] = 1;
+  std::vector<char> alive(grids.size(), 1);
+  merged_into.resize(grids.size());
+  std::iota(merged_into.begin(), merged_into.end(), GO{0});
+  auto side_key = [](GO first, GO last, std::size_t n) {
+    return std::array<GO, 3>{first, last, static_cast<GO>(n)};
+  };
+  for (bool changed = true; changed;) {
+    changed = false;
+    std::map<std::array<GO, 3>, std::vector<std::pair<std::size_t, int>>> sides;
+    for (std::size_t k = 0; k < grids.size(); ++k) {
+      if (!alive[k]) continue;
+      for (int s = 0; s < 4; ++s) {
+        const std::vector<GO> seq = grids[k].side(s);
+        sides[side_key(seq.front(), seq.back(), seq.size())].emplace_back(k, s);
+      }
+    }
+    std::vector<char> touched(grids.size(), 0);
+    for (std::size_t a = 0; a < grids.size(); ++a) {
+      if (!alive[a] || touched[a]) continue;
+      for (int s = 0; s < 4; ++s) {
+        const std::vector<GO> seq = grids[a].side(s);
+        bool on_curve = false;
+        for (std::size_t i = 0; i + 1 < seq.size() && !on_curve; ++i)
+          on_curve = bar_set.count(ekey(seq[i], seq[i + 1])) > 0;
+        if (on_curve) continue;
+        const auto it = sides.find(side_key(seq.back(), seq.front(), seq.size()));
+        if (it == sides.end()) continue;
+        std::size_t b = grids.size();
+        int t = 0;
+        for (const auto& [k, side] : it->second) {
+          if (k == a || !alive[k] || touched[k] || grids[k].face != grids[a].face) continue;
+          std::vector<GO> other = grids[k].side(side);
+          std::reverse(other.begin(), other.end());
+          if (other != seq) continue;
+          b = k;
+          t = side;
+          break;
+        }
+        if (b == grids.size()) continue;
+        Grid ga = grids[a], gb = grids[b];
+        for (int sa = s; sa != 1; sa = (sa + 3) % 4) ga.rotate();
+        for (int sb = t; sb != 3; sb = (sb + 3) % 4) gb.rotate();
+        if (ga.nj != gb.nj) continue;
+        Grid m;
+        m.face = ga.face;
+        m.ni = ga.ni + gb.ni;
+        m.nj = ga.nj;
+        m.v.resize(static_cast<std::size_t>(m.ni + 1) * static_cast<std::size_t>(m.nj + 1));
+        for (LO j = 0; j <= m.nj; ++j)
+          for (LO i = 0; i <= m.ni; ++i)
+            m.v[static_cast<std::size_t>(j) * static_cast<std::size_t>(m.ni + 1) +
+                static_cast<std::size_t>(i)] = i <= ga.ni ? ga.at(i, j) : gb.at(i - ga.ni, j);
+        grids[a] = std::move(m);
+        grids[b].v.clear();
+        alive[b] = 0;
+        touched[a] = touched[b] = 1;
+        merged_into[b] = static_cast<GO>(a);
+        changed = true;
+        break;
+      }
+    }
+  }
+  for (std::size_t k = 0; k < merged_into.size(); ++k) {
+    GO r = static_cast<GO>(k);
+    while (merged_into[static_cast<std::size_t>(r)] != r)
+      r = merged_into[static_cast<std::size_t>(r)];
+    merged_into[k] = r;
+  }
+}
+
+}  // namespace
+
 QuadLayout extract_quad_layout(const mesh::SurfaceMesh& mesh, const LayoutOptions& options) {
   QSMESH_CHECK(
       mesh.quad_face.size() == mesh.quads.size() && mesh.vclass.size() == mesh.points.size(),
@@ -389,6 +514,40 @@ QuadLayout extract_quad_layout(const mesh::SurfaceMesh& mesh, const LayoutOption
   }
   for (std::size_t f = 0; f < nf; ++f)
     if (bad[f]) out.unblocked_faces.push_back(static_cast<LO>(f));
+  if (!options.merge) return out;
+
+  std::vector<Grid> grids(out.blocks.size());
+  for (std::size_t k = 0; k < grids.size(); ++k) {
+    const Block& b = out.blocks[k];
+    grids[k].face = b.face;
+    grids[k].ni = b.ni;
+    grids[k].nj = b.nj;
+    const auto n = static_cast<std::int64_t>(b.ni + 1) * static_cast<std::int64_t>(b.nj + 1);
+    grids[k].v.assign(out.vertices.begin() + b.first, out.vertices.begin() + b.first + n);
+  }
+  std::vector<GO> merged_into;
+  merge_blocks(grids, mesh.bars, mesh.num_vertices(), merged_into);
+  QuadLayout merged;
+  merged.unblocked_faces = out.unblocked_faces;
+  merged.faces_with_extended_traces = out.faces_with_extended_traces;
+  std::vector<GO> new_id(grids.size(), -1);
+  for (std::size_t k = 0; k < grids.size(); ++k) {
+    if (merged_into[k] != static_cast<GO>(k)) continue;
+    new_id[k] = static_cast<GO>(merged.blocks.size());
+    Block b;
+    b.face = grids[k].face;
+    b.ni = grids[k].ni;
+    b.nj = grids[k].nj;
+    b.first = static_cast<std::int64_t>(merged.vertices.size());
+    merged.vertices.insert(merged.vertices.end(), grids[k].v.begin(), grids[k].v.end());
+    merged.blocks.push_back(b);
+  }
+  merged.quad2block.assign(mesh.quads.size(), -1);
+  for (std::size_t q = 0; q < mesh.quads.size(); ++q)
+    if (out.quad2block[q] >= 0)
+      merged.quad2block[q] = new_id[static_cast<std::size_t>(
+          merged_into[static_cast<std::size_t>(out.quad2block[q])])];
+  return merged;
   return out;
 }
 

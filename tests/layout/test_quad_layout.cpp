@@ -162,7 +162,9 @@ TEST(QuadLayout, FlatCornersDoNotCutTheFace) {
   for (auto& c : m.vclass)
     if (c.dim == 1 && c.entity == 5) c = {2, 0, kNoIndex, {0, 0}};
   m.face2curves = Adjacency::from_pairs(1, {{0, 0}, {0, 1}, {0, 2}, {0, 3}, {0, 4}, {0, 6}});
-  const QuadLayout l = extract_quad_layout(m);
+  LayoutOptions unmerged;  // one block before any merging
+  unmerged.merge = false;
+  const QuadLayout l = extract_quad_layout(m, unmerged);
   ASSERT_EQ(l.blocks.size(), 1u);
   EXPECT_EQ(l.blocks[0].ni * l.blocks[0].nj, 8);
   expect_blocks_cover_the_quads(m, l);
@@ -170,13 +172,28 @@ TEST(QuadLayout, FlatCornersDoNotCutTheFace) {
 
 TEST(QuadLayout, TracesFromAnIrregularVertexCutTheFace) {
   const mesh::SurfaceMesh m = triangle_face();
-  const QuadLayout l = extract_quad_layout(m);
+  LayoutOptions unmerged;
+  unmerged.merge = false;
+  const QuadLayout l = extract_quad_layout(m, unmerged);
   ASSERT_EQ(l.blocks.size(), 3u);
   for (const Block& b : l.blocks) {
     EXPECT_EQ(b.ni, 1);
     EXPECT_EQ(b.nj, 1);
   }
   expect_blocks_cover_the_quads(m, l);
+  // Merged: the first two quads share the trace from the valence-3 vertex to the first curve's
+  // midpoint, a whole side of each, and become one 2 x 1 block; the third shares no whole side.
+  const QuadLayout merged = extract_quad_layout(m);
+  ASSERT_EQ(merged.blocks.size(), 2u);
+  EXPECT_EQ(merged.blocks[0].ni * merged.blocks[0].nj, 2);
+  EXPECT_EQ(merged.blocks[1].ni * merged.blocks[1].nj, 1);
+  expect_blocks_cover_the_quads(m, merged);
+}
+
+TEST(QuadLayout, BlocksAreNotMergedAcrossCurves) {
+  // Two faces whose blocks match along the curve between them stay two blocks.
+  const mesh::SurfaceMesh m = two_faces(2, 2, 2);
+  EXPECT_EQ(extract_quad_layout(m).blocks.size(), 2u);
 }
 
 TEST(QuadLayout, FacesWithTrianglesAreLeftOut) {
@@ -209,10 +226,10 @@ TEST(CgnsBlocks, InterfacesJoinTheSamePoints) {
     EXPECT_EQ(s.structured_zones, static_cast<int>(l.blocks.size()));
     EXPECT_EQ(s.unstructured_zones, 0);
     EXPECT_EQ(s.block_quads, static_cast<std::int64_t>(m.quads.size()));
-    // Two faces: one interface each way along the shared curve (3 edges, 4 points). Triangle: each
-    // pair of its three blocks shares one edge, both ways.
-    EXPECT_EQ(s.interfaces, triangle ? 6 : 2);
-    EXPECT_EQ(s.interface_points, triangle ? 12 : 8);
+    // Two faces: one interface each way along the shared curve (3 edges, 4 points). Triangle: the
+    // 2 x 1 block's long side meets two sides of the 1 x 1 block, one edge each, both ways.
+    EXPECT_EQ(s.interfaces, triangle ? 4 : 2);
+    EXPECT_EQ(s.interface_points, 8);
   }
 }
 

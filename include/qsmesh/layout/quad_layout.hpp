@@ -9,8 +9,9 @@
 // or, as in the motorcycle graph of paper 002 Sec. III.A, at a vertex another trace has already
 // reached (a T-junction). All traces advance one edge per round in a fixed order, so the layout
 // depends on the mesh only. The quads are then grouped into patches bounded by traces and CAD
-// curves; each patch is a grid of ni x nj quads, a block. Paper 002 goes on to simplify this layout
-// (ILP quantization, Sec. III.B-C); that is not done here, so the blocks are those of the
+// curves; each patch is a grid of ni x nj quads, a block, and blocks of one face sharing a whole
+// side off the CAD curves are merged while any do. Paper 002 goes on to simplify this layout (ILP
+// quantization, Sec. III.B-C); that is not done here, so the blocks are those of the
 // quasi-structured mesh as it is.
 #pragma once
 
@@ -39,6 +40,9 @@ struct LayoutOptions {
   /// A face whose patches are not all grids this way (a patch around a hole, say) is traced again
   /// with every trace extended to a CAD curve or an irregular vertex.
   bool motorcycle = true;
+  /// Then merge, face by face, blocks sharing a whole side that is not on a CAD curve (their union
+  /// is a grid), as long as any do.
+  bool merge = true;
 };
 
 struct QuadLayout {
