@@ -13,7 +13,13 @@ ranks=2
 mpiexec --oversubscribe --bind-to none -n "$ranks" ./build/drivers/qsmesh mesh example_output/wing_body.step \
   -o example_output/wing_body.cgns --stats example_output/wing_body_stats.json
 ./build/drivers/qsmesh mesh example_output/wing_body.step -o example_output/wing_body.vtu -q
+mpiexec --oversubscribe --bind-to none -n "$ranks" ./build/drivers/qsmesh mesh example_output/wing_body.step \
+  -o example_output/wing_body.h5 -q
+mpiexec --oversubscribe --bind-to none -n "$ranks" ./build/drivers/qsmesh mesh example_output/wing_body.step \
+  -o example_output/wing_body_blocks.cgns --block-structured -q --stats example_output/wing_body_blocks_stats.json
 if command -v cgnscheck >/dev/null; then
   cgnscheck example_output/wing_body.cgns | tail -n 3
 fi
-echo "outputs: example_output/wing_body.cgns (CGNS), example_output/wing_body.vtu (ParaView), example_output/wing_body_stats.json"
+echo "outputs: example_output/wing_body.cgns (CGNS), example_output/wing_body_blocks.cgns (block-structured"
+echo "CGNS), example_output/wing_body.h5 + wing_body.xdmf (HDF5; the .xdmf opens in ParaView),"
+echo "example_output/wing_body.vtu (ParaView), example_output/wing_body_stats.json"
