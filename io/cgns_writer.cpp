@@ -331,6 +331,16 @@ void write_cgns(const mesh::SurfaceMesh& mesh, const std::string& path, const Wr
 
 namespace {
 
+// cgnslib 3.4 writes the 33-byte label of IndexRange_t nodes from an uninitialised buffer (see
+// write_cgns): rewrites the label of the node at `node` from a zero-padded one.
+void fix_range_label(int cgio, double root, const std::string& node, const std::string& path) {
+  double id = 0;
+  QSMESH_CGIO(cgio_get_node_id(cgio, root, node.c_str(), &id));
+  char label[CGIO_MAX_LABEL_LENGTH + 1] = {};
+  std::strncpy(label, "IndexRange_t", CGIO_MAX_LABEL_LENGTH);
+  QSMESH_CGIO(cgio_set_label(cgio, id, label));
+}
+
 // One side of a block: its vertices in order, and where it lies in the block's index space.
 struct Side {
   int tangent;  // index (0: i, 1: j) that runs along the side
@@ -418,6 +428,25 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
       QSMESH_CG(cg_family_write(fn, base, ("Face_" + std::to_string(f)).c_str(), &family));
     }
   }
+  // Curves with free block edges (no other block across: an open shell's border, a cut plane) get a
+  // family and BCs on those edges, as in write_cgns.
+  std::unordered_map<std::uint64_t, LO> edge_curve;
+  for (std::size_t e = 0; e < mesh.bars.size(); ++e)
+    edge_curve[key(mesh.bars[e][0], mesh.bars[e][1])] = mesh.bar_curve[e];
+  {
+    std::vector<char> free_curve(static_cast<std::size_t>(mesh.num_cad_curves), 0);
+    for (const auto& [k, uses] : edge_uses) {
+      if (uses.size() != 1) continue;
+      const auto it = edge_curve.find(k);
+      if (it != edge_curve.end()) free_curve[static_cast<std::size_t>(it->second)] = 1;
+    }
+    for (LO c = 0; c < mesh.num_cad_curves; ++c) {
+      if (!free_curve[static_cast<std::size_t>(c)]) continue;
+      int family = 0, fambc = 0;
+      QSMESH_CG(cg_family_write(fn, base, ("Curve_" + std::to_string(c)).c_str(), &family));
+      QSMESH_CG(cg_fambc_write(fn, base, family, "FamBC", CGNS_ENUMV(BCWall), &fambc));
+    }
+  }
 
   int cgio = 0;
   double root = 0;
@@ -464,7 +493,7 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
 
     // 1-to-1 interfaces: maximal runs of side edges shared with the same side of the same block,
     // the donor positions moving by one edge per edge.
-    int connections = 0;
+    int connections = 0, boundaries = 0;
     double zgc_id = 0;  // the zone's ZoneGridConnectivity node, made with its first interface
     for (int s = 0; s < 4; ++s) {
       struct Run {
@@ -549,6 +578,35 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
                                   range, &child));
         QSMESH_CGIO(cgio_new_node(cgio, conn_id, "PointRangeDonor", "IndexRange_t", "I4", 2,
                                   range_dims, donor, &child));
+      }
+      // Free edges: one BC per run of them on one curve.
+      for (LO p = 0; p < side_edges(b, s);) {
+        auto curve_of_free = [&](LO q) -> LO {
+          const std::uint64_t e =
+              key(side_vertex(b, s, q, layout.vertices), side_vertex(b, s, q + 1, layout.vertices));
+          if (edge_uses.at(e).size() != 1) return kNoIndex;
+          const auto it = edge_curve.find(e);
+          return it == edge_curve.end() ? kNoIndex : it->second;
+        };
+        const LO c = curve_of_free(p);
+        if (c == kNoIndex) {
+          ++p;
+          continue;
+        }
+        LO q = p;
+        while (q + 1 < side_edges(b, s) && curve_of_free(q + 1) == c) ++q;
+        const auto i0 = side_index(b, s, p), i1 = side_index(b, s, q + 1);
+        cgsize_t range[4] = {i0[0], i0[1], i1[0], i1[1]};
+        std::string bcname("BC");
+        bcname += std::to_string(++boundaries);
+        int bc = 0;
+        QSMESH_CG(cg_boco_write(fn, base, zone, bcname.c_str(), CGNS_ENUMV(FamilySpecified),
+                                CGNS_ENUMV(PointRange), 2, range, &bc));
+        fix_range_label(cgio, root, "/" + options.cgns_base_name + "/" + name + "/ZoneBC/" + bcname + "/PointRange",
+                        path);
+        QSMESH_CG(cg_goto(fn, base, "Zone_t", zone, "ZoneBC_t", 1, "BC_t", bc, "end"));
+        QSMESH_CG(cg_famname_write(("Curve_" + std::to_string(c)).c_str()));
+        p = q + 1;
       }
     }
   }

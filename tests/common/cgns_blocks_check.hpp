@@ -21,6 +21,7 @@ struct BlockFileSummary {
   std::int64_t block_quads = 0;
   std::int64_t interfaces = 0;
   std::int64_t interface_points = 0;
+  std::int64_t boundary_conditions = 0;  ///< BCs (free block edges), each checked to lie on a side
 };
 
 inline BlockFileSummary check_block_file(const std::string& path) {
@@ -76,6 +77,24 @@ inline BlockFileSummary check_block_file(const std::string& path) {
   for (int z = 1; z <= nzones; ++z) {
     const Zone& zone = zones[static_cast<std::size_t>(z - 1)];
     if (zone.ni == 0) continue;
+    int nbc = 0;
+    cg_nbocos(fn, 1, z, &nbc);
+    for (int bc = 1; bc <= nbc; ++bc) {
+      char bname[33] = {};
+      CGNS_ENUMT(BCType_t) btype;
+      CGNS_ENUMT(PointSetType_t) ptype;
+      cgsize_t npnts = 0, normal_list = 0;
+      int normal_index[2] = {};
+      CGNS_ENUMT(DataType_t) ntype;
+      int ndata = 0;
+      cg_boco_info(fn, 1, z, bc, bname, &btype, &ptype, &npnts, normal_index, &normal_list, &ntype, &ndata);
+      cgsize_t r[4] = {};
+      cg_boco_read(fn, 1, z, bc, r, nullptr);
+      ++out.boundary_conditions;
+      const bool on_side = (r[0] == r[2] && (r[0] == 1 || r[0] == zone.ni)) ||
+                           (r[1] == r[3] && (r[1] == 1 || r[1] == zone.nj));
+      if (ptype != CGNS_ENUMV(PointRange) || !on_side) err << zone.name << "/" << bname << ": not a side range; ";
+    }
     int n = 0;
     cg_n1to1(fn, 1, z, &n);
     for (int c = 1; c <= n; ++c) {

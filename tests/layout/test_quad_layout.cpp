@@ -230,6 +230,9 @@ TEST(CgnsBlocks, InterfacesJoinTheSamePoints) {
     // 2 x 1 block's long side meets two sides of the 1 x 1 block, one edge each, both ways.
     EXPECT_EQ(s.interfaces, triangle ? 4 : 2);
     EXPECT_EQ(s.interface_points, 8);
+    // Free edges get a BC per run on one curve: two faces, three sides each off the shared curve;
+    // triangle, the 2 x 1 block's three free sides and the 1 x 1 block's two.
+    EXPECT_EQ(s.boundary_conditions, triangle ? 5 : 6);
   }
 }
 

@@ -85,6 +85,8 @@ void write_cgns(const mesh::SurfaceMesh& mesh, const std::string& path, const Wr
 /// fastest) with FamilyName "Face_<f>", and a GridConnectivity1to1 for every maximal stretch of a
 /// block side shared with one side of another block (or of itself, across a seam), within a face
 /// or across a CAD curve: point ranges, donor ranges and the transform relating the index spaces.
+/// Free block edges (no block across: an open shell's border) get a BC (FamilySpecified, family
+/// "Curve_<c>" with FamilyBC BCWall, as write_cgns) per run of them on one curve.
 /// The faces in layout.unblocked_faces go into one unstructured zone "Unstructured" (a section per
 /// face), without connectivity to the blocks. `layout` must come from extract_quad_layout(mesh).
 void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& layout,
