@@ -119,6 +119,11 @@ Arguments parse(const std::vector<std::string>& args) {
       a.face_time_budget = parse_positive(opt, value());
     else if (opt == "--stats" && meshing) a.stats = value();
     else if (opt == "--block-structured" && a.command == Command::Mesh) a.block_structured = true;
+    else if (opt == "--order" && a.command == Command::Mesh) {
+      const std::string& v = value();
+      if (v != "1" && v != "2") throw InputError("--order: '" + v + "' is not 1 or 2");
+      a.order = v == "2" ? 2 : 1;
+    }
     else if (opt == "--check" && a.command == Command::CrossField) a.check = true;
     else if (opt == "--curvature-edges" && sizing) {
       const std::string& v = value();
@@ -201,7 +206,11 @@ Arguments parse(const std::vector<std::string>& args) {
         throw InputError("--block-structured: the blocks are written as CGNS; give -o FILE.cgns");
       if (a.until == "background")
         throw InputError("--block-structured needs a quad mesh: not with --until background");
+      if (a.order == 2)
+        throw InputError("--block-structured with --order 2: blocks of second-order quads are not written yet");
     }
+    if (a.order == 2 && a.until == "background")
+      throw InputError("--order 2 needs a quad mesh: not with --until background");
     if (a.command == Command::CrossField && a.output.empty() && !a.check)
       throw InputError("crossfield: missing -o OUT.vtu (or --check)");
     if (a.command == Command::SizeMap && a.output.empty())
@@ -240,6 +249,9 @@ std::string help(const std::string& topic) {
           "  --threads T           threads per rank (default: the cores of the machine divided\n"
           "                        among the ranks running on it)\n"
           "  --stats FILE.json     also write the run statistics as JSON\n"
+          "  --order 2             second-order elements: 9-node quads and 3-node bars, the new\n"
+          "                        nodes on the CAD (CGNS QUAD_9/BAR_3, VTU, MSH; in .h5 the\n"
+          "                        datasets quad_nodes and bar_nodes)\n"
           "  --block-structured    write the .cgns file as structured zones, one per block of the\n"
           "                        quad layout (traces from irregular vertices and CAD corners,\n"
           "                        paper 002 Sec. III.A), joined by 1-to-1 connectivity; faces\n"

@@ -28,6 +28,9 @@ struct Arguments {
   /// --block-structured: write the CGNS file as structured blocks of the quad layout
   /// (layout::extract_quad_layout, io::write_cgns_blocks) instead of one unstructured zone.
   bool block_structured = false;
+  /// --order 2: second-order quads (9 nodes) and bars (3 nodes) on the CAD
+  /// (highorder::make_quadratic); 1: linear.
+  int order = 1;
   bool json = false;               ///< info --json
   bool check = false;              ///< crossfield --check
   std::string sizemap = "crossfield";  ///< --sizemap features|crossfield

@@ -20,6 +20,7 @@
 #include "qsmesh/core/log.hpp"
 #include "qsmesh/core/tasks.hpp"
 #include "qsmesh/core/timer.hpp"
+#include "qsmesh/highorder/quadratic.hpp"
 #include "qsmesh/io/atomic_file.hpp"
 #include "qsmesh/io/writer.hpp"
 #include "qsmesh/layout/quad_layout.hpp"
@@ -160,6 +161,7 @@ struct Checks {
     LO unblocked_faces = 0, extended_faces = 0;
   };
   std::optional<Blocks> blocks;
+  std::optional<highorder::QuadraticReport> quadratic;  ///< with --order 2
 };
 
 /// How one face ended at the last stage run.
@@ -323,6 +325,15 @@ std::string stats_json(const Arguments& args, const Session& session,
     j.end_array();
     j.value("load_imbalance", load_imbalance(r.rank_busy_seconds));
   }
+  if (checks.quadratic) {
+    j.value("order", 2);
+    j.value("high_order_curve_nodes", checks.quadratic->curve_nodes);
+    j.value("high_order_face_nodes", checks.quadratic->face_nodes);
+    j.value("high_order_unprojected_nodes", checks.quadratic->unprojected);
+    j.value("high_order_straightened_quads", checks.quadratic->straightened);
+    j.value("high_order_curve_straightened_quads", checks.quadratic->curve_straightened);
+    j.value("high_order_invalid_quads", checks.quadratic->invalid);
+  }
   if (checks.blocks) {
     j.value("blocks", checks.blocks->blocks);
     j.value("block_quads_mean", checks.blocks->blocks > 0
@@ -439,6 +450,13 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
         std::minmax_element(r.rank_busy_seconds.begin(), r.rank_busy_seconds.end());
     os << "  ranks' time in the per-face stages (s): min " << *lo << ", max " << *hi
        << "; load imbalance (max / mean) " << load_imbalance(r.rank_busy_seconds) << "\n";
+  }
+  if (checks.quadratic) {
+    const highorder::QuadraticReport& q = *checks.quadratic;
+    os << "  second-order nodes: " << q.curve_nodes << " on curves, " << q.face_nodes
+       << " in faces (" << q.unprojected << " left straight: no CAD point near); quads put back "
+       << "straight to stay valid " << q.straightened << " (" << q.curve_straightened
+       << " of them along their curves too), still invalid " << q.invalid << "\n";
   }
   if (checks.blocks) {
     const Checks::Blocks& b = *checks.blocks;
@@ -639,6 +657,11 @@ int run_mesh(const Arguments& args) {
         mesh::max_distance_to_cad(result.mesh, s.model) / s.model.diagonal();
     s.times.add("statistics", clock.seconds());
     clock.reset();
+    if (args.order == 2) {
+      checks.quadratic = highorder::make_quadratic(result.mesh, s.model, *s.tasks);
+      s.times.add("high_order", clock.seconds());
+      clock.reset();
+    }
     if (args.block_structured) {
       const layout::QuadLayout lay = layout::extract_quad_layout(result.mesh);
       Checks::Blocks b;

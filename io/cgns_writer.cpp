@@ -197,6 +197,9 @@ void write_cgns(const mesh::SurfaceMesh& mesh, const std::string& path, const Wr
   (void)to_cg(nv, path);
   (void)to_cg(ncells + static_cast<GO>(mesh.bars.size()), path);
   const detail::ElementGroups groups = detail::group_elements(mesh);
+  const bool quadratic = !mesh.quad_nodes.empty();
+  QSMESH_CHECK(!quadratic || mesh.triangles.empty(),
+               "CGNS output " << path << ": second-order quads with triangles");
 
   AtomicFile out(path);
   CgFile file;
@@ -255,6 +258,9 @@ void write_cgns(const mesh::SurfaceMesh& mesh, const std::string& path, const Wr
     for (GO q : quads) {
       if (mixed) conn.push_back(CGNS_ENUMV(QUAD_4));
       for (GO v : mesh.quads[static_cast<std::size_t>(q)]) conn.push_back(static_cast<cgsize_t>(v + 1));
+      if (quadratic)
+        for (GO v : mesh.quad_nodes[static_cast<std::size_t>(q)])
+          conn.push_back(static_cast<cgsize_t>(v + 1));
       offsets.push_back(static_cast<cgsize_t>(conn.size()));
     }
     int section = 0;
@@ -262,9 +268,10 @@ void write_cgns(const mesh::SurfaceMesh& mesh, const std::string& path, const Wr
       QSMESH_CG(cg_poly_section_write(fn, base, zone, name.c_str(), CGNS_ENUMV(MIXED), next,
                                       next + n - 1, 0, conn.data(), offsets.data(), &section));
     } else {
-      QSMESH_CG(cg_section_write(fn, base, zone, name.c_str(),
-                                 tris.empty() ? CGNS_ENUMV(QUAD_4) : CGNS_ENUMV(TRI_3), next,
-                                 next + n - 1, 0, conn.data(), &section));
+      QSMESH_CG(cg_section_write(
+          fn, base, zone, name.c_str(),
+          tris.empty() ? (quadratic ? CGNS_ENUMV(QUAD_9) : CGNS_ENUMV(QUAD_4)) : CGNS_ENUMV(TRI_3),
+          next, next + n - 1, 0, conn.data(), &section));
     }
     int family = 0;
     QSMESH_CG(cg_family_write(fn, base, name.c_str(), &family));
@@ -284,10 +291,13 @@ void write_cgns(const mesh::SurfaceMesh& mesh, const std::string& path, const Wr
     conn.clear();
     for (GO b : bars) {
       for (GO v : mesh.bars[static_cast<std::size_t>(b)]) conn.push_back(static_cast<cgsize_t>(v + 1));
+      if (quadratic)
+        conn.push_back(static_cast<cgsize_t>(mesh.bar_nodes[static_cast<std::size_t>(b)] + 1));
     }
     int section = 0;
-    QSMESH_CG(cg_section_write(fn, base, zone, name.c_str(), CGNS_ENUMV(BAR_2), next, next + n - 1,
-                               0, conn.data(), &section));
+    QSMESH_CG(cg_section_write(fn, base, zone, name.c_str(),
+                               quadratic ? CGNS_ENUMV(BAR_3) : CGNS_ENUMV(BAR_2), next,
+                               next + n - 1, 0, conn.data(), &section));
     int family = 0;
     QSMESH_CG(cg_family_write(fn, base, name.c_str(), &family));
     int fambc = 0;
@@ -373,6 +383,8 @@ LO side_edges(const layout::Block& b, int s) {
 void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& layout,
                        const std::string& path, const WriteOptions& options) {
   check_mesh_for_output(mesh);
+  QSMESH_CHECK(mesh.quad_nodes.empty(),
+               "CGNS block output " << path << ": blocks of second-order quads are not written");
   const auto unit = length_unit(mesh.length_unit);
   const auto nb = static_cast<GO>(layout.blocks.size());
   for (const layout::Block& b : layout.blocks) {

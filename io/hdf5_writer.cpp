@@ -214,6 +214,10 @@ void write_hdf5(const mesh::SurfaceMesh& mesh, const std::string& path,
     h5.dataset("bars", H5T_STD_I64LE, nb, 2, mesh.bars.data());
     h5.dataset("bar_cad_curve", H5T_STD_I32LE, nb, 0, mesh.bar_curve.data());
     h5.dataset("curve_corners", H5T_STD_I32LE, nc, 2, mesh.curve_corners.data());
+    if (!mesh.quad_nodes.empty()) {
+      h5.dataset("quad_nodes", H5T_STD_I64LE, nq, 5, mesh.quad_nodes.data());
+      h5.dataset("bar_nodes", H5T_STD_I64LE, nb, 0, mesh.bar_nodes.data());
+    }
     {
       std::vector<std::int64_t> offsets(mesh.face2curves.offsets.begin(),
                                         mesh.face2curves.offsets.end());

@@ -156,6 +156,7 @@ void write_msh(const mesh::SurfaceMesh& mesh, const std::string& path, const Wri
   out << "$Elements\n"
       << elem_blocks << ' ' << num_elems << ' ' << (num_elems > 0 ? 1 : 0) << ' ' << num_elems << '\n';
   GO tag = 1;
+  const bool quadratic = !mesh.quad_nodes.empty();
   if (options.msh_corner_elements) {
     for (std::size_t k = 0; k < entity2nodes[0].size(); ++k) {
       const auto& nodes = entity2nodes[0][k];
@@ -166,10 +167,12 @@ void write_msh(const mesh::SurfaceMesh& mesh, const std::string& path, const Wri
   for (std::size_t c = 0; c < groups.curve2bars.size(); ++c) {
     const auto& bars = groups.curve2bars[c];
     if (bars.empty()) continue;
-    out << "1 " << c + 1 << " 1 " << bars.size() << '\n';
+    out << "1 " << c + 1 << (quadratic ? " 8 " : " 1 ") << bars.size() << '\n';
     for (GO e : bars) {
       const auto& b = mesh.bars[static_cast<std::size_t>(e)];
-      out << tag++ << ' ' << b[0] + 1 << ' ' << b[1] + 1 << '\n';
+      out << tag++ << ' ' << b[0] + 1 << ' ' << b[1] + 1;
+      if (quadratic) out << ' ' << mesh.bar_nodes[static_cast<std::size_t>(e)] + 1;
+      out << '\n';
     }
   }
   for (LO f = 0; f < mesh.num_cad_faces; ++f) {
@@ -183,11 +186,13 @@ void write_msh(const mesh::SurfaceMesh& mesh, const std::string& path, const Wri
     }
     const auto& quads = groups.face2quads[static_cast<std::size_t>(f)];
     if (!quads.empty()) {
-      out << "2 " << f + 1 << " 3 " << quads.size() << '\n';
+      out << "2 " << f + 1 << (quadratic ? " 10 " : " 3 ") << quads.size() << '\n';
       for (GO e : quads) {
         const auto& q = mesh.quads[static_cast<std::size_t>(e)];
-        out << tag++ << ' ' << q[0] + 1 << ' ' << q[1] + 1 << ' ' << q[2] + 1 << ' ' << q[3] + 1
-            << '\n';
+        out << tag++ << ' ' << q[0] + 1 << ' ' << q[1] + 1 << ' ' << q[2] + 1 << ' ' << q[3] + 1;
+        if (quadratic)
+          for (GO v : mesh.quad_nodes[static_cast<std::size_t>(e)]) out << ' ' << v + 1;
+        out << '\n';
       }
     }
   }

@@ -182,15 +182,18 @@ void write_vtu(const mesh::SurfaceMesh& mesh, const std::string& path, const Wri
       offsets.push_back(static_cast<std::int64_t>(conn.size()));
       types.push_back(5);  // VTK_TRIANGLE
     }
-    for (const auto& q : mesh.quads) {
-      conn.insert(conn.end(), q.begin(), q.end());
+    const bool quadratic = !mesh.quad_nodes.empty();
+    for (std::size_t e = 0; e < mesh.quads.size(); ++e) {
+      conn.insert(conn.end(), mesh.quads[e].begin(), mesh.quads[e].end());
+      if (quadratic) conn.insert(conn.end(), mesh.quad_nodes[e].begin(), mesh.quad_nodes[e].end());
       offsets.push_back(static_cast<std::int64_t>(conn.size()));
-      types.push_back(9);  // VTK_QUAD
+      types.push_back(quadratic ? 28 : 9);  // VTK_BIQUADRATIC_QUAD, VTK_QUAD
     }
     for (std::size_t e = 0; e < nb; ++e) {
       conn.insert(conn.end(), mesh.bars[e].begin(), mesh.bars[e].end());
+      if (quadratic) conn.push_back(mesh.bar_nodes[e]);
       offsets.push_back(static_cast<std::int64_t>(conn.size()));
-      types.push_back(3);  // VTK_LINE
+      types.push_back(quadratic ? 21 : 3);  // VTK_QUADRATIC_EDGE, VTK_LINE
     }
     for (std::size_t m = 0; m < nm; ++m) {
       conn.push_back(static_cast<std::int64_t>(nmesh + m));

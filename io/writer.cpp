@@ -106,6 +106,16 @@ void check_mesh_for_output(const mesh::SurfaceMesh& m) {
       }
     }
   };
+  QSMESH_CHECK(m.quad_nodes.empty() || (m.quad_nodes.size() == m.quads.size() &&
+                                        m.bar_nodes.size() == m.bars.size() && m.triangles.empty()),
+               "output: second-order nodes for " << m.quad_nodes.size() << " of " << m.quads.size()
+                                                 << " quads and " << m.bar_nodes.size() << " of "
+                                                 << m.bars.size() << " bars, " << m.triangles.size()
+                                                 << " triangles");
+  check_vertices(m.quad_nodes, "quad");
+  for (std::size_t e = 0; e < m.bar_nodes.size(); ++e)
+    QSMESH_CHECK(m.bar_nodes[e] >= 0 && m.bar_nodes[e] < nv,
+                 "output: bar " << e << " has node " << m.bar_nodes[e] << " out of range");
   check_vertices(m.triangles, "triangle");
   check_vertices(m.quads, "quad");
   check_vertices(m.bars, "bar");

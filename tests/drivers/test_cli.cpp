@@ -39,6 +39,19 @@ TEST(Cli, MeshOptions) {
   EXPECT_NE(help("mesh").find("--face-time-budget"), std::string::npos);
 }
 
+TEST(Cli, SecondOrder) {
+  EXPECT_EQ(p({"mesh", "m.step", "-o", "o.cgns"}).order, 1);
+  EXPECT_EQ(p({"mesh", "m.step", "-o", "o.msh", "--order", "2"}).order, 2);
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.msh", "--order", "3"}).find("--order"),
+            std::string::npos);
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.msh", "--order", "2", "--until", "background"})
+                .find("quad mesh"),
+            std::string::npos);
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.cgns", "--order", "2", "--block-structured"})
+                .find("not written yet"),
+            std::string::npos);
+}
+
 TEST(Cli, BlockStructuredNeedsCgnsAndQuads) {
   EXPECT_TRUE(p({"mesh", "m.step", "-o", "o.cgns", "--block-structured"}).block_structured);
   EXPECT_FALSE(p({"mesh", "m.step", "-o", "o.cgns"}).block_structured);

@@ -160,6 +160,79 @@ double json_number(const std::string& json, const std::string& key) {
 
 // Issue "valid all-quad meshes": on the small shared models and the built-in example, at the
 // default size: no triangle, every quad valid, conforming, every vertex on its CAD entity.
+// The nodes of a MSH 4.1 file written by qsmesh, and its number of elements of `type`.
+struct MshNodes {
+  std::vector<std::array<double, 3>> xyz;
+  std::int64_t elements_of_type = 0;
+};
+MshNodes read_msh_nodes(const std::string& path, int type) {
+  MshNodes out;
+  std::istringstream in(slurp(path));
+  std::string line;
+  while (std::getline(in, line)) {
+    if (line == "$Nodes") {
+      std::int64_t blocks = 0, n = 0, lo = 0, hi = 0;
+      in >> blocks >> n >> lo >> hi;
+      for (std::int64_t b = 0; b < blocks; ++b) {
+        std::int64_t dim = 0, tag = 0, param = 0, count = 0;
+        in >> dim >> tag >> param >> count;
+        for (std::int64_t i = 0; i < count; ++i) in >> tag;
+        for (std::int64_t i = 0; i < count; ++i) {
+          std::array<double, 3> p{};
+          in >> p[0] >> p[1] >> p[2];
+          out.xyz.push_back(p);
+        }
+      }
+    } else if (line == "$Elements") {
+      std::int64_t blocks = 0, n = 0, lo = 0, hi = 0;
+      in >> blocks >> n >> lo >> hi;
+      std::getline(in, line);
+      for (std::int64_t b = 0; b < blocks; ++b) {
+        std::getline(in, line);
+        std::istringstream h(line);
+        std::int64_t dim = 0, tag = 0, t = 0, count = 0;
+        h >> dim >> tag >> t >> count;
+        if (t == type) out.elements_of_type += count;
+        for (std::int64_t i = 0; i < count; ++i) std::getline(in, line);
+      }
+    }
+  }
+  return out;
+}
+
+TEST_F(Qsmesh, SecondOrderNodesLieOnTheCad) {
+  // A sphere of radius 3 and a cylinder of radius 2, height 5: every node of the 9-node quads (the
+  // edge midpoints and centres included, which a straight midpoint would put inside) is on them.
+  const std::string sphere = qsmesh::test::write_sphere(tmp("ho_sphere.brep"));
+  const std::string cylinder = qsmesh::test::write_cylinder(tmp("ho_cylinder.brep"));
+  for (const std::string& model : {sphere, cylinder}) {
+    const bool is_sphere = model == sphere;
+    const std::string out = tmp(is_sphere ? "ho_sphere.msh" : "ho_cylinder.msh");
+    const std::string stats = tmp(is_sphere ? "ho_sphere.json" : "ho_cylinder.json");
+    const ExeResult r = run("mesh " + model + " -o " + out +
+                            " --order 2 --size 0.9 -q --threads 2 --stats " + stats);
+    ASSERT_EQ(r.code, 0) << r.err;
+    const std::string json = slurp(stats);
+    EXPECT_EQ(json_number(json, "order"), 2);
+    EXPECT_EQ(json_number(json, "high_order_unprojected_nodes"), 0);
+    EXPECT_EQ(json_number(json, "high_order_invalid_quads"), 0);
+    const MshNodes m = read_msh_nodes(out, 10);
+    EXPECT_EQ(static_cast<double>(m.elements_of_type), json_number(json, "quads"));
+    // vertices + one node per edge + one per quad: V + E + Q, E = 2 Q on a closed all-quad surface.
+    EXPECT_EQ(static_cast<double>(m.xyz.size()),
+              json_number(json, "vertices") + 3 * json_number(json, "quads"));
+    int off = 0;
+    for (const auto& p : m.xyz) {
+      const double r_xy = std::hypot(p[0], p[1]);
+      const bool on = is_sphere ? std::abs(std::hypot(r_xy, p[2]) - 3.0) < 1e-7
+                                : (std::abs(r_xy - 2.0) < 1e-7 || std::abs(p[2]) < 1e-9 ||
+                                   std::abs(p[2] - 5.0) < 1e-9);
+      off += on ? 0 : 1;
+    }
+    EXPECT_EQ(off, 0) << model;
+  }
+}
+
 TEST_F(Qsmesh, BlockStructuredCgnsJoinsItsBlocks) {
   // The quad layout as structured zones: every quad in a block, every 1-to-1 interface joining
   // the same points, the same file at 1 and 2 threads.

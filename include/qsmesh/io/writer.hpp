@@ -115,6 +115,8 @@ void write_vtu(const mesh::SurfaceMesh& mesh, const std::string& path, const Wri
 ///   curve_corners       int32 [n_curves, 2]: end corners of each curve (-1: none)
 ///   face_curve_offsets  int64 [n_faces + 1]; face_curves int32: the curves bounding face f are
 ///                       face_curves[face_curve_offsets[f] .. face_curve_offsets[f + 1])
+///   quad_nodes          int64 [n_quads, 5], bar_nodes int64 [n_bars]: only for second-order
+///                       meshes (SurfaceMesh::quad_nodes; the XDMF file shows the linear quads)
 /// Empty element kinds are zero-row datasets. Objects carry no timestamps: the same mesh gives the
 /// same bytes. Throws qsmesh::Error on an inconsistent mesh or a failed HDF5 call.
 void write_hdf5(const mesh::SurfaceMesh& mesh, const std::string& path,

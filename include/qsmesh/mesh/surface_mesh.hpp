@@ -55,6 +55,11 @@ struct SurfaceMesh {
   std::vector<LO> quad_face;                  ///< CAD face of each quad
   std::vector<std::array<GO, 2>> bars;        ///< curve edges
   std::vector<LO> bar_curve;                  ///< CAD curve of each bar
+  /// Second-order nodes (empty for linear elements; highorder::make_quadratic): per quad the
+  /// midpoints of its edges 0-1, 1-2, 2-3, 3-0, then its centre (the order of CGNS QUAD_9, VTK 28
+  /// and MSH type 10 after the four corners); per bar its midpoint.
+  std::vector<std::array<GO, 5>> quad_nodes;
+  std::vector<GO> bar_nodes;
   LO num_cad_faces = 0;
   LO num_cad_curves = 0;
   LO num_cad_corners = 0;
