@@ -10,8 +10,10 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <functional>
 #include <limits>
 #include <map>
+#include <numeric>
 #include <string>
 #include <string_view>
 #include <tuple>
@@ -186,9 +188,90 @@ void strip_hdf5_times(const std::string& file) {
 }
 static_assert(std::endian::native == std::endian::little, "strip_hdf5_times assumes little endian");
 
+// The base of every qsmesh CGNS file: CellDimension 2, PhysicalDimension 3, dimensional data in
+// the mesh's length unit.
+int write_base(int fn, const WriteOptions& options, CGNS_ENUMT(LengthUnits_t) unit,
+               const std::string& path) {
+  int base = 0;
+  QSMESH_CG(cg_base_write(fn, options.cgns_base_name.c_str(), 2, 3, &base));
+  QSMESH_CG(cg_goto(fn, base, "end"));
+  QSMESH_CG(cg_dataclass_write(CGNS_ENUMV(Dimensional)));
+  QSMESH_CG(cg_units_write(CGNS_ENUMV(Kilogram), unit, CGNS_ENUMV(Second), CGNS_ENUMV(Kelvin),
+                           CGNS_ENUMV(Degree)));
+  return base;
+}
+
+// The coordinates of a zone, point(i) for i < n, with their dimensional exponents.
+void write_coordinates(int fn, int base, int zone, std::size_t n,
+                       const std::function<Vec3(std::size_t)>& point, const std::string& path) {
+  std::vector<double> coord(n);
+  const char* names[3] = {"CoordinateX", "CoordinateY", "CoordinateZ"};
+  for (int d = 0; d < 3; ++d) {
+    for (std::size_t v = 0; v < n; ++v) coord[v] = point(v)[d];
+    int c = 0;
+    QSMESH_CG(cg_coord_write(fn, base, zone, CGNS_ENUMV(RealDouble), names[d], coord.data(), &c));
+    // Coordinates are lengths: exponents (mass, length, time, temperature, angle) = (0,1,0,0,0).
+    QSMESH_CG(cg_goto(fn, base, "Zone_t", zone, "GridCoordinates_t", 1, "DataArray_t", c, "end"));
+    const float exponents[5] = {0, 1, 0, 0, 0};
+    QSMESH_CG(cg_exponents_write(CGNS_ENUMV(RealSingle), exponents));
+  }
+}
+
+// One section "Face_<f>" per face of `faces` with elements (TRI_3, QUAD_4 or QUAD_9, MIXED when
+// both), element ids from `next` on, vertex v written as id(v); also the face's family when
+// `families`. Returns the next free element id. cgnslib 3.4 refuses FamilyName_t under
+// Elements_t, so a section is tied to its family by the shared name only.
+cgsize_t write_face_sections(int fn, int base, int zone, const mesh::SurfaceMesh& mesh,
+                             const detail::ElementGroups& groups, const std::vector<LO>& faces,
+                             const std::function<cgsize_t(GO)>& id, cgsize_t next, bool families,
+                             const std::string& path) {
+  const bool quadratic = !mesh.quad_nodes.empty();
+  std::vector<cgsize_t> conn, offsets;
+  for (LO f : faces) {
+    const auto& tris = groups.face2tris[static_cast<std::size_t>(f)];
+    const auto& quads = groups.face2quads[static_cast<std::size_t>(f)];
+    const auto n = static_cast<cgsize_t>(tris.size() + quads.size());
+    if (n == 0) continue;
+    const std::string name = "Face_" + std::to_string(f);
+    const bool mixed = !tris.empty() && !quads.empty();
+    conn.clear();
+    offsets.assign(1, 0);
+    // MIXED connectivity: each element's type code, then its vertices; offsets into it.
+    for (GO t : tris) {
+      if (mixed) conn.push_back(CGNS_ENUMV(TRI_3));
+      for (GO v : mesh.triangles[static_cast<std::size_t>(t)]) conn.push_back(id(v));
+      offsets.push_back(static_cast<cgsize_t>(conn.size()));
+    }
+    for (GO q : quads) {
+      if (mixed) conn.push_back(CGNS_ENUMV(QUAD_4));
+      for (GO v : mesh.quads[static_cast<std::size_t>(q)]) conn.push_back(id(v));
+      if (quadratic)
+        for (GO v : mesh.quad_nodes[static_cast<std::size_t>(q)]) conn.push_back(id(v));
+      offsets.push_back(static_cast<cgsize_t>(conn.size()));
+    }
+    int section = 0;
+    if (mixed) {
+      QSMESH_CG(cg_poly_section_write(fn, base, zone, name.c_str(), CGNS_ENUMV(MIXED), next,
+                                      next + n - 1, 0, conn.data(), offsets.data(), &section));
+    } else {
+      QSMESH_CG(cg_section_write(
+          fn, base, zone, name.c_str(),
+          tris.empty() ? (quadratic ? CGNS_ENUMV(QUAD_9) : CGNS_ENUMV(QUAD_4)) : CGNS_ENUMV(TRI_3),
+          next, next + n - 1, 0, conn.data(), &section));
+    }
+    if (families) {
+      int family = 0;
+      QSMESH_CG(cg_family_write(fn, base, name.c_str(), &family));
+    }
+    next += n;
+  }
+  return next;
+}
+
 }  // namespace
 
-void write_cgns(const mesh::SurfaceMesh& mesh, const std::string& path, const WriteOptions& options) {
+void write_cgns(const mesh::SurfaceMesh& mesh, const std::string& path,
+                const WriteOptions& options) {
   detail::check_output_folder(path);
   check_mesh_for_output(mesh);
   const auto unit = length_unit(mesh.length_unit);
@@ -207,76 +290,23 @@ void write_cgns(const mesh::SurfaceMesh& mesh, const std::string& path, const Wr
   QSMESH_CG(cg_open(out.temp_path().c_str(), CG_MODE_WRITE, &file.fn));
   const int fn = file.fn;
 
-  int base = 0;
-  QSMESH_CG(cg_base_write(fn, options.cgns_base_name.c_str(), 2, 3, &base));
-  QSMESH_CG(cg_goto(fn, base, "end"));
-  QSMESH_CG(cg_dataclass_write(CGNS_ENUMV(Dimensional)));
-  QSMESH_CG(cg_units_write(CGNS_ENUMV(Kilogram), unit, CGNS_ENUMV(Second), CGNS_ENUMV(Kelvin),
-                           CGNS_ENUMV(Degree)));
+  const int base = write_base(fn, options, unit, path);
 
   // Zone size for an unstructured zone: vertices, cells (the 2D elements), boundary vertices (0:
   // unsorted).
   cgsize_t size[3] = {to_cg(nv, path), to_cg(ncells, path), 0};
   int zone = 0;
-  QSMESH_CG(cg_zone_write(fn, base, options.cgns_zone_name.c_str(), size,
-                          CGNS_ENUMV(Unstructured), &zone));
+  QSMESH_CG(cg_zone_write(fn, base, options.cgns_zone_name.c_str(), size, CGNS_ENUMV(Unstructured),
+                          &zone));
+  write_coordinates(
+      fn, base, zone, mesh.points.size(), [&](std::size_t v) { return mesh.points[v]; }, path);
 
-  {
-    std::vector<double> coord(static_cast<std::size_t>(nv));
-    const char* names[3] = {"CoordinateX", "CoordinateY", "CoordinateZ"};
-    for (int d = 0; d < 3; ++d) {
-      for (std::size_t v = 0; v < coord.size(); ++v) coord[v] = mesh.points[v][d];
-      int c = 0;
-      QSMESH_CG(cg_coord_write(fn, base, zone, CGNS_ENUMV(RealDouble), names[d], coord.data(), &c));
-      // Coordinates are lengths: exponents (mass, length, time, temperature, angle) = (0,1,0,0,0).
-      QSMESH_CG(cg_goto(fn, base, "Zone_t", zone, "GridCoordinates_t", 1, "DataArray_t", c, "end"));
-      const float exponents[5] = {0, 1, 0, 0, 0};
-      QSMESH_CG(cg_exponents_write(CGNS_ENUMV(RealSingle), exponents));
-    }
-  }
-
-  // cgnslib 3.4 refuses FamilyName_t under Elements_t, so a section is tied to its family by the
-  // shared name only ("Face_<f>", "Curve_<c>").
-  cgsize_t next = 1;  // next element id
+  std::vector<LO> all_faces(static_cast<std::size_t>(mesh.num_cad_faces));
+  std::iota(all_faces.begin(), all_faces.end(), LO{0});
+  cgsize_t next = write_face_sections(
+      fn, base, zone, mesh, groups, all_faces, [](GO v) { return static_cast<cgsize_t>(v + 1); }, 1,
+      true, path);
   std::vector<cgsize_t> conn;
-  std::vector<cgsize_t> offsets;
-  for (LO f = 0; f < mesh.num_cad_faces; ++f) {
-    const auto& tris = groups.face2tris[static_cast<std::size_t>(f)];
-    const auto& quads = groups.face2quads[static_cast<std::size_t>(f)];
-    const auto n = static_cast<cgsize_t>(tris.size() + quads.size());
-    if (n == 0) continue;
-    const std::string name = "Face_" + std::to_string(f);
-    const bool mixed = !tris.empty() && !quads.empty();
-    conn.clear();
-    offsets.assign(1, 0);
-    // MIXED connectivity: each element's type code, then its vertices; offsets into it.
-    for (GO t : tris) {
-      if (mixed) conn.push_back(CGNS_ENUMV(TRI_3));
-      for (GO v : mesh.triangles[static_cast<std::size_t>(t)]) conn.push_back(static_cast<cgsize_t>(v + 1));
-      offsets.push_back(static_cast<cgsize_t>(conn.size()));
-    }
-    for (GO q : quads) {
-      if (mixed) conn.push_back(CGNS_ENUMV(QUAD_4));
-      for (GO v : mesh.quads[static_cast<std::size_t>(q)]) conn.push_back(static_cast<cgsize_t>(v + 1));
-      if (quadratic)
-        for (GO v : mesh.quad_nodes[static_cast<std::size_t>(q)])
-          conn.push_back(static_cast<cgsize_t>(v + 1));
-      offsets.push_back(static_cast<cgsize_t>(conn.size()));
-    }
-    int section = 0;
-    if (mixed) {
-      QSMESH_CG(cg_poly_section_write(fn, base, zone, name.c_str(), CGNS_ENUMV(MIXED), next,
-                                      next + n - 1, 0, conn.data(), offsets.data(), &section));
-    } else {
-      QSMESH_CG(cg_section_write(
-          fn, base, zone, name.c_str(),
-          tris.empty() ? (quadratic ? CGNS_ENUMV(QUAD_9) : CGNS_ENUMV(QUAD_4)) : CGNS_ENUMV(TRI_3),
-          next, next + n - 1, 0, conn.data(), &section));
-    }
-    int family = 0;
-    QSMESH_CG(cg_family_write(fn, base, name.c_str(), &family));
-    next += n;
-  }
 
   struct CurveRange {
     std::string name;
@@ -424,12 +454,7 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
   QSMESH_CG(cg_set_file_type(CG_FILE_HDF5));
   QSMESH_CG(cg_open(out.temp_path().c_str(), CG_MODE_WRITE, &file.fn));
   const int fn = file.fn;
-  int base = 0;
-  QSMESH_CG(cg_base_write(fn, options.cgns_base_name.c_str(), 2, 3, &base));
-  QSMESH_CG(cg_goto(fn, base, "end"));
-  QSMESH_CG(cg_dataclass_write(CGNS_ENUMV(Dimensional)));
-  QSMESH_CG(cg_units_write(CGNS_ENUMV(Kilogram), unit, CGNS_ENUMV(Second), CGNS_ENUMV(Kelvin),
-                           CGNS_ENUMV(Degree)));
+  const int base = write_base(fn, options, unit, path);
   {
     std::vector<char> has(static_cast<std::size_t>(mesh.num_cad_faces), 0);
     for (const layout::Block& b : layout.blocks) has[static_cast<std::size_t>(b.face)] = 1;
@@ -478,7 +503,6 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
     return "Block_" + padded(k) + "_Face_" +
            padded(layout.blocks[static_cast<std::size_t>(k)].face);
   };
-  std::vector<double> coord;
   for (GO k = 0; k < nb; ++k) {
     const layout::Block& b = layout.blocks[static_cast<std::size_t>(k)];
     const std::string name = zone_name(k);
@@ -488,18 +512,13 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
     int zone = 0;
     QSMESH_CG(cg_zone_write(fn, base, name.c_str(), size, CGNS_ENUMV(Structured), &zone));
     const auto n = static_cast<std::size_t>(b.ni + 1) * static_cast<std::size_t>(b.nj + 1);
-    coord.resize(n);
-    const char* names[3] = {"CoordinateX", "CoordinateY", "CoordinateZ"};
-    for (int d = 0; d < 3; ++d) {
-      for (std::size_t i = 0; i < n; ++i)
-        coord[i] = mesh.points[static_cast<std::size_t>(
-            layout.vertices[static_cast<std::size_t>(b.first) + i])][d];
-      int c = 0;
-      QSMESH_CG(cg_coord_write(fn, base, zone, CGNS_ENUMV(RealDouble), names[d], coord.data(), &c));
-      QSMESH_CG(cg_goto(fn, base, "Zone_t", zone, "GridCoordinates_t", 1, "DataArray_t", c, "end"));
-      const float exponents[5] = {0, 1, 0, 0, 0};
-      QSMESH_CG(cg_exponents_write(CGNS_ENUMV(RealSingle), exponents));
-    }
+    write_coordinates(
+        fn, base, zone, n,
+        [&](std::size_t i) {
+          return mesh.points[static_cast<std::size_t>(
+              layout.vertices[static_cast<std::size_t>(b.first) + i])];
+        },
+        path);
     QSMESH_CG(cg_goto(fn, base, "Zone_t", zone, "end"));
     QSMESH_CG(cg_famname_write(("Face_" + std::to_string(b.face)).c_str()));
 
@@ -625,8 +644,6 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
 
   // Faces the layout could not cut into blocks: one unstructured zone with a section per face.
   if (!layout.unblocked_faces.empty()) {
-    std::vector<char> unblocked(static_cast<std::size_t>(mesh.num_cad_faces), 0);
-    for (LO f : layout.unblocked_faces) unblocked[static_cast<std::size_t>(f)] = 1;
     const detail::ElementGroups groups = detail::group_elements(mesh);
     std::vector<GO> local(static_cast<std::size_t>(mesh.num_vertices()), -1);
     std::vector<GO> used;
@@ -648,51 +665,13 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
     cgsize_t size[3] = {to_cg(static_cast<GO>(used.size()), path), to_cg(ncells, path), 0};
     int zone = 0;
     QSMESH_CG(cg_zone_write(fn, base, "Unstructured", size, CGNS_ENUMV(Unstructured), &zone));
-    const char* names[3] = {"CoordinateX", "CoordinateY", "CoordinateZ"};
-    coord.resize(used.size());
-    for (int d = 0; d < 3; ++d) {
-      for (std::size_t i = 0; i < used.size(); ++i)
-        coord[i] = mesh.points[static_cast<std::size_t>(used[i])][d];
-      int c = 0;
-      QSMESH_CG(cg_coord_write(fn, base, zone, CGNS_ENUMV(RealDouble), names[d], coord.data(), &c));
-      QSMESH_CG(cg_goto(fn, base, "Zone_t", zone, "GridCoordinates_t", 1, "DataArray_t", c, "end"));
-      const float exponents[5] = {0, 1, 0, 0, 0};
-      QSMESH_CG(cg_exponents_write(CGNS_ENUMV(RealSingle), exponents));
-    }
-    cgsize_t next = 1;
-    std::vector<cgsize_t> conn, offsets;
-    for (LO f : layout.unblocked_faces) {
-      const auto& tris = groups.face2tris[static_cast<std::size_t>(f)];
-      const auto& quads = groups.face2quads[static_cast<std::size_t>(f)];
-      const auto n = static_cast<cgsize_t>(tris.size() + quads.size());
-      if (n == 0) continue;
-      const std::string name = "Face_" + std::to_string(f);
-      const bool mixed = !tris.empty() && !quads.empty();
-      conn.clear();
-      offsets.assign(1, 0);
-      for (GO t : tris) {
-        if (mixed) conn.push_back(CGNS_ENUMV(TRI_3));
-        for (GO v : mesh.triangles[static_cast<std::size_t>(t)])
-          conn.push_back(static_cast<cgsize_t>(local[static_cast<std::size_t>(v)] + 1));
-        offsets.push_back(static_cast<cgsize_t>(conn.size()));
-      }
-      for (GO q : quads) {
-        if (mixed) conn.push_back(CGNS_ENUMV(QUAD_4));
-        for (GO v : mesh.quads[static_cast<std::size_t>(q)])
-          conn.push_back(static_cast<cgsize_t>(local[static_cast<std::size_t>(v)] + 1));
-        offsets.push_back(static_cast<cgsize_t>(conn.size()));
-      }
-      int section = 0;
-      if (mixed) {
-        QSMESH_CG(cg_poly_section_write(fn, base, zone, name.c_str(), CGNS_ENUMV(MIXED), next,
-                                        next + n - 1, 0, conn.data(), offsets.data(), &section));
-      } else {
-        QSMESH_CG(cg_section_write(fn, base, zone, name.c_str(),
-                                   tris.empty() ? CGNS_ENUMV(QUAD_4) : CGNS_ENUMV(TRI_3), next,
-                                   next + n - 1, 0, conn.data(), &section));
-      }
-      next += n;
-    }
+    write_coordinates(
+        fn, base, zone, used.size(),
+        [&](std::size_t i) { return mesh.points[static_cast<std::size_t>(used[i])]; }, path);
+    (void)write_face_sections(
+        fn, base, zone, mesh, groups, layout.unblocked_faces,
+        [&](GO v) { return static_cast<cgsize_t>(local[static_cast<std::size_t>(v)] + 1); }, 1,
+        false, path);
   }
 
   file.fn = -1;
