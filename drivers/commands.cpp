@@ -454,9 +454,10 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
   if (checks.quadratic) {
     const highorder::QuadraticReport& q = *checks.quadratic;
     os << "  second-order nodes: " << q.curve_nodes << " on curves, " << q.face_nodes
-       << " in faces (" << q.unprojected << " left straight: no CAD point near); quads put back "
-       << "straight to stay valid " << q.straightened << " (" << q.curve_straightened
-       << " of them along their curves too), still invalid " << q.invalid << "\n";
+       << " in faces (" << q.unprojected
+       << " left straight: no CAD point near); quads whose face nodes went back "
+       << "straight to stay valid " << q.straightened << ", made entirely straight "
+       << q.curve_straightened << ", still invalid " << q.invalid << "\n";
   }
   if (checks.blocks) {
     const Checks::Blocks& b = *checks.blocks;

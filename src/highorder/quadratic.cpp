@@ -286,11 +286,17 @@ QuadraticReport make_quadratic(mesh::SurfaceMesh& m, const cad::CadModel& model,
           node_point(m.quad_nodes[static_cast<std::size_t>(q)][static_cast<std::size_t>(k)]);
     return x;
   };
+  // The normal SICN (Eq. 12) measures the linear quad against: the sum of its corner cross
+  // products. A linear quad of positive SICN is then valid as a straight 9-node quad.
   auto linear_normal = [&](GO q) {
     const auto& quad = m.quads[static_cast<std::size_t>(q)];
-    const auto& p = m.points;
-    return cross(p[static_cast<std::size_t>(quad[2])] - p[static_cast<std::size_t>(quad[0])],
-                 p[static_cast<std::size_t>(quad[3])] - p[static_cast<std::size_t>(quad[1])]);
+    Vec3 n{};
+    for (int k = 0; k < 4; ++k) {
+      const Vec3& c = m.points[static_cast<std::size_t>(quad[k])];
+      n += cross(m.points[static_cast<std::size_t>(quad[(k + 1) % 4])] - c,
+                 m.points[static_cast<std::size_t>(quad[(k + 3) % 4])] - c);
+    }
+    return n;
   };
   for (GO q = 0; q < nq; ++q) {
     if (quad9_valid(element(q), linear_normal(q))) continue;
@@ -309,16 +315,28 @@ QuadraticReport make_quadratic(mesh::SurfaceMesh& m, const cad::CadModel& model,
   }
   // A quad still folded by its curve nodes (at a sharp CAD corner the curve bends across the
   // element) gets those straight too: its edge then leaves the curve between its ends.
+  // Straightening a node changes the quads around it too, so this runs until no quad changes;
+  // each quad goes straight once at most.
   if (report.straightened > 0) {
-    for (GO q = 0; q < nq; ++q) {
-      if (quad9_valid(element(q), linear_normal(q))) continue;
-      ++report.curve_straightened;
-      const auto& quad = m.quads[static_cast<std::size_t>(q)];
-      for (int k = 0; k < 4; ++k) {
-        const auto node = static_cast<std::size_t>(
-            m.quad_nodes[static_cast<std::size_t>(q)][static_cast<std::size_t>(k)] - nv);
-        points[node] = 0.5 * (m.points[static_cast<std::size_t>(quad[k])] +
-                              m.points[static_cast<std::size_t>(quad[(k + 1) % 4])]);
+    std::vector<char> straight(static_cast<std::size_t>(nq), 0);
+    for (bool changed = true; changed;) {
+      changed = false;
+      for (GO q = 0; q < nq; ++q) {
+        if (straight[static_cast<std::size_t>(q)] || quad9_valid(element(q), linear_normal(q)))
+          continue;
+        straight[static_cast<std::size_t>(q)] = 1;
+        changed = true;
+        ++report.curve_straightened;
+        const auto& quad = m.quads[static_cast<std::size_t>(q)];
+        for (int k = 0; k < 4; ++k) {
+          const auto node = static_cast<std::size_t>(
+              m.quad_nodes[static_cast<std::size_t>(q)][static_cast<std::size_t>(k)] - nv);
+          points[node] = 0.5 * (m.points[static_cast<std::size_t>(quad[k])] +
+                                m.points[static_cast<std::size_t>(quad[(k + 1) % 4])]);
+        }
+        Vec3 centre{};
+        for (GO v : quad) centre += m.points[static_cast<std::size_t>(v)];
+        points[static_cast<std::size_t>(ne + q)] = 0.25 * centre;
       }
     }
     for (GO q = 0; q < nq; ++q)

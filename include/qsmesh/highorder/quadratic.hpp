@@ -20,8 +20,9 @@ struct QuadraticReport {
   /// Quads whose curved element was not valid (the Jacobian of the 9-node map not positive along
   /// the face normal at every node) and whose face nodes were put back on their straight positions.
   std::int64_t straightened = 0;
-  /// Of those, quads still not valid until their curve nodes went straight as well (their edges
-  /// then leave the curve between their ends; a sharp CAD corner bends the curve across them).
+  /// Quads then made fully straight, curve nodes included (their edges then leave the curve
+  /// between their ends; a sharp CAD corner bends the curve across them), until none is left
+  /// folded by its own or a neighbour's straightened nodes.
   std::int64_t curve_straightened = 0;
   /// Quads not valid even with every node straight (their linear quad is not valid).
   std::int64_t invalid = 0;
