@@ -633,8 +633,10 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
         int bc = 0;
         QSMESH_CG(cg_boco_write(fn, base, zone, bcname.c_str(), CGNS_ENUMV(FamilySpecified),
                                 CGNS_ENUMV(PointRange), 2, range, &bc));
-        fix_range_label(cgio, root, "/" + options.cgns_base_name + "/" + name + "/ZoneBC/" + bcname + "/PointRange",
-                        path);
+        std::string node(1, '/');
+        node.append(options.cgns_base_name).append("/").append(name).append("/ZoneBC/");
+        node.append(bcname).append("/PointRange");
+        fix_range_label(cgio, root, node, path);
         QSMESH_CG(cg_goto(fn, base, "Zone_t", zone, "ZoneBC_t", 1, "BC_t", bc, "end"));
         QSMESH_CG(cg_famname_write(("Curve_" + std::to_string(c)).c_str()));
         p = q + 1;

@@ -198,7 +198,8 @@ void write_hdf5(const mesh::SurfaceMesh& mesh, const std::string& path,
       std::vector<std::int32_t> dim(static_cast<std::size_t>(nv)), entity(dim.size());
       std::vector<double> param(2 * dim.size());
       for (std::size_t v = 0; v < dim.size(); ++v) {
-        dim[v] = mesh.vclass[v].dim;
+        // NOLINTNEXTLINE(bugprone-signed-char-misuse): a dimension, 0, 1 or 2, not a character
+        dim[v] = static_cast<std::int32_t>(mesh.vclass[v].dim);
         entity[v] = mesh.vclass[v].entity;
         param[2 * v] = mesh.vclass[v].param[0];
         param[2 * v + 1] = mesh.vclass[v].param[1];

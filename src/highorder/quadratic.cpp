@@ -281,9 +281,8 @@ QuadraticReport make_quadratic(mesh::SurfaceMesh& m, const cad::CadModel& model,
     const auto& quad = m.quads[static_cast<std::size_t>(q)];
     for (int k = 0; k < 4; ++k)
       x[static_cast<std::size_t>(k)] = m.points[static_cast<std::size_t>(quad[k])];
-    for (int k = 0; k < 5; ++k)
-      x[static_cast<std::size_t>(4 + k)] =
-          node_point(m.quad_nodes[static_cast<std::size_t>(q)][static_cast<std::size_t>(k)]);
+    for (std::size_t k = 0; k < 5; ++k)
+      x[4 + k] = node_point(m.quad_nodes[static_cast<std::size_t>(q)][k]);
     return x;
   };
   // The normal SICN (Eq. 12) measures the linear quad against: the sum of its corner cross
