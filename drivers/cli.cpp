@@ -1,12 +1,12 @@
 #include "cli.hpp"
 
-#include <cctype>
 #include <cmath>
 #include <cstdlib>
 #include <optional>
 #include <sstream>
 
 #include "qsmesh/core/error.hpp"
+#include "qsmesh/io/writer.hpp"
 
 namespace qsmesh::cli {
 
@@ -200,9 +200,7 @@ Arguments parse(const std::vector<std::string>& args) {
     if (a.command == Command::Mesh && a.output.empty())
       throw InputError("mesh: missing -o OUT (.cgns, .vtu, .msh or .h5)");
     if (a.block_structured) {
-      std::string ext = a.output.size() >= 5 ? a.output.substr(a.output.size() - 5) : "";
-      for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-      if (ext != ".cgns")
+      if (io::output_format(a.output) != io::Format::kCgns)
         throw InputError("--block-structured: the blocks are written as CGNS; give -o FILE.cgns");
       if (a.until == "background")
         throw InputError("--block-structured needs a quad mesh: not with --until background");

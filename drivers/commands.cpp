@@ -682,11 +682,10 @@ int run_mesh(const Arguments& args) {
       io::write_mesh(result.mesh, args.output);
     }
     s.times.add("write", clock.seconds());
-    const bool h5 = std::filesystem::path(args.output).extension() == ".h5" ||
-                    std::filesystem::path(args.output).extension() == ".H5";
-    s.log.info(h5 ? cat("wrote ", args.output, " and ", io::xdmf_path_for(args.output),
-                        " (open it in ParaView)")
-                  : cat("wrote ", args.output));
+    s.log.info(io::output_format(args.output) == io::Format::kHdf5
+                   ? cat("wrote ", args.output, " and ", io::xdmf_path_for(args.output),
+                         " (open it in ParaView)")
+                   : cat("wrote ", args.output));
     peak_mb.front() = peak_resident_mb();
     checks.rank_peak_mb = std::move(peak_mb);
     if (!args.quiet)

@@ -25,6 +25,7 @@
 #include "qsmesh/io/atomic_file.hpp"
 #include "qsmesh/io/writer.hpp"
 #include "qsmesh/layout/quad_layout.hpp"
+#include "qsmesh/mesh/edges.hpp"
 
 namespace qsmesh::io {
 
@@ -188,6 +189,24 @@ void strip_hdf5_times(const std::string& file) {
 }
 static_assert(std::endian::native == std::endian::little, "strip_hdf5_times assumes little endian");
 
+// Opens the temporary of `out` for writing; `file` closes it on the error path.
+int open_for_write(const AtomicFile& out, CgFile& file, const std::string& path) {
+  QSMESH_CG(cg_set_file_type(CG_FILE_HDF5));
+  QSMESH_CG(cg_open(out.temp_path().c_str(), CG_MODE_WRITE, &file.fn));
+  return file.fn;
+}
+
+// cgnslib 3.4 writes the 33-byte label of IndexRange_t nodes (BC point ranges) from an
+// uninitialised stack buffer (bytes after "IndexRange_t" are garbage), so files would differ
+// between runs: rewrites the label of the node at path `node` from a zero-padded buffer.
+void fix_range_label(int cgio, double root, const std::string& node, const std::string& path) {
+  double id = 0;
+  QSMESH_CGIO(cgio_get_node_id(cgio, root, node.c_str(), &id));
+  char label[CGIO_MAX_LABEL_LENGTH + 1] = {};
+  std::strncpy(label, "IndexRange_t", CGIO_MAX_LABEL_LENGTH);
+  QSMESH_CGIO(cgio_set_label(cgio, id, label));
+}
+
 // The base of every qsmesh CGNS file: CellDimension 2, PhysicalDimension 3, dimensional data in
 // the mesh's length unit.
 int write_base(int fn, const WriteOptions& options, CGNS_ENUMT(LengthUnits_t) unit,
@@ -286,9 +305,7 @@ void write_cgns(const mesh::SurfaceMesh& mesh, const std::string& path,
 
   AtomicFile out(path);
   CgFile file;
-  QSMESH_CG(cg_set_file_type(CG_FILE_HDF5));
-  QSMESH_CG(cg_open(out.temp_path().c_str(), CG_MODE_WRITE, &file.fn));
-  const int fn = file.fn;
+  const int fn = open_for_write(out, file, path);
 
   const int base = write_base(fn, options, unit, path);
 
@@ -347,18 +364,10 @@ void write_cgns(const mesh::SurfaceMesh& mesh, const std::string& path,
     QSMESH_CG(cg_boco_write(fn, base, zone, r.name.c_str(), CGNS_ENUMV(FamilySpecified),
                             CGNS_ENUMV(PointRange), 2, range, &bc));
     QSMESH_CG(cg_boco_gridlocation_write(fn, base, zone, bc, CGNS_ENUMV(EdgeCenter)));
-    // cgnslib 3.4 writes the 33-byte label of the point set node from an uninitialized stack
-    // buffer (bytes after "IndexRange_t" are garbage), so files would differ between runs;
-    // rewrite the label from a zero-padded buffer.
-    {
-      const std::string node = "/" + options.cgns_base_name + "/" + options.cgns_zone_name +
-                               "/ZoneBC/" + r.name + "/PointRange";
-      double id = 0;
-      QSMESH_CGIO(cgio_get_node_id(cgio, root, node.c_str(), &id));
-      char label[CGIO_MAX_LABEL_LENGTH + 1] = {};
-      std::strncpy(label, "IndexRange_t", CGIO_MAX_LABEL_LENGTH);
-      QSMESH_CGIO(cgio_set_label(cgio, id, label));
-    }
+    fix_range_label(cgio, root,
+                    "/" + options.cgns_base_name + "/" + options.cgns_zone_name + "/ZoneBC/" +
+                        r.name + "/PointRange",
+                    path);
     QSMESH_CG(cg_goto(fn, base, "Zone_t", zone, "ZoneBC_t", 1, "BC_t", bc, "end"));
     QSMESH_CG(cg_famname_write(r.name.c_str()));
   }
@@ -370,16 +379,6 @@ void write_cgns(const mesh::SurfaceMesh& mesh, const std::string& path,
 }
 
 namespace {
-
-// cgnslib 3.4 writes the 33-byte label of IndexRange_t nodes from an uninitialised buffer (see
-// write_cgns): rewrites the label of the node at `node` from a zero-padded one.
-void fix_range_label(int cgio, double root, const std::string& node, const std::string& path) {
-  double id = 0;
-  QSMESH_CGIO(cgio_get_node_id(cgio, root, node.c_str(), &id));
-  char label[CGIO_MAX_LABEL_LENGTH + 1] = {};
-  std::strncpy(label, "IndexRange_t", CGIO_MAX_LABEL_LENGTH);
-  QSMESH_CGIO(cgio_set_label(cgio, id, label));
-}
 
 // One side of a block: its vertices in order, and where it lies in the block's index space.
 struct Side {
@@ -435,25 +434,19 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
     LO p;
   };
   std::unordered_map<std::uint64_t, std::vector<Use>> edge_uses;
-  const auto nv = static_cast<std::uint64_t>(mesh.num_vertices());
-  auto key = [nv](GO a, GO b) {
-    if (a > b) std::swap(a, b);
-    return static_cast<std::uint64_t>(a) * nv + static_cast<std::uint64_t>(b);
-  };
+  using mesh::edge_key;
   for (GO k = 0; k < nb; ++k) {
     const layout::Block& b = layout.blocks[static_cast<std::size_t>(k)];
     for (int s = 0; s < 4; ++s)
       for (LO p = 0; p < side_edges(b, s); ++p)
-        edge_uses[key(side_vertex(b, s, p, layout.vertices),
-                      side_vertex(b, s, p + 1, layout.vertices))]
+        edge_uses[edge_key(side_vertex(b, s, p, layout.vertices),
+                           side_vertex(b, s, p + 1, layout.vertices))]
             .push_back({k, s, p});
   }
 
   AtomicFile out(path);
   CgFile file;
-  QSMESH_CG(cg_set_file_type(CG_FILE_HDF5));
-  QSMESH_CG(cg_open(out.temp_path().c_str(), CG_MODE_WRITE, &file.fn));
-  const int fn = file.fn;
+  const int fn = open_for_write(out, file, path);
   const int base = write_base(fn, options, unit, path);
   {
     std::vector<char> has(static_cast<std::size_t>(mesh.num_cad_faces), 0);
@@ -467,9 +460,7 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
   }
   // Curves with free block edges (no other block across: an open shell's border, a cut plane) get a
   // family and BCs on those edges, as in write_cgns.
-  std::unordered_map<std::uint64_t, LO> edge_curve;
-  for (std::size_t e = 0; e < mesh.bars.size(); ++e)
-    edge_curve[key(mesh.bars[e][0], mesh.bars[e][1])] = mesh.bar_curve[e];
+  const std::unordered_map<std::uint64_t, LO> edge_curve = mesh::bar_curves(mesh);
   {
     std::vector<char> free_curve(static_cast<std::size_t>(mesh.num_cad_curves), 0);
     for (const auto& [k, uses] : edge_uses) {
@@ -538,7 +529,7 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
         const GO a = side_vertex(b, s, p, layout.vertices),
                  c = side_vertex(b, s, p + 1, layout.vertices);
         std::vector<Run> next;
-        for (const Use& u : edge_uses.at(key(a, c))) {
+        for (const Use& u : edge_uses.at(edge_key(a, c))) {
           if (u.block == k && u.side == s) continue;
           auto it = std::find_if(open.begin(), open.end(), [&](const Run& r) {
             if (r.block != u.block || r.side != u.side || r.p1 != p - 1) return false;
@@ -613,8 +604,8 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
       // Free edges: one BC per run of them on one curve.
       for (LO p = 0; p < side_edges(b, s);) {
         auto curve_of_free = [&](LO q) -> LO {
-          const std::uint64_t e =
-              key(side_vertex(b, s, q, layout.vertices), side_vertex(b, s, q + 1, layout.vertices));
+          const std::uint64_t e = edge_key(side_vertex(b, s, q, layout.vertices),
+                                           side_vertex(b, s, q + 1, layout.vertices));
           if (edge_uses.at(e).size() != 1) return kNoIndex;
           const auto it = edge_curve.find(e);
           return it == edge_curve.end() ? kNoIndex : it->second;

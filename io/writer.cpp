@@ -14,11 +14,7 @@ namespace qsmesh::io {
 
 namespace fs = std::filesystem;
 
-namespace {
-
-enum class Format { kNone, kCgns, kVtu, kMsh, kHdf5 };
-
-Format format_of(const std::string& path) {
+Format output_format(const std::string& path) {
   std::string ext = fs::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
@@ -29,10 +25,8 @@ Format format_of(const std::string& path) {
   return Format::kNone;
 }
 
-}  // namespace
-
 bool is_supported_output(const std::string& path) {
-  return !fs::path(path).stem().empty() && format_of(path) != Format::kNone;
+  return !fs::path(path).stem().empty() && output_format(path) != Format::kNone;
 }
 
 void check_output_path(const std::string& path) {
@@ -41,7 +35,7 @@ void check_output_path(const std::string& path) {
                      "': unsupported format (the extension must be .cgns, .vtu, .msh or .h5)");
   }
   detail::check_output_folder(path);
-  if (format_of(path) == Format::kHdf5) detail::check_output_folder(xdmf_path_for(path));
+  if (output_format(path) == Format::kHdf5) detail::check_output_folder(xdmf_path_for(path));
 }
 
 namespace detail {
@@ -133,7 +127,7 @@ void check_mesh_for_output(const mesh::SurfaceMesh& m) {
 
 void write_mesh(const mesh::SurfaceMesh& mesh, const std::string& path, const WriteOptions& options) {
   check_output_path(path);
-  switch (format_of(path)) {
+  switch (output_format(path)) {
     case Format::kCgns: write_cgns(mesh, path, options); return;
     case Format::kVtu: write_vtu(mesh, path, options); return;
     case Format::kMsh: write_msh(mesh, path, options); return;

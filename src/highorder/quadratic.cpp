@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "qsmesh/core/error.hpp"
+#include "qsmesh/mesh/edges.hpp"
 
 namespace qsmesh::highorder {
 
@@ -88,19 +89,13 @@ QuadraticReport make_quadratic(mesh::SurfaceMesh& m, const cad::CadModel& model,
                "second-order elements: the mesh has them already");
   const GO nv = m.num_vertices();
   const auto nq = static_cast<GO>(m.quads.size());
-  auto key = [nv](GO a, GO b) {
-    if (a > b) std::swap(a, b);
-    return static_cast<std::uint64_t>(a) * static_cast<std::uint64_t>(nv) +
-           static_cast<std::uint64_t>(b);
-  };
-
   // Unique edges: the bars first (their curve), then the quads' (their face).
   std::unordered_map<std::uint64_t, GO> edge_of;
   std::vector<Edge> edges;
   m.bar_nodes.resize(m.bars.size());
   for (std::size_t b = 0; b < m.bars.size(); ++b) {
-    const auto [it, fresh] =
-        edge_of.try_emplace(key(m.bars[b][0], m.bars[b][1]), static_cast<GO>(edges.size()));
+    const auto [it, fresh] = edge_of.try_emplace(mesh::edge_key(m.bars[b][0], m.bars[b][1]),
+                                                 static_cast<GO>(edges.size()));
     if (fresh) edges.push_back({m.bars[b][0], m.bars[b][1], kNoIndex, m.bar_curve[b], -1});
     m.bar_nodes[b] = nv + it->second;
   }
@@ -108,8 +103,8 @@ QuadraticReport make_quadratic(mesh::SurfaceMesh& m, const cad::CadModel& model,
   for (GO q = 0; q < nq; ++q) {
     const auto& quad = m.quads[static_cast<std::size_t>(q)];
     for (int k = 0; k < 4; ++k) {
-      const auto [it, fresh] =
-          edge_of.try_emplace(key(quad[k], quad[(k + 1) % 4]), static_cast<GO>(edges.size()));
+      const auto [it, fresh] = edge_of.try_emplace(mesh::edge_key(quad[k], quad[(k + 1) % 4]),
+                                                   static_cast<GO>(edges.size()));
       if (fresh) edges.push_back({quad[k], quad[(k + 1) % 4], kNoIndex, kNoIndex, -1});
       Edge& e = edges[static_cast<std::size_t>(it->second)];
       if (e.quad < 0) {
@@ -118,9 +113,8 @@ QuadraticReport make_quadratic(mesh::SurfaceMesh& m, const cad::CadModel& model,
       }
       m.quad_nodes[static_cast<std::size_t>(q)][static_cast<std::size_t>(k)] = nv + it->second;
     }
-    m.quad_nodes[static_cast<std::size_t>(q)][4] =
-        nv + static_cast<GO>(edges.size());  // fixed below
   }
+  // The centres follow the edge nodes.
   const auto ne = static_cast<GO>(edges.size());
   for (GO q = 0; q < nq; ++q) m.quad_nodes[static_cast<std::size_t>(q)][4] = nv + ne + q;
 
@@ -178,11 +172,11 @@ QuadraticReport make_quadratic(mesh::SurfaceMesh& m, const cad::CadModel& model,
     }
   });
 
+  // Faces: their edge nodes, then their centres (which read the edge nodes of their quads, on
+  // this face or on its curves, placed above).
   tasks.parallel_for(model.num_faces(), [&](std::int64_t fi) {
     const auto f = static_cast<LO>(fi);
-    if (face_edges[static_cast<std::size_t>(f)].empty() &&
-        face_quads[static_cast<std::size_t>(f)].empty())
-      return;
+    if (face_quads[static_cast<std::size_t>(f)].empty()) return;
     const auto geom = model.face_geometry(f);
     // A reference (u, v) near a quad: a face vertex's own, else an image of its first corner.
     auto reference = [&](GO q) {
@@ -198,14 +192,16 @@ QuadraticReport make_quadratic(mesh::SurfaceMesh& m, const cad::CadModel& model,
       const auto images = uv_images(model, *geom, f, m.vclass[static_cast<std::size_t>(v)]);
       return images.empty() ? ref : nearest(images, ref);
     };
-    auto place = [&](std::size_t node, const Vec3& straight, const Vec2& guess, double reach) {
+    // Node `node` at the projection of `target` on the face, or at `target` itself when the
+    // projection lands further than `reach` from it.
+    auto place = [&](std::size_t node, const Vec3& target, const Vec2& guess, double reach) {
       Vec3 foot{};
-      const Vec2 uv = geom->project(straight, guess, &foot);
-      if (distance(foot, straight) <= reach) {
+      const Vec2 uv = geom->project(target, guess, &foot);
+      if (distance(foot, target) <= reach) {
         points[node] = foot;
         vclass[node] = {2, f, kNoIndex, {uv.u, uv.v}};
       } else {
-        points[node] = straight;
+        points[node] = target;
         vclass[node] = {2, f, kNoIndex, {guess.u, guess.v}};
         projected[node] = 0;
       }
@@ -218,12 +214,8 @@ QuadraticReport make_quadratic(mesh::SurfaceMesh& m, const cad::CadModel& model,
                  pb = m.points[static_cast<std::size_t>(x.b)];
       place(static_cast<std::size_t>(e), 0.5 * (pa + pb), 0.5 * (ua + ub), distance(pa, pb));
     }
-  });
-  // Centres, once every edge node is placed: the point the 8 boundary nodes predict.
-  tasks.parallel_for(model.num_faces(), [&](std::int64_t fi) {
-    const auto f = static_cast<LO>(fi);
-    if (face_quads[static_cast<std::size_t>(f)].empty()) return;
-    const auto geom = model.face_geometry(f);
+    // Centres: the point the 8 boundary nodes predict, guessed at the mean (u, v) of the quad's
+    // face edge nodes.
     for (GO q : face_quads[static_cast<std::size_t>(f)]) {
       const auto& quad = m.quads[static_cast<std::size_t>(q)];
       const auto& ho = m.quad_nodes[static_cast<std::size_t>(q)];
@@ -235,30 +227,14 @@ QuadraticReport make_quadratic(mesh::SurfaceMesh& m, const cad::CadModel& model,
         const auto node = static_cast<std::size_t>(ho[static_cast<std::size_t>(k)] - nv);
         mids += points[node];
         if (vclass[node].dim == 2) {
-          guess = guess + Vec2{vclass[node].param[0], vclass[node].param[1]};
+          guess += Vec2{vclass[node].param[0], vclass[node].param[1]};
           ++guesses;
         }
       }
-      if (guesses > 0) {
-        guess = Vec2{guess.u / guesses, guess.v / guesses};
-      } else {
-        const auto images = uv_images(model, *geom, f, m.vclass[static_cast<std::size_t>(quad[0])]);
-        if (!images.empty()) guess = images.front();
-      }
-      const Vec3 target = 0.5 * mids - 0.25 * corners;
-      const double reach = distance(m.points[static_cast<std::size_t>(quad[0])],
-                                    m.points[static_cast<std::size_t>(quad[2])]);
-      const auto node = static_cast<std::size_t>(ne + q);
-      Vec3 foot{};
-      const Vec2 uv = geom->project(target, guess, &foot);
-      if (distance(foot, target) <= reach) {
-        points[node] = foot;
-        vclass[node] = {2, f, kNoIndex, {uv.u, uv.v}};
-      } else {
-        points[node] = target;
-        vclass[node] = {2, f, kNoIndex, {guess.u, guess.v}};
-        projected[node] = 0;
-      }
+      guess = guesses > 0 ? guess / guesses : reference(q);
+      place(static_cast<std::size_t>(ne + q), 0.5 * mids - 0.25 * corners, guess,
+            distance(m.points[static_cast<std::size_t>(quad[0])],
+                     m.points[static_cast<std::size_t>(quad[2])]));
     }
   });
 
@@ -297,20 +273,25 @@ QuadraticReport make_quadratic(mesh::SurfaceMesh& m, const cad::CadModel& model,
     }
     return n;
   };
-  for (GO q = 0; q < nq; ++q) {
-    if (quad9_valid(element(q), linear_normal(q))) continue;
-    ++report.straightened;
+  // Puts the edge nodes of quad q (its face nodes only, or all of them) and its centre back on the
+  // straight positions.
+  auto straighten = [&](GO q, bool curve_nodes_too) {
     const auto& quad = m.quads[static_cast<std::size_t>(q)];
     for (int k = 0; k < 4; ++k) {
       const auto node = static_cast<std::size_t>(
           m.quad_nodes[static_cast<std::size_t>(q)][static_cast<std::size_t>(k)] - nv);
-      if (vclass[node].dim != 2) continue;
+      if (vclass[node].dim != 2 && !curve_nodes_too) continue;
       points[node] = 0.5 * (m.points[static_cast<std::size_t>(quad[k])] +
                             m.points[static_cast<std::size_t>(quad[(k + 1) % 4])]);
     }
     Vec3 centre{};
     for (GO v : quad) centre += m.points[static_cast<std::size_t>(v)];
     points[static_cast<std::size_t>(ne + q)] = 0.25 * centre;
+  };
+  for (GO q = 0; q < nq; ++q) {
+    if (quad9_valid(element(q), linear_normal(q))) continue;
+    ++report.straightened;
+    straighten(q, false);
   }
   // A quad still folded by its curve nodes (at a sharp CAD corner the curve bends across the
   // element) gets those straight too: its edge then leaves the curve between its ends.
@@ -326,16 +307,7 @@ QuadraticReport make_quadratic(mesh::SurfaceMesh& m, const cad::CadModel& model,
         straight[static_cast<std::size_t>(q)] = 1;
         changed = true;
         ++report.curve_straightened;
-        const auto& quad = m.quads[static_cast<std::size_t>(q)];
-        for (int k = 0; k < 4; ++k) {
-          const auto node = static_cast<std::size_t>(
-              m.quad_nodes[static_cast<std::size_t>(q)][static_cast<std::size_t>(k)] - nv);
-          points[node] = 0.5 * (m.points[static_cast<std::size_t>(quad[k])] +
-                                m.points[static_cast<std::size_t>(quad[(k + 1) % 4])]);
-        }
-        Vec3 centre{};
-        for (GO v : quad) centre += m.points[static_cast<std::size_t>(v)];
-        points[static_cast<std::size_t>(ne + q)] = 0.25 * centre;
+        straighten(q, true);
       }
     }
     for (GO q = 0; q < nq; ++q)

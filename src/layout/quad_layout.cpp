@@ -5,11 +5,13 @@
 #include <cstdint>
 #include <map>
 #include <numeric>
+#include <optional>
 #include <unordered_map>
 #include <utility>
 #include <vector>
 
 #include "qsmesh/core/error.hpp"
+#include "qsmesh/mesh/edges.hpp"
 
 namespace qsmesh::layout {
 
@@ -20,6 +22,46 @@ struct EdgeInfo {
   int count = 0;     // quads using the edge (2 inside a face; 1 on a free boundary)
   bool bar = false;  // on a CAD curve
   bool traced = false;
+};
+
+// A block with its own vertex grid and its quads, as the patches give them and merging joins them.
+struct Grid {
+  LO face = kNoIndex;
+  LO ni = 0, nj = 0;
+  std::vector<GO> v;      // (ni + 1) x (nj + 1), i fastest
+  std::vector<GO> quads;  // the mesh quads it covers
+  [[nodiscard]] GO at(LO i, LO j) const {
+    return v[static_cast<std::size_t>(j) * static_cast<std::size_t>(ni + 1) +
+             static_cast<std::size_t>(i)];
+  }
+  // Boundary vertices of side s, counter-clockwise around the block: 0 = j min (i up), 1 = i max
+  // (j up), 2 = j max (i down), 3 = i min (j down).
+  [[nodiscard]] std::vector<GO> side(int s) const {
+    std::vector<GO> out;
+    if (s == 0)
+      for (LO i = 0; i <= ni; ++i) out.push_back(at(i, 0));
+    if (s == 1)
+      for (LO j = 0; j <= nj; ++j) out.push_back(at(ni, j));
+    if (s == 2)
+      for (LO i = ni; i >= 0; --i) out.push_back(at(i, nj));
+    if (s == 3)
+      for (LO j = nj; j >= 0; --j) out.push_back(at(0, j));
+    return out;
+  }
+  // Turns the index axes a quarter turn, keeping i x j (side s becomes side (s + 3) % 4).
+  void rotate() {
+    Grid r;
+    r.face = face;
+    r.ni = nj;
+    r.nj = ni;
+    r.quads = std::move(quads);
+    r.v.resize(v.size());
+    for (LO jr = 0; jr <= r.nj; ++jr)
+      for (LO ir = 0; ir <= r.ni; ++ir)
+        r.v[static_cast<std::size_t>(jr) * static_cast<std::size_t>(r.ni + 1) +
+            static_cast<std::size_t>(ir)] = at(ni - jr, ir);
+    *this = std::move(r);
+  }
 };
 
 class Layouter {
@@ -42,16 +84,19 @@ class Layouter {
     for (GO q = 0; q < nq; ++q) {
       const auto& quad = m.quads[static_cast<std::size_t>(q)];
       for (int k = 0; k < 4; ++k) {
-        EdgeInfo& e = edges_[key(quad[k], quad[(k + 1) % 4])];
+        EdgeInfo& e = edges_[mesh::edge_key(quad[k], quad[(k + 1) % 4])];
         if (e.count < 2) e.quads[static_cast<std::size_t>(e.count)] = q;
         ++e.count;
       }
     }
     for (const auto& b : m.bars) {
-      auto it = edges_.find(key(b[0], b[1]));
+      auto it = edges_.find(mesh::edge_key(b[0], b[1]));
       if (it != edges_.end()) it->second.bar = true;
     }
   }
+
+  /// 1 for the faces with triangles: they get no block.
+  [[nodiscard]] const std::vector<char>& face_unblocked() const { return face_unblocked_; }
 
   [[nodiscard]] bool blocked_quad(GO q) const {
     return face_unblocked_[static_cast<std::size_t>(m_.quad_face[static_cast<std::size_t>(q)])] ==
@@ -91,7 +136,7 @@ class Layouter {
       std::vector<std::pair<GO, std::size_t>> interior_edges;  // (w, quad index)
       for (std::size_t a = 0; a < quads.size(); ++a) {
         for (GO w : neighbours_in_quad(quads[a], v)) {
-          const EdgeInfo& e = edges_.at(key(v, w));
+          const EdgeInfo& e = edges_.at(mesh::edge_key(v, w));
           if (!interior(e)) continue;
           interior_edges.emplace_back(w, a);
           const GO other = e.quads[0] == quads[a] ? e.quads[1] : e.quads[0];
@@ -127,7 +172,7 @@ class Layouter {
     };
     std::vector<State> live;
     for (const auto& [v, w] : from) {
-      EdgeInfo& e = edges_.at(key(v, w));
+      EdgeInfo& e = edges_.at(mesh::edge_key(v, w));
       if (motorcycle && e.traced) continue;
       e.traced = true;
       reached[static_cast<std::size_t>(v)] = 1;
@@ -141,7 +186,7 @@ class Layouter {
         if (motorcycle && reached[static_cast<std::size_t>(s.cur)]) continue;
         reached[static_cast<std::size_t>(s.cur)] = 1;
         const GO after = straight_on(s.cur, s.prev);
-        EdgeInfo& e = edges_.at(key(s.cur, after));
+        EdgeInfo& e = edges_.at(mesh::edge_key(s.cur, after));
         if (!motorcycle && e.traced) continue;  // the rest of this line is traced already
         e.traced = true;
         next.push_back({s.cur, after});
@@ -157,9 +202,9 @@ class Layouter {
         e.traced = false;
   }
 
-  // Patches of the quads of the faces in `faces`, as grids: appends the blocks to `out`; returns
-  // the faces with a patch that is not a grid.
-  std::vector<LO> patches(const std::vector<char>& faces, QuadLayout& out) const {
+  // Patches of the quads of the faces in `faces`, as grids appended to `out` in the order of their
+  // smallest quad; returns the faces with a patch that is not a grid.
+  std::vector<LO> patches(const std::vector<char>& faces, std::vector<Grid>& out) const {
     const auto nq = static_cast<GO>(m_.quads.size());
     std::vector<GO> patch(static_cast<std::size_t>(nq), -1);
     std::vector<LO> failed;
@@ -177,7 +222,7 @@ class Layouter {
         members.push_back(q);
         const auto& quad = m_.quads[static_cast<std::size_t>(q)];
         for (int k = 0; k < 4; ++k) {
-          const EdgeInfo& e = edges_.at(key(quad[k], quad[(k + 1) % 4]));
+          const EdgeInfo& e = edges_.at(mesh::edge_key(quad[k], quad[(k + 1) % 4]));
           if (!crossable(e)) continue;
           const GO other = e.quads[0] == q ? e.quads[1] : e.quads[0];
           if (patch[static_cast<std::size_t>(other)] >= 0) continue;
@@ -186,7 +231,11 @@ class Layouter {
         }
       }
       std::sort(members.begin(), members.end());
-      if (!grid(members, f, out)) failed.push_back(f);
+      if (auto g = grid(members, f)) {
+        out.push_back(std::move(*g));
+      } else {
+        failed.push_back(f);
+      }
     }
     std::sort(failed.begin(), failed.end());
     failed.erase(std::unique(failed.begin(), failed.end()), failed.end());
@@ -194,12 +243,6 @@ class Layouter {
   }
 
  private:
-  [[nodiscard]] std::uint64_t key(GO a, GO b) const {
-    if (a > b) std::swap(a, b);
-    return static_cast<std::uint64_t>(a) * static_cast<std::uint64_t>(nv_) +
-           static_cast<std::uint64_t>(b);
-  }
-
   [[nodiscard]] bool crossable(const EdgeInfo& e) const { return interior(e) && !e.traced; }
 
   [[nodiscard]] std::array<GO, 2> neighbours_in_quad(GO q, GO v) const {
@@ -212,7 +255,7 @@ class Layouter {
 
   // At a valence-4 vertex c reached from prev: the vertex across c on the same grid line.
   [[nodiscard]] GO straight_on(GO c, GO prev) const {
-    const EdgeInfo& e = edges_.at(key(c, prev));
+    const EdgeInfo& e = edges_.at(mesh::edge_key(c, prev));
     std::array<GO, 3> side{prev, -1, -1};
     for (int s = 0; s < 2; ++s) {
       const auto n = neighbours_in_quad(e.quads[static_cast<std::size_t>(s)], c);
@@ -234,11 +277,11 @@ class Layouter {
     return -1;
   }
 
-  // The patch `members` (sorted quad ids) as an ni x nj grid; false when it is not one.
-  bool grid(const std::vector<GO>& members, LO face, QuadLayout& out) const {
+  // The patch `members` (sorted quad ids) as an ni x nj grid; none when it is not one.
+  [[nodiscard]] std::optional<Grid> grid(const std::vector<GO>& members, LO face) const {
     auto in_patch = [&](GO q) { return std::binary_search(members.begin(), members.end(), q); };
     auto across = [&](GO q, GO a, GO b) -> GO {  // the patch quad across edge (a, b) of q, or -1
-      const EdgeInfo& e = edges_.at(key(a, b));
+      const EdgeInfo& e = edges_.at(mesh::edge_key(a, b));
       if (!crossable(e)) return -1;
       const GO other = e.quads[0] == q ? e.quads[1] : e.quads[0];
       return in_patch(other) ? other : -1;
@@ -261,7 +304,7 @@ class Layouter {
       }
       if (start.q >= 0) break;
     }
-    if (start.q < 0) return false;
+    if (start.q < 0) return std::nullopt;
     auto step_i = [&](Oriented o) -> Oriented {
       const GO b = corner(o, 1), c = corner(o, 2);
       const GO n = across(o.q, b, c);
@@ -274,17 +317,17 @@ class Layouter {
     };
     LO ni = 0;
     for (Oriented o = start; o.q >= 0; o = step_i(o)) {
-      if (++ni > static_cast<LO>(members.size())) return false;
+      if (++ni > static_cast<LO>(members.size())) return std::nullopt;
     }
     std::vector<GO> grid_vertices;
     std::vector<GO> seen;
     LO nj = 0;
     for (Oriented row = start; row.q >= 0; row = step_j(row)) {
-      if (static_cast<GO>(nj + 1) * ni > static_cast<GO>(members.size())) return false;
+      if (static_cast<GO>(nj + 1) * ni > static_cast<GO>(members.size())) return std::nullopt;
       grid_vertices.resize(static_cast<std::size_t>(ni + 1) * static_cast<std::size_t>(nj + 2), -1);
       Oriented o = row;
       for (LO i = 0; i < ni; ++i) {
-        if (o.q < 0) return false;
+        if (o.q < 0) return std::nullopt;
         seen.push_back(o.q);
         const std::array<std::pair<LO, LO>, 4> at{
             {{i, nj}, {i + 1, nj}, {i + 1, nj + 1}, {i, nj + 1}}};
@@ -292,26 +335,17 @@ class Layouter {
           GO& slot = grid_vertices[static_cast<std::size_t>(at[c].second) *
                                        static_cast<std::size_t>(ni + 1) +
                                    static_cast<std::size_t>(at[c].first)];
-          if (slot >= 0 && slot != corner(o, c)) return false;
+          if (slot >= 0 && slot != corner(o, c)) return std::nullopt;
           slot = corner(o, c);
         }
         o = step_i(o);
       }
-      if (o.q >= 0) return false;  // a longer row: not a grid
+      if (o.q >= 0) return std::nullopt;  // a longer row: not a grid
       ++nj;
     }
     std::sort(seen.begin(), seen.end());
-    if (seen != members) return false;
-    Block b;
-    b.face = face;
-    b.ni = ni;
-    b.nj = nj;
-    b.first = static_cast<std::int64_t>(out.vertices.size());
-    out.vertices.insert(out.vertices.end(), grid_vertices.begin(), grid_vertices.end());
-    out.blocks.push_back(b);
-    for (GO q : members)
-      out.quad2block[static_cast<std::size_t>(q)] = static_cast<GO>(out.blocks.size()) - 1;
-    return true;
+    if (seen != members) return std::nullopt;
+    return Grid{face, ni, nj, std::move(grid_vertices), members};
   }
 
   const mesh::SurfaceMesh& m_;
@@ -319,133 +353,60 @@ class Layouter {
   std::vector<char> face_unblocked_;
   std::vector<GO> v2q_offsets_, v2q_;
   std::unordered_map<std::uint64_t, EdgeInfo> edges_;
-
- public:
-  [[nodiscard]] const std::vector<char>& face_unblocked() const { return face_unblocked_; }
-};
-
-}  // namespace
-
-namespace {
-
-// A block as its own vertex grid, for merging.
-struct Grid {
-  LO face = kNoIndex;
-  LO ni = 0, nj = 0;
-  std::vector<GO> v;  // (ni + 1) x (nj + 1), i fastest
-  [[nodiscard]] GO at(LO i, LO j) const {
-    return v[static_cast<std::size_t>(j) * static_cast<std::size_t>(ni + 1) +
-             static_cast<std::size_t>(i)];
-  }
-  // Boundary vertices of side s, counter-clockwise around the block: 0 = j min (i up), 1 = i max
-  // (j up), 2 = j max (i down), 3 = i min (j down).
-  [[nodiscard]] std::vector<GO> side(int s) const {
-    std::vector<GO> out;
-    if (s == 0)
-      for (LO i = 0; i <= ni; ++i) out.push_back(at(i, 0));
-    if (s == 1)
-      for (LO j = 0; j <= nj; ++j) out.push_back(at(ni, j));
-    if (s == 2)
-      for (LO i = ni; i >= 0; --i) out.push_back(at(i, nj));
-    if (s == 3)
-      for (LO j = nj; j >= 0; --j) out.push_back(at(0, j));
-    return out;
-  }
-  // Turns the index axes a quarter turn, keeping i x j (side s becomes side (s + 3) % 4).
-  void rotate() {
-    Grid r;
-    r.face = face;
-    r.ni = nj;
-    r.nj = ni;
-    r.v.resize(v.size());
-    for (LO jr = 0; jr <= r.nj; ++jr)
-      for (LO ir = 0; ir <= r.ni; ++ir)
-        r.v[static_cast<std::size_t>(jr) * static_cast<std::size_t>(r.ni + 1) +
-            static_cast<std::size_t>(ir)] = at(ni - jr, ir);
-    *this = std::move(r);
-  }
 };
 
 // Merges blocks of one face that share a whole side, not along a CAD curve, while any do: the
 // union of two such grids is a grid. Blocks are visited in order and each merge keeps the lower
-// index, so the result depends on the layout only. merged_into[k]: the block block k ended in.
-void merge_blocks(std::vector<Grid>& grids, const std::vector<std::array<GO, 2>>& bars, GO nv,
-                  std::vector<GO>& merged_into) {
-  std::unordered_map<std::uint64_t, char> bar_set;
-  auto ekey = [nv](GO a, GO b) {
-    if (a > b) std::swap(a, b);
-    return static_cast<std::uint64_t>(a) * static_cast<std::uint64_t>(nv) +
-           static_cast<std::uint64_t>(b);
-  };
-  for (const auto& b : bars) bar_set[ekey(b[0], b[1])] = 1;
+// index, so the result depends on the layout only.
+void merge_blocks(std::vector<Grid>& grids, const mesh::SurfaceMesh& mesh) {
+  const std::unordered_map<std::uint64_t, LO> on_curve = mesh::bar_curves(mesh);
   std::vector<char> alive(grids.size(), 1);
-  merged_into.resize(grids.size());
-  std::iota(merged_into.begin(), merged_into.end(), GO{0});
-  auto side_key = [](GO first, GO last, std::size_t n) {
-    return std::array<GO, 3>{first, last, static_cast<GO>(n)};
+  auto side_key = [](const std::vector<GO>& seq) {
+    return std::array<GO, 3>{seq.front(), seq.back(), static_cast<GO>(seq.size())};
   };
   for (bool changed = true; changed;) {
     changed = false;
     std::map<std::array<GO, 3>, std::vector<std::pair<std::size_t, int>>> sides;
-    for (std::size_t k = 0; k < grids.size(); ++k) {
-      if (!alive[k]) continue;
-      for (int s = 0; s < 4; ++s) {
-        const std::vector<GO> seq = grids[k].side(s);
-        sides[side_key(seq.front(), seq.back(), seq.size())].emplace_back(k, s);
-      }
-    }
+    for (std::size_t k = 0; k < grids.size(); ++k)
+      for (int s = 0; alive[k] && s < 4; ++s) sides[side_key(grids[k].side(s))].emplace_back(k, s);
     std::vector<char> touched(grids.size(), 0);
     for (std::size_t a = 0; a < grids.size(); ++a) {
-      if (!alive[a] || touched[a]) continue;
-      for (int s = 0; s < 4; ++s) {
+      for (int s = 0; alive[a] && !touched[a] && s < 4; ++s) {
         const std::vector<GO> seq = grids[a].side(s);
-        bool on_curve = false;
-        for (std::size_t i = 0; i + 1 < seq.size() && !on_curve; ++i)
-          on_curve = bar_set.count(ekey(seq[i], seq[i + 1])) > 0;
-        if (on_curve) continue;
-        const auto it = sides.find(side_key(seq.back(), seq.front(), seq.size()));
-        if (it == sides.end()) continue;
-        std::size_t b = grids.size();
-        int t = 0;
-        for (const auto& [k, side] : it->second) {
-          if (k == a || !alive[k] || touched[k] || grids[k].face != grids[a].face) continue;
-          std::vector<GO> other = grids[k].side(side);
+        bool along_curve = false;
+        for (std::size_t i = 0; i + 1 < seq.size(); ++i)
+          along_curve = along_curve || on_curve.count(mesh::edge_key(seq[i], seq[i + 1])) > 0;
+        // The partner's side runs the other way round: its key has the ends swapped.
+        const auto it = sides.find({seq.back(), seq.front(), static_cast<GO>(seq.size())});
+        if (along_curve || it == sides.end()) continue;
+        for (const auto& [b, t] : it->second) {
+          if (b == a || !alive[b] || touched[b] || grids[b].face != grids[a].face) continue;
+          std::vector<GO> other = grids[b].side(t);
           std::reverse(other.begin(), other.end());
           if (other != seq) continue;
-          b = k;
-          t = side;
+          Grid ga = grids[a], gb = std::move(grids[b]);
+          for (int sa = s; sa != 1; sa = (sa + 3) % 4) ga.rotate();
+          for (int sb = t; sb != 3; sb = (sb + 3) % 4) gb.rotate();
+          Grid m{ga.face, ga.ni + gb.ni, ga.nj, {}, std::move(ga.quads)};
+          m.v.resize(static_cast<std::size_t>(m.ni + 1) * static_cast<std::size_t>(m.nj + 1));
+          for (LO j = 0; j <= m.nj; ++j)
+            for (LO i = 0; i <= m.ni; ++i)
+              m.v[static_cast<std::size_t>(j) * static_cast<std::size_t>(m.ni + 1) +
+                  static_cast<std::size_t>(i)] = i <= ga.ni ? ga.at(i, j) : gb.at(i - ga.ni, j);
+          m.quads.insert(m.quads.end(), gb.quads.begin(), gb.quads.end());
+          grids[a] = std::move(m);
+          alive[b] = 0;
+          touched[a] = touched[b] = 1;
+          changed = true;
           break;
         }
-        if (b == grids.size()) continue;
-        Grid ga = grids[a], gb = grids[b];
-        for (int sa = s; sa != 1; sa = (sa + 3) % 4) ga.rotate();
-        for (int sb = t; sb != 3; sb = (sb + 3) % 4) gb.rotate();
-        if (ga.nj != gb.nj) continue;
-        Grid m;
-        m.face = ga.face;
-        m.ni = ga.ni + gb.ni;
-        m.nj = ga.nj;
-        m.v.resize(static_cast<std::size_t>(m.ni + 1) * static_cast<std::size_t>(m.nj + 1));
-        for (LO j = 0; j <= m.nj; ++j)
-          for (LO i = 0; i <= m.ni; ++i)
-            m.v[static_cast<std::size_t>(j) * static_cast<std::size_t>(m.ni + 1) +
-                static_cast<std::size_t>(i)] = i <= ga.ni ? ga.at(i, j) : gb.at(i - ga.ni, j);
-        grids[a] = std::move(m);
-        grids[b].v.clear();
-        alive[b] = 0;
-        touched[a] = touched[b] = 1;
-        merged_into[b] = static_cast<GO>(a);
-        changed = true;
-        break;
       }
     }
   }
-  for (std::size_t k = 0; k < merged_into.size(); ++k) {
-    GO r = static_cast<GO>(k);
-    while (merged_into[static_cast<std::size_t>(r)] != r)
-      r = merged_into[static_cast<std::size_t>(r)];
-    merged_into[k] = r;
-  }
+  std::size_t kept = 0;
+  for (std::size_t k = 0; k < grids.size(); ++k)
+    if (alive[k] && kept++ != k) grids[kept - 1] = std::move(grids[k]);
+  grids.resize(kept);
 }
 
 }  // namespace
@@ -454,100 +415,44 @@ QuadLayout extract_quad_layout(const mesh::SurfaceMesh& mesh, const LayoutOption
   QSMESH_CHECK(
       mesh.quad_face.size() == mesh.quads.size() && mesh.vclass.size() == mesh.points.size(),
       "layout: inconsistent mesh arrays");
-  QuadLayout out;
-  out.quad2block.assign(mesh.quads.size(), -1);
   const auto nf = static_cast<std::size_t>(std::max<LO>(mesh.num_cad_faces, 0));
   Layouter layouter(mesh);
+  std::vector<char> bad = layouter.face_unblocked();  // faces that get no block
   std::vector<char> faces(nf, 0);
-  for (std::size_t f = 0; f < nf; ++f) faces[f] = layouter.face_unblocked()[f] == 0 ? 1 : 0;
+  for (std::size_t f = 0; f < nf; ++f) faces[f] = bad[f] ? 0 : 1;
 
+  QuadLayout out;
   layouter.trace(layouter.starts(nullptr), options.motorcycle);
-  QuadLayout first;
-  first.quad2block.assign(mesh.quads.size(), -1);
-  std::vector<LO> failed = layouter.patches(faces, first);
+  std::vector<Grid> grids;
+  const std::vector<LO> failed = layouter.patches(faces, grids);
   std::vector<char> again(nf, 0);
   for (LO f : failed) again[static_cast<std::size_t>(f)] = 1;
-
-  QuadLayout second;
-  second.quad2block.assign(mesh.quads.size(), -1);
-  std::vector<LO> still_failed;
   if (!failed.empty() && options.motorcycle) {
+    // Those faces' first grids go; their traces are run again, extended.
+    std::erase_if(grids,
+                  [&](const Grid& g) { return again[static_cast<std::size_t>(g.face)] != 0; });
     layouter.clear_traces(again);
     layouter.trace(layouter.starts(&again), false);
-    still_failed = layouter.patches(again, second);
+    for (LO f : layouter.patches(again, grids)) bad[static_cast<std::size_t>(f)] = 1;
     out.faces_with_extended_traces = static_cast<LO>(failed.size());
   } else {
-    still_failed = failed;
+    for (LO f : failed) bad[static_cast<std::size_t>(f)] = 1;
   }
-  std::vector<char> bad(nf, 0);
-  for (std::size_t f = 0; f < nf; ++f) bad[f] = layouter.face_unblocked()[f];
-  for (LO f : still_failed) bad[static_cast<std::size_t>(f)] = 1;
+  std::erase_if(grids, [&](const Grid& g) { return bad[static_cast<std::size_t>(g.face)] != 0; });
+  // By face; within a face the grids are already in the order of their smallest quad.
+  std::stable_sort(grids.begin(), grids.end(),
+                   [](const Grid& a, const Grid& b) { return a.face < b.face; });
+  if (options.merge) merge_blocks(grids, mesh);
 
-  // Blocks by face: those of the first pass for the faces that passed, of the second for the faces
-  // traced again; faces failing both keep no block.
-  std::vector<std::vector<std::pair<const QuadLayout*, GO>>> by_face(nf);
-  for (const QuadLayout* from : {&first, &second})
-    for (std::size_t k = 0; k < from->blocks.size(); ++k) {
-      const auto f = static_cast<std::size_t>(from->blocks[k].face);
-      const bool use = from == &first ? (faces[f] && !again[f]) : again[f] != 0;
-      if (use && !bad[f]) by_face[f].emplace_back(from, static_cast<GO>(k));
-    }
-  std::vector<GO> remap_first(first.blocks.size(), -1), remap_second(second.blocks.size(), -1);
-  for (std::size_t f = 0; f < nf; ++f)
-    for (const auto& [from, k] : by_face[f]) {
-      const Block& b = from->blocks[static_cast<std::size_t>(k)];
-      Block c = b;
-      c.first = static_cast<std::int64_t>(out.vertices.size());
-      const auto n = static_cast<std::int64_t>(b.ni + 1) * static_cast<std::int64_t>(b.nj + 1);
-      out.vertices.insert(out.vertices.end(), from->vertices.begin() + b.first,
-                          from->vertices.begin() + b.first + n);
-      (from == &first ? remap_first : remap_second)[static_cast<std::size_t>(k)] =
-          static_cast<GO>(out.blocks.size());
-      out.blocks.push_back(c);
-    }
-  for (std::size_t q = 0; q < mesh.quads.size(); ++q) {
-    if (first.quad2block[q] >= 0 && remap_first[static_cast<std::size_t>(first.quad2block[q])] >= 0)
-      out.quad2block[q] = remap_first[static_cast<std::size_t>(first.quad2block[q])];
-    if (second.quad2block[q] >= 0 &&
-        remap_second[static_cast<std::size_t>(second.quad2block[q])] >= 0)
-      out.quad2block[q] = remap_second[static_cast<std::size_t>(second.quad2block[q])];
+  out.quad2block.assign(mesh.quads.size(), -1);
+  for (Grid& g : grids) {
+    for (GO q : g.quads)
+      out.quad2block[static_cast<std::size_t>(q)] = static_cast<GO>(out.blocks.size());
+    out.blocks.push_back({g.face, g.ni, g.nj, static_cast<std::int64_t>(out.vertices.size())});
+    out.vertices.insert(out.vertices.end(), g.v.begin(), g.v.end());
   }
   for (std::size_t f = 0; f < nf; ++f)
     if (bad[f]) out.unblocked_faces.push_back(static_cast<LO>(f));
-  if (!options.merge) return out;
-
-  std::vector<Grid> grids(out.blocks.size());
-  for (std::size_t k = 0; k < grids.size(); ++k) {
-    const Block& b = out.blocks[k];
-    grids[k].face = b.face;
-    grids[k].ni = b.ni;
-    grids[k].nj = b.nj;
-    const auto n = static_cast<std::int64_t>(b.ni + 1) * static_cast<std::int64_t>(b.nj + 1);
-    grids[k].v.assign(out.vertices.begin() + b.first, out.vertices.begin() + b.first + n);
-  }
-  std::vector<GO> merged_into;
-  merge_blocks(grids, mesh.bars, mesh.num_vertices(), merged_into);
-  QuadLayout merged;
-  merged.unblocked_faces = out.unblocked_faces;
-  merged.faces_with_extended_traces = out.faces_with_extended_traces;
-  std::vector<GO> new_id(grids.size(), -1);
-  for (std::size_t k = 0; k < grids.size(); ++k) {
-    if (merged_into[k] != static_cast<GO>(k)) continue;
-    new_id[k] = static_cast<GO>(merged.blocks.size());
-    Block b;
-    b.face = grids[k].face;
-    b.ni = grids[k].ni;
-    b.nj = grids[k].nj;
-    b.first = static_cast<std::int64_t>(merged.vertices.size());
-    merged.vertices.insert(merged.vertices.end(), grids[k].v.begin(), grids[k].v.end());
-    merged.blocks.push_back(b);
-  }
-  merged.quad2block.assign(mesh.quads.size(), -1);
-  for (std::size_t q = 0; q < mesh.quads.size(); ++q)
-    if (out.quad2block[q] >= 0)
-      merged.quad2block[q] = new_id[static_cast<std::size_t>(
-          merged_into[static_cast<std::size_t>(out.quad2block[q])])];
-  return merged;
   return out;
 }
 

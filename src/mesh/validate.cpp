@@ -6,6 +6,8 @@
 #include <sstream>
 #include <unordered_map>
 
+#include "qsmesh/mesh/edges.hpp"
+
 namespace qsmesh::mesh {
 
 std::string ConformityReport::summary() const {
@@ -26,7 +28,6 @@ struct EdgeUse {
 ConformityReport check_conformity(const SurfaceMesh& mesh, const cad::CadModel& model) {
   ConformityReport r;
   std::unordered_map<std::uint64_t, std::vector<EdgeUse>> uses;
-  auto key = [](GO a, GO b) { return (static_cast<std::uint64_t>(std::min(a, b)) << 32) | static_cast<std::uint64_t>(std::max(a, b)); };
   std::vector<std::int64_t> per_face(static_cast<std::size_t>(model.num_faces()), 0);
   auto add = [&](const GO* v, int n, LO face) {
     ++per_face[face];
@@ -38,7 +39,7 @@ ConformityReport check_conformity(const SurfaceMesh& mesh, const cad::CadModel& 
         }
     for (int i = 0; i < n; ++i) {
       const GO a = v[i], b = v[(i + 1) % n];
-      uses[key(a, b)].push_back({face, a < b});
+      uses[edge_key(a, b)].push_back({face, a < b});
     }
   };
   for (std::size_t i = 0; i < mesh.triangles.size(); ++i) add(mesh.triangles[i].data(), 3, mesh.triangle_face[i]);
@@ -49,8 +50,7 @@ ConformityReport check_conformity(const SurfaceMesh& mesh, const cad::CadModel& 
   for (const auto& f : model.faces())
     for (const auto& l : f.loops)
       for (const auto& u : l.uses) ++curve_uses[u.curve];
-  std::unordered_map<std::uint64_t, LO> bar_curve;
-  for (std::size_t i = 0; i < mesh.bars.size(); ++i) bar_curve[key(mesh.bars[i][0], mesh.bars[i][1])] = mesh.bar_curve[i];
+  const std::unordered_map<std::uint64_t, LO> bar_curve = bar_curves(mesh);
 
   r.edges = static_cast<std::int64_t>(uses.size());
   for (const auto& [k, list] : uses) {

@@ -79,6 +79,25 @@ mesh::SurfaceMesh two_faces(int a, int b, int n) {
   return m;
 }
 
+// two_faces(2, 2, 2) with the last quad of face 1 split into two triangles.
+mesh::SurfaceMesh two_faces_with_triangles() {
+  mesh::SurfaceMesh m = two_faces(2, 2, 2);
+  const auto q = m.quads.back();
+  m.quads.pop_back();
+  m.quad_face.pop_back();
+  m.triangles = {{q[0], q[1], q[2]}, {q[0], q[2], q[3]}};
+  m.triangle_face = {1, 1};
+  return m;
+}
+
+// A fresh, empty folder under the test temp folder.
+fs::path fresh_dir(const std::string& name) {
+  const fs::path dir = fs::path(qsmesh::test::tmp_dir()) / name;
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  return dir;
+}
+
 // A triangular face of three quads around a valence-3 vertex O: corners A, B, C; the midpoints of
 // its three curves; the triangle pattern of paper 000 Fig. 4.
 mesh::SurfaceMesh triangle_face() {
@@ -197,13 +216,7 @@ TEST(QuadLayout, BlocksAreNotMergedAcrossCurves) {
 }
 
 TEST(QuadLayout, FacesWithTrianglesAreLeftOut) {
-  mesh::SurfaceMesh m = two_faces(2, 2, 2);
-  // Split the last quad of face 1 into two triangles.
-  const auto q = m.quads.back();
-  m.quads.pop_back();
-  m.quad_face.pop_back();
-  m.triangles = {{q[0], q[1], q[2]}, {q[0], q[2], q[3]}};
-  m.triangle_face = {1, 1};
+  const mesh::SurfaceMesh m = two_faces_with_triangles();
   const QuadLayout l = extract_quad_layout(m);
   ASSERT_EQ(l.blocks.size(), 1u);
   EXPECT_EQ(l.blocks[0].face, 0);
@@ -213,9 +226,7 @@ TEST(QuadLayout, FacesWithTrianglesAreLeftOut) {
 }
 
 TEST(CgnsBlocks, InterfacesJoinTheSamePoints) {
-  const fs::path dir = fs::path(qsmesh::test::tmp_dir()) / "cgns_blocks";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
+  const fs::path dir = fresh_dir("cgns_blocks");
   for (const bool triangle : {false, true}) {
     const mesh::SurfaceMesh m = triangle ? triangle_face() : two_faces(4, 2, 3);
     const QuadLayout l = extract_quad_layout(m);
@@ -237,15 +248,8 @@ TEST(CgnsBlocks, InterfacesJoinTheSamePoints) {
 }
 
 TEST(CgnsBlocks, UnblockedFacesGoToAnUnstructuredZone) {
-  const fs::path dir = fs::path(qsmesh::test::tmp_dir()) / "cgns_blocks_mixed";
-  fs::remove_all(dir);
-  fs::create_directories(dir);
-  mesh::SurfaceMesh m = two_faces(2, 2, 2);
-  const auto q = m.quads.back();
-  m.quads.pop_back();
-  m.quad_face.pop_back();
-  m.triangles = {{q[0], q[1], q[2]}, {q[0], q[2], q[3]}};
-  m.triangle_face = {1, 1};
+  const fs::path dir = fresh_dir("cgns_blocks_mixed");
+  const mesh::SurfaceMesh m = two_faces_with_triangles();
   const QuadLayout l = extract_quad_layout(m);
   const std::string path = (dir / "mixed.cgns").string();
   io::write_cgns_blocks(m, l, path);

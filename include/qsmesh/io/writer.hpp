@@ -61,6 +61,10 @@ struct WriteOptions {
 /// (check_mesh_for_output) or writing fails.
 void write_mesh(const mesh::SurfaceMesh& mesh, const std::string& path, const WriteOptions& options = {});
 
+/// Output formats, from the extension of the path (case-insensitive): .cgns, .vtu, .msh, .h5.
+enum class Format { kNone, kCgns, kVtu, kMsh, kHdf5 };
+[[nodiscard]] Format output_format(const std::string& path);
+
 /// True when the extension of `path` names a format write_mesh writes (case-insensitive).
 [[nodiscard]] bool is_supported_output(const std::string& path);
 
