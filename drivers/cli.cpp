@@ -268,7 +268,8 @@ std::string help(const std::string& topic) {
           "  -v, --verbose         print per-face details (with the quad stages: method, why no\n"
           "                        pattern was kept, counts, irregular vertices, SICN and time of\n"
           "                        every face)\n\n"
-          "Exit codes: 0 success, 2 bad input (one line on stderr says what to fix), 1 internal error.\n";
+          "Exit codes: 0 success, 2 bad input (one line on stderr says what to fix), 1 the output\n"
+          "could not be written (disk full, say; nothing half-written is left) or an internal error.\n";
   } else if (topic == "crossfield") {
     os << "usage: [mpirun -np P] qsmesh crossfield MODEL [-o OUT.vtu] [--check] [options]\n\n"
           "Computes, on the background triangulation of every CAD face, the boundary-aligned cross\n"

@@ -49,7 +49,7 @@ void check_writable(const std::string& option, const std::string& path) {
 
 void write_text_file_atomically(const std::string& path, const std::string& text) {
   io::AtomicFile file(path);
-  io::OutputFile out(file.temp_path());
+  io::OutputFile out(file.temp_path(), path);
   out << std::string_view(text);
   out.close();
   file.commit();
@@ -455,7 +455,7 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
     const highorder::QuadraticReport& q = *checks.quadratic;
     os << "  second-order nodes: " << q.curve_nodes << " on curves, " << q.face_nodes
        << " in faces (" << q.unprojected
-       << " left straight: no CAD point near); quads whose face nodes went back "
+       << " off the CAD: no CAD point near, or put back straight); quads whose face nodes went back "
        << "straight to stay valid " << q.straightened << ", made entirely straight "
        << q.curve_straightened << ", still invalid " << q.invalid << "\n";
   }

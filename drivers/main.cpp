@@ -8,10 +8,12 @@
 #include "commands.hpp"
 #include "qsmesh/cad/model.hpp"
 #include "qsmesh/core/error.hpp"
+#include "qsmesh/io/writer.hpp"
 #include "qsmesh/parallel/comm.hpp"
 
 int main(int argc, char** argv) {
   using namespace qsmesh;
+  io::prepare_output_libraries();
   std::vector<std::string> args(argv + 1, argv + argc);
   cli::Arguments parsed;
   try {
@@ -40,6 +42,9 @@ int main(int argc, char** argv) {
     } catch (const InputError& e) {
       std::cerr << "qsmesh: " << e.what() << "\n";
       return 2;
+    } catch (const OutputError& e) {
+      std::cerr << "qsmesh: " << e.what() << "\n";
+      return 1;
     } catch (const std::exception& e) {
       std::cerr << "qsmesh: internal error: " << e.what() << "\n";
       return 1;
@@ -58,6 +63,11 @@ int main(int argc, char** argv) {
     // Every rank reads the same input and fails the same way: one line, from rank 0.
     if (root) std::cerr << "qsmesh: " << e.what() << "\n";
     return 2;
+  } catch (const OutputError& e) {
+    // Only rank 0 writes: the disk, not the mesh, failed.
+    std::cerr << "qsmesh: " << e.what() << "\n";
+    if (parallel::Comm::world().size() > 1) parallel::MpiSession::abort(1);
+    return 1;
   } catch (const std::exception& e) {
     std::cerr << "qsmesh: internal error: " << e.what() << "\n";
     if (parallel::Comm::world().size() > 1) parallel::MpiSession::abort(1);

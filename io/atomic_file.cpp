@@ -42,7 +42,7 @@ void AtomicFile::commit() {
     const int err = errno;
     std::error_code ec;
     fs::remove(fs::path(temp_), ec);
-    throw Error("cannot rename " + temp_ + " to " + path_ + ": " + std::strerror(err));
+    throw OutputError("cannot rename " + temp_ + " to " + path_ + ": " + std::strerror(err));
   }
   committed_ = true;
 }
@@ -51,10 +51,11 @@ namespace {
 constexpr std::size_t kFlushBytes = std::size_t{1} << 20;
 }
 
-OutputFile::OutputFile(const std::string& path) : name_(path) {
+OutputFile::OutputFile(const std::string& path, std::string shown)
+    : name_(shown.empty() ? path : std::move(shown)) {
   file_ = std::fopen(path.c_str(), "wb");
   if (file_ == nullptr) {
-    throw Error("cannot open " + path + " for writing: " + std::strerror(errno));
+    throw OutputError("cannot open " + name_ + " for writing: " + std::strerror(errno));
   }
   buffer_.reserve(kFlushBytes + 4096);
 }
@@ -67,7 +68,7 @@ void OutputFile::flush() {
   QSMESH_CHECK(file_ != nullptr, "write to closed file " << name_);
   if (buffer_.empty()) return;
   if (std::fwrite(buffer_.data(), 1, buffer_.size(), file_) != buffer_.size()) {
-    throw Error("cannot write " + name_ + ": " + std::strerror(errno));
+    throw OutputError("cannot write " + name_ + ": " + std::strerror(errno));
   }
   buffer_.clear();
 }
@@ -108,7 +109,7 @@ void OutputFile::close() {
   const bool ok = std::fflush(f) == 0 && ::fsync(::fileno(f)) == 0;
   const int err = errno;
   if (std::fclose(f) != 0 || !ok) {
-    throw Error("cannot write " + name_ + ": " + std::strerror(ok ? errno : err));
+    throw OutputError("cannot write " + name_ + ": " + std::strerror(ok ? errno : err));
   }
 }
 

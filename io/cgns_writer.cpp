@@ -31,10 +31,18 @@ namespace qsmesh::io {
 
 namespace {
 
-// Every cgnslib call goes through here: a nonzero return becomes an Error naming the call and file.
+// The function a QSMESH_CG / QSMESH_CGIO call names (the text before its argument list).
+std::string function_of(const char* call) {
+  const std::string_view text(call);
+  return std::string(text.substr(0, text.find('(')));
+}
+
+// Every cgnslib call goes through here: a nonzero return becomes an OutputError naming the file and
+// the function (with cgnslib's reason: a full disk shows as a failed H5Dwrite).
 void cg_check(int rc, const char* call, const std::string& path) {
   if (rc != CG_OK) {
-    throw Error("CGNS " + std::string(call) + " failed for " + path + ": " + cg_get_error());
+    throw OutputError("cannot write " + path + ": CGNS " + function_of(call) + " failed: " +
+                      cg_get_error());
   }
 }
 #define QSMESH_CG(call) cg_check((call), #call, path)
@@ -43,7 +51,7 @@ void cgio_check(int rc, const char* call, const std::string& path) {
   if (rc != CGIO_ERR_NONE) {
     char msg[CGIO_MAX_ERROR_LENGTH + 1] = {};
     cgio_error_message(msg);
-    throw Error("CGNS " + std::string(call) + " failed for " + path + ": " + msg);
+    throw OutputError("cannot write " + path + ": CGNS " + function_of(call) + " failed: " + msg);
   }
 }
 #define QSMESH_CGIO(call) cgio_check((call), #call, path)
@@ -530,7 +538,9 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
                  c = side_vertex(b, s, p + 1, layout.vertices);
         std::vector<Run> next;
         for (const Use& u : edge_uses.at(edge_key(a, c))) {
-          if (u.block == k && u.side == s) continue;
+          // The edge itself; another position of this same side (a side running along both
+          // banks of a seam) is an interface of the block with itself.
+          if (u.block == k && u.side == s && u.p == p) continue;
           auto it = std::find_if(open.begin(), open.end(), [&](const Run& r) {
             if (r.block != u.block || r.side != u.side || r.p1 != p - 1) return false;
             const LO step = r.p1 > r.p0 ? (r.d1 - r.d0) / (r.p1 - r.p0) : u.p - r.d1;

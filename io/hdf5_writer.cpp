@@ -28,7 +28,10 @@ static_assert(std::endian::native == std::endian::little,
 // HDF5 calls return a negative value on failure; every one goes through here.
 template <typename T>
 T h5_check(T rc, const char* call, const std::string& path) {
-  if (rc < 0) throw Error("HDF5 " + std::string(call) + " failed for " + path);
+  if (rc < 0) {
+    const std::string_view text(call);
+    throw Error("HDF5 " + std::string(text.substr(0, text.find('('))) + " failed for " + path);
+  }
   return rc;
 }
 #define QSMESH_H5(call) h5_check((call), #call, path)
@@ -55,17 +58,46 @@ class H5Handle {
   Closer closer_;
 };
 
-// One file, every object created without timestamps, so that the same mesh gives the same bytes.
+// HDF5's error stack printing off while the writer runs (its failures become one Error line), and
+// back to what it was after.
+class QuietHdf5Errors {
+ public:
+  QuietHdf5Errors() {
+    H5Eget_auto2(H5E_DEFAULT, &func_, &data_);
+    H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  }
+  QuietHdf5Errors(const QuietHdf5Errors&) = delete;
+  QuietHdf5Errors& operator=(const QuietHdf5Errors&) = delete;
+  ~QuietHdf5Errors() { H5Eset_auto2(H5E_DEFAULT, func_, data_); }
+
+ private:
+  H5E_auto2_t func_ = nullptr;
+  void* data_ = nullptr;
+};
+
+// One file, built in memory (HDF5's core driver, no backing store) and every object created
+// without timestamps, so that the same mesh gives the same bytes. HDF5 never touches the disk:
+// image() hands the bytes to OutputFile, whose checked writes report a full disk as one error,
+// where a failed HDF5 write would leave the library holding a half-closed file that its exit
+// handler then crashes on.
 class H5Writer {
  public:
-  H5Writer(const std::string& temp_path, std::string name)
+  explicit H5Writer(std::string name)
       : path_(std::move(name)),
-        file_(H5Fcreate(temp_path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT), H5Fclose),
+        fapl_(H5Pcreate(H5P_FILE_ACCESS), H5Pclose),
+        file_(create_in_memory(path_, fapl_.get()), H5Fclose),
         dcpl_(H5Pcreate(H5P_DATASET_CREATE), H5Pclose) {
     const std::string& path = path_;
     QSMESH_H5(file_.get());
     QSMESH_H5(dcpl_.get());
     QSMESH_H5(H5Pset_obj_track_times(dcpl_.get(), 0));
+  }
+
+  // Grows the image 4 MiB at a time; the name only labels errors (nothing is opened by it).
+  static hid_t create_in_memory(const std::string& path, hid_t fapl) {
+    QSMESH_H5(fapl);
+    QSMESH_H5(H5Pset_fapl_core(fapl, std::size_t{1} << 22, 0));
+    return H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
   }
 
   // A dataset of rows x cols values (cols 0: one dimension), written from `data` (row-major).
@@ -115,14 +147,22 @@ class H5Writer {
     QSMESH_H5(type.close());
   }
 
-  void close() {
+  // The bytes of the finished file; the writer is closed afterwards.
+  std::vector<unsigned char> image() {
     const std::string& path = path_;
+    QSMESH_H5(H5Fflush(file_.get(), H5F_SCOPE_GLOBAL));
+    const ssize_t size = QSMESH_H5(H5Fget_file_image(file_.get(), nullptr, 0));
+    std::vector<unsigned char> bytes(static_cast<std::size_t>(size));
+    QSMESH_H5(H5Fget_file_image(file_.get(), bytes.data(), bytes.size()));
     QSMESH_H5(dcpl_.close());
     QSMESH_H5(file_.close());
+    QSMESH_H5(fapl_.close());
+    return bytes;
   }
 
  private:
   std::string path_;
+  H5Handle fapl_;
   H5Handle file_;
   H5Handle dcpl_;
 };
@@ -184,10 +224,12 @@ void write_hdf5(const mesh::SurfaceMesh& mesh, const std::string& path,
   const std::string xdmf = xdmf_path_for(path);
   AtomicFile h5_out(path);
   AtomicFile xdmf_out(xdmf);
+  const bool quadratic = !mesh.quad_nodes.empty();
   {
-    H5Writer h5(h5_out.temp_path(), path);
+    const QuietHdf5Errors quiet;
+    H5Writer h5(path);
     h5.attribute("format", std::string("qsmesh surface mesh"));
-    h5.attribute("format_version", std::int64_t{1});
+    h5.attribute("format_version", std::int64_t{2});
     h5.attribute("length_unit", mesh.length_unit);
     h5.attribute("num_cad_corners", std::int64_t{mesh.num_cad_corners});
     h5.attribute("num_cad_curves", std::int64_t{mesh.num_cad_curves});
@@ -215,9 +257,19 @@ void write_hdf5(const mesh::SurfaceMesh& mesh, const std::string& path,
     h5.dataset("bars", H5T_STD_I64LE, nb, 2, mesh.bars.data());
     h5.dataset("bar_cad_curve", H5T_STD_I32LE, nb, 0, mesh.bar_curve.data());
     h5.dataset("curve_corners", H5T_STD_I32LE, nc, 2, mesh.curve_corners.data());
-    if (!mesh.quad_nodes.empty()) {
-      h5.dataset("quad_nodes", H5T_STD_I64LE, nq, 5, mesh.quad_nodes.data());
-      h5.dataset("bar_nodes", H5T_STD_I64LE, nb, 0, mesh.bar_nodes.data());
+    if (quadratic) {
+      // Whole second-order connectivities, corners first, so that a reader (and XDMF) needs one
+      // dataset per element kind.
+      std::vector<std::array<GO, 9>> quad9(static_cast<std::size_t>(nq));
+      for (std::size_t q = 0; q < quad9.size(); ++q) {
+        std::copy(mesh.quads[q].begin(), mesh.quads[q].end(), quad9[q].begin());
+        std::copy(mesh.quad_nodes[q].begin(), mesh.quad_nodes[q].end(), quad9[q].begin() + 4);
+      }
+      std::vector<std::array<GO, 3>> bar3(static_cast<std::size_t>(nb));
+      for (std::size_t b = 0; b < bar3.size(); ++b)
+        bar3[b] = {mesh.bars[b][0], mesh.bars[b][1], mesh.bar_nodes[b]};
+      h5.dataset("quad9", H5T_STD_I64LE, nq, 9, quad9.data());
+      h5.dataset("bar3", H5T_STD_I64LE, nb, 3, bar3.data());
     }
     {
       std::vector<std::int64_t> offsets(mesh.face2curves.offsets.begin(),
@@ -229,14 +281,17 @@ void write_hdf5(const mesh::SurfaceMesh& mesh, const std::string& path,
                  static_cast<std::int64_t>(mesh.face2curves.targets.size()), 0,
                  mesh.face2curves.targets.data());
     }
-    h5.close();
+    const std::vector<unsigned char> bytes = h5.image();
+    OutputFile out(h5_out.temp_path(), path);
+    out.write(bytes.data(), bytes.size());
+    out.close();
   }
 
   // XDMF: a spatial collection of one grid per element kind, all on the same points; ParaView shows
   // each as a block with cell data cad_face (or cad_curve) and point data cad_dim / cad_entity.
   {
     const std::string h5_name = xml_escape(fs::path(path).filename().string());
-    OutputFile x(xdmf_out.temp_path());
+    OutputFile x(xdmf_out.temp_path(), xdmf);
     x << "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n <Domain>\n"
       << "  <Grid Name=\"qsmesh\" GridType=\"Collection\" CollectionType=\"Spatial\">\n";
     auto grid = [&](const char* name, const char* topology, int nodes, std::int64_t n,
@@ -259,9 +314,14 @@ void write_hdf5(const mesh::SurfaceMesh& mesh, const std::string& path,
       }
       x << "   </Grid>\n";
     };
-    grid("quads", "Quadrilateral", 4, nq, "quads", "cad_face", "quad_cad_face");
-    grid("triangles", "Triangle", 3, nt, "triangles", "cad_face", "triangle_cad_face");
-    grid("curves", "Polyline", 2, nb, "bars", "cad_curve", "bar_cad_curve");
+    if (quadratic) {
+      grid("quads", "Quadrilateral_9", 9, nq, "quad9", "cad_face", "quad_cad_face");
+      grid("curves", "Edge_3", 3, nb, "bar3", "cad_curve", "bar_cad_curve");
+    } else {
+      grid("quads", "Quadrilateral", 4, nq, "quads", "cad_face", "quad_cad_face");
+      grid("triangles", "Triangle", 3, nt, "triangles", "cad_face", "triangle_cad_face");
+      grid("curves", "Polyline", 2, nb, "bars", "cad_curve", "bar_cad_curve");
+    }
     x << "  </Grid>\n </Domain>\n</Xdmf>\n";
     x.close();
   }

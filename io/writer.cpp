@@ -1,5 +1,6 @@
 #include "qsmesh/io/writer.hpp"
 
+#include <hdf5.h>
 #include <unistd.h>
 
 #include <algorithm>
@@ -35,7 +36,20 @@ void check_output_path(const std::string& path) {
                      "': unsupported format (the extension must be .cgns, .vtu, .msh or .h5)");
   }
   detail::check_output_folder(path);
-  if (output_format(path) == Format::kHdf5) detail::check_output_folder(xdmf_path_for(path));
+  if (output_format(path) == Format::kHdf5) {
+    // XDMF names its data "file:/dataset" and splits at the first colon.
+    if (fs::path(path).filename().string().find(':') != std::string::npos)
+      throw InputError("output '" + path +
+                       "': an .h5 file name cannot contain ':' (the XDMF description beside it "
+                       "could not refer to it); rename it");
+    detail::check_output_folder(xdmf_path_for(path));
+  }
+}
+
+void prepare_output_libraries() {
+  // Without this, a CGNS file whose write failed (disk full) stays half-open inside HDF5, and the
+  // library's exit handler crashes on it after the run has already reported the error.
+  H5dont_atexit();
 }
 
 namespace detail {

@@ -239,13 +239,6 @@ QuadraticReport make_quadratic(mesh::SurfaceMesh& m, const cad::CadModel& model,
   });
 
   QuadraticReport report;
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    if (vclass[i].dim == 1)
-      ++report.curve_nodes;
-    else
-      ++report.face_nodes;
-    if (!projected[i]) ++report.unprojected;
-  }
 
   // Validity: a curved quad that folds gets its face nodes back on the straight positions.
   auto node_point = [&](GO id) {
@@ -283,10 +276,12 @@ QuadraticReport make_quadratic(mesh::SurfaceMesh& m, const cad::CadModel& model,
       if (vclass[node].dim != 2 && !curve_nodes_too) continue;
       points[node] = 0.5 * (m.points[static_cast<std::size_t>(quad[k])] +
                             m.points[static_cast<std::size_t>(quad[(k + 1) % 4])]);
+      projected[node] = 0;
     }
     Vec3 centre{};
     for (GO v : quad) centre += m.points[static_cast<std::size_t>(v)];
     points[static_cast<std::size_t>(ne + q)] = 0.25 * centre;
+    projected[static_cast<std::size_t>(ne + q)] = 0;
   };
   for (GO q = 0; q < nq; ++q) {
     if (quad9_valid(element(q), linear_normal(q))) continue;
@@ -312,6 +307,19 @@ QuadraticReport make_quadratic(mesh::SurfaceMesh& m, const cad::CadModel& model,
     }
     for (GO q = 0; q < nq; ++q)
       if (!quad9_valid(element(q), linear_normal(q))) ++report.invalid;
+  }
+
+  // A node off its entity keeps the entity it belongs to (dim, id) but no parameters: a reader
+  // that evaluated them would put it back on the CAD, curving the quad that had to go straight.
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (vclass[i].dim == 1)
+      ++report.curve_nodes;
+    else
+      ++report.face_nodes;
+    if (projected[i]) continue;
+    ++report.unprojected;
+    vclass[i].param = {std::numeric_limits<double>::quiet_NaN(),
+                       std::numeric_limits<double>::quiet_NaN()};
   }
 
   m.points.insert(m.points.end(), points.begin(), points.end());

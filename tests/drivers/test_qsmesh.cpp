@@ -1,5 +1,6 @@
 // End-to-end tests of the qsmesh executable: help, info, example, mesh, and bad input.
 #include <gtest/gtest.h>
+#include <hdf5.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -231,6 +232,67 @@ TEST_F(Qsmesh, SecondOrderNodesLieOnTheCad) {
     }
     EXPECT_EQ(off, 0) << model;
   }
+}
+
+// A whole dataset of the HDF5 file `file` as doubles (HDF5 converts), empty when it is missing.
+std::vector<double> h5_values(hid_t file, const char* name) {
+  std::vector<double> out;
+  const hid_t set = H5Dopen2(file, name, H5P_DEFAULT);
+  if (set < 0) return out;
+  const hid_t space = H5Dget_space(set);
+  out.resize(static_cast<std::size_t>(H5Sget_simple_extent_npoints(space)));
+  if (!out.empty() &&
+      H5Dread(set, H5T_NATIVE_DOUBLE, H5S_ALL, H5S_ALL, H5P_DEFAULT, out.data()) < 0)
+    out.clear();
+  H5Sclose(space);
+  H5Dclose(set);
+  return out;
+}
+
+TEST_F(Qsmesh, SecondOrderNodesOffTheCadHaveNoParameters) {
+  // The wing-body example at a coarse size has quads that fold when curved (the wing's leading
+  // edge): their nodes go back to the straight positions, off the CAD. Those, and only those,
+  // carry NaN parameters, so that nothing re-evaluates them onto the CAD.
+  const std::string step = tmp("e2e_wing_body_o2.step");
+  ASSERT_EQ(run("example wing-body -o " + step).code, 0);
+  const std::string out = tmp("e2e_wing_body_o2.h5");
+  const std::string stats = tmp("e2e_wing_body_o2.json");
+  const ExeResult r =
+      run("mesh " + step + " -o " + out + " --order 2 --size-factor 0.05 -q --stats " + stats);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string json = slurp(stats);
+  EXPECT_GT(json_number(json, "high_order_straightened_quads"), 0);
+  const hid_t file = H5Fopen(out.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(file, 0);
+  const std::vector<double> xyz = h5_values(file, "coordinates");
+  const std::vector<double> param = h5_values(file, "vertex_cad_param");
+  const std::vector<double> quad9 = h5_values(file, "quad9");
+  H5Fclose(file);
+  ASSERT_EQ(param.size(), xyz.size() / 3 * 2);
+  ASSERT_EQ(quad9.size(), 9 * static_cast<std::size_t>(json_number(json, "quads")));
+  std::size_t off = 0;
+  for (std::size_t v = 0; v < param.size() / 2; ++v) off += std::isnan(param[2 * v]) ? 1 : 0;
+  EXPECT_EQ(static_cast<double>(off), json_number(json, "high_order_unprojected_nodes"));
+  EXPECT_GT(off, 0u);
+  // Every node off the CAD sits at its straight position: its edge's midpoint or its quad's
+  // centre.
+  auto point = [&](double id, int d) { return xyz[3 * static_cast<std::size_t>(id) + d]; };
+  std::size_t straight = 0;
+  for (std::size_t q = 0; q < quad9.size() / 9; ++q) {
+    const double* e = &quad9[9 * q];
+    for (int k = 0; k < 5; ++k) {
+      const auto node = static_cast<std::size_t>(e[4 + k]);
+      if (!std::isnan(param[2 * node])) continue;
+      for (int d = 0; d < 3; ++d) {
+        const double want = k < 4 ? 0.5 * (point(e[k], d) + point(e[(k + 1) % 4], d))
+                                  : 0.25 * (point(e[0], d) + point(e[1], d) + point(e[2], d) +
+                                            point(e[3], d));
+        EXPECT_NEAR(point(e[4 + k], d), want, 1e-9) << "quad " << q << " node " << k;
+      }
+      ++straight;
+    }
+  }
+  EXPECT_GE(straight, off);  // an edge node is seen from both of its quads
 }
 
 TEST_F(Qsmesh, BlockStructuredCgnsJoinsItsBlocks) {

@@ -2,7 +2,10 @@
 #include <gtest/gtest.h>
 #include <hdf5.h>
 
+#include <sys/resource.h>
+
 #include <chrono>
+#include <csignal>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -84,7 +87,7 @@ TEST(Hdf5, ReadBack) {
   const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
   ASSERT_GE(file, 0);
   EXPECT_EQ(read_string_attribute(file, "format"), "qsmesh surface mesh");
-  EXPECT_EQ(read_int_attribute(file, "format_version"), 1);
+  EXPECT_EQ(read_int_attribute(file, "format_version"), 2);
   EXPECT_EQ(read_string_attribute(file, "length_unit"), "mm");
   EXPECT_EQ(read_int_attribute(file, "num_cad_corners"), 7);
   EXPECT_EQ(read_int_attribute(file, "num_cad_curves"), 10);
@@ -187,6 +190,88 @@ TEST(Hdf5, EmptyKindsAreZeroRowsAndNoGrid) {
   EXPECT_NE(x.find("Quadrilateral"), std::string::npos);
 }
 
+// Two quads [0,1]x[0,1] and [1,2]x[0,1] of face 0, bounded by the closed curve 0 at corner 0,
+// with second-order nodes: edge midpoints 6..12, centres 13 and 14.
+mesh::SurfaceMesh make_quadratic_mesh() {
+  mesh::SurfaceMesh m;
+  m.num_cad_corners = 1;
+  m.num_cad_curves = 1;
+  m.num_cad_faces = 1;
+  m.points = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {0, 1, 0}, {1, 1, 0}, {2, 1, 0},
+              {0.5, 0, 0}, {1, 0.5, 0}, {0.5, 1, 0}, {0, 0.5, 0}, {1.5, 0, 0}, {2, 0.5, 0},
+              {1.5, 1, 0}, {0.5, 0.5, 0.1}, {1.5, 0.5, 0.1}};
+  m.vclass.assign(m.points.size(), {1, 0, kNoIndex, {0, 0}});
+  m.vclass[0] = {0, 0, kNoIndex, {0, 0}};
+  for (std::size_t v : {std::size_t{7}, std::size_t{13}, std::size_t{14}})
+    m.vclass[v] = {2, 0, kNoIndex, {0.25, 0.25}};
+  m.quads = {{0, 1, 4, 3}, {1, 2, 5, 4}};
+  m.quad_face = {0, 0};
+  m.quad_nodes = {{6, 7, 8, 9, 13}, {10, 11, 12, 7, 14}};
+  m.bars = {{0, 1}, {1, 2}, {2, 5}, {5, 4}, {4, 3}, {3, 0}};
+  m.bar_curve.assign(m.bars.size(), 0);
+  m.bar_nodes = {6, 10, 11, 12, 8, 9};
+  m.curve_corners = {{0, 0}};
+  m.face2curves = Adjacency::from_pairs(1, {{0, 0}});
+  return m;
+}
+
+TEST(Hdf5, SecondOrderWholeConnectivitiesAndXdmf) {
+  // quad9 / bar3 hold corners then nodes (the order of CGNS QUAD_9 / BAR_3), and the XDMF
+  // description shows them as 9-node quads and 3-node edges.
+  const fs::path dir = fresh_dir("hdf5_order2");
+  const mesh::SurfaceMesh m = make_quadratic_mesh();
+  const std::string path = (dir / "q2.h5").string();
+  write_mesh(m, path);
+  const hid_t file = H5Fopen(path.c_str(), H5F_ACC_RDONLY, H5P_DEFAULT);
+  ASSERT_GE(file, 0);
+  const auto quad9 = read_dataset<std::int64_t>(file, "quad9", H5T_NATIVE_INT64);
+  EXPECT_EQ(quad9.dims, dims({2, 9}));
+  EXPECT_EQ(quad9.values,
+            (std::vector<std::int64_t>{0, 1, 4, 3, 6, 7, 8, 9, 13, 1, 2, 5, 4, 10, 11, 12, 7, 14}));
+  const auto bar3 = read_dataset<std::int64_t>(file, "bar3", H5T_NATIVE_INT64);
+  EXPECT_EQ(bar3.dims, dims({6, 3}));
+  EXPECT_EQ(bar3.values, (std::vector<std::int64_t>{0, 1, 6, 1, 2, 10, 2, 5, 11, 5, 4, 12, 4, 3,
+                                                     8, 3, 0, 9}));
+  const auto quads = read_dataset<std::int64_t>(file, "quads", H5T_NATIVE_INT64);
+  EXPECT_EQ(quads.dims, dims({2, 4}));
+  H5Fclose(file);
+  const std::string x = read_all(dir / "q2.xdmf");
+  for (const char* s : {"TopologyType=\"Quadrilateral_9\" NumberOfElements=\"2\"",
+                        "Dimensions=\"2 9\" NumberType=\"Int\" Precision=\"8\" Format=\"HDF\">q2.h5:/quad9<",
+                        "TopologyType=\"Edge_3\" NumberOfElements=\"6\"",
+                        "Dimensions=\"6 3\" NumberType=\"Int\" Precision=\"8\" Format=\"HDF\">q2.h5:/bar3<"})
+    EXPECT_NE(x.find(s), std::string::npos) << s;
+  EXPECT_EQ(x.find("TopologyType=\"Quadrilateral\""), std::string::npos);
+}
+
+TEST(Hdf5, FullDiskIsOneOutputErrorAndLeavesNothing) {
+  // A file size limit below the file's size: the write fails as the disk being full does. The
+  // writer reports it as one OutputError naming the file, and leaves neither file nor temporary.
+  const fs::path dir = fresh_dir("hdf5_full");
+  mesh::SurfaceMesh m = make_test_mesh();
+  for (int k = 0; k < 20000; ++k) {  // unused points, to make the file larger than the limit
+    m.points.push_back({static_cast<double>(k), 0, 0});
+    m.vclass.push_back({2, 1, kNoIndex, {0, 0}});
+  }
+  const auto old_handler = std::signal(SIGXFSZ, SIG_IGN);
+  rlimit old{};
+  ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &old), 0);
+  rlimit small = old;
+  small.rlim_cur = 64 * 1024;
+  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &small), 0);
+  std::string message;
+  try {
+    write_mesh(m, (dir / "m.h5").string());
+  } catch (const OutputError& e) {
+    message = e.what();
+  }
+  setrlimit(RLIMIT_FSIZE, &old);
+  std::signal(SIGXFSZ, old_handler);
+  EXPECT_NE(message.find("cannot write " + (dir / "m.h5").string()), std::string::npos) << message;
+  EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+  EXPECT_TRUE(dir_entries(dir).empty());
+}
+
 TEST(Hdf5, NoClockInTheBytes) {
   // Two writes more than a second apart (HDF5 object times have one-second resolution).
   const fs::path dir = fresh_dir("hdf5_clock");
@@ -205,6 +290,8 @@ TEST(Hdf5, FailuresLeaveNothing) {
   EXPECT_THROW(check_output_path((dir / "m.h5").string()), InputError);
   EXPECT_THROW(write_mesh(make_test_mesh(), (dir / "m.h5").string()), InputError);
   EXPECT_EQ(dir_entries(dir), std::vector<std::string>{"m.xdmf"});
+  // XDMF splits "file:/dataset" at the first colon: such a name is refused before any work.
+  EXPECT_THROW(check_output_path((dir / "a:b.h5").string()), InputError);
   // An inconsistent mesh: Error, and neither file nor temporary.
   mesh::SurfaceMesh bad = make_test_mesh();
   bad.quads[0][2] = 99;

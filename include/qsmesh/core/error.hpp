@@ -33,6 +33,14 @@ class Error : public std::runtime_error {
   ErrorContext context_;
 };
 
+/// The output could not be written (disk full, a file size limit, the folder gone mid-run): the
+/// mesh is fine, its destination is not. The drivers print what() as one line (not as an internal
+/// error) and exit 1; the writers have removed their temporary files by then.
+class OutputError : public Error {
+ public:
+  using Error::Error;
+};
+
 /// Bad input from the user (file, option). The drivers turn it into one line on stderr and exit 2.
 class InputError : public std::runtime_error {
  public:

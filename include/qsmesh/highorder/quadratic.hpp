@@ -14,8 +14,10 @@ namespace qsmesh::highorder {
 struct QuadraticReport {
   std::int64_t curve_nodes = 0;  ///< edge nodes on CAD curves
   std::int64_t face_nodes = 0;   ///< edge and centre nodes inside CAD faces
-  /// Nodes left at their straight (linear) position: the projection went further from it than the
-  /// edge is long (a wrong branch of a periodic surface, say).
+  /// Nodes not on the CAD in the result: left at their straight (linear) position because the
+  /// projection went further from it than the edge is long (a wrong branch of a periodic surface,
+  /// say), or put back there to keep a quad valid (straightened, below). Their classification
+  /// keeps the curve or face they belong to, with parameters NaN.
   std::int64_t unprojected = 0;
   /// Quads whose curved element was not valid (the Jacobian of the 9-node map not positive along
   /// the face normal at every node) and whose face nodes were put back on their straight positions.
@@ -31,7 +33,7 @@ struct QuadraticReport {
 /// Appends the second-order nodes to `mesh` (an assembled all-quad SurfaceMesh: no triangles):
 /// the midpoint of every mesh edge and the centre of every quad, projected on the CAD curve
 /// (bar edges) or face they lie on, and classified there (dim 1 with the curve parameter, dim 2
-/// with (u, v); index kNoIndex). Fills mesh.quad_nodes and mesh.bar_nodes (SurfaceMesh documents
+/// with (u, v); index kNoIndex; parameters NaN for the nodes left off the CAD, see unprojected). Fills mesh.quad_nodes and mesh.bar_nodes (SurfaceMesh documents
 /// their order). Quads whose curved form is not valid get their face nodes back on the straight
 /// positions, and then their curve nodes if still not valid. Deterministic whatever the thread
 /// count of `tasks`. Throws qsmesh::Error when the mesh has triangles or already has second-order

@@ -23,7 +23,7 @@ class AtomicFile {
   [[nodiscard]] const std::string& temp_path() const { return temp_; }
   [[nodiscard]] bool committed() const { return committed_; }
 
-  /// Renames the temporary to path(). Throws qsmesh::Error (temporary removed) on failure.
+  /// Renames the temporary to path(). Throws qsmesh::OutputError (temporary removed) on failure.
   void commit();
 
  private:
@@ -33,10 +33,11 @@ class AtomicFile {
 };
 
 /// Buffered text/binary output to a FILE* with every C library return code checked; errors throw
-/// qsmesh::Error naming the file. close() must be called for the data to count as written.
+/// qsmesh::OutputError naming the file (`shown`, else `path`: the name the user asked for when
+/// `path` is an AtomicFile's temporary). close() must be called for the data to count as written.
 class OutputFile {
  public:
-  explicit OutputFile(const std::string& path);
+  explicit OutputFile(const std::string& path, std::string shown = {});
   ~OutputFile();  ///< closes without checking (error path only)
   OutputFile(const OutputFile&) = delete;
   OutputFile& operator=(const OutputFile&) = delete;

@@ -68,8 +68,15 @@ enum class Format { kNone, kCgns, kVtu, kMsh, kHdf5 };
 /// True when the extension of `path` names a format write_mesh writes (case-insensitive).
 [[nodiscard]] bool is_supported_output(const std::string& path);
 
+/// For a program's main, first thing (before any HDF5 or CGNS call; later it does nothing): keeps
+/// HDF5 from closing its files at exit. A CGNS file whose write failed (disk full) stays half-open
+/// inside the library, whose exit handler would then crash the process after the error was
+/// reported; the operating system closes what is left instead.
+void prepare_output_libraries();
+
 /// For the CLI at start-up, before meshing: throws InputError (one line naming the path) unless the
-/// extension is supported, the path is not a folder, and its folder exists and is writable.
+/// extension is supported, the path is not a folder, and its folder exists and is writable (and,
+/// for .h5, the file name has no ':', which its XDMF description could not refer to).
 void check_output_path(const std::string& path);
 
 /// Throws qsmesh::Error unless the arrays of `mesh` agree: per-element CAD ids sized like the
