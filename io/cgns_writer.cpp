@@ -397,6 +397,35 @@ constexpr std::array<Side, 4> kSides{
     {{0, false}, {1, true}, {0, true}, {1, false}}};  // jmin imax jmax imin
 
 // The 1-based (i, j) of position p on side s of block b.
+// The zone of the faces the layout left out.
+constexpr const char* kUnstructuredZone = "Unstructured";
+
+// A GridConnectivity_t node (Abutting1to1, at vertices) under the ZoneGridConnectivity `parent`:
+// this zone's points as `points` (a PointRange or a PointList), the donor's as a PointListDonor
+// in the same order. Written through cgio, as the 1-to-1 interfaces are: cgnslib does not know
+// the ZoneGridConnectivity nodes made that way.
+void write_abutment(int cgio, double parent, const std::string& name, const std::string& donor,
+                    const char* points_name, const char* points_label,
+                    std::array<cgsize_t, 2> points_dims, const cgsize_t* points,
+                    std::array<cgsize_t, 2> donor_dims, const cgsize_t* donor_points,
+                    const std::string& path) {
+  double id = 0, child = 0;
+  const cgsize_t donor_size[1] = {static_cast<cgsize_t>(donor.size())};
+  QSMESH_CGIO(cgio_new_node(cgio, parent, name.c_str(), "GridConnectivity_t", "C1", 1, donor_size,
+                            donor.data(), &id));
+  const std::string type = "Abutting1to1", location = "Vertex";
+  const cgsize_t type_size[1] = {static_cast<cgsize_t>(type.size())};
+  const cgsize_t location_size[1] = {static_cast<cgsize_t>(location.size())};
+  QSMESH_CGIO(cgio_new_node(cgio, id, "GridConnectivityType", "GridConnectivityType_t", "C1", 1,
+                            type_size, type.data(), &child));
+  QSMESH_CGIO(cgio_new_node(cgio, id, "GridLocation", "GridLocation_t", "C1", 1, location_size,
+                            location.data(), &child));
+  QSMESH_CGIO(cgio_new_node(cgio, id, points_name, points_label, "I4", 2, points_dims.data(),
+                            points, &child));
+  QSMESH_CGIO(cgio_new_node(cgio, id, "PointListDonor", "IndexArray_t", "I4", 2,
+                            donor_dims.data(), donor_points, &child));
+}
+
 std::array<cgsize_t, 2> side_index(const layout::Block& b, int s, LO p) {
   const Side& side = kSides[static_cast<std::size_t>(s)];
   std::array<cgsize_t, 2> ij{};
@@ -419,6 +448,9 @@ LO side_edges(const layout::Block& b, int s) {
 
 void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& layout,
                        const std::string& path, const WriteOptions& options) {
+  static_assert(sizeof(cgsize_t) == sizeof(std::int32_t),
+                "point ranges and lists are written as I4 cgio nodes from cgsize_t arrays");
+  detail::check_output_folder(path);
   check_mesh_for_output(mesh);
   QSMESH_CHECK(mesh.quad_nodes.empty(),
                "CGNS block output " << path << ": blocks of second-order quads are not written");
@@ -452,6 +484,51 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
             .push_back({k, s, p});
   }
 
+  // The faces left out go into one unstructured zone; its vertices are numbered in the order its
+  // elements first use them, and its element edges are where blocks abut it.
+  const detail::ElementGroups groups = detail::group_elements(mesh);
+  std::vector<GO> local(static_cast<std::size_t>(mesh.num_vertices()), -1);
+  std::vector<GO> used;
+  std::unordered_map<std::uint64_t, char> unstructured_edges;
+  GO unstructured_cells = 0;
+  {
+    auto use = [&](GO v) {
+      if (local[static_cast<std::size_t>(v)] < 0) {
+        local[static_cast<std::size_t>(v)] = static_cast<GO>(used.size());
+        used.push_back(v);
+      }
+    };
+    auto element = [&](const auto& vertices) {
+      const std::size_t n = vertices.size();
+      for (std::size_t i = 0; i < n; ++i) {
+        use(vertices[i]);
+        unstructured_edges[edge_key(vertices[i], vertices[(i + 1) % n])] = 1;
+      }
+    };
+    for (LO f : layout.unblocked_faces) {
+      for (GO t : groups.face2tris[static_cast<std::size_t>(f)])
+        element(mesh.triangles[static_cast<std::size_t>(t)]);
+      for (GO q : groups.face2quads[static_cast<std::size_t>(f)])
+        element(mesh.quads[static_cast<std::size_t>(q)]);
+      unstructured_cells +=
+          static_cast<GO>(groups.face2tris[static_cast<std::size_t>(f)].size() +
+                          groups.face2quads[static_cast<std::size_t>(f)].size());
+    }
+  }
+  // A block edge is free (a BC) when no other block side and no element of the unstructured zone
+  // has it.
+  auto is_free = [&](std::uint64_t e) {
+    return edge_uses.at(e).size() == 1 && unstructured_edges.count(e) == 0;
+  };
+  // What the unstructured zone's connectivity to the blocks needs: per run of block side edges on
+  // it, the block and the points' (i, j) and unstructured ids, in the same order.
+  struct Abutment {
+    GO block;
+    std::vector<cgsize_t> ij;     // i1, j1, i2, j2, ...
+    std::vector<cgsize_t> local;  // 1-based ids in the unstructured zone
+  };
+  std::vector<Abutment> abutments;
+
   AtomicFile out(path);
   CgFile file;
   const int fn = open_for_write(out, file, path);
@@ -472,7 +549,7 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
   {
     std::vector<char> free_curve(static_cast<std::size_t>(mesh.num_cad_curves), 0);
     for (const auto& [k, uses] : edge_uses) {
-      if (uses.size() != 1) continue;
+      if (!is_free(k)) continue;
       const auto it = edge_curve.find(k);
       if (it != edge_curve.end()) free_curve[static_cast<std::size_t>(it->second)] = 1;
     }
@@ -611,12 +688,50 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
         QSMESH_CGIO(cgio_new_node(cgio, conn_id, "PointRangeDonor", "IndexRange_t", "I4", 2,
                                   range_dims, donor, &child));
       }
+      // Runs of side edges on the unstructured zone: a GridConnectivity (Abutting1to1, vertex
+      // ranges here, vertex lists there), written as cgio nodes beside the 1-to-1 ones.
+      for (LO p = 0; p < side_edges(b, s);) {
+        auto on_unstructured = [&](LO q) {
+          return unstructured_edges.count(
+                     edge_key(side_vertex(b, s, q, layout.vertices),
+                              side_vertex(b, s, q + 1, layout.vertices))) > 0;
+        };
+        if (!on_unstructured(p)) {
+          ++p;
+          continue;
+        }
+        LO q = p;
+        while (q + 1 < side_edges(b, s) && on_unstructured(q + 1)) ++q;
+        Abutment a{k, {}, {}};
+        for (LO x = p; x <= q + 1; ++x) {
+          const auto ij = side_index(b, s, x);
+          a.ij.insert(a.ij.end(), ij.begin(), ij.end());
+          a.local.push_back(static_cast<cgsize_t>(
+              local[static_cast<std::size_t>(side_vertex(b, s, x, layout.vertices))] + 1));
+        }
+        const auto i0 = side_index(b, s, p), i1 = side_index(b, s, q + 1);
+        cgsize_t range[4] = {i0[0], i0[1], i1[0], i1[1]};
+        if (zgc_id == 0) {
+          double zone_id = 0;
+          QSMESH_CGIO(cgio_get_node_id(
+              cgio, root, ("/" + options.cgns_base_name + "/" + name).c_str(), &zone_id));
+          QSMESH_CGIO(cgio_new_node(cgio, zone_id, "ZoneGridConnectivity", "ZoneGridConnectivity_t",
+                                    "MT", 0, nullptr, nullptr, &zgc_id));
+        }
+        std::string cname(1, 'C');
+        cname += std::to_string(++connections);
+        write_abutment(cgio, zgc_id, cname, kUnstructuredZone, "PointRange", "IndexRange_t",
+                       {2, 2}, range, {1, static_cast<cgsize_t>(a.local.size())}, a.local.data(),
+                       path);
+        abutments.push_back(std::move(a));
+        p = q + 1;
+      }
       // Free edges: one BC per run of them on one curve.
       for (LO p = 0; p < side_edges(b, s);) {
         auto curve_of_free = [&](LO q) -> LO {
           const std::uint64_t e = edge_key(side_vertex(b, s, q, layout.vertices),
                                            side_vertex(b, s, q + 1, layout.vertices));
-          if (edge_uses.at(e).size() != 1) return kNoIndex;
+          if (!is_free(e)) return kNoIndex;
           const auto it = edge_curve.find(e);
           return it == edge_curve.end() ? kNoIndex : it->second;
         };
@@ -645,29 +760,13 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
     }
   }
 
-  // Faces the layout could not cut into blocks: one unstructured zone with a section per face.
+  // Faces the layout could not cut into blocks: one unstructured zone with a section per face, and
+  // a GridConnectivity back to every block run abutting it.
   if (!layout.unblocked_faces.empty()) {
-    const detail::ElementGroups groups = detail::group_elements(mesh);
-    std::vector<GO> local(static_cast<std::size_t>(mesh.num_vertices()), -1);
-    std::vector<GO> used;
-    auto use = [&](GO v) {
-      if (local[static_cast<std::size_t>(v)] < 0) {
-        local[static_cast<std::size_t>(v)] = static_cast<GO>(used.size());
-        used.push_back(v);
-      }
-    };
-    GO ncells = 0;
-    for (LO f : layout.unblocked_faces) {
-      for (GO t : groups.face2tris[static_cast<std::size_t>(f)])
-        for (GO v : mesh.triangles[static_cast<std::size_t>(t)]) use(v);
-      for (GO q : groups.face2quads[static_cast<std::size_t>(f)])
-        for (GO v : mesh.quads[static_cast<std::size_t>(q)]) use(v);
-      ncells += static_cast<GO>(groups.face2tris[static_cast<std::size_t>(f)].size() +
-                                groups.face2quads[static_cast<std::size_t>(f)].size());
-    }
-    cgsize_t size[3] = {to_cg(static_cast<GO>(used.size()), path), to_cg(ncells, path), 0};
+    cgsize_t size[3] = {to_cg(static_cast<GO>(used.size()), path), to_cg(unstructured_cells, path),
+                        0};
     int zone = 0;
-    QSMESH_CG(cg_zone_write(fn, base, "Unstructured", size, CGNS_ENUMV(Unstructured), &zone));
+    QSMESH_CG(cg_zone_write(fn, base, kUnstructuredZone, size, CGNS_ENUMV(Unstructured), &zone));
     write_coordinates(
         fn, base, zone, used.size(),
         [&](std::size_t i) { return mesh.points[static_cast<std::size_t>(used[i])]; }, path);
@@ -675,6 +774,21 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
         fn, base, zone, mesh, groups, layout.unblocked_faces,
         [&](GO v) { return static_cast<cgsize_t>(local[static_cast<std::size_t>(v)] + 1); }, 1,
         false, path);
+    if (!abutments.empty()) {
+      double zone_id = 0, zgc_id = 0;
+      QSMESH_CGIO(cgio_get_node_id(
+          cgio, root, ("/" + options.cgns_base_name + "/" + kUnstructuredZone).c_str(), &zone_id));
+      QSMESH_CGIO(cgio_new_node(cgio, zone_id, "ZoneGridConnectivity", "ZoneGridConnectivity_t",
+                                "MT", 0, nullptr, nullptr, &zgc_id));
+      int connections = 0;
+      for (const Abutment& a : abutments) {
+        std::string cname(1, 'C');
+        cname += std::to_string(++connections);
+        const auto n = static_cast<cgsize_t>(a.local.size());
+        write_abutment(cgio, zgc_id, cname, zone_name(a.block), "PointList", "IndexArray_t",
+                       {1, n}, a.local.data(), {2, n}, a.ij.data(), path);
+      }
+    }
   }
 
   file.fn = -1;

@@ -1,15 +1,26 @@
 // Reads a block-structured CGNS file (io::write_cgns_blocks) back through cgnslib and checks it:
-// every zone structured, and every GridConnectivity1to1 joining points with the same coordinates
-// under its transform. Header-only; the test must link cgnslib (qsmesh_cgns).
+// - every GridConnectivity1to1 joins points with the same coordinates under its transform (a
+//   signed permutation whose image of the range's end is the donor range's end), and has its
+//   reciprocal in the donor zone;
+// - every general GridConnectivity (a block abutting the unstructured zone) joins points with the
+//   same coordinates, point by point;
+// - every BC lies on a block side;
+// - every edge of every block side is covered exactly once, by an interface, a connectivity or a
+//   BC (a side edge nothing covers would be an open boundary inside the surface).
+// Every cgnslib return code is checked. Header-only; the test must link cgnslib (qsmesh_cgns).
 #pragma once
 
 #include <cgnslib.h>
 
+#include <algorithm>
 #include <array>
 #include <cstdint>
+#include <cstdlib>
 #include <map>
+#include <set>
 #include <sstream>
 #include <string>
+#include <tuple>
 #include <vector>
 
 namespace qsmesh::test {
@@ -22,6 +33,7 @@ struct BlockFileSummary {
   std::int64_t interfaces = 0;
   std::int64_t interface_points = 0;
   std::int64_t boundary_conditions = 0;  ///< BCs (free block edges), each checked to lie on a side
+  std::int64_t abutments = 0;  ///< general connectivities between a block and the unstructured zone
 };
 
 inline BlockFileSummary check_block_file(const std::string& path) {
@@ -32,53 +44,103 @@ inline BlockFileSummary check_block_file(const std::string& path) {
     out.error = std::string("cg_open: ") + cg_get_error();
     return out;
   }
+  bool failed = false;
+  auto ok = [&](int rc, const std::string& what) {
+    if (rc == CG_OK) return true;
+    err << what << ": " << cg_get_error() << "; ";
+    failed = true;
+    return false;
+  };
   struct Zone {
     std::string name;
-    cgsize_t ni = 0, nj = 0;  // vertices along i and j
+    bool structured = false;
+    cgsize_t ni = 0, nj = 0;  // vertices along i and j (structured); ni vertices (unstructured)
     std::array<std::vector<double>, 3> xyz;
+    // Side edges covered, per side (0: j = 1, 1: i = ni, 2: j = nj, 3: i = 1), by position.
+    std::array<std::vector<int>, 4> covered;
   };
   std::vector<Zone> zones;
   std::map<std::string, int> by_name;
   int nzones = 0;
-  cg_nzones(fn, 1, &nzones);
+  ok(cg_nzones(fn, 1, &nzones), "cg_nzones");
+  const char* coord_names[3] = {"CoordinateX", "CoordinateY", "CoordinateZ"};
   for (int z = 1; z <= nzones; ++z) {
-    CGNS_ENUMT(ZoneType_t) type;
-    cg_zone_type(fn, 1, z, &type);
+    CGNS_ENUMT(ZoneType_t) type = CGNS_ENUMV(ZoneTypeNull);
     char name[33] = {};
     cgsize_t size[9] = {};
-    cg_zone_read(fn, 1, z, name, size);
+    ok(cg_zone_type(fn, 1, z, &type), "cg_zone_type");
+    ok(cg_zone_read(fn, 1, z, name, size), "cg_zone_read");
     Zone zone;
     zone.name = name;
-    if (type != CGNS_ENUMV(Structured)) {
+    zone.structured = type == CGNS_ENUMV(Structured);
+    std::size_t n = 0;
+    if (zone.structured) {
+      ++out.structured_zones;
+      zone.ni = size[0];
+      zone.nj = size[1];
+      n = static_cast<std::size_t>(zone.ni * zone.nj);
+      out.block_quads += static_cast<std::int64_t>(size[2]) * size[3];
+      if (size[2] != size[0] - 1 || size[3] != size[1] - 1) err << name << ": cell sizes; ";
+      for (int s = 0; s < 4; ++s)
+        zone.covered[static_cast<std::size_t>(s)].assign(
+            static_cast<std::size_t>(s % 2 == 0 ? zone.ni - 1 : zone.nj - 1), 0);
+    } else {
       ++out.unstructured_zones;
-      zones.push_back(zone);
-      continue;
+      zone.ni = size[0];
+      n = static_cast<std::size_t>(zone.ni);
     }
-    ++out.structured_zones;
-    zone.ni = size[0];
-    zone.nj = size[1];
-    out.block_quads += static_cast<std::int64_t>(size[2]) * size[3];
-    if (size[2] != size[0] - 1 || size[3] != size[1] - 1) err << name << ": cell sizes; ";
-    const char* names[3] = {"CoordinateX", "CoordinateY", "CoordinateZ"};
     for (int d = 0; d < 3; ++d) {
-      zone.xyz[static_cast<std::size_t>(d)].resize(static_cast<std::size_t>(zone.ni * zone.nj));
-      cgsize_t lo[2] = {1, 1}, hi[2] = {zone.ni, zone.nj};
-      if (cg_coord_read(fn, 1, z, names[d], CGNS_ENUMV(RealDouble), lo, hi,
-                        zone.xyz[static_cast<std::size_t>(d)].data()) != CG_OK)
-        err << name << ": " << names[d] << " unreadable; ";
+      auto& x = zone.xyz[static_cast<std::size_t>(d)];
+      x.resize(n);
+      cgsize_t lo[2] = {1, 1}, hi[2] = {zone.ni, zone.structured ? zone.nj : 1};
+      ok(cg_coord_read(fn, 1, z, coord_names[d], CGNS_ENUMV(RealDouble), lo, hi, x.data()),
+         zone.name + " " + coord_names[d]);
     }
     by_name[zone.name] = z - 1;
     zones.push_back(std::move(zone));
   }
   auto point = [](const Zone& zone, cgsize_t i, cgsize_t j) {
-    const auto k = static_cast<std::size_t>((j - 1) * zone.ni + (i - 1));
+    const auto k = static_cast<std::size_t>(zone.structured ? (j - 1) * zone.ni + (i - 1) : i - 1);
     return std::array<double, 3>{zone.xyz[0][k], zone.xyz[1][k], zone.xyz[2][k]};
   };
-  for (int z = 1; z <= nzones; ++z) {
-    const Zone& zone = zones[static_cast<std::size_t>(z - 1)];
-    if (zone.ni == 0) continue;
+  // Marks the side edges of the side range r (one index constant) of a structured zone as covered.
+  auto cover = [&](Zone& zone, const cgsize_t r[4], const std::string& what) {
+    int side = -1;
+    if (r[1] == r[3] && r[1] == 1) side = 0;
+    else if (r[0] == r[2] && r[0] == zone.ni) side = 1;
+    else if (r[1] == r[3] && r[1] == zone.nj) side = 2;
+    else if (r[0] == r[2] && r[0] == 1) side = 3;
+    if (side < 0 || (r[0] == r[2] && r[1] == r[3])) {
+      err << zone.name << "/" << what << ": not a side range; ";
+      return false;
+    }
+    const int t = side % 2 == 0 ? 0 : 1;  // the index moving along the side
+    const cgsize_t a = std::min(r[t], r[t + 2]), b = std::max(r[t], r[t + 2]);
+    auto& c = zone.covered[static_cast<std::size_t>(side)];
+    for (cgsize_t p = a; p < b; ++p) {
+      if (p < 1 || static_cast<std::size_t>(p) > c.size()) {
+        err << zone.name << "/" << what << ": range out of the zone; ";
+        return false;
+      }
+      ++c[static_cast<std::size_t>(p - 1)];
+    }
+    return true;
+  };
+  // (zone, range, donor zone, donor range), ranges sorted so that both directions compare.
+  std::set<std::tuple<int, std::array<cgsize_t, 4>, int, std::array<cgsize_t, 4>>> links;
+  auto normal = [](const cgsize_t r[4]) {
+    std::array<cgsize_t, 4> x{r[0], r[1], r[2], r[3]};
+    if (std::tie(x[2], x[3]) < std::tie(x[0], x[1])) {
+      std::swap(x[0], x[2]);
+      std::swap(x[1], x[3]);
+    }
+    return x;
+  };
+  for (int z = 1; z <= nzones && !failed; ++z) {
+    Zone& zone = zones[static_cast<std::size_t>(z - 1)];
+    if (!zone.structured) continue;
     int nbc = 0;
-    cg_nbocos(fn, 1, z, &nbc);
+    ok(cg_nbocos(fn, 1, z, &nbc), "cg_nbocos");
     for (int bc = 1; bc <= nbc; ++bc) {
       char bname[33] = {};
       CGNS_ENUMT(BCType_t) btype;
@@ -87,44 +149,59 @@ inline BlockFileSummary check_block_file(const std::string& path) {
       int normal_index[2] = {};
       CGNS_ENUMT(DataType_t) ntype;
       int ndata = 0;
-      cg_boco_info(fn, 1, z, bc, bname, &btype, &ptype, &npnts, normal_index, &normal_list, &ntype, &ndata);
+      if (!ok(cg_boco_info(fn, 1, z, bc, bname, &btype, &ptype, &npnts, normal_index, &normal_list,
+                           &ntype, &ndata),
+              "cg_boco_info"))
+        continue;
       cgsize_t r[4] = {};
-      cg_boco_read(fn, 1, z, bc, r, nullptr);
+      if (ptype != CGNS_ENUMV(PointRange) || npnts != 2) {
+        err << zone.name << "/" << bname << ": not a point range; ";
+        continue;
+      }
+      if (!ok(cg_boco_read(fn, 1, z, bc, r, nullptr), "cg_boco_read")) continue;
       ++out.boundary_conditions;
-      const bool on_side = (r[0] == r[2] && (r[0] == 1 || r[0] == zone.ni)) ||
-                           (r[1] == r[3] && (r[1] == 1 || r[1] == zone.nj));
-      if (ptype != CGNS_ENUMV(PointRange) || !on_side) err << zone.name << "/" << bname << ": not a side range; ";
+      cover(zone, r, bname);
     }
     int n = 0;
-    cg_n1to1(fn, 1, z, &n);
+    ok(cg_n1to1(fn, 1, z, &n), "cg_n1to1");
     for (int c = 1; c <= n; ++c) {
       char cname[33] = {}, dname[33] = {};
       cgsize_t range[4] = {}, donor[4] = {};
       int transform[2] = {};
-      cg_1to1_read(fn, 1, z, c, cname, dname, range, donor, transform);
+      if (!ok(cg_1to1_read(fn, 1, z, c, cname, dname, range, donor, transform), "cg_1to1_read"))
+        continue;
       ++out.interfaces;
+      cover(zone, range, cname);
       const auto it = by_name.find(dname);
-      if (it == by_name.end()) {
-        err << zone.name << "/" << cname << ": no donor zone " << dname << "; ";
+      if (it == by_name.end() || !zones[static_cast<std::size_t>(it->second)].structured) {
+        err << zone.name << "/" << cname << ": no structured donor zone " << dname << "; ";
         continue;
       }
+      links.insert({z - 1, normal(range), it->second, normal(donor)});
       const Zone& dz = zones[static_cast<std::size_t>(it->second)];
+      if (std::abs(transform[0]) == std::abs(transform[1]) || std::abs(transform[0]) < 1 ||
+          std::abs(transform[0]) > 2 || std::abs(transform[1]) < 1 || std::abs(transform[1]) > 2) {
+        err << zone.name << "/" << cname << ": transform is not a signed permutation; ";
+        continue;
+      }
       // donor index = T (index - begin) + donor begin, T the signed permutation of `transform`.
+      auto donor_of = [&](cgsize_t i, cgsize_t j) {
+        const std::array<cgsize_t, 2> delta{i - range[0], j - range[1]};
+        std::array<cgsize_t, 2> d{donor[0], donor[1]};
+        for (int k = 0; k < 2; ++k) {
+          const int t = transform[k];
+          d[static_cast<std::size_t>(std::abs(t) - 1)] +=
+              (t > 0 ? 1 : -1) * delta[static_cast<std::size_t>(k)];
+        }
+        return d;
+      };
+      const auto end = donor_of(range[2], range[3]);
+      if (end[0] != donor[2] || end[1] != donor[3])
+        err << zone.name << "/" << cname << ": PointRangeDonor's end is not the range's image; ";
       const cgsize_t di = range[2] >= range[0] ? 1 : -1, dj = range[3] >= range[1] ? 1 : -1;
       for (cgsize_t i = range[0];; i += di) {
         for (cgsize_t j = range[1];; j += dj) {
-          const std::array<cgsize_t, 2> delta{i - range[0], j - range[1]};
-          std::array<cgsize_t, 2> d{donor[0], donor[1]};
-          for (int k = 0; k < 2; ++k) {
-            const int t = transform[k];
-            const int axis = (t > 0 ? t : -t) - 1;
-            if (axis < 0 || axis > 1) {
-              err << zone.name << "/" << cname << ": transform; ";
-              break;
-            }
-            d[static_cast<std::size_t>(axis)] +=
-                (t > 0 ? 1 : -1) * delta[static_cast<std::size_t>(k)];
-          }
+          const auto d = donor_of(i, j);
           if (d[0] < 1 || d[1] < 1 || d[0] > dz.ni || d[1] > dz.nj) {
             err << zone.name << "/" << cname << ": donor index out of range; ";
           } else if (point(zone, i, j) != point(dz, d[0], d[1])) {
@@ -137,8 +214,66 @@ inline BlockFileSummary check_block_file(const std::string& path) {
         if (i == range[2]) break;
       }
     }
+    // General connectivities: a block abutting the unstructured zone, point by point.
+    int nconn = 0;
+    ok(cg_nconns(fn, 1, z, &nconn), "cg_nconns");
+    for (int c = 1; c <= nconn; ++c) {
+      char cname[33] = {}, dname[33] = {};
+      CGNS_ENUMT(GridLocation_t) location;
+      CGNS_ENUMT(GridConnectivityType_t) type;
+      CGNS_ENUMT(PointSetType_t) ptype, dptype;
+      CGNS_ENUMT(ZoneType_t) dztype;
+      CGNS_ENUMT(DataType_t) ddtype;
+      cgsize_t npnts = 0, ndonor = 0;
+      if (!ok(cg_conn_info(fn, 1, z, c, cname, &location, &type, &ptype, &npnts, dname, &dztype,
+                           &dptype, &ddtype, &ndonor),
+              "cg_conn_info"))
+        continue;
+      ++out.abutments;
+      const auto it = by_name.find(dname);
+      if (ptype != CGNS_ENUMV(PointRange) || npnts != 2 || it == by_name.end() ||
+          zones[static_cast<std::size_t>(it->second)].structured ||
+          type != CGNS_ENUMV(Abutting1to1) || location != CGNS_ENUMV(Vertex)) {
+        err << zone.name << "/" << cname << ": not a vertex range abutting the unstructured zone; ";
+        continue;
+      }
+      cgsize_t range[4] = {};
+      std::vector<cgsize_t> ids(static_cast<std::size_t>(ndonor));
+      if (!ok(cg_conn_read(fn, 1, z, c, range, CGNS_ENUMV(Integer), ids.data()), "cg_conn_read"))
+        continue;
+      if (!cover(zone, range, cname)) continue;
+      const Zone& dz = zones[static_cast<std::size_t>(it->second)];
+      const cgsize_t di = range[2] >= range[0] ? 1 : -1, dj = range[3] >= range[1] ? 1 : -1;
+      std::size_t k = 0;
+      for (cgsize_t i = range[0];; i += di) {
+        for (cgsize_t j = range[1];; j += dj) {
+          if (k >= ids.size() || ids[k] < 1 || ids[k] > dz.ni) {
+            err << zone.name << "/" << cname << ": donor point list too short or out of range; ";
+          } else if (point(zone, i, j) != point(dz, ids[k], 1)) {
+            err << zone.name << "/" << cname << ": point (" << i << "," << j
+                << ") is not point " << ids[k] << " of " << dname << "; ";
+          }
+          ++k;
+          if (j == range[3]) break;
+        }
+        if (i == range[2]) break;
+      }
+      if (k != ids.size()) err << zone.name << "/" << cname << ": donor list length; ";
+    }
   }
-  cg_close(fn);
+  for (const auto& [a, ra, b, rb] : links)
+    if (links.count({b, rb, a, ra}) == 0)
+      err << zones[static_cast<std::size_t>(a)].name << ": an interface to "
+          << zones[static_cast<std::size_t>(b)].name << " has no reciprocal; ";
+  for (const Zone& zone : zones)
+    for (int s = 0; s < 4; ++s)
+      for (std::size_t p = 0; p < zone.covered[static_cast<std::size_t>(s)].size(); ++p) {
+        const int c = zone.covered[static_cast<std::size_t>(s)][p];
+        if (c != 1)
+          err << zone.name << ": side " << s << " edge " << p + 1 << " covered " << c
+              << " times; ";
+      }
+  ok(cg_close(fn), "cg_close");
   out.error = err.str();
   return out;
 }

@@ -321,6 +321,21 @@ TEST_F(Qsmesh, BlockStructuredCgnsJoinsItsBlocks) {
   }
 }
 
+TEST_F(Qsmesh, BlockSidesAlongBothBanksOfASeamAreJoined) {
+  // On the wing-body example at a coarse size, a block of the fuselage (a surface of revolution)
+  // runs along its seam on both banks: the same mesh edges at two places of one side. They are an
+  // interface of the block with itself; nothing on any block side is left open.
+  const std::string step = tmp("e2e_wing_body_seam.step");
+  ASSERT_EQ(run("example wing-body -o " + step).code, 0);
+  const std::string out = tmp("e2e_wing_body_seam.cgns");
+  const ExeResult r =
+      run("mesh " + step + " -o " + out + " --block-structured --size-factor 0.1 --threads 1 -q");
+  ASSERT_EQ(r.code, 0) << r.err;
+  const qsmesh::test::BlockFileSummary s = qsmesh::test::check_block_file(out);
+  EXPECT_EQ(s.error, "");
+  EXPECT_GT(s.interfaces, s.structured_zones);
+}
+
 TEST_F(Qsmesh, UnstructuredValidOnSmallModels) {
   std::vector<std::string> models;
   const std::string example = tmp("e2e_wing_body.step");

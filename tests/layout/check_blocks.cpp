@@ -1,5 +1,6 @@
 // check_blocks FILE.cgns: reads a block-structured CGNS file (qsmesh mesh --block-structured) back
-// and checks every 1-to-1 interface point by point (tests/common/cgns_blocks_check.hpp). Prints a
+// and checks every interface point by point, their reciprocity and that every block side edge is
+// covered once (tests/common/cgns_blocks_check.hpp). Prints a
 // one-line summary; exit 1 when a check fails.
 #include <iostream>
 
@@ -14,6 +15,7 @@ int main(int argc, char** argv) {
   std::cout << argv[1] << ": " << s.structured_zones << " structured zones (" << s.block_quads
             << " quads), " << s.unstructured_zones << " unstructured, " << s.interfaces
             << " 1-to-1 interfaces over " << s.interface_points << " points, "
-            << s.boundary_conditions << " BCs: " << (s.error.empty() ? "all match" : s.error.substr(0, 2000)) << "\n";
+            << s.abutments << " connectivities to the unstructured zone, " << s.boundary_conditions
+            << " BCs: " << (s.error.empty() ? "all match" : s.error.substr(0, 2000)) << "\n";
   return s.error.empty() ? 0 : 1;
 }

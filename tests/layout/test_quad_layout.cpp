@@ -258,6 +258,11 @@ TEST(CgnsBlocks, UnblockedFacesGoToAnUnstructuredZone) {
   EXPECT_EQ(s.structured_zones, 1);
   EXPECT_EQ(s.unstructured_zones, 1);
   EXPECT_EQ(s.block_quads, 4);
+  // The block's side on the curve shared with the triangles abuts the unstructured zone (one
+  // connectivity, checked point by point, and its reverse there), not a wall: BCs only on the
+  // block's three other sides.
+  EXPECT_EQ(s.abutments, 1);
+  EXPECT_EQ(s.boundary_conditions, 3);
 }
 
 }  // namespace

@@ -99,7 +99,10 @@ void write_cgns(const mesh::SurfaceMesh& mesh, const std::string& path, const Wr
 /// Free block edges (no block across: an open shell's border) get a BC (FamilySpecified, family
 /// "Curve_<c>" with FamilyBC BCWall, as write_cgns) per run of them on one curve.
 /// The faces in layout.unblocked_faces go into one unstructured zone "Unstructured" (a section per
-/// face), without connectivity to the blocks. `layout` must come from extract_quad_layout(mesh).
+/// face). Where a block side runs along it, both zones get a GridConnectivity (Abutting1to1,
+/// Vertex: the block's PointRange against the unstructured zone's PointListDonor, and that zone's
+/// PointList against the block's (i, j) PointListDonor), and no BC is written there.
+/// `layout` must come from extract_quad_layout(mesh).
 void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& layout,
                        const std::string& path, const WriteOptions& options = {});
 
@@ -108,11 +111,11 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
 /// "cad_entity" (the vertex classification), plus options.point_fields / cell_fields.
 void write_vtu(const mesh::SurfaceMesh& mesh, const std::string& path, const WriteOptions& options = {});
 
-/// HDF5 (format_version 1) for solvers, plus the XDMF 3 file xdmf_path_for(path) describing it
+/// HDF5 (format_version 2) for solvers, plus the XDMF 3 file xdmf_path_for(path) describing it
 /// (open that one in ParaView: one block each for the quads, the triangles and the curve bars, with
 /// cell data cad_face / cad_curve and point data cad_dim / cad_entity). Both are written under
 /// temporary names; the XDMF file is renamed first and removed again if the HDF5 file fails.
-/// Root attributes: format ("qsmesh surface mesh"), format_version (1), length_unit,
+/// Root attributes: format ("qsmesh surface mesh"), format_version (2), length_unit,
 /// num_cad_corners, num_cad_curves, num_cad_faces. Datasets (little-endian, ids 0-based, elements
 /// in mesh order):
 ///   coordinates         float64 [n_vertices, 3]
@@ -126,10 +129,18 @@ void write_vtu(const mesh::SurfaceMesh& mesh, const std::string& path, const Wri
 ///   curve_corners       int32 [n_curves, 2]: end corners of each curve (-1: none)
 ///   face_curve_offsets  int64 [n_faces + 1]; face_curves int32: the curves bounding face f are
 ///                       face_curves[face_curve_offsets[f] .. face_curve_offsets[f + 1])
-///   quad_nodes          int64 [n_quads, 5], bar_nodes int64 [n_bars]: only for second-order
-///                       meshes (SurfaceMesh::quad_nodes; the XDMF file shows the linear quads)
+///   quad9               int64 [n_quads, 9], bar3 int64 [n_bars, 3]: only for second-order meshes,
+///                       the corners then the nodes (SurfaceMesh::quad_nodes: the order of CGNS
+///                       QUAD_9 / BAR_3); the XDMF file then shows these (Quadrilateral_9,
+///                       Edge_3) instead of the linear quads and bars. A node put back on its
+///                       straight position (off the CAD) has vertex_cad_param NaN.
+/// (format_version 1, of the seventeenth session, had quad_nodes [n_quads, 5] and bar_nodes
+/// [n_bars] instead of quad9 and bar3.)
 /// Empty element kinds are zero-row datasets. Objects carry no timestamps: the same mesh gives the
-/// same bytes. Throws qsmesh::Error on an inconsistent mesh or a failed HDF5 call.
+/// same bytes. The file is built in memory (HDF5's core driver; as large as the file) and written
+/// by OutputFile, so a full disk is one OutputError and HDF5 never holds a half-written file.
+/// Throws qsmesh::Error on an inconsistent mesh or a failed HDF5 call, qsmesh::OutputError when
+/// the files cannot be written.
 void write_hdf5(const mesh::SurfaceMesh& mesh, const std::string& path,
                 const WriteOptions& options = {});
 
