@@ -400,6 +400,16 @@ constexpr std::array<Side, 4> kSides{
 // The zone of the faces the layout left out.
 constexpr const char* kUnstructuredZone = "Unstructured";
 
+// The ZoneGridConnectivity node of zone `zone` (made through cgio, as the connectivities under it).
+double new_zone_grid_connectivity(int cgio, double root, const std::string& base,
+                                  const std::string& zone, const std::string& path) {
+  double zone_id = 0, id = 0;
+  QSMESH_CGIO(cgio_get_node_id(cgio, root, ("/" + base + "/" + zone).c_str(), &zone_id));
+  QSMESH_CGIO(cgio_new_node(cgio, zone_id, "ZoneGridConnectivity", "ZoneGridConnectivity_t", "MT",
+                            0, nullptr, nullptr, &id));
+  return id;
+}
+
 // A GridConnectivity_t node (Abutting1to1, at vertices) under the ZoneGridConnectivity `parent`:
 // this zone's points as `points` (a PointRange or a PointList), the donor's as a PointListDonor
 // in the same order. Written through cgio, as the 1-to-1 interfaces are: cgnslib does not know
@@ -602,6 +612,11 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
     // the donor positions moving by one edge per edge.
     int connections = 0, boundaries = 0;
     double zgc_id = 0;  // the zone's ZoneGridConnectivity node, made with its first interface
+    // The name of the zone's next connectivity node, the ZoneGridConnectivity made with the first.
+    auto next_connection = [&] {
+      if (zgc_id == 0) zgc_id = new_zone_grid_connectivity(cgio, root, options.cgns_base_name, name, path);
+      return "C" + std::to_string(++connections);
+    };
     for (int s = 0; s < 4; ++s) {
       struct Run {
         GO block;
@@ -666,15 +681,7 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
         // Leaving this block across the side is entering the donor across its side.
         const int normal = 1 - me.tangent, donor_normal = 1 - them.tangent;
         transform[normal] = (me.at_max == them.at_max ? -1 : 1) * (donor_normal + 1);
-        std::string cname(1, 'C');
-        cname += std::to_string(++connections);
-        if (zgc_id == 0) {
-          double zone_id = 0;
-          QSMESH_CGIO(cgio_get_node_id(
-              cgio, root, ("/" + options.cgns_base_name + "/" + name).c_str(), &zone_id));
-          QSMESH_CGIO(cgio_new_node(cgio, zone_id, "ZoneGridConnectivity", "ZoneGridConnectivity_t",
-                                    "MT", 0, nullptr, nullptr, &zgc_id));
-        }
+        const std::string cname = next_connection();
         const std::string donor_name = zone_name(r.block);
         const cgsize_t name_size[1] = {static_cast<cgsize_t>(donor_name.size())};
         double conn_id = 0, child = 0;
@@ -711,15 +718,7 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
         }
         const auto i0 = side_index(b, s, p), i1 = side_index(b, s, q + 1);
         cgsize_t range[4] = {i0[0], i0[1], i1[0], i1[1]};
-        if (zgc_id == 0) {
-          double zone_id = 0;
-          QSMESH_CGIO(cgio_get_node_id(
-              cgio, root, ("/" + options.cgns_base_name + "/" + name).c_str(), &zone_id));
-          QSMESH_CGIO(cgio_new_node(cgio, zone_id, "ZoneGridConnectivity", "ZoneGridConnectivity_t",
-                                    "MT", 0, nullptr, nullptr, &zgc_id));
-        }
-        std::string cname(1, 'C');
-        cname += std::to_string(++connections);
+        const std::string cname = next_connection();
         write_abutment(cgio, zgc_id, cname, kUnstructuredZone, "PointRange", "IndexRange_t",
                        {2, 2}, range, {1, static_cast<cgsize_t>(a.local.size())}, a.local.data(),
                        path);
@@ -775,11 +774,8 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
         [&](GO v) { return static_cast<cgsize_t>(local[static_cast<std::size_t>(v)] + 1); }, 1,
         false, path);
     if (!abutments.empty()) {
-      double zone_id = 0, zgc_id = 0;
-      QSMESH_CGIO(cgio_get_node_id(
-          cgio, root, ("/" + options.cgns_base_name + "/" + kUnstructuredZone).c_str(), &zone_id));
-      QSMESH_CGIO(cgio_new_node(cgio, zone_id, "ZoneGridConnectivity", "ZoneGridConnectivity_t",
-                                "MT", 0, nullptr, nullptr, &zgc_id));
+      const double zgc_id = new_zone_grid_connectivity(cgio, root, options.cgns_base_name,
+                                                       kUnstructuredZone, path);
       int connections = 0;
       for (const Abutment& a : abutments) {
         std::string cname(1, 'C');

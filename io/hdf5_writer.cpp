@@ -325,14 +325,15 @@ void write_hdf5(const mesh::SurfaceMesh& mesh, const std::string& path,
     x << "  </Grid>\n </Domain>\n</Xdmf>\n";
     x.close();
   }
-  // The description is committed first: if the data then fails to land, it is removed again, so
-  // that no description points at a file that is not there.
-  xdmf_out.commit();
+  // The data land first, then their description: a run stopped between the two renames leaves a
+  // complete .h5 without its .xdmf, never a description of data that are not there. If the
+  // description cannot land, the data go again: the run wrote nothing.
+  h5_out.commit();
   try {
-    h5_out.commit();
+    xdmf_out.commit();
   } catch (...) {
     std::error_code ec;
-    fs::remove(xdmf, ec);
+    fs::remove(path, ec);
     throw;
   }
 }
