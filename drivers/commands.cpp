@@ -455,7 +455,8 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
     const highorder::QuadraticReport& q = *checks.quadratic;
     os << "  second-order nodes: " << q.curve_nodes << " on curves, " << q.face_nodes
        << " in faces (" << q.unprojected
-       << " off the CAD: no CAD point near, or put back straight); quads whose face nodes went back "
+       << " off the CAD: no CAD point near, or put back straight); quads whose face nodes went "
+          "back "
        << "straight to stay valid " << q.straightened << ", made entirely straight "
        << q.curve_straightened << ", still invalid " << q.invalid << "\n";
   }

@@ -41,8 +41,8 @@ std::string function_of(const char* call) {
 // the function (with cgnslib's reason: a full disk shows as a failed H5Dwrite).
 void cg_check(int rc, const char* call, const std::string& path) {
   if (rc != CG_OK) {
-    throw OutputError("cannot write " + path + ": CGNS " + function_of(call) + " failed: " +
-                      cg_get_error());
+    throw OutputError("cannot write " + path + ": CGNS " + function_of(call) +
+                      " failed: " + cg_get_error());
   }
 }
 #define QSMESH_CG(call) cg_check((call), #call, path)
@@ -432,8 +432,8 @@ void write_abutment(int cgio, double parent, const std::string& name, const std:
                             location.data(), &child));
   QSMESH_CGIO(cgio_new_node(cgio, id, points_name, points_label, "I4", 2, points_dims.data(),
                             points, &child));
-  QSMESH_CGIO(cgio_new_node(cgio, id, "PointListDonor", "IndexArray_t", "I4", 2,
-                            donor_dims.data(), donor_points, &child));
+  QSMESH_CGIO(cgio_new_node(cgio, id, "PointListDonor", "IndexArray_t", "I4", 2, donor_dims.data(),
+                            donor_points, &child));
 }
 
 std::array<cgsize_t, 2> side_index(const layout::Block& b, int s, LO p) {
@@ -520,9 +520,8 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
         element(mesh.triangles[static_cast<std::size_t>(t)]);
       for (GO q : groups.face2quads[static_cast<std::size_t>(f)])
         element(mesh.quads[static_cast<std::size_t>(q)]);
-      unstructured_cells +=
-          static_cast<GO>(groups.face2tris[static_cast<std::size_t>(f)].size() +
-                          groups.face2quads[static_cast<std::size_t>(f)].size());
+      unstructured_cells += static_cast<GO>(groups.face2tris[static_cast<std::size_t>(f)].size() +
+                                            groups.face2quads[static_cast<std::size_t>(f)].size());
     }
   }
   // A block edge is free (a BC) when no other block side and no element of the unstructured zone
@@ -614,8 +613,12 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
     double zgc_id = 0;  // the zone's ZoneGridConnectivity node, made with its first interface
     // The name of the zone's next connectivity node, the ZoneGridConnectivity made with the first.
     auto next_connection = [&] {
-      if (zgc_id == 0) zgc_id = new_zone_grid_connectivity(cgio, root, options.cgns_base_name, name, path);
-      return "C" + std::to_string(++connections);
+      if (zgc_id == 0)
+        zgc_id = new_zone_grid_connectivity(cgio, root, options.cgns_base_name, name, path);
+      // Appended rather than "C" + ...: GCC 12 reports a false -Wrestrict on that concatenation.
+      std::string next(1, 'C');
+      next += std::to_string(++connections);
+      return next;
     };
     for (int s = 0; s < 4; ++s) {
       struct Run {
@@ -699,9 +702,8 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
       // ranges here, vertex lists there), written as cgio nodes beside the 1-to-1 ones.
       for (LO p = 0; p < side_edges(b, s);) {
         auto on_unstructured = [&](LO q) {
-          return unstructured_edges.count(
-                     edge_key(side_vertex(b, s, q, layout.vertices),
-                              side_vertex(b, s, q + 1, layout.vertices))) > 0;
+          return unstructured_edges.count(edge_key(side_vertex(b, s, q, layout.vertices),
+                                                   side_vertex(b, s, q + 1, layout.vertices))) > 0;
         };
         if (!on_unstructured(p)) {
           ++p;
@@ -719,9 +721,8 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
         const auto i0 = side_index(b, s, p), i1 = side_index(b, s, q + 1);
         cgsize_t range[4] = {i0[0], i0[1], i1[0], i1[1]};
         const std::string cname = next_connection();
-        write_abutment(cgio, zgc_id, cname, kUnstructuredZone, "PointRange", "IndexRange_t",
-                       {2, 2}, range, {1, static_cast<cgsize_t>(a.local.size())}, a.local.data(),
-                       path);
+        write_abutment(cgio, zgc_id, cname, kUnstructuredZone, "PointRange", "IndexRange_t", {2, 2},
+                       range, {1, static_cast<cgsize_t>(a.local.size())}, a.local.data(), path);
         abutments.push_back(std::move(a));
         p = q + 1;
       }
@@ -774,15 +775,15 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
         [&](GO v) { return static_cast<cgsize_t>(local[static_cast<std::size_t>(v)] + 1); }, 1,
         false, path);
     if (!abutments.empty()) {
-      const double zgc_id = new_zone_grid_connectivity(cgio, root, options.cgns_base_name,
-                                                       kUnstructuredZone, path);
+      const double zgc_id =
+          new_zone_grid_connectivity(cgio, root, options.cgns_base_name, kUnstructuredZone, path);
       int connections = 0;
       for (const Abutment& a : abutments) {
         std::string cname(1, 'C');
         cname += std::to_string(++connections);
         const auto n = static_cast<cgsize_t>(a.local.size());
-        write_abutment(cgio, zgc_id, cname, zone_name(a.block), "PointList", "IndexArray_t",
-                       {1, n}, a.local.data(), {2, n}, a.ij.data(), path);
+        write_abutment(cgio, zgc_id, cname, zone_name(a.block), "PointList", "IndexArray_t", {1, n},
+                       a.local.data(), {2, n}, a.ij.data(), path);
       }
     }
   }

@@ -106,10 +106,14 @@ inline BlockFileSummary check_block_file(const std::string& path) {
   // Marks the side edges of the side range r (one index constant) of a structured zone as covered.
   auto cover = [&](Zone& zone, const cgsize_t r[4], const std::string& what) {
     int side = -1;
-    if (r[1] == r[3] && r[1] == 1) side = 0;
-    else if (r[0] == r[2] && r[0] == zone.ni) side = 1;
-    else if (r[1] == r[3] && r[1] == zone.nj) side = 2;
-    else if (r[0] == r[2] && r[0] == 1) side = 3;
+    if (r[1] == r[3] && r[1] == 1)
+      side = 0;
+    else if (r[0] == r[2] && r[0] == zone.ni)
+      side = 1;
+    else if (r[1] == r[3] && r[1] == zone.nj)
+      side = 2;
+    else if (r[0] == r[2] && r[0] == 1)
+      side = 3;
     if (side < 0 || (r[0] == r[2] && r[1] == r[3])) {
       err << zone.name << "/" << what << ": not a side range; ";
       return false;
@@ -250,8 +254,8 @@ inline BlockFileSummary check_block_file(const std::string& path) {
           if (k >= ids.size() || ids[k] < 1 || ids[k] > dz.ni) {
             err << zone.name << "/" << cname << ": donor point list too short or out of range; ";
           } else if (point(zone, i, j) != point(dz, ids[k], 1)) {
-            err << zone.name << "/" << cname << ": point (" << i << "," << j
-                << ") is not point " << ids[k] << " of " << dname << "; ";
+            err << zone.name << "/" << cname << ": point (" << i << "," << j << ") is not point "
+                << ids[k] << " of " << dname << "; ";
           }
           ++k;
           if (j == range[3]) break;
@@ -270,8 +274,7 @@ inline BlockFileSummary check_block_file(const std::string& path) {
       for (std::size_t p = 0; p < zone.covered[static_cast<std::size_t>(s)].size(); ++p) {
         const int c = zone.covered[static_cast<std::size_t>(s)][p];
         if (c != 1)
-          err << zone.name << ": side " << s << " edge " << p + 1 << " covered " << c
-              << " times; ";
+          err << zone.name << ": side " << s << " edge " << p + 1 << " covered " << c << " times; ";
       }
   ok(cg_close(fn), "cg_close");
   out.error = err.str();

@@ -284,9 +284,9 @@ TEST_F(Qsmesh, SecondOrderNodesOffTheCadHaveNoParameters) {
       const auto node = static_cast<std::size_t>(e[4 + k]);
       if (!std::isnan(param[2 * node])) continue;
       for (int d = 0; d < 3; ++d) {
-        const double want = k < 4 ? 0.5 * (point(e[k], d) + point(e[(k + 1) % 4], d))
-                                  : 0.25 * (point(e[0], d) + point(e[1], d) + point(e[2], d) +
-                                            point(e[3], d));
+        const double want =
+            k < 4 ? 0.5 * (point(e[k], d) + point(e[(k + 1) % 4], d))
+                  : 0.25 * (point(e[0], d) + point(e[1], d) + point(e[2], d) + point(e[3], d));
         EXPECT_NEAR(point(e[4 + k], d), want, 1e-9) << "quad " << q << " node " << k;
       }
       ++straight;

@@ -1,7 +1,6 @@
 // HDF5 output read back through the HDF5 C API, and its XDMF description.
 #include <gtest/gtest.h>
 #include <hdf5.h>
-
 #include <sys/resource.h>
 
 #include <chrono>
@@ -197,9 +196,9 @@ mesh::SurfaceMesh make_quadratic_mesh() {
   m.num_cad_corners = 1;
   m.num_cad_curves = 1;
   m.num_cad_faces = 1;
-  m.points = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}, {0, 1, 0}, {1, 1, 0}, {2, 1, 0},
-              {0.5, 0, 0}, {1, 0.5, 0}, {0.5, 1, 0}, {0, 0.5, 0}, {1.5, 0, 0}, {2, 0.5, 0},
-              {1.5, 1, 0}, {0.5, 0.5, 0.1}, {1.5, 0.5, 0.1}};
+  m.points = {{0, 0, 0},   {1, 0, 0},   {2, 0, 0},   {0, 1, 0},       {1, 1, 0},
+              {2, 1, 0},   {0.5, 0, 0}, {1, 0.5, 0}, {0.5, 1, 0},     {0, 0.5, 0},
+              {1.5, 0, 0}, {2, 0.5, 0}, {1.5, 1, 0}, {0.5, 0.5, 0.1}, {1.5, 0.5, 0.1}};
   m.vclass.assign(m.points.size(), {1, 0, kNoIndex, {0, 0}});
   m.vclass[0] = {0, 0, kNoIndex, {0, 0}};
   for (std::size_t v : {std::size_t{7}, std::size_t{13}, std::size_t{14}})
@@ -230,16 +229,17 @@ TEST(Hdf5, SecondOrderWholeConnectivitiesAndXdmf) {
             (std::vector<std::int64_t>{0, 1, 4, 3, 6, 7, 8, 9, 13, 1, 2, 5, 4, 10, 11, 12, 7, 14}));
   const auto bar3 = read_dataset<std::int64_t>(file, "bar3", H5T_NATIVE_INT64);
   EXPECT_EQ(bar3.dims, dims({6, 3}));
-  EXPECT_EQ(bar3.values, (std::vector<std::int64_t>{0, 1, 6, 1, 2, 10, 2, 5, 11, 5, 4, 12, 4, 3,
-                                                     8, 3, 0, 9}));
+  EXPECT_EQ(bar3.values,
+            (std::vector<std::int64_t>{0, 1, 6, 1, 2, 10, 2, 5, 11, 5, 4, 12, 4, 3, 8, 3, 0, 9}));
   const auto quads = read_dataset<std::int64_t>(file, "quads", H5T_NATIVE_INT64);
   EXPECT_EQ(quads.dims, dims({2, 4}));
   H5Fclose(file);
   const std::string x = read_all(dir / "q2.xdmf");
-  for (const char* s : {"TopologyType=\"Quadrilateral_9\" NumberOfElements=\"2\"",
-                        "Dimensions=\"2 9\" NumberType=\"Int\" Precision=\"8\" Format=\"HDF\">q2.h5:/quad9<",
-                        "TopologyType=\"Edge_3\" NumberOfElements=\"6\"",
-                        "Dimensions=\"6 3\" NumberType=\"Int\" Precision=\"8\" Format=\"HDF\">q2.h5:/bar3<"})
+  for (const char* s :
+       {"TopologyType=\"Quadrilateral_9\" NumberOfElements=\"2\"",
+        "Dimensions=\"2 9\" NumberType=\"Int\" Precision=\"8\" Format=\"HDF\">q2.h5:/quad9<",
+        "TopologyType=\"Edge_3\" NumberOfElements=\"6\"",
+        "Dimensions=\"6 3\" NumberType=\"Int\" Precision=\"8\" Format=\"HDF\">q2.h5:/bar3<"})
     EXPECT_NE(x.find(s), std::string::npos) << s;
   EXPECT_EQ(x.find("TopologyType=\"Quadrilateral\""), std::string::npos);
 }

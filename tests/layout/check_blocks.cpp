@@ -14,8 +14,8 @@ int main(int argc, char** argv) {
   const qsmesh::test::BlockFileSummary s = qsmesh::test::check_block_file(argv[1]);
   std::cout << argv[1] << ": " << s.structured_zones << " structured zones (" << s.block_quads
             << " quads), " << s.unstructured_zones << " unstructured, " << s.interfaces
-            << " 1-to-1 interfaces over " << s.interface_points << " points, "
-            << s.abutments << " connectivities to the unstructured zone, " << s.boundary_conditions
+            << " 1-to-1 interfaces over " << s.interface_points << " points, " << s.abutments
+            << " connectivities to the unstructured zone, " << s.boundary_conditions
             << " BCs: " << (s.error.empty() ? "all match" : s.error.substr(0, 2000)) << "\n";
   return s.error.empty() ? 0 : 1;
 }

@@ -33,11 +33,11 @@ struct QuadraticReport {
 /// Appends the second-order nodes to `mesh` (an assembled all-quad SurfaceMesh: no triangles):
 /// the midpoint of every mesh edge and the centre of every quad, projected on the CAD curve
 /// (bar edges) or face they lie on, and classified there (dim 1 with the curve parameter, dim 2
-/// with (u, v); index kNoIndex; parameters NaN for the nodes left off the CAD, see unprojected). Fills mesh.quad_nodes and mesh.bar_nodes (SurfaceMesh documents
-/// their order). Quads whose curved form is not valid get their face nodes back on the straight
-/// positions, and then their curve nodes if still not valid. Deterministic whatever the thread
-/// count of `tasks`. Throws qsmesh::Error when the mesh has triangles or already has second-order
-/// nodes.
+/// with (u, v); index kNoIndex; parameters NaN for the nodes left off the CAD, see unprojected).
+/// Fills mesh.quad_nodes and mesh.bar_nodes (SurfaceMesh documents their order). Quads whose curved
+/// form is not valid get their face nodes back on the straight positions, and then their curve
+/// nodes if still not valid. Deterministic whatever the thread count of `tasks`. Throws
+/// qsmesh::Error when the mesh has triangles or already has second-order nodes.
 QuadraticReport make_quadratic(mesh::SurfaceMesh& mesh, const cad::CadModel& model,
                                const TaskArena& tasks);
 

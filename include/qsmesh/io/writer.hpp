@@ -92,17 +92,17 @@ void write_cgns(const mesh::SurfaceMesh& mesh, const std::string& path, const Wr
 
 /// Block-structured CGNS/HDF5 (paper 002's block-structured output, from the layout as it is): one
 /// base (CellDimension 2, PhysicalDimension 3, units as write_cgns), one structured zone
-/// "Block_<k>_Face_<f>" (k and f zero-padded to 6 digits or more) of (ni + 1) x (nj + 1) vertices per block of `layout` (its vertex grid, i
-/// fastest) with FamilyName "Face_<f>", and a GridConnectivity1to1 for every maximal stretch of a
-/// block side shared with one side of another block (or of itself, across a seam), within a face
-/// or across a CAD curve: point ranges, donor ranges and the transform relating the index spaces.
-/// Free block edges (no block across: an open shell's border) get a BC (FamilySpecified, family
-/// "Curve_<c>" with FamilyBC BCWall, as write_cgns) per run of them on one curve.
-/// The faces in layout.unblocked_faces go into one unstructured zone "Unstructured" (a section per
-/// face). Where a block side runs along it, both zones get a GridConnectivity (Abutting1to1,
-/// Vertex: the block's PointRange against the unstructured zone's PointListDonor, and that zone's
-/// PointList against the block's (i, j) PointListDonor), and no BC is written there.
-/// `layout` must come from extract_quad_layout(mesh).
+/// "Block_<k>_Face_<f>" (k and f zero-padded to 6 digits or more) of (ni + 1) x (nj + 1) vertices
+/// per block of `layout` (its vertex grid, i fastest) with FamilyName "Face_<f>", and a
+/// GridConnectivity1to1 for every maximal stretch of a block side shared with one side of another
+/// block (or of itself, across a seam), within a face or across a CAD curve: point ranges, donor
+/// ranges and the transform relating the index spaces. Free block edges (no block across: an open
+/// shell's border) get a BC (FamilySpecified, family "Curve_<c>" with FamilyBC BCWall, as
+/// write_cgns) per run of them on one curve. The faces in layout.unblocked_faces go into one
+/// unstructured zone "Unstructured" (a section per face). Where a block side runs along it, both
+/// zones get a GridConnectivity (Abutting1to1, Vertex: the block's PointRange against the
+/// unstructured zone's PointListDonor, and that zone's PointList against the block's (i, j)
+/// PointListDonor), and no BC is written there. `layout` must come from extract_quad_layout(mesh).
 void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& layout,
                        const std::string& path, const WriteOptions& options = {});
 
