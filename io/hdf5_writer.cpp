@@ -82,10 +82,13 @@ class QuietHdf5Errors {
 // handler then crashes on.
 class H5Writer {
  public:
-  explicit H5Writer(std::string name)
-      : path_(std::move(name)),
+  // `core_name`: the name HDF5 gives the image, a path that does not exist (the core driver
+  // looks for a file of that name, and would open the user's old file if given its name);
+  // `shown`: the file named in errors.
+  H5Writer(const std::string& core_name, std::string shown)
+      : path_(std::move(shown)),
         fapl_(H5Pcreate(H5P_FILE_ACCESS), H5Pclose),
-        file_(create_in_memory(path_, fapl_.get()), H5Fclose),
+        file_(create_in_memory(core_name, path_, fapl_.get()), H5Fclose),
         dcpl_(H5Pcreate(H5P_DATASET_CREATE), H5Pclose) {
     const std::string& path = path_;
     QSMESH_H5(file_.get());
@@ -93,11 +96,12 @@ class H5Writer {
     QSMESH_H5(H5Pset_obj_track_times(dcpl_.get(), 0));
   }
 
-  // Grows the image 4 MiB at a time; the name only labels errors (nothing is opened by it).
-  static hid_t create_in_memory(const std::string& path, hid_t fapl) {
+  // Grows the image 4 MiB at a time.
+  static hid_t create_in_memory(const std::string& core_name, const std::string& path,
+                                hid_t fapl) {
     QSMESH_H5(fapl);
     QSMESH_H5(H5Pset_fapl_core(fapl, std::size_t{1} << 22, 0));
-    return H5Fcreate(path.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
+    return H5Fcreate(core_name.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl);
   }
 
   // A dataset of rows x cols values (cols 0: one dimension), written from `data` (row-major).
@@ -227,7 +231,7 @@ void write_hdf5(const mesh::SurfaceMesh& mesh, const std::string& path,
   const bool quadratic = !mesh.quad_nodes.empty();
   {
     const QuietHdf5Errors quiet;
-    H5Writer h5(path);
+    H5Writer h5(h5_out.temp_path(), path);
     h5.attribute("format", std::string("qsmesh surface mesh"));
     h5.attribute("format_version", std::int64_t{2});
     h5.attribute("length_unit", mesh.length_unit);

@@ -7,6 +7,7 @@
 #include <csignal>
 #include <cstdint>
 #include <filesystem>
+#include <fstream>
 #include <string>
 #include <thread>
 #include <vector>
@@ -246,8 +247,13 @@ TEST(Hdf5, SecondOrderWholeConnectivitiesAndXdmf) {
 
 TEST(Hdf5, FullDiskIsOneOutputErrorAndLeavesNothing) {
   // A file size limit below the file's size: the write fails as the disk being full does. The
-  // writer reports it as one OutputError naming the file, and leaves neither file nor temporary.
+  // writer reports it as one OutputError naming the file, leaves no temporary, and the file of an
+  // earlier run under the same name is untouched.
   const fs::path dir = fresh_dir("hdf5_full");
+  {
+    std::ofstream old(dir / "m.h5");
+    old << "an earlier run";
+  }
   mesh::SurfaceMesh m = make_test_mesh();
   for (int k = 0; k < 20000; ++k) {  // unused points, to make the file larger than the limit
     m.points.push_back({static_cast<double>(k), 0, 0});
@@ -269,7 +275,8 @@ TEST(Hdf5, FullDiskIsOneOutputErrorAndLeavesNothing) {
   std::signal(SIGXFSZ, old_handler);
   EXPECT_NE(message.find("cannot write " + (dir / "m.h5").string()), std::string::npos) << message;
   EXPECT_EQ(message.find('\n'), std::string::npos) << message;
-  EXPECT_TRUE(dir_entries(dir).empty());
+  EXPECT_EQ(dir_entries(dir), std::vector<std::string>{"m.h5"});
+  EXPECT_EQ(read_all(dir / "m.h5"), "an earlier run");
 }
 
 TEST(Hdf5, NoClockInTheBytes) {
