@@ -51,8 +51,8 @@ namespace {
 constexpr std::size_t kFlushBytes = std::size_t{1} << 20;
 }
 
-OutputFile::OutputFile(const std::string& path, std::string shown)
-    : name_(shown.empty() ? path : std::move(shown)) {
+OutputFile::OutputFile(const std::string& path, const std::string& shown)
+    : name_(shown.empty() ? path : shown) {
   file_ = std::fopen(path.c_str(), "wb");
   if (file_ == nullptr) {
     throw OutputError("cannot open " + name_ + " for writing: " + std::strerror(errno));

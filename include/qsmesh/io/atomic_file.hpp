@@ -37,7 +37,7 @@ class AtomicFile {
 /// `path` is an AtomicFile's temporary). close() must be called for the data to count as written.
 class OutputFile {
  public:
-  explicit OutputFile(const std::string& path, std::string shown = {});
+  explicit OutputFile(const std::string& path, const std::string& shown = {});
   ~OutputFile();  ///< closes without checking (error path only)
   OutputFile(const OutputFile&) = delete;
   OutputFile& operator=(const OutputFile&) = delete;
