@@ -146,6 +146,10 @@ Arguments parse(const std::vector<std::string>& args) {
       const auto r = parse_double(v);
       if (!r || !(*r > 0 && *r <= 1)) throw InputError(opt + ": '" + v + "' is not a number in (0, 1]");
       a.size_min_ratio = *r;
+    } else if (opt == "--sizing" && sizing) {
+      a.sizing = value();
+      if (a.sizing != "paper" && a.sizing != "gmsh")
+        throw InputError("--sizing: unknown rules '" + a.sizing + "' (paper or gmsh)");
     } else if (opt == "--sizemap" && sizing) {
       a.sizemap = value();
       if (a.sizemap != "features" && a.sizemap != "crossfield")
@@ -176,6 +180,11 @@ Arguments parse(const std::vector<std::string>& args) {
   if (a.size && a.size_factor) throw InputError("--size and --size-factor: give one, not both");
   if (a.size_min && a.size_min_ratio)
     throw InputError("--size-min and --size-min-ratio: give one, not both");
+  // Gmsh's rules as the two options that make them; options given explicitly win.
+  if (a.sizing == "gmsh") {
+    if (!a.curvature_edges) a.curvature_edges = 0.0;
+    if (!a.size_min && !a.size_min_ratio) a.size_min_ratio = kGmshSizeMinRatio;
+  }
   const bool sizing_given = a.sizemap != "crossfield" || a.quads > 0 || a.curvature_edges ||
                             a.face_curvature || a.feature_ratio || a.size_min || a.size_min_ratio ||
                             !a.curve_edges.empty() ||
@@ -255,7 +264,7 @@ std::string help(const std::string& topic) {
           "                        paper 002 Sec. III.A), joined by 1-to-1 connectivity; faces\n"
           "                        that do not split into blocks go to one unstructured zone\n"
           "  --quads N, --curvature-edges N, --face-curvature, --feature-ratio R, --size-min H,\n"
-          "  --size-min-ratio R, --curve-edges C:N,.., --face-quads F:N,..,\n"
+          "  --size-min-ratio R, --sizing RULES, --curve-edges C:N,.., --face-quads F:N,..,\n"
           "  --corner-size K:H,.., --curve-size C:H,.., --face-size F:H,.., --sizemap METHOD\n"
           "                        size-map controls, as for sizemap (see qsmesh sizemap --help);\n"
           "                        they act on the quad mesh, not with --until background\n"
@@ -313,6 +322,10 @@ std::string help(const std::string& topic) {
           "                        fraction of the target size): fewer irregular vertices and\n"
           "                        flatter quads against sliver curves; at coarse sizes curved faces\n"
           "                        may get too few edges and fail (docs/benchmarks.md)\n"
+          "  --sizing RULES        paper (the default: paper 000 Sec. 4.1, a sliver curve refines\n"
+          "                        the mesh around it down to its length) or gmsh (the rules of\n"
+          "                        Gmsh's implementation: --curvature-edges 0 --size-min-ratio\n"
+          "                        0.17, options given explicitly still win)\n"
           "  --curve-edges C:N,..  prescribe the (even) number of edges of curves; kept exactly\n"
           "  --face-quads F:N,..   prescribe the number of quads of faces\n"
           "  --corner-size K:H,.., --curve-size C:H,.., --face-size F:H,..\n"

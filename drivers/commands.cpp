@@ -261,6 +261,7 @@ std::string stats_json(const Arguments& args, const Session& session,
   write_run_header(j, args, session);
   j.value("output", args.output);
   j.value("stage", args.until);
+  j.value("sizing", args.sizing);  // paper or gmsh (--sizing); the options below are its result
   j.value("curvature_edges", curvature_edges(args));  // edges per full turn (0: none)
   j.value("face_curvature", args.face_curvature);
   j.value("feature_ratio", feature_ratio(args));

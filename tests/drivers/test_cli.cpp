@@ -89,6 +89,30 @@ TEST(Cli, BadSizesNameTheOption) {
   EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--size"}).find("missing value"), std::string::npos);
 }
 
+TEST(Cli, GmshSizingIsItsTwoOptions) {
+  // --sizing gmsh stands for --curvature-edges 0 --size-min-ratio 0.17; options given explicitly
+  // win, whatever their place on the line.
+  const Arguments g = p({"mesh", "m.step", "-o", "o.vtu", "--sizing", "gmsh"});
+  EXPECT_EQ(g.sizing, "gmsh");
+  ASSERT_TRUE(g.curvature_edges && g.size_min_ratio);
+  EXPECT_DOUBLE_EQ(*g.curvature_edges, 0.0);
+  EXPECT_DOUBLE_EQ(*g.size_min_ratio, kGmshSizeMinRatio);
+  EXPECT_FALSE(g.size_min);
+  const Arguments e = p({"sizemap", "m.step", "-o", "s.vtu", "--curvature-edges", "8", "--sizing", "gmsh",
+                         "--size-min", "0.4"});
+  EXPECT_DOUBLE_EQ(*e.curvature_edges, 8.0);
+  EXPECT_DOUBLE_EQ(*e.size_min, 0.4);
+  EXPECT_FALSE(e.size_min_ratio);
+  const Arguments d = p({"mesh", "m.step", "-o", "o.vtu"});
+  EXPECT_EQ(d.sizing, "paper");
+  EXPECT_FALSE(d.curvature_edges || d.size_min_ratio);
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--sizing", "fast"}).find("paper or gmsh"),
+            std::string::npos);
+  // Like every sizing option, not with --until background, where it would change nothing.
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--sizing", "gmsh", "--until", "background"}),
+            "");
+}
+
 TEST(Cli, SizeMapOptions) {
   const Arguments a = p({"sizemap", "m.step", "-o", "s.vtu", "--sizemap", "features", "--curve-edges", "3:8,7:12",
                          "--face-quads", "2:100", "--corner-size", "0:0.5", "--curve-size", "4:1.5",

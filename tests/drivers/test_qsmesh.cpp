@@ -523,6 +523,17 @@ TEST_F(Qsmesh, MeshHonoursSizeMapOptions) {
   EXPECT_LT(json_number(jr, "vertices"), json_number(j16, "vertices"));
 }
 
+TEST_F(Qsmesh, GmshSizingGivesTheMeshOfItsTwoOptions) {
+  const auto [rg, jg] = mesh_with_stats(model_, "--size 0.8 --sizing gmsh", "e2e_sizing_gmsh");
+  const auto [ro, jo] = mesh_with_stats(
+      model_, "--size 0.8 --curvature-edges 0 --size-min-ratio 0.17", "e2e_sizing_options");
+  ASSERT_EQ(rg.code, 0) << rg.err;
+  ASSERT_EQ(ro.code, 0) << ro.err;
+  EXPECT_NE(jg.find("\"sizing\": \"gmsh\""), std::string::npos);
+  EXPECT_EQ(json_number(jg, "curvature_edges"), 0);
+  EXPECT_TRUE(slurp(tmp("e2e_sizing_gmsh.msh")) == slurp(tmp("e2e_sizing_options.msh")));
+}
+
 TEST_F(Qsmesh, ExampleWingBody) {
   const std::string step = tmp("e2e_wing_body.step");
   const ExeResult r = run("example wing-body -o " + step);
