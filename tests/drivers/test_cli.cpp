@@ -98,8 +98,8 @@ TEST(Cli, GmshSizingIsItsTwoOptions) {
   EXPECT_DOUBLE_EQ(*g.curvature_edges, 0.0);
   EXPECT_DOUBLE_EQ(*g.size_min_ratio, kGmshSizeMinRatio);
   EXPECT_FALSE(g.size_min);
-  const Arguments e = p({"sizemap", "m.step", "-o", "s.vtu", "--curvature-edges", "8", "--sizing", "gmsh",
-                         "--size-min", "0.4"});
+  const Arguments e = p({"sizemap", "m.step", "-o", "s.vtu", "--curvature-edges", "8", "--sizing",
+                         "gmsh", "--size-min", "0.4"});
   EXPECT_DOUBLE_EQ(*e.curvature_edges, 8.0);
   EXPECT_DOUBLE_EQ(*e.size_min, 0.4);
   EXPECT_FALSE(e.size_min_ratio);
@@ -109,8 +109,8 @@ TEST(Cli, GmshSizingIsItsTwoOptions) {
   EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--sizing", "fast"}).find("paper or gmsh"),
             std::string::npos);
   // Like every sizing option, not with --until background, where it would change nothing.
-  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--sizing", "gmsh", "--until", "background"}),
-            "");
+  EXPECT_NE(
+      error_of({"mesh", "m.step", "-o", "o.vtu", "--sizing", "gmsh", "--until", "background"}), "");
 }
 
 TEST(Cli, SizeMapOptions) {
