@@ -547,8 +547,9 @@ Session::Session(const Arguments& args, const char* command)
         std::max(1, static_cast<int>(std::thread::hardware_concurrency()) / comm.local_size());
   tasks = std::make_unique<TaskArena>(threads);
   log.info(cat("qsmesh ", command, " ", args.model, ": ", model.num_corners(), " corners, ",
-               model.num_curves(), " curves, ", model.num_faces(), " faces; size ", size, "; ",
-               ranks, " rank(s) x ", threads, " thread(s)"));
+               model.num_curves(), " curves, ", model.num_faces(), " faces; size ", size,
+               args.sizing == "paper" ? "" : " (" + args.sizing + " sizing rules)", "; ", ranks,
+               " rank(s) x ", threads, " thread(s)"));
 }
 
 namespace {
