@@ -258,7 +258,7 @@ std::string help(const std::string& topic) {
           "  --stats FILE.json     also write the run statistics as JSON\n"
           "  --order 2             second-order elements: 9-node quads and 3-node bars, the new\n"
           "                        nodes on the CAD (CGNS QUAD_9/BAR_3, VTU, MSH; in .h5 the\n"
-          "                        datasets quad_nodes and bar_nodes)\n"
+          "                        datasets quad9 and bar3)\n"
           "  --block-structured    write the .cgns file as structured zones, one per block of the\n"
           "                        quad layout (traces from irregular vertices and CAD corners,\n"
           "                        paper 002 Sec. III.A), joined by 1-to-1 connectivity; faces\n"

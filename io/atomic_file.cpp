@@ -99,7 +99,15 @@ OutputFile& OutputFile::operator<<(double v) {
 }
 
 void OutputFile::write(const void* data, std::size_t bytes) {
-  *this << std::string_view(static_cast<const char*>(data), bytes);
+  if (bytes < kFlushBytes) {
+    *this << std::string_view(static_cast<const char*>(data), bytes);
+    return;
+  }
+  // A large block (an HDF5 file image) goes straight out rather than through a copy in the buffer.
+  flush();
+  if (std::fwrite(data, 1, bytes, file_) != bytes) {
+    throw OutputError("cannot write " + name_ + ": " + std::strerror(errno));
+  }
 }
 
 void OutputFile::close() {

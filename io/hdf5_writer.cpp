@@ -1,6 +1,7 @@
 // HDF5 output through the HDF5 C API (Debian: the serial library cgnslib also uses), with an XDMF 3
 // description beside it. Its own handles only: nothing here touches cgnslib's files.
 #include <hdf5.h>
+#include <unistd.h>
 
 #include <algorithm>
 #include <array>
@@ -329,17 +330,39 @@ void write_hdf5(const mesh::SurfaceMesh& mesh, const std::string& path,
     x << "  </Grid>\n </Domain>\n</Xdmf>\n";
     x.close();
   }
-  // The data land first, then their description: a run stopped between the two renames leaves a
-  // complete .h5 without its .xdmf, never a description of data that are not there. If the
-  // description cannot land, the data go again: the run wrote nothing.
-  h5_out.commit();
+  // The pair lands together or not at all: an earlier .h5 of the same name is moved aside first
+  // and put back if either rename fails, so that a failure leaves the earlier pair as it was. The
+  // data land before their description: a run stopped between the two renames leaves the new
+  // .h5 beside the old .xdmf (the same layout, at worst other counts), never a description of
+  // data that are not there.
+  std::error_code ec;
+  const fs::path aside = fs::path(path).parent_path() /
+                         ("." + fs::path(path).filename().string() + ".old." +
+                          std::to_string(::getpid()));
+  const bool had_earlier = fs::exists(path, ec);
+  if (had_earlier) {
+    fs::rename(path, aside, ec);
+    if (ec) throw OutputError("cannot replace " + path + ": " + ec.message());
+  }
+  auto restore = [&] {
+    std::error_code ignored;
+    if (had_earlier) fs::rename(aside, path, ignored);
+  };
+  try {
+    h5_out.commit();
+  } catch (...) {
+    restore();
+    throw;
+  }
   try {
     xdmf_out.commit();
   } catch (...) {
-    std::error_code ec;
-    fs::remove(path, ec);
+    std::error_code ignored;
+    fs::remove(path, ignored);
+    restore();
     throw;
   }
+  if (had_earlier) fs::remove(aside, ec);
 }
 
 }  // namespace qsmesh::io

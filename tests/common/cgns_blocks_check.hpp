@@ -3,8 +3,10 @@
 //   signed permutation whose image of the range's end is the donor range's end), and has its
 //   reciprocal in the donor zone;
 // - every general GridConnectivity (a block abutting the unstructured zone) joins points with the
-//   same coordinates, point by point;
-// - every BC lies on a block side;
+//   same coordinates, point by point, and has its reverse in the unstructured zone (the same
+//   points, read there and checked there too);
+// - every BC lies on a block side, on no edge another block side or an unstructured element also
+//   has (that would be a wall inside the surface where a connection is missing);
 // - every edge of every block side is covered exactly once, by an interface, a connectivity or a
 //   BC (a side edge nothing covers would be an open boundary inside the surface).
 // Every cgnslib return code is checked. Header-only; the test must link cgnslib (qsmesh_cgns).
@@ -130,6 +132,12 @@ inline BlockFileSummary check_block_file(const std::string& path) {
     }
     return true;
   };
+  // Abutments as (block zone, its points' (i, j), sorted), from the block side and from the
+  // unstructured side: the two lists must be equal.
+  std::multiset<std::pair<int, std::vector<std::array<cgsize_t, 2>>>> abut_blocks, abut_unstructured;
+  // BC edges as (zone, point a, point b), checked at the end against every zone's edges.
+  std::vector<std::array<std::array<double, 3>, 2>> bc_edges;
+  std::vector<std::string> bc_names;
   // (zone, range, donor zone, donor range), ranges sorted so that both directions compare.
   std::set<std::tuple<int, std::array<cgsize_t, 4>, int, std::array<cgsize_t, 4>>> links;
   auto normal = [](const cgsize_t r[4]) {
@@ -164,7 +172,13 @@ inline BlockFileSummary check_block_file(const std::string& path) {
       }
       if (!ok(cg_boco_read(fn, 1, z, bc, r, nullptr), "cg_boco_read")) continue;
       ++out.boundary_conditions;
-      cover(zone, r, bname);
+      if (!cover(zone, r, bname)) continue;
+      const int t = r[0] == r[2] ? 1 : 0;  // the index moving along the BC
+      for (cgsize_t x = std::min(r[t], r[t + 2]); x < std::max(r[t], r[t + 2]); ++x) {
+        const cgsize_t i0 = t == 0 ? x : r[0], j0 = t == 0 ? r[1] : x;
+        bc_edges.push_back({point(zone, i0, j0), point(zone, t == 0 ? x + 1 : i0, t == 0 ? j0 : x + 1)});
+        bc_names.push_back(zone.name + "/" + bname);
+      }
     }
     int n = 0;
     ok(cg_n1to1(fn, 1, z, &n), "cg_n1to1");
@@ -248,6 +262,7 @@ inline BlockFileSummary check_block_file(const std::string& path) {
       if (!cover(zone, range, cname)) continue;
       const Zone& dz = zones[static_cast<std::size_t>(it->second)];
       const cgsize_t di = range[2] >= range[0] ? 1 : -1, dj = range[3] >= range[1] ? 1 : -1;
+      std::vector<std::array<cgsize_t, 2>> ij;
       std::size_t k = 0;
       for (cgsize_t i = range[0];; i += di) {
         for (cgsize_t j = range[1];; j += dj) {
@@ -257,13 +272,115 @@ inline BlockFileSummary check_block_file(const std::string& path) {
             err << zone.name << "/" << cname << ": point (" << i << "," << j << ") is not point "
                 << ids[k] << " of " << dname << "; ";
           }
+          ij.push_back({i, j});
           ++k;
           if (j == range[3]) break;
         }
         if (i == range[2]) break;
       }
       if (k != ids.size()) err << zone.name << "/" << cname << ": donor list length; ";
+      std::sort(ij.begin(), ij.end());
+      abut_blocks.insert({z - 1, ij});
     }
+  }
+  // The unstructured zone: its connectivities back to the blocks, and its element edges.
+  std::map<std::array<double, 6>, int> edge_count;  // surface edges (both ends' coordinates)
+  auto edge_key = [](std::array<double, 3> a, std::array<double, 3> b) {
+    if (b < a) std::swap(a, b);
+    return std::array<double, 6>{a[0], a[1], a[2], b[0], b[1], b[2]};
+  };
+  for (int z = 1; z <= nzones && !failed; ++z) {
+    const Zone& zone = zones[static_cast<std::size_t>(z - 1)];
+    if (zone.structured) {
+      for (cgsize_t j = 1; j <= zone.nj; ++j)
+        for (cgsize_t i = 1; i <= zone.ni; ++i) {
+          const bool side_j = j == 1 || j == zone.nj, side_i = i == 1 || i == zone.ni;
+          if (i < zone.ni && side_j) ++edge_count[edge_key(point(zone, i, j), point(zone, i + 1, j))];
+          if (j < zone.nj && side_i) ++edge_count[edge_key(point(zone, i, j), point(zone, i, j + 1))];
+        }
+      continue;
+    }
+    int nsections = 0;
+    ok(cg_nsections(fn, 1, z, &nsections), "cg_nsections");
+    for (int sec = 1; sec <= nsections; ++sec) {
+      char sname[33] = {};
+      CGNS_ENUMT(ElementType_t) etype;
+      cgsize_t start = 0, end = 0, size = 0;
+      int nbndry = 0, parent_flag = 0;
+      if (!ok(cg_section_read(fn, 1, z, sec, sname, &etype, &start, &end, &nbndry, &parent_flag),
+              "cg_section_read") ||
+          !ok(cg_ElementDataSize(fn, 1, z, sec, &size), "cg_ElementDataSize"))
+        continue;
+      std::vector<cgsize_t> data(static_cast<std::size_t>(size));
+      if (etype == CGNS_ENUMV(MIXED)) {  // with offsets; the data still lead with each type
+        std::vector<cgsize_t> offsets(static_cast<std::size_t>(end - start + 2));
+        if (!ok(cg_poly_elements_read(fn, 1, z, sec, data.data(), offsets.data(), nullptr),
+                "cg_poly_elements_read"))
+          continue;
+      } else if (!ok(cg_elements_read(fn, 1, z, sec, data.data(), nullptr), "cg_elements_read")) {
+        continue;
+      }
+      for (std::size_t at = 0; at < data.size();) {
+        CGNS_ENUMT(ElementType_t) type = etype;
+        if (etype == CGNS_ENUMV(MIXED)) type = static_cast<CGNS_ENUMT(ElementType_t)>(data[at++]);
+        const std::size_t n = type == CGNS_ENUMV(QUAD_4) ? 4 : type == CGNS_ENUMV(TRI_3) ? 3 : 0;
+        if (n == 0) {
+          err << zone.name << "/" << sname << ": element type " << type << " not read; ";
+          break;
+        }
+        for (std::size_t k = 0; k < n; ++k)
+          ++edge_count[edge_key(point(zone, data[at + k], 1), point(zone, data[at + (k + 1) % n], 1))];
+        at += n;
+      }
+    }
+    int nconn = 0;
+    ok(cg_nconns(fn, 1, z, &nconn), "cg_nconns");
+    for (int c = 1; c <= nconn; ++c) {
+      char cname[33] = {}, dname[33] = {};
+      CGNS_ENUMT(GridLocation_t) location;
+      CGNS_ENUMT(GridConnectivityType_t) type;
+      CGNS_ENUMT(PointSetType_t) ptype, dptype;
+      CGNS_ENUMT(ZoneType_t) dztype;
+      CGNS_ENUMT(DataType_t) ddtype;
+      cgsize_t npnts = 0, ndonor = 0;
+      if (!ok(cg_conn_info(fn, 1, z, c, cname, &location, &type, &ptype, &npnts, dname, &dztype,
+                           &dptype, &ddtype, &ndonor),
+              "cg_conn_info"))
+        continue;
+      const auto it = by_name.find(dname);
+      if (ptype != CGNS_ENUMV(PointList) || it == by_name.end() ||
+          !zones[static_cast<std::size_t>(it->second)].structured || ndonor != npnts ||
+          type != CGNS_ENUMV(Abutting1to1) || location != CGNS_ENUMV(Vertex)) {
+        err << zone.name << "/" << cname << ": not a vertex list abutting a block; ";
+        continue;
+      }
+      std::vector<cgsize_t> ids(static_cast<std::size_t>(npnts)), donor(2 * ids.size());
+      if (!ok(cg_conn_read(fn, 1, z, c, ids.data(), CGNS_ENUMV(Integer), donor.data()),
+              "cg_conn_read"))
+        continue;
+      const Zone& dz = zones[static_cast<std::size_t>(it->second)];
+      std::vector<std::array<cgsize_t, 2>> ij;
+      for (std::size_t k = 0; k < ids.size(); ++k) {
+        const cgsize_t i = donor[2 * k], j = donor[2 * k + 1];
+        if (ids[k] < 1 || ids[k] > zone.ni || i < 1 || j < 1 || i > dz.ni || j > dz.nj) {
+          err << zone.name << "/" << cname << ": point out of range; ";
+          continue;
+        }
+        if (point(zone, ids[k], 1) != point(dz, i, j))
+          err << zone.name << "/" << cname << ": point " << ids[k] << " is not (" << i << "," << j
+              << ") of " << dname << "; ";
+        ij.push_back({i, j});
+      }
+      std::sort(ij.begin(), ij.end());
+      abut_unstructured.insert({it->second, ij});
+    }
+  }
+  if (abut_blocks != abut_unstructured)
+    err << "the connectivities between blocks and the unstructured zone are not the same both ways; ";
+  for (std::size_t e = 0; e < bc_edges.size(); ++e) {
+    const auto found = edge_count.find(edge_key(bc_edges[e][0], bc_edges[e][1]));
+    if (found != edge_count.end() && found->second > 1)
+      err << bc_names[e] << ": a BC on an edge another zone also has; ";
   }
   for (const auto& [a, ra, b, rb] : links)
     if (links.count({b, rb, a, ra}) == 0)

@@ -279,6 +279,28 @@ TEST(Hdf5, FullDiskIsOneOutputErrorAndLeavesNothing) {
   EXPECT_EQ(read_all(dir / "m.h5"), "an earlier run");
 }
 
+TEST(Hdf5, TheTwoFilesLandTogether) {
+  // The description cannot land (its name is a folder with something in it): the new .h5 is not
+  // left beside the earlier description, and the earlier .h5 is back, as before the run.
+  const fs::path dir = fresh_dir("hdf5_pair");
+  {
+    std::ofstream old(dir / "m.h5");
+    old << "an earlier run";
+  }
+  fs::create_directories(dir / "m.xdmf");
+  {
+    std::ofstream inside(dir / "m.xdmf" / "x");
+    inside << "x";
+  }
+  EXPECT_THROW(write_hdf5(make_test_mesh(), (dir / "m.h5").string()), OutputError);
+  EXPECT_EQ(dir_entries(dir), (std::vector<std::string>{"m.h5", "m.xdmf"}));
+  EXPECT_EQ(read_all(dir / "m.h5"), "an earlier run");
+  // Without an earlier .h5 nothing is left at all.
+  fs::remove(dir / "m.h5");
+  EXPECT_THROW(write_hdf5(make_test_mesh(), (dir / "m.h5").string()), OutputError);
+  EXPECT_EQ(dir_entries(dir), std::vector<std::string>{"m.xdmf"});
+}
+
 TEST(Hdf5, NoClockInTheBytes) {
   // Two writes more than a second apart (HDF5 object times have one-second resolution).
   const fs::path dir = fresh_dir("hdf5_clock");

@@ -1,4 +1,6 @@
 // Quad layouts of hand-built meshes, and their block-structured CGNS output read back.
+#include <cgns_io.h>
+#include <cgnslib.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -263,6 +265,61 @@ TEST(CgnsBlocks, UnblockedFacesGoToAnUnstructuredZone) {
   // block's three other sides.
   EXPECT_EQ(s.abutments, 1);
   EXPECT_EQ(s.boundary_conditions, 3);
+}
+
+// Deletes the node at `node` (a path from the root) of the CGNS file `path`, through cgio.
+void delete_node(const std::string& path, const std::string& node) {
+  int cgio = 0;
+  ASSERT_EQ(cgio_open_file(path.c_str(), CGIO_MODE_MODIFY, CGIO_FILE_NONE, &cgio), CGIO_ERR_NONE);
+  double root = 0, id = 0, parent = 0;
+  ASSERT_EQ(cgio_get_root_id(cgio, &root), CGIO_ERR_NONE);
+  ASSERT_EQ(cgio_get_node_id(cgio, root, node.c_str(), &id), CGIO_ERR_NONE) << node;
+  ASSERT_EQ(cgio_get_node_id(cgio, root, node.substr(0, node.rfind('/')).c_str(), &parent),
+            CGIO_ERR_NONE);
+  ASSERT_EQ(cgio_delete_node(cgio, parent, id), CGIO_ERR_NONE);
+  ASSERT_EQ(cgio_close_file(cgio), CGIO_ERR_NONE);
+}
+
+TEST(CgnsBlocks, TheReaderCatchesMissingConnections) {
+  // The reader the other tests trust must fail on the files a broken writer would make: the
+  // unstructured zone's connectivity back to the block missing, and the block's own connectivity
+  // replaced by a wall BC over the same edges.
+  const fs::path dir = fresh_dir("cgns_blocks_broken");
+  const mesh::SurfaceMesh m = two_faces_with_triangles();
+  const QuadLayout l = extract_quad_layout(m);
+  const std::string good = (dir / "good.cgns").string();
+  io::write_cgns_blocks(m, l, good);
+  ASSERT_EQ(qsmesh::test::check_block_file(good).error, "");
+  const std::string block = "/qsmesh/Block_000000_Face_000000";
+
+  const std::string no_reverse = (dir / "no_reverse.cgns").string();
+  fs::copy_file(good, no_reverse);
+  delete_node(no_reverse, "/qsmesh/Unstructured/ZoneGridConnectivity");
+  EXPECT_NE(qsmesh::test::check_block_file(no_reverse).error.find("not the same both ways"),
+            std::string::npos);
+
+  // The block's abutting range, then a wall BC over it in place of the connectivity.
+  cgsize_t range[4] = {};
+  {
+    int fn = 0;
+    ASSERT_EQ(cg_open(good.c_str(), CG_MODE_READ, &fn), CG_OK);
+    std::vector<cgsize_t> donor(64);
+    ASSERT_EQ(cg_conn_read(fn, 1, 1, 1, range, CGNS_ENUMV(Integer), donor.data()), CG_OK);
+    cg_close(fn);
+  }
+  const std::string wall = (dir / "wall.cgns").string();
+  fs::copy_file(good, wall);
+  delete_node(wall, block + "/ZoneGridConnectivity");
+  {
+    int fn = 0, bc = 0;
+    ASSERT_EQ(cg_open(wall.c_str(), CG_MODE_MODIFY, &fn), CG_OK);
+    ASSERT_EQ(cg_boco_write(fn, 1, 1, "Wall", CGNS_ENUMV(BCWall), CGNS_ENUMV(PointRange), 2, range,
+                            &bc),
+              CG_OK);
+    cg_close(fn);
+  }
+  const std::string error = qsmesh::test::check_block_file(wall).error;
+  EXPECT_NE(error.find("a BC on an edge another zone also has"), std::string::npos) << error;
 }
 
 }  // namespace

@@ -114,7 +114,8 @@ void write_vtu(const mesh::SurfaceMesh& mesh, const std::string& path, const Wri
 /// HDF5 (format_version 2) for solvers, plus the XDMF 3 file xdmf_path_for(path) describing it
 /// (open that one in ParaView: one block each for the quads, the triangles and the curve bars, with
 /// cell data cad_face / cad_curve and point data cad_dim / cad_entity). Both are written under
-/// temporary names; the HDF5 file is renamed first and removed again if the XDMF file fails.
+/// temporary names and renamed together: if either rename fails, an earlier .h5 of the same name
+/// is put back, so a failure leaves the earlier pair as it was.
 /// Root attributes: format ("qsmesh surface mesh"), format_version (2), length_unit,
 /// num_cad_corners, num_cad_curves, num_cad_faces. Datasets (little-endian, ids 0-based, elements
 /// in mesh order):
