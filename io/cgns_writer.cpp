@@ -404,11 +404,11 @@ constexpr const char* kUnstructuredZone = "Unstructured";
 // bytes) read from the pointers it is given, whatever the strings' lengths: given literals, the
 // bytes that follow them in the program's memory went into the file, so files differed between
 // builds. They go through zero-padded copies.
-void new_node(int cgio, double parent, const std::string& name, const char* label,
-              const char* type, int ndims, const cgsize_t* dims, const void* data, double* id,
+void new_node(int cgio, double parent, const std::string& name, const char* label, const char* type,
+              int ndims, const cgsize_t* dims, const void* data, double* id,
               const std::string& path) {
   char n[CGIO_MAX_NAME_LENGTH + 1] = {}, l[CGIO_MAX_LABEL_LENGTH + 1] = {},
-       t[CGIO_MAX_DATATYPE_LENGTH + 1] = {};
+                                t[CGIO_MAX_DATATYPE_LENGTH + 1] = {};
   std::strncpy(n, name.c_str(), CGIO_MAX_NAME_LENGTH);
   std::strncpy(l, label, CGIO_MAX_LABEL_LENGTH);
   std::strncpy(t, type, CGIO_MAX_DATATYPE_LENGTH);
@@ -420,8 +420,8 @@ double new_zone_grid_connectivity(int cgio, double root, const std::string& base
                                   const std::string& zone, const std::string& path) {
   double zone_id = 0, id = 0;
   QSMESH_CGIO(cgio_get_node_id(cgio, root, ("/" + base + "/" + zone).c_str(), &zone_id));
-  new_node(cgio, zone_id, "ZoneGridConnectivity", "ZoneGridConnectivity_t", "MT",
-                            0, nullptr, nullptr, &id, path);
+  new_node(cgio, zone_id, "ZoneGridConnectivity", "ZoneGridConnectivity_t", "MT", 0, nullptr,
+           nullptr, &id, path);
   return id;
 }
 
@@ -436,19 +436,18 @@ void write_abutment(int cgio, double parent, const std::string& name, const std:
                     const std::string& path) {
   double id = 0, child = 0;
   const cgsize_t donor_size[1] = {static_cast<cgsize_t>(donor.size())};
-  new_node(cgio, parent, name.c_str(), "GridConnectivity_t", "C1", 1, donor_size,
-                            donor.data(), &id, path);
+  new_node(cgio, parent, name.c_str(), "GridConnectivity_t", "C1", 1, donor_size, donor.data(), &id,
+           path);
   const std::string type = "Abutting1to1", location = "Vertex";
   const cgsize_t type_size[1] = {static_cast<cgsize_t>(type.size())};
   const cgsize_t location_size[1] = {static_cast<cgsize_t>(location.size())};
-  new_node(cgio, id, "GridConnectivityType", "GridConnectivityType_t", "C1", 1,
-                            type_size, type.data(), &child, path);
-  new_node(cgio, id, "GridLocation", "GridLocation_t", "C1", 1, location_size,
-                            location.data(), &child, path);
-  new_node(cgio, id, points_name, points_label, "I4", 2, points_dims.data(),
-                            points, &child, path);
-  new_node(cgio, id, "PointListDonor", "IndexArray_t", "I4", 2, donor_dims.data(),
-                            donor_points, &child, path);
+  new_node(cgio, id, "GridConnectivityType", "GridConnectivityType_t", "C1", 1, type_size,
+           type.data(), &child, path);
+  new_node(cgio, id, "GridLocation", "GridLocation_t", "C1", 1, location_size, location.data(),
+           &child, path);
+  new_node(cgio, id, points_name, points_label, "I4", 2, points_dims.data(), points, &child, path);
+  new_node(cgio, id, "PointListDonor", "IndexArray_t", "I4", 2, donor_dims.data(), donor_points,
+           &child, path);
 }
 
 std::array<cgsize_t, 2> side_index(const layout::Block& b, int s, LO p) {
@@ -703,15 +702,15 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
         const std::string donor_name = zone_name(r.block);
         const cgsize_t name_size[1] = {static_cast<cgsize_t>(donor_name.size())};
         double conn_id = 0, child = 0;
-        new_node(cgio, zgc_id, cname.c_str(), "GridConnectivity1to1_t", "C1", 1,
-                                  name_size, donor_name.data(), &conn_id, path);
+        new_node(cgio, zgc_id, cname.c_str(), "GridConnectivity1to1_t", "C1", 1, name_size,
+                 donor_name.data(), &conn_id, path);
         const cgsize_t range_dims[2] = {2, 2}, transform_dims[1] = {2};
-        new_node(cgio, conn_id, "Transform", "\"int[IndexDimension]\"", "I4", 1,
-                                  transform_dims, transform, &child, path);
-        new_node(cgio, conn_id, "PointRange", "IndexRange_t", "I4", 2, range_dims,
-                                  range, &child, path);
-        new_node(cgio, conn_id, "PointRangeDonor", "IndexRange_t", "I4", 2,
-                                  range_dims, donor, &child, path);
+        new_node(cgio, conn_id, "Transform", "\"int[IndexDimension]\"", "I4", 1, transform_dims,
+                 transform, &child, path);
+        new_node(cgio, conn_id, "PointRange", "IndexRange_t", "I4", 2, range_dims, range, &child,
+                 path);
+        new_node(cgio, conn_id, "PointRangeDonor", "IndexRange_t", "I4", 2, range_dims, donor,
+                 &child, path);
       }
       // Runs of side edges on the unstructured zone: a GridConnectivity (Abutting1to1, vertex
       // ranges here, vertex lists there), written as cgio nodes beside the 1-to-1 ones.

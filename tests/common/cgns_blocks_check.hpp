@@ -134,7 +134,8 @@ inline BlockFileSummary check_block_file(const std::string& path) {
   };
   // Abutments as (block zone, its points' (i, j), sorted), from the block side and from the
   // unstructured side: the two lists must be equal.
-  std::multiset<std::pair<int, std::vector<std::array<cgsize_t, 2>>>> abut_blocks, abut_unstructured;
+  std::multiset<std::pair<int, std::vector<std::array<cgsize_t, 2>>>> abut_blocks,
+      abut_unstructured;
   // BC edges as (zone, point a, point b), checked at the end against every zone's edges.
   std::vector<std::array<std::array<double, 3>, 2>> bc_edges;
   std::vector<std::string> bc_names;
@@ -176,7 +177,8 @@ inline BlockFileSummary check_block_file(const std::string& path) {
       const int t = r[0] == r[2] ? 1 : 0;  // the index moving along the BC
       for (cgsize_t x = std::min(r[t], r[t + 2]); x < std::max(r[t], r[t + 2]); ++x) {
         const cgsize_t i0 = t == 0 ? x : r[0], j0 = t == 0 ? r[1] : x;
-        bc_edges.push_back({point(zone, i0, j0), point(zone, t == 0 ? x + 1 : i0, t == 0 ? j0 : x + 1)});
+        bc_edges.push_back(
+            {point(zone, i0, j0), point(zone, t == 0 ? x + 1 : i0, t == 0 ? j0 : x + 1)});
         bc_names.push_back(zone.name + "/" + bname);
       }
     }
@@ -295,8 +297,10 @@ inline BlockFileSummary check_block_file(const std::string& path) {
       for (cgsize_t j = 1; j <= zone.nj; ++j)
         for (cgsize_t i = 1; i <= zone.ni; ++i) {
           const bool side_j = j == 1 || j == zone.nj, side_i = i == 1 || i == zone.ni;
-          if (i < zone.ni && side_j) ++edge_count[edge_key(point(zone, i, j), point(zone, i + 1, j))];
-          if (j < zone.nj && side_i) ++edge_count[edge_key(point(zone, i, j), point(zone, i, j + 1))];
+          if (i < zone.ni && side_j)
+            ++edge_count[edge_key(point(zone, i, j), point(zone, i + 1, j))];
+          if (j < zone.nj && side_i)
+            ++edge_count[edge_key(point(zone, i, j), point(zone, i, j + 1))];
         }
       continue;
     }
@@ -329,7 +333,8 @@ inline BlockFileSummary check_block_file(const std::string& path) {
           break;
         }
         for (std::size_t k = 0; k < n; ++k)
-          ++edge_count[edge_key(point(zone, data[at + k], 1), point(zone, data[at + (k + 1) % n], 1))];
+          ++edge_count[edge_key(point(zone, data[at + k], 1),
+                                point(zone, data[at + (k + 1) % n], 1))];
         at += n;
       }
     }
@@ -376,7 +381,8 @@ inline BlockFileSummary check_block_file(const std::string& path) {
     }
   }
   if (abut_blocks != abut_unstructured)
-    err << "the connectivities between blocks and the unstructured zone are not the same both ways; ";
+    err << "the connectivities between blocks and the unstructured zone are not the same both "
+           "ways; ";
   for (std::size_t e = 0; e < bc_edges.size(); ++e) {
     const auto found = edge_count.find(edge_key(bc_edges[e][0], bc_edges[e][1]));
     if (found != edge_count.end() && found->second > 1)

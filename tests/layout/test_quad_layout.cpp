@@ -313,9 +313,9 @@ TEST(CgnsBlocks, TheReaderCatchesMissingConnections) {
   {
     int fn = 0, bc = 0;
     ASSERT_EQ(cg_open(wall.c_str(), CG_MODE_MODIFY, &fn), CG_OK);
-    ASSERT_EQ(cg_boco_write(fn, 1, 1, "Wall", CGNS_ENUMV(BCWall), CGNS_ENUMV(PointRange), 2, range,
-                            &bc),
-              CG_OK);
+    ASSERT_EQ(
+        cg_boco_write(fn, 1, 1, "Wall", CGNS_ENUMV(BCWall), CGNS_ENUMV(PointRange), 2, range, &bc),
+        CG_OK);
     cg_close(fn);
   }
   const std::string error = qsmesh::test::check_block_file(wall).error;
