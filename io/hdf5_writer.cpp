@@ -336,8 +336,12 @@ void write_hdf5(const mesh::SurfaceMesh& mesh, const std::string& path,
   // .h5 beside the old .xdmf (the same layout, at worst other counts), never a description of
   // data that are not there.
   std::error_code ec;
-  const fs::path aside = fs::path(path).parent_path() / ("." + fs::path(path).filename().string() +
-                                                         ".old." + std::to_string(::getpid()));
+  // Appended rather than "." + ...: GCC 12 reports a false -Wrestrict on that concatenation.
+  std::string aside_name(1, '.');
+  aside_name += fs::path(path).filename().string();
+  aside_name += ".old.";
+  aside_name += std::to_string(::getpid());
+  const fs::path aside = fs::path(path).parent_path() / aside_name;
   const bool had_earlier = fs::exists(path, ec);
   if (had_earlier) {
     fs::rename(path, aside, ec);
