@@ -49,7 +49,7 @@ void check_writable(const std::string& option, const std::string& path) {
 
 void write_text_file_atomically(const std::string& path, const std::string& text) {
   io::AtomicFile file(path);
-  io::OutputFile out(file.temp_path(), path);
+  io::OutputFile out(file);
   out << std::string_view(text);
   out.close();
   file.commit();
@@ -159,6 +159,9 @@ struct Checks {
   struct Blocks {
     std::int64_t blocks = 0, quads = 0, largest = 0;
     LO unblocked_faces = 0, extended_faces = 0;
+    [[nodiscard]] double mean_quads() const {
+      return blocks > 0 ? static_cast<double>(quads) / static_cast<double>(blocks) : 0.0;
+    }
   };
   std::optional<Blocks> blocks;
   std::optional<highorder::QuadraticReport> quadratic;  ///< with --order 2
@@ -337,10 +340,7 @@ std::string stats_json(const Arguments& args, const Session& session,
   }
   if (checks.blocks) {
     j.value("blocks", checks.blocks->blocks);
-    j.value("block_quads_mean", checks.blocks->blocks > 0
-                                    ? static_cast<double>(checks.blocks->quads) /
-                                          static_cast<double>(checks.blocks->blocks)
-                                    : 0.0);
+    j.value("block_quads_mean", checks.blocks->mean_quads());
     j.value("block_quads_largest", checks.blocks->largest);
     j.value("faces_not_in_blocks", static_cast<std::int64_t>(checks.blocks->unblocked_faces));
     j.value("faces_with_extended_traces", static_cast<std::int64_t>(checks.blocks->extended_faces));
@@ -463,8 +463,7 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
   }
   if (checks.blocks) {
     const Checks::Blocks& b = *checks.blocks;
-    os << "  blocks (structured zones): " << b.blocks << ", "
-       << (b.blocks > 0 ? static_cast<double>(b.quads) / static_cast<double>(b.blocks) : 0.0)
+    os << "  blocks (structured zones): " << b.blocks << ", " << b.mean_quads()
        << " quads each on average, largest " << b.largest << "; faces not in blocks "
        << b.unblocked_faces << "; faces traced again with extended traces " << b.extended_faces
        << "\n";

@@ -14,19 +14,28 @@ namespace qsmesh::io {
 
 namespace fs = std::filesystem;
 
-AtomicFile::AtomicFile(std::string path) : path_(std::move(path)) {
-  const fs::path p(path_);
-  // Same folder as the target, so that rename() never crosses file systems; the pid keeps two
-  // processes writing the same name apart.
+namespace {
+
+// "<dir>/.<name>.<tag>.<pid>" for `path`: in the same folder, so that rename() never crosses file
+// systems; the pid keeps two processes writing the same name apart.
+std::string hidden_sibling(const std::string& path, const char* tag) {
+  const fs::path p(path);
   // Appended rather than "." + ...: GCC 12 reports a false -Wrestrict on that concatenation.
   std::string name = ".";
   name += p.filename().string();
-  name += ".tmp.";
+  name += '.';
+  name += tag;
+  name += '.';
   name += std::to_string(::getpid());
-  const fs::path temp = p.parent_path() / name;
-  temp_ = temp.string();
+  return (p.parent_path() / name).string();
+}
+
+}  // namespace
+
+AtomicFile::AtomicFile(std::string path)
+    : path_(std::move(path)), temp_(hidden_sibling(path_, "tmp")) {
   std::error_code ec;
-  fs::remove(temp, ec);
+  fs::remove(fs::path(temp_), ec);
 }
 
 AtomicFile::~AtomicFile() {
@@ -47,12 +56,44 @@ void AtomicFile::commit() {
   committed_ = true;
 }
 
+void commit_together(AtomicFile& first, AtomicFile& second) {
+  std::error_code ec;
+  const std::string aside = hidden_sibling(first.path(), "old");
+  const bool had_earlier = fs::exists(first.path(), ec);
+  if (had_earlier) {
+    fs::rename(first.path(), aside, ec);
+    if (ec) throw OutputError("cannot replace " + first.path() + ": " + ec.message());
+  }
+  auto restore = [&] {
+    std::error_code ignored;
+    if (had_earlier) fs::rename(aside, first.path(), ignored);
+  };
+  try {
+    first.commit();
+  } catch (...) {
+    restore();
+    throw;
+  }
+  try {
+    second.commit();
+  } catch (...) {
+    std::error_code ignored;
+    fs::remove(first.path(), ignored);
+    restore();
+    throw;
+  }
+  if (had_earlier) fs::remove(aside, ec);
+}
+
 namespace {
 constexpr std::size_t kFlushBytes = std::size_t{1} << 20;
 }
 
-OutputFile::OutputFile(const std::string& path, const std::string& shown)
-    : name_(shown.empty() ? path : shown) {
+OutputFile::OutputFile(const std::string& path) : OutputFile(path, path) {}
+
+OutputFile::OutputFile(const AtomicFile& target) : OutputFile(target.temp_path(), target.path()) {}
+
+OutputFile::OutputFile(const std::string& path, std::string shown) : name_(std::move(shown)) {
   file_ = std::fopen(path.c_str(), "wb");
   if (file_ == nullptr) {
     throw OutputError("cannot open " + name_ + " for writing: " + std::strerror(errno));
@@ -67,10 +108,14 @@ OutputFile::~OutputFile() {
 void OutputFile::flush() {
   QSMESH_CHECK(file_ != nullptr, "write to closed file " << name_);
   if (buffer_.empty()) return;
-  if (std::fwrite(buffer_.data(), 1, buffer_.size(), file_) != buffer_.size()) {
+  put(buffer_.data(), buffer_.size());
+  buffer_.clear();
+}
+
+void OutputFile::put(const void* data, std::size_t bytes) {
+  if (std::fwrite(data, 1, bytes, file_) != bytes) {
     throw OutputError("cannot write " + name_ + ": " + std::strerror(errno));
   }
-  buffer_.clear();
 }
 
 OutputFile& OutputFile::operator<<(std::string_view s) {
@@ -105,9 +150,7 @@ void OutputFile::write(const void* data, std::size_t bytes) {
   }
   // A large block (an HDF5 file image) goes straight out rather than through a copy in the buffer.
   flush();
-  if (std::fwrite(data, 1, bytes, file_) != bytes) {
-    throw OutputError("cannot write " + name_ + ": " + std::strerror(errno));
-  }
+  put(data, bytes);
 }
 
 void OutputFile::close() {

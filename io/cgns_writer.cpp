@@ -18,6 +18,7 @@
 #include <string_view>
 #include <tuple>
 #include <unordered_map>
+#include <unordered_set>
 #include <vector>
 
 #include "detail.hpp"
@@ -31,17 +32,11 @@ namespace qsmesh::io {
 
 namespace {
 
-// The function a QSMESH_CG / QSMESH_CGIO call names (the text before its argument list).
-std::string function_of(const char* call) {
-  const std::string_view text(call);
-  return std::string(text.substr(0, text.find('(')));
-}
-
 // Every cgnslib call goes through here: a nonzero return becomes an OutputError naming the file and
 // the function (with cgnslib's reason: a full disk shows as a failed H5Dwrite).
 void cg_check(int rc, const char* call, const std::string& path) {
   if (rc != CG_OK) {
-    throw OutputError("cannot write " + path + ": CGNS " + function_of(call) +
+    throw OutputError("cannot write " + path + ": CGNS " + detail::function_name(call) +
                       " failed: " + cg_get_error());
   }
 }
@@ -51,7 +46,8 @@ void cgio_check(int rc, const char* call, const std::string& path) {
   if (rc != CGIO_ERR_NONE) {
     char msg[CGIO_MAX_ERROR_LENGTH + 1] = {};
     cgio_error_message(msg);
-    throw OutputError("cannot write " + path + ": CGNS " + function_of(call) + " failed: " + msg);
+    throw OutputError("cannot write " + path + ": CGNS " + detail::function_name(call) +
+                      " failed: " + msg);
   }
 }
 #define QSMESH_CGIO(call) cgio_check((call), #call, path)
@@ -396,7 +392,6 @@ struct Side {
 constexpr std::array<Side, 4> kSides{
     {{0, false}, {1, true}, {0, true}, {1, false}}};  // jmin imax jmax imin
 
-// The 1-based (i, j) of position p on side s of block b.
 // The zone of the faces the layout left out.
 constexpr const char* kUnstructuredZone = "Unstructured";
 
@@ -450,6 +445,7 @@ void write_abutment(int cgio, double parent, const std::string& name, const std:
            &child, path);
 }
 
+// The 1-based (i, j) of position p on side s of block b.
 std::array<cgsize_t, 2> side_index(const layout::Block& b, int s, LO p) {
   const Side& side = kSides[static_cast<std::size_t>(s)];
   std::array<cgsize_t, 2> ij{};
@@ -466,6 +462,33 @@ GO side_vertex(const layout::Block& b, int s, LO p, const std::vector<GO>& verti
 
 LO side_edges(const layout::Block& b, int s) {
   return kSides[static_cast<std::size_t>(s)].tangent == 0 ? b.ni : b.nj;
+}
+
+// The vertex range (i0, j0, i1, j1) of edges p..q of side s of block b.
+std::array<cgsize_t, 4> side_range(const layout::Block& b, int s, LO p, LO q) {
+  const auto a = side_index(b, s, p), c = side_index(b, s, q + 1);
+  return {a[0], a[1], c[0], c[1]};
+}
+
+// Calls f(p, q, key) for every maximal run p..q of positions in [0, n) with the same key(x),
+// other than kNoIndex.
+template <typename Key, typename F>
+void for_each_run(LO n, const Key& key, const F& f) {
+  for (LO p = 0; p < n;) {
+    const LO k = key(p);
+    LO q = p;
+    while (q + 1 < n && key(q + 1) == k) ++q;
+    if (k != kNoIndex) f(p, q, k);
+    p = q + 1;
+  }
+}
+
+// The name of connectivity node number n of a zone ("C1", "C2", ...).
+std::string connection_name(int n) {
+  // Appended rather than "C" + ...: GCC 12 reports a false -Wrestrict on that concatenation.
+  std::string name(1, 'C');
+  name += std::to_string(n);
+  return name;
 }
 
 }  // namespace
@@ -513,7 +536,7 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
   const detail::ElementGroups groups = detail::group_elements(mesh);
   std::vector<GO> local(static_cast<std::size_t>(mesh.num_vertices()), -1);
   std::vector<GO> used;
-  std::unordered_map<std::uint64_t, char> unstructured_edges;
+  std::unordered_set<std::uint64_t> unstructured_edges;
   GO unstructured_cells = 0;
   {
     auto use = [&](GO v) {
@@ -526,7 +549,7 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
       const std::size_t n = vertices.size();
       for (std::size_t i = 0; i < n; ++i) {
         use(vertices[i]);
-        unstructured_edges[edge_key(vertices[i], vertices[(i + 1) % n])] = 1;
+        unstructured_edges.insert(edge_key(vertices[i], vertices[(i + 1) % n]));
       }
     };
     for (LO f : layout.unblocked_faces) {
@@ -629,12 +652,13 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
     auto next_connection = [&] {
       if (zgc_id == 0)
         zgc_id = new_zone_grid_connectivity(cgio, root, options.cgns_base_name, name, path);
-      // Appended rather than "C" + ...: GCC 12 reports a false -Wrestrict on that concatenation.
-      std::string next(1, 'C');
-      next += std::to_string(++connections);
-      return next;
+      return connection_name(++connections);
     };
     for (int s = 0; s < 4; ++s) {
+      auto edge_at = [&](LO q) {
+        return edge_key(side_vertex(b, s, q, layout.vertices),
+                        side_vertex(b, s, q + 1, layout.vertices));
+      };
       struct Run {
         GO block;
         int side;
@@ -643,10 +667,8 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
       };
       std::vector<Run> open, done;
       for (LO p = 0; p < side_edges(b, s); ++p) {
-        const GO a = side_vertex(b, s, p, layout.vertices),
-                 c = side_vertex(b, s, p + 1, layout.vertices);
         std::vector<Run> next;
-        for (const Use& u : edge_uses.at(edge_key(a, c))) {
+        for (const Use& u : edge_uses.at(edge_at(p))) {
           // The edge itself; another position of this same side (a side running along both
           // banks of a seam) is an interface of the block with itself.
           if (u.block == k && u.side == s && u.p == p) continue;
@@ -687,10 +709,9 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
                              side_vertex(b, s, r.p1 + 1, layout.vertices),
                      "CGNS block output " << path << ": blocks " << k << " and " << r.block
                                           << " do not match along their interface");
-        const auto i0 = side_index(b, s, r.p0), i1 = side_index(b, s, r.p1 + 1);
+        const auto range = side_range(b, s, r.p0, r.p1);
         const auto j0 = side_index(d, r.side, dv0), j1 = side_index(d, r.side, dv1);
-        cgsize_t range[4] = {i0[0], i0[1], i1[0], i1[1]};
-        cgsize_t donor[4] = {j0[0], j0[1], j1[0], j1[1]};
+        const cgsize_t donor[4] = {j0[0], j0[1], j1[0], j1[1]};
         const Side& me = kSides[static_cast<std::size_t>(s)];
         const Side& them = kSides[static_cast<std::size_t>(r.side)];
         int transform[2] = {0, 0};
@@ -707,70 +728,52 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
         const cgsize_t range_dims[2] = {2, 2}, transform_dims[1] = {2};
         new_node(cgio, conn_id, "Transform", "\"int[IndexDimension]\"", "I4", 1, transform_dims,
                  transform, &child, path);
-        new_node(cgio, conn_id, "PointRange", "IndexRange_t", "I4", 2, range_dims, range, &child,
-                 path);
+        new_node(cgio, conn_id, "PointRange", "IndexRange_t", "I4", 2, range_dims, range.data(),
+                 &child, path);
         new_node(cgio, conn_id, "PointRangeDonor", "IndexRange_t", "I4", 2, range_dims, donor,
                  &child, path);
       }
       // Runs of side edges on the unstructured zone: a GridConnectivity (Abutting1to1, vertex
       // ranges here, vertex lists there), written as cgio nodes beside the 1-to-1 ones.
-      for (LO p = 0; p < side_edges(b, s);) {
-        auto on_unstructured = [&](LO q) {
-          return unstructured_edges.count(edge_key(side_vertex(b, s, q, layout.vertices),
-                                                   side_vertex(b, s, q + 1, layout.vertices))) > 0;
-        };
-        if (!on_unstructured(p)) {
-          ++p;
-          continue;
-        }
-        LO q = p;
-        while (q + 1 < side_edges(b, s) && on_unstructured(q + 1)) ++q;
-        Abutment a{k, {}, {}};
-        for (LO x = p; x <= q + 1; ++x) {
-          const auto ij = side_index(b, s, x);
-          a.ij.insert(a.ij.end(), ij.begin(), ij.end());
-          a.local.push_back(static_cast<cgsize_t>(
-              local[static_cast<std::size_t>(side_vertex(b, s, x, layout.vertices))] + 1));
-        }
-        const auto i0 = side_index(b, s, p), i1 = side_index(b, s, q + 1);
-        cgsize_t range[4] = {i0[0], i0[1], i1[0], i1[1]};
-        const std::string cname = next_connection();
-        write_abutment(cgio, zgc_id, cname, kUnstructuredZone, "PointRange", "IndexRange_t", {2, 2},
-                       range, {1, static_cast<cgsize_t>(a.local.size())}, a.local.data(), path);
-        abutments.push_back(std::move(a));
-        p = q + 1;
-      }
+      for_each_run(
+          side_edges(b, s),
+          [&](LO q) { return unstructured_edges.count(edge_at(q)) > 0 ? LO{0} : kNoIndex; },
+          [&](LO p, LO q, LO) {
+            Abutment a{k, {}, {}};
+            for (LO x = p; x <= q + 1; ++x) {
+              const auto ij = side_index(b, s, x);
+              a.ij.insert(a.ij.end(), ij.begin(), ij.end());
+              a.local.push_back(static_cast<cgsize_t>(
+                  local[static_cast<std::size_t>(side_vertex(b, s, x, layout.vertices))] + 1));
+            }
+            const auto range = side_range(b, s, p, q);
+            const std::string cname = next_connection();  // makes zgc_id with the first
+            write_abutment(cgio, zgc_id, cname, kUnstructuredZone, "PointRange", "IndexRange_t",
+                           {2, 2}, range.data(), {1, static_cast<cgsize_t>(a.local.size())},
+                           a.local.data(), path);
+            abutments.push_back(std::move(a));
+          });
       // Free edges: one BC per run of them on one curve.
-      for (LO p = 0; p < side_edges(b, s);) {
-        auto curve_of_free = [&](LO q) -> LO {
-          const std::uint64_t e = edge_key(side_vertex(b, s, q, layout.vertices),
-                                           side_vertex(b, s, q + 1, layout.vertices));
-          if (!is_free(e)) return kNoIndex;
-          const auto it = edge_curve.find(e);
-          return it == edge_curve.end() ? kNoIndex : it->second;
-        };
-        const LO c = curve_of_free(p);
-        if (c == kNoIndex) {
-          ++p;
-          continue;
-        }
-        LO q = p;
-        while (q + 1 < side_edges(b, s) && curve_of_free(q + 1) == c) ++q;
-        const auto i0 = side_index(b, s, p), i1 = side_index(b, s, q + 1);
-        cgsize_t range[4] = {i0[0], i0[1], i1[0], i1[1]};
+      auto curve_of_free = [&](LO q) -> LO {
+        const std::uint64_t e = edge_at(q);
+        if (!is_free(e)) return kNoIndex;
+        const auto it = edge_curve.find(e);
+        return it == edge_curve.end() ? kNoIndex : it->second;
+      };
+      for_each_run(side_edges(b, s), curve_of_free, [&](LO p, LO q, LO c) {
+        const auto range = side_range(b, s, p, q);
         std::string bcname("BC");
         bcname += std::to_string(++boundaries);
         int bc = 0;
         QSMESH_CG(cg_boco_write(fn, base, zone, bcname.c_str(), CGNS_ENUMV(FamilySpecified),
-                                CGNS_ENUMV(PointRange), 2, range, &bc));
+                                CGNS_ENUMV(PointRange), 2, range.data(), &bc));
         std::string node(1, '/');
         node.append(options.cgns_base_name).append("/").append(name).append("/ZoneBC/");
         node.append(bcname).append("/PointRange");
         fix_range_label(cgio, root, node, path);
         QSMESH_CG(cg_goto(fn, base, "Zone_t", zone, "ZoneBC_t", 1, "BC_t", bc, "end"));
         QSMESH_CG(cg_famname_write(("Curve_" + std::to_string(c)).c_str()));
-        p = q + 1;
-      }
+      });
     }
   }
 
@@ -793,11 +796,10 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
           new_zone_grid_connectivity(cgio, root, options.cgns_base_name, kUnstructuredZone, path);
       int connections = 0;
       for (const Abutment& a : abutments) {
-        std::string cname(1, 'C');
-        cname += std::to_string(++connections);
         const auto n = static_cast<cgsize_t>(a.local.size());
-        write_abutment(cgio, zgc_id, cname, zone_name(a.block), "PointList", "IndexArray_t", {1, n},
-                       a.local.data(), {2, n}, a.ij.data(), path);
+        write_abutment(cgio, zgc_id, connection_name(++connections), zone_name(a.block),
+                       "PointList", "IndexArray_t", {1, n}, a.local.data(), {2, n}, a.ij.data(),
+                       path);
       }
     }
   }

@@ -20,6 +20,10 @@ struct ElementGroups {
 /// existing, writable folder.
 void check_output_folder(const std::string& path);
 
+/// The function a checked library call names, for error messages: the text of `call` (the
+/// stringified call, "cg_open(path, ...)") before its argument list.
+[[nodiscard]] std::string function_name(const char* call);
+
 /// Groups the elements of a mesh that passed check_mesh_for_output.
 ElementGroups group_elements(const mesh::SurfaceMesh& mesh);
 

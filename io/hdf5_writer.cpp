@@ -1,7 +1,6 @@
 // HDF5 output through the HDF5 C API (Debian: the serial library cgnslib also uses), with an XDMF 3
 // description beside it. Its own handles only: nothing here touches cgnslib's files.
 #include <hdf5.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <array>
@@ -29,10 +28,7 @@ static_assert(std::endian::native == std::endian::little,
 // HDF5 calls return a negative value on failure; every one goes through here.
 template <typename T>
 T h5_check(T rc, const char* call, const std::string& path) {
-  if (rc < 0) {
-    const std::string_view text(call);
-    throw Error("HDF5 " + std::string(text.substr(0, text.find('('))) + " failed for " + path);
-  }
+  if (rc < 0) throw Error("HDF5 " + detail::function_name(call) + " failed for " + path);
   return rc;
 }
 #define QSMESH_H5(call) h5_check((call), #call, path)
@@ -121,18 +117,9 @@ class H5Writer {
     QSMESH_H5(space.close());
   }
 
-  // An attribute of the root group.
+  // Attributes of the root group.
   void attribute(const char* name, std::int64_t value) {
-    const std::string& path = path_;
-    H5Handle space(H5Screate(H5S_SCALAR), H5Sclose);
-    QSMESH_H5(space.get());
-    H5Handle attr(
-        H5Acreate2(file_.get(), name, H5T_STD_I64LE, space.get(), H5P_DEFAULT, H5P_DEFAULT),
-        H5Aclose);
-    QSMESH_H5(attr.get());
-    QSMESH_H5(H5Awrite(attr.get(), H5T_NATIVE_INT64, &value));
-    QSMESH_H5(attr.close());
-    QSMESH_H5(space.close());
+    scalar_attribute(name, H5T_STD_I64LE, H5T_NATIVE_INT64, &value);
   }
   void attribute(const char* name, const std::string& value) {
     const std::string& path = path_;
@@ -140,15 +127,8 @@ class H5Writer {
     QSMESH_H5(type.get());
     QSMESH_H5(H5Tset_size(type.get(), std::max<std::size_t>(1, value.size())));
     QSMESH_H5(H5Tset_strpad(type.get(), H5T_STR_NULLPAD));
-    H5Handle space(H5Screate(H5S_SCALAR), H5Sclose);
-    QSMESH_H5(space.get());
-    H5Handle attr(H5Acreate2(file_.get(), name, type.get(), space.get(), H5P_DEFAULT, H5P_DEFAULT),
-                  H5Aclose);
-    QSMESH_H5(attr.get());
     const std::string padded = value.empty() ? std::string(1, '\0') : value;
-    QSMESH_H5(H5Awrite(attr.get(), type.get(), padded.data()));
-    QSMESH_H5(attr.close());
-    QSMESH_H5(space.close());
+    scalar_attribute(name, type.get(), type.get(), padded.data());
     QSMESH_H5(type.close());
   }
 
@@ -166,6 +146,20 @@ class H5Writer {
   }
 
  private:
+  // A scalar attribute of the root group, stored as `file_type`, written from `value` of
+  // `memory_type`.
+  void scalar_attribute(const char* name, hid_t file_type, hid_t memory_type, const void* value) {
+    const std::string& path = path_;
+    H5Handle space(H5Screate(H5S_SCALAR), H5Sclose);
+    QSMESH_H5(space.get());
+    H5Handle attr(H5Acreate2(file_.get(), name, file_type, space.get(), H5P_DEFAULT, H5P_DEFAULT),
+                  H5Aclose);
+    QSMESH_H5(attr.get());
+    QSMESH_H5(H5Awrite(attr.get(), memory_type, value));
+    QSMESH_H5(attr.close());
+    QSMESH_H5(space.close());
+  }
+
   std::string path_;
   H5Handle fapl_;
   H5Handle file_;
@@ -287,7 +281,7 @@ void write_hdf5(const mesh::SurfaceMesh& mesh, const std::string& path,
                  mesh.face2curves.targets.data());
     }
     const std::vector<unsigned char> bytes = h5.image();
-    OutputFile out(h5_out.temp_path(), path);
+    OutputFile out(h5_out);
     out.write(bytes.data(), bytes.size());
     out.close();
   }
@@ -296,7 +290,7 @@ void write_hdf5(const mesh::SurfaceMesh& mesh, const std::string& path,
   // each as a block with cell data cad_face (or cad_curve) and point data cad_dim / cad_entity.
   {
     const std::string h5_name = xml_escape(fs::path(path).filename().string());
-    OutputFile x(xdmf_out.temp_path(), xdmf);
+    OutputFile x(xdmf_out);
     x << "<?xml version=\"1.0\" ?>\n<Xdmf Version=\"3.0\">\n <Domain>\n"
       << "  <Grid Name=\"qsmesh\" GridType=\"Collection\" CollectionType=\"Spatial\">\n";
     auto grid = [&](const char* name, const char* topology, int nodes, std::int64_t n,
@@ -330,42 +324,8 @@ void write_hdf5(const mesh::SurfaceMesh& mesh, const std::string& path,
     x << "  </Grid>\n </Domain>\n</Xdmf>\n";
     x.close();
   }
-  // The pair lands together or not at all: an earlier .h5 of the same name is moved aside first
-  // and put back if either rename fails, so that a failure leaves the earlier pair as it was. The
-  // data land before their description: a run stopped between the two renames leaves the new
-  // .h5 beside the old .xdmf (the same layout, at worst other counts), never a description of
-  // data that are not there.
-  std::error_code ec;
-  // Appended rather than "." + ...: GCC 12 reports a false -Wrestrict on that concatenation.
-  std::string aside_name(1, '.');
-  aside_name += fs::path(path).filename().string();
-  aside_name += ".old.";
-  aside_name += std::to_string(::getpid());
-  const fs::path aside = fs::path(path).parent_path() / aside_name;
-  const bool had_earlier = fs::exists(path, ec);
-  if (had_earlier) {
-    fs::rename(path, aside, ec);
-    if (ec) throw OutputError("cannot replace " + path + ": " + ec.message());
-  }
-  auto restore = [&] {
-    std::error_code ignored;
-    if (had_earlier) fs::rename(aside, path, ignored);
-  };
-  try {
-    h5_out.commit();
-  } catch (...) {
-    restore();
-    throw;
-  }
-  try {
-    xdmf_out.commit();
-  } catch (...) {
-    std::error_code ignored;
-    fs::remove(path, ignored);
-    restore();
-    throw;
-  }
-  if (had_earlier) fs::remove(aside, ec);
+  // The pair lands together: a description never points at data that are not there.
+  commit_together(h5_out, xdmf_out);
 }
 
 }  // namespace qsmesh::io

@@ -72,7 +72,7 @@ void write_msh(const mesh::SurfaceMesh& mesh, const std::string& path, const Wri
   }
 
   AtomicFile atomic(path);
-  OutputFile out(atomic.temp_path(), path);
+  OutputFile out(atomic);
   out << "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n";
 
   // $Entities: numPoints numCurves numSurfaces numVolumes, then each entity with no physical tag.

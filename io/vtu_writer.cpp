@@ -119,7 +119,7 @@ void write_vtu(const mesh::SurfaceMesh& mesh, const std::string& path, const Wri
   const bool bin = options.vtu_binary;
 
   AtomicFile atomic(path);
-  OutputFile out(atomic.temp_path(), path);
+  OutputFile out(atomic);
   out << "<?xml version=\"1.0\"?>\n"
          "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" "
          "header_type=\"UInt64\">\n"

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cctype>
 #include <filesystem>
+#include <string_view>
 #include <system_error>
 
 #include "detail.hpp"
@@ -53,6 +54,11 @@ void prepare_output_libraries() {
 }
 
 namespace detail {
+
+std::string function_name(const char* call) {
+  const std::string_view text(call);
+  return std::string(text.substr(0, text.find('(')));
+}
 
 void check_output_folder(const std::string& path) {
   const fs::path p(path);

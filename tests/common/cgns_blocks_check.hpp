@@ -19,6 +19,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <map>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <string>
@@ -132,6 +133,28 @@ inline BlockFileSummary check_block_file(const std::string& path) {
     }
     return true;
   };
+  // What cg_conn_info says of general connectivity c of zone z (nothing when it fails).
+  struct Connection {
+    std::string name, donor;
+    CGNS_ENUMT(GridLocation_t) location;
+    CGNS_ENUMT(GridConnectivityType_t) type;
+    CGNS_ENUMT(PointSetType_t) points;
+    cgsize_t npnts, ndonor;
+  };
+  auto connection = [&](int z, int c) -> std::optional<Connection> {
+    char cname[33] = {}, dname[33] = {};
+    Connection info{};
+    CGNS_ENUMT(PointSetType_t) dptype;
+    CGNS_ENUMT(ZoneType_t) dztype;
+    CGNS_ENUMT(DataType_t) ddtype;
+    if (!ok(cg_conn_info(fn, 1, z, c, cname, &info.location, &info.type, &info.points, &info.npnts,
+                         dname, &dztype, &dptype, &ddtype, &info.ndonor),
+            "cg_conn_info"))
+      return std::nullopt;
+    info.name = cname;
+    info.donor = dname;
+    return info;
+  };
   // Abutments as (block zone, its points' (i, j), sorted), from the block side and from the
   // unstructured side: the two lists must be equal.
   std::multiset<std::pair<int, std::vector<std::array<cgsize_t, 2>>>> abut_blocks,
@@ -238,17 +261,9 @@ inline BlockFileSummary check_block_file(const std::string& path) {
     int nconn = 0;
     ok(cg_nconns(fn, 1, z, &nconn), "cg_nconns");
     for (int c = 1; c <= nconn; ++c) {
-      char cname[33] = {}, dname[33] = {};
-      CGNS_ENUMT(GridLocation_t) location;
-      CGNS_ENUMT(GridConnectivityType_t) type;
-      CGNS_ENUMT(PointSetType_t) ptype, dptype;
-      CGNS_ENUMT(ZoneType_t) dztype;
-      CGNS_ENUMT(DataType_t) ddtype;
-      cgsize_t npnts = 0, ndonor = 0;
-      if (!ok(cg_conn_info(fn, 1, z, c, cname, &location, &type, &ptype, &npnts, dname, &dztype,
-                           &dptype, &ddtype, &ndonor),
-              "cg_conn_info"))
-        continue;
+      const std::optional<Connection> info = connection(z, c);
+      if (!info) continue;
+      const auto& [cname, dname, location, type, ptype, npnts, ndonor] = *info;
       ++out.abutments;
       const auto it = by_name.find(dname);
       if (ptype != CGNS_ENUMV(PointRange) || npnts != 2 || it == by_name.end() ||
@@ -341,17 +356,9 @@ inline BlockFileSummary check_block_file(const std::string& path) {
     int nconn = 0;
     ok(cg_nconns(fn, 1, z, &nconn), "cg_nconns");
     for (int c = 1; c <= nconn; ++c) {
-      char cname[33] = {}, dname[33] = {};
-      CGNS_ENUMT(GridLocation_t) location;
-      CGNS_ENUMT(GridConnectivityType_t) type;
-      CGNS_ENUMT(PointSetType_t) ptype, dptype;
-      CGNS_ENUMT(ZoneType_t) dztype;
-      CGNS_ENUMT(DataType_t) ddtype;
-      cgsize_t npnts = 0, ndonor = 0;
-      if (!ok(cg_conn_info(fn, 1, z, c, cname, &location, &type, &ptype, &npnts, dname, &dztype,
-                           &dptype, &ddtype, &ndonor),
-              "cg_conn_info"))
-        continue;
+      const std::optional<Connection> info = connection(z, c);
+      if (!info) continue;
+      const auto& [cname, dname, location, type, ptype, npnts, ndonor] = *info;
       const auto it = by_name.find(dname);
       if (ptype != CGNS_ENUMV(PointList) || it == by_name.end() ||
           !zones[static_cast<std::size_t>(it->second)].structured || ndonor != npnts ||

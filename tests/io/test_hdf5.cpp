@@ -77,6 +77,21 @@ std::string read_string_attribute(hid_t file, const char* name) {
 
 std::vector<hsize_t> dims(std::initializer_list<hsize_t> d) { return d; }
 
+// Dataset `name` holds `elements` (rows of N ids, in order) and `cad_name` their CAD ids.
+template <std::size_t N>
+void expect_elements(hid_t file, const char* name, const char* cad_name,
+                     const std::vector<std::array<GO, N>>& elements, const std::vector<LO>& cad) {
+  const auto ids = read_dataset<std::int64_t>(file, name, H5T_NATIVE_INT64);
+  const auto entity = read_dataset<std::int32_t>(file, cad_name, H5T_NATIVE_INT32);
+  EXPECT_EQ(ids.dims, (std::vector<hsize_t>{elements.size(), N})) << name;
+  ASSERT_EQ(ids.values.size(), N * elements.size()) << name;
+  ASSERT_EQ(entity.values.size(), elements.size()) << cad_name;
+  for (std::size_t e = 0; e < elements.size(); ++e) {
+    for (std::size_t k = 0; k < N; ++k) EXPECT_EQ(ids.values[N * e + k], elements[e][k]) << name;
+    EXPECT_EQ(entity.values[e], cad[e]) << cad_name;
+  }
+}
+
 TEST(Hdf5, ReadBack) {
   const fs::path dir = fresh_dir("hdf5_read");
   const mesh::SurfaceMesh m = make_test_mesh();
@@ -114,31 +129,9 @@ TEST(Hdf5, ReadBack) {
   }
 
   // Elements in mesh order, 0-based, with their CAD entity.
-  const auto quads = read_dataset<std::int64_t>(file, "quads", H5T_NATIVE_INT64);
-  const auto qface = read_dataset<std::int32_t>(file, "quad_cad_face", H5T_NATIVE_INT32);
-  EXPECT_EQ(quads.dims, dims({3, 4}));
-  ASSERT_EQ(quads.values.size(), 12u);
-  for (std::size_t q = 0; q < 3; ++q) {
-    for (int k = 0; k < 4; ++k) EXPECT_EQ(quads.values[4 * q + k], m.quads[q][k]);
-    EXPECT_EQ(qface.values.at(q), m.quad_face[q]);
-  }
-  const auto tris = read_dataset<std::int64_t>(file, "triangles", H5T_NATIVE_INT64);
-  const auto tface = read_dataset<std::int32_t>(file, "triangle_cad_face", H5T_NATIVE_INT32);
-  EXPECT_EQ(tris.dims, dims({6, 3}));
-  ASSERT_EQ(tris.values.size(), 18u);
-  for (std::size_t t = 0; t < 6; ++t) {
-    for (int k = 0; k < 3; ++k) EXPECT_EQ(tris.values[3 * t + k], m.triangles[t][k]);
-    EXPECT_EQ(tface.values.at(t), m.triangle_face[t]);
-  }
-  const auto bars = read_dataset<std::int64_t>(file, "bars", H5T_NATIVE_INT64);
-  const auto bcurve = read_dataset<std::int32_t>(file, "bar_cad_curve", H5T_NATIVE_INT32);
-  EXPECT_EQ(bars.dims, dims({13, 2}));
-  ASSERT_EQ(bars.values.size(), 26u);
-  for (std::size_t b = 0; b < 13; ++b) {
-    EXPECT_EQ(bars.values[2 * b], m.bars[b][0]);
-    EXPECT_EQ(bars.values[2 * b + 1], m.bars[b][1]);
-    EXPECT_EQ(bcurve.values.at(b), m.bar_curve[b]);
-  }
+  expect_elements(file, "quads", "quad_cad_face", m.quads, m.quad_face);
+  expect_elements(file, "triangles", "triangle_cad_face", m.triangles, m.triangle_face);
+  expect_elements(file, "bars", "bar_cad_curve", m.bars, m.bar_curve);
 
   // CAD topology.
   const auto cc = read_dataset<std::int32_t>(file, "curve_corners", H5T_NATIVE_INT32);

@@ -32,12 +32,20 @@ class AtomicFile {
   bool committed_ = false;
 };
 
+/// Commits two files that only make sense together (an HDF5 file and its XDMF description):
+/// `first`, then `second`. An earlier file at first.path() is moved aside before and put back if
+/// either rename fails, so that a failure leaves the earlier pair as it was; a run stopped between
+/// the renames leaves the new `first` beside the earlier `second`, never `second` without `first`.
+/// Throws qsmesh::OutputError on failure.
+void commit_together(AtomicFile& first, AtomicFile& second);
+
 /// Buffered text/binary output to a FILE* with every C library return code checked; errors throw
-/// qsmesh::OutputError naming the file (`shown`, else `path`: the name the user asked for when
-/// `path` is an AtomicFile's temporary). close() must be called for the data to count as written.
+/// qsmesh::OutputError naming the file. close() must be called for the data to count as written.
 class OutputFile {
  public:
-  explicit OutputFile(const std::string& path, const std::string& shown = {});
+  explicit OutputFile(const std::string& path);
+  /// Writes `target`'s temporary; errors name the file the user asked for, target.path().
+  explicit OutputFile(const AtomicFile& target);
   ~OutputFile();  ///< closes without checking (error path only)
   OutputFile(const OutputFile&) = delete;
   OutputFile& operator=(const OutputFile&) = delete;
@@ -56,7 +64,9 @@ class OutputFile {
   void close();
 
  private:
+  OutputFile(const std::string& path, std::string shown);
   void flush();
+  void put(const void* data, std::size_t bytes);  // straight to the FILE*, checked
   std::string name_;
   std::FILE* file_ = nullptr;
   std::string buffer_;
