@@ -19,11 +19,11 @@
 #include <cstdint>
 #include <cstdlib>
 #include <map>
-#include <optional>
 #include <set>
 #include <sstream>
 #include <string>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 namespace qsmesh::test {
@@ -133,7 +133,8 @@ inline BlockFileSummary check_block_file(const std::string& path) {
     }
     return true;
   };
-  // What cg_conn_info says of general connectivity c of zone z (nothing when it fails).
+  // What cg_conn_info says of each general connectivity of zone z, with its index (those it
+  // cannot read are reported and left out).
   struct Connection {
     std::string name, donor;
     CGNS_ENUMT(GridLocation_t) location;
@@ -141,19 +142,25 @@ inline BlockFileSummary check_block_file(const std::string& path) {
     CGNS_ENUMT(PointSetType_t) points;
     cgsize_t npnts, ndonor;
   };
-  auto connection = [&](int z, int c) -> std::optional<Connection> {
-    char cname[33] = {}, dname[33] = {};
-    Connection info{};
-    CGNS_ENUMT(PointSetType_t) dptype;
-    CGNS_ENUMT(ZoneType_t) dztype;
-    CGNS_ENUMT(DataType_t) ddtype;
-    if (!ok(cg_conn_info(fn, 1, z, c, cname, &info.location, &info.type, &info.points, &info.npnts,
-                         dname, &dztype, &dptype, &ddtype, &info.ndonor),
-            "cg_conn_info"))
-      return std::nullopt;
-    info.name = cname;
-    info.donor = dname;
-    return info;
+  auto connections = [&](int z) {
+    std::vector<std::pair<int, Connection>> list;
+    int n = 0;
+    ok(cg_nconns(fn, 1, z, &n), "cg_nconns");
+    for (int c = 1; c <= n; ++c) {
+      char cname[33] = {}, dname[33] = {};
+      Connection info{};
+      CGNS_ENUMT(PointSetType_t) dptype;
+      CGNS_ENUMT(ZoneType_t) dztype;
+      CGNS_ENUMT(DataType_t) ddtype;
+      if (!ok(cg_conn_info(fn, 1, z, c, cname, &info.location, &info.type, &info.points,
+                           &info.npnts, dname, &dztype, &dptype, &ddtype, &info.ndonor),
+              "cg_conn_info"))
+        continue;
+      info.name = cname;
+      info.donor = dname;
+      list.emplace_back(c, info);
+    }
+    return list;
   };
   // Abutments as (block zone, its points' (i, j), sorted), from the block side and from the
   // unstructured side: the two lists must be equal.
@@ -258,12 +265,8 @@ inline BlockFileSummary check_block_file(const std::string& path) {
       }
     }
     // General connectivities: a block abutting the unstructured zone, point by point.
-    int nconn = 0;
-    ok(cg_nconns(fn, 1, z, &nconn), "cg_nconns");
-    for (int c = 1; c <= nconn; ++c) {
-      const std::optional<Connection> info = connection(z, c);
-      if (!info) continue;
-      const auto& [cname, dname, location, type, ptype, npnts, ndonor] = *info;
+    for (const auto& [c, info] : connections(z)) {
+      const auto& [cname, dname, location, type, ptype, npnts, ndonor] = info;
       ++out.abutments;
       const auto it = by_name.find(dname);
       if (ptype != CGNS_ENUMV(PointRange) || npnts != 2 || it == by_name.end() ||
@@ -353,12 +356,8 @@ inline BlockFileSummary check_block_file(const std::string& path) {
         at += n;
       }
     }
-    int nconn = 0;
-    ok(cg_nconns(fn, 1, z, &nconn), "cg_nconns");
-    for (int c = 1; c <= nconn; ++c) {
-      const std::optional<Connection> info = connection(z, c);
-      if (!info) continue;
-      const auto& [cname, dname, location, type, ptype, npnts, ndonor] = *info;
+    for (const auto& [c, info] : connections(z)) {
+      const auto& [cname, dname, location, type, ptype, npnts, ndonor] = info;
       const auto it = by_name.find(dname);
       if (ptype != CGNS_ENUMV(PointList) || it == by_name.end() ||
           !zones[static_cast<std::size_t>(it->second)].structured || ndonor != npnts ||
