@@ -1,10 +1,13 @@
 #include "cli.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <limits>
 #include <optional>
 #include <sstream>
 
+#include "qsmesh/cad/model.hpp"
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/io/writer.hpp"
 
@@ -23,6 +26,12 @@ double parse_positive(const std::string& option, const std::string& text) {
   if (used != text.size()) throw InputError(option + ": '" + text + "' is not a number");
   if (!std::isfinite(v) || v <= 0) throw InputError(option + ": must be positive, got '" + text + "'");
   return v;
+}
+
+std::string item_text(double v) {
+  std::ostringstream os;
+  os << v;
+  return os.str();
 }
 
 // The whole of `text` as a number (strtod's syntax: inf and nan included), or nothing.
@@ -46,6 +55,13 @@ int parse_threads(const std::string& text) {
   return v;
 }
 
+// A value each ID:VALUE option accepts, for its error messages.
+const char* id_value_example(const std::string& option) {
+  if (option == "--curve-edges") return "12:8,40:16";
+  if (option == "--face-quads") return "3:500,7:1200";
+  return "12:0.5,40:2";
+}
+
 /// "ID:VALUE[,ID:VALUE...]" with ids >= 0 and values > 0.
 std::vector<std::pair<int, double>> parse_id_values(const std::string& option, const std::string& text) {
   std::vector<std::pair<int, double>> out;
@@ -55,7 +71,8 @@ std::vector<std::pair<int, double>> parse_id_values(const std::string& option, c
     const std::string item = text.substr(start, end - start);
     const std::size_t colon = item.find(':');
     if (colon == std::string::npos)
-      throw InputError(option + ": '" + item + "' is not ID:VALUE (e.g. " + option + " 12:0.5,40:2)");
+      throw InputError(option + ": '" + item + "' is not ID:VALUE (e.g. " + option + " " +
+                       id_value_example(option) + ")");
     const std::string id_text = item.substr(0, colon);
     std::size_t used = 0;
     int id = -1;
@@ -70,6 +87,26 @@ std::vector<std::pair<int, double>> parse_id_values(const std::string& option, c
     start = end + 1;
   }
   return out;
+}
+
+/// Throws InputError when an id appears twice in one ID:VALUE option (over all its occurrences):
+/// which of the two values the user meant cannot be guessed.
+template <class T>
+void check_unique_ids(const char* option, const char* what,
+                      const std::vector<std::pair<int, T>>& items) {
+  std::vector<int> ids;
+  ids.reserve(items.size());
+  for (const auto& item : items) ids.push_back(item.first);
+  std::sort(ids.begin(), ids.end());
+  const auto twice = std::adjacent_find(ids.begin(), ids.end());
+  if (twice != ids.end())
+    throw InputError(std::string(option) + ": " + what + " " + std::to_string(*twice) +
+                     " is given twice; give each " + what + " once");
+}
+
+template <class T>
+void append(std::vector<T>& to, const std::vector<T>& from) {
+  to.insert(to.end(), from.begin(), from.end());
 }
 
 }  // namespace
@@ -158,6 +195,9 @@ Arguments parse(const std::vector<std::string>& args) {
     else if (opt == "--curve-edges" && sizing) {
       for (const auto& [id, v] : parse_id_values(opt, value())) {
         if (v != std::floor(v)) throw InputError(opt + ": curve " + std::to_string(id) + ": edge count must be an integer");
+        if (v > std::numeric_limits<int>::max())
+          throw InputError(opt + ": curve " + std::to_string(id) + ": " + item_text(v) +
+                           " edges is more than any mesh can hold");
         // Refused here, before any work, rather than by the quantization after the cross fields.
         if (static_cast<long>(v) % 2 != 0)
           throw InputError(opt + ": curve " + std::to_string(id) + ": " + std::to_string(static_cast<long>(v)) +
@@ -165,11 +205,22 @@ Arguments parse(const std::vector<std::string>& args) {
                            "(odd counts are not supported yet)");
         a.curve_edges.emplace_back(id, static_cast<int>(v));
       }
-    } else if (opt == "--face-quads" && sizing) a.face_quads = parse_id_values(opt, value());
-    else if (opt == "--corner-size" && sizing) a.corner_sizes = parse_id_values(opt, value());
-    else if (opt == "--curve-size" && sizing) a.curve_sizes = parse_id_values(opt, value());
-    else if (opt == "--face-size" && sizing) a.face_sizes = parse_id_values(opt, value());
-    else if (opt == "--json" && a.command == Command::Info) a.json = true;
+    } else if (opt == "--face-quads" && sizing)
+      append(a.face_quads, parse_id_values(opt, value()));
+    else if (opt == "--corner-size" && sizing)
+      append(a.corner_sizes, parse_id_values(opt, value()));
+    else if (opt == "--curve-size" && sizing)
+      append(a.curve_sizes, parse_id_values(opt, value()));
+    else if (opt == "--face-size" && sizing)
+      append(a.face_sizes, parse_id_values(opt, value()));
+    else if (opt == "--max-quads" && meshing) {
+      const std::string& v = value();
+      const auto n = parse_double(v);
+      if (!n || !std::isfinite(*n) || *n < 0)
+        throw InputError(opt + ": '" + v + "' is not a number of quads (0: no bound)");
+      a.max_quads = *n;
+    } else if (opt == "--json" && a.command == Command::Info)
+      a.json = true;
     else if (opt == "--sew") a.sew = true;
     else if (opt == "--quiet" || opt == "-q") a.quiet = true;
     else if (opt == "--verbose" || opt == "-v") a.verbose = true;
@@ -177,6 +228,11 @@ Arguments parse(const std::vector<std::string>& args) {
       throw InputError("unknown option '" + opt + "' for '" + cmd + "' (see qsmesh " + cmd + " --help)");
     else positional.push_back(opt);
   }
+  check_unique_ids("--curve-edges", "curve", a.curve_edges);
+  check_unique_ids("--curve-size", "curve", a.curve_sizes);
+  check_unique_ids("--face-quads", "face", a.face_quads);
+  check_unique_ids("--face-size", "face", a.face_sizes);
+  check_unique_ids("--corner-size", "corner", a.corner_sizes);
   if (a.size && a.size_factor) throw InputError("--size and --size-factor: give one, not both");
   if (a.size_min && a.size_min_ratio)
     throw InputError("--size-min and --size-min-ratio: give one, not both");
@@ -202,6 +258,10 @@ Arguments parse(const std::vector<std::string>& args) {
     if (a.example_name != "wing-body")
       throw InputError("example: unknown example '" + a.example_name + "' (available: wing-body)");
     if (a.output.empty()) throw InputError("example: missing -o FILE.step");
+    if (!cad::example_format(a.output))
+      throw InputError(
+          "example: cannot write '" + a.output +
+          "': the extension picks the CAD format, .step/.stp (STEP) or .brep/.brp (BREP)");
   } else {
     if (positional.empty()) throw InputError(cmd + ": missing MODEL file (STEP, IGES or BREP)");
     if (positional.size() > 1) throw InputError(cmd + ": unexpected argument '" + positional[1] + "'");
@@ -230,31 +290,45 @@ std::string help(const std::string& topic) {
   std::ostringstream os;
   if (topic == "info") {
     os << "usage: qsmesh info MODEL [--json] [--sew]\n\n"
-          "Reads a CAD model (STEP .step/.stp, IGES .iges/.igs, BREP .brep) and prints its topology:\n"
+          "Reads a CAD model (STEP .step/.stp, IGES .iges/.igs, BREP .brep/.brp) and prints its "
+          "topology:\n"
           "the numbers of corners, curves and faces, the bounding box, and one line per face\n"
           "(surface type, loops, curve uses, seams, area).\n\n"
-          "  --json    print the same as one JSON object (keys: corners, curves, faces, face_list, ...)\n"
+          "  --json    print the same as one JSON object (keys: corners, curves, faces, face_list, "
+          "...)\n"
           "  --sew     sew faces that arrive disconnected before building the topology\n";
   } else if (topic == "mesh") {
     os << "usage: [mpirun -np P] qsmesh mesh MODEL -o OUT [options]\n\n"
-          "Meshes every face of a CAD model and writes the surface mesh to OUT; the extension picks\n"
-          "the format: .cgns (CGNS, unstructured zone, one section and family per CAD face and curve),\n"
+          "Meshes every face of a CAD model and writes the surface mesh to OUT; the extension "
+          "picks\n"
+          "the format: .cgns (CGNS, unstructured zone, one section and family per CAD face and "
+          "curve),\n"
           ".vtu (VTK XML, opens in ParaView; cell data cad_face), .msh (Gmsh 4.1 with entities),\n"
           ".h5 (HDF5 datasets for solvers: coordinates, quads, CAD ids and parameters of every\n"
-          "vertex; an XDMF file of the same name, .xdmf, is written beside it to open in ParaView).\n"
-          "Faces are distributed over the MPI ranks (METIS) and over threads inside a rank; the mesh\n"
+          "vertex; an XDMF file of the same name, .xdmf, is written beside it to open in "
+          "ParaView).\n"
+          "Faces are distributed over the MPI ranks (METIS) and over threads inside a rank; the "
+          "mesh\n"
           "is the same whatever the numbers of ranks and threads.\n\n"
-          "  -o, --output OUT      output file (written under a temporary name, renamed at the end)\n"
+          "  -o, --output OUT      output file (written under a temporary name, renamed at the "
+          "end)\n"
           "  --size H              largest edge length, in model units (STEP: millimetres)\n"
           "  --size-factor F       largest edge length as a fraction of the model's bounding-box\n"
-          "                        diagonal (default " << kDefaultSizeFactor << " when --size is not given)\n"
+          "                        diagonal (default "
+       << kDefaultSizeFactor
+       << " when --size is not given)\n"
           "  --until STAGE         last pipeline stage to run: background (the curvature- and\n"
-          "                        feature-adapted triangulation), unstructured (the all-quad mesh\n"
-          "                        of paper 000 Sec. 5 on the quantized curves) or quasi-structured\n"
-          "                        (the default: simple CAD faces meshed by patterns, Sec. 6.1, the\n"
-          "                        others unstructured, then cavity and disk remeshing, Sec. 6.2-6.3)\n"
+          "                        feature-adapted triangulation), unstructured (the all-quad "
+          "mesh\n"
+          "                        of paper 000 Sec. 5 on the quantized curves) or "
+          "quasi-structured\n"
+          "                        (the default: simple CAD faces meshed by patterns, Sec. 6.1, "
+          "the\n"
+          "                        others unstructured, then cavity and disk remeshing, Sec. "
+          "6.2-6.3)\n"
           "  --threads T           threads per rank (default: the cores of the machine divided\n"
-          "                        among the ranks running on it)\n"
+          "                        among the ranks running on it; more than the cores a rank may\n"
+          "                        run on are not granted, and the run says so)\n"
           "  --stats FILE.json     also write the run statistics as JSON\n"
           "  --order 2             second-order elements: 9-node quads and 3-node bars, the new\n"
           "                        nodes on the CAD (CGNS QUAD_9/BAR_3, VTU, MSH; in .h5 the\n"
@@ -269,48 +343,69 @@ std::string help(const std::string& topic) {
           "                        size-map controls, as for sizemap (see qsmesh sizemap --help);\n"
           "                        they act on the quad mesh, not with --until background\n"
           "  --face-time-budget S  at most S seconds of cavity remeshing (paper 000 Sec. 6.2) per\n"
-          "                        face; a face that reaches it keeps the mesh it has (valid) and is\n"
+          "                        face; a face that reaches it keeps the mesh it has (valid) and "
+          "is\n"
           "                        counted in the summary. Without it the work is bounded by\n"
           "                        iteration counts only and the mesh does not depend on timing\n"
+          "  --max-quads N         refuse, before any work, a run whose estimated quad count is\n"
+          "                        above N (default "
+       << kDefaultMaxQuads
+       << "; 0: no bound). A run is\n"
+          "                        also refused when the memory it would need, estimated from the\n"
+          "                        same count, is more than this machine has\n"
           "  --sew                 sew faces that arrive disconnected\n"
           "  -q, --quiet           print only warnings and errors\n"
           "  -v, --verbose         print per-face details (with the quad stages: method, why no\n"
           "                        pattern was kept, counts, irregular vertices, SICN and time of\n"
           "                        every face)\n\n"
           "Exit codes: 0 success, 2 bad input (one line on stderr says what to fix), 1 the output\n"
-          "could not be written (disk full, say; nothing half-written is left) or an internal error.\n";
+          "could not be written (disk full, say; nothing half-written is left) or an internal "
+          "error.\n";
   } else if (topic == "crossfield") {
     os << "usage: [mpirun -np P] qsmesh crossfield MODEL [-o OUT.vtu] [--check] [options]\n\n"
-          "Computes, on the background triangulation of every CAD face, the boundary-aligned cross\n"
-          "field (multilevel heat diffusion, paper 000 Sec. 3.1), its singularities (Sec. 3.2) and\n"
-          "its conformal scaling H, h = exp(H) (Sec. 3.3). OUT.vtu holds the triangulation with cell\n"
-          "data cross_u and cross_v (the two cross directions), u_norm (|U| before projection), H, h,\n"
+          "Computes, on the background triangulation of every CAD face, the boundary-aligned "
+          "cross\n"
+          "field (multilevel heat diffusion, paper 000 Sec. 3.1), its singularities (Sec. 3.2) "
+          "and\n"
+          "its conformal scaling H, h = exp(H) (Sec. 3.3). OUT.vtu holds the triangulation with "
+          "cell\n"
+          "data cross_u and cross_v (the two cross directions), u_norm (|U| before projection), H, "
+          "h,\n"
           "and the singularities as vertex cells with cell data singularity_index (+1: valence 3,\n"
-          "-1: valence 5). The summary lists, per face, its singularities and whether they satisfy\n"
+          "-1: valence 5). The summary lists, per face, its singularities and whether they "
+          "satisfy\n"
           "the Euler relation of the face (paper 000 Eq. 2).\n\n"
           "  -o, --output OUT.vtu  output file (VTK XML, opens in ParaView)\n"
-          "  --check               list the faces whose singularities break the Euler relation and end\n"
+          "  --check               list the faces whose singularities break the Euler relation and "
+          "end\n"
           "                        with the line 'euler-consistent: K/N'\n"
-          "  --size H, --size-factor F, --threads T, --stats FILE.json, --sew, -q, -v: as for mesh\n";
+          "  --size H, --size-factor F, --threads T, --stats FILE.json, --max-quads N, --sew, -q,\n"
+          "  -v: as for mesh\n";
   } else if (topic == "sizemap") {
     os << "usage: [mpirun -np P] qsmesh sizemap MODEL -o OUT.vtu [options]\n\n"
           "Computes the size map (paper 000 Sec. 4.1-4.2) and the curve quantization (Sec. 4.3):\n"
-          "OUT.vtu holds the background triangulation with point data s (the size map), s_min (small\n"
-          "CAD features) and s_cf (cross-field conformal sizes), the background curve meshes, and the\n"
-          "vertices of the quantized curve meshes as vertex cells. The summary gives the numbers of\n"
+          "OUT.vtu holds the background triangulation with point data s (the size map), s_min "
+          "(small\n"
+          "CAD features) and s_cf (cross-field conformal sizes), the background curve meshes, and "
+          "the\n"
+          "vertices of the quantized curve meshes as vertex cells. The summary gives the numbers "
+          "of\n"
           "curves, chords and edges.\n\n"
           "  --sizemap METHOD      features (small features and user sizes only) or crossfield\n"
           "                        (also the conformal scaling of the cross fields; default)\n"
           "  --quads N             target number of quads of the model (default: area / size^2)\n"
           "  --curvature-edges N   edges per full turn on curved curves: a radius R gets edges of\n"
-          "                        2 pi R / N at most (default 16); 0 sizes by the cross field and\n"
+          "                        2 pi R / N at most (default 16); 0 sizes by the cross field "
+          "and\n"
           "                        the small CAD features only (paper 000 Sec. 4)\n"
           "  --face-curvature      the same bound from the faces' curvature along their curves\n"
           "                        (finer on curved faces, e.g. a wing's leading edge, but the\n"
-          "                        isotropic sizes then make the counts of opposite sides unequal)\n"
+          "                        isotropic sizes then make the counts of opposite sides "
+          "unequal)\n"
           "  --feature-ratio R     small CAD features (curves closer than the size) refine the\n"
           "                        size to no less than R times what it is without them (default\n"
-          "                        0.75); 0 resolves every feature, at the price of more irregular\n"
+          "                        0.75); 0 resolves every feature, at the price of more "
+          "irregular\n"
           "                        vertices along thin strips and slots\n"
           "  --size-min H          smallest size the size map may ask for (model units; default\n"
           "                        the size cap / 100); given, it also stops curves shorter than\n"
@@ -320,7 +415,8 @@ std::string help(const std::string& topic) {
           "                        --curvature-edges 0 it sizes about as Gmsh's implementation of\n"
           "                        the paper does (no curvature sizes, no feature finer than a\n"
           "                        fraction of the target size): fewer irregular vertices and\n"
-          "                        flatter quads against sliver curves; at coarse sizes curved faces\n"
+          "                        flatter quads against sliver curves; at coarse sizes curved "
+          "faces\n"
           "                        may get too few edges and fail (docs/benchmarks.md)\n"
           "  --sizing RULES        paper (the default: paper 000 Sec. 4.1, a sliver curve refines\n"
           "                        the mesh around it down to its length) or gmsh (the rules of\n"
@@ -330,13 +426,17 @@ std::string help(const std::string& topic) {
           "  --face-quads F:N,..   prescribe the number of quads of faces\n"
           "  --corner-size K:H,.., --curve-size C:H,.., --face-size F:H,..\n"
           "                        size constraints at corners, on curves, on faces (model units)\n"
-          "  --size H, --size-factor F, --threads T, --stats FILE.json, --sew, -q, -v: as for mesh\n";
+          "  --size H, --size-factor F, --threads T, --stats FILE.json, --max-quads N, --sew, -q,\n"
+          "  -v: as for mesh\n";
   } else if (topic == "example") {
-    os << "usage: qsmesh example wing-body -o FILE.step\n\n"
-          "Writes a built-in CAD model built with OpenCASCADE:\n"
-          "  wing-body   a fuselage of revolution fused with a wing lofted from NACA 4-digit sections\n";
+    os << "usage: qsmesh example wing-body -o FILE\n\n"
+          "Writes a built-in CAD model built with OpenCASCADE, as STEP (FILE.step, .stp) or BREP\n"
+          "(FILE.brep, .brp):\n"
+          "  wing-body   a fuselage of revolution fused with a wing lofted from NACA 4-digit "
+          "sections\n";
   } else {
-    os << "qsmesh - quasi-structured quadrilateral surface meshes of CAD models, distributed with MPI\n\n"
+    os << "qsmesh - quasi-structured quadrilateral surface meshes of CAD models, distributed with "
+          "MPI\n\n"
           "usage: qsmesh COMMAND [options]\n\n"
           "commands:\n"
           "  info MODEL            print the CAD topology (corners, curves, faces)\n"
@@ -345,7 +445,7 @@ std::string help(const std::string& topic) {
           "                        cross fields, singularities and scaling of every face\n"
           "  sizemap MODEL -o OUT.vtu\n"
           "                        size map and curve quantization\n"
-          "  example NAME -o FILE  write a built-in CAD model (wing-body)\n\n"
+          "  example NAME -o FILE  write a built-in CAD model (wing-body) as STEP or BREP\n\n"
           "Run 'qsmesh COMMAND --help' for the options of a command.\n"
           "Quick start:\n"
           "  qsmesh example wing-body -o wing_body.step\n"

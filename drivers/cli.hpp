@@ -57,6 +57,9 @@ struct Arguments {
   std::vector<std::pair<int, double>> corner_sizes;   ///< --corner-size K:H,...
   std::vector<std::pair<int, double>> curve_sizes;    ///< --curve-size C:H,...
   std::vector<std::pair<int, double>> face_sizes;     ///< --face-size F:H,...
+  /// --max-quads N: refuse, before any work, a run whose estimated quad count is above N
+  /// (0: no bound; the machine's memory still bounds it). See kDefaultMaxQuads.
+  double max_quads = -1;  ///< -1: kDefaultMaxQuads
   bool sew = false;
   bool quiet = false;
   bool verbose = false;
@@ -69,6 +72,11 @@ inline constexpr double kDefaultSizeFactor = 0.02;
 /// models meet the Gmsh reference runs' criteria (docs/benchmarks.md, fifteenth session; 0.10 and
 /// 0.25 miss wing_fuselage's).
 inline constexpr double kGmshSizeMinRatio = 0.17;
+
+/// Default --max-quads: far above any mesh the project has been run on (1.2M vertices) and far
+/// below what a mistyped size asks for (--size-factor 1e-6: about 1e12 quads), so that a runaway
+/// request is refused with its estimate instead of exhausting the machine.
+inline constexpr double kDefaultMaxQuads = 2e8;
 
 /// Parses argv[1..]. Throws InputError (one line naming the option and the reason) on bad input.
 [[nodiscard]] Arguments parse(const std::vector<std::string>& args);

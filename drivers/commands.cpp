@@ -15,6 +15,7 @@
 #include <thread>
 
 #include "json.hpp"
+#include "limits.hpp"
 #include "qsmesh/cad/model.hpp"
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/core/log.hpp"
@@ -45,6 +46,64 @@ void check_writable(const std::string& option, const std::string& path) {
     throw InputError(option + ": cannot write '" + path + "': directory '" + dir.string() +
                      "' is not writable");
   if (fs::is_directory(p, ec)) throw InputError(option + ": '" + path + "' is a directory");
+  // The output replaces whatever has its name by a rename: a device or a pipe would be replaced
+  // by a regular file (as root, /dev/null itself).
+  if (fs::exists(fs::symlink_status(p, ec)) && !fs::is_regular_file(fs::symlink_status(p, ec)) &&
+      !fs::is_symlink(fs::symlink_status(p, ec)))
+    throw InputError(option + ": '" + path +
+                     "' exists and is not a regular file (a device or a pipe); give a file name");
+  // Permission bits do not tell everything (root may write anywhere by them, yet not create a file
+  // in /proc or on a full or read-only file system): create and remove a file where the temporary
+  // will be, before any work.
+  if (const auto why = io::probe_create(path))
+    throw InputError(option + ": cannot write '" + path + "': " + *why);
+}
+
+namespace {
+
+// The name a path resolves to (symbolic links and '..' resolved as far as it exists), for telling
+// whether two names are one file.
+fs::path resolved(const std::string& path) {
+  std::error_code ec;
+  fs::path r = fs::weakly_canonical(fs::absolute(fs::path(path), ec), ec);
+  return ec ? fs::absolute(fs::path(path), ec).lexically_normal() : r;
+}
+
+bool same_file(const std::string& a, const std::string& b) {
+  if (resolved(a) == resolved(b)) return true;
+  std::error_code ec;
+  return fs::exists(a, ec) && fs::exists(b, ec) && fs::equivalent(a, b, ec) && !ec;  // hard links
+}
+
+}  // namespace
+
+void check_output_files(const Arguments& args) {
+  struct Named {
+    std::string what, path, after;
+    [[nodiscard]] std::string text() const { return what + " '" + path + "'" + after; }
+  };
+  std::vector<Named> outputs;
+  if (!args.output.empty()) {
+    outputs.push_back({"-o", args.output, ""});
+    if (args.command != Command::Example && io::output_format(args.output) == io::Format::kHdf5)
+      outputs.push_back({"the .xdmf file", io::xdmf_path_for(args.output), " written beside -o"});
+  }
+  if (!args.stats.empty()) outputs.push_back({"--stats", args.stats, ""});
+  std::vector<Named> inputs;
+  if (!args.model.empty()) inputs.push_back({"the model", args.model, ""});
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    for (const Named& in : inputs)
+      if (same_file(outputs[i].path, in.path))
+        throw InputError(outputs[i].text() + " names the same file as " + in.text() +
+                         ", which it would overwrite; give another name");
+    for (std::size_t j = 0; j < i; ++j)
+      if (same_file(outputs[i].path, outputs[j].path))
+        throw InputError(outputs[i].text() + " names the same file as " + outputs[j].text() +
+                         "; give another name");
+  }
+  for (const Named& out : outputs)
+    if (out.what == "--stats" || args.command == Command::Example)
+      check_writable(out.what, out.path);
 }
 
 void write_text_file_atomically(const std::string& path, const std::string& text) {
@@ -140,8 +199,14 @@ int run_info(const Arguments& args) {
 }
 
 int run_example(const Arguments& args) {
-  check_writable("-o", args.output);
-  cad::write_wing_body_example(args.output);
+  check_output_files(args);
+  const auto format = cad::example_format(args.output);
+  if (!format)
+    throw InputError("example: cannot write '" + args.output +
+                     "': the extension picks the CAD format, .step/.stp or .brep/.brp");
+  io::AtomicFile file(args.output);
+  cad::write_wing_body_example(file.temp_path(), *format);
+  file.commit();
   std::cout << "wrote " << args.output << " (example " << args.example_name << ")\n";
   return 0;
 }
@@ -545,10 +610,47 @@ Session::Session(const Arguments& args, const char* command)
     threads =
         std::max(1, static_cast<int>(std::thread::hardware_concurrency()) / comm.local_size());
   tasks = std::make_unique<TaskArena>(threads);
+  if (tasks->threads() < threads && args.threads > 0)
+    log.warn(cat("--threads ", args.threads, ": this process may run on ", tasks->threads(),
+                 " core(s); using ", tasks->threads(), " thread(s)"));
+  threads = tasks->threads();
+}
+
+void Session::announce(const Arguments& args, const char* command) {
   log.info(cat("qsmesh ", command, " ", args.model, ": ", model.num_corners(), " corners, ",
                model.num_curves(), " curves, ", model.num_faces(), " faces; size ", size,
                args.sizing == "paper" ? "" : " (" + args.sizing + " sizing rules)", "; ", ranks,
                " rank(s) x ", threads, " thread(s)"));
+}
+
+void check_request(const Arguments& args, const Session& s) {
+  ModelMeasures m;
+  for (const cad::Face& f : s.model.faces()) {
+    m.face_area.push_back(f.area);
+    std::vector<int> curves;
+    for (const cad::Loop& l : f.loops)
+      for (const cad::CurveUse& u : l.uses) curves.push_back(u.curve);
+    m.face_curves.push_back(std::move(curves));
+  }
+  for (const cad::Curve& c : s.model.curves()) m.curve_length.push_back(c.length);
+  SizeRequest r;
+  r.size_max = s.size;
+  r.target_quads = args.quads;
+  r.face_quads = args.face_quads;
+  r.face_sizes = args.face_sizes;
+  r.curve_edges = args.curve_edges;
+  r.curve_sizes = args.curve_sizes;
+  std::ostringstream what;
+  if (args.size)
+    what << "--size " << *args.size;
+  else if (args.size_factor)
+    what << "--size-factor " << *args.size_factor;
+  else
+    what << "the default size factor " << kDefaultSizeFactor;
+  const double max_quads = args.max_quads < 0 ? kDefaultMaxQuads : args.max_quads;
+  if (const auto refusal = refuse_request(estimate_request(m, r), max_quads, s.ranks,
+                                          s.comm.local_size(), machine_memory(), what.str()))
+    throw InputError(*refusal);
 }
 
 namespace {
@@ -585,6 +687,7 @@ void apply_size_options(const Arguments& args, const Session& s,
   check_ids("--corner-size", "corner", args.corner_sizes, s.model.num_corners());
   check_ids("--face-quads", "face", args.face_quads, s.model.num_faces());
   check_ids("--face-size", "face", args.face_sizes, s.model.num_faces());
+  check_request(args, s);
   sizemap::SizeMapOptions& so = options.sizemap;
   so.method = args.sizemap == "features" ? sizemap::Method::Features : sizemap::Method::CrossField;
   so.size_max = s.size;
@@ -630,16 +733,44 @@ void note_sliver_curves(Session& s, const sizemap::SizeMapOptions& so) {
 }
 }  // namespace
 
+namespace {
+// A prescription the mesh could not follow (a face's quads decided by its curves' counts) is a
+// warning, not a silent difference.
+void warn_unmet_prescriptions(const Arguments& args, const parallel::PipelineResult& r,
+                              Logger& log) {
+  const mesh::SurfaceMesh& m = r.mesh;
+  if (m.quads.empty()) return;
+  std::vector<std::int64_t> face_quads(static_cast<std::size_t>(m.num_cad_faces), 0);
+  for (const LO f : m.quad_face) face_quads[static_cast<std::size_t>(f)] += 1;
+  for (const auto& [f, asked] : args.face_quads) {
+    const double got = static_cast<double>(face_quads[static_cast<std::size_t>(f)]);
+    if (got > 2 * asked || 2 * got < asked)
+      log.warn(cat("--face-quads ", f, ":", asked, ": face ", f, " got ", got,
+                   " quads; its curves' edge counts and the sizes of its neighbours decide"));
+  }
+  std::vector<std::int64_t> curve_bars(static_cast<std::size_t>(m.num_cad_curves), 0);
+  for (const LO c : m.bar_curve) curve_bars[static_cast<std::size_t>(c)] += 1;
+  for (const auto& [c, asked] : args.curve_edges)
+    if (curve_bars[static_cast<std::size_t>(c)] != asked)
+      log.warn(cat("--curve-edges ", c, ":", asked, ": curve ", c, " got ",
+                   curve_bars[static_cast<std::size_t>(c)], " edges"));
+}
+}  // namespace
+
 int run_mesh(const Arguments& args) {
   // Everything the user could get wrong is checked before any work.
   const parallel::Stage until = parallel::parse_stage(args.until);
   io::check_output_path(args.output);
-  if (!args.stats.empty()) check_writable("--stats", args.stats);
+  check_output_files(args);
 
   Session s(args, "mesh");
   parallel::PipelineOptions options;
   options.background.sizes.size = s.size;
-  apply_size_options(args, s, options);
+  if (until >= parallel::Stage::Unstructured)
+    apply_size_options(args, s, options);
+  else
+    check_request(args, s);
+  s.announce(args, "mesh");
   options.until = until;
   if (until >= parallel::Stage::Unstructured) note_sliver_curves(s, options.sizemap);
   options.cavities.time_budget_s = args.face_time_budget;
@@ -696,6 +827,7 @@ int run_mesh(const Arguments& args) {
       write_text_file_atomically(args.stats, stats_json(args, s, result, stats, checks));
     for (const auto& o : outcomes(result))
       if (!o.ok) s.log.warn(o.error);
+    warn_unmet_prescriptions(args, result, s.log);
   }
   return 0;
 }

@@ -18,6 +18,9 @@ namespace qsmesh::cli {
 /// Collective: MPI must be initialised. Throws InputError for a bad model file.
 struct Session {
   Session(const Arguments& args, const char* command);
+  /// The run's first line (model, size, ranks and threads): printed once the request is checked,
+  /// so that a refused run prints only its error.
+  void announce(const Arguments& args, const char* command);
   parallel::Comm comm;
   int rank = 0, ranks = 1;
   Logger log;
@@ -59,6 +62,16 @@ double feature_ratio(const Arguments& args);
 /// The floor of the automatic sizes the user gave, in model units: --size-min, or --size-min-ratio
 /// times `size` (the size cap); 0 when neither is given (the size map's default floor).
 double given_size_min(const Arguments& args, double size);
+
+/// Throws InputError when the size options ask for more quads than --max-quads allows or more
+/// memory than this machine has (lower estimates, limits.hpp), naming the request and the estimate.
+void check_request(const Arguments& args, const Session& s);
+
+/// Checks the files a run writes before any work: every output (-o, the .xdmf beside an .h5,
+/// --stats) names a file distinct from the model and from the others (symbolic links, '..' and
+/// hard links resolved), and each can be created where it will be written. Throws InputError.
+/// The -o of mesh, crossfield and sizemap is checked by io::check_output_path as well.
+void check_output_files(const Arguments& args);
 
 /// Writes `text` to `path` through a temporary file renamed at the end.
 void write_text_file_atomically(const std::string& path, const std::string& text);

@@ -60,9 +60,11 @@ int run_crossfield(const Arguments& args) {
         args.output.substr(args.output.size() - 4) != ".vtu")
       throw InputError("-o: '" + args.output + "': the cross field is written as VTU (.vtu)");
   }
-  if (!args.stats.empty()) check_writable("--stats", args.stats);
+  check_output_files(args);
 
   Session s(args, "crossfield");
+  check_request(args, s);
+  s.announce(args, "crossfield");
   linalg::PetscLane lane;
   parallel::PipelineOptions options;
   options.background.sizes.size = s.size;

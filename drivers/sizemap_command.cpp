@@ -74,7 +74,7 @@ int run_sizemap(const Arguments& args) {
   io::check_output_path(args.output);
   if (args.output.size() < 4 || args.output.substr(args.output.size() - 4) != ".vtu")
     throw InputError("-o: '" + args.output + "': the size map is written as VTU (.vtu)");
-  if (!args.stats.empty()) check_writable("--stats", args.stats);
+  check_output_files(args);
 
   Session s(args, "sizemap");
   linalg::PetscLane lane;
@@ -82,6 +82,7 @@ int run_sizemap(const Arguments& args) {
   options.background.sizes.size = s.size;
   options.size_map = true;
   apply_size_options(args, s, options);
+  s.announce(args, "sizemap");
   const parallel::PipelineResult result = parallel::run_pipeline(s.comm, s.model, options, *s.tasks, s.log, &lane);
   for (const auto& [stage, sec] : result.times.entries()) s.times.add(stage, sec);
   if (s.rank != 0) return 0;

@@ -1,10 +1,13 @@
 #include "qsmesh/io/writer.hpp"
 
+#include <fcntl.h>
 #include <hdf5.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cctype>
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
 #include <string_view>
 #include <system_error>
@@ -47,6 +50,26 @@ void check_output_path(const std::string& path) {
   }
 }
 
+std::optional<std::string> probe_create(const std::string& path) {
+  const fs::path p(path);
+  const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
+  std::string name = ".";
+  name += p.filename().string();
+  name += ".probe.";
+  name += std::to_string(::getpid());
+  const std::string probe = (dir / name).string();
+  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+  if (fd < 0) {
+    // A probe of the same name is this process's own (two outputs in one folder): no proof either
+    // way, but it shows the folder accepted a file.
+    if (errno == EEXIST) return std::nullopt;
+    return std::string(std::strerror(errno));
+  }
+  ::close(fd);
+  ::unlink(probe.c_str());
+  return std::nullopt;
+}
+
 void prepare_output_libraries() {
   // Without this, a CGNS file whose write failed (disk full) stays half-open inside HDF5, and the
   // library's exit handler crashes on it after the run has already reported the error.
@@ -77,6 +100,9 @@ void check_output_folder(const std::string& path) {
   if (::access(dir.c_str(), W_OK | X_OK) != 0) {
     throw InputError("output '" + path + "': folder '" + dir.string() + "' is not writable");
   }
+  if (const auto why = probe_create(path))
+    throw InputError("output '" + path + "': cannot create a file in folder '" + dir.string() +
+                     "': " + *why);
 }
 
 }  // namespace detail

@@ -7,6 +7,7 @@
 #include <BRepCheck_Analyzer.hxx>
 #include <BRepOffsetAPI_ThruSections.hxx>
 #include <BRepPrimAPI_MakeRevol.hxx>
+#include <BRepTools.hxx>
 #include <GC_MakeArcOfEllipse.hxx>
 #include <GeomAPI_Interpolate.hxx>
 #include <Geom_BSplineCurve.hxx>
@@ -19,7 +20,10 @@
 #include <TColgp_HArray1OfPnt.hxx>
 #include <TopExp_Explorer.hxx>
 #include <TopoDS.hxx>
+#include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <filesystem>
 #include <gp_Ax1.hxx>
 #include <gp_Ax2.hxx>
 #include <gp_Elips.hxx>
@@ -137,7 +141,20 @@ TopoDS_Shape fuse(const TopoDS_Shape& a, const TopoDS_Shape& b) {
 
 }  // namespace
 
-void write_wing_body_example(const std::string& path) {
+std::optional<ExampleFormat> example_format(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+  if (ext == ".step" || ext == ".stp") return ExampleFormat::Step;
+  if (ext == ".brep" || ext == ".brp") return ExampleFormat::Brep;
+  return std::nullopt;
+}
+
+void write_wing_body_example(const std::string& path, std::optional<ExampleFormat> format) {
+  if (!format) format = example_format(path);
+  if (!format)
+    throw InputError("cannot write the wing-body example to '" + path +
+                     "': the extension picks the format, .step/.stp or .brep/.brp");
   TopoDS_Shape shape;
   try {
     shape = fuse(fuse(make_fuselage(), make_wing(+1)), make_wing(-1));
@@ -150,6 +167,11 @@ void write_wing_body_example(const std::string& path) {
   BRepCheck_Analyzer check(shape);
   QSMESH_CHECK(check.IsValid(), "wing-body example: the fused solid is not valid");
 
+  if (*format == ExampleFormat::Brep) {
+    if (!BRepTools::Write(shape, path.c_str()))
+      throw InputError("cannot write the wing-body example to '" + path + "'");
+    return;
+  }
   STEPControl_Writer writer;
   if (writer.Transfer(shape, STEPControl_AsIs) != IFSelect_RetDone)
     throw Error("wing-body example: STEP transfer failed");

@@ -66,10 +66,11 @@ CadModel load_cad(const std::string& path, const LoadOptions& options) {
     format = Format::Step;
   } else if (ext == ".iges" || ext == ".igs") {
     format = Format::Iges;
-  } else if (ext == ".brep") {
+  } else if (ext == ".brep" || ext == ".brp") {
     format = Format::Brep;
   } else {
-    fail(path, "unsupported extension '" + ext + "' (expected .step, .stp, .iges, .igs or .brep)");
+    fail(path,
+         "unsupported extension '" + ext + "' (expected .step, .stp, .iges, .igs, .brep or .brp)");
   }
   std::error_code ec;
   if (!fs::exists(path, ec)) fail(path, "file does not exist");

@@ -14,8 +14,18 @@ struct TaskArena::Impl {
   tbb::task_arena arena;
 };
 
+// Asking TBB for more threads than it grants gave an arena that reported the number asked while
+// running on the cores available, and 100000 of them crashed at exit: the request is clamped.
 TaskArena::TaskArena(int threads)
-    : impl_(std::make_unique<Impl>(threads > 0 ? threads : tbb::this_task_arena::max_concurrency())) {}
+    : impl_(
+          std::make_unique<Impl>(threads > 0 ? std::min(threads, max_threads()) : max_threads())) {}
+
+int TaskArena::max_threads() {
+  return std::max(
+      1, static_cast<int>(std::min<std::size_t>(
+             static_cast<std::size_t>(tbb::this_task_arena::max_concurrency()),
+             tbb::global_control::active_value(tbb::global_control::max_allowed_parallelism))));
+}
 
 TaskArena::~TaskArena() = default;
 

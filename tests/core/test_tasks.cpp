@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
 #include <stdexcept>
 #include <vector>
@@ -12,11 +13,23 @@ namespace {
 TEST(TaskArena, EveryIndexRunsOnce) {
   for (int threads : {1, 2, 4}) {
     const TaskArena arena(threads);
-    EXPECT_EQ(arena.threads(), threads);
+    EXPECT_EQ(arena.threads(), std::min(threads, TaskArena::max_threads()));
     std::vector<int> hits(1000, 0);
     arena.parallel_for(static_cast<std::int64_t>(hits.size()), [&](std::int64_t i) { hits[i] += 1; });
     for (int h : hits) ASSERT_EQ(h, 1);
   }
+}
+
+// A request beyond what the scheduler grants is clamped, not reported as granted (it used to be,
+// and 100000 threads crashed at exit).
+TEST(TaskArena, MoreThreadsThanGrantedAreClamped) {
+  ASSERT_GE(TaskArena::max_threads(), 1);
+  const TaskArena arena(100000);
+  EXPECT_EQ(arena.threads(), TaskArena::max_threads());
+  std::vector<int> hits(100, 0);
+  arena.parallel_for(static_cast<std::int64_t>(hits.size()), [&](std::int64_t i) { hits[i] += 1; });
+  for (int h : hits) ASSERT_EQ(h, 1);
+  EXPECT_EQ(TaskArena(0).threads(), TaskArena::max_threads());
 }
 
 TEST(TaskArena, ExceptionPropagates) {

@@ -193,5 +193,64 @@ TEST(Cli, MissingPiecesAndUnknowns) {
   EXPECT_NE(error_of({"info", "a.step", "b.step"}).find("unexpected argument"), std::string::npos);
 }
 
+// An id given twice in one option, even over two occurrences of it, is refused at parse time:
+// which value was meant cannot be guessed (it used to be found after the curves were meshed).
+TEST(Cli, AnIdGivenTwiceIsRefused) {
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.msh", "--curve-edges", "3:8,3:10"})
+                .find("curve 3 is given twice"),
+            std::string::npos);
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.msh", "--face-size", "1:2", "--face-size", "1:3"})
+                .find("face 1 is given twice"),
+            std::string::npos);
+  EXPECT_NE(
+      error_of({"sizemap", "m.step", "-o", "o.vtu", "--corner-size", "4:1,4:1"}).find("corner 4"),
+      std::string::npos);
+  // Repeating the option adds to it.
+  EXPECT_EQ(p({"mesh", "m.step", "-o", "o.msh", "--curve-size", "1:2", "--curve-size", "5:3"})
+                .curve_sizes.size(),
+            2u);
+  EXPECT_EQ(p({"mesh", "m.step", "-o", "o.msh", "--curve-edges", "1:8,5:10"}).curve_edges.size(),
+            2u);
+}
+
+// Each ID:VALUE option's hint shows a value the option itself accepts.
+TEST(Cli, HintsShowAcceptedValues) {
+  for (const std::string option :
+       {"--curve-edges", "--face-quads", "--curve-size", "--face-size", "--corner-size"}) {
+    const std::string err = error_of({"mesh", "m.step", "-o", "o.msh", option, "7"});
+    const auto at = err.find("(e.g. " + option + " ");
+    ASSERT_NE(at, std::string::npos) << err;
+    const std::size_t from = at + std::string("(e.g. ").size() + option.size() + 1;
+    const std::string example = err.substr(from, err.find(')', at) - from);
+    EXPECT_FALSE(example.empty()) << err;
+    EXPECT_EQ(error_of({"mesh", "m.step", "-o", "o.msh", option, example}), "")
+        << option << " " << example;
+  }
+}
+
+TEST(Cli, MaxQuads) {
+  EXPECT_LT(p({"mesh", "m.step", "-o", "o.msh"}).max_quads, 0);  // the default applies
+  EXPECT_DOUBLE_EQ(p({"mesh", "m.step", "-o", "o.msh", "--max-quads", "1e6"}).max_quads, 1e6);
+  EXPECT_DOUBLE_EQ(p({"sizemap", "m.step", "-o", "o.vtu", "--max-quads", "0"}).max_quads, 0);
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.msh", "--max-quads", "-1"}).find("--max-quads"),
+            std::string::npos);
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.msh", "--max-quads", "lots"}).find("--max-quads"),
+            std::string::npos);
+  EXPECT_NE(help("mesh").find("--max-quads N"), std::string::npos);
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.msh", "--curve-edges", "1:4000000000"})
+                .find("more than any mesh"),
+            std::string::npos);
+}
+
+// The example is written in the format its extension names; other names are refused up front.
+TEST(Cli, ExampleFormatByExtension) {
+  EXPECT_EQ(p({"example", "wing-body", "-o", "w.step"}).output, "w.step");
+  EXPECT_EQ(p({"example", "wing-body", "-o", "w.BRP"}).output, "w.BRP");
+  EXPECT_EQ(p({"example", "wing-body", "-o", "w.brep"}).output, "w.brep");
+  for (const std::string bad : {"w.cgns", "w.iges", "w"})
+    EXPECT_NE(error_of({"example", "wing-body", "-o", bad}).find(".brep"), std::string::npos)
+        << bad;
+}
+
 }  // namespace
 }  // namespace qsmesh::cli

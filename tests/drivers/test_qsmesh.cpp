@@ -598,15 +598,26 @@ TEST_F(Qsmesh, BadInputIsOneLineAndExitTwo) {
       {"garbage file", "mesh " + tmp("garbage.step") + " -o " + tmp("bad3.vtu"), "garbage.step"},
       {"unsupported input", "mesh " + tmp("model.xyz") + " -o " + tmp("bad4.vtu"), "model.xyz"},
       {"unsupported output", "mesh " + model_ + " -o " + tmp("bad5.stl"), "bad5.stl"},
-      {"unwritable output dir", "mesh " + model_ + " -o /nonexistent_dir/bad6.vtu", "/nonexistent_dir"},
+      {"unwritable output dir", "mesh " + model_ + " -o /nonexistent_dir/bad6.vtu",
+       "/nonexistent_dir"},
       {"negative size", "mesh " + model_ + " -o " + tmp("bad7.vtu") + " --size -3", "--size"},
       {"non-numeric size", "mesh " + model_ + " -o " + tmp("bad8.vtu") + " --size big", "--size"},
-      {"zero size factor", "mesh " + model_ + " -o " + tmp("bad9.vtu") + " --size-factor 0", "--size-factor"},
-      {"unknown stage", "mesh " + model_ + " -o " + tmp("bad10.vtu") + " --until everything", "--until"},
+      {"zero size factor", "mesh " + model_ + " -o " + tmp("bad9.vtu") + " --size-factor 0",
+       "--size-factor"},
+      {"unknown stage", "mesh " + model_ + " -o " + tmp("bad10.vtu") + " --until everything",
+       "--until"},
       // Known only once the model is read, after its progress line: -q keeps stderr to the error.
-      {"unknown curve id", "mesh " + model_ + " -o " + tmp("bad11.msh") + " --curve-size 100000:1 -q",
+      {"unknown curve id",
+       "mesh " + model_ + " -o " + tmp("bad11.msh") + " --curve-size 100000:1 -q",
        "curve 100000 does not exist"},
       {"info missing file", "info " + tmp("no_such.brep"), "no_such.brep"},
+      // Checked before the run's first line: without -q too, the error is the only line.
+      {"unknown face id, not quiet",
+       "mesh " + model_ + " -o " + tmp("bad12.msh") + " --face-quads 900:10",
+       "face 900 does not exist"},
+      {"curve given twice",
+       "mesh " + model_ + " -o " + tmp("bad13.msh") + " --curve-edges 3:8,3:10",
+       "curve 3 is given twice"},
   };
   for (const auto& c : cases) {
     const ExeResult r = run(c.args);
@@ -619,7 +630,137 @@ TEST_F(Qsmesh, BadInputIsOneLineAndExitTwo) {
   std::string prefix = "p";
   prefix += std::to_string(::getpid());
   prefix += "_bad";
-  for (int i = 1; i <= 11; ++i) EXPECT_TRUE(nothing_written(dir, prefix + std::to_string(i) + ".")) << i;
+  for (int i = 1; i <= 13; ++i)
+    EXPECT_TRUE(nothing_written(dir, prefix + std::to_string(i) + ".")) << i;
+}
+
+// Every output of a run names a file of its own: never the model, never another output, whatever
+// the links and '..' in the names. Refused with exit 2 before any work, the files untouched.
+TEST_F(Qsmesh, OutputsNeverOverwriteTheModelOrEachOther) {
+  const std::string model = tmp("distinct_model.step");
+  fs::copy_file(model_, model, fs::copy_options::overwrite_existing);
+  const std::string before = slurp(model);
+  fs::create_directories(tmp("distinct_sub"));
+  std::error_code ec;
+  fs::remove(tmp("distinct_link.step"), ec);
+  fs::create_symlink(model, tmp("distinct_link.step"));
+  fs::remove(tmp("distinct_hard.step"), ec);
+  fs::create_hard_link(model, tmp("distinct_hard.step"));
+  std::ofstream(tmp("distinct_mesh.cgns")) << "earlier mesh";
+  struct Case {
+    std::string args, expect;
+  };
+  const std::vector<Case> cases = {
+      {"-o " + tmp("distinct_a.cgns") + " --stats " + model, "names the same file as the model"},
+      {"-o " + tmp("distinct_mesh.cgns") + " --stats " + tmp("distinct_mesh.cgns"),
+       "names the same file as -o"},
+      {"-o " + tmp("distinct_b.h5") + " --stats " + tmp("distinct_b.xdmf"), "the .xdmf file"},
+      {"-o " + tmp("distinct_c.msh") + " --stats " + tmp("distinct_sub") + "/../" +
+           fs::path(tmp("distinct_link.step")).filename().string(),
+       "names the same file as the model"},
+      {"-o " + tmp("distinct_d.msh") + " --stats " + tmp("distinct_hard.step"),
+       "names the same file as the model"},
+  };
+  for (const Case& c : cases) {
+    const ExeResult r = run("mesh " + model + " " + c.args);
+    EXPECT_EQ(r.code, 2) << c.args << ": " << r.err;
+    EXPECT_EQ(lines(r.err), 1) << c.args << ": " << r.err;
+    EXPECT_NE(r.err.find(c.expect), std::string::npos) << c.args << ": " << r.err;
+  }
+  EXPECT_EQ(slurp(model), before);
+  EXPECT_EQ(slurp(tmp("distinct_mesh.cgns")), "earlier mesh");
+  for (const char* name : {"distinct_a.cgns", "distinct_b.h5", "distinct_c.msh", "distinct_d.msh"})
+    EXPECT_FALSE(fs::exists(tmp(name))) << name;
+}
+
+// Outputs that cannot be created are found before any work (exit 2), not after the meshing
+// (root passes every permission check, yet cannot create a file in /proc); a device is never
+// replaced by a file.
+TEST_F(Qsmesh, UnwritableOutputsAreRefusedBeforeAnyWork) {
+  struct Case {
+    std::string args, expect;
+  };
+  const std::vector<Case> cases = {
+      {"mesh " + model_ + " -o /proc/qsmesh_m.cgns", "/proc"},
+      {"mesh " + model_ + " -o " + tmp("unwritable_a.msh") + " --stats /proc/qsmesh_s.json",
+       "/proc/qsmesh_s.json"},
+      {"mesh " + model_ + " -o " + tmp("unwritable_b.msh") + " --stats /dev/null",
+       "not a regular file"},
+      {"example wing-body -o /proc/qsmesh_w.step", "/proc"},
+      {"sizemap " + model_ + " -o " + tmp("unwritable_c.vtu") + " --stats /proc/qsmesh_s.json",
+       "/proc"},
+  };
+  for (const Case& c : cases) {
+    const ExeResult r = run(c.args);
+    EXPECT_EQ(r.code, 2) << c.args << ": " << r.err;
+    EXPECT_EQ(lines(r.err), 1) << c.args << ": " << r.err;
+    EXPECT_NE(r.err.find(c.expect), std::string::npos) << c.args << ": " << r.err;
+  }
+  for (const char* name : {"unwritable_a.msh", "unwritable_b.msh", "unwritable_c.vtu"})
+    EXPECT_FALSE(fs::exists(tmp(name))) << name;
+}
+
+// A request no machine can meet is refused at once with its estimate (it used to run until killed
+// or end in bad_alloc), and so is one over --max-quads; sizes too small to square are no
+// exception.
+TEST_F(Qsmesh, RunawayRequestsAreRefusedWithTheirEstimate) {
+  struct Case {
+    std::string options, expect;
+  };
+  const std::vector<Case> cases = {
+      {"--size-factor 1e-9", "--size-factor 1e-09 asks for at least"},
+      {"--size-factor 1e-6 --max-quads 0", "of memory on this machine"},
+      {"--size 1e-12", "--size 1e-12 asks for at least"},
+      {"--size 1e-300", "more quads than a double can count"},
+      {"--quads 1e12", "--quads 1e+12 asks for at least 1e+12 quads"},
+      {"--curve-edges 1:2000000000", "--curve-edges 1:2000000000 asks for at least"},
+      {"--face-quads 0:2000000000", "--face-quads 0:2e+09 asks for at least 2e+09 quads"},
+      {"--curve-size 2:1e-9", "--curve-size 2:1e-09 asks for at least"},
+      {"--max-quads 10", "more than --max-quads 10 allows"},
+  };
+  for (const Case& c : cases) {
+    const ExeResult r = run("mesh " + model_ + " -o " + tmp("runaway.msh") + " " + c.options);
+    EXPECT_EQ(r.code, 2) << c.options << ": " << r.err;
+    EXPECT_EQ(lines(r.err), 1) << c.options << ": " << r.err;
+    EXPECT_NE(r.err.find(c.expect), std::string::npos) << c.options << ": " << r.err;
+  }
+  EXPECT_FALSE(fs::exists(tmp("runaway.msh")));
+  // The same bound holds for the other commands that mesh.
+  const ExeResult cf = run("crossfield " + model_ + " --check --size-factor 1e-7");
+  EXPECT_EQ(cf.code, 2) << cf.err;
+  EXPECT_NE(cf.err.find("asks for at least"), std::string::npos) << cf.err;
+}
+
+// More threads than the process may run on are clamped with one line, and the run goes on.
+TEST_F(Qsmesh, ThreadsBeyondTheCoresAreClamped) {
+  const auto [r, json] = mesh_with_stats(
+      model_, "--threads 100000 --size-factor 0.2 --until unstructured", "threads_clamped");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("--threads 100000: this process may run on"), std::string::npos) << r.err;
+  EXPECT_LT(json_number(json, "threads"), 100000);
+  EXPECT_GE(json_number(json, "threads"), 1);
+}
+
+// The example's format follows the extension; other extensions are refused before writing.
+TEST_F(Qsmesh, ExampleFormatFollowsTheExtension) {
+  const ExeResult brep = run("example wing-body -o " + tmp("example_fmt.brep"));
+  ASSERT_EQ(brep.code, 0) << brep.err;
+  EXPECT_EQ(slurp(tmp("example_fmt.brep")).rfind("DBRep_DrawableShape", 0), 0u);
+  const ExeResult step = run("example wing-body -o " + tmp("example_fmt.STP"));
+  ASSERT_EQ(step.code, 0) << step.err;
+  EXPECT_EQ(slurp(tmp("example_fmt.STP")).rfind("ISO-10303-21", 0), 0u);
+  // .brp, which Gmsh reads, is read too.
+  fs::copy_file(tmp("example_fmt.brep"), tmp("example_fmt.brp"),
+                fs::copy_options::overwrite_existing);
+  const ExeResult info = run("info --json " + tmp("example_fmt.brp"));
+  ASSERT_EQ(info.code, 0) << info.err;
+  EXPECT_NE(info.out.find("\"faces\": "), std::string::npos);
+  for (const char* name : {"example_fmt.cgns", "example_fmt.iges"}) {
+    const ExeResult r = run(std::string("example wing-body -o ") + tmp(name));
+    EXPECT_EQ(r.code, 2) << name << ": " << r.err;
+    EXPECT_NE(r.err.find(".brep"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(tmp(name))) << name;
+  }
 }
 
 }  // namespace

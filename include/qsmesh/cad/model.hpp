@@ -5,6 +5,7 @@
 #include <array>
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -128,9 +129,9 @@ class CadModel {
   std::unique_ptr<Impl> impl_;
 };
 
-/// Reads a STEP (.step, .stp), IGES (.iges, .igs) or BREP (.brep) file and builds the topology.
-/// Entity ids follow OpenCASCADE's unique-shape maps (TopExp::MapShapes order), so they are the
-/// same on every rank and every run. Throws InputError for a missing, empty, unreadable or
+/// Reads a STEP (.step, .stp), IGES (.iges, .igs) or BREP (.brep, .brp) file and builds the
+/// topology. Entity ids follow OpenCASCADE's unique-shape maps (TopExp::MapShapes order), so they
+/// are the same on every rank and every run. Throws InputError for a missing, empty, unreadable or
 /// unsupported file, naming the file and the reason.
 [[nodiscard]] CadModel load_cad(const std::string& path, const LoadOptions& options = {});
 
@@ -140,8 +141,17 @@ class CadModel {
 /// the driver calls it once at start-up, before any thread exists.
 void set_kernel_messages(bool quiet);
 
+/// The CAD formats the built-in examples are written in.
+enum class ExampleFormat { Step, Brep };
+
+/// The format a file name asks for by its extension: .step/.stp STEP, .brep/.brp BREP (any case);
+/// nothing for any other name.
+[[nodiscard]] std::optional<ExampleFormat> example_format(const std::string& path);
+
 /// Writes the built-in wing-body example (fuselage of revolution fused with a wing lofted from
-/// NACA 4-digit sections) as STEP to `path`. Throws InputError when the file cannot be written.
-void write_wing_body_example(const std::string& path);
+/// NACA 4-digit sections) to `path`, as `format`, or as example_format(path) when not given.
+/// Throws InputError when the format is unknown or the file cannot be written.
+void write_wing_body_example(const std::string& path,
+                             std::optional<ExampleFormat> format = std::nullopt);
 
 }  // namespace qsmesh::cad

@@ -17,6 +17,7 @@
 // CAD faces and curves without elements get no section, family, BC nor element block.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -75,9 +76,15 @@ enum class Format { kNone, kCgns, kVtu, kMsh, kHdf5 };
 void prepare_output_libraries();
 
 /// For the CLI at start-up, before meshing: throws InputError (one line naming the path) unless the
-/// extension is supported, the path is not a folder, and its folder exists and is writable (and,
-/// for .h5, the file name has no ':', which its XDMF description could not refer to).
+/// extension is supported, the path is not a folder, and its folder exists and a file can be
+/// created in it (probe_create) (and, for .h5, the file name has no ':', which its XDMF description
+/// could not refer to).
 void check_output_path(const std::string& path);
+
+/// Creates and removes an empty hidden file ".<name>.probe.<pid>" beside `path`, to learn before
+/// any work whether a file can be created there at all (permission bits cannot tell: root passes
+/// them and still cannot create a file in /proc). Returns the reason it cannot, or nothing.
+[[nodiscard]] std::optional<std::string> probe_create(const std::string& path);
 
 /// Throws qsmesh::Error unless the arrays of `mesh` agree: per-element CAD ids sized like the
 /// elements and in range, vertex ids in range, one classification per vertex, curve_corners sized
