@@ -33,8 +33,9 @@ std::vector<std::string> outputs_of(const cli::Arguments& a) {
 
 // What a run killed outright (SIGKILL: no handler runs) left beside these outputs, before any
 // work: its temporaries would otherwise stay forever, hidden and megabytes large.
-void clean_leftovers_of(const std::vector<std::string>& outputs, const cli::Arguments& a) {
-  Logger log(std::cerr, a.quiet ? LogLevel::Warning : LogLevel::Info);
+void clean_leftovers_of(const std::vector<std::string>& outputs, const cli::Arguments& a,
+                        std::string prefix) {
+  Logger log(std::cerr, a.quiet ? LogLevel::Warning : LogLevel::Info, std::move(prefix));
   for (const std::string& out : outputs)
     for (const std::string& line :
          io::clean_leftovers(out, io::find_leftovers(out, io::process_exists)))
@@ -78,7 +79,7 @@ int main(int argc, char** argv) {
                            parsed.command == cli::Command::SizeMap;
   if (!distributed) {
     const io::SignalCleanup on_signal(outputs);
-    clean_leftovers_of(outputs, parsed);
+    clean_leftovers_of(outputs, parsed, "");
     try {
       return parsed.command == cli::Command::Info ? cli::run_info(parsed)
                                                   : cli::run_example(parsed);
@@ -99,8 +100,11 @@ int main(int argc, char** argv) {
   // Every rank: mpirun forwards SIGINT and SIGTERM to all of them. After MPI_Init, so that the
   // handler is the one that stays.
   const io::SignalCleanup on_signal(outputs);
-  // Only rank 0 writes, so only rank 0 looks for what an earlier run left.
-  if (root) clean_leftovers_of(outputs, parsed);
+  // Only rank 0 writes, so only rank 0 looks for what an earlier run left (its lines prefixed as
+  // the run's own are).
+  if (root)
+    clean_leftovers_of(outputs, parsed,
+                       parallel::Comm::world().size() > 1 ? "[rank 0] " : std::string());
   try {
     switch (parsed.command) {
       case cli::Command::Mesh:
