@@ -15,7 +15,9 @@ namespace qsmesh::io {
 /// commit_together had moved aside (aside_path) when the output itself is missing, and then die of
 /// that same signal: the default action is restored and the signal raised again, so that a shell
 /// reports $? = 128 + signal, a parent's waitpid sees WIFSIGNALED (a calling shell script stops on
-/// SIGINT, as it should), and mpirun reports the rank as killed by the signal it forwarded.
+/// SIGINT, as it should), and mpirun (Open MPI 4.1), when a rank is signalled directly (a batch
+/// scheduler), reports "exited on signal N" and exits 128 + N itself. mpirun signalled itself
+/// sends the ranks SIGCONT, SIGTERM one second later, SIGKILL one more second later, and exits 1.
 /// A signal that was ignored when the object was made (nohup, a background job of a script) stays
 /// ignored. The destructor puts the earlier actions back.
 ///
