@@ -8,13 +8,52 @@
 #include "commands.hpp"
 #include "qsmesh/cad/model.hpp"
 #include "qsmesh/core/error.hpp"
+#include "qsmesh/core/log.hpp"
+#include "qsmesh/io/atomic_file.hpp"
+#include "qsmesh/io/signal_cleanup.hpp"
 #include "qsmesh/io/writer.hpp"
 #include "qsmesh/parallel/comm.hpp"
+
+namespace {
+
+using namespace qsmesh;
+
+// Every file the command may write: -o (for .h5 also its XDMF description) and --stats. Known
+// right after parsing, so that a signal at any later point finds the names of their temporaries.
+std::vector<std::string> outputs_of(const cli::Arguments& a) {
+  std::vector<std::string> files;
+  if (!a.output.empty()) {
+    files.push_back(a.output);
+    if (io::output_format(a.output) == io::Format::kHdf5)
+      files.push_back(io::xdmf_path_for(a.output));
+  }
+  if (!a.stats.empty()) files.push_back(a.stats);
+  return files;
+}
+
+// What a run killed outright (SIGKILL: no handler runs) left beside these outputs, before any
+// work: its temporaries would otherwise stay forever, hidden and megabytes large.
+void clean_leftovers_of(const std::vector<std::string>& outputs, const cli::Arguments& a,
+                        std::string prefix) {
+  Logger log(std::cerr, a.quiet ? LogLevel::Warning : LogLevel::Info, std::move(prefix));
+  for (const std::string& out : outputs)
+    for (const std::string& line :
+         io::clean_leftovers(out, io::find_leftovers(out, io::process_exists)))
+      log.info(line);
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   using namespace qsmesh;
   io::prepare_output_libraries();
   std::vector<std::string> args(argv + 1, argv + argc);
+  if (args.empty()) {
+    // Nothing asked: a usage error, not a successful run (scripts calling it with an empty
+    // variable must notice).
+    std::cerr << cli::help("");
+    return 2;
+  }
   cli::Arguments parsed;
   try {
     parsed = cli::parse(args);
@@ -32,13 +71,18 @@ int main(int argc, char** argv) {
   }
 
   cad::set_kernel_messages(!parsed.verbose);
+  const std::vector<std::string> outputs = outputs_of(parsed);
 
   // Only the mesh and crossfield commands run distributed; the others need no MPI.
-  const bool distributed = parsed.command == cli::Command::Mesh || parsed.command == cli::Command::CrossField ||
+  const bool distributed = parsed.command == cli::Command::Mesh ||
+                           parsed.command == cli::Command::CrossField ||
                            parsed.command == cli::Command::SizeMap;
   if (!distributed) {
+    const io::SignalCleanup on_signal(outputs);
+    clean_leftovers_of(outputs, parsed, "");
     try {
-      return parsed.command == cli::Command::Info ? cli::run_info(parsed) : cli::run_example(parsed);
+      return parsed.command == cli::Command::Info ? cli::run_info(parsed)
+                                                  : cli::run_example(parsed);
     } catch (const InputError& e) {
       std::cerr << "qsmesh: " << e.what() << "\n";
       return 2;
@@ -53,11 +97,22 @@ int main(int argc, char** argv) {
 
   parallel::MpiSession mpi(&argc, &argv);
   const bool root = parallel::Comm::world().rank() == 0;
+  // Every rank: mpirun forwards SIGINT and SIGTERM to all of them. After MPI_Init, so that the
+  // handler is the one that stays.
+  const io::SignalCleanup on_signal(outputs);
+  // Only rank 0 writes, so only rank 0 looks for what an earlier run left (its lines prefixed as
+  // the run's own are).
+  if (root)
+    clean_leftovers_of(outputs, parsed,
+                       parallel::Comm::world().size() > 1 ? "[rank 0] " : std::string());
   try {
     switch (parsed.command) {
-      case cli::Command::Mesh: return cli::run_mesh(parsed);
-      case cli::Command::CrossField: return cli::run_crossfield(parsed);
-      default: return cli::run_sizemap(parsed);
+      case cli::Command::Mesh:
+        return cli::run_mesh(parsed);
+      case cli::Command::CrossField:
+        return cli::run_crossfield(parsed);
+      default:
+        return cli::run_sizemap(parsed);
     }
   } catch (const InputError& e) {
     // Every rank reads the same input and fails the same way: one line, from rank 0.

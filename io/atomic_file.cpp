@@ -1,11 +1,15 @@
 #include "qsmesh/io/atomic_file.hpp"
 
+#include <signal.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <charconv>
 #include <cstring>
 #include <filesystem>
+#include <limits>
+#include <optional>
 #include <system_error>
 
 #include "qsmesh/core/error.hpp"
@@ -16,24 +20,108 @@ namespace fs = std::filesystem;
 
 namespace {
 
-// "<dir>/.<name>.<tag>.<pid>" for `path`: in the same folder, so that rename() never crosses file
-// systems; the pid keeps two processes writing the same name apart.
-std::string hidden_sibling(const std::string& path, const char* tag) {
-  const fs::path p(path);
+constexpr const char* kTemporaryTag = "tmp";
+constexpr const char* kAsideTag = "old";
+
+// ".<name>.<tag>." of a file name: the hidden siblings of one output differ only by the pid after
+// it.
+std::string hidden_prefix(const std::string& filename, const char* tag) {
   // Appended rather than "." + ...: GCC 12 reports a false -Wrestrict on that concatenation.
   std::string name = ".";
-  name += p.filename().string();
+  name += filename;
   name += '.';
   name += tag;
   name += '.';
-  name += std::to_string(::getpid());
-  return (p.parent_path() / name).string();
+  return name;
+}
+
+// "<dir>/.<name>.<tag>.<pid>" for `path`: in the same folder, so that rename() never crosses file
+// systems; the pid keeps two processes writing the same name apart.
+std::string hidden_sibling(const std::string& path, const char* tag, long pid) {
+  const fs::path p(path);
+  return (p.parent_path() / (hidden_prefix(p.filename().string(), tag) + std::to_string(pid)))
+      .string();
+}
+
+// The pid of `filename` when it is `prefix` followed by decimal digits only.
+std::optional<long> pid_after(const std::string& filename, const std::string& prefix) {
+  if (filename.size() <= prefix.size() || filename.compare(0, prefix.size(), prefix) != 0)
+    return std::nullopt;
+  const char* first = filename.data() + prefix.size();
+  const char* last = filename.data() + filename.size();
+  long pid = 0;
+  const auto r = std::from_chars(first, last, pid);
+  if (r.ec != std::errc() || r.ptr != last || *first < '0' || *first > '9') return std::nullopt;
+  return pid;
 }
 
 }  // namespace
 
+std::string temporary_path(const std::string& path, long pid) {
+  return hidden_sibling(path, kTemporaryTag, pid);
+}
+
+std::string aside_path(const std::string& path, long pid) {
+  return hidden_sibling(path, kAsideTag, pid);
+}
+
+std::vector<LeftoverFile> find_leftovers(const std::string& output,
+                                         const std::function<bool(long)>& is_alive) {
+  const fs::path p(output);
+  const std::string filename = p.filename().string();
+  std::vector<LeftoverFile> found;
+  if (filename.empty()) return found;
+  const std::string temp_prefix = hidden_prefix(filename, kTemporaryTag);
+  const std::string aside_prefix = hidden_prefix(filename, kAsideTag);
+  const fs::path dir = p.parent_path().empty() ? fs::path(".") : p.parent_path();
+  std::error_code ec;
+  fs::directory_iterator it(dir, ec);
+  // A folder that cannot be read has nothing this process could clean either.
+  for (; !ec && it != fs::directory_iterator(); it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    bool aside = false;
+    std::optional<long> pid = pid_after(name, temp_prefix);
+    if (!pid) {
+      pid = pid_after(name, aside_prefix);
+      aside = true;
+    }
+    if (!pid || is_alive(*pid)) continue;
+    found.push_back({(p.parent_path() / name).string(), *pid, aside});
+  }
+  std::sort(found.begin(), found.end(),
+            [](const LeftoverFile& a, const LeftoverFile& b) { return a.path < b.path; });
+  return found;
+}
+
+bool process_exists(long pid) {
+  if (pid <= 0 || pid > std::numeric_limits<pid_t>::max()) return false;
+  return ::kill(static_cast<pid_t>(pid), 0) == 0 || errno != ESRCH;
+}
+
+std::vector<std::string> clean_leftovers(const std::string& output,
+                                         const std::vector<LeftoverFile>& leftovers) {
+  std::vector<std::string> lines;
+  for (const LeftoverFile& f : leftovers) {
+    const std::string of_run = " of an interrupted run (process " + std::to_string(f.pid) + ")";
+    std::error_code ec;
+    if (f.aside && !fs::exists(output, ec) && !ec) {
+      fs::rename(f.path, output, ec);
+      lines.push_back(ec ? "could not put back " + f.path + of_run + " as " + output + ": " +
+                               ec.message()
+                         : "put back " + output + " from " + f.path + of_run);
+      continue;
+    }
+    fs::remove(f.path, ec);
+    const char* what = f.aside ? "set-aside copy " : "temporary ";
+    lines.push_back(ec ? "could not remove stale " + std::string(what) + f.path + of_run + ": " +
+                             ec.message()
+                       : "removed stale " + std::string(what) + f.path + of_run);
+  }
+  return lines;
+}
+
 AtomicFile::AtomicFile(std::string path)
-    : path_(std::move(path)), temp_(hidden_sibling(path_, "tmp")) {
+    : path_(std::move(path)), temp_(temporary_path(path_, ::getpid())) {
   std::error_code ec;
   fs::remove(fs::path(temp_), ec);
 }
@@ -58,7 +146,7 @@ void AtomicFile::commit() {
 
 void commit_together(AtomicFile& first, AtomicFile& second) {
   std::error_code ec;
-  const std::string aside = hidden_sibling(first.path(), "old");
+  const std::string aside = aside_path(first.path(), ::getpid());
   const bool had_earlier = fs::exists(first.path(), ec);
   if (had_earlier) {
     fs::rename(first.path(), aside, ec);
