@@ -561,10 +561,26 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
                                             groups.face2quads[static_cast<std::size_t>(f)].size());
     }
   }
-  // A block edge is free (a BC) when no other block side and no element of the unstructured zone
-  // has it.
-  auto is_free = [&](std::uint64_t e) {
-    return edge_uses.at(e).size() == 1 && unstructured_edges.count(e) == 0;
+  // Which block sides a side edge is joined to. On a CAD curve: every other block side along it,
+  // and the unstructured zone when one of its faces has the edge; where three or more faces border
+  // the curve (non-manifold), every pair of sides at the edge is thus joined, once each way. Off
+  // the curves only sides of the same face: two faces on one surface with one boundary (a face
+  // given twice) may have edges between the same boundary vertices, but they meet on their curves
+  // only.
+  const std::unordered_map<std::uint64_t, LO> edge_curve = mesh::bar_curves(mesh);
+  auto joins = [&](GO k, std::uint64_t e, const Use& u) {
+    return edge_curve.count(e) > 0 || layout.blocks[static_cast<std::size_t>(u.block)].face ==
+                                          layout.blocks[static_cast<std::size_t>(k)].face;
+  };
+  auto abuts_unstructured = [&](std::uint64_t e) {
+    return edge_curve.count(e) > 0 && unstructured_edges.count(e) > 0;
+  };
+  // A block edge (of block k, at side s, position p) is free (a BC) when no other block side it
+  // joins and no element of the unstructured zone has it.
+  auto is_free = [&](GO k, int s, LO p, std::uint64_t e) {
+    for (const Use& u : edge_uses.at(e))
+      if (!(u.block == k && u.side == s && u.p == p) && joins(k, e, u)) return false;
+    return !abuts_unstructured(e);
   };
   // What the unstructured zone's connectivity to the blocks needs: per run of block side edges on
   // it, the block and the points' (i, j) and unstructured ids, in the same order.
@@ -591,13 +607,13 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
   }
   // Curves with free block edges (no other block across: an open shell's border, a cut plane) get a
   // family and BCs on those edges, as in write_cgns.
-  const std::unordered_map<std::uint64_t, LO> edge_curve = mesh::bar_curves(mesh);
   {
     std::vector<char> free_curve(static_cast<std::size_t>(mesh.num_cad_curves), 0);
-    for (const auto& [k, uses] : edge_uses) {
-      if (!is_free(k)) continue;
-      const auto it = edge_curve.find(k);
-      if (it != edge_curve.end()) free_curve[static_cast<std::size_t>(it->second)] = 1;
+    for (const auto& [e, uses] : edge_uses) {
+      const auto it = edge_curve.find(e);
+      if (it == edge_curve.end()) continue;
+      for (const Use& u : uses)
+        if (is_free(u.block, u.side, u.p, e)) free_curve[static_cast<std::size_t>(it->second)] = 1;
     }
     for (LO c = 0; c < mesh.num_cad_curves; ++c) {
       if (!free_curve[static_cast<std::size_t>(c)]) continue;
@@ -668,10 +684,11 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
       std::vector<Run> open, done;
       for (LO p = 0; p < side_edges(b, s); ++p) {
         std::vector<Run> next;
-        for (const Use& u : edge_uses.at(edge_at(p))) {
+        const std::uint64_t e = edge_at(p);
+        for (const Use& u : edge_uses.at(e)) {
           // The edge itself; another position of this same side (a side running along both
           // banks of a seam) is an interface of the block with itself.
-          if (u.block == k && u.side == s && u.p == p) continue;
+          if ((u.block == k && u.side == s && u.p == p) || !joins(k, e, u)) continue;
           auto it = std::find_if(open.begin(), open.end(), [&](const Run& r) {
             if (r.block != u.block || r.side != u.side || r.p1 != p - 1) return false;
             const LO step = r.p1 > r.p0 ? (r.d1 - r.d0) / (r.p1 - r.p0) : u.p - r.d1;
@@ -736,8 +753,7 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
       // Runs of side edges on the unstructured zone: a GridConnectivity (Abutting1to1, vertex
       // ranges here, vertex lists there), written as cgio nodes beside the 1-to-1 ones.
       for_each_run(
-          side_edges(b, s),
-          [&](LO q) { return unstructured_edges.count(edge_at(q)) > 0 ? LO{0} : kNoIndex; },
+          side_edges(b, s), [&](LO q) { return abuts_unstructured(edge_at(q)) ? LO{0} : kNoIndex; },
           [&](LO p, LO q, LO) {
             Abutment a{k, {}, {}};
             for (LO x = p; x <= q + 1; ++x) {
@@ -756,7 +772,7 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
       // Free edges: one BC per run of them on one curve.
       auto curve_of_free = [&](LO q) -> LO {
         const std::uint64_t e = edge_at(q);
-        if (!is_free(e)) return kNoIndex;
+        if (!is_free(k, s, q, e)) return kNoIndex;
         const auto it = edge_curve.find(e);
         return it == edge_curve.end() ? kNoIndex : it->second;
       };

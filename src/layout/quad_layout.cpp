@@ -17,11 +17,33 @@ namespace qsmesh::layout {
 
 namespace {
 
+// The edges are those of each face: a face given twice in the CAD (the same surface and boundary)
+// may mesh an edge between the same two boundary vertices as its copy does, and each copy's
+// blocks are cut along its own traces.
+struct FaceEdge {
+  std::uint64_t edge;  // mesh::edge_key
+  LO face;
+  bool operator==(const FaceEdge&) const = default;
+};
+struct FaceEdgeHash {
+  std::size_t operator()(const FaceEdge& e) const {
+    return std::hash<std::uint64_t>()(e.edge ^
+                                      (static_cast<std::uint64_t>(e.face) * 0x9E3779B97F4A7C15ULL));
+  }
+};
+
 struct EdgeInfo {
   std::array<GO, 2> quads{-1, -1};
-  int count = 0;     // quads using the edge (2 inside a face; 1 on a free boundary)
+  int count = 0;     // quads of the face using the edge (2 inside it; 1 on a free boundary)
   bool bar = false;  // on a CAD curve
   bool traced = false;
+};
+
+// A trace start: the edge (v, w) of face `face`.
+struct Start {
+  GO v, w;
+  LO face;
+  auto operator<=>(const Start&) const = default;
 };
 
 // A block with its own vertex grid and its quads, as the patches give them and merging joins them.
@@ -84,15 +106,13 @@ class Layouter {
     for (GO q = 0; q < nq; ++q) {
       const auto& quad = m.quads[static_cast<std::size_t>(q)];
       for (int k = 0; k < 4; ++k) {
-        EdgeInfo& e = edges_[mesh::edge_key(quad[k], quad[(k + 1) % 4])];
+        EdgeInfo& e = edges_[edge(quad[k], quad[(k + 1) % 4], q)];
         if (e.count < 2) e.quads[static_cast<std::size_t>(e.count)] = q;
         ++e.count;
       }
     }
-    for (const auto& b : m.bars) {
-      auto it = edges_.find(mesh::edge_key(b[0], b[1]));
-      if (it != edges_.end()) it->second.bar = true;
-    }
+    const std::unordered_map<std::uint64_t, LO> on_curve = mesh::bar_curves(m);
+    for (auto& [k, e] : edges_) e.bar = on_curve.count(k.edge) > 0;
   }
 
   /// 1 for the faces with triangles: they get no block.
@@ -115,11 +135,11 @@ class Layouter {
                4;
   }
 
-  // Trace starts (v, w): the edges leaving irregular interior vertices, and the interior edges of
-  // the sides of other than two quads of CAD corners and curve vertices (poles included: their fan
-  // is one side). Restricted to the faces in `faces` when given.
-  [[nodiscard]] std::vector<std::pair<GO, GO>> starts(const std::vector<char>* faces) const {
-    std::vector<std::pair<GO, GO>> out;
+  // Trace starts (v, w) in their face: the edges leaving irregular interior vertices, and the
+  // interior edges of the sides of other than two quads of CAD corners and curve vertices (poles
+  // included: their fan is one side). Restricted to the faces in `faces` when given.
+  [[nodiscard]] std::vector<Start> starts(const std::vector<char>* faces) const {
+    std::vector<Start> out;
     std::vector<GO> quads, parent;
     for (GO v = 0; v < nv_; ++v) {
       const auto& c = m_.vclass[static_cast<std::size_t>(v)];
@@ -136,7 +156,7 @@ class Layouter {
       std::vector<std::pair<GO, std::size_t>> interior_edges;  // (w, quad index)
       for (std::size_t a = 0; a < quads.size(); ++a) {
         for (GO w : neighbours_in_quad(quads[a], v)) {
-          const EdgeInfo& e = edges_.at(mesh::edge_key(v, w));
+          const EdgeInfo& e = edges_.at(edge(v, w, quads[a]));
           if (!interior(e)) continue;
           interior_edges.emplace_back(w, a);
           const GO other = e.quads[0] == quads[a] ? e.quads[1] : e.quads[0];
@@ -152,10 +172,9 @@ class Layouter {
         const bool irregular_side =
             side_size[static_cast<std::size_t>(find(static_cast<GO>(a)))] != 2;
         if (c.dim == 2 || irregular_side) {
-          if (faces != nullptr && (*faces)[static_cast<std::size_t>(
-                                      m_.quad_face[static_cast<std::size_t>(quads[a])])] == 0)
-            continue;
-          out.emplace_back(v, w);
+          const LO f = m_.quad_face[static_cast<std::size_t>(quads[a])];
+          if (faces != nullptr && (*faces)[static_cast<std::size_t>(f)] == 0) continue;
+          out.push_back({v, w, f});
         }
       }
     }
@@ -165,18 +184,19 @@ class Layouter {
   }
 
   // Runs the traces from `from`, all advancing one edge per round in order (see the header).
-  void trace(const std::vector<std::pair<GO, GO>>& from, bool motorcycle) {
+  void trace(const std::vector<Start>& from, bool motorcycle) {
     std::vector<char> reached(static_cast<std::size_t>(nv_), 0);
     struct State {
       GO prev, cur;
+      LO face;
     };
     std::vector<State> live;
-    for (const auto& [v, w] : from) {
-      EdgeInfo& e = edges_.at(mesh::edge_key(v, w));
+    for (const auto& [v, w, f] : from) {
+      EdgeInfo& e = edges_.at({mesh::edge_key(v, w), f});
       if (motorcycle && e.traced) continue;
       e.traced = true;
       reached[static_cast<std::size_t>(v)] = 1;
-      live.push_back({v, w});
+      live.push_back({v, w, f});
     }
     std::vector<State> next;
     while (!live.empty()) {
@@ -185,11 +205,11 @@ class Layouter {
         if (!regular_interior(s.cur)) continue;
         if (motorcycle && reached[static_cast<std::size_t>(s.cur)]) continue;
         reached[static_cast<std::size_t>(s.cur)] = 1;
-        const GO after = straight_on(s.cur, s.prev);
-        EdgeInfo& e = edges_.at(mesh::edge_key(s.cur, after));
+        const GO after = straight_on(s.cur, s.prev, s.face);
+        EdgeInfo& e = edges_.at({mesh::edge_key(s.cur, after), s.face});
         if (!motorcycle && e.traced) continue;  // the rest of this line is traced already
         e.traced = true;
-        next.push_back({s.cur, after});
+        next.push_back({s.cur, after, s.face});
       }
       live.swap(next);
     }
@@ -197,9 +217,7 @@ class Layouter {
 
   void clear_traces(const std::vector<char>& faces) {
     for (auto& [k, e] : edges_)
-      if (e.count >= 1 &&
-          faces[static_cast<std::size_t>(m_.quad_face[static_cast<std::size_t>(e.quads[0])])])
-        e.traced = false;
+      if (faces[static_cast<std::size_t>(k.face)]) e.traced = false;
   }
 
   // Patches of the quads of the faces in `faces`, as grids appended to `out` in the order of their
@@ -222,7 +240,7 @@ class Layouter {
         members.push_back(q);
         const auto& quad = m_.quads[static_cast<std::size_t>(q)];
         for (int k = 0; k < 4; ++k) {
-          const EdgeInfo& e = edges_.at(mesh::edge_key(quad[k], quad[(k + 1) % 4]));
+          const EdgeInfo& e = edges_.at({mesh::edge_key(quad[k], quad[(k + 1) % 4]), f});
           if (!crossable(e)) continue;
           const GO other = e.quads[0] == q ? e.quads[1] : e.quads[0];
           if (patch[static_cast<std::size_t>(other)] >= 0) continue;
@@ -243,6 +261,11 @@ class Layouter {
   }
 
  private:
+  // The edge (a, b) in the face of quad q.
+  [[nodiscard]] FaceEdge edge(GO a, GO b, GO q) const {
+    return {mesh::edge_key(a, b), m_.quad_face[static_cast<std::size_t>(q)]};
+  }
+
   [[nodiscard]] bool crossable(const EdgeInfo& e) const { return interior(e) && !e.traced; }
 
   [[nodiscard]] std::array<GO, 2> neighbours_in_quad(GO q, GO v) const {
@@ -253,9 +276,10 @@ class Layouter {
     return {};
   }
 
-  // At a valence-4 vertex c reached from prev: the vertex across c on the same grid line.
-  [[nodiscard]] GO straight_on(GO c, GO prev) const {
-    const EdgeInfo& e = edges_.at(mesh::edge_key(c, prev));
+  // At a valence-4 vertex c of face `face` reached from prev: the vertex across c on the same grid
+  // line.
+  [[nodiscard]] GO straight_on(GO c, GO prev, LO face) const {
+    const EdgeInfo& e = edges_.at({mesh::edge_key(c, prev), face});
     std::array<GO, 3> side{prev, -1, -1};
     for (int s = 0; s < 2; ++s) {
       const auto n = neighbours_in_quad(e.quads[static_cast<std::size_t>(s)], c);
@@ -281,7 +305,7 @@ class Layouter {
   [[nodiscard]] std::optional<Grid> grid(const std::vector<GO>& members, LO face) const {
     auto in_patch = [&](GO q) { return std::binary_search(members.begin(), members.end(), q); };
     auto across = [&](GO q, GO a, GO b) -> GO {  // the patch quad across edge (a, b) of q, or -1
-      const EdgeInfo& e = edges_.at(mesh::edge_key(a, b));
+      const EdgeInfo& e = edges_.at({mesh::edge_key(a, b), face});
       if (!crossable(e)) return -1;
       const GO other = e.quads[0] == q ? e.quads[1] : e.quads[0];
       return in_patch(other) ? other : -1;
@@ -352,7 +376,7 @@ class Layouter {
   GO nv_;
   std::vector<char> face_unblocked_;
   std::vector<GO> v2q_offsets_, v2q_;
-  std::unordered_map<std::uint64_t, EdgeInfo> edges_;
+  std::unordered_map<FaceEdge, EdgeInfo, FaceEdgeHash> edges_;
 };
 
 // Merges blocks of one face that share a whole side, not along a CAD curve, while any do: the

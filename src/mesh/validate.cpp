@@ -59,11 +59,27 @@ ConformityReport check_conformity(const SurfaceMesh& mesh, const cad::CadModel& 
       if (static_cast<int>(list.size()) != curve_uses[bar->second]) ++r.curve_edges_bad;
       continue;
     }
-    if (list.size() != 2 || list[0].face != list[1].face) {
-      ++r.interior_edges_bad;
-      continue;
+    // Off the curves, each face that has the edge has it twice, traversed both ways. Two faces may
+    // both have an edge between the same two curve vertices (a face given twice in the CAD, or
+    // faces sharing two curves), each inside itself; faces meeting at it, once each, do not
+    // conform.
+    std::vector<EdgeUse> sorted = list;
+    std::sort(sorted.begin(), sorted.end(),
+              [](const EdgeUse& x, const EdgeUse& y) { return x.face < y.face; });
+    bool bad = false, misoriented = false;
+    for (std::size_t i = 0; i < sorted.size(); i += 2) {
+      if (i + 1 >= sorted.size() || sorted[i].face != sorted[i + 1].face ||
+          (i + 2 < sorted.size() && sorted[i + 2].face == sorted[i].face)) {
+        bad = true;
+        break;
+      }
+      misoriented = misoriented || sorted[i].forward == sorted[i + 1].forward;
     }
-    if (list[0].forward == list[1].forward) ++r.orientation_bad;
+    if (bad) {
+      ++r.interior_edges_bad;
+    } else if (misoriented) {
+      ++r.orientation_bad;
+    }
   }
   for (LO f = 0; f < model.num_faces(); ++f)
     if (per_face[f] == 0) ++r.faces_without_elements;

@@ -8,7 +8,12 @@
 // - every BC lies on a block side, on no edge another block side or an unstructured element also
 //   has (that would be a wall inside the surface where a connection is missing);
 // - every edge of every block side is covered exactly once, by an interface, a connectivity or a
-//   BC (a side edge nothing covers would be an open boundary inside the surface).
+//   BC (a side edge nothing covers would be an open boundary inside the surface); except where
+//   m > 2 zone sides meet at one edge (a non-manifold CAD curve: three or more faces along it):
+//   there each block side edge is covered m - 1 times, once by each of the other sides and by no
+//   BC, every other side having the same partners at that edge (the interfaces at an edge join
+//   every pair of its sides, each pair once, both ways: edge by edge, this is also what makes two
+//   sides covered once each a reciprocal pair).
 // Every cgnslib return code is checked. Header-only; the test must link cgnslib (qsmesh_cgns).
 #pragma once
 
@@ -59,8 +64,9 @@ inline BlockFileSummary check_block_file(const std::string& path) {
     bool structured = false;
     cgsize_t ni = 0, nj = 0;  // vertices along i and j (structured); ni vertices (unstructured)
     std::array<std::vector<double>, 3> xyz;
-    // Side edges covered, per side (0: j = 1, 1: i = ni, 2: j = nj, 3: i = 1), by position.
-    std::array<std::vector<int>, 4> covered;
+    // Side edges covered, per side (0: j = 1, 1: i = ni, 2: j = nj, 3: i = 1), by position; and
+    // by BCs only.
+    std::array<std::vector<int>, 4> covered, walls;
   };
   std::vector<Zone> zones;
   std::map<std::string, int> by_name;
@@ -84,9 +90,11 @@ inline BlockFileSummary check_block_file(const std::string& path) {
       n = static_cast<std::size_t>(zone.ni * zone.nj);
       out.block_quads += static_cast<std::int64_t>(size[2]) * size[3];
       if (size[2] != size[0] - 1 || size[3] != size[1] - 1) err << name << ": cell sizes; ";
-      for (int s = 0; s < 4; ++s)
+      for (int s = 0; s < 4; ++s) {
         zone.covered[static_cast<std::size_t>(s)].assign(
             static_cast<std::size_t>(s % 2 == 0 ? zone.ni - 1 : zone.nj - 1), 0);
+        zone.walls[static_cast<std::size_t>(s)] = zone.covered[static_cast<std::size_t>(s)];
+      }
     } else {
       ++out.unstructured_zones;
       zone.ni = size[0];
@@ -106,18 +114,20 @@ inline BlockFileSummary check_block_file(const std::string& path) {
     const auto k = static_cast<std::size_t>(zone.structured ? (j - 1) * zone.ni + (i - 1) : i - 1);
     return std::array<double, 3>{zone.xyz[0][k], zone.xyz[1][k], zone.xyz[2][k]};
   };
-  // Marks the side edges of the side range r (one index constant) of a structured zone as covered.
-  auto cover = [&](Zone& zone, const cgsize_t r[4], const std::string& what) {
-    int side = -1;
-    if (r[1] == r[3] && r[1] == 1)
-      side = 0;
-    else if (r[0] == r[2] && r[0] == zone.ni)
-      side = 1;
-    else if (r[1] == r[3] && r[1] == zone.nj)
-      side = 2;
-    else if (r[0] == r[2] && r[0] == 1)
-      side = 3;
-    if (side < 0 || (r[0] == r[2] && r[1] == r[3])) {
+  // The side of a structured zone that the range r (one index constant) lies on, or -1.
+  auto side_of = [](const Zone& zone, const cgsize_t r[4]) {
+    if (r[0] == r[2] && r[1] == r[3]) return -1;
+    if (r[1] == r[3] && r[1] == 1) return 0;
+    if (r[0] == r[2] && r[0] == zone.ni) return 1;
+    if (r[1] == r[3] && r[1] == zone.nj) return 2;
+    if (r[0] == r[2] && r[0] == 1) return 3;
+    return -1;
+  };
+  // Marks the side edges of the side range r (one index constant) of a structured zone as covered
+  // (by a BC when `wall`).
+  auto cover = [&](Zone& zone, const cgsize_t r[4], const std::string& what, bool wall = false) {
+    const int side = side_of(zone, r);
+    if (side < 0) {
       err << zone.name << "/" << what << ": not a side range; ";
       return false;
     }
@@ -130,8 +140,30 @@ inline BlockFileSummary check_block_file(const std::string& path) {
         return false;
       }
       ++c[static_cast<std::size_t>(p - 1)];
+      if (wall) ++zone.walls[static_cast<std::size_t>(side)][static_cast<std::size_t>(p - 1)];
     }
     return true;
+  };
+  // The side edges each block side edge is joined to, (zone, side, 0-based position); the
+  // unstructured zone's edges as (zone, -1, 0). Checked at the end: each edge's partners are
+  // distinct, and each block partner has the same partners, with this edge for itself.
+  using EdgeRef = std::tuple<int, int, cgsize_t>;
+  std::map<EdgeRef, std::vector<EdgeRef>> partners;
+  // The edges of side range r of zone z, each with its two end points (i, j), in range order.
+  auto range_edges = [](const cgsize_t r[4], const auto& f) {
+    const int t = r[0] == r[2] ? 1 : 0;  // the index moving along the range
+    const cgsize_t step = r[t + 2] >= r[t] ? 1 : -1;
+    for (cgsize_t x = r[t]; x != r[t + 2]; x += step) {
+      std::array<cgsize_t, 2> a{r[0], r[1]}, b{r[0], r[1]};
+      a[static_cast<std::size_t>(t)] = x;
+      b[static_cast<std::size_t>(t)] = x + step;
+      f(a, b);
+    }
+  };
+  // The side edge between the points a and b of side s of a structured zone.
+  auto edge_ref = [](int z, int s, std::array<cgsize_t, 2> a, std::array<cgsize_t, 2> b) {
+    const auto t = static_cast<std::size_t>(s % 2);
+    return EdgeRef{z, s, std::min(a[t], b[t]) - 1};
   };
   // What cg_conn_info says of each general connectivity of zone z, with its index (those it
   // cannot read are reported and left out).
@@ -203,7 +235,7 @@ inline BlockFileSummary check_block_file(const std::string& path) {
       }
       if (!ok(cg_boco_read(fn, 1, z, bc, r, nullptr), "cg_boco_read")) continue;
       ++out.boundary_conditions;
-      if (!cover(zone, r, bname)) continue;
+      if (!cover(zone, r, bname, true)) continue;
       const int t = r[0] == r[2] ? 1 : 0;  // the index moving along the BC
       for (cgsize_t x = std::min(r[t], r[t + 2]); x < std::max(r[t], r[t + 2]); ++x) {
         const cgsize_t i0 = t == 0 ? x : r[0], j0 = t == 0 ? r[1] : x;
@@ -248,6 +280,15 @@ inline BlockFileSummary check_block_file(const std::string& path) {
       const auto end = donor_of(range[2], range[3]);
       if (end[0] != donor[2] || end[1] != donor[3])
         err << zone.name << "/" << cname << ": PointRangeDonor's end is not the range's image; ";
+      const int my_side = side_of(zone, range), donor_side = side_of(dz, donor);
+      if (my_side < 0 || donor_side < 0) {
+        err << zone.name << "/" << cname << ": not between two side ranges; ";
+        continue;
+      }
+      range_edges(range, [&](std::array<cgsize_t, 2> a, std::array<cgsize_t, 2> b) {
+        partners[edge_ref(z - 1, my_side, a, b)].push_back(
+            edge_ref(it->second, donor_side, donor_of(a[0], a[1]), donor_of(b[0], b[1])));
+      });
       const cgsize_t di = range[2] >= range[0] ? 1 : -1, dj = range[3] >= range[1] ? 1 : -1;
       for (cgsize_t i = range[0];; i += di) {
         for (cgsize_t j = range[1];; j += dj) {
@@ -280,6 +321,9 @@ inline BlockFileSummary check_block_file(const std::string& path) {
       if (!ok(cg_conn_read(fn, 1, z, c, range, CGNS_ENUMV(Integer), ids.data()), "cg_conn_read"))
         continue;
       if (!cover(zone, range, cname)) continue;
+      range_edges(range, [&](std::array<cgsize_t, 2> a, std::array<cgsize_t, 2> b) {
+        partners[edge_ref(z - 1, side_of(zone, range), a, b)].push_back({it->second, -1, 0});
+      });
       const Zone& dz = zones[static_cast<std::size_t>(it->second)];
       const cgsize_t di = range[2] >= range[0] ? 1 : -1, dj = range[3] >= range[1] ? 1 : -1;
       std::vector<std::array<cgsize_t, 2>> ij;
@@ -398,13 +442,47 @@ inline BlockFileSummary check_block_file(const std::string& path) {
     if (links.count({b, rb, a, ra}) == 0)
       err << zones[static_cast<std::size_t>(a)].name << ": an interface to "
           << zones[static_cast<std::size_t>(b)].name << " has no reciprocal; ";
-  for (const Zone& zone : zones)
+  // Edge by edge: partners distinct, and every block partner joined to the same others.
+  for (auto& [x, list] : partners) {
+    std::vector<EdgeRef> mine = list;
+    std::sort(mine.begin(), mine.end());
+    const std::string where = zones[static_cast<std::size_t>(std::get<0>(x))].name + ": side " +
+                              std::to_string(std::get<1>(x)) + " edge " +
+                              std::to_string(std::get<2>(x) + 1);
+    if (std::adjacent_find(mine.begin(), mine.end()) != mine.end())
+      err << where << " joined twice to the same edge; ";
+    for (const EdgeRef& y : mine) {
+      if (std::get<1>(y) < 0) continue;  // the unstructured zone: checked both ways above
+      const auto found = partners.find(y);
+      std::vector<EdgeRef> theirs =
+          found == partners.end() ? std::vector<EdgeRef>{} : found->second;
+      std::vector<EdgeRef> expected = mine;
+      expected.erase(std::find(expected.begin(), expected.end(), y));
+      expected.push_back(x);
+      std::sort(theirs.begin(), theirs.end());
+      std::sort(expected.begin(), expected.end());
+      if (theirs != expected)
+        err << where << ": the side edge it is joined to in "
+            << zones[static_cast<std::size_t>(std::get<0>(y))].name
+            << " is not joined to the same edges; ";
+    }
+  }
+  // Once, by one interface, connectivity or BC; or, where m > 2 sides meet, m - 1 times, by the
+  // other sides (the partners checked above) and no BC.
+  for (std::size_t z = 0; z < zones.size(); ++z) {
+    const Zone& zone = zones[z];
     for (int s = 0; s < 4; ++s)
       for (std::size_t p = 0; p < zone.covered[static_cast<std::size_t>(s)].size(); ++p) {
         const int c = zone.covered[static_cast<std::size_t>(s)][p];
-        if (c != 1)
+        if (c == 1) continue;
+        const auto found = partners.find({static_cast<int>(z), s, static_cast<cgsize_t>(p)});
+        const bool joined_to_each_other_side =
+            c > 1 && zone.walls[static_cast<std::size_t>(s)][p] == 0 && found != partners.end() &&
+            static_cast<int>(found->second.size()) == c;
+        if (!joined_to_each_other_side)
           err << zone.name << ": side " << s << " edge " << p + 1 << " covered " << c << " times; ";
       }
+  }
   ok(cg_close(fn), "cg_close");
   out.error = err.str();
   return out;

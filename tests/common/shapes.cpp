@@ -4,21 +4,28 @@
 #include <BRepBuilderAPI_MakeEdge.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepBuilderAPI_MakePolygon.hxx>
+#include <BRepBuilderAPI_MakeVertex.hxx>
 #include <BRepBuilderAPI_MakeWire.hxx>
 #include <BRepFilletAPI_MakeFillet.hxx>
 #include <BRepPrimAPI_MakeBox.hxx>
 #include <BRepPrimAPI_MakeCylinder.hxx>
 #include <BRepPrimAPI_MakeSphere.hxx>
 #include <BRepTools.hxx>
+#include <BRep_Builder.hxx>
+#include <BRep_Tool.hxx>
 #include <GC_MakeArcOfCircle.hxx>
 #include <IFSelect_ReturnStatus.hxx>
 #include <STEPControl_Writer.hxx>
 #include <TopExp_Explorer.hxx>
 #include <TopoDS.hxx>
+#include <TopoDS_Iterator.hxx>
+#include <TopoDS_Shell.hxx>
+#include <TopoDS_Vertex.hxx>
 #include <TopoDS_Wire.hxx>
 #include <cmath>
 #include <gp_Ax2.hxx>
 #include <stdexcept>
+#include <string_view>
 #include <vector>
 
 namespace qsmesh::test {
@@ -27,6 +34,26 @@ namespace {
 std::string write(const TopoDS_Shape& s, const std::string& path) {
   if (!BRepTools::Write(s, path.c_str())) throw std::runtime_error("cannot write " + path);
   return path;
+}
+
+// BREP, or STEP when the path ends in .step or .stp.
+std::string write_brep_or_step(const TopoDS_Shape& s, const std::string& path) {
+  const std::string_view p(path);
+  if (!p.ends_with(".step") && !p.ends_with(".stp")) return write(s, path);
+  STEPControl_Writer w;
+  if (w.Transfer(s, STEPControl_AsIs) != IFSelect_RetDone ||
+      w.Write(path.c_str()) != IFSelect_RetDone)
+    throw std::runtime_error("cannot write " + path);
+  return path;
+}
+
+// A new face entity on the surface of `f`, bounded by its wires (hence the same edges): what a
+// STEP file that gives a face twice holds.
+TopoDS_Face given_again(const TopoDS_Face& f) {
+  TopoDS_Face copy = TopoDS::Face(f.EmptyCopied());
+  BRep_Builder builder;
+  for (TopoDS_Iterator w(f); w.More(); w.Next()) builder.Add(copy, w.Value());
+  return copy;
 }
 
 // The planar face bounded by `wire`, written as BREP; `what` names the shape in errors.
@@ -138,6 +165,68 @@ std::string write_filleted_box(const std::string& path) {
       w.Write(path.c_str()) != IFSelect_RetDone)
     throw std::runtime_error("cannot write " + path);
   return path;
+}
+
+std::string write_t_of_three_plates(const std::string& path) {
+  // Vertices and edges are made once and shared, so the three faces hold the same TopoDS edge.
+  auto vertex = [](double x, double y, double z) {
+    return BRepBuilderAPI_MakeVertex(gp_Pnt(x, y, z)).Vertex();
+  };
+  const TopoDS_Vertex a0 = vertex(0, 0, 0), a1 = vertex(0, 2, 0), m0 = vertex(4, 0, 0),
+                      m1 = vertex(4, 2, 0), b0 = vertex(8, 0, 0), b1 = vertex(8, 2, 0),
+                      t0 = vertex(4, 0, 3), t1 = vertex(4, 2, 3);
+  auto edge = [](const TopoDS_Vertex& p, const TopoDS_Vertex& q) {
+    return BRepBuilderAPI_MakeEdge(p, q).Edge();
+  };
+  const TopoDS_Edge spine = edge(m0, m1);
+  auto face = [&](const std::vector<TopoDS_Edge>& edges) {
+    BRepBuilderAPI_MakeWire wire;
+    for (const TopoDS_Edge& e : edges) wire.Add(e);
+    if (!wire.IsDone()) throw std::runtime_error("T plate wire construction failed");
+    BRepBuilderAPI_MakeFace f(wire.Wire(), /*OnlyPlane=*/true);
+    if (!f.IsDone()) throw std::runtime_error("T plate face construction failed");
+    return f.Face();
+  };
+  TopoDS_Shell t;
+  BRep_Builder builder;
+  builder.MakeShell(t);
+  builder.Add(t, face({edge(a0, m0), spine, edge(m1, a1), edge(a1, a0)}));
+  builder.Add(t, face({edge(m0, b0), edge(b0, b1), edge(b1, m1), spine}));
+  builder.Add(t, face({spine, edge(m1, t1), edge(t1, t0), edge(t0, m0)}));
+  return write_brep_or_step(t, path);
+}
+
+std::string write_box_with_duplicated_face(double depth, const std::string& path) {
+  const double height = 4.0;
+  const TopoDS_Shape box = BRepPrimAPI_MakeBox(10.0, depth, height).Shape();
+  TopoDS_Shell out;
+  BRep_Builder builder;
+  builder.MakeShell(out);
+  TopoDS_Face top;
+  for (TopExp_Explorer e(box, TopAbs_FACE); e.More(); e.Next()) {
+    const TopoDS_Face f = TopoDS::Face(e.Current());
+    builder.Add(out, f);
+    double u0 = 0, u1 = 0, v0 = 0, v1 = 0;
+    BRepTools::UVBounds(f, u0, u1, v0, v1);
+    const gp_Pnt mid = BRep_Tool::Surface(f)->Value(0.5 * (u0 + u1), 0.5 * (v0 + v1));
+    if (std::abs(mid.Z() - height) < 1e-9) top = f;
+  }
+  if (top.IsNull()) throw std::runtime_error("box top face not found");
+  builder.Add(out, given_again(top));
+  return write_brep_or_step(out, path);
+}
+
+std::string write_rectangle_given_twice(double length, double width, const std::string& path) {
+  BRepBuilderAPI_MakePolygon poly(gp_Pnt(0, 0, 0), gp_Pnt(length, 0, 0), gp_Pnt(length, width, 0),
+                                  gp_Pnt(0, width, 0), /*Close=*/true);
+  BRepBuilderAPI_MakeFace face(poly.Wire(), /*OnlyPlane=*/true);
+  if (!face.IsDone()) throw std::runtime_error("rectangle face construction failed");
+  TopoDS_Shell out;
+  BRep_Builder builder;
+  builder.MakeShell(out);
+  builder.Add(out, face.Face());
+  builder.Add(out, given_again(face.Face()));
+  return write_brep_or_step(out, path);
 }
 
 mesh::CurveMesh uniform_curve_mesh(const cad::CadModel& model, LO c, LO n) {

@@ -43,5 +43,19 @@ std::string write_half_annulus(double inner, double outer, const std::string& pa
 std::string write_half_disk(double radius, const std::string& path);
 /// Writes a box with filleted edges (radius 1), as STEP.
 std::string write_filleted_box(const std::string& path);
+/// Writes a T of three plates meeting along one curve (non-manifold: three faces border it): the
+/// 4 x 2 rectangles [0, 4] x [0, 2] and [4, 8] x [0, 2] at z = 0 and the upright 2 x 3 one
+/// x = 4, 0 <= z <= 3, all bounded by the shared TopoDS edge x = 4, z = 0. The faces are one
+/// (non-manifold) shell, as a STEP surface model holds them (a STEP file of a compound of faces
+/// would not share their edges); written as BREP, or as STEP when `path` ends in .step or .stp.
+std::string write_t_of_three_plates(const std::string& path);
+/// Writes a 10 x `depth` x 4 box whose top face (10 x `depth`) appears twice: a second face with
+/// the same surface and the same TopoDS edges (another face entity, as a STEP file that repeats a
+/// face gives), so each of the top's four curves borders three faces. A shell of seven faces, as
+/// BREP (or STEP, by the extension as above).
+std::string write_box_with_duplicated_face(double depth, const std::string& path);
+/// Writes the rectangle [0, length] x [0, width] at z = 0 twice: two faces on one plane with the
+/// same four TopoDS edges, a shell (BREP, or STEP by the extension as above).
+std::string write_rectangle_given_twice(double length, double width, const std::string& path);
 
 }  // namespace qsmesh::test

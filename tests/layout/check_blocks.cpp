@@ -1,6 +1,7 @@
 // check_blocks FILE.cgns: reads a block-structured CGNS file (qsmesh mesh --block-structured) back
 // and checks every interface point by point, their reciprocity and that every block side edge is
-// covered once (tests/common/cgns_blocks_check.hpp). Prints a
+// covered once, or once by each other side where more than two meet (a non-manifold curve;
+// tests/common/cgns_blocks_check.hpp). Prints a
 // one-line summary; exit 1 when a check fails.
 #include <iostream>
 

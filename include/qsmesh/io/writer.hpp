@@ -109,7 +109,12 @@ void write_cgns(const mesh::SurfaceMesh& mesh, const std::string& path, const Wr
 /// unstructured zone "Unstructured" (a section per face). Where a block side runs along it, both
 /// zones get a GridConnectivity (Abutting1to1, Vertex: the block's PointRange against the
 /// unstructured zone's PointListDonor, and that zone's PointList against the block's (i, j)
-/// PointListDonor), and no BC is written there. `layout` must come from extract_quad_layout(mesh).
+/// PointListDonor), and no BC is written there. Along a CAD curve that three or more faces border
+/// (non-manifold), each block side is joined to every other block side (and the unstructured zone)
+/// along it: a side edge where m sides meet is in m - 1 interfaces, one per other side, ordered by
+/// their first edge along the side, then donor block and side; off the CAD curves only sides of
+/// the same face are joined (a face given twice meets its copy on its curves only).
+/// `layout` must come from extract_quad_layout(mesh).
 void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& layout,
                        const std::string& path, const WriteOptions& options = {});
 

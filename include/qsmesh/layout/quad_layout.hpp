@@ -12,7 +12,10 @@
 // curves; each patch is a grid of ni x nj quads, a block, and blocks of one face sharing a whole
 // side off the CAD curves are merged while any do. Paper 002 goes on to simplify this layout (ILP
 // quantization, Sec. III.B-C); that is not done here, so the blocks are those of the
-// quasi-structured mesh as it is.
+// quasi-structured mesh as it is. A curve that three or more faces border is a curve like any
+// other: no trace crosses it, and each face's blocks end on it. Edges are taken face by face, so
+// a face the CAD gives twice (the same surface and boundary) is cut along its own traces even
+// where both copies hold an edge between the same two curve vertices.
 #pragma once
 
 #include <cstdint>

@@ -13,7 +13,9 @@ namespace qsmesh::mesh {
 
 struct ConformityReport {
   std::int64_t edges = 0;                 ///< distinct element edges
-  std::int64_t interior_edges_bad = 0;    ///< edges off the curves not shared by exactly 2 elements of one face
+  /// Edges off the curves that some face using them does not have in exactly 2 of its elements
+  /// (two faces may each have one inside: a face given twice, faces sharing two curves).
+  std::int64_t interior_edges_bad = 0;
   std::int64_t curve_edges_bad = 0;       ///< curve edges not used once per use of the curve by a face
   std::int64_t orientation_bad = 0;       ///< interior edges traversed the same way by both elements
   std::int64_t degenerate_elements = 0;   ///< elements repeating a vertex
