@@ -3,7 +3,7 @@
 standard views into one PNG: iso, top, front and side in a 2x2 grid, quads coloured by SICN (the
 signed inverse condition number of src/mesh/quality.cpp, mesh::quad_sicn: the worst corner's
 2 (n_i . n) / (|e_prev|^2 + |e_next|^2) with n the quad's mean normal), irregular interior vertices
-marked (valence 3 blue, valence 5 red, others magenta), CAD curves drawn in black, with a colour bar
+marked (valence 3 blue, valence 5 red, others magenta; 5 and 7 in a triangle mesh), CAD curves drawn in black, with a colour bar
 and the mesh's counts beside the views. Triangles, where the mesh has some, are coloured by their
 quality 2 sqrt(3) area / sum of squared edge lengths, in the same scale.
 
@@ -43,7 +43,8 @@ VIEWS = [
 SICN_COLOURS = [(0.0, (0.65, 0.0, 0.0)), (0.3, (0.9, 0.2, 0.1)), (0.6, (1.0, 0.75, 0.2)),
                 (0.8, (0.95, 0.95, 0.55)), (0.9, (0.55, 0.85, 0.55)), (1.0, (0.35, 0.6, 0.9))]
 INVERTED_COLOUR = (1.0, 0.0, 1.0)  # SICN < 0: an inverted or degenerate quad
-VALENCE_COLOURS = {3: (0, 90, 255), 5: (230, 0, 0)}
+BELOW_COLOUR = (0, 90, 255)  # valence one below the regular one (3 in a quad mesh)
+ABOVE_COLOUR = (230, 0, 0)  # one above (5)
 OTHER_VALENCE_COLOUR = (200, 0, 200)
 
 
@@ -262,7 +263,8 @@ def build_actors(mesh, lut, edges, point_size):
     mark_points.SetData(numpy_to_vtk(mesh.points[mesh.irregular], deep=True))
     marks.SetPoints(mark_points)
     marks.SetVerts(cell_array(np.arange(len(mesh.irregular)).reshape(-1, 1)))
-    rgb = np.array([VALENCE_COLOURS.get(int(v), OTHER_VALENCE_COLOUR) for v in mesh.irregular_valence],
+    palette = {mesh.regular - 1: BELOW_COLOUR, mesh.regular + 1: ABOVE_COLOUR}
+    rgb = np.array([palette.get(int(v), OTHER_VALENCE_COLOUR) for v in mesh.irregular_valence],
                    dtype=np.uint8).reshape(-1, 3)
     colours = numpy_to_vtk(rgb, deep=True)
     colours.SetName("valence_colour")
@@ -424,8 +426,8 @@ def render(mesh, args):
     lines.append((f"irregular interior\nvertices {len(mesh.irregular)} ({irr_pct:.2f}%)", (0, 0, 0),
                   False))
     lines.append(("", None, False))
-    lines.append(("o valence 3", tuple(c / 255 for c in VALENCE_COLOURS[3]), True))
-    lines.append(("o valence 5", tuple(c / 255 for c in VALENCE_COLOURS[5]), True))
+    lines.append((f"o valence {mesh.regular - 1}", tuple(c / 255 for c in BELOW_COLOUR), True))
+    lines.append((f"o valence {mesh.regular + 1}", tuple(c / 255 for c in ABOVE_COLOUR), True))
     lines.append(("o other valence", tuple(c / 255 for c in OTHER_VALENCE_COLOUR), True))
     lines.append(("- CAD curves", (0, 0, 0), True))
     y = 0.38 * h
