@@ -6,9 +6,9 @@
 # assembles and writes the mesh) and the largest of the other ranks' (--stats),
 # and whether the mesh is byte-identical to the first configuration's (it must be: the mesh does
 # not depend on the numbers of ranks and threads). Prints a markdown table; --csv also writes the
-# rows as CSV.
+# rows as CSV, --png plots speedup and efficiency per configuration (scripts/plot_table.py).
 # Usage: scripts/scaling_study.sh MODEL [--size-factor F] [--until STAGE] [--configs "PxT ..."]
-#                                 [--repeat N] [--csv FILE]   (after scripts/build.sh)
+#                                 [--repeat N] [--csv FILE] [--png FILE]   (after scripts/build.sh)
 #   defaults: --size-factor 0.02, --until quasi-structured, --configs "1x1 1x2 2x1" (and 2x2, 4x1,
 #   4x2, 8x1, 8x2, 16x1 where the machine has that many cores), --repeat 3.
 # Wall time is that of the whole command (mpiexec, loading and writing included); the median of an
@@ -25,6 +25,7 @@ factor=0.02
 until=quasi-structured
 repeat=3
 csv=
+png=
 cores=$(nproc)
 configs=
 while [ $# -gt 0 ]; do
@@ -34,6 +35,7 @@ while [ $# -gt 0 ]; do
     --configs) configs=$2; shift 2 ;;
     --repeat) repeat=$2; shift 2 ;;
     --csv) csv=$2; shift 2 ;;
+    --png) png=$2; shift 2 ;;
     *) echo "scaling_study: unknown option $1" >&2; usage ;;
   esac
 done
@@ -50,6 +52,10 @@ for c in $configs; do
 done
 exe=./build/drivers/qsmesh
 [ -x "$exe" ] || { echo "scaling_study: $exe missing; run scripts/build.sh first" >&2; exit 2; }
+if [ -n "$png" ]; then
+  /usr/bin/python3 -c "import vtkmodules.vtkChartsCore" 2>/dev/null ||
+    { echo "scaling_study: --png needs VTK's Python module (Debian python3-vtk9; scripts/setup.sh installs it)" >&2; exit 2; }
+fi
 [ -x /usr/bin/time ] || { echo "scaling_study: /usr/bin/time missing (Debian package 'time'; scripts/setup.sh installs it)" >&2; exit 2; }
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 out=$(mktemp -d)
@@ -71,7 +77,10 @@ for c in $configs; do
   done
 done
 
-python3 - "$runs" "$model" "$factor" "$until" "$cores" "$repeat" "$csv" <<'PY'
+table_csv=$csv
+[ -n "$table_csv" ] || table_csv=$out/table.csv
+status=0
+python3 - "$runs" "$model" "$factor" "$until" "$cores" "$repeat" "$table_csv" <<'PY' || status=$?
 import csv, filecmp, json, statistics, sys
 runs_path, model, factor, until, cores, repeat, csv_path = sys.argv[1:8]
 cores = int(cores)
@@ -133,3 +142,8 @@ if any(r[-1] == "NO" for r in rows):
     print("\nscaling_study: the mesh differs between configurations", file=sys.stderr)
     sys.exit(1)
 PY
+if [ -n "$png" ]; then
+  /usr/bin/python3 scripts/plot_table.py "$table_csv" -o "$png" --x "ranks x threads" --y speedup,efficiency \
+    --title "$(basename "$model"), --size-factor $factor: speedup and efficiency against ${configs%% *}"
+fi
+exit "$status"

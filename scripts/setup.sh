@@ -18,6 +18,9 @@ packages=(
   libgtest-dev
   python3
   time
+  # Pictures (scripts/render_mesh.py, scripts/plot_table.py): Debian's VTK renders through X even
+  # offscreen, so a virtual X server (xvfb-run) with Mesa's software OpenGL.
+  python3-vtk9 python3-numpy xvfb xauth libgl1-mesa-dri
 )
 
 missing=()
