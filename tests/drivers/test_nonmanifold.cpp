@@ -12,19 +12,12 @@
 
 #include "cgns_blocks_check.hpp"
 #include "shapes.hpp"
+#include "tmp_dir.hpp"
 
 namespace {
 
-std::string tmp(const std::string& name) {
-  return std::string(QSMESH_TEST_TMP_DIR) + "/p" + std::to_string(::getpid()) + "_" + name;
-}
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using qsmesh::test::slurp;
+using qsmesh::test::tmp;
 
 // Exit code of `qsmesh ARGS` (output to files beside the test's).
 int qsmesh(const std::string& args, const std::string& log) {

@@ -15,6 +15,7 @@
 
 #include "cgns_blocks_check.hpp"
 #include "shapes.hpp"
+#include "tmp_dir.hpp"
 
 namespace {
 
@@ -25,17 +26,8 @@ struct ExeResult {
   std::string out, err;
 };
 
-// ctest runs each test in its own process, several at once: every name carries the process id.
-std::string tmp(const std::string& name) {
-  return std::string(QSMESH_TEST_TMP_DIR) + "/p" + std::to_string(::getpid()) + "_" + name;
-}
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using qsmesh::test::slurp;
+using qsmesh::test::tmp;
 
 /// Runs qsmesh with the given argument string (shell-quoted by the caller).
 ExeResult run(const std::string& args) {

@@ -20,18 +20,14 @@
 #include <vector>
 
 #include "shapes.hpp"
+#include "tmp_dir.hpp"
 
 namespace {
 
 namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
-std::string slurp(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using qsmesh::test::slurp;
 
 // A folder of its own for each test (ctest runs several test processes at once).
 fs::path fresh_dir(const std::string& name) {
