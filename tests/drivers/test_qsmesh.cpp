@@ -755,4 +755,13 @@ TEST_F(Qsmesh, ExampleFormatFollowsTheExtension) {
   }
 }
 
+// A prescription the mesh cannot follow is said, not silently dropped: one quad asked on a face
+// whose curves carry tens of edges.
+TEST_F(Qsmesh, UnmetPrescriptionIsAWarning) {
+  const ExeResult r =
+      run("mesh " + model_ + " -o " + tmp("unmet.msh") + " --size-factor 0.1 --face-quads 0:1 -q");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_NE(r.err.find("warning: --face-quads 0:1: face 0 got "), std::string::npos) << r.err;
+}
+
 }  // namespace
