@@ -1,13 +1,14 @@
 #include "cli.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdlib>
+#include <filesystem>
 #include <limits>
 #include <optional>
 #include <sstream>
 
-#include "qsmesh/cad/model.hpp"
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/io/writer.hpp"
 
@@ -110,6 +111,15 @@ void append(std::vector<T>& to, const std::vector<T>& from) {
 }
 
 }  // namespace
+
+std::optional<cad::ExampleFormat> example_format(const std::string& path) {
+  std::string ext = std::filesystem::path(path).extension().string();
+  std::transform(ext.begin(), ext.end(), ext.begin(),
+                 [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+  if (ext == ".step" || ext == ".stp") return cad::ExampleFormat::Step;
+  if (ext == ".brep" || ext == ".brp") return cad::ExampleFormat::Brep;
+  return std::nullopt;
+}
 
 Arguments parse(const std::vector<std::string>& args) {
   Arguments a;
@@ -258,7 +268,7 @@ Arguments parse(const std::vector<std::string>& args) {
     if (a.example_name != "wing-body")
       throw InputError("example: unknown example '" + a.example_name + "' (available: wing-body)");
     if (a.output.empty()) throw InputError("example: missing -o FILE.step");
-    if (!cad::example_format(a.output))
+    if (!example_format(a.output))
       throw InputError(
           "example: cannot write '" + a.output +
           "': the extension picks the CAD format, .step/.stp (STEP) or .brep/.brp (BREP)");

@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "qsmesh/cad/model.hpp"
+
 namespace qsmesh::cli {
 
 enum class Command { Help, Version, Info, Mesh, CrossField, SizeMap, Example };
@@ -77,6 +79,10 @@ inline constexpr double kGmshSizeMinRatio = 0.17;
 /// below what a mistyped size asks for (--size-factor 1e-6: about 1e12 quads), so that a runaway
 /// request is refused with its estimate instead of exhausting the machine.
 inline constexpr double kDefaultMaxQuads = 2e8;
+
+/// The CAD format a file name asks `example` for by its extension: .step/.stp STEP, .brep/.brp BREP
+/// (any case); nothing for any other name.
+[[nodiscard]] std::optional<cad::ExampleFormat> example_format(const std::string& path);
 
 /// Parses argv[1..]. Throws InputError (one line naming the option and the reason) on bad input.
 [[nodiscard]] Arguments parse(const std::vector<std::string>& args);

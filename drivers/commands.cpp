@@ -200,7 +200,7 @@ int run_info(const Arguments& args) {
 
 int run_example(const Arguments& args) {
   check_output_files(args);
-  const auto format = cad::example_format(args.output);
+  const auto format = example_format(args.output);
   if (!format)
     throw InputError("example: cannot write '" + args.output +
                      "': the extension picks the CAD format, .step/.stp or .brep/.brp");
@@ -633,23 +633,10 @@ void check_request(const Arguments& args, const Session& s) {
     m.face_curves.push_back(std::move(curves));
   }
   for (const cad::Curve& c : s.model.curves()) m.curve_length.push_back(c.length);
-  SizeRequest r;
-  r.size_max = s.size;
-  r.target_quads = args.quads;
-  r.face_quads = args.face_quads;
-  r.face_sizes = args.face_sizes;
-  r.curve_edges = args.curve_edges;
-  r.curve_sizes = args.curve_sizes;
-  std::ostringstream what;
-  if (args.size)
-    what << "--size " << *args.size;
-  else if (args.size_factor)
-    what << "--size-factor " << *args.size_factor;
-  else
-    what << "the default size factor " << kDefaultSizeFactor;
   const double max_quads = args.max_quads < 0 ? kDefaultMaxQuads : args.max_quads;
-  if (const auto refusal = refuse_request(estimate_request(m, r), max_quads, s.ranks,
-                                          s.comm.local_size(), machine_memory(), what.str()))
+  if (const auto refusal =
+          refuse_request(estimate_request(m, size_request(args, s.size)), max_quads, s.ranks,
+                         s.comm.local_size(), machine_memory(), size_option_text(args)))
     throw InputError(*refusal);
 }
 

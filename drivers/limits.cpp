@@ -39,6 +39,28 @@ std::string gigabytes(double bytes) {
 
 }  // namespace
 
+SizeRequest size_request(const Arguments& args, double size_max) {
+  SizeRequest r;
+  r.size_max = size_max;
+  r.target_quads = args.quads;
+  r.face_quads = args.face_quads;
+  r.face_sizes = args.face_sizes;
+  r.curve_edges = args.curve_edges;
+  r.curve_sizes = args.curve_sizes;
+  return r;
+}
+
+std::string size_option_text(const Arguments& args) {
+  std::ostringstream what;
+  if (args.size)
+    what << "--size " << *args.size;
+  else if (args.size_factor)
+    what << "--size-factor " << *args.size_factor;
+  else
+    what << "the default size factor " << kDefaultSizeFactor;
+  return what.str();
+}
+
 RequestEstimate estimate_request(const ModelMeasures& model, const SizeRequest& request) {
   const std::size_t nf = model.face_area.size(), nc = model.curve_length.size();
   double total_area = 0;

@@ -10,6 +10,8 @@
 #include <utility>
 #include <vector>
 
+#include "cli.hpp"
+
 namespace qsmesh::cli {
 
 /// What the estimate needs to know of a model.
@@ -29,6 +31,13 @@ struct SizeRequest {
   std::vector<std::pair<int, int>> curve_edges;     ///< --curve-edges
   std::vector<std::pair<int, double>> curve_sizes;  ///< --curve-size
 };
+
+/// The size requests of parsed arguments, with the size cap `size_max` the run computed.
+[[nodiscard]] SizeRequest size_request(const Arguments& args, double size_max);
+
+/// The size option a run was given, for messages: "--size 0.5", "--size-factor 0.01" or "the
+/// default size factor 0.02".
+[[nodiscard]] std::string size_option_text(const Arguments& args);
 
 /// A lower estimate of a request's cost. The size map only refines below the size cap (curvature,
 /// small features), so the quads of the size cap and the prescriptions bound the mesh from below.

@@ -5,7 +5,6 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <cctype>
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
@@ -18,21 +17,6 @@
 namespace qsmesh::io {
 
 namespace fs = std::filesystem;
-
-Format output_format(const std::string& path) {
-  std::string ext = fs::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  if (ext == ".cgns") return Format::kCgns;
-  if (ext == ".vtu") return Format::kVtu;
-  if (ext == ".msh") return Format::kMsh;
-  if (ext == ".h5") return Format::kHdf5;
-  return Format::kNone;
-}
-
-bool is_supported_output(const std::string& path) {
-  return !fs::path(path).stem().empty() && output_format(path) != Format::kNone;
-}
 
 void check_output_path(const std::string& path) {
   if (!is_supported_output(path)) {

@@ -16,6 +16,8 @@ packages=(
   libhdf5-dev
   libcgns-dev cgns-convert
   libgtest-dev
+  # the libFuzzer targets of scripts/fuzz.sh (llvm-14: llvm-symbolizer for their reports)
+  clang-14 libclang-rt-14-dev llvm-14
   python3
   time
   # Pictures (scripts/render_mesh.py, scripts/plot_table.py): Debian's VTK renders through X even

@@ -20,10 +20,7 @@
 #include <TColgp_HArray1OfPnt.hxx>
 #include <TopExp_Explorer.hxx>
 #include <TopoDS.hxx>
-#include <algorithm>
-#include <cctype>
 #include <cmath>
-#include <filesystem>
 #include <gp_Ax1.hxx>
 #include <gp_Ax2.hxx>
 #include <gp_Elips.hxx>
@@ -141,20 +138,7 @@ TopoDS_Shape fuse(const TopoDS_Shape& a, const TopoDS_Shape& b) {
 
 }  // namespace
 
-std::optional<ExampleFormat> example_format(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
-  if (ext == ".step" || ext == ".stp") return ExampleFormat::Step;
-  if (ext == ".brep" || ext == ".brp") return ExampleFormat::Brep;
-  return std::nullopt;
-}
-
-void write_wing_body_example(const std::string& path, std::optional<ExampleFormat> format) {
-  if (!format) format = example_format(path);
-  if (!format)
-    throw InputError("cannot write the wing-body example to '" + path +
-                     "': the extension picks the format, .step/.stp or .brep/.brp");
+void write_wing_body_example(const std::string& path, ExampleFormat format) {
   TopoDS_Shape shape;
   try {
     shape = fuse(fuse(make_fuselage(), make_wing(+1)), make_wing(-1));
@@ -167,7 +151,7 @@ void write_wing_body_example(const std::string& path, std::optional<ExampleForma
   BRepCheck_Analyzer check(shape);
   QSMESH_CHECK(check.IsValid(), "wing-body example: the fused solid is not valid");
 
-  if (*format == ExampleFormat::Brep) {
+  if (format == ExampleFormat::Brep) {
     if (!BRepTools::Write(shape, path.c_str()))
       throw InputError("cannot write the wing-body example to '" + path + "'");
     return;

@@ -36,7 +36,8 @@ void get_vec(const std::vector<char>& in, std::size_t& pos, std::vector<T>& v) {
   const auto n = static_cast<std::size_t>(get<std::int64_t>(in, pos));
   QSMESH_CHECK(pos + n * sizeof(T) <= in.size(), "truncated face record");
   v.resize(n);
-  std::memcpy(v.data(), in.data() + pos, n * sizeof(T));
+  // An empty vector's data() may be null, and memcpy from or to null is undefined even for 0 bytes.
+  if (n > 0) std::memcpy(v.data(), in.data() + pos, n * sizeof(T));
   pos += n * sizeof(T);
 }
 

@@ -5,7 +5,6 @@
 #include <array>
 #include <cstdint>
 #include <memory>
-#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -144,14 +143,10 @@ void set_kernel_messages(bool quiet);
 /// The CAD formats the built-in examples are written in.
 enum class ExampleFormat { Step, Brep };
 
-/// The format a file name asks for by its extension: .step/.stp STEP, .brep/.brp BREP (any case);
-/// nothing for any other name.
-[[nodiscard]] std::optional<ExampleFormat> example_format(const std::string& path);
-
 /// Writes the built-in wing-body example (fuselage of revolution fused with a wing lofted from
-/// NACA 4-digit sections) to `path`, as `format`, or as example_format(path) when not given.
-/// Throws InputError when the format is unknown or the file cannot be written.
-void write_wing_body_example(const std::string& path,
-                             std::optional<ExampleFormat> format = std::nullopt);
+/// NACA 4-digit sections) to `path` as `format`, whatever its extension (the driver picks the
+/// format by the name the user gave and writes a temporary). Throws InputError when the file
+/// cannot be written.
+void write_wing_body_example(const std::string& path, ExampleFormat format = ExampleFormat::Step);
 
 }  // namespace qsmesh::cad
