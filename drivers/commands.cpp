@@ -302,7 +302,7 @@ struct QuasiTotals {
   std::array<std::int64_t, 4> cavities{};                  // remeshed, by step
   std::int64_t defects_before = 0, defects_after = 0, disk_replaced = 0;  // Sec. 6.3
   std::int64_t time_budget_hit = 0;  // faces whose cavity remeshing stopped on --face-time-budget
-  // Faces whose fill, kept on its minimum SICN alone, gave way to their unstructured mesh
+  // Faces whose kept fill, with a poor mean, gave way to their unstructured mesh
   // (qstruct::unstructured_clearly_better).
   std::int64_t fill_gave_way = 0;
 };
@@ -359,8 +359,8 @@ std::string stats_json(const Arguments& args, const Session& session,
     // Of those, the faces whose pattern mesh the quality thresholds refused but which was no
     // worse than the unstructured path's (PipelineOptions::pattern_compare_tolerance).
     j.value("faces_meshed_by_pattern_after_comparison", t.by_comparison);
-    // Faces whose fill passed on its minimum SICN alone but whose unstructured mesh was clearly
-    // better on average (qstruct::PatternFaceOptions::keep_min_avg_margin).
+    // Faces whose fill passed with a poor mean but whose unstructured mesh was clearly better on
+    // average (qstruct::PatternFaceOptions::compare_below_avg, compare_avg_margin).
     j.value("faces_fill_gave_way_to_unstructured", t.fill_gave_way);
     // Sec. 6.2 on the other faces: interior irregular vertices of their unstructured meshes
     // before and after cavity remeshing, cavities remeshed by step.
@@ -510,8 +510,7 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
          << " of them as good as their unstructured mesh, below the pattern thresholds)";
     if (t.fill_gave_way > 0)
       os << "; " << t.fill_gave_way
-         << " fill(s) passing on their minimum SICN alone gave way to a clearly better "
-            "unstructured mesh";
+         << " fill(s) with a poor mean gave way to a clearly better unstructured mesh";
     os << "\n"
        << "  cavity remeshing (other faces): irregular interior vertices " << t.irregular_before
        << " -> " << t.irregular_after << "; cavities remeshed by step " << t.cavities[0] << ", "

@@ -397,9 +397,9 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
   struct RefusedFill {
     mesh::FaceMesh mesh;
     std::string pattern;
-    // A fill kept on keep_sicn_min alone, held back until the face's unstructured mesh is known
-    // (qstruct::unstructured_clearly_better decides between them).
-    bool kept_on_minimum = false;
+    // A kept fill with a poor mean (qstruct::fill_to_compare), held back until the face's
+    // unstructured mesh is known (qstruct::unstructured_clearly_better decides between them).
+    bool kept = false;
   };
   std::vector<RefusedFill> refused(quasi ? mine.size() : 0);
   // The quad bound of each face's fills (0: none), by face id: computed by the face's owner,
@@ -456,8 +456,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     // Fills to their owners.
     const auto take = [&](std::int64_t i, Fill&& fill) {
       const qstruct::PatternFaceReport& pr = fill.report;
-      if (pr.ok && options.patterns.keep_min_avg_margin >= 0 &&
-          qstruct::kept_on_minimum_alone(pr.sicn_avg, pr.quads, options.patterns)) {
+      if (pr.ok && qstruct::fill_to_compare(pr.sicn_avg, pr.quads, options.patterns)) {
         refused[i] = {std::move(fill.mesh), pr.pattern_name, true};
       } else if (pr.ok) {
         quasi_reports[i].by_pattern = true;
@@ -633,14 +632,14 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
       tasks.parallel_for(total, [&](std::int64_t i) {
         if (refused[i].mesh.quads.empty()) return;
         const mesh::FaceQuadStats pat = mesh::face_quad_stats(refused[i].mesh);
-        const bool kept_on_minimum = refused[i].kept_on_minimum;
+        const bool kept = refused[i].kept;
         bool take = no_valid_quads(i);
         if (!take) {
           const mesh::FaceQuadStats uns = mesh::face_quad_stats(quad_meshes[i]);
-          if (kept_on_minimum) {
+          if (kept) {
             take = !qstruct::unstructured_clearly_better(pat, uns, options.patterns);
-            log.debug(cat("face ", mine[i], ": fill kept on its minimum (", refused[i].pattern,
-                          ", ", pat.quads, " quads, SICN ", pat.sicn_min, " / ", pat.sicn_avg,
+            log.debug(cat("face ", mine[i], ": kept fill (", refused[i].pattern, ", ", pat.quads,
+                          " quads, SICN ", pat.sicn_min, " / ", pat.sicn_avg,
                           ") against unstructured (", uns.quads, " quads, SICN ", uns.sicn_min,
                           " / ", uns.sicn_avg, "): ", take ? "fill" : "unstructured"));
             if (!take)
@@ -657,9 +656,9 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
           quad_reports[i].sicn_min = pat.sicn_min;
           quad_reports[i].quads = pat.quads;
           quasi_reports[i].by_pattern = true;
-          quasi_reports[i].by_comparison = !kept_on_minimum;  // that one passed the thresholds
+          quasi_reports[i].by_comparison = !kept;  // that one passed the thresholds
           quasi_reports[i].pattern = refused[i].pattern;
-          if (kept_on_minimum) quasi_reports[i].refusal.clear();
+          if (kept) quasi_reports[i].refusal.clear();
         }
         refused[i] = RefusedFill{};
       });

@@ -38,17 +38,18 @@ const char* to_string(Refusal r) {
   return "?";
 }
 
-bool kept_on_minimum_alone(double sicn_avg, std::int64_t quads, const PatternFaceOptions& options) {
-  return !(sicn_avg > options.min_sicn_avg) && quads > options.small_fill_quads;
+bool fill_to_compare(double sicn_avg, std::int64_t quads, const PatternFaceOptions& options) {
+  return options.compare_avg_margin >= 0 && quads > options.small_fill_quads &&
+         !(sicn_avg > options.compare_below_avg);
 }
 
 bool unstructured_clearly_better(const mesh::FaceQuadStats& fill,
                                  const mesh::FaceQuadStats& unstructured,
                                  const PatternFaceOptions& options) {
-  if (options.keep_min_avg_margin < 0) return false;
+  if (options.compare_avg_margin < 0) return false;
   if (unstructured.quads <= 0 || unstructured.triangles > 0) return false;
   return unstructured.sicn_min > options.min_sicn &&
-         unstructured.sicn_avg > fill.sicn_avg + options.keep_min_avg_margin;
+         unstructured.sicn_avg > fill.sicn_avg + options.compare_avg_margin;
 }
 
 namespace {

@@ -200,16 +200,19 @@ TEST(FacePattern, SmallFillIsKeptOnItsMinimumAlone) {
   EXPECT_LT(kept.sicn_min, PatternFaceOptions{}.keep_sicn_min);
 }
 
-// A fill that passes on keep_sicn_min alone (mean at or below min_sicn_avg, more than
-// small_fill_quads quads) is the one compared with the face's unstructured mesh; it gives way
-// only to a valid all-quad mesh without a quad at or below min_sicn whose mean is higher by more
-// than keep_min_avg_margin. The numbers are wing_fuselage's face 15 at size factor 0.0058 with
-// the clamped sizing: a one-corner fill at 0.55 / 0.678 against an unstructured mesh at 0.96.
-TEST(FacePattern, FillKeptOnItsMinimumGivesWayOnlyToAClearlyBetterMean) {
+// A kept fill of more than small_fill_quads quads with its mean at or below compare_below_avg
+// (every fill kept on keep_sicn_min alone, and those kept on a mean just above min_sicn_avg) is
+// compared with the face's unstructured mesh; it gives way only to a valid all-quad mesh without
+// a quad at or below min_sicn whose mean is higher by more than compare_avg_margin. The numbers
+// are wing_fuselage's face 15 with the clamped sizing: a one-corner fill at 0.50 / 0.678 (size
+// factor 0.0058) against an unstructured mesh at 0.61 / 0.958.
+TEST(FacePattern, PoorMeanFillGivesWayOnlyToAClearlyBetterUnstructuredMesh) {
   const PatternFaceOptions o;
-  EXPECT_TRUE(kept_on_minimum_alone(0.678, 1725, o));
-  EXPECT_FALSE(kept_on_minimum_alone(0.75, 1725, o));                 // passed on its mean
-  EXPECT_FALSE(kept_on_minimum_alone(0.678, o.small_fill_quads, o));  // a small fill
+  ASSERT_GE(o.compare_below_avg, o.min_sicn_avg);  // every fill kept on its minimum alone
+  EXPECT_TRUE(fill_to_compare(0.678, 1725, o));
+  EXPECT_TRUE(fill_to_compare(0.727, 1248, o));  // kept on its mean, just above
+  EXPECT_FALSE(fill_to_compare(o.compare_below_avg + 0.01, 1725, o));  // a good mean
+  EXPECT_FALSE(fill_to_compare(0.678, o.small_fill_quads, o));         // a small fill
   const auto stats = [](std::int64_t quads, std::int64_t triangles, double mn, double avg) {
     mesh::FaceQuadStats s;
     s.quads = quads;
@@ -218,20 +221,21 @@ TEST(FacePattern, FillKeptOnItsMinimumGivesWayOnlyToAClearlyBetterMean) {
     s.sicn_avg = avg;
     return s;
   };
-  const mesh::FaceQuadStats fill = stats(1725, 0, 0.55, 0.678);
-  EXPECT_TRUE(unstructured_clearly_better(fill, stats(1500, 0, 0.45, 0.96), o));
+  const mesh::FaceQuadStats fill = stats(1725, 0, 0.50, 0.678);
+  EXPECT_TRUE(unstructured_clearly_better(fill, stats(660, 0, 0.61, 0.958), o));
   // Within the margin, the fill's fewer irregular vertices win.
   EXPECT_FALSE(unstructured_clearly_better(
-      fill, stats(1500, 0, 0.45, 0.678 + 0.9 * o.keep_min_avg_margin), o));
+      fill, stats(660, 0, 0.61, 0.678 + 0.9 * o.compare_avg_margin), o));
   EXPECT_TRUE(unstructured_clearly_better(
-      fill, stats(1500, 0, 0.45, 0.678 + 1.1 * o.keep_min_avg_margin), o));
+      fill, stats(660, 0, 0.61, 0.678 + 1.1 * o.compare_avg_margin), o));
   // A better mean bought with a poor quad, or a mesh that is not all quads, does not replace it.
-  EXPECT_FALSE(unstructured_clearly_better(fill, stats(1500, 0, o.min_sicn, 0.96), o));
-  EXPECT_FALSE(unstructured_clearly_better(fill, stats(1500, 3, 0.45, 0.96), o));
+  EXPECT_FALSE(unstructured_clearly_better(fill, stats(660, 0, o.min_sicn, 0.958), o));
+  EXPECT_FALSE(unstructured_clearly_better(fill, stats(660, 3, 0.61, 0.958), o));
   EXPECT_FALSE(unstructured_clearly_better(fill, stats(0, 0, 0, 0), o));
   PatternFaceOptions off;
-  off.keep_min_avg_margin = -1;
-  EXPECT_FALSE(unstructured_clearly_better(fill, stats(1500, 0, 0.45, 0.96), off));
+  off.compare_avg_margin = -1;
+  EXPECT_FALSE(fill_to_compare(0.678, 1725, off));
+  EXPECT_FALSE(unstructured_clearly_better(fill, stats(660, 0, 0.61, 0.958), off));
 }
 
 TEST(FacePattern, RectangleWithATransitionGetsOneValence3And5) {

@@ -53,13 +53,16 @@ struct PatternFaceOptions {
   /// faces 44 and 79: 22-quad half-disks at SICN avg 0.52 where 14 unstructured quads had 0.74,
   /// with the same 2 irregular vertices. 0: off.
   std::int64_t small_fill_quads = 40;
-  /// A fill kept on keep_sicn_min alone (kept_on_minimum_alone) gives way to the unstructured
-  /// mesh of the same face when the latter's mean SICN is higher by more than this
-  /// (unstructured_clearly_better; the caller meshes the face both ways to compare). Negative:
-  /// off. wing_fuselage.step with the clamped sizing at size factor 0.0058: face 15, a plane at
-  /// a wing tip, got a one-corner fill of 1725 quads at SICN min / avg 0.55 / 0.678 where its
-  /// unstructured mesh has 0.96 (docs/benchmarks.md).
-  double keep_min_avg_margin = 0.1;
+  /// A kept fill of more than small_fill_quads quads whose mean SICN is at or below
+  /// compare_below_avg (fill_to_compare: every fill kept on keep_sicn_min alone, and those kept on
+  /// a mean just above min_sicn_avg) gives way to the unstructured mesh of the same face when the
+  /// latter's mean SICN is higher by more than compare_avg_margin (unstructured_clearly_better;
+  /// the caller meshes such faces both ways). A negative margin: off. wing_fuselage.step with the
+  /// clamped sizing: face 15, a plane at a wing tip, got one-corner fills at SICN avg 0.678 (size
+  /// factor 0.0058, kept on its minimum 0.50) and 0.727 (0.0064, kept on its mean) where its
+  /// unstructured mesh has 0.95-0.96 (docs/benchmarks.md).
+  double compare_below_avg = 0.8;
+  double compare_avg_margin = 0.1;
   /// The quad at a corner of angle a < 90 degrees reaches SICN sin(a) at best (equal edges): at a
   /// face with a side-splitting corner where sin(a) <= min_sicn, which min_sicn would refuse
   /// whatever the mesh (a < 17.5 degrees for 0.3), the min threshold is corner_sicn_factor x
@@ -111,8 +114,8 @@ enum class Refusal : std::uint8_t {
   Quality,       ///< every candidate tried left a quad at or below the quality thresholds
   TooManyQuads,  ///< every fitting pattern needs more quads than PatternFaceOptions::max_quads
   Error,         ///< an error from the geometry or the smoother
-  /// a fill kept on its minimum alone gave way to the face's unstructured mesh, clearly better on
-  /// average (PatternFaceOptions::keep_min_avg_margin; set by the caller that compares)
+  /// a kept fill with a poor mean gave way to the face's unstructured mesh, clearly better on
+  /// average (PatternFaceOptions::compare_avg_margin; set by the caller that compares)
   UnstructuredBetter,
 };
 [[nodiscard]] const char* to_string(Refusal r);
@@ -204,20 +207,21 @@ struct FaceSides {
 ///    report->refused_mesh on a quality refusal).
 /// Never throws for a face-level failure. Deterministic.
 /// Whether a fill kept by mesh_face_pattern (valid, its minimum above the face's threshold) with
-/// this mean SICN and quad count passed on options.keep_sicn_min alone: its mean at or below
-/// options.min_sicn_avg and more than options.small_fill_quads quads. Such a fill is kept by the
-/// acceptance rule of Gmsh's implementation (every quad above keep_sicn_min, whatever the mean)
-/// and is the one worth comparing with the face's unstructured mesh.
-[[nodiscard]] bool kept_on_minimum_alone(double sicn_avg, std::int64_t quads,
-                                         const PatternFaceOptions& options);
+/// this mean SICN and quad count is compared with the face's unstructured mesh: more than
+/// options.small_fill_quads quads and its mean at or below options.compare_below_avg. That takes
+/// in every fill kept on options.keep_sicn_min alone (the acceptance rule of Gmsh's
+/// implementation: every quad above it, whatever the mean) when compare_below_avg is at least
+/// min_sicn_avg. False when options.compare_avg_margin is negative (no comparison).
+[[nodiscard]] bool fill_to_compare(double sicn_avg, std::int64_t quads,
+                                   const PatternFaceOptions& options);
 
 /// Whether the unstructured mesh of a face (paper 000 Sec. 5-6.3, after the topological steps)
-/// is clearly better than a fill of the same face kept on its minimum alone, so that it replaces
+/// is clearly better than a kept fill of the same face (fill_to_compare), so that it replaces
 /// the fill: it is all quads, valid, with its minimum SICN above options.min_sicn (it trades no
 /// poor quad for the fill's mean), and its mean SICN is above the fill's by more than
-/// options.keep_min_avg_margin (never when that is negative). Irregular vertices are not
-/// weighed: the fill has the fewest a pattern allows, and the mean is what the rule of
-/// keep_sicn_min gave up. Serial, pure.
+/// options.compare_avg_margin (never when that is negative). Irregular vertices are not
+/// weighed: the fill has the fewest a pattern allows, and its mean is what was given up to get
+/// them. Serial, pure.
 [[nodiscard]] bool unstructured_clearly_better(const mesh::FaceQuadStats& fill,
                                                const mesh::FaceQuadStats& unstructured,
                                                const PatternFaceOptions& options);
