@@ -151,8 +151,10 @@ TEST_F(Qsmesh, UnstructuredStageGivesValidQuads) {
   const auto at = json.find("\"sicn_min\": ");
   ASSERT_NE(at, std::string::npos);
   EXPECT_GT(std::stod(json.substr(at + 12)), 0.0) << json.substr(at, 40);
+  // 304 quads with the default (clamped) sizing, which has no curvature sizes on the fillets;
+  // more than 500 with --sizing paper.
   const auto quads = json.find("\"quads\": ");
-  EXPECT_GT(std::stol(json.substr(quads + 9)), 500) << json.substr(quads, 30);
+  EXPECT_GT(std::stol(json.substr(quads + 9)), 250) << json.substr(quads, 30);
 }
 
 /// The number after "key": in a stats JSON (NaN when absent).
@@ -354,7 +356,9 @@ TEST_F(Qsmesh, UnstructuredValidOnSmallModels) {
     const auto [r, json] = mesh_with_stats(model, "--until unstructured --threads 2", "e2e_valid");
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_EQ(json_number(json, "triangles"), 0);
-    EXPECT_GT(json_number(json, "quads"), 1000);
+    // The fewest: the built-in example, 826 quads with the default (clamped) sizing (no
+    // curvature sizes; 2.4k with --sizing paper).
+    EXPECT_GT(json_number(json, "quads"), 700);
     EXPECT_EQ(json_number(json, "faces_failed"), 0) << r.err;
     EXPECT_GT(json_number(json, "sicn_min"), 0);
     EXPECT_LE(json_number(json, "max_distance_to_cad"), 1e-6);
@@ -368,12 +372,14 @@ TEST_F(Qsmesh, UnstructuredValidOnSmallModels) {
 // The fuselage face of wing_fuselage.step at the reference run's vertex count: on the stretched
 // afterbody of the surface of revolution the kernel joined frontal points 100 apart across rows
 // spaced 6, the thin triangles folded quads, and the face fell back to the uniform triangulation
-// (4 s of the 4.3 s of the stage).
+// (4 s of the 4.3 s of the stage). Found with the paper's sizing, which the test keeps (the
+// default clamped sizing gives other curve counts there, and two faces fall back).
 TEST_F(Qsmesh, FuselageKeepsFrontalPathAtCoarseSize) {
   const std::string path = std::string(QSMESH_SHARED_CAD_DIR) + "/wing_fuselage.step";
   if (!fs::exists(path)) GTEST_SKIP() << path << " not found";
-  const auto [r, json] = mesh_with_stats(
-      path, "--size-factor 0.08298 --until unstructured --threads 2", "e2e_fuselage");
+  const auto [r, json] =
+      mesh_with_stats(path, "--size-factor 0.08298 --until unstructured --threads 2 --sizing paper",
+                      "e2e_fuselage");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(json_number(json, "faces_fell_back"), 0);
   EXPECT_GT(json_number(json, "sicn_min"), 0);
@@ -383,12 +389,14 @@ TEST_F(Qsmesh, FuselageKeepsFrontalPathAtCoarseSize) {
 // stretched unevenly toward its tip, and the (u, v) Delaunay steps spanned its narrow part with a
 // fan of triangles 60 long across a strip 8 wide. The recombined quads folded and the face fell
 // back to subdividing every triangle (42 interior irregular vertices). The retry with the
-// length-reducing flips (UnstructuredOptions::retry_shorten_ratio) keeps the frontal path.
+// length-reducing flips (UnstructuredOptions::retry_shorten_ratio) keeps the frontal path. Found
+// with the paper's sizing, which the test keeps: the default clamped sizing leaves flat quads
+// against the sliver curves by design (SICN min 0.022 here).
 TEST_F(Qsmesh, FairingSliverKeepsFrontalPath) {
   const std::string path = std::string(QSMESH_SHARED_CAD_DIR) + "/wing_fuselage.step";
   if (!fs::exists(path)) GTEST_SKIP() << path << " not found";
-  const auto [r, json] =
-      mesh_with_stats(path, "--size-factor 0.005 --until unstructured --threads 2", "e2e_fairing");
+  const auto [r, json] = mesh_with_stats(
+      path, "--size-factor 0.005 --until unstructured --threads 2 --sizing paper", "e2e_fairing");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(json_number(json, "faces_fell_back"), 0);
   EXPECT_GT(json_number(json, "sicn_min"), 0.1);
@@ -581,17 +589,26 @@ TEST_F(Qsmesh, ExampleWingBody) {
 // were all refused because quads around them, already valid, had corners turning against the
 // surface normal at their vertex on the leading edge (SICN 0.051). Since the faces' curvature no
 // longer sizes the curves by default, one quad of this coarse mesh (2.3k vertices) bends over the
-// wing's leading edge at SICN 0.19: poor, not flat (0.21 with --face-curvature).
+// wing's leading edge at SICN 0.19: poor, not flat (0.21 with --face-curvature). Those are the
+// figures of --sizing paper (2416 vertices, 85 = 3.5% interior irregular, SICN 0.214 / 0.909).
+// The default, clamped, has no curvature sizes either: 796 vertices at this size, 50 = 6.3%
+// irregular, SICN 0.174 / 0.878, no flat quad; the mean and the irregular share are those of a
+// coarser mesh, bounded here a little below what was measured.
 TEST_F(Qsmesh, ExampleQuasiStructuredHasNoFlatQuad) {
   const std::string step = tmp("e2e_wing_body_qs.step");
   ASSERT_EQ(run("example wing-body -o " + step).code, 0);
+  const auto [rp, jp] = mesh_with_stats(step, "--threads 2 --sizing paper", "e2e_wing_body_qsp");
+  ASSERT_EQ(rp.code, 0) << rp.err;
+  EXPECT_GT(json_number(jp, "sicn_min"), 0.15);
+  EXPECT_GT(json_number(jp, "sicn_avg"), 0.88);
+  EXPECT_LT(json_number(jp, "irregular_interior"), 0.06 * json_number(jp, "vertices"));
   const auto [r, json] = mesh_with_stats(step, "--threads 2", "e2e_wing_body_qs");
   ASSERT_EQ(r.code, 0) << r.err;
   EXPECT_EQ(json_number(json, "triangles"), 0);
   EXPECT_EQ(json_number(json, "faces_failed"), 0);
   EXPECT_GT(json_number(json, "sicn_min"), 0.15);
-  EXPECT_GT(json_number(json, "sicn_avg"), 0.88);
-  EXPECT_LT(json_number(json, "irregular_interior"), 0.06 * json_number(json, "vertices"));
+  EXPECT_GT(json_number(json, "sicn_avg"), 0.86);
+  EXPECT_LT(json_number(json, "irregular_interior"), 0.07 * json_number(json, "vertices"));
   // Every face says why it has no pattern; the faces meshed by one say nothing.
   const auto count = [&](const std::string& what) {
     std::size_t n = 0;
