@@ -25,7 +25,8 @@ double parse_positive(const std::string& option, const std::string& text) {
     throw InputError(option + ": '" + text + "' is not a number");
   }
   if (used != text.size()) throw InputError(option + ": '" + text + "' is not a number");
-  if (!std::isfinite(v) || v <= 0) throw InputError(option + ": must be positive, got '" + text + "'");
+  if (!std::isfinite(v) || v <= 0)
+    throw InputError(option + ": must be positive, got '" + text + "'");
   return v;
 }
 
@@ -64,7 +65,8 @@ const char* id_value_example(const std::string& option) {
 }
 
 /// "ID:VALUE[,ID:VALUE...]" with ids >= 0 and values > 0.
-std::vector<std::pair<int, double>> parse_id_values(const std::string& option, const std::string& text) {
+std::vector<std::pair<int, double>> parse_id_values(const std::string& option,
+                                                    const std::string& text) {
   std::vector<std::pair<int, double>> out;
   std::size_t start = 0;
   while (start <= text.size()) {
@@ -134,16 +136,25 @@ Arguments parse(const std::vector<std::string>& args) {
     a.command = Command::Version;
     return a;
   }
-  if (cmd == "info") a.command = Command::Info;
-  else if (cmd == "mesh") a.command = Command::Mesh;
-  else if (cmd == "crossfield") a.command = Command::CrossField;
-  else if (cmd == "sizemap") a.command = Command::SizeMap;
-  else if (cmd == "example") a.command = Command::Example;
-  else throw InputError("unknown command '" + cmd + "' (commands: info, mesh, crossfield, sizemap, example; see qsmesh --help)");
-  const bool meshing = a.command == Command::Mesh || a.command == Command::CrossField || a.command == Command::SizeMap;
+  if (cmd == "info")
+    a.command = Command::Info;
+  else if (cmd == "mesh")
+    a.command = Command::Mesh;
+  else if (cmd == "crossfield")
+    a.command = Command::CrossField;
+  else if (cmd == "sizemap")
+    a.command = Command::SizeMap;
+  else if (cmd == "example")
+    a.command = Command::Example;
+  else
+    throw InputError("unknown command '" + cmd +
+                     "' (commands: info, mesh, crossfield, sizemap, example; see qsmesh --help)");
+  const bool meshing = a.command == Command::Mesh || a.command == Command::CrossField ||
+                       a.command == Command::SizeMap;
   // Size-map options: the sizemap command and the mesh command (whose quad stages use the size
   // map; with --until background they are refused, see below).
   const bool sizing = a.command == Command::SizeMap || a.command == Command::Mesh;
+  bool sizing_rules_given = false;  // --sizing on the line
 
   std::vector<std::string> positional;
   for (std::size_t i = 1; i < args.size(); ++i) {
@@ -176,8 +187,9 @@ Arguments parse(const std::vector<std::string>& args) {
       const std::string& v = value();
       const auto n = parse_double(v);
       if (!n || !std::isfinite(*n) || *n < 0 || (*n > 0 && *n < 3))
-        throw InputError(opt + ": '" + v +
-                         "' is not 0 (no curvature sizes) or a number of edges per turn of at least 3");
+        throw InputError(
+            opt + ": '" + v +
+            "' is not 0 (no curvature sizes) or a number of edges per turn of at least 3");
       a.curvature_edges = *n;
     } else if (opt == "--face-curvature" && sizing) {
       a.face_curvature = true;
@@ -195,24 +207,30 @@ Arguments parse(const std::vector<std::string>& args) {
       a.size_min_ratio = *r;
     } else if (opt == "--sizing" && sizing) {
       a.sizing = value();
-      if (a.sizing != "paper" && a.sizing != "gmsh")
-        throw InputError("--sizing: unknown rules '" + a.sizing + "' (paper or gmsh)");
+      if (a.sizing == "gmsh") a.sizing = "clamped";  // the name it had before it was the default
+      if (a.sizing != "clamped" && a.sizing != "paper")
+        throw InputError("--sizing: unknown rules '" + a.sizing + "' (clamped, gmsh or paper)");
+      sizing_rules_given = true;
     } else if (opt == "--sizemap" && sizing) {
       a.sizemap = value();
       if (a.sizemap != "features" && a.sizemap != "crossfield")
         throw InputError("--sizemap: unknown method '" + a.sizemap + "' (features or crossfield)");
-    } else if (opt == "--quads" && sizing) a.quads = parse_positive(opt, value());
+    } else if (opt == "--quads" && sizing)
+      a.quads = parse_positive(opt, value());
     else if (opt == "--curve-edges" && sizing) {
       for (const auto& [id, v] : parse_id_values(opt, value())) {
-        if (v != std::floor(v)) throw InputError(opt + ": curve " + std::to_string(id) + ": edge count must be an integer");
+        if (v != std::floor(v))
+          throw InputError(opt + ": curve " + std::to_string(id) +
+                           ": edge count must be an integer");
         if (v > std::numeric_limits<int>::max())
           throw InputError(opt + ": curve " + std::to_string(id) + ": " + item_text(v) +
                            " edges is more than any mesh can hold");
         // Refused here, before any work, rather than by the quantization after the cross fields.
         if (static_cast<long>(v) % 2 != 0)
-          throw InputError(opt + ": curve " + std::to_string(id) + ": " + std::to_string(static_cast<long>(v)) +
-                           " edges prescribed, but all-quad meshing by midpoint subdivision needs an even count "
-                           "(odd counts are not supported yet)");
+          throw InputError(
+              opt + ": curve " + std::to_string(id) + ": " + std::to_string(static_cast<long>(v)) +
+              " edges prescribed, but all-quad meshing by midpoint subdivision needs an even count "
+              "(odd counts are not supported yet)");
         a.curve_edges.emplace_back(id, static_cast<int>(v));
       }
     } else if (opt == "--face-quads" && sizing)
@@ -235,8 +253,10 @@ Arguments parse(const std::vector<std::string>& args) {
     else if (opt == "--quiet" || opt == "-q") a.quiet = true;
     else if (opt == "--verbose" || opt == "-v") a.verbose = true;
     else if (!opt.empty() && opt[0] == '-' && opt.size() > 1)
-      throw InputError("unknown option '" + opt + "' for '" + cmd + "' (see qsmesh " + cmd + " --help)");
-    else positional.push_back(opt);
+      throw InputError("unknown option '" + opt + "' for '" + cmd + "' (see qsmesh " + cmd +
+                       " --help)");
+    else
+      positional.push_back(opt);
   }
   check_unique_ids("--curve-edges", "curve", a.curve_edges);
   check_unique_ids("--curve-size", "curve", a.curve_sizes);
@@ -246,20 +266,21 @@ Arguments parse(const std::vector<std::string>& args) {
   if (a.size && a.size_factor) throw InputError("--size and --size-factor: give one, not both");
   if (a.size_min && a.size_min_ratio)
     throw InputError("--size-min and --size-min-ratio: give one, not both");
-  // Gmsh's rules as the two options that make them; options given explicitly win.
-  if (a.sizing == "gmsh") {
-    if (!a.curvature_edges) a.curvature_edges = 0.0;
-    if (!a.size_min && !a.size_min_ratio) a.size_min_ratio = kGmshSizeMinRatio;
-  }
-  const bool sizing_given = a.sizemap != "crossfield" || a.quads > 0 || a.curvature_edges ||
-                            a.face_curvature || a.feature_ratio || a.size_min || a.size_min_ratio ||
-                            !a.curve_edges.empty() ||
+  // The size-map options asked for on the line; the default rules' own options (below) are not.
+  const bool sizing_given = sizing_rules_given || a.sizemap != "crossfield" || a.quads > 0 ||
+                            a.curvature_edges || a.face_curvature || a.feature_ratio ||
+                            a.size_min || a.size_min_ratio || !a.curve_edges.empty() ||
                             !a.face_quads.empty() || !a.corner_sizes.empty() ||
                             !a.curve_sizes.empty() || !a.face_sizes.empty();
   if (a.command == Command::Mesh && sizing_given && a.until == "background")
     throw InputError(
         "size-map options act on the quad mesh: with --until background only --size or "
         "--size-factor applies");
+  // The clamped rules as the two options that make them; options given explicitly win.
+  if (sizing && a.sizing == "clamped") {
+    if (!a.curvature_edges) a.curvature_edges = 0.0;
+    if (!a.size_min && !a.size_min_ratio) a.size_min_ratio = kClampedSizeMinRatio;
+  }
 
   if (a.command == Command::Example) {
     if (positional.size() != 1)
@@ -274,7 +295,8 @@ Arguments parse(const std::vector<std::string>& args) {
           "': the extension picks the CAD format, .step/.stp (STEP) or .brep/.brp (BREP)");
   } else {
     if (positional.empty()) throw InputError(cmd + ": missing MODEL file (STEP, IGES or BREP)");
-    if (positional.size() > 1) throw InputError(cmd + ": unexpected argument '" + positional[1] + "'");
+    if (positional.size() > 1)
+      throw InputError(cmd + ": unexpected argument '" + positional[1] + "'");
     a.model = positional[0];
     if (a.command == Command::Mesh && a.output.empty())
       throw InputError("mesh: missing -o OUT (.cgns, .vtu, .msh or .h5)");
@@ -284,7 +306,8 @@ Arguments parse(const std::vector<std::string>& args) {
       if (a.until == "background")
         throw InputError("--block-structured needs a quad mesh: not with --until background");
       if (a.order == 2)
-        throw InputError("--block-structured with --order 2: blocks of second-order quads are not written yet");
+        throw InputError(
+            "--block-structured with --order 2: blocks of second-order quads are not written yet");
     }
     if (a.order == 2 && a.until == "background")
       throw InputError("--order 2 needs a quad mesh: not with --until background");
@@ -405,9 +428,9 @@ std::string help(const std::string& topic) {
           "                        (also the conformal scaling of the cross fields; default)\n"
           "  --quads N             target number of quads of the model (default: area / size^2)\n"
           "  --curvature-edges N   edges per full turn on curved curves: a radius R gets edges of\n"
-          "                        2 pi R / N at most (default 16); 0 sizes by the cross field "
-          "and\n"
-          "                        the small CAD features only (paper 000 Sec. 4)\n"
+          "                        2 pi R / N at most (default 0 with the default sizing rules,\n"
+          "                        16 with --sizing paper); 0 sizes by the cross field and the\n"
+          "                        small CAD features only (paper 000 Sec. 4)\n"
           "  --face-curvature      the same bound from the faces' curvature along their curves\n"
           "                        (finer on curved faces, e.g. a wing's leading edge, but the\n"
           "                        isotropic sizes then make the counts of opposite sides "
@@ -418,20 +441,24 @@ std::string help(const std::string& topic) {
           "irregular\n"
           "                        vertices along thin strips and slots\n"
           "  --size-min H          smallest size the size map may ask for (model units; default\n"
-          "                        the size cap / 100); given, it also stops curves shorter than\n"
-          "                        H (sliver edges of the CAD) from refining the mesh around them\n"
-          "                        (they keep their 2 edges)\n"
+          "                        0.17 x the size cap with the default sizing rules, the size\n"
+          "                        cap / 100 with --sizing paper); given, it also stops curves\n"
+          "                        shorter than H (sliver edges of the CAD) from refining the "
+          "mesh\n"
+          "                        around them (they keep their 2 edges)\n"
           "  --size-min-ratio R    the same floor as R times the size cap. With\n"
           "                        --curvature-edges 0 it sizes about as Gmsh's implementation of\n"
           "                        the paper does (no curvature sizes, no feature finer than a\n"
           "                        fraction of the target size): fewer irregular vertices and\n"
-          "                        flatter quads against sliver curves; at coarse sizes curved "
-          "faces\n"
-          "                        may get too few edges and fail (docs/benchmarks.md)\n"
-          "  --sizing RULES        paper (the default: paper 000 Sec. 4.1, a sliver curve refines\n"
-          "                        the mesh around it down to its length) or gmsh (the rules of\n"
-          "                        Gmsh's implementation: --curvature-edges 0 --size-min-ratio\n"
-          "                        0.17, options given explicitly still win)\n"
+          "                        flatter quads against sliver curves; at coarse sizes curved\n"
+          "                        faces may get too few edges and fail (docs/benchmarks.md)\n"
+          "  --sizing RULES        clamped (the default; gmsh is another name for it, the rules\n"
+          "                        of Gmsh's implementation): --curvature-edges 0\n"
+          "                        --size-min-ratio 0.17, options given explicitly still win; no\n"
+          "                        size below the floor, so quads against a sliver curve are\n"
+          "                        flat. paper: paper 000 Sec. 4.1, a sliver curve refines the\n"
+          "                        mesh around it down to its length, with curvature sizes of\n"
+          "                        16 edges per turn and the floor the size cap / 100\n"
           "  --curve-edges C:N,..  prescribe the (even) number of edges of curves; kept exactly\n"
           "  --face-quads F:N,..   prescribe the number of quads of faces\n"
           "  --corner-size K:H,.., --curve-size C:H,.., --face-size F:H,..\n"

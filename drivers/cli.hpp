@@ -14,32 +14,35 @@ enum class Command { Help, Version, Info, Mesh, CrossField, SizeMap, Example };
 
 struct Arguments {
   Command command = Command::Help;
-  std::string help_topic;          ///< command whose --help was asked ("" = general)
-  std::string model;               ///< input CAD file (info, mesh)
-  std::string output;              ///< -o
-  std::optional<double> size;      ///< --size (model units)
+  std::string help_topic;             ///< command whose --help was asked ("" = general)
+  std::string model;                  ///< input CAD file (info, mesh)
+  std::string output;                 ///< -o
+  std::optional<double> size;         ///< --size (model units)
   std::optional<double> size_factor;  ///< --size-factor (fraction of the bounding-box diagonal)
   /// Last stage to run. `unstructured` exists but still fails on some faces of the shared models
   /// (reported per face), so the default stays the furthest stage that is complete.
   std::string until = "quasi-structured";
-  int threads = 0;                 ///< 0: automatic
+  int threads = 0;  ///< 0: automatic
   /// --face-time-budget S: wall-clock seconds the topological improvement (cavity remeshing,
   /// paper 000 Sec. 6.2) may spend on one face (0: no bound; the result is then reproducible).
   double face_time_budget = 0;
-  std::string stats;               ///< --stats FILE.json
+  std::string stats;  ///< --stats FILE.json
   /// --block-structured: write the CGNS file as structured blocks of the quad layout
   /// (layout::extract_quad_layout, io::write_cgns_blocks) instead of one unstructured zone.
   bool block_structured = false;
   /// --order 2: second-order quads (9 nodes) and bars (3 nodes) on the CAD
   /// (highorder::make_quadratic); 1: linear.
   int order = 1;
-  bool json = false;               ///< info --json
-  bool check = false;              ///< crossfield --check
+  bool json = false;                   ///< info --json
+  bool check = false;                  ///< crossfield --check
   std::string sizemap = "crossfield";  ///< --sizemap features|crossfield
-  /// --sizing paper|gmsh: "gmsh" stands for --curvature-edges 0 --size-min-ratio
-  /// kGmshSizeMinRatio where those (or --size-min) are not given (applied by parse).
-  std::string sizing = "paper";
-  double quads = 0;                ///< --quads N: target quad count of the model (0: from the size)
+  /// --sizing clamped|paper (gmsh: an alias of clamped, recorded as "clamped"). "clamped", the
+  /// default, stands for --curvature-edges 0 --size-min-ratio kClampedSizeMinRatio where those (or
+  /// --size-min) are not given (applied by parse, for sizemap and mesh); "paper" keeps rule (i) of
+  /// paper 000 Sec. 4.1 (a curve sizes the mesh by its length, below every floor) and the
+  /// curvature sizes of sizemap::SizeMapOptions.
+  std::string sizing = "clamped";
+  double quads = 0;  ///< --quads N: target quad count of the model (0: from the size)
   /// --curvature-edges N: edges per full turn on curved curves and faces (0: no curvature sizes;
   /// unset: sizemap::SizeMapOptions' default).
   std::optional<double> curvature_edges;
@@ -54,26 +57,26 @@ struct Arguments {
   std::optional<double> size_min;
   /// --size-min-ratio R: the same floor as R times the size cap (0 < R <= 1; not with --size-min).
   std::optional<double> size_min_ratio;
-  std::vector<std::pair<int, int>> curve_edges;       ///< --curve-edges C:N,...
-  std::vector<std::pair<int, double>> face_quads;     ///< --face-quads F:N,...
-  std::vector<std::pair<int, double>> corner_sizes;   ///< --corner-size K:H,...
-  std::vector<std::pair<int, double>> curve_sizes;    ///< --curve-size C:H,...
-  std::vector<std::pair<int, double>> face_sizes;     ///< --face-size F:H,...
+  std::vector<std::pair<int, int>> curve_edges;      ///< --curve-edges C:N,...
+  std::vector<std::pair<int, double>> face_quads;    ///< --face-quads F:N,...
+  std::vector<std::pair<int, double>> corner_sizes;  ///< --corner-size K:H,...
+  std::vector<std::pair<int, double>> curve_sizes;   ///< --curve-size C:H,...
+  std::vector<std::pair<int, double>> face_sizes;    ///< --face-size F:H,...
   /// --max-quads N: refuse, before any work, a run whose estimated quad count is above N
   /// (0: no bound; the machine's memory still bounds it). See kDefaultMaxQuads.
   double max_quads = -1;  ///< -1: kDefaultMaxQuads
   bool sew = false;
   bool quiet = false;
   bool verbose = false;
-  std::string example_name;        ///< example NAME
+  std::string example_name;  ///< example NAME
 };
 
 /// Default --size-factor when neither --size nor --size-factor is given: a medium mesh.
 inline constexpr double kDefaultSizeFactor = 0.02;
-/// The floor of --sizing gmsh, as a fraction of the size cap: the value at which all six shared
-/// models meet the Gmsh reference runs' criteria (docs/benchmarks.md, fifteenth session; 0.10 and
-/// 0.25 miss wing_fuselage's).
-inline constexpr double kGmshSizeMinRatio = 0.17;
+/// The floor of --sizing clamped (the default; Gmsh's implementation sizes alike), as a fraction
+/// of the size cap: the value at which all six shared models meet the Gmsh reference runs'
+/// criteria (docs/benchmarks.md, fifteenth session; 0.10 and 0.25 miss wing_fuselage's).
+inline constexpr double kClampedSizeMinRatio = 0.17;
 
 /// Default --max-quads: far above any mesh the project has been run on (1.2M vertices) and far
 /// below what a mistyped size asks for (--size-factor 1e-6: about 1e12 quads), so that a runaway

@@ -302,6 +302,9 @@ struct QuasiTotals {
   std::array<std::int64_t, 4> cavities{};                  // remeshed, by step
   std::int64_t defects_before = 0, defects_after = 0, disk_replaced = 0;  // Sec. 6.3
   std::int64_t time_budget_hit = 0;  // faces whose cavity remeshing stopped on --face-time-budget
+  // Faces whose kept fill, with a poor mean, gave way to their unstructured mesh
+  // (qstruct::unstructured_clearly_better).
+  std::int64_t fill_gave_way = 0;
 };
 
 QuasiTotals quasi_totals(const parallel::PipelineResult& r) {
@@ -316,6 +319,8 @@ QuasiTotals quasi_totals(const parallel::PipelineResult& r) {
     t.defects_after += q.defects_after;
     t.disk_replaced += q.disk_replaced;
     t.time_budget_hit += q.time_budget_hit ? 1 : 0;
+    if (!q.by_pattern && q.refusal == qstruct::to_string(qstruct::Refusal::UnstructuredBetter))
+      ++t.fill_gave_way;
   }
   return t;
 }
@@ -329,7 +334,7 @@ std::string stats_json(const Arguments& args, const Session& session,
   write_run_header(j, args, session);
   j.value("output", args.output);
   j.value("stage", args.until);
-  j.value("sizing", args.sizing);  // paper or gmsh (--sizing); the options below are its result
+  j.value("sizing", args.sizing);  // clamped or paper (--sizing); the options below are its result
   j.value("curvature_edges", curvature_edges(args));  // edges per full turn (0: none)
   j.value("face_curvature", args.face_curvature);
   j.value("feature_ratio", feature_ratio(args));
@@ -354,6 +359,9 @@ std::string stats_json(const Arguments& args, const Session& session,
     // Of those, the faces whose pattern mesh the quality thresholds refused but which was no
     // worse than the unstructured path's (PipelineOptions::pattern_compare_tolerance).
     j.value("faces_meshed_by_pattern_after_comparison", t.by_comparison);
+    // Faces whose fill passed with a poor mean but whose unstructured mesh was clearly better on
+    // average (qstruct::PatternFaceOptions::compare_below_avg, compare_avg_margin).
+    j.value("faces_fill_gave_way_to_unstructured", t.fill_gave_way);
     // Sec. 6.2 on the other faces: interior irregular vertices of their unstructured meshes
     // before and after cavity remeshing, cavities remeshed by step.
     j.value("irregular_unstructured_before", t.irregular_before);
@@ -377,6 +385,12 @@ std::string stats_json(const Arguments& args, const Session& session,
   if (!r.face_stats.empty()) j.value("irregular_boundary", total_irregular_boundary(r));
   j.value("sicn_min", s.sicn_min);
   j.value("sicn_avg", s.sicn_avg);
+  // Quads with SICN < 0.1, and of them those at a CAD corner sharper than 8 degrees in their face
+  // (no quad there does better); the rest by face in face_stats.
+  j.value("quads_sicn_below_0_1", s.quads_sicn_below_0_1);
+  j.value("quads_sicn_below_0_1_forced_by_corner", s.quads_sicn_below_0_1_forced_by_corner);
+  j.value("quads_sicn_below_0_1_other",
+          s.quads_sicn_below_0_1 - s.quads_sicn_below_0_1_forced_by_corner);
   j.value("triangle_quality_min", s.tri_quality_min);
   j.value("triangle_quality_avg", s.tri_quality_avg);
   j.value("min_angle_deg", s.min_angle_deg);
@@ -451,6 +465,8 @@ std::string stats_json(const Arguments& args, const Session& session,
           .value("irregular_boundary", st.irregular_boundary)
           .value("sicn_min", st.sicn_min)
           .value("sicn_avg", st.sicn_avg)
+          .value("quads_sicn_below_0_1",  // not forced by a sharp CAD corner
+                 f < s.face_quads_sicn_below_0_1.size() ? s.face_quads_sicn_below_0_1[f] : 0)
           .value("seconds", r.face_seconds[f])
           .value("time_budget_hit", !r.quasi_reports.empty() && r.quasi_reports[f].time_budget_hit)
           .end_object();
@@ -476,7 +492,11 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
   if (!r.face_stats.empty())
     os << "  boundary vertices away from their ideal valence (per face): "
        << total_irregular_boundary(r) << "\n";
-  if (s.quads > 0) os << "  SICN min/avg: " << s.sicn_min << " / " << s.sicn_avg << "\n";
+  if (s.quads > 0)
+    os << "  SICN min/avg: " << s.sicn_min << " / " << s.sicn_avg << "\n"
+       << "  quads with SICN < 0.1: " << s.quads_sicn_below_0_1 << " ("
+       << s.quads_sicn_below_0_1_forced_by_corner
+       << " at CAD corners sharper than 8 deg, where no quad does better)\n";
   if (!r.curves_refined_for_crossings.empty()) {
     LO refined = 0;
     for (const LO n : r.curves_refined_for_crossings) refined += n;
@@ -488,6 +508,9 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
     if (t.by_comparison > 0)
       os << " (" << t.by_comparison
          << " of them as good as their unstructured mesh, below the pattern thresholds)";
+    if (t.fill_gave_way > 0)
+      os << "; " << t.fill_gave_way
+         << " fill(s) with a poor mean gave way to a clearly better unstructured mesh";
     os << "\n"
        << "  cavity remeshing (other faces): irregular interior vertices " << t.irregular_before
        << " -> " << t.irregular_after << "; cavities remeshed by step " << t.cavities[0] << ", "
@@ -619,7 +642,7 @@ Session::Session(const Arguments& args, const char* command)
 void Session::announce(const Arguments& args, const char* command) {
   log.info(cat("qsmesh ", command, " ", args.model, ": ", model.num_corners(), " corners, ",
                model.num_curves(), " curves, ", model.num_faces(), " faces; size ", size,
-               args.sizing == "paper" ? "" : " (" + args.sizing + " sizing rules)", "; ", ranks,
+               args.sizing == "clamped" ? "" : " (" + args.sizing + " sizing rules)", "; ", ranks,
                " rank(s) x ", threads, " thread(s)"));
 }
 
@@ -715,8 +738,8 @@ void note_sliver_curves(Session& s, const sizemap::SizeMapOptions& so) {
                  " shorter than the size floor ", floor, " (shortest: curve ", shortest, ", ",
                  s.model.curves()[shortest].length,
                  "); the sizes around them grade down to their length (paper 000 Sec. 4.1), with "
-                 "irregular vertices in the transition; --size-min H or --size-min-ratio R stops "
-                 "that"));
+                 "irregular vertices in the transition; --size-min H, --size-min-ratio R or the "
+                 "default --sizing clamped stops that"));
 }
 }  // namespace
 

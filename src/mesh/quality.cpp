@@ -130,30 +130,58 @@ MeshStats compute_stats(const SurfaceMesh& mesh) {
     if (valence[v] != regular) ++s.irregular_interior;
   }
 
+  // Angle of each face at each CAD corner: the sum of its elements' 3D angles there.
+  std::unordered_map<std::int64_t, double> corner_angle;
+  auto key = [](LO face, GO corner) { return (static_cast<std::int64_t>(face) << 32) | corner; };
+  std::vector<std::array<double, 3>> angles(mesh.triangles.size());
+  for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
+    const auto& t = mesh.triangles[i];
+    angles[i] = triangle_angles(mesh.points[t[0]], mesh.points[t[1]], mesh.points[t[2]]);
+    for (int k = 0; k < 3; ++k)
+      if (mesh.vclass[t[k]].dim == 0)
+        corner_angle[key(mesh.triangle_face[i], t[k])] += angles[i][k];
+  }
+  const bool quad_faces = mesh.quad_face.size() == mesh.quads.size();
+  if (quad_faces)
+    for (std::size_t i = 0; i < mesh.quads.size(); ++i) {
+      const auto& q = mesh.quads[i];
+      for (int k = 0; k < 4; ++k)
+        if (mesh.vclass[q[k]].dim == 0)
+          corner_angle[key(mesh.quad_face[i], q[k])] += triangle_angles(
+              mesh.points[q[k]], mesh.points[q[(k + 1) % 4]], mesh.points[q[(k + 3) % 4]])[0];
+    }
+
   if (s.quads > 0) {
     double sum = 0;
     s.sicn_min = std::numeric_limits<double>::max();
-    for (const auto& q : mesh.quads) {
+    if (quad_faces)
+      s.face_quads_sicn_below_0_1.assign(static_cast<std::size_t>(mesh.num_cad_faces), 0);
+    for (std::size_t i = 0; i < mesh.quads.size(); ++i) {
+      const auto& q = mesh.quads[i];
       const double v =
           quad_sicn({mesh.points[q[0]], mesh.points[q[1]], mesh.points[q[2]], mesh.points[q[3]]});
       s.sicn_min = std::min(s.sicn_min, v);
       sum += v;
+      if (!(v < kPoorSicn)) continue;
+      ++s.quads_sicn_below_0_1;
+      bool forced = false;
+      for (int k = 0; k < 4 && quad_faces && !forced; ++k)
+        if (mesh.vclass[q[k]].dim == 0) {
+          const auto it = corner_angle.find(key(mesh.quad_face[i], q[k]));
+          forced = it != corner_angle.end() && it->second < kForcingCornerDeg;
+        }
+      if (forced) {
+        ++s.quads_sicn_below_0_1_forced_by_corner;
+      } else if (quad_faces) {
+        const LO f = mesh.quad_face[i];
+        if (f >= 0 && static_cast<std::size_t>(f) < s.face_quads_sicn_below_0_1.size())
+          ++s.face_quads_sicn_below_0_1[static_cast<std::size_t>(f)];
+      }
     }
     s.sicn_avg = sum / static_cast<double>(s.quads);
   }
 
   if (s.triangles > 0) {
-    // Angle of each face at each CAD corner: the sum of its triangles' angles there.
-    std::unordered_map<std::int64_t, double> corner_angle;
-    auto key = [](LO face, GO corner) { return (static_cast<std::int64_t>(face) << 32) | corner; };
-    std::vector<std::array<double, 3>> angles(mesh.triangles.size());
-    for (std::size_t i = 0; i < mesh.triangles.size(); ++i) {
-      const auto& t = mesh.triangles[i];
-      angles[i] = triangle_angles(mesh.points[t[0]], mesh.points[t[1]], mesh.points[t[2]]);
-      for (int k = 0; k < 3; ++k)
-        if (mesh.vclass[t[k]].dim == 0)
-          corner_angle[key(mesh.triangle_face[i], t[k])] += angles[i][k];
-    }
     // Curves forming a sharp corner of a face: (face, curve) pairs.
     std::unordered_map<std::int64_t, std::vector<GO>> sharp_curves;  // face -> corners
     for (const auto& [k, angle] : corner_angle)

@@ -327,8 +327,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
       log.info(cat("quantize: faces fitting a pattern ", result.balance.fitting_before, " -> ",
                    result.balance.fitting_after, " of ", result.balance.faces_considered,
                    ", grids ", result.balance.grids_before, " -> ", result.balance.grids_after,
-                   " (",
-                   result.balance.curves_changed, " curves changed)"));
+                   " (", result.balance.curves_changed, " curves changed)"));
     }
     // Boundary repair: a face whose boundary crosses itself in its parameter plane cannot be
     // triangulated. Each rank checks its own faces; the flags are summed, so every rank refines
@@ -398,6 +397,9 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
   struct RefusedFill {
     mesh::FaceMesh mesh;
     std::string pattern;
+    // A kept fill with a poor mean (qstruct::fill_to_compare), held back until the face's
+    // unstructured mesh is known (qstruct::unstructured_clearly_better decides between them).
+    bool kept = false;
   };
   std::vector<RefusedFill> refused(quasi ? mine.size() : 0);
   // The quad bound of each face's fills (0: none), by face id: computed by the face's owner,
@@ -454,7 +456,9 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     // Fills to their owners.
     const auto take = [&](std::int64_t i, Fill&& fill) {
       const qstruct::PatternFaceReport& pr = fill.report;
-      if (pr.ok) {
+      if (pr.ok && qstruct::fill_to_compare(pr.sicn_avg, pr.quads, options.patterns)) {
+        refused[i] = {std::move(fill.mesh), pr.pattern_name, true};
+      } else if (pr.ok) {
         quasi_reports[i].by_pattern = true;
         quasi_reports[i].pattern = pr.pattern_name;
         quad_reports[i].ok = true;
@@ -484,6 +488,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
         put<qstruct::Refusal>(outgoing, pr.refusal);
         put_string(outgoing, pr.pattern_name);
         put<double>(outgoing, pr.sicn_min);
+        put<double>(outgoing, pr.sicn_avg);
         put<std::int64_t>(outgoing, pr.quads);
         pack_mesh(fill.mesh, outgoing);
         pack_mesh(pr.refused_mesh, outgoing);
@@ -502,6 +507,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
           pr.refusal = get<qstruct::Refusal>(bytes, pos);
           pr.pattern_name = get_string(bytes, pos);
           pr.sicn_min = get<double>(bytes, pos);
+          pr.sicn_avg = get<double>(bytes, pos);
           pr.quads = get<std::int64_t>(bytes, pos);
           unpack_mesh(bytes, pos, fill.mesh);
           unpack_mesh(bytes, pos, pr.refused_mesh);
@@ -626,11 +632,22 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
       tasks.parallel_for(total, [&](std::int64_t i) {
         if (refused[i].mesh.quads.empty()) return;
         const mesh::FaceQuadStats pat = mesh::face_quad_stats(refused[i].mesh);
+        const bool kept = refused[i].kept;
         bool take = no_valid_quads(i);
         if (!take) {
           const mesh::FaceQuadStats uns = mesh::face_quad_stats(quad_meshes[i]);
-          take = pat.sicn_min >= uns.sicn_min - tol && pat.sicn_avg >= uns.sicn_avg - tol &&
-                 pat.irregular_interior <= uns.irregular_interior;
+          if (kept) {
+            take = !qstruct::unstructured_clearly_better(pat, uns, options.patterns);
+            log.debug(cat("face ", mine[i], ": kept fill (", refused[i].pattern, ", ", pat.quads,
+                          " quads, SICN ", pat.sicn_min, " / ", pat.sicn_avg,
+                          ") against unstructured (", uns.quads, " quads, SICN ", uns.sicn_min,
+                          " / ", uns.sicn_avg, "): ", take ? "fill" : "unstructured"));
+            if (!take)
+              quasi_reports[i].refusal = qstruct::to_string(qstruct::Refusal::UnstructuredBetter);
+          } else {
+            take = pat.sicn_min >= uns.sicn_min - tol && pat.sicn_avg >= uns.sicn_avg - tol &&
+                   pat.irregular_interior <= uns.irregular_interior;
+          }
         }
         if (take) {
           quad_meshes[i] = std::move(refused[i].mesh);
@@ -639,8 +656,9 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
           quad_reports[i].sicn_min = pat.sicn_min;
           quad_reports[i].quads = pat.quads;
           quasi_reports[i].by_pattern = true;
-          quasi_reports[i].by_comparison = true;
+          quasi_reports[i].by_comparison = !kept;  // that one passed the thresholds
           quasi_reports[i].pattern = refused[i].pattern;
+          if (kept) quasi_reports[i].refusal.clear();
         }
         refused[i] = RefusedFill{};
       });

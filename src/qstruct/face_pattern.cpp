@@ -18,15 +18,38 @@ namespace qsmesh::qstruct {
 
 const char* to_string(Refusal r) {
   switch (r) {
-    case Refusal::None: return "none";
-    case Refusal::Loops: return "loops";
-    case Refusal::Degenerate: return "degenerate";
-    case Refusal::NoPattern: return "no_pattern";
-    case Refusal::Quality: return "quality";
-    case Refusal::TooManyQuads: return "too_many_quads";
-    case Refusal::Error: return "error";
+    case Refusal::None:
+      return "none";
+    case Refusal::Loops:
+      return "loops";
+    case Refusal::Degenerate:
+      return "degenerate";
+    case Refusal::NoPattern:
+      return "no_pattern";
+    case Refusal::Quality:
+      return "quality";
+    case Refusal::TooManyQuads:
+      return "too_many_quads";
+    case Refusal::Error:
+      return "error";
+    case Refusal::UnstructuredBetter:
+      return "unstructured_better";
   }
   return "?";
+}
+
+bool fill_to_compare(double sicn_avg, std::int64_t quads, const PatternFaceOptions& options) {
+  return options.compare_avg_margin >= 0 && quads > options.small_fill_quads &&
+         !(sicn_avg > options.compare_below_avg);
+}
+
+bool unstructured_clearly_better(const mesh::FaceQuadStats& fill,
+                                 const mesh::FaceQuadStats& unstructured,
+                                 const PatternFaceOptions& options) {
+  if (options.compare_avg_margin < 0) return false;
+  if (unstructured.quads <= 0 || unstructured.triangles > 0) return false;
+  return unstructured.sicn_min > options.min_sicn &&
+         unstructured.sicn_avg > fill.sicn_avg + options.compare_avg_margin;
 }
 
 namespace {
@@ -37,7 +60,8 @@ Vec3 project_tangent(const Vec3& t, const Vec3& n) { return t - n * dot(t, n); }
 
 // Tangent of a curve use at its start (at_end false) or end, along the traversal direction.
 // Where the parametrisation stalls (zero derivative), the first or last mesh edge stands in.
-Vec3 use_tangent(const cad::CadModel& model, const cad::CurveUse& use, const mesh::CurveMesh& cm, bool at_end) {
+Vec3 use_tangent(const cad::CadModel& model, const cad::CurveUse& use, const mesh::CurveMesh& cm,
+                 bool at_end) {
   const cad::Curve& curve = model.curves()[use.curve];
   const bool at_t1 = at_end != use.reversed;
   const auto geo = model.curve_geometry(use.curve);
@@ -60,8 +84,8 @@ struct Candidate {
   int score = 0;        // boundary valence mismatch at the corners that do not split sides
 };
 
-mesh::FaceMesh build_mesh(LO f, const cad::Face& face, const cad::FaceGeometry& surface, const FaceSides& fs,
-                          const Candidate& cand) {
+mesh::FaceMesh build_mesh(LO f, const cad::Face& face, const cad::FaceGeometry& surface,
+                          const FaceSides& fs, const Candidate& cand) {
   const LO nb = static_cast<LO>(fs.points.size());
   const RefinedPattern& r = cand.refined;
   std::vector<LO> r2m(static_cast<std::size_t>(r.num_vertices), kNoIndex);
@@ -277,9 +301,9 @@ LO ring_layers(const FaceSides& fs) {
 
 // Matching, ranking and geometric trials for one split of the boundary into sides. Fills `rep`
 // (ok, or the refusal and its reason) and returns the mesh kept, or an empty one.
-mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& surface, const FaceSides& fs,
-                         std::span<const Pattern> patterns, const PatternFaceOptions& options,
-                         PatternFaceReport& rep) {
+mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& surface,
+                         const FaceSides& fs, std::span<const Pattern> patterns,
+                         const PatternFaceOptions& options, PatternFaceReport& rep) {
   const ErrorContext context{"qstruct", 2, f};
   mesh::FaceMesh empty;
   empty.face = f;
@@ -601,9 +625,10 @@ int side_of(const FaceSides& fs, LO pos) {
                                      : static_cast<int>(after - fs.corners.begin()) - 1;
 }
 
-mesh::FaceMesh mesh_face_pattern(const cad::CadModel& model, LO f, std::span<const mesh::CurveMesh> full_curves,
-                                 std::span<const Pattern> patterns, const PatternFaceOptions& options,
-                                 PatternFaceReport* report) {
+mesh::FaceMesh mesh_face_pattern(const cad::CadModel& model, LO f,
+                                 std::span<const mesh::CurveMesh> full_curves,
+                                 std::span<const Pattern> patterns,
+                                 const PatternFaceOptions& options, PatternFaceReport* report) {
   PatternFaceReport local;
   PatternFaceReport& rep = report != nullptr ? *report : local;
   rep = PatternFaceReport{};
@@ -617,7 +642,9 @@ mesh::FaceMesh mesh_face_pattern(const cad::CadModel& model, LO f, std::span<con
     return empty;
   };
   const cad::Face& face = model.faces()[f];
-  if (face.loops.size() != 1) return refuse(Refusal::Loops, "the face has " + std::to_string(face.loops.size()) + " boundary loops");
+  if (face.loops.size() != 1)
+    return refuse(Refusal::Loops,
+                  "the face has " + std::to_string(face.loops.size()) + " boundary loops");
   if (!face.loops_closed) return refuse(Refusal::Loops, "the boundary loop is not closed");
   try {
     const auto surface = model.face_geometry(f);

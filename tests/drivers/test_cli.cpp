@@ -28,13 +28,16 @@ TEST(Cli, MeshOptions) {
   EXPECT_EQ(a.threads, 3);
   EXPECT_EQ(a.stats, "s.json");
   EXPECT_EQ(a.until, "background");
-  EXPECT_DOUBLE_EQ(*p({"mesh", "m.step", "-o", "o.vtu", "--size-factor", "0.01"}).size_factor, 0.01);
+  EXPECT_DOUBLE_EQ(*p({"mesh", "m.step", "-o", "o.vtu", "--size-factor", "0.01"}).size_factor,
+                   0.01);
   // The default is the furthest stage that exists.
   EXPECT_EQ(p({"mesh", "m.step", "-o", "o.vtu"}).until, "quasi-structured");
   // No time budget unless asked: the mesh then does not depend on timing.
   EXPECT_EQ(p({"mesh", "m.step", "-o", "o.vtu"}).face_time_budget, 0.0);
-  EXPECT_DOUBLE_EQ(p({"mesh", "m.step", "-o", "o.vtu", "--face-time-budget", "0.5"}).face_time_budget, 0.5);
-  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--face-time-budget", "-1"}).find("--face-time-budget"),
+  EXPECT_DOUBLE_EQ(
+      p({"mesh", "m.step", "-o", "o.vtu", "--face-time-budget", "0.5"}).face_time_budget, 0.5);
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--face-time-budget", "-1"})
+                .find("--face-time-budget"),
             std::string::npos);
   EXPECT_NE(help("mesh").find("--face-time-budget"), std::string::npos);
 }
@@ -79,65 +82,101 @@ TEST(Cli, HelpEverywhere) {
 }
 
 TEST(Cli, BadSizesNameTheOption) {
-  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--size", "-1"}).find("--size: must be positive"), std::string::npos);
-  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--size", "0"}).find("--size"), std::string::npos);
-  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--size", "abc"}).find("not a number"), std::string::npos);
-  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--size", "1.5x"}).find("not a number"), std::string::npos);
-  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--size-factor", "nan"}).find("--size-factor"), std::string::npos);
-  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--size", "1", "--size-factor", "0.1"}).find("not both"), std::string::npos);
-  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--threads", "0"}).find("--threads"), std::string::npos);
-  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--size"}).find("missing value"), std::string::npos);
+  EXPECT_NE(
+      error_of({"mesh", "m.step", "-o", "o.vtu", "--size", "-1"}).find("--size: must be positive"),
+      std::string::npos);
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--size", "0"}).find("--size"),
+            std::string::npos);
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--size", "abc"}).find("not a number"),
+            std::string::npos);
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--size", "1.5x"}).find("not a number"),
+            std::string::npos);
+  EXPECT_NE(
+      error_of({"mesh", "m.step", "-o", "o.vtu", "--size-factor", "nan"}).find("--size-factor"),
+      std::string::npos);
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--size", "1", "--size-factor", "0.1"})
+                .find("not both"),
+            std::string::npos);
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--threads", "0"}).find("--threads"),
+            std::string::npos);
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--size"}).find("missing value"),
+            std::string::npos);
 }
 
-TEST(Cli, GmshSizingIsItsTwoOptions) {
-  // --sizing gmsh stands for --curvature-edges 0 --size-min-ratio 0.17; options given explicitly
-  // win, whatever their place on the line.
-  const Arguments g = p({"mesh", "m.step", "-o", "o.vtu", "--sizing", "gmsh"});
-  EXPECT_EQ(g.sizing, "gmsh");
+TEST(Cli, ClampedSizingIsTheDefaultAndItsTwoOptions) {
+  // The default rules, clamped, stand for --curvature-edges 0 --size-min-ratio 0.17; gmsh is
+  // another name for them (recorded as clamped); options given explicitly win, whatever their
+  // place on the line.
+  const Arguments d = p({"mesh", "m.step", "-o", "o.vtu"});
+  EXPECT_EQ(d.sizing, "clamped");
+  ASSERT_TRUE(d.curvature_edges && d.size_min_ratio);
+  EXPECT_DOUBLE_EQ(*d.curvature_edges, 0.0);
+  EXPECT_DOUBLE_EQ(*d.size_min_ratio, kClampedSizeMinRatio);
+  EXPECT_FALSE(d.size_min);
+  const Arguments g = p({"sizemap", "m.step", "-o", "s.vtu", "--sizing", "gmsh"});
+  EXPECT_EQ(g.sizing, "clamped");
   ASSERT_TRUE(g.curvature_edges && g.size_min_ratio);
   EXPECT_DOUBLE_EQ(*g.curvature_edges, 0.0);
-  EXPECT_DOUBLE_EQ(*g.size_min_ratio, kGmshSizeMinRatio);
-  EXPECT_FALSE(g.size_min);
+  EXPECT_DOUBLE_EQ(*g.size_min_ratio, kClampedSizeMinRatio);
   const Arguments e = p({"sizemap", "m.step", "-o", "s.vtu", "--curvature-edges", "8", "--sizing",
-                         "gmsh", "--size-min", "0.4"});
+                         "clamped", "--size-min", "0.4"});
   EXPECT_DOUBLE_EQ(*e.curvature_edges, 8.0);
   EXPECT_DOUBLE_EQ(*e.size_min, 0.4);
   EXPECT_FALSE(e.size_min_ratio);
-  const Arguments d = p({"mesh", "m.step", "-o", "o.vtu"});
-  EXPECT_EQ(d.sizing, "paper");
-  EXPECT_FALSE(d.curvature_edges || d.size_min_ratio);
-  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--sizing", "fast"}).find("paper or gmsh"),
+  // paper: rule (i) of Sec. 4.1 below every floor, SizeMapOptions' defaults.
+  const Arguments pa = p({"mesh", "m.step", "-o", "o.vtu", "--sizing", "paper"});
+  EXPECT_EQ(pa.sizing, "paper");
+  EXPECT_FALSE(pa.curvature_edges || pa.size_min_ratio || pa.size_min);
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--sizing", "fast"}).find("clamped, gmsh"),
             std::string::npos);
-  // Like every sizing option, not with --until background, where it would change nothing.
+  // The default rules do not refuse --until background; named on the line, like every sizing
+  // option, they do, since they would change nothing there.
+  EXPECT_EQ(error_of({"mesh", "m.step", "-o", "o.vtu", "--until", "background"}), "");
   EXPECT_NE(
       error_of({"mesh", "m.step", "-o", "o.vtu", "--sizing", "gmsh", "--until", "background"}), "");
+  EXPECT_NE(
+      error_of({"mesh", "m.step", "-o", "o.vtu", "--sizing", "paper", "--until", "background"}),
+      "");
+  // Commands without a size map get none of its options.
+  const Arguments c = p({"crossfield", "m.step", "-o", "c.vtu"});
+  EXPECT_FALSE(c.curvature_edges || c.size_min_ratio);
 }
 
 TEST(Cli, SizeMapOptions) {
-  const Arguments a = p({"sizemap", "m.step", "-o", "s.vtu", "--sizemap", "features", "--curve-edges", "3:8,7:12",
-                         "--face-quads", "2:100", "--corner-size", "0:0.5", "--curve-size", "4:1.5",
-                         "--face-size", "1:2", "--quads", "5000"});
+  const Arguments a =
+      p({"sizemap", "m.step", "-o", "s.vtu", "--sizemap", "features", "--curve-edges", "3:8,7:12",
+         "--face-quads", "2:100", "--corner-size", "0:0.5", "--curve-size", "4:1.5", "--face-size",
+         "1:2", "--quads", "5000"});
   EXPECT_EQ(a.command, Command::SizeMap);
   EXPECT_EQ(a.sizemap, "features");
   EXPECT_EQ(a.curve_edges, (std::vector<std::pair<int, int>>{{3, 8}, {7, 12}}));
   EXPECT_EQ(a.face_quads, (std::vector<std::pair<int, double>>{{2, 100.0}}));
   EXPECT_EQ(a.corner_sizes, (std::vector<std::pair<int, double>>{{0, 0.5}}));
   EXPECT_DOUBLE_EQ(a.quads, 5000);
-  EXPECT_NE(error_of({"sizemap", "m.step", "-o", "s.vtu", "--sizemap", "magic"}).find("--sizemap"), std::string::npos);
-  EXPECT_NE(error_of({"sizemap", "m.step", "-o", "s.vtu", "--curve-edges", "3"}).find("ID:VALUE"), std::string::npos);
-  EXPECT_NE(error_of({"sizemap", "m.step", "-o", "s.vtu", "--curve-edges", "x:4"}).find("entity id"), std::string::npos);
-  EXPECT_NE(error_of({"sizemap", "m.step", "-o", "s.vtu", "--curve-edges", "3:4.5"}).find("integer"), std::string::npos);
-  EXPECT_NE(error_of({"sizemap", "m.step", "-o", "s.vtu", "--curve-size", "3:-1"}).find("positive"), std::string::npos);
+  EXPECT_NE(error_of({"sizemap", "m.step", "-o", "s.vtu", "--sizemap", "magic"}).find("--sizemap"),
+            std::string::npos);
+  EXPECT_NE(error_of({"sizemap", "m.step", "-o", "s.vtu", "--curve-edges", "3"}).find("ID:VALUE"),
+            std::string::npos);
+  EXPECT_NE(
+      error_of({"sizemap", "m.step", "-o", "s.vtu", "--curve-edges", "x:4"}).find("entity id"),
+      std::string::npos);
+  EXPECT_NE(
+      error_of({"sizemap", "m.step", "-o", "s.vtu", "--curve-edges", "3:4.5"}).find("integer"),
+      std::string::npos);
+  EXPECT_NE(error_of({"sizemap", "m.step", "-o", "s.vtu", "--curve-size", "3:-1"}).find("positive"),
+            std::string::npos);
   EXPECT_NE(error_of({"sizemap", "m.step"}).find("missing -o"), std::string::npos);
   // The mesh command takes them too (its quad stages use the size map), but not with --until
   // background, where they would change nothing: refused rather than silently ignored.
-  const Arguments m = p({"mesh", "m.step", "-o", "o.vtu", "--curve-edges", "3:8", "--curvature-edges", "0",
-                         "--curve-size", "4:1.5", "--quads", "5000"});
+  const Arguments m = p({"mesh", "m.step", "-o", "o.vtu", "--curve-edges", "3:8",
+                         "--curvature-edges", "0", "--curve-size", "4:1.5", "--quads", "5000"});
   EXPECT_EQ(m.curve_edges, (std::vector<std::pair<int, int>>{{3, 8}}));
   ASSERT_TRUE(m.curvature_edges.has_value());
   EXPECT_DOUBLE_EQ(*m.curvature_edges, 0.0);
-  EXPECT_DOUBLE_EQ(*p({"sizemap", "m.step", "-o", "s.vtu", "--curvature-edges", "8"}).curvature_edges, 8.0);
-  EXPECT_FALSE(p({"mesh", "m.step", "-o", "o.vtu"}).curvature_edges.has_value());
+  EXPECT_DOUBLE_EQ(
+      *p({"sizemap", "m.step", "-o", "s.vtu", "--curvature-edges", "8"}).curvature_edges, 8.0);
+  EXPECT_FALSE(
+      p({"mesh", "m.step", "-o", "o.vtu", "--sizing", "paper"}).curvature_edges.has_value());
   EXPECT_FALSE(p({"mesh", "m.step", "-o", "o.vtu"}).face_curvature);
   EXPECT_TRUE(p({"sizemap", "m.step", "-o", "s.vtu", "--face-curvature"}).face_curvature);
   EXPECT_FALSE(p({"mesh", "m.step", "-o", "o.vtu"}).feature_ratio.has_value());
@@ -156,31 +195,36 @@ TEST(Cli, SizeMapOptions) {
     EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--size-min", bad}).find("--size-min"),
               std::string::npos)
         << bad;
-  EXPECT_FALSE(p({"mesh", "m.step", "-o", "o.vtu"}).size_min_ratio.has_value());
-  EXPECT_DOUBLE_EQ(
-      *p({"mesh", "m.step", "-o", "o.vtu", "--size-min-ratio", "0.17"}).size_min_ratio, 0.17);
+  EXPECT_FALSE(
+      p({"mesh", "m.step", "-o", "o.vtu", "--sizing", "paper"}).size_min_ratio.has_value());
+  EXPECT_DOUBLE_EQ(*p({"mesh", "m.step", "-o", "o.vtu", "--size-min-ratio", "0.17"}).size_min_ratio,
+                   0.17);
   for (const char* bad : {"0", "-0.1", "1.5", "x"})
     EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--size-min-ratio", bad})
                   .find("--size-min-ratio"),
               std::string::npos)
         << bad;
-  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--size-min", "1", "--size-min-ratio", "0.2"})
-                .find("give one, not both"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of({"mesh", "m.step", "-o", "o.vtu", "--size-min", "1", "--size-min-ratio", "0.2"})
+          .find("give one, not both"),
+      std::string::npos);
   EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--until", "background", "--size-min", "1"})
                 .find("--until background"),
             std::string::npos);
   EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--until", "background", "--face-curvature"})
                 .find("--until background"),
             std::string::npos);
-  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--until", "background", "--curve-size", "4:1"})
-                .find("--until background"),
-            std::string::npos);
+  EXPECT_NE(
+      error_of({"mesh", "m.step", "-o", "o.vtu", "--until", "background", "--curve-size", "4:1"})
+          .find("--until background"),
+      std::string::npos);
   for (const char* bad : {"2", "-1", "x", "8x", "inf"})
-    EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--curvature-edges", bad}).find("--curvature-edges"),
+    EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--curvature-edges", bad})
+                  .find("--curvature-edges"),
               std::string::npos)
         << bad;
-  EXPECT_NE(error_of({"crossfield", "m.step", "-o", "c.vtu", "--curve-size", "4:1"}).find("unknown option"),
+  EXPECT_NE(error_of({"crossfield", "m.step", "-o", "c.vtu", "--curve-size", "4:1"})
+                .find("unknown option"),
             std::string::npos);
 }
 
@@ -188,8 +232,10 @@ TEST(Cli, MissingPiecesAndUnknowns) {
   EXPECT_NE(error_of({"mesh", "m.step"}).find("missing -o"), std::string::npos);
   EXPECT_NE(error_of({"mesh", "-o", "x.vtu"}).find("missing MODEL"), std::string::npos);
   EXPECT_NE(error_of({"frobnicate"}).find("unknown command"), std::string::npos);
-  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--bogus"}).find("unknown option '--bogus'"), std::string::npos);
-  EXPECT_NE(error_of({"example", "rocket", "-o", "r.step"}).find("unknown example"), std::string::npos);
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--bogus"}).find("unknown option '--bogus'"),
+            std::string::npos);
+  EXPECT_NE(error_of({"example", "rocket", "-o", "r.step"}).find("unknown example"),
+            std::string::npos);
   EXPECT_NE(error_of({"info", "a.step", "b.step"}).find("unexpected argument"), std::string::npos);
 }
 

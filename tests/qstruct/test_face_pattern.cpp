@@ -24,14 +24,16 @@ using XY = std::vector<std::pair<double, double>>;
 std::string tmp(const std::string& name) { return qsmesh::test::tmp_dir() + "/" + name; }
 
 // Curve meshes of a polygon face: counts[k] edges on the polygon edge from xy[k] to xy[k + 1].
-std::vector<mesh::CurveMesh> polygon_curves(const cad::CadModel& model, const XY& xy, const std::vector<LO>& counts) {
+std::vector<mesh::CurveMesh> polygon_curves(const cad::CadModel& model, const XY& xy,
+                                            const std::vector<LO>& counts) {
   std::vector<mesh::CurveMesh> out;
   const auto near = [](const Vec3& p, const std::pair<double, double>& q) {
     return std::abs(p.x - q.first) + std::abs(p.y - q.second) < 1e-9;
   };
   for (LO c = 0; c < model.num_curves(); ++c) {
     const auto& curve = model.curves()[c];
-    const Vec3 a = model.corners()[curve.corners[0]].point, b = model.corners()[curve.corners[1]].point;
+    const Vec3 a = model.corners()[curve.corners[0]].point,
+               b = model.corners()[curve.corners[1]].point;
     LO n = 0;
     for (std::size_t k = 0; k < xy.size(); ++k) {
       const auto& p = xy[k];
@@ -196,6 +198,44 @@ TEST(FacePattern, SmallFillIsKeptOnItsMinimumAlone) {
   fewer.small_fill_quads = 15;
   const auto kept = grid_kept_then_refused(18, "qs_rect_small.brep", 9.0 / 21.25, fewer);
   EXPECT_LT(kept.sicn_min, PatternFaceOptions{}.keep_sicn_min);
+}
+
+// A kept fill of more than small_fill_quads quads with its mean at or below compare_below_avg
+// (every fill kept on keep_sicn_min alone, and those kept on a mean just above min_sicn_avg) is
+// compared with the face's unstructured mesh; it gives way only to a valid all-quad mesh without
+// a quad at or below min_sicn whose mean is higher by more than compare_avg_margin. The numbers
+// are wing_fuselage's face 15 with the clamped sizing: a one-corner fill at 0.50 / 0.678 (size
+// factor 0.0058) against an unstructured mesh at 0.61 / 0.958.
+TEST(FacePattern, PoorMeanFillGivesWayOnlyToAClearlyBetterUnstructuredMesh) {
+  const PatternFaceOptions o;
+  ASSERT_GE(o.compare_below_avg, o.min_sicn_avg);  // every fill kept on its minimum alone
+  EXPECT_TRUE(fill_to_compare(0.678, 1725, o));
+  EXPECT_TRUE(fill_to_compare(0.727, 1248, o));  // kept on its mean, just above
+  EXPECT_FALSE(fill_to_compare(o.compare_below_avg + 0.01, 1725, o));  // a good mean
+  EXPECT_FALSE(fill_to_compare(0.678, o.small_fill_quads, o));         // a small fill
+  const auto stats = [](std::int64_t quads, std::int64_t triangles, double mn, double avg) {
+    mesh::FaceQuadStats s;
+    s.quads = quads;
+    s.triangles = triangles;
+    s.sicn_min = mn;
+    s.sicn_avg = avg;
+    return s;
+  };
+  const mesh::FaceQuadStats fill = stats(1725, 0, 0.50, 0.678);
+  EXPECT_TRUE(unstructured_clearly_better(fill, stats(660, 0, 0.61, 0.958), o));
+  // Within the margin, the fill's fewer irregular vertices win.
+  EXPECT_FALSE(unstructured_clearly_better(
+      fill, stats(660, 0, 0.61, 0.678 + 0.9 * o.compare_avg_margin), o));
+  EXPECT_TRUE(unstructured_clearly_better(
+      fill, stats(660, 0, 0.61, 0.678 + 1.1 * o.compare_avg_margin), o));
+  // A better mean bought with a poor quad, or a mesh that is not all quads, does not replace it.
+  EXPECT_FALSE(unstructured_clearly_better(fill, stats(660, 0, o.min_sicn, 0.958), o));
+  EXPECT_FALSE(unstructured_clearly_better(fill, stats(660, 3, 0.61, 0.958), o));
+  EXPECT_FALSE(unstructured_clearly_better(fill, stats(0, 0, 0, 0), o));
+  PatternFaceOptions off;
+  off.compare_avg_margin = -1;
+  EXPECT_FALSE(fill_to_compare(0.678, 1725, off));
+  EXPECT_FALSE(unstructured_clearly_better(fill, stats(660, 0, 0.61, 0.958), off));
 }
 
 TEST(FacePattern, RectangleWithATransitionGetsOneValence3And5) {
@@ -645,7 +685,8 @@ TEST(Balance, SidesOfSeveralCurvesAreMadeToFit) {
   ASSERT_EQ(pc.model.num_curves(), 5);
   const quantize::Quantization q = quantization_of(pc);
   const auto patterns = builtin_patterns();
-  const auto fs = face_sides(pc.model, 0, *pc.model.face_geometry(0), pc.curves, PatternFaceOptions{});
+  const auto fs =
+      face_sides(pc.model, 0, *pc.model.face_geometry(0), pc.curves, PatternFaceOptions{});
   ASSERT_EQ(fs.corners.size(), 4u);  // the 180-degree vertex at (3, 0) is no corner
   const auto& uses = pc.model.faces()[0].loops[0].uses;
   ASSERT_EQ(fs.use_start.size(), uses.size());
@@ -658,14 +699,16 @@ TEST(Balance, SidesOfSeveralCurvesAreMadeToFit) {
   ASSERT_TRUE(match_patterns(patterns, before).empty());
 
   BalanceReport rep;
-  const std::vector<int> edges = balance_curve_counts(pc.model, pc.curves, q, patterns, {}, BalanceOptions{}, &rep);
+  const std::vector<int> edges =
+      balance_curve_counts(pc.model, pc.curves, q, patterns, {}, BalanceOptions{}, &rep);
   EXPECT_EQ(rep.faces_considered, 1);
   EXPECT_EQ(rep.fitting_before, 0);
   EXPECT_EQ(rep.fitting_after, 1);
   EXPECT_FALSE(match_patterns(patterns, sides(edges)).empty());
   for (LO c = 0; c < 5; ++c) {
     EXPECT_EQ(edges[c] % 2, 0);
-    EXPECT_LE(std::abs(edges[c] - q.ideal[c]), std::max(2.0, 0.35 * q.ideal[c]) + 1e-9) << "curve " << c;
+    EXPECT_LE(std::abs(edges[c] - q.ideal[c]), std::max(2.0, 0.35 * q.ideal[c]) + 1e-9)
+        << "curve " << c;
   }
 
   // With the bottom and top curves prescribed (user sizes) only the ends may move, and the fit

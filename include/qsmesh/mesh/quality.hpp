@@ -27,16 +27,31 @@ struct MeshStats {
   /// (4 for a quad mesh, 6 for a triangle mesh).
   std::int64_t irregular_interior = 0;
   std::int64_t interior_vertices = 0;
-  double sicn_min = 0, sicn_avg = 0;          ///< over quads (0 when none)
+  double sicn_min = 0, sicn_avg = 0;                ///< over quads (0 when none)
   double tri_quality_min = 0, tri_quality_avg = 0;  ///< over triangles (0 when none)
   /// Triangles by their smallest 3D angle: [0,5), [5,10), [10,20), [20,30), [30,60] degrees.
   std::array<std::int64_t, 5> min_angle_histogram{};
-  double min_angle_deg = 0;                   ///< smallest triangle angle (degrees)
+  double min_angle_deg = 0;  ///< smallest triangle angle (degrees)
   /// Among the triangles with an angle below 10 degrees, those inside the wedge of a CAD corner
-  /// whose angle in that face is itself below 10 degrees: every vertex is that corner or lies on one
-  /// of the two curves forming it (no triangle there can do better than the wedge allows).
+  /// whose angle in that face is itself below 10 degrees: every vertex is that corner or lies on
+  /// one of the two curves forming it (no triangle there can do better than the wedge allows).
   std::int64_t small_angle_at_sharp_corner = 0;
+  /// Quads with SICN (Eq. 12) below kPoorSicn (0.1): flat or nearly folded.
+  std::int64_t quads_sicn_below_0_1 = 0;
+  /// Of those, the quads with a vertex at a CAD corner whose angle in the quad's face (the sum of
+  /// the face's element angles there, 3D) is below kForcingCornerDeg: a quad there reaches SICN
+  /// sin(angle) at best (below 0.14 under 8 degrees), so the corner, not the mesher, makes it poor.
+  std::int64_t quads_sicn_below_0_1_forced_by_corner = 0;
+  /// The others (quads_sicn_below_0_1 less the forced ones) by CAD face: one entry per face
+  /// (SurfaceMesh::num_cad_faces), by quad_face; empty without quads or quad_face.
+  std::vector<std::int64_t> face_quads_sicn_below_0_1;
 };
+
+/// The SICN below which compute_stats counts a quad as poor (MeshStats::quads_sicn_below_0_1).
+inline constexpr double kPoorSicn = 0.1;
+/// CAD corners sharper than this (degrees, in the face) force poor quads
+/// (MeshStats::quads_sicn_below_0_1_forced_by_corner).
+inline constexpr double kForcingCornerDeg = 8.0;
 
 /// Statistics of one face's mesh (paper 000 Sec. 5, the per-face report of the quad stages).
 struct FaceQuadStats {

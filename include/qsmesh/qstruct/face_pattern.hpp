@@ -13,6 +13,7 @@
 
 #include "qsmesh/cad/model.hpp"
 #include "qsmesh/mesh/delaunay.hpp"
+#include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/mesh/surface_mesh.hpp"
 #include "qsmesh/qstruct/patterns.hpp"
 #include "qsmesh/smooth/smooth.hpp"
@@ -52,6 +53,16 @@ struct PatternFaceOptions {
   /// faces 44 and 79: 22-quad half-disks at SICN avg 0.52 where 14 unstructured quads had 0.74,
   /// with the same 2 irregular vertices. 0: off.
   std::int64_t small_fill_quads = 40;
+  /// A kept fill of more than small_fill_quads quads whose mean SICN is at or below
+  /// compare_below_avg (fill_to_compare: every fill kept on keep_sicn_min alone, and those kept on
+  /// a mean just above min_sicn_avg) gives way to the unstructured mesh of the same face when the
+  /// latter's mean SICN is higher by more than compare_avg_margin (unstructured_clearly_better;
+  /// the caller meshes such faces both ways). A negative margin: off. wing_fuselage.step with the
+  /// clamped sizing: face 15, a plane at a wing tip, got one-corner fills at SICN avg 0.678 (size
+  /// factor 0.0058, kept on its minimum 0.50) and 0.727 (0.0064, kept on its mean) where its
+  /// unstructured mesh has 0.95-0.96 (docs/benchmarks.md).
+  double compare_below_avg = 0.8;
+  double compare_avg_margin = 0.1;
   /// The quad at a corner of angle a < 90 degrees reaches SICN sin(a) at best (equal edges): at a
   /// face with a side-splitting corner where sin(a) <= min_sicn, which min_sicn would refuse
   /// whatever the mesh (a < 17.5 degrees for 0.3), the min threshold is corner_sicn_factor x
@@ -96,13 +107,16 @@ struct PatternFaceOptions {
 
 /// Why a face was not meshed by a pattern.
 enum class Refusal : std::uint8_t {
-  None,        ///< meshed
-  Loops,       ///< not exactly one boundary loop (holes), or a loop that is not closed
-  Degenerate,  ///< a degenerate curve (pole, cone apex) or a corner where the surface is singular
-  NoPattern,   ///< no pattern has as many sides, or none fits the side counts (Eq. 14)
-  Quality,     ///< every candidate tried left a quad at or below the quality thresholds
+  None,          ///< meshed
+  Loops,         ///< not exactly one boundary loop (holes), or a loop that is not closed
+  Degenerate,    ///< a degenerate curve (pole, cone apex) or a corner where the surface is singular
+  NoPattern,     ///< no pattern has as many sides, or none fits the side counts (Eq. 14)
+  Quality,       ///< every candidate tried left a quad at or below the quality thresholds
   TooManyQuads,  ///< every fitting pattern needs more quads than PatternFaceOptions::max_quads
-  Error,       ///< an error from the geometry or the smoother
+  Error,         ///< an error from the geometry or the smoother
+  /// a kept fill with a poor mean gave way to the face's unstructured mesh, clearly better on
+  /// average (PatternFaceOptions::compare_avg_margin; set by the caller that compares)
+  UnstructuredBetter,
 };
 [[nodiscard]] const char* to_string(Refusal r);
 
@@ -110,18 +124,18 @@ enum class Refusal : std::uint8_t {
 struct PatternFaceReport {
   bool ok = false;
   Refusal refusal = Refusal::None;
-  std::string reason;            ///< refusal details, with the face id
+  std::string reason;  ///< refusal details, with the face id
   /// Edges of each side, from the side after the first corner; without corner one side, the
   /// whole loop.
   std::vector<LO> side_edges;
-  LO pattern = kNoIndex;         ///< index in the pattern list of the mesh kept (or last tried)
+  LO pattern = kNoIndex;  ///< index in the pattern list of the mesh kept (or last tried)
   std::string pattern_name;
-  int start = 0;                 ///< face side holding pattern side 0 (PatternMatch::start)
+  int start = 0;  ///< face side holding pattern side 0 (PatternMatch::start)
   bool reversed = false;
-  std::vector<LO> chords;        ///< chord subdivisions of that match
-  int candidates = 0;            ///< matches tried geometrically
-  int lifts = 0;                 ///< candidates handed to the untangler (lift_poor_quads)
-  int moves = 0;  ///< improving moves made by the search (over every start without corner)
+  std::vector<LO> chords;  ///< chord subdivisions of that match
+  int candidates = 0;      ///< matches tried geometrically
+  int lifts = 0;           ///< candidates handed to the untangler (lift_poor_quads)
+  int moves = 0;           ///< improving moves made by the search (over every start without corner)
   double sicn_min = 0, sicn_avg = 0;  ///< of the mesh kept (or of the best refused one)
   /// The min threshold applied (options.min_sicn, lowered at sharp corners: corner_sicn_factor).
   double min_sicn = 0;
@@ -145,8 +159,8 @@ struct FaceSides {
   /// Position in `points` where each use of the face's loop starts (loop order). Corners sit at
   /// use starts, so a use lies in one side: side_of(fs, use_start[u]).
   std::vector<LO> use_start;
-  double uv_area = 0;       ///< signed area of the loop in the parameter plane (> 0: CCW)
-  std::vector<LO> poles;    ///< positions in `points` of the poles (merged degenerate curves)
+  double uv_area = 0;     ///< signed area of the loop in the parameter plane (> 0: CCW)
+  std::vector<LO> poles;  ///< positions in `points` of the poles (merged degenerate curves)
 };
 
 /// Splits the boundary of face f (one loop) into sides. `curves`: the final curve meshes of all
@@ -192,6 +206,26 @@ struct FaceSides {
 ///    mesh (face id set) and the reason in the report (with the best valid candidate in
 ///    report->refused_mesh on a quality refusal).
 /// Never throws for a face-level failure. Deterministic.
+/// Whether a fill kept by mesh_face_pattern (valid, its minimum above the face's threshold) with
+/// this mean SICN and quad count is compared with the face's unstructured mesh: more than
+/// options.small_fill_quads quads and its mean at or below options.compare_below_avg. That takes
+/// in every fill kept on options.keep_sicn_min alone (the acceptance rule of Gmsh's
+/// implementation: every quad above it, whatever the mean) when compare_below_avg is at least
+/// min_sicn_avg. False when options.compare_avg_margin is negative (no comparison).
+[[nodiscard]] bool fill_to_compare(double sicn_avg, std::int64_t quads,
+                                   const PatternFaceOptions& options);
+
+/// Whether the unstructured mesh of a face (paper 000 Sec. 5-6.3, after the topological steps)
+/// is clearly better than a kept fill of the same face (fill_to_compare), so that it replaces
+/// the fill: it is all quads, valid, with its minimum SICN above options.min_sicn (it trades no
+/// poor quad for the fill's mean), and its mean SICN is above the fill's by more than
+/// options.compare_avg_margin (never when that is negative). Irregular vertices are not
+/// weighed: the fill has the fewest a pattern allows, and its mean is what was given up to get
+/// them. Serial, pure.
+[[nodiscard]] bool unstructured_clearly_better(const mesh::FaceQuadStats& fill,
+                                               const mesh::FaceQuadStats& unstructured,
+                                               const PatternFaceOptions& options);
+
 [[nodiscard]] mesh::FaceMesh mesh_face_pattern(const cad::CadModel& model, LO f,
                                                std::span<const mesh::CurveMesh> full_curves,
                                                std::span<const Pattern> patterns,
