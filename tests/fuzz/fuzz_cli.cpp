@@ -27,7 +27,7 @@ void check(const qsmesh::cli::Arguments& a) {
   require(a.threads >= 0);
   require(a.order == 1 || a.order == 2);
   require(a.sizemap == "features" || a.sizemap == "crossfield");
-  require(a.sizing == "paper" || a.sizing == "gmsh");
+  require(a.sizing == "paper" || a.sizing == "clamped");
   for (const auto& [id, n] : a.curve_edges) require(id >= 0 && n > 0 && n % 2 == 0);
   for (const auto* list : {&a.face_quads, &a.corner_sizes, &a.curve_sizes, &a.face_sizes})
     for (const auto& [id, v] : *list) require(id >= 0 && std::isfinite(v) && v > 0);
