@@ -1,10 +1,8 @@
 #include "cli.hpp"
 
 #include <algorithm>
-#include <cctype>
 #include <cmath>
 #include <cstdlib>
-#include <filesystem>
 #include <limits>
 #include <optional>
 #include <sstream>
@@ -115,9 +113,7 @@ void append(std::vector<T>& to, const std::vector<T>& from) {
 }  // namespace
 
 std::optional<cad::ExampleFormat> example_format(const std::string& path) {
-  std::string ext = std::filesystem::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
+  const std::string ext = io::lowercase_extension(path);
   if (ext == ".step" || ext == ".stp") return cad::ExampleFormat::Step;
   if (ext == ".brep" || ext == ".brp") return cad::ExampleFormat::Brep;
   return std::nullopt;

@@ -35,30 +35,6 @@ namespace qsmesh::cli {
 
 namespace fs = std::filesystem;
 
-void check_writable(const std::string& option, const std::string& path) {
-  const fs::path p(path);
-  const fs::path dir = p.parent_path().empty() ? fs::path(".") : p.parent_path();
-  std::error_code ec;
-  if (!fs::is_directory(dir, ec))
-    throw InputError(option + ": cannot write '" + path + "': directory '" + dir.string() +
-                     "' does not exist");
-  if (::access(dir.c_str(), W_OK) != 0)
-    throw InputError(option + ": cannot write '" + path + "': directory '" + dir.string() +
-                     "' is not writable");
-  if (fs::is_directory(p, ec)) throw InputError(option + ": '" + path + "' is a directory");
-  // The output replaces whatever has its name by a rename: a device or a pipe would be replaced
-  // by a regular file (as root, /dev/null itself).
-  if (fs::exists(fs::symlink_status(p, ec)) && !fs::is_regular_file(fs::symlink_status(p, ec)) &&
-      !fs::is_symlink(fs::symlink_status(p, ec)))
-    throw InputError(option + ": '" + path +
-                     "' exists and is not a regular file (a device or a pipe); give a file name");
-  // Permission bits do not tell everything (root may write anywhere by them, yet not create a file
-  // in /proc or on a full or read-only file system): create and remove a file where the temporary
-  // will be, before any work.
-  if (const auto why = io::probe_create(path))
-    throw InputError(option + ": cannot write '" + path + "': " + *why);
-}
-
 namespace {
 
 // The name a path resolves to (symbolic links and '..' resolved as far as it exists), for telling
@@ -77,22 +53,23 @@ bool same_file(const std::string& a, const std::string& b) {
 
 }  // namespace
 
-void check_output_files(const Arguments& args) {
-  struct Named {
-    std::string what, path, after;
-    [[nodiscard]] std::string text() const { return what + " '" + path + "'" + after; }
-  };
-  std::vector<Named> outputs;
+std::vector<RunOutput> run_outputs(const Arguments& args) {
+  std::vector<RunOutput> outputs;
   if (!args.output.empty()) {
     outputs.push_back({"-o", args.output, ""});
     if (args.command != Command::Example && io::output_format(args.output) == io::Format::kHdf5)
       outputs.push_back({"the .xdmf file", io::xdmf_path_for(args.output), " written beside -o"});
   }
   if (!args.stats.empty()) outputs.push_back({"--stats", args.stats, ""});
-  std::vector<Named> inputs;
+  return outputs;
+}
+
+void check_output_files(const Arguments& args) {
+  const std::vector<RunOutput> outputs = run_outputs(args);
+  std::vector<RunOutput> inputs;
   if (!args.model.empty()) inputs.push_back({"the model", args.model, ""});
   for (std::size_t i = 0; i < outputs.size(); ++i) {
-    for (const Named& in : inputs)
+    for (const RunOutput& in : inputs)
       if (same_file(outputs[i].path, in.path))
         throw InputError(outputs[i].text() + " names the same file as " + in.text() +
                          ", which it would overwrite; give another name");
@@ -101,9 +78,10 @@ void check_output_files(const Arguments& args) {
         throw InputError(outputs[i].text() + " names the same file as " + outputs[j].text() +
                          "; give another name");
   }
-  for (const Named& out : outputs)
+  // The mesh commands' -o and its .xdmf are checked with their format (io::check_output_path).
+  for (const RunOutput& out : outputs)
     if (out.what == "--stats" || args.command == Command::Example)
-      check_writable(out.what, out.path);
+      io::check_output_file(out.what, out.path);
 }
 
 void write_text_file_atomically(const std::string& path, const std::string& text) {
@@ -201,9 +179,7 @@ int run_info(const Arguments& args) {
 int run_example(const Arguments& args) {
   check_output_files(args);
   const auto format = example_format(args.output);
-  if (!format)
-    throw InputError("example: cannot write '" + args.output +
-                     "': the extension picks the CAD format, .step/.stp or .brep/.brp");
+  QSMESH_CHECK(format, "example: no CAD format for " << args.output << " (parse refuses it)");
   io::AtomicFile file(args.output);
   cad::write_wing_body_example(file.temp_path(), *format);
   file.commit();
@@ -697,7 +673,6 @@ void apply_size_options(const Arguments& args, const Session& s,
   check_ids("--corner-size", "corner", args.corner_sizes, s.model.num_corners());
   check_ids("--face-quads", "face", args.face_quads, s.model.num_faces());
   check_ids("--face-size", "face", args.face_sizes, s.model.num_faces());
-  check_request(args, s);
   sizemap::SizeMapOptions& so = options.sizemap;
   so.method = args.sizemap == "features" ? sizemap::Method::Features : sizemap::Method::CrossField;
   so.size_max = s.size;
@@ -749,11 +724,9 @@ namespace {
 void warn_unmet_prescriptions(const Arguments& args, const parallel::PipelineResult& r,
                               Logger& log) {
   const mesh::SurfaceMesh& m = r.mesh;
-  if (m.quads.empty()) return;
-  std::vector<std::int64_t> face_quads(static_cast<std::size_t>(m.num_cad_faces), 0);
-  for (const LO f : m.quad_face) face_quads[static_cast<std::size_t>(f)] += 1;
+  if (r.face_stats.empty()) return;  // no quad stage ran
   for (const auto& [f, asked] : args.face_quads) {
-    const double got = static_cast<double>(face_quads[static_cast<std::size_t>(f)]);
+    const double got = static_cast<double>(r.face_stats[static_cast<std::size_t>(f)].quads);
     if (got > 2 * asked || 2 * got < asked)
       log.warn(cat("--face-quads ", f, ":", asked, ": face ", f, " got ", got,
                    " quads; its curves' edge counts and the sizes of its neighbours decide"));
@@ -776,10 +749,8 @@ int run_mesh(const Arguments& args) {
   Session s(args, "mesh");
   parallel::PipelineOptions options;
   options.background.sizes.size = s.size;
-  if (until >= parallel::Stage::Unstructured)
-    apply_size_options(args, s, options);
-  else
-    check_request(args, s);
+  check_request(args, s);
+  if (until >= parallel::Stage::Unstructured) apply_size_options(args, s, options);
   s.announce(args, "mesh");
   options.until = until;
   if (until >= parallel::Stage::Unstructured) note_sliver_curves(s, options.sizemap);

@@ -75,7 +75,13 @@ void check_output_files(const Arguments& args);
 
 /// Writes `text` to `path` through a temporary file renamed at the end.
 void write_text_file_atomically(const std::string& path, const std::string& text);
-/// Throws InputError when `path` cannot be created (missing or unwritable directory).
-void check_writable(const std::string& option, const std::string& path);
+/// One file a run writes, named for messages: `what` ("-o", "--stats", "the .xdmf file") and
+/// `after` (" written beside -o").
+struct RunOutput {
+  std::string what, path, after;
+  [[nodiscard]] std::string text() const { return what + " '" + path + "'" + after; }
+};
+/// Every file the command of `args` may write: -o (for .h5 also its XDMF description) and --stats.
+[[nodiscard]] std::vector<RunOutput> run_outputs(const Arguments& args);
 
 }  // namespace qsmesh::cli

@@ -8,6 +8,7 @@
 #include <fstream>
 #include <iomanip>
 #include <limits>
+#include <map>
 #include <sstream>
 
 namespace qsmesh::cli {
@@ -16,11 +17,15 @@ namespace {
 
 bool usable(double v) { return std::isfinite(v) && v > 0; }
 
-// a / (h * h) without overflow to a finite wrong value: +inf when the quotient is beyond doubles.
-double per_square(double a, double h) {
-  if (!(a > 0) || !std::isfinite(a) || !usable(h)) return 0;
-  const double q = a / h / h;
-  return std::isnan(q) ? std::numeric_limits<double>::infinity() : q;
+// a / (h * h), dividing twice so that h * h cannot underflow to 0: +inf beyond doubles.
+double per_square(double a, double h) { return usable(a) && usable(h) ? a / h / h : 0; }
+
+// "OPTION ID:VALUE", the request as the user typed it.
+template <class T>
+std::string option_text(const char* option, int id, T value) {
+  std::ostringstream os;
+  os << option << " " << id << ":" << value;
+  return os.str();
 }
 
 bool valid_id(int id, std::size_t count) { return id >= 0 && static_cast<std::size_t>(id) < count; }
@@ -65,13 +70,13 @@ RequestEstimate estimate_request(const ModelMeasures& model, const SizeRequest& 
   const std::size_t nf = model.face_area.size(), nc = model.curve_length.size();
   double total_area = 0;
   for (double a : model.face_area)
-    if (a > 0 && std::isfinite(a)) total_area += a;
+    if (usable(a)) total_area += a;
 
   // Per face: the best lower bound and which request gave it.
   std::vector<double> quads(nf, 0.0);
   std::vector<std::string> why(nf, "the size cap");
   auto raise = [&](std::size_t f, double q, const std::string& reason) {
-    if (q > quads[f] || (std::isinf(q) && !std::isinf(quads[f]))) {
+    if (q > quads[f]) {
       quads[f] = q;
       why[f] = reason;
     }
@@ -81,8 +86,7 @@ RequestEstimate estimate_request(const ModelMeasures& model, const SizeRequest& 
   quads_os << "--quads " << request.target_quads;
   const std::string quads_text = quads_os.str();
   for (std::size_t f = 0; f < nf; ++f) {
-    const double a =
-        model.face_area[f] > 0 && std::isfinite(model.face_area[f]) ? model.face_area[f] : 0;
+    const double a = usable(model.face_area[f]) ? model.face_area[f] : 0;
     if (by_target)
       raise(f, total_area > 0 ? a / total_area * request.target_quads : request.target_quads / nf,
             quads_text);
@@ -91,18 +95,14 @@ RequestEstimate estimate_request(const ModelMeasures& model, const SizeRequest& 
   }
   for (const auto& [f, q] : request.face_quads) {
     if (!valid_id(f, nf) || !usable(q)) continue;
-    std::ostringstream os;
-    os << "--face-quads " << f << ":" << q;
     // A prescription replaces the face's share, so it may lower the bound too.
     quads[static_cast<std::size_t>(f)] = q;
-    why[static_cast<std::size_t>(f)] = os.str();
+    why[static_cast<std::size_t>(f)] = option_text("--face-quads", f, q);
   }
   for (const auto& [f, h] : request.face_sizes) {
     if (!valid_id(f, nf) || !usable(h)) continue;
-    std::ostringstream os;
-    os << "--face-size " << f << ":" << h;
     raise(static_cast<std::size_t>(f), per_square(model.face_area[static_cast<std::size_t>(f)], h),
-          os.str());
+          option_text("--face-size", f, h));
   }
   // Edges of the curves with a prescription, and the option that set each.
   std::vector<double> edges(nc, 0.0);
@@ -110,18 +110,14 @@ RequestEstimate estimate_request(const ModelMeasures& model, const SizeRequest& 
   for (const auto& [c, h] : request.curve_sizes) {
     if (!valid_id(c, nc) || !usable(h)) continue;
     const double len = model.curve_length[static_cast<std::size_t>(c)];
-    if (!(len > 0) || !std::isfinite(len)) continue;
-    std::ostringstream os;
-    os << "--curve-size " << c << ":" << h;
+    if (!usable(len)) continue;
     edges[static_cast<std::size_t>(c)] = len / h;
-    edge_why[static_cast<std::size_t>(c)] = os.str();
+    edge_why[static_cast<std::size_t>(c)] = option_text("--curve-size", c, h);
   }
   for (const auto& [c, n] : request.curve_edges) {
     if (!valid_id(c, nc) || n <= 0) continue;
-    std::ostringstream os;
-    os << "--curve-edges " << c << ":" << n;
     edges[static_cast<std::size_t>(c)] = n;
-    edge_why[static_cast<std::size_t>(c)] = os.str();
+    edge_why[static_cast<std::size_t>(c)] = option_text("--curve-edges", c, n);
   }
   for (std::size_t f = 0; f < nf && f < model.face_curves.size(); ++f) {
     double sum = 0, largest = 0;
@@ -139,24 +135,17 @@ RequestEstimate estimate_request(const ModelMeasures& model, const SizeRequest& 
   }
 
   RequestEstimate out;
-  std::vector<double> by_reason_quads;
-  std::vector<std::string> reasons;
+  std::map<std::string, double> by_reason;  // quads each request accounts for
   for (std::size_t f = 0; f < nf; ++f) {
     out.quads += quads[f];
-    const auto it = std::find(reasons.begin(), reasons.end(), why[f]);
-    if (it == reasons.end()) {
-      reasons.push_back(why[f]);
-      by_reason_quads.push_back(quads[f]);
-    } else {
-      by_reason_quads[static_cast<std::size_t>(it - reasons.begin())] += quads[f];
-    }
+    by_reason[why[f]] += quads[f];
   }
   out.dominant = "the size cap";
   double most = -1;
-  for (std::size_t k = 0; k < reasons.size(); ++k)
-    if (by_reason_quads[k] > most) {
-      most = by_reason_quads[k];
-      out.dominant = reasons[k];
+  for (const auto& [reason, q] : by_reason)
+    if (q > most) {
+      most = q;
+      out.dominant = reason;
     }
   return out;
 }

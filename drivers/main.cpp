@@ -18,19 +18,6 @@ namespace {
 
 using namespace qsmesh;
 
-// Every file the command may write: -o (for .h5 also its XDMF description) and --stats. Known
-// right after parsing, so that a signal at any later point finds the names of their temporaries.
-std::vector<std::string> outputs_of(const cli::Arguments& a) {
-  std::vector<std::string> files;
-  if (!a.output.empty()) {
-    files.push_back(a.output);
-    if (io::output_format(a.output) == io::Format::kHdf5)
-      files.push_back(io::xdmf_path_for(a.output));
-  }
-  if (!a.stats.empty()) files.push_back(a.stats);
-  return files;
-}
-
 // What a run killed outright (SIGKILL: no handler runs) left beside these outputs, before any
 // work: its temporaries would otherwise stay forever, hidden and megabytes large.
 void clean_leftovers_of(const std::vector<std::string>& outputs, const cli::Arguments& a,
@@ -71,7 +58,9 @@ int main(int argc, char** argv) {
   }
 
   cad::set_kernel_messages(!parsed.verbose);
-  const std::vector<std::string> outputs = outputs_of(parsed);
+  // Known right after parsing, so that a signal at any later point finds their temporaries' names.
+  std::vector<std::string> outputs;
+  for (const cli::RunOutput& out : cli::run_outputs(parsed)) outputs.push_back(out.path);
 
   // Only the mesh and crossfield commands run distributed; the others need no MPI.
   const bool distributed = parsed.command == cli::Command::Mesh ||

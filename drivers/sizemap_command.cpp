@@ -81,6 +81,7 @@ int run_sizemap(const Arguments& args) {
   parallel::PipelineOptions options;
   options.background.sizes.size = s.size;
   options.size_map = true;
+  check_request(args, s);
   apply_size_options(args, s, options);
   s.announce(args, "sizemap");
   const parallel::PipelineResult result = parallel::run_pipeline(s.comm, s.model, options, *s.tasks, s.log, &lane);

@@ -16,9 +16,9 @@ struct ElementGroups {
   std::vector<std::vector<GO>> curve2bars;
 };
 
-/// Throws InputError (one line naming the path) unless `path` names a file (not a folder) in an
+/// Throws InputError (one line, "WHAT 'path' ...") unless `path` names a file (not a folder) in an
 /// existing, writable folder.
-void check_output_folder(const std::string& path);
+void check_output_folder(const std::string& path, const std::string& what = "output");
 
 /// The function a checked library call names, for error messages: the text of `call` (the
 /// stringified call, "cg_open(path, ...)") before its argument list.

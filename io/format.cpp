@@ -11,10 +11,15 @@ namespace qsmesh::io {
 
 namespace fs = std::filesystem;
 
-Format output_format(const std::string& path) {
+std::string lowercase_extension(const std::string& path) {
   std::string ext = fs::path(path).extension().string();
   std::transform(ext.begin(), ext.end(), ext.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return ext;
+}
+
+Format output_format(const std::string& path) {
+  const std::string ext = lowercase_extension(path);
   if (ext == ".cgns") return Format::kCgns;
   if (ext == ".vtu") return Format::kVtu;
   if (ext == ".msh") return Format::kMsh;

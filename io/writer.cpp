@@ -13,6 +13,7 @@
 
 #include "detail.hpp"
 #include "qsmesh/core/error.hpp"
+#include "qsmesh/io/atomic_file.hpp"
 
 namespace qsmesh::io {
 
@@ -23,35 +24,35 @@ void check_output_path(const std::string& path) {
     throw InputError("output '" + path +
                      "': unsupported format (the extension must be .cgns, .vtu, .msh or .h5)");
   }
-  detail::check_output_folder(path);
+  check_output_file("output", path);
   if (output_format(path) == Format::kHdf5) {
     // XDMF names its data "file:/dataset" and splits at the first colon.
     if (fs::path(path).filename().string().find(':') != std::string::npos)
       throw InputError("output '" + path +
                        "': an .h5 file name cannot contain ':' (the XDMF description beside it "
                        "could not refer to it); rename it");
-    detail::check_output_folder(xdmf_path_for(path));
+    check_output_file("output", xdmf_path_for(path));
   }
 }
 
-std::optional<std::string> probe_create(const std::string& path) {
-  const fs::path p(path);
-  const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
-  std::string name = ".";
-  name += p.filename().string();
-  name += ".probe.";
-  name += std::to_string(::getpid());
-  const std::string probe = (dir / name).string();
-  const int fd = ::open(probe.c_str(), O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0600);
+void check_output_file(const std::string& what, const std::string& path) {
+  detail::check_output_folder(path, what);
+  std::error_code ec;
+  const auto status = fs::symlink_status(path, ec);
+  if (fs::exists(status) && !fs::is_regular_file(status) && !fs::is_symlink(status))
+    throw InputError(what + " '" + path +
+                     "' exists and is not a regular file (a device or a pipe); give a file name");
+  // The very temporary the writer will create (AtomicFile removes a stale one of its name too).
+  const std::string temp = temporary_path(path, ::getpid());
+  const int fd = ::open(temp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0600);
   if (fd < 0) {
-    // A probe of the same name is this process's own (two outputs in one folder): no proof either
-    // way, but it shows the folder accepted a file.
-    if (errno == EEXIST) return std::nullopt;
-    return std::string(std::strerror(errno));
+    const fs::path p(path);
+    throw InputError(what + " '" + path + "': cannot create a file in folder '" +
+                     (p.has_parent_path() ? p.parent_path().string() : std::string(".")) +
+                     "': " + std::strerror(errno));
   }
   ::close(fd);
-  ::unlink(probe.c_str());
-  return std::nullopt;
+  ::unlink(temp.c_str());
 }
 
 void prepare_output_libraries() {
@@ -67,26 +68,18 @@ std::string function_name(const char* call) {
   return std::string(text.substr(0, text.find('(')));
 }
 
-void check_output_folder(const std::string& path) {
+void check_output_folder(const std::string& path, const std::string& what) {
   const fs::path p(path);
   std::error_code ec;
-  if (p.filename().empty()) {
-    throw InputError("output '" + path + "' names no file");
-  }
-  if (fs::is_directory(p, ec)) {
-    throw InputError("output '" + path + "' is a folder");
-  }
+  const std::string named = what + " '" + path + "'";
+  if (p.filename().empty()) throw InputError(named + " names no file");
+  if (fs::is_directory(p, ec)) throw InputError(named + " is a folder");
   const fs::path dir = p.has_parent_path() ? p.parent_path() : fs::path(".");
-  if (!fs::is_directory(dir, ec)) {
-    throw InputError("output '" + path + "': folder '" + dir.string() + "' does not exist");
-  }
+  if (!fs::is_directory(dir, ec))
+    throw InputError(named + ": folder '" + dir.string() + "' does not exist");
   // access() also reports read-only file systems, which the permission bits do not show.
-  if (::access(dir.c_str(), W_OK | X_OK) != 0) {
-    throw InputError("output '" + path + "': folder '" + dir.string() + "' is not writable");
-  }
-  if (const auto why = probe_create(path))
-    throw InputError("output '" + path + "': cannot create a file in folder '" + dir.string() +
-                     "': " + *why);
+  if (::access(dir.c_str(), W_OK | X_OK) != 0)
+    throw InputError(named + ": folder '" + dir.string() + "' is not writable");
 }
 
 }  // namespace detail

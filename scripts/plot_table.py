@@ -43,17 +43,9 @@ def parse_args():
     p.add_argument("--ylabel", default="", help="y axis title (default: none)")
     p.add_argument("--size", default="900x600", help="image size WxH in pixels (default 900x600)")
     a = p.parse_args()
-    try:
-        a.width, a.height = (int(x) for x in a.size.lower().split("x"))
-        if a.width < 200 or a.height < 150:
-            raise ValueError
-    except ValueError:
-        p.error(f"--size must be WxH with W >= 200 and H >= 150, not '{a.size}'")
+    vtk_offscreen.check_picture_args(p, a)
     if not os.path.isfile(a.table):
         p.error(f"{a.table}: no such file")
-    out_dir = os.path.dirname(os.path.abspath(a.output))
-    if not os.path.isdir(out_dir):
-        p.error(f"{a.output}: the folder {out_dir} does not exist")
     a.y = [c for c in a.y.split(",") if c]
     if not a.y:
         p.error("--y names no column")

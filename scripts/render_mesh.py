@@ -57,20 +57,11 @@ def parse_args():
     p.add_argument("--edges", choices=["auto", "on", "off"], default="auto",
                    help="draw the element edges (auto: when the mesh has at most 60000 elements)")
     a = p.parse_args()
-    try:
-        w, h = (int(x) for x in a.size.lower().split("x"))
-        if w < 200 or h < 150:
-            raise ValueError
-    except ValueError:
-        p.error(f"--size must be WxH with W >= 200 and H >= 150, not '{a.size}'")
-    a.width, a.height = w, h
+    vtk_offscreen.check_picture_args(p, a)
     if not a.mesh.endswith(".vtu"):
         p.error(f"{a.mesh}: only .vtu meshes are read (write one with qsmesh mesh ... -o MESH.vtu)")
     if not os.path.isfile(a.mesh):
         p.error(f"{a.mesh}: no such file")
-    out_dir = os.path.dirname(os.path.abspath(a.output))
-    if not os.path.isdir(out_dir):
-        p.error(f"{a.output}: the folder {out_dir} does not exist")
     return a
 
 

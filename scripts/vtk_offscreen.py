@@ -13,6 +13,21 @@ import sys
 _MARK = "QSMESH_UNDER_XVFB"
 
 
+def check_picture_args(parser, args):
+    """The arguments both picture scripts take: sets args.width and args.height from args.size
+    ("WxH", at least 200x150) and checks that args.output's folder exists; parser.error (exit 2)
+    otherwise."""
+    try:
+        args.width, args.height = (int(x) for x in args.size.lower().split("x"))
+        if args.width < 200 or args.height < 150:
+            raise ValueError
+    except ValueError:
+        parser.error(f"--size must be WxH with W >= 200 and H >= 150, not '{args.size}'")
+    out_dir = os.path.dirname(os.path.abspath(args.output))
+    if not os.path.isdir(out_dir):
+        parser.error(f"{args.output}: the folder {out_dir} does not exist")
+
+
 def ensure_display(tool, screen="2560x1600x24"):
     """Returns when an X display is there; otherwise re-executes this script under xvfb-run (does
     not return), or exits with status 2 naming the missing package."""

@@ -636,17 +636,14 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
         bool take = no_valid_quads(i);
         if (!take) {
           const mesh::FaceQuadStats uns = mesh::face_quad_stats(quad_meshes[i]);
+          take = qstruct::fill_wins(pat, uns, kept, tol, options.patterns);
           if (kept) {
-            take = !qstruct::unstructured_clearly_better(pat, uns, options.patterns);
             log.debug(cat("face ", mine[i], ": kept fill (", refused[i].pattern, ", ", pat.quads,
                           " quads, SICN ", pat.sicn_min, " / ", pat.sicn_avg,
                           ") against unstructured (", uns.quads, " quads, SICN ", uns.sicn_min,
                           " / ", uns.sicn_avg, "): ", take ? "fill" : "unstructured"));
             if (!take)
               quasi_reports[i].refusal = qstruct::to_string(qstruct::Refusal::UnstructuredBetter);
-          } else {
-            take = pat.sicn_min >= uns.sicn_min - tol && pat.sicn_avg >= uns.sicn_avg - tol &&
-                   pat.irregular_interior <= uns.irregular_interior;
           }
         }
         if (take) {

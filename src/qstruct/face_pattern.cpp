@@ -52,6 +52,14 @@ bool unstructured_clearly_better(const mesh::FaceQuadStats& fill,
          unstructured.sicn_avg > fill.sicn_avg + options.compare_avg_margin;
 }
 
+bool fill_wins(const mesh::FaceQuadStats& fill, const mesh::FaceQuadStats& unstructured, bool kept,
+               double tolerance, const PatternFaceOptions& options) {
+  if (kept) return !unstructured_clearly_better(fill, unstructured, options);
+  return fill.sicn_min >= unstructured.sicn_min - tolerance &&
+         fill.sicn_avg >= unstructured.sicn_avg - tolerance &&
+         fill.irregular_interior <= unstructured.irregular_interior;
+}
+
 namespace {
 
 constexpr double kDeg = 180.0 / std::numbers::pi;

@@ -238,6 +238,28 @@ TEST(FacePattern, PoorMeanFillGivesWayOnlyToAClearlyBetterUnstructuredMesh) {
   EXPECT_FALSE(unstructured_clearly_better(fill, stats(660, 0, 0.61, 0.958), off));
 }
 
+// The choice between a fill waiting for its face's unstructured mesh and that mesh, in one place
+// for both kinds of waiting fill.
+TEST(FacePattern, FillWinsByItsKind) {
+  const PatternFaceOptions o;
+  mesh::FaceQuadStats fill, uns;
+  fill.quads = 100, fill.sicn_min = 0.5, fill.sicn_avg = 0.70, fill.irregular_interior = 2;
+  uns.quads = 80, uns.sicn_min = 0.6, uns.sicn_avg = 0.95, uns.irregular_interior = 6;
+  // Kept by the thresholds: only a clearly better unstructured mesh replaces it.
+  EXPECT_FALSE(fill_wins(fill, uns, true, 0.0, o));
+  uns.sicn_avg = fill.sicn_avg + 0.5 * o.compare_avg_margin;
+  EXPECT_TRUE(fill_wins(fill, uns, true, 0.0, o));
+  // Refused by the thresholds: it must be no worse in min and mean (within the tolerance) and have
+  // no more irregular vertices.
+  uns.sicn_min = 0.5, uns.sicn_avg = 0.70;
+  EXPECT_TRUE(fill_wins(fill, uns, false, 0.0, o));
+  uns.sicn_avg = 0.72;
+  EXPECT_FALSE(fill_wins(fill, uns, false, 0.0, o));
+  EXPECT_TRUE(fill_wins(fill, uns, false, 0.03, o));
+  uns.irregular_interior = 1;
+  EXPECT_FALSE(fill_wins(fill, uns, false, 0.03, o));
+}
+
 TEST(FacePattern, RectangleWithATransitionGetsOneValence3And5) {
   const XY xy = {{0, 0}, {10, 0}, {10, 5}, {0, 5}};
   const auto pc = polygon(xy, {11, 4, 9, 6}, "qs_trans.brep");

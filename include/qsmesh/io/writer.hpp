@@ -17,7 +17,6 @@
 // CAD faces and curves without elements get no section, family, BC nor element block.
 #pragma once
 
-#include <optional>
 #include <string>
 #include <vector>
 
@@ -65,6 +64,8 @@ void write_mesh(const mesh::SurfaceMesh& mesh, const std::string& path, const Wr
 /// Output formats, from the extension of the path (case-insensitive): .cgns, .vtu, .msh, .h5.
 enum class Format { kNone, kCgns, kVtu, kMsh, kHdf5 };
 [[nodiscard]] Format output_format(const std::string& path);
+/// The extension of `path` in lower case, with its dot (".h5"; "" when it has none).
+[[nodiscard]] std::string lowercase_extension(const std::string& path);
 
 /// True when the extension of `path` names a format write_mesh writes (case-insensitive).
 [[nodiscard]] bool is_supported_output(const std::string& path);
@@ -76,15 +77,17 @@ enum class Format { kNone, kCgns, kVtu, kMsh, kHdf5 };
 void prepare_output_libraries();
 
 /// For the CLI at start-up, before meshing: throws InputError (one line naming the path) unless the
-/// extension is supported, the path is not a folder, and its folder exists and a file can be
-/// created in it (probe_create) (and, for .h5, the file name has no ':', which its XDMF description
-/// could not refer to).
+/// extension is supported and check_output_file("output", ...) passes for it (and for .h5 its
+/// XDMF description, whose file name then may have no ':', which XDMF could not refer to).
 void check_output_path(const std::string& path);
 
-/// Creates and removes an empty hidden file ".<name>.probe.<pid>" beside `path`, to learn before
-/// any work whether a file can be created there at all (permission bits cannot tell: root passes
-/// them and still cannot create a file in /proc). Returns the reason it cannot, or nothing.
-[[nodiscard]] std::optional<std::string> probe_create(const std::string& path);
+/// For the CLI at start-up, before any work, for any file a run writes (`what` names it in the
+/// message: "output", "--stats"): throws InputError (one line) unless `path` names a file, not a
+/// folder nor an existing device or pipe (the rename at the end would replace it: as root,
+/// /dev/null itself), in an existing folder where this process can create its temporary
+/// (created and removed here: permission bits cannot tell, root passes them and still cannot
+/// create a file in /proc).
+void check_output_file(const std::string& what, const std::string& path);
 
 /// Throws qsmesh::Error unless the arrays of `mesh` agree: per-element CAD ids sized like the
 /// elements and in range, vertex ids in range, one classification per vertex, curve_corners sized

@@ -206,6 +206,12 @@ struct FaceSides {
 ///    mesh (face id set) and the reason in the report (with the best valid candidate in
 ///    report->refused_mesh on a quality refusal).
 /// Never throws for a face-level failure. Deterministic.
+[[nodiscard]] mesh::FaceMesh mesh_face_pattern(const cad::CadModel& model, LO f,
+                                               std::span<const mesh::CurveMesh> full_curves,
+                                               std::span<const Pattern> patterns,
+                                               const PatternFaceOptions& options,
+                                               PatternFaceReport* report = nullptr);
+
 /// Whether a fill kept by mesh_face_pattern (valid, its minimum above the face's threshold) with
 /// this mean SICN and quad count is compared with the face's unstructured mesh: more than
 /// options.small_fill_quads quads and its mean at or below options.compare_below_avg. That takes
@@ -226,10 +232,13 @@ struct FaceSides {
                                                const mesh::FaceQuadStats& unstructured,
                                                const PatternFaceOptions& options);
 
-[[nodiscard]] mesh::FaceMesh mesh_face_pattern(const cad::CadModel& model, LO f,
-                                               std::span<const mesh::CurveMesh> full_curves,
-                                               std::span<const Pattern> patterns,
-                                               const PatternFaceOptions& options,
-                                               PatternFaceReport* report = nullptr);
+/// Which mesh a face keeps when a pattern fill waits for its unstructured mesh (the pipeline's
+/// comparison after paper 000 Sec. 6.2-6.3): true for the fill. A fill kept by mesh_face_pattern
+/// but held back by fill_to_compare (`kept`) wins unless unstructured_clearly_better; a fill the
+/// thresholds refused wins when it is no worse than the unstructured mesh in SICN min and mean
+/// (within `tolerance`) and has no more interior irregular vertices. Serial, pure.
+[[nodiscard]] bool fill_wins(const mesh::FaceQuadStats& fill,
+                             const mesh::FaceQuadStats& unstructured, bool kept, double tolerance,
+                             const PatternFaceOptions& options);
 
 }  // namespace qsmesh::qstruct
