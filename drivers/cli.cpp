@@ -160,9 +160,11 @@ Arguments parse(const std::vector<std::string>& args) {
       return args[++i];
     };
     if (opt == "--help" || opt == "-h") {
-      a.help_topic = cmd;
-      a.command = Command::Help;
-      return a;
+      // Help alone, not the options parsed before it: those were never checked together.
+      Arguments help_only;
+      help_only.help_topic = cmd;
+      help_only.command = Command::Help;
+      return help_only;
     }
     if (opt == "-o" || opt == "--output") a.output = value();
     else if (opt == "--size" && meshing) a.size = parse_positive(opt, value());

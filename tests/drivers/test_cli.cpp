@@ -298,5 +298,15 @@ TEST(Cli, ExampleFormatByExtension) {
         << bad;
 }
 
+// --help anywhere gives the help alone: options before it, which were never checked together,
+// are dropped (the fuzzer found --size-min and --size-min-ratio both set on a help request).
+TEST(Cli, HelpDropsTheOptionsBeforeIt) {
+  const Arguments a = p({"mesh", "m.step", "--size-min", "1", "--size-min-ratio", "0.5", "--help"});
+  EXPECT_EQ(a.command, Command::Help);
+  EXPECT_EQ(a.help_topic, "mesh");
+  EXPECT_FALSE(a.size_min.has_value());
+  EXPECT_FALSE(a.size_min_ratio.has_value());
+}
+
 }  // namespace
 }  // namespace qsmesh::cli
