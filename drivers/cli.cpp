@@ -174,7 +174,16 @@ Arguments parse(const std::vector<std::string>& args) {
     else if (opt == "--face-time-budget" && a.command == Command::Mesh)
       a.face_time_budget = parse_positive(opt, value());
     else if (opt == "--stats" && meshing) a.stats = value();
-    else if (opt == "--block-structured" && a.command == Command::Mesh) a.block_structured = true;
+    else if (opt == "--field-divisions" && meshing) {
+      const std::string& v = value();
+      const auto n = parse_double(v);
+      if (!n || !std::isfinite(*n) || *n < 0 || (*n > 0 && *n < 1) || *n > 1e6)
+        throw InputError(opt + ": '" + v +
+                         "' is not 0 (the background follows the target size) or a number of "
+                         "divisions in [1, 1e6]");
+      a.field_divisions = *n;
+    } else if (opt == "--block-structured" && a.command == Command::Mesh)
+      a.block_structured = true;
     else if (opt == "--order" && a.command == Command::Mesh) {
       const std::string& v = value();
       if (v != "1" && v != "2") throw InputError("--order: '" + v + "' is not 1 or 2");
@@ -373,6 +382,17 @@ std::string help(const std::string& topic) {
           "  --corner-size K:H,.., --curve-size C:H,.., --face-size F:H,.., --sizemap METHOD\n"
           "                        size-map controls, as for sizemap (see qsmesh sizemap --help);\n"
           "                        they act on the quad mesh, not with --until background\n"
+          "  --field-divisions N   the background triangulation, on which the cross fields and "
+          "the\n"
+          "                        size map are computed, follows the geometry: curvature, small\n"
+          "                        CAD features, and edges of at most the face's bounding-box\n"
+          "                        diagonal / N (default "
+       << kDefaultFieldDivisions
+       << ") or the target size, whichever\n"
+          "                        is larger; the quad stages sample the fields. 0: the "
+          "background\n"
+          "                        follows the target size (paper 000 Sec. 3.1; its cost grows\n"
+          "                        faster than the mesh)\n"
           "  --face-time-budget S  at most S seconds of cavity remeshing (paper 000 Sec. 6.2) per\n"
           "                        face; a face that reaches it keeps the mesh it has (valid) and "
           "is\n"
@@ -410,8 +430,8 @@ std::string help(const std::string& topic) {
           "  --check               list the faces whose singularities break the Euler relation and "
           "end\n"
           "                        with the line 'euler-consistent: K/N'\n"
-          "  --size H, --size-factor F, --threads T, --stats FILE.json, --max-quads N, --sew, -q,\n"
-          "  -v: as for mesh\n";
+          "  --size H, --size-factor F, --threads T, --stats FILE.json, --max-quads N,\n"
+          "  --field-divisions N, --sew, -q, -v: as for mesh\n";
   } else if (topic == "sizemap") {
     os << "usage: [mpirun -np P] qsmesh sizemap MODEL -o OUT.vtu [options]\n\n"
           "Computes the size map (paper 000 Sec. 4.1-4.2) and the curve quantization (Sec. 4.3):\n"
@@ -461,8 +481,8 @@ std::string help(const std::string& topic) {
           "  --face-quads F:N,..   prescribe the number of quads of faces\n"
           "  --corner-size K:H,.., --curve-size C:H,.., --face-size F:H,..\n"
           "                        size constraints at corners, on curves, on faces (model units)\n"
-          "  --size H, --size-factor F, --threads T, --stats FILE.json, --max-quads N, --sew, -q,\n"
-          "  -v: as for mesh\n";
+          "  --size H, --size-factor F, --threads T, --stats FILE.json, --max-quads N,\n"
+          "  --field-divisions N, --sew, -q, -v: as for mesh\n";
   } else if (topic == "example") {
     os << "usage: qsmesh example wing-body -o FILE\n\n"
           "Writes a built-in CAD model built with OpenCASCADE, as STEP (FILE.step, .stp) or BREP\n"

@@ -65,11 +65,19 @@ struct Arguments {
   /// --max-quads N: refuse, before any work, a run whose estimated quad count is above N
   /// (0: no bound; the machine's memory still bounds it). See kDefaultMaxQuads.
   double max_quads = -1;  ///< -1: kDefaultMaxQuads
+  /// --field-divisions N: the background (where the fields are computed) at the geometry's
+  /// resolution, each face's edges at most its bounding-box diagonal / N (and at most the target
+  /// size's resolution); 0: the background follows the target size. See kDefaultFieldDivisions.
+  std::optional<double> field_divisions;
   bool sew = false;
   bool quiet = false;
   bool verbose = false;
   std::string example_name;  ///< example NAME
 };
+
+/// Default --field-divisions (background::SizeOptions::field_divisions): docs/benchmarks.md,
+/// "Fields at the geometry's resolution", has the measurements behind it.
+inline constexpr double kDefaultFieldDivisions = 64;
 
 /// Default --size-factor when neither --size nor --size-factor is given: a medium mesh.
 inline constexpr double kDefaultSizeFactor = 0.02;

@@ -572,6 +572,7 @@ void write_run_header(JsonWriter& j, const Arguments& args, const Session& s) {
   j.value("ranks", s.ranks);
   j.value("threads", s.threads);
   j.value("size", s.size);
+  j.value("field_divisions", field_divisions(args));
 }
 
 void write_times(JsonWriter& j, const StageTimes& times) {
@@ -652,6 +653,10 @@ void check_ids(const char* option, const char* what, const std::vector<std::pair
 }
 
 }  // namespace
+
+double field_divisions(const Arguments& args) {
+  return args.field_divisions.value_or(kDefaultFieldDivisions);
+}
 
 double curvature_edges(const Arguments& args) {
   return args.curvature_edges.value_or(sizemap::SizeMapOptions{}.edges_per_turn);
@@ -749,6 +754,7 @@ int run_mesh(const Arguments& args) {
   Session s(args, "mesh");
   parallel::PipelineOptions options;
   options.background.sizes.size = s.size;
+  options.background.sizes.field_divisions = field_divisions(args);
   check_request(args, s);
   if (until >= parallel::Stage::Unstructured) apply_size_options(args, s, options);
   s.announce(args, "mesh");

@@ -55,6 +55,8 @@ int run_sizemap(const Arguments& args);
 /// options.sizemap.size_max is the session's size.
 void apply_size_options(const Arguments& args, const Session& s,
                         parallel::PipelineOptions& options);
+/// The background's field divisions a run uses: --field-divisions, or kDefaultFieldDivisions.
+double field_divisions(const Arguments& args);
 /// The curvature edges per turn a run uses: --curvature-edges, or the size map's default.
 double curvature_edges(const Arguments& args);
 /// The feature ratio a run uses: --feature-ratio, or the size map's default.

@@ -68,6 +68,7 @@ int run_crossfield(const Arguments& args) {
   linalg::PetscLane lane;
   parallel::PipelineOptions options;
   options.background.sizes.size = s.size;
+  options.background.sizes.field_divisions = field_divisions(args);
   options.cross_fields = true;
   const parallel::PipelineResult result = parallel::run_pipeline(s.comm, s.model, options, *s.tasks, s.log, &lane);
   for (const auto& [stage, sec] : result.times.entries()) s.times.add(stage, sec);

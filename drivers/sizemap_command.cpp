@@ -80,6 +80,7 @@ int run_sizemap(const Arguments& args) {
   linalg::PetscLane lane;
   parallel::PipelineOptions options;
   options.background.sizes.size = s.size;
+  options.background.sizes.field_divisions = field_divisions(args);
   options.size_map = true;
   check_request(args, s);
   apply_size_options(args, s, options);

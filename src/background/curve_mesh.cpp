@@ -1,13 +1,14 @@
 #include "qsmesh/background/curve_mesh.hpp"
-#include "qsmesh/background/feature_size.hpp"
 
 #include <algorithm>
-#include <cmath>
 #include <array>
+#include <cmath>
+#include <limits>
 #include <map>
-#include <unordered_map>
 #include <memory>
+#include <unordered_map>
 
+#include "qsmesh/background/feature_size.hpp"
 #include "qsmesh/core/error.hpp"
 
 namespace qsmesh::background {
@@ -135,6 +136,18 @@ std::vector<mesh::CurveMesh> mesh_curves(const cad::CadModel& model, const SizeO
     }
   };
 
+  // 0. The largest size of each curve: the smallest background cap of the faces using it (the
+  //    target size, or the geometry's resolution with SizeOptions::field_divisions).
+  std::vector<double> cap(static_cast<std::size_t>(n), sizes.size);
+  for (LO c = 0; c < n; ++c) {
+    if (uses[c].empty()) continue;
+    double v = std::numeric_limits<double>::infinity();
+    for (const CurveUseRef& u : uses[c])
+      v = std::min(v, sizes.field_cap(model.faces()[u.face].box.diagonal()));
+    cap[c] = v;
+  }
+  const double largest = n > 0 ? *std::max_element(cap.begin(), cap.end()) : sizes.size;
+
   // 1. Sample every curve with its curvature sizes.
   std::vector<std::unique_ptr<CurveCurvatureSize>> sizers(static_cast<std::size_t>(n));
   std::vector<CurveSamples> samples(static_cast<std::size_t>(n));
@@ -142,8 +155,8 @@ std::vector<mesh::CurveMesh> mesh_curves(const cad::CadModel& model, const SizeO
     const auto c = static_cast<LO>(i);
     if (model.curves()[c].degenerate) return;
     with_context(c, [&] {
-      sizers[c] = std::make_unique<CurveCurvatureSize>(model, c, uses[c], sizes);
-      samples[c] = sample_curve(*sizers[c], model.curves()[c], sizes.size);
+      sizers[c] = std::make_unique<CurveCurvatureSize>(model, c, uses[c], sizes.capped(cap[c]));
+      samples[c] = sample_curve(*sizers[c], model.curves()[c], cap[c]);
     });
   });
 
@@ -158,13 +171,13 @@ std::vector<mesh::CurveMesh> mesh_curves(const cad::CadModel& model, const SizeO
     // Gaps narrower than a tenth of the smallest size are curves touching or lying on top of each
     // other (unsewn volumes, sloppy models), not features the mesh could resolve.
     limit_by_feature_distance(model, polylines, h, 0.1 * sizes.effective_min_size(),
-                              sizes.effective_min_size(), sizes.size, tasks);
+                              sizes.effective_min_size(), tasks);
     for (std::size_t c = 0; c < samples.size(); ++c) samples[c].h = std::move(h[c]);
   }
 
   // 3. Corners take the smallest size of the curves ending there (a curve never asks for more than
   //    its length); then sizes grade along each curve from its two corners.
-  std::vector<double> corner_size(static_cast<std::size_t>(model.num_corners()), sizes.size);
+  std::vector<double> corner_size(static_cast<std::size_t>(model.num_corners()), largest);
   for (LO c = 0; c < n; ++c) {
     const auto& cc = model.curves()[c];
     if (cc.degenerate || samples[c].p.empty()) continue;

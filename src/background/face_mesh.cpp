@@ -73,7 +73,9 @@ mesh::FaceMesh mesh_face_background(const cad::CadModel& model, LO f,
         bsizes.push_back(prev <= 0 ? next : next <= 0 ? prev : 0.5 * (prev + next));
       }
     }
-    const FaceSizeField field(*surface, options.sizes, std::move(bpoints), std::move(bsizes));
+    const SizeOptions sizes =
+        options.sizes.capped(options.sizes.field_cap(model.faces()[f].box.diagonal()));
+    const FaceSizeField field(*surface, sizes, std::move(bpoints), std::move(bsizes));
     const mesh::SizeFunction size = [&](const Vec2& uv, const Vec3& xyz) { return field(uv, xyz); };
     const bool reversed = model.faces()[f].reversed;
     try {

@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <unordered_map>
+#include <vector>
 
 namespace qsmesh::background {
 
@@ -24,72 +24,111 @@ double distance_to_polyline(const std::vector<Vec3>& line, LO j, const Vec3& p) 
   return d;
 }
 
-/// Uniform hash grid over the polyline vertices of all curves.
-class PointGrid {
+/// Static k-d tree over the polyline vertices of all curves. The search radius of a vertex is its
+/// current size, which varies by orders of magnitude over a model whose background follows the
+/// geometry (a far-field box next to a wing); a uniform grid sized for one end is quadratic at the
+/// other, the tree is not.
+class PointTree {
  public:
-  PointGrid(std::span<const std::vector<Vec3>> lines, double cell) : cell_(cell) {
+  explicit PointTree(std::span<const std::vector<Vec3>> lines) {
     for (LO c = 0; c < static_cast<LO>(lines.size()); ++c)
-      for (LO i = 0; i < static_cast<LO>(lines[c].size()); ++i) cells_[key(lines[c][i])].push_back({c, i});
+      for (LO i = 0; i < static_cast<LO>(lines[c].size()); ++i)
+        items_.push_back({lines[c][i], c, i});
+    splits_.assign(items_.size(), Split{});
+    if (!items_.empty()) build(0, items_.size());
   }
 
   /// For each curve with `eligible(curve)` that has a sample within `radius` of p: its nearest
-  /// sample's (curve, sample index), in increasing curve id.
+  /// sample's (curve, sample index), in increasing curve id; ties go to the smaller index.
   template <class Eligible>
-  [[nodiscard]] std::vector<std::pair<LO, LO>> candidates(std::span<const std::vector<Vec3>> lines,
-                                                          const Vec3& p, double radius,
+  [[nodiscard]] std::vector<std::pair<LO, LO>> candidates(const Vec3& p, double radius,
                                                           const Eligible& eligible) const {
     std::vector<std::pair<LO, LO>> best;  // (curve, sample)
     std::vector<double> best_d2;
+    if (items_.empty()) return best;
     const double r2 = radius * radius;
-    const auto r = static_cast<std::int64_t>(std::ceil(radius / cell_));
-    const auto [cx, cy, cz] = coords(p);
-    for (std::int64_t x = cx - r; x <= cx + r; ++x)
-      for (std::int64_t y = cy - r; y <= cy + r; ++y)
-        for (std::int64_t z = cz - r; z <= cz + r; ++z) {
-          const auto it = cells_.find(pack(x, y, z));
-          if (it == cells_.end()) continue;
-          for (const auto& [c, i] : it->second) {
-            const double d2 = norm2(lines[c][i] - p);
-            if (d2 >= r2 || !eligible(c)) continue;
-            std::size_t k = 0;
-            while (k < best.size() && best[k].first != c) ++k;
-            if (k == best.size()) {
-              best.emplace_back(c, i);
-              best_d2.push_back(d2);
-            } else if (d2 < best_d2[k] || (d2 == best_d2[k] && i < best[k].second)) {
-              best[k].second = i;
-              best_d2[k] = d2;
-            }
-          }
-        }
+    search(0, items_.size(), p, r2, [&](const Item& it, double d2) {
+      if (!eligible(it.curve)) return;
+      std::size_t k = 0;
+      while (k < best.size() && best[k].first != it.curve) ++k;
+      if (k == best.size()) {
+        best.emplace_back(it.curve, it.index);
+        best_d2.push_back(d2);
+      } else if (d2 < best_d2[k] || (d2 == best_d2[k] && it.index < best[k].second)) {
+        best[k].second = it.index;
+        best_d2[k] = d2;
+      }
+    });
     std::sort(best.begin(), best.end());
     return best;
   }
 
  private:
-  [[nodiscard]] std::array<std::int64_t, 3> coords(const Vec3& p) const {
-    return {static_cast<std::int64_t>(std::floor(p.x / cell_)), static_cast<std::int64_t>(std::floor(p.y / cell_)),
-            static_cast<std::int64_t>(std::floor(p.z / cell_))};
+  struct Item {
+    Vec3 p;
+    LO curve, index;
+  };
+  struct Split {
+    int axis = -1;  // -1: a leaf
+    double value = 0;
+  };
+  static constexpr std::size_t kLeaf = 16;
+
+  static double coord(const Vec3& p, int axis) { return axis == 0 ? p.x : axis == 1 ? p.y : p.z; }
+
+  // Nodes are implicit: the range [lo, hi) splits at its middle, and splits_[middle] says how
+  // (the middles of different nodes differ).
+  void build(std::size_t lo, std::size_t hi) {
+    if (hi - lo <= kLeaf) return;
+    Box3 box;
+    for (std::size_t i = lo; i < hi; ++i) box.add(items_[i].p);
+    const Vec3 extent = box.hi - box.lo;
+    const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0
+                     : extent.y >= extent.z                       ? 1
+                                                                  : 2;
+    const std::size_t mid = lo + (hi - lo) / 2;
+    // Ties on the coordinate are ordered by (curve, index), so the tree is the same on every run.
+    std::nth_element(items_.begin() + static_cast<std::ptrdiff_t>(lo),
+                     items_.begin() + static_cast<std::ptrdiff_t>(mid),
+                     items_.begin() + static_cast<std::ptrdiff_t>(hi),
+                     [axis](const Item& a, const Item& b) {
+                       const double ca = coord(a.p, axis), cb = coord(b.p, axis);
+                       if (ca != cb) return ca < cb;
+                       return a.curve != b.curve ? a.curve < b.curve : a.index < b.index;
+                     });
+    splits_[mid] = {axis, coord(items_[mid].p, axis)};
+    build(lo, mid);
+    build(mid, hi);
   }
-  static std::uint64_t pack(std::int64_t x, std::int64_t y, std::int64_t z) {
-    constexpr std::int64_t kBias = 1 << 20;
-    return (static_cast<std::uint64_t>(x + kBias) << 42) ^ (static_cast<std::uint64_t>(y + kBias) << 21) ^
-           static_cast<std::uint64_t>(z + kBias);
+
+  template <class Visit>
+  void search(std::size_t lo, std::size_t hi, const Vec3& p, double r2, const Visit& visit) const {
+    if (hi - lo <= kLeaf) {
+      for (std::size_t i = lo; i < hi; ++i) {
+        const double d2 = norm2(items_[i].p - p);
+        if (d2 < r2) visit(items_[i], d2);
+      }
+      return;
+    }
+    const std::size_t mid = lo + (hi - lo) / 2;
+    const Split& s = splits_[mid];
+    const double d = coord(p, s.axis) - s.value;
+    // Items of [lo, mid) are at most s.value on the axis, those of [mid, hi) at least.
+    if (d <= 0 || d * d < r2) search(lo, mid, p, r2, visit);
+    if (d >= 0 || d * d < r2) search(mid, hi, p, r2, visit);
   }
-  [[nodiscard]] std::uint64_t key(const Vec3& p) const {
-    const auto [x, y, z] = coords(p);
-    return pack(x, y, z);
-  }
-  double cell_;
-  std::unordered_map<std::uint64_t, std::vector<std::pair<LO, LO>>> cells_;
+
+  std::vector<Item> items_;
+  std::vector<Split> splits_;
 };
 
 }  // namespace
 
-void limit_by_feature_distance(const cad::CadModel& model, std::span<const std::vector<Vec3>> polylines,
-                               std::vector<std::vector<double>>& sizes, double touching, double floor,
-                               double cell, const TaskArena& tasks) {
-  const PointGrid grid(polylines, cell);
+void limit_by_feature_distance(const cad::CadModel& model,
+                               std::span<const std::vector<Vec3>> polylines,
+                               std::vector<std::vector<double>>& sizes, double touching,
+                               double floor, const TaskArena& tasks) {
+  const PointTree tree(polylines);
   tasks.parallel_for(static_cast<std::int64_t>(polylines.size()), [&](std::int64_t i) {
     const auto c = static_cast<LO>(i);
     const auto& cc = model.curves()[c];
@@ -104,7 +143,8 @@ void limit_by_feature_distance(const cad::CadModel& model, std::span<const std::
     const auto& line = polylines[c];
     auto& h = sizes[c];
     for (std::size_t k = 0; k < line.size(); ++k) {
-      for (const auto& [o, j] : grid.candidates(polylines, line[k], h[k], [&](LO x) { return !adjacent(x); })) {
+      for (const auto& [o, j] :
+           tree.candidates(line[k], h[k], [&](LO x) { return !adjacent(x); })) {
         // The other curve near its nearest vertex is the polyline through the vertices around it:
         // exact enough for dense polylines, and far cheaper than a CAD projection.
         const double d = distance_to_polyline(polylines[o], j, line[k]);

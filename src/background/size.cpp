@@ -13,6 +13,18 @@ double SizeOptions::from_curvature(double kappa) const {
   return std::clamp(h, lo, size);
 }
 
+SizeOptions SizeOptions::capped(double cap) const {
+  SizeOptions out = *this;
+  out.min_size = effective_min_size();
+  out.size = std::max(size, cap);
+  return out;
+}
+
+double SizeOptions::field_cap(double diagonal) const {
+  if (!(field_divisions > 0) || !(diagonal > 0) || !std::isfinite(diagonal)) return size;
+  return std::max(size, diagonal / field_divisions);
+}
+
 FaceSizeField::FaceSizeField(const cad::FaceGeometry& surface, const SizeOptions& sizes,
                              std::vector<Vec3> boundary_points, std::vector<double> boundary_sizes)
     : surface_(surface),

@@ -201,7 +201,20 @@ mesh::FaceMesh move_irregular_vertices(LO f, const cad::Face& face,
   if (fs.corners.empty()) moves.emplace_back();
   if (moves.empty()) return mesh;
   Candidate best = start;
+  const int moves_before = rep.moves;
   int evaluations = 0;
+  // The layouts are compared after a few smoothing passes, the winner smoothed fully at the end;
+  // the start is compared as the others are (the caller's mesh of it had every pass).
+  smooth::SmoothOptions search = options.smooth;
+  const bool light =
+      options.move_search_iterations > 0 && options.move_search_iterations < search.iterations;
+  if (light) search.iterations = options.move_search_iterations;
+  const mesh::FaceMesh given = light ? mesh : mesh::FaceMesh{};
+  const smooth::QualityReport given_q = q;
+  if (light && q.invalid == 0) {
+    mesh = smooth::smooth_face(build_mesh(f, face, surface, fs, start), surface, search);
+    q = smooth::measure(mesh);
+  }
   // The mean, less twice the shortfall of the minimum below its threshold: a refused fill climbs
   // toward the thresholds, a kept one (no shortfall) toward a higher mean.
   const auto score = [&](const smooth::QualityReport& r) {
@@ -224,8 +237,7 @@ mesh::FaceMesh move_irregular_vertices(LO f, const cad::Face& face,
         static_cast<std::int64_t>(c.refined.quads.size()) > options.max_quads)
       return false;
     ++evaluations;
-    mesh::FaceMesh m =
-        smooth::smooth_face(build_mesh(f, face, surface, fs, c), surface, options.smooth);
+    mesh::FaceMesh m = smooth::smooth_face(build_mesh(f, face, surface, fs, c), surface, search);
     const smooth::QualityReport mq = smooth::measure(m);
     if (mq.invalid != 0) return false;
     const bool good_new = passes(mq, min_sicn, options), good_old = passes(q, min_sicn, options);
@@ -266,6 +278,30 @@ mesh::FaceMesh move_irregular_vertices(LO f, const cad::Face& face,
         at -= step;
       }
     }
+  }
+  if (light && rep.moves > moves_before) {
+    mesh::FaceMesh full =
+        smooth::smooth_face(build_mesh(f, face, surface, fs, best), surface, options.smooth);
+    const smooth::QualityReport fq = smooth::measure(full);
+    // The given mesh may have been lifted (untangled) where the light start was not: the moved
+    // fill wins only when it is also better smoothed fully.
+    const bool good_new = passes(fq, min_sicn, options);
+    const bool good_old = passes(given_q, min_sicn, options);
+    const bool wins =
+        fq.invalid == 0 &&
+        (given_q.invalid != 0 || (good_new != good_old ? good_new : score(fq) > score(given_q)));
+    if (wins) {
+      mesh = std::move(full);
+      q = fq;
+    } else {
+      best = start;
+      mesh = given;
+      q = given_q;
+      rep.moves = moves_before;
+    }
+  } else if (light) {
+    mesh = given;
+    q = given_q;
   }
   rep.chords = best.match.chords;
   rep.sicn_min = q.sicn_min;

@@ -243,7 +243,7 @@ CurveSizes initial_curve_sizes(const cad::CadModel& model, std::span<const mesh:
     if (cell > 0) {
       // Gaps narrower than a tenth of the floor are curves touching or lying on top of each other
       // (unsewn or sloppy models), not features a mesh could resolve.
-      background::limit_by_feature_distance(model, dense, h, 0.1 * floor, floor, cell, tasks);
+      background::limit_by_feature_distance(model, dense, h, 0.1 * floor, floor, tasks);
       // h only ever lowers the sizes it started from, and the ratio is at most 1.
       for (LO c = 0; c < nc; ++c)
         for (std::size_t i = 0; i < original[c].size(); ++i) {

@@ -196,6 +196,40 @@ std::string write_t_of_three_plates(const std::string& path) {
   return write_brep_or_step(t, path);
 }
 
+std::string write_plate_with_strip(double length, double side, double strip,
+                                   const std::string& path) {
+  auto vertex = [](double x, double y) {
+    return BRepBuilderAPI_MakeVertex(gp_Pnt(x, y, 0)).Vertex();
+  };
+  const double y[4] = {0, side, side + strip, 2 * side + strip};
+  std::vector<TopoDS_Vertex> left, right;
+  for (const double v : y) {
+    left.push_back(vertex(0, v));
+    right.push_back(vertex(length, v));
+  }
+  auto edge = [](const TopoDS_Vertex& p, const TopoDS_Vertex& q) {
+    return BRepBuilderAPI_MakeEdge(p, q).Edge();
+  };
+  // The three long edges between the rectangles are made once, so neighbours share them.
+  std::vector<TopoDS_Edge> across;
+  for (int k = 0; k < 4; ++k) across.push_back(edge(left[k], right[k]));
+  TopoDS_Shell shell;
+  BRep_Builder builder;
+  builder.MakeShell(shell);
+  for (int k = 0; k < 3; ++k) {
+    BRepBuilderAPI_MakeWire wire;
+    wire.Add(across[k]);
+    wire.Add(edge(right[k], right[k + 1]));
+    wire.Add(across[k + 1]);
+    wire.Add(edge(left[k + 1], left[k]));
+    if (!wire.IsDone()) throw std::runtime_error("plate wire construction failed");
+    BRepBuilderAPI_MakeFace f(wire.Wire(), /*OnlyPlane=*/true);
+    if (!f.IsDone()) throw std::runtime_error("plate face construction failed");
+    builder.Add(shell, f.Face());
+  }
+  return write_brep_or_step(shell, path);
+}
+
 std::string write_box_with_duplicated_face(double depth, const std::string& path) {
   const double height = 4.0;
   const TopoDS_Shape box = BRepPrimAPI_MakeBox(10.0, depth, height).Shape();

@@ -57,5 +57,10 @@ std::string write_box_with_duplicated_face(double depth, const std::string& path
 /// Writes the rectangle [0, length] x [0, width] at z = 0 twice: two faces on one plane with the
 /// same four TopoDS edges, a shell (BREP, or STEP by the extension as above).
 std::string write_rectangle_given_twice(double length, double width, const std::string& path);
+/// Writes a plate of three coplanar rectangles (z = 0) sharing their TopoDS edges: [0, length] x
+/// [0, side], the strip [0, length] x [side, side + strip], and [0, length] x [side + strip,
+/// 2 side + strip]. A shell (BREP, or STEP by the extension as above).
+std::string write_plate_with_strip(double length, double side, double strip,
+                                   const std::string& path);
 
 }  // namespace qsmesh::test

@@ -15,11 +15,12 @@ namespace qsmesh::background {
 
 /// Meshes every curve of `model`: the number of edges is the integral of 1/h along the curve,
 /// rounded (at least 1; at least 3 on a closed curve; at least 2 when another curve joins the same
-/// two corners, so the two never coincide), with h the smallest of `sizes.size`, the curvature size
-/// of the curve and the curvature sizes of its adjacent faces along it; vertices are placed where
-/// the integral of 1/h reaches equal steps. Degenerate curves get one edge.
-/// Depends only on the model and the options: every rank computes the same meshes, whatever the
-/// thread count of `tasks`. Returns one CurveMesh per curve, indexed by curve id.
+/// two corners, so the two never coincide), with h the smallest of the curve's cap (`sizes.size`,
+/// or with `sizes.field_divisions` the smallest SizeOptions::field_cap of its faces), the curvature
+/// size of the curve and the curvature sizes of its adjacent faces along it; vertices are placed
+/// where the integral of 1/h reaches equal steps. Degenerate curves get one edge. Depends only on
+/// the model and the options: every rank computes the same meshes, whatever the thread count of
+/// `tasks`. Returns one CurveMesh per curve, indexed by curve id.
 [[nodiscard]] std::vector<mesh::CurveMesh> mesh_curves(const cad::CadModel& model,
                                                        const SizeOptions& sizes,
                                                        const TaskArena& tasks);

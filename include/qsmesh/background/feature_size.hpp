@@ -13,15 +13,16 @@
 namespace qsmesh::background {
 
 /// Lowers sizes[c][k] to the distance from polyline vertex k of curve c to the nearest curve that
-/// shares no corner with c (model units), searching only within the current sizes[c][k] (a uniform
-/// hash grid with cells of `cell`, no all-pairs search). polylines[c] are points along curve c,
-/// dense enough that the polyline stands for the curve (its segments are what distances are taken
-/// to); empty polylines (degenerate curves) are skipped. Distances up to `touching` are ignored:
-/// curves that touch or lie on top of each other are not features. A feature never asks for less
-/// than `floor` (sizes already below it stay as they are).
+/// shares no corner with c (model units), searching only within the current sizes[c][k] (a k-d tree
+/// over all vertices: no all-pairs search, and no cost that depends on how the radii vary).
+/// polylines[c] are points along curve c, dense enough that the polyline stands for the curve (its
+/// segments are what distances are taken to); empty polylines (degenerate curves) are skipped.
+/// Distances up to `touching` are ignored: curves that touch or lie on top of each other are not
+/// features. A feature never asks for less than `floor` (sizes already below it stay as they are).
 /// Deterministic, whatever the thread count of `tasks`.
-void limit_by_feature_distance(const cad::CadModel& model, std::span<const std::vector<Vec3>> polylines,
-                               std::vector<std::vector<double>>& sizes, double touching, double floor,
-                               double cell, const TaskArena& tasks);
+void limit_by_feature_distance(const cad::CadModel& model,
+                               std::span<const std::vector<Vec3>> polylines,
+                               std::vector<std::vector<double>>& sizes, double touching,
+                               double floor, const TaskArena& tasks);
 
 }  // namespace qsmesh::background

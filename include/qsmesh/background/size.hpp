@@ -24,10 +24,24 @@ struct SizeOptions {
   /// Cap the size on curves by the distance to the nearest non-adjacent curve (small CAD features,
   /// paper 000 Sec. 4.1), so that narrow faces get edges as short as they are wide.
   bool feature_size = true;
+  /// Fields at the geometry's resolution: when > 0, the background of a face is not capped by
+  /// `size` but by field_cap(), the larger of `size` and the diagonal of the face's bounding box
+  /// divided by this number; curvature, small features and the gradation from the boundary refine
+  /// it as before. The cross field, its singularities, the conformal scaling and the size map are
+  /// smooth and computed on this mesh; the quad stages sample them. Its vertex count then depends
+  /// on the geometry, not on the target size, and the field stages cost little next to the quads.
+  /// 0: the background follows `size`, as in paper 000 Sec. 3.1.
+  double field_divisions = 0;
 
   [[nodiscard]] double effective_min_size() const { return min_size > 0 ? min_size : size / 20; }
   /// The size for a radius of curvature 1/kappa (kappa >= 0, 1/model units), within the bounds.
   [[nodiscard]] double from_curvature(double kappa) const;
+  /// The background's largest edge length on a face whose 3D bounding box has diagonal `diagonal`
+  /// (model units): `size`, or max(size, diagonal / field_divisions) when field_divisions > 0.
+  [[nodiscard]] double field_cap(double diagonal) const;
+  /// These options with the largest size raised to `cap` (>= size) and the smallest kept: the
+  /// sizes of one face or curve of a background at the geometry's resolution.
+  [[nodiscard]] SizeOptions capped(double cap) const;
 };
 
 /// Size field of one face: the curvature size of the face, graded from the boundary: at a point x it

@@ -99,6 +99,12 @@ struct PatternFaceOptions {
   /// disks, avg 0.53 -> 0.80-0.84); the pattern stage 1.2-2.3 s longer on Block.
   int move_evaluations = 40;
   double move_below_avg = 0.97;
+  /// Explicit smoothing passes of each layout the move search compares (the start among them):
+  /// the layouts are ranked after this many passes, and only the winner is smoothed with `smooth`.
+  /// A search lays out up to move_evaluations fills of the whole face, so its cost is that many
+  /// smoothings; ranked after 3 passes of 10 it is about a third (docs/benchmarks.md, "Fields at
+  /// the geometry's resolution"). 0, or at least smooth.iterations: every layout fully smoothed.
+  int move_search_iterations = 3;
   /// Matches tried geometrically (laid out, smoothed, measured) before giving up, best first.
   int max_candidates = 4;
   MatchOptions match;
