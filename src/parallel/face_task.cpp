@@ -8,6 +8,31 @@
 
 namespace qsmesh::parallel {
 
+CrossFieldOutput summarize(const crossfield::FaceCrossField& cf) {
+  CrossFieldOutput out;
+  out.ok = true;
+  const std::size_t nt = cf.triangles.size();
+  out.directions = cf.directions;
+  out.u_norm.resize(nt);
+  out.H.resize(nt);
+  for (std::size_t t = 0; t < nt; ++t) {
+    double un = 0, h = 0;
+    for (int k = 0; k < 3; ++k) {
+      un += cf.u_norm[cf.tri2edges[t][k]];
+      h += cf.H[cf.triangles[t][k]];
+    }
+    out.u_norm[t] = un / 3;
+    out.H[t] = h / 3;
+  }
+  out.singularities = cf.singularities;
+  out.euler = cf.euler;
+  out.levels = cf.stats.levels;
+  out.factorizations = cf.stats.factorizations;
+  out.solves = cf.stats.solves;
+  out.seconds = cf.stats.seconds;
+  return out;
+}
+
 void mesh_background(FaceTask& task, const cad::CadModel& model,
                      std::span<const mesh::CurveMesh> curves,
                      const background::BackgroundOptions& options) {
@@ -142,6 +167,8 @@ FillComparison compare_refused_fill(FaceTask& task, double tolerance,
   r = RefusedFill{};
   return c;
 }
+
+bool wants_unstructured(const FaceTask& task) { return !task.quasi.by_pattern; }
 
 bool wants_improvement(const FaceTask& task) {
   return !task.quasi.by_pattern && task.unstructured.ok && task.quad_mesh.triangles.empty();

@@ -1,13 +1,12 @@
 #include "qsmesh/parallel/pipeline.hpp"
 
 #include <algorithm>
+#include <array>
 #include <atomic>
 #include <cmath>
-#include <cstring>
-#include <limits>
-#include <memory>
 #include <numeric>
 #include <optional>
+#include <span>
 
 #include "exchange.hpp"
 #include "improve.hpp"
@@ -47,388 +46,333 @@ std::vector<double> estimate_face_costs(const cad::CadModel& model, double size)
   return cost;
 }
 
-CrossFieldOutput summarize(const crossfield::FaceCrossField& cf) {
-  CrossFieldOutput out;
-  out.ok = true;
-  const std::size_t nt = cf.triangles.size();
-  out.directions = cf.directions;
-  out.u_norm.resize(nt);
-  out.H.resize(nt);
-  for (std::size_t t = 0; t < nt; ++t) {
-    double un = 0, h = 0;
-    for (int k = 0; k < 3; ++k) {
-      un += cf.u_norm[cf.tri2edges[t][k]];
-      h += cf.H[cf.triangles[t][k]];
-    }
-    out.u_norm[t] = un / 3;
-    out.H[t] = h / 3;
+namespace {
+
+// Stage times: each stage ends with the slowest rank's time; the stages split by faces also add
+// this rank's own time to busy() (PipelineResult::rank_busy_seconds). The clock is read before
+// the reduction, so a rank's time is its work, not its wait for the others.
+class StageClock {
+ public:
+  StageClock(const Comm& comm, StageTimes& times) : comm_(comm), times_(times) {}
+  void start() { clock_.reset(); }
+  void end(const char* stage, bool by_faces) {
+    const double seconds = clock_.seconds();
+    if (by_faces) busy_ += seconds;
+    times_.add(stage, comm_.allreduce_max(seconds));
   }
-  out.singularities = cf.singularities;
-  out.euler = cf.euler;
-  out.levels = cf.stats.levels;
-  out.factorizations = cf.stats.factorizations;
-  out.solves = cf.stats.solves;
-  out.seconds = cf.stats.seconds;
-  return out;
+  [[nodiscard]] double busy() const { return busy_; }
+
+ private:
+  const Comm& comm_;
+  StageTimes& times_;
+  Stopwatch clock_;
+  double busy_ = 0;
+};
+
+// What the stages share: the communicator, the model, the options, the threads and the log.
+struct Context {
+  const Comm& comm;
+  const cad::CadModel& model;
+  const PipelineOptions& options;
+  const TaskArena& tasks;
+  Logger& log;
+};
+
+// body(task) on every face of this rank, one TBB task per face. With a stage name, progress is
+// counted on this rank and rank 0's logger prints it at every tenth of the faces (the other
+// ranks' loggers are quiet by default).
+template <class Body>
+void each_face(const Context& cx, std::vector<FaceTask>& faces, const char* stage,
+               const Body& body) {
+  const auto total = static_cast<std::int64_t>(faces.size());
+  std::atomic<std::int64_t> done{0};
+  cx.tasks.parallel_for(total, [&](std::int64_t i) {
+    body(faces[static_cast<std::size_t>(i)]);
+    if (stage == nullptr) return;
+    const std::int64_t n = ++done;
+    if (n * 10 / total != (n - 1) * 10 / total)
+      cx.log.info(cat(stage, ": ", n, "/", total, " faces on rank ", cx.comm.rank()));
+  });
 }
 
-PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
-                            const PipelineOptions& options, const TaskArena& tasks, Logger& log,
-                            linalg::PetscLane* lane) {
-  PipelineResult result;
-  const int rank = comm.rank();
-  const int nranks = comm.size();
-  const LO nfaces = model.num_faces();
-
-  // Curves: every rank computes the same meshes (cheap next to the faces, and no communication).
-  Stopwatch clock;
-  // Each stage ends with the slowest rank's time; the stages split by faces also add this rank's
-  // own time to `busy` (PipelineResult::rank_busy_seconds). The clock is read before the
-  // reduction, so a rank's time is its work, not its wait for the others.
-  double busy = 0;
-  const auto end_stage = [&](const char* stage, bool by_faces) {
-    const double seconds = clock.seconds();
-    if (by_faces) busy += seconds;
-    result.times.add(stage, comm.allreduce_max(seconds));
-  };
-  const std::vector<mesh::CurveMesh> curves =
-      background::mesh_curves(model, options.background.sizes, tasks);
-  std::int64_t curve_edges = 0;
-  for (const auto& c : curves) curve_edges += c.num_edges();
-  end_stage("curves", false);
-  log.info(cat("curves: ", model.num_curves(), " curves meshed, ", curve_edges, " edges (",
-               result.times.get("curves"), " s)"));
-
-  // Faces: METIS partition weighted by the estimated cost. Each face of this rank is one record
-  // (FaceTask) that the stages below fill in turn.
-  clock.reset();
-  result.face_rank = partition_faces(
-      model.face2faces(), estimate_face_costs(model, options.background.sizes.size), nranks);
-  std::vector<FaceTask> faces;
-  for (LO f = 0; f < nfaces; ++f)
-    if (result.face_rank[f] == rank) faces.emplace_back().face = f;
-  const auto total = static_cast<std::int64_t>(faces.size());
-  end_stage("partition", false);
-  if (nranks > 1) {
-    std::vector<std::int64_t> per_rank(static_cast<std::size_t>(nranks), 0);
-    per_rank[rank] = total;
-    comm.allreduce_sum(per_rank);
-    std::string line = "partition: faces per rank";
-    for (auto n : per_rank) line += cat(" ", n);
-    log.info(line);
-  }
-  // One task per face of this rank; progress is counted on this rank and rank 0's logger prints
-  // it at every tenth of the faces (the other ranks' loggers are quiet by default).
-  const auto each_face = [&](const char* stage, const auto& body) {
-    std::atomic<std::int64_t> done{0};
-    tasks.parallel_for(total, [&](std::int64_t i) {
-      body(faces[static_cast<std::size_t>(i)]);
-      const std::int64_t n = ++done;
-      if (n * 10 / total != (n - 1) * 10 / total)
-        log.info(cat(stage, ": ", n, "/", total, " faces on rank ", rank));
+// Size map (paper 000 Sec. 4.1-4.2): curve sizes known to every rank, face fields on the faces'
+// ranks, their union on shared curves by an MPI min-reduction, then the faces again. Returns the
+// united curve sizes (every rank); fills each task's sizes.
+sizemap::CurveSizes size_map_stage(const Context& cx, std::span<const mesh::CurveMesh> curves,
+                                   std::vector<FaceTask>& faces, bool cf_sizes) {
+  const sizemap::SizeMapOptions& so = cx.options.sizemap;
+  const sizemap::CurveSizes initial = sizemap::initial_curve_sizes(cx.model, curves, so, cx.tasks);
+  const std::vector<double> targets = sizemap::face_quad_targets(cx.model, so);
+  const auto face_pass = [&](const sizemap::CurveSizes& on_curves) {
+    each_face(cx, faces, nullptr, [&](FaceTask& t) {
+      t.sizes = sizemap::face_sizes(t.background, cf_sizes ? t.cross_field.get() : nullptr, curves,
+                                    on_curves, targets[t.face], so);
     });
   };
-
-  // Background triangulation of this rank's faces.
-  clock.reset();
-  each_face("background",
-            [&](FaceTask& t) { mesh_background(t, model, curves, options.background); });
-  end_stage("background", true);
-
-  // Cross fields (paper 000 Sec. 3) on the same faces. The size map (it needs H at every vertex)
-  // and the frontal insertion (the crosses) keep the whole fields; the drivers that asked for
-  // them (options.cross_fields) get summaries.
-  const bool quads = options.until >= Stage::Unstructured;
-  const bool quasi = options.until >= Stage::QuasiStructured;
-  const bool size_map = options.size_map || quads;
-  const bool cf_sizes = size_map && options.sizemap.method == sizemap::Method::CrossField;
-  const bool keep_fields = cf_sizes || quads;
-  if (options.cross_fields || keep_fields) {
-    clock.reset();
-    each_face("crossfield", [&](FaceTask& t) {
-      compute_cross_field(t, options.crossfield, options.cross_fields, keep_fields, lane);
+  face_pass(initial);
+  // The union on shared curves and corners starts from the initial sizes on every rank (the
+  // minimum is idempotent), so curves that no face of this rank touches keep their values.
+  sizemap::CurveSizes united = initial;
+  for (const FaceTask& t : faces) sizemap::fold_boundary_min(t.background, t.sizes.s, united);
+  std::vector<double> flat = united.pack();
+  cx.comm.allreduce_min(flat);
+  united.unpack(flat);
+  sizemap::grade_curves(cx.model, curves, so.gradation, united);
+  face_pass(united);  // faces now agree on their shared curves
+  // The frontal insertion reads only the crosses of each field; the rest was for the size map.
+  if (!cx.options.cross_fields)
+    each_face(cx, faces, nullptr, [&](FaceTask& t) {
+      if (t.cross_field != nullptr)
+        crossfield::shrink_cross_field(*t.cross_field, crossfield::CrossFieldUse::Guide);
     });
-    end_stage("crossfield", true);
-  }
+  return united;
+}
 
-  // Size map (paper 000 Sec. 4.1-4.2): curve sizes known to every rank, face fields on the faces'
-  // ranks, their union on shared curves by an MPI min-reduction, then quantization (Sec. 4.3)
-  // computed identically on every rank.
-  // The halved curve meshes of the final quantization (paper 000 Sec. 5.2), when the boundary
-  // check already placed them; else the unstructured stage places them.
+// Quantization (paper 000 Sec. 4.3), balanced against the patterns and repaired where a face
+// boundary crosses itself, computed identically on every rank: fills result.quantization,
+// balance, curves_refined_for_crossings and quantized_curves. Returns the halved curve meshes of
+// the final quantization when the boundary check placed them (else empty).
+std::vector<mesh::CurveMesh> quantize_stage(const Context& cx,
+                                            std::span<const mesh::CurveMesh> curves,
+                                            const std::vector<FaceTask>& faces,
+                                            PipelineResult& result) {
+  const PipelineOptions& options = cx.options;
+  const cad::CadModel& model = cx.model;
+  std::vector<LO> fixed;  // user prescriptions: never changed
+  for (const auto& [c, n] : options.quantize.prescribed) fixed.push_back(c);
+  const std::vector<double> ideal = quantize::ideal_edge_counts(curves, result.curve_sizes.at);
+  result.quantization = quantize::quantize_curves(model, ideal, options.quantize);
+  if (options.balance_counts) {
+    // Every rank balances the whole model the same way (deterministic, model-wide data only).
+    const auto patterns = qstruct::builtin_patterns();
+    std::vector<int> edges = qstruct::balance_curve_counts(
+        model, curves, result.quantization, patterns, fixed, options.balance, &result.balance);
+    result.quantization.total_edges = 0;
+    for (const int e : edges) result.quantization.total_edges += e;
+    result.quantization.edges = std::move(edges);
+    cx.log.info(cat("quantize: faces fitting a pattern ", result.balance.fitting_before, " -> ",
+                    result.balance.fitting_after, " of ", result.balance.faces_considered,
+                    ", grids ", result.balance.grids_before, " -> ", result.balance.grids_after,
+                    " (", result.balance.curves_changed, " curves changed)"));
+  }
+  // Boundary repair: a face whose boundary crosses itself in its parameter plane cannot be
+  // triangulated. Each rank checks its own faces; the flags are summed, so every rank refines
+  // the same curves and keeps the same quantization.
   std::vector<mesh::CurveMesh> halved_curves;
-  if (size_map) {
-    clock.reset();
-    const sizemap::SizeMapOptions& so = options.sizemap;
-    const sizemap::CurveSizes initial = sizemap::initial_curve_sizes(model, curves, so, tasks);
-    const std::vector<double> targets = sizemap::face_quad_targets(model, so);
-    auto face_pass = [&](const sizemap::CurveSizes& on_curves) {
-      tasks.parallel_for(total, [&](std::int64_t i) {
-        FaceTask& t = faces[static_cast<std::size_t>(i)];
-        t.sizes = sizemap::face_sizes(t.background, cf_sizes ? t.cross_field.get() : nullptr,
-                                      curves, on_curves, targets[t.face], so);
-      });
-    };
-    face_pass(initial);
-    // The union on shared curves and corners starts from the initial sizes on every rank (the
-    // minimum is idempotent), so curves that no face of this rank touches keep their values.
-    sizemap::CurveSizes united = initial;
-    for (const FaceTask& t : faces) sizemap::fold_boundary_min(t.background, t.sizes.s, united);
-    std::vector<double> flat = united.pack();
-    comm.allreduce_min(flat);
-    united.unpack(flat);
-    sizemap::grade_curves(model, curves, so.gradation, united);
-    face_pass(united);  // faces now agree on their shared curves
-    // The frontal insertion reads only the crosses of each field; the rest was for the size map.
-    if (!options.cross_fields)
-      tasks.parallel_for(total, [&](std::int64_t i) {
-        FaceTask& t = faces[static_cast<std::size_t>(i)];
-        if (t.cross_field != nullptr)
-          crossfield::shrink_cross_field(*t.cross_field, crossfield::CrossFieldUse::Guide);
-      });
-    result.curve_sizes = std::move(united);
-    end_stage("sizemap", true);
-
-    clock.reset();
-    const std::vector<double> ideal = quantize::ideal_edge_counts(curves, result.curve_sizes.at);
-    result.quantization = quantize::quantize_curves(model, ideal, options.quantize);
-    if (options.balance_counts) {
-      // Every rank balances the whole model the same way (deterministic, model-wide data only).
-      std::vector<LO> fixed;
-      for (const auto& [c, n] : options.quantize.prescribed) fixed.push_back(c);
-      const auto patterns = qstruct::builtin_patterns();
-      std::vector<int> edges = qstruct::balance_curve_counts(
-          model, curves, result.quantization, patterns, fixed, options.balance, &result.balance);
-      result.quantization.total_edges = 0;
-      for (const int e : edges) result.quantization.total_edges += e;
-      result.quantization.edges = std::move(edges);
-      log.info(cat("quantize: faces fitting a pattern ", result.balance.fitting_before, " -> ",
-                   result.balance.fitting_after, " of ", result.balance.faces_considered,
-                   ", grids ", result.balance.grids_before, " -> ", result.balance.grids_after,
-                   " (", result.balance.curves_changed, " curves changed)"));
-    }
-    // Boundary repair: a face whose boundary crosses itself in its parameter plane cannot be
-    // triangulated. Each rank checks its own faces; the flags are summed, so every rank refines
-    // the same curves and keeps the same quantization.
-    std::vector<LO> fixed;
-    for (const auto& [c, n] : options.quantize.prescribed) fixed.push_back(c);
-    bool placed_final = false;  // result.quantized_curves holds the final quantization's meshes
-    for (int round = 0; round < options.boundary_repair_rounds; ++round) {
-      std::vector<std::int64_t> flags(static_cast<std::size_t>(model.num_curves()), 0);
-      std::vector<std::vector<LO>> found(faces.size());
-      for (const bool halved : {true, false}) {
-        std::vector<mesh::CurveMesh> placed =
-            quantize::place_vertices(model, curves, result.curve_sizes.at, result.quantization,
-                                     halved, tasks, options.place);
-        tasks.parallel_for(total, [&](std::int64_t i) {
-          const LO f = faces[static_cast<std::size_t>(i)].face;
-          try {
-            const auto c = quantize::crossing_curves(model, f, placed);
-            found[i].insert(found[i].end(), c.begin(), c.end());
-          } catch (const std::exception& e) {
-            // The face's own stages report its geometry errors; this check only looks for
-            // crossings.
-            log.debug(Error(e.what(), ErrorContext{"quantize", 2, f}).what());
-          }
-        });
-        (halved ? halved_curves : result.quantized_curves) = std::move(placed);
-      }
-      placed_final = true;
-      for (const auto& list : found)
-        for (const LO c : list) flags[c] = 1;
-      comm.allreduce_sum(flags);
-      std::vector<LO> flagged;
-      for (LO c = 0; c < model.num_curves(); ++c)
-        if (flags[c] > 0) flagged.push_back(c);
-      if (flagged.empty()) break;
-      const std::int64_t before = result.quantization.total_edges;
-      quantize::refine_curves(result.quantization, flagged, fixed);
-      if (result.quantization.total_edges == before) break;  // only fixed curves are involved
-      placed_final = false;
-      halved_curves.clear();
-      result.curves_refined_for_crossings.push_back(static_cast<LO>(flagged.size()));
-      log.info(
-          cat("quantize: ", flagged.size(),
-              " curves refined where face boundaries crossed themselves in the parameter plane"));
-    }
-    if (!placed_final)
-      result.quantized_curves =
+  bool placed_final = false;  // result.quantized_curves holds the final quantization's meshes
+  for (int round = 0; round < options.boundary_repair_rounds; ++round) {
+    std::vector<std::int64_t> flags(static_cast<std::size_t>(model.num_curves()), 0);
+    std::vector<std::vector<LO>> found(faces.size());
+    for (const bool halved : {true, false}) {
+      std::vector<mesh::CurveMesh> placed =
           quantize::place_vertices(model, curves, result.curve_sizes.at, result.quantization,
-                                   /*halved=*/false, tasks, options.place);
-    end_stage("quantize", false);
-    log.info(cat("quantize: ", model.num_curves(), " curves, ", result.quantization.num_chords,
-                 " chords, ", result.quantization.total_edges, " edges"));
-  }
-
-  // The coarse patterns serve both whole faces (Sec. 6.1.2) and cavities (Sec. 6.2).
-  const std::vector<qstruct::Pattern> patterns =
-      quasi ? qstruct::builtin_patterns() : std::vector<qstruct::Pattern>{};
-  // The quad bound of each face's fills (0: none), by face id: computed by the face's owner,
-  // known to every rank (the fills are dealt out), read again by the second look below.
-  std::vector<std::int64_t> fill_bound(quasi ? static_cast<std::size_t>(nfaces) : 0, 0);
-  const bool compare_fills = options.pattern_compare_tolerance >= 0;
-  if (quasi) {
-    // Simple CAD faces meshed directly by a pattern (paper 000 Sec. 6.1.2, pipeline step 4); the
-    // others go through the unstructured path below. A fill needs only the model, the curve meshes
-    // (every rank has them) and the face's quad bound (if any), which its owner computes from its
-    // size map and shares with the quads the size map asks for; the faces are then dealt out over
-    // all ranks (deal_out), those asking for the most quads first: a few faces whose fills are
-    // refused and searched take most of the stage.
-    clock.reset();
-    std::vector<double> expected(static_cast<std::size_t>(nfaces), 0.0);
-    tasks.parallel_for(total, [&](std::int64_t i) {
-      const FaceTask& t = faces[static_cast<std::size_t>(i)];
-      expected[static_cast<std::size_t>(t.face)] = sizemap::expected_quads(t.background, t.sizes.s);
-    });
-    comm.allreduce_sum(expected);  // each face's entry is set by its owner alone
-    if (options.pattern_max_quad_ratio > 0)
-      for (LO f = 0; f < nfaces; ++f)
-        fill_bound[f] = std::max<std::int64_t>(
-            options.pattern_min_quad_bound,
-            static_cast<std::int64_t>(std::ceil(options.pattern_max_quad_ratio * expected[f])));
-    std::vector<LO> order(static_cast<std::size_t>(nfaces));
-    std::iota(order.begin(), order.end(), LO{0});
-    std::sort(order.begin(), order.end(), [&](LO a, LO b) {
-      return expected[a] != expected[b] ? expected[a] > expected[b] : a < b;
-    });
-    std::vector<PatternFill> fills(static_cast<std::size_t>(nfaces));
-    std::vector<char> filled(static_cast<std::size_t>(nfaces), 0);  // by this rank
-    DealProgress progress("patterns", nfaces, comm, log);
-    deal_out(comm, nfaces, tasks, [&](std::int64_t k) {
-      const LO f = order[static_cast<std::size_t>(k)];
-      fills[static_cast<std::size_t>(f)] =
-          mesh_face_fill(model, f, result.quantized_curves, patterns, options.patterns,
-                         fill_bound[static_cast<std::size_t>(f)], compare_fills);
-      filled[static_cast<std::size_t>(f)] = 1;
-      progress.done();
-    });
-    // Fills to their owners.
-    std::vector<std::int64_t> local_of(static_cast<std::size_t>(nfaces), -1);
-    for (std::int64_t i = 0; i < total; ++i)
-      local_of[static_cast<std::size_t>(faces[static_cast<std::size_t>(i)].face)] = i;
-    ToOwners<PatternFill> to_owners(nranks);
-    for (LO f = 0; f < nfaces; ++f) {
-      if (filled[static_cast<std::size_t>(f)] == 0) continue;
-      PatternFill& fill = fills[static_cast<std::size_t>(f)];
-      const std::int64_t i = local_of[static_cast<std::size_t>(f)];
-      if (i >= 0)
-        take_fill(faces[static_cast<std::size_t>(i)], std::move(fill), options.patterns);
-      else
-        to_owners.add(result.face_rank[f], f, fill);
-      fill = PatternFill{};
-    }
-    to_owners.deliver(comm, [&](LO f, PatternFill&& fill) {
-      QSMESH_CHECK(
-          f >= 0 && f < nfaces && local_of[static_cast<std::size_t>(f)] >= 0,
-          "pattern fill of face " << f << " sent to rank " << rank << ", which does not own it");
-      take_fill(faces[static_cast<std::size_t>(local_of[static_cast<std::size_t>(f)])],
-                std::move(fill), options.patterns);
-    });
-    end_stage("patterns", true);
-  }
-
-  // Unstructured all-quad meshes (paper 000 Sec. 5) on the quantized curve meshes: frontal points
-  // guided by the face's cross field and size map (read on its background mesh) on the halved
-  // curves, recombined, subdivided onto the full ones, smoothed.
-  if (quads) {
-    clock.reset();
-    const std::vector<mesh::CurveMesh> halved =
-        !halved_curves.empty()
-            ? std::move(halved_curves)
-            : quantize::place_vertices(model, curves, result.curve_sizes.at, result.quantization,
-                                       /*halved=*/true, tasks, options.place);
-    quad::UnstructuredOptions qo;
-    qo.size = options.background.sizes.size;
-    // Of a face's cross field, the later steps need only its singularities; the field, the
-    // background mesh and the size map (the largest per-face data) go as soon as the face's
-    // unstructured mesh is made, so that they are not held through the improvement and the output
-    // (Block.stp at its reference count, one rank: peak heap 131 -> 101 MB, and 74 MB with
-    // crossfield::shrink_cross_field; docs/benchmarks.md).
-    each_face("unstructured", [&](FaceTask& t) {
-      if (!(quasi && t.quasi.by_pattern)) {
-        const Stopwatch face_clock;
-        quad::FaceFields face_fields;
-        if (t.background_report.ok && t.cross_field != nullptr) {
-          face_fields.background = &t.background;
-          face_fields.cross_field = t.cross_field.get();
-          face_fields.sizes = t.sizes.s;
+                                   halved, cx.tasks, options.place);
+      cx.tasks.parallel_for(static_cast<std::int64_t>(faces.size()), [&](std::int64_t i) {
+        const LO f = faces[static_cast<std::size_t>(i)].face;
+        try {
+          const auto c = quantize::crossing_curves(model, f, placed);
+          found[i].insert(found[i].end(), c.begin(), c.end());
+        } catch (const std::exception& e) {
+          // The face's own stages report its geometry errors; this check only looks for
+          // crossings.
+          cx.log.debug(Error(e.what(), ErrorContext{"quantize", 2, f}).what());
         }
-        t.quad_mesh = quad::mesh_face_unstructured(model, t.face, halved, result.quantized_curves,
-                                                   face_fields, qo, &t.unstructured);
-        t.seconds += face_clock.seconds();
-      }
-      if (t.cross_field != nullptr && quasi)
-        t.singularities = std::move(t.cross_field->singularities);
-      t.cross_field.reset();
-      t.background = mesh::FaceMesh{};
-      if (!options.size_map) t.sizes = sizemap::FaceSizes{};
-    });
-    end_stage("unstructured", true);
-  }
-  if (quasi) {
-    // Topological improvement of the faces the unstructured path meshed with quads only (Sec.
-    // 6.2-6.3, then the final smoothing), dealt out over ranks and threads as faces finish.
-    clock.reset();
-    std::vector<ImproveFace> to_improve;
-    for (FaceTask& t : faces) {
-      if (!wants_improvement(t)) continue;
-      ImproveFace f;
-      f.face = t.face;
-      f.mesh = &t.quad_mesh;
-      f.singularities = t.singularities;
-      f.report = &t.quasi.improvement;
-      f.seconds = &t.seconds;
-      to_improve.push_back(f);
-    }
-    const remesh::DiskQuadTable table = remesh::DiskQuadTable::builtin();
-    ImproveSettings settings;
-    settings.patterns = patterns;
-    settings.table = &table;
-    settings.cavities = options.cavities;
-    settings.disk = options.disk;
-    settings.final_smoothing = options.final_smoothing;
-    settings.final_smooth = options.final_smooth;
-    result.improvement_seconds = improve_faces(comm, model, to_improve, settings, tasks, log);
-    end_stage("improvement", true);
-    // Second chance for the fills that the size map's quad bound refused (second_fill_bound:
-    // wing_fuselage's blunt trailing edges at size factor 0.02, strips [2, 48, 2, 48] sized for
-    // one quad, 101 unstructured quads with 3 irregular vertices inside a strip two quads wide;
-    // t20's chamfer slivers with a 0-degree cusp at size factor 0.01, where the fallback folded
-    // a quad too). The comparison below then decides.
-    clock.reset();
-    if (compare_fills)
-      tasks.parallel_for(total, [&](std::int64_t i) {
-        FaceTask& t = faces[static_cast<std::size_t>(i)];
-        const std::optional<std::int64_t> max_quads =
-            second_fill_bound(t, fill_bound[static_cast<std::size_t>(t.face)]);
-        if (max_quads)
-          take_second_fill(t, mesh_face_fill(model, t.face, result.quantized_curves, patterns,
-                                             options.patterns, *max_quads, true));
       });
-    // Second look at the pattern meshes refused on quality: where the unstructured path did no
-    // better, the pattern's fewer irregular vertices win (a small triangle face is often the
-    // same three quads either way).
-    tasks.parallel_for(total, [&](std::int64_t i) {
-      FaceTask& t = faces[static_cast<std::size_t>(i)];
-      const FillComparison c =
-          compare_refused_fill(t, options.pattern_compare_tolerance, options.patterns);
-      if (c.kept && c.against_unstructured)
-        log.debug(cat("face ", t.face, ": kept fill (", c.pattern, ", ", c.fill.quads,
-                      " quads, SICN ", c.fill.sicn_min, " / ", c.fill.sicn_avg,
-                      ") against unstructured (", c.unstructured.quads, " quads, SICN ",
-                      c.unstructured.sicn_min, " / ", c.unstructured.sicn_avg,
-                      "): ", c.fill_taken ? "fill" : "unstructured"));
-    });
-    end_stage("pattern_compare", true);
+      (halved ? halved_curves : result.quantized_curves) = std::move(placed);
+    }
+    placed_final = true;
+    for (const auto& list : found)
+      for (const LO c : list) flags[c] = 1;
+    cx.comm.allreduce_sum(flags);
+    std::vector<LO> flagged;
+    for (LO c = 0; c < model.num_curves(); ++c)
+      if (flags[c] > 0) flagged.push_back(c);
+    if (flagged.empty()) break;
+    const std::int64_t before = result.quantization.total_edges;
+    quantize::refine_curves(result.quantization, flagged, fixed);
+    if (result.quantization.total_edges == before) break;  // only fixed curves are involved
+    placed_final = false;
+    halved_curves.clear();
+    result.curves_refined_for_crossings.push_back(static_cast<LO>(flagged.size()));
+    cx.log.info(
+        cat("quantize: ", flagged.size(),
+            " curves refined where face boundaries crossed themselves in the parameter plane"));
   }
+  if (!placed_final)
+    result.quantized_curves =
+        quantize::place_vertices(model, curves, result.curve_sizes.at, result.quantization,
+                                 /*halved=*/false, cx.tasks, options.place);
+  cx.log.info(cat("quantize: ", model.num_curves(), " curves, ", result.quantization.num_chords,
+                  " chords, ", result.quantization.total_edges, " edges"));
+  return halved_curves;
+}
 
-  // Gather on rank 0 and assemble. The assembled mesh is sized first from every face's counts;
-  // the faces then arrive one rank at a time and each is written in place and dropped, so that
-  // rank 0 holds the assembled mesh and one rank's faces, not every face twice over.
-  clock.reset();
-  const std::span<const mesh::CurveMesh> final_curves =
-      quads ? std::span<const mesh::CurveMesh>(result.quantized_curves)
-            : std::span<const mesh::CurveMesh>(curves);
+// Simple CAD faces meshed directly by a pattern (paper 000 Sec. 6.1.2, pipeline step 4); the
+// others go through the unstructured path. A fill needs only the model, the curve meshes (every
+// rank has them) and the face's quad bound (if any), which its owner computes from its size map
+// and shares with the quads the size map asks for; the faces are then dealt out over all ranks
+// (deal_out), those asking for the most quads first: a few faces whose fills are refused and
+// searched take most of the stage. Each fill goes to its owner (take_fill). Returns the quad
+// bound of each face's fills (0: none), by face id, on every rank.
+std::vector<std::int64_t> pattern_stage(const Context& cx, std::vector<FaceTask>& faces,
+                                        std::span<const qstruct::Pattern> patterns,
+                                        const PipelineResult& result) {
+  const PipelineOptions& options = cx.options;
+  const LO nfaces = cx.model.num_faces();
+  std::vector<double> expected(static_cast<std::size_t>(nfaces), 0.0);
+  each_face(cx, faces, nullptr, [&](const FaceTask& t) {
+    expected[static_cast<std::size_t>(t.face)] = sizemap::expected_quads(t.background, t.sizes.s);
+  });
+  cx.comm.allreduce_sum(expected);  // each face's entry is set by its owner alone
+  std::vector<std::int64_t> fill_bound(static_cast<std::size_t>(nfaces), 0);
+  if (options.pattern_max_quad_ratio > 0)
+    for (LO f = 0; f < nfaces; ++f)
+      fill_bound[f] = std::max<std::int64_t>(
+          options.pattern_min_quad_bound,
+          static_cast<std::int64_t>(std::ceil(options.pattern_max_quad_ratio * expected[f])));
+  std::vector<LO> order(static_cast<std::size_t>(nfaces));
+  std::iota(order.begin(), order.end(), LO{0});
+  std::sort(order.begin(), order.end(), [&](LO a, LO b) {
+    return expected[a] != expected[b] ? expected[a] > expected[b] : a < b;
+  });
+  std::vector<PatternFill> fills(static_cast<std::size_t>(nfaces));
+  std::vector<char> filled(static_cast<std::size_t>(nfaces), 0);  // by this rank
+  DealProgress progress("patterns", nfaces, cx.comm, cx.log);
+  deal_out(cx.comm, nfaces, cx.tasks, [&](std::int64_t k) {
+    const auto f = static_cast<std::size_t>(order[static_cast<std::size_t>(k)]);
+    fills[f] =
+        mesh_face_fill(cx.model, static_cast<LO>(f), result.quantized_curves, patterns,
+                       options.patterns, fill_bound[f], options.pattern_compare_tolerance >= 0);
+    filled[f] = 1;
+    progress.done();
+  });
+  // Fills to their owners.
+  std::vector<std::int64_t> local_of(static_cast<std::size_t>(nfaces), -1);
+  for (std::size_t i = 0; i < faces.size(); ++i)
+    local_of[static_cast<std::size_t>(faces[i].face)] = static_cast<std::int64_t>(i);
+  ToOwners<PatternFill> to_owners(cx.comm.size());
+  for (LO f = 0; f < nfaces; ++f) {
+    if (filled[static_cast<std::size_t>(f)] == 0) continue;
+    PatternFill& fill = fills[static_cast<std::size_t>(f)];
+    const std::int64_t i = local_of[static_cast<std::size_t>(f)];
+    if (i >= 0)
+      take_fill(faces[static_cast<std::size_t>(i)], std::move(fill), options.patterns);
+    else
+      to_owners.add(result.face_rank[f], f, fill);
+    fill = PatternFill{};
+  }
+  to_owners.deliver(cx.comm, [&](LO f, PatternFill&& fill) {
+    QSMESH_CHECK(f >= 0 && f < nfaces && local_of[static_cast<std::size_t>(f)] >= 0,
+                 "pattern fill of face " << f << " sent to rank " << cx.comm.rank()
+                                         << ", which does not own it");
+    take_fill(faces[static_cast<std::size_t>(local_of[static_cast<std::size_t>(f)])],
+              std::move(fill), options.patterns);
+  });
+  return fill_bound;
+}
+
+// Unstructured all-quad meshes (paper 000 Sec. 5) of the faces without a pattern mesh, on the
+// quantized curve meshes: frontal points guided by the face's cross field and size map (read on
+// its background mesh) on the halved curves, recombined, subdivided onto the full ones,
+// smoothed. Of a face's cross field, the later steps need only its singularities; the field, the
+// background mesh and the size map (the largest per-face data) go as soon as the face's
+// unstructured mesh is made, so that they are not held through the improvement and the output
+// (Block.stp at its reference count, one rank: peak heap 131 -> 101 MB, and 74 MB with
+// crossfield::shrink_cross_field; docs/benchmarks.md).
+void unstructured_stage(const Context& cx, std::vector<FaceTask>& faces,
+                        std::span<const mesh::CurveMesh> halved,
+                        std::span<const mesh::CurveMesh> full, bool keep_singularities) {
+  quad::UnstructuredOptions qo;
+  qo.size = cx.options.background.sizes.size;
+  each_face(cx, faces, "unstructured", [&](FaceTask& t) {
+    if (wants_unstructured(t)) {
+      const Stopwatch face_clock;
+      quad::FaceFields face_fields;
+      if (t.background_report.ok && t.cross_field != nullptr) {
+        face_fields.background = &t.background;
+        face_fields.cross_field = t.cross_field.get();
+        face_fields.sizes = t.sizes.s;
+      }
+      t.quad_mesh = quad::mesh_face_unstructured(cx.model, t.face, halved, full, face_fields, qo,
+                                                 &t.unstructured);
+      t.seconds += face_clock.seconds();
+    }
+    if (t.cross_field != nullptr && keep_singularities)
+      t.singularities = std::move(t.cross_field->singularities);
+    t.cross_field.reset();
+    t.background = mesh::FaceMesh{};
+    if (!cx.options.size_map) t.sizes = sizemap::FaceSizes{};
+  });
+}
+
+// Topological improvement of the faces the unstructured path meshed with quads only (Sec.
+// 6.2-6.3, then the final smoothing), dealt out over ranks and threads as faces finish. Returns
+// the time of its three steps summed over the faces of all ranks.
+std::array<double, 3> improvement_stage(const Context& cx, std::vector<FaceTask>& faces,
+                                        std::span<const qstruct::Pattern> patterns) {
+  std::vector<ImproveFace> to_improve;
+  for (FaceTask& t : faces) {
+    if (!wants_improvement(t)) continue;
+    ImproveFace f;
+    f.face = t.face;
+    f.mesh = &t.quad_mesh;
+    f.singularities = t.singularities;
+    f.report = &t.quasi.improvement;
+    f.seconds = &t.seconds;
+    to_improve.push_back(f);
+  }
+  const remesh::DiskQuadTable table = remesh::DiskQuadTable::builtin();
+  ImproveSettings settings;
+  settings.patterns = patterns;
+  settings.table = &table;
+  settings.cavities = cx.options.cavities;
+  settings.disk = cx.options.disk;
+  settings.final_smoothing = cx.options.final_smoothing;
+  settings.final_smooth = cx.options.final_smooth;
+  return improve_faces(cx.comm, cx.model, to_improve, settings, cx.tasks, cx.log);
+}
+
+// The fills that wait for the face's final mesh (compare_refused_fill), after a second chance for
+// those the size map's quad bound refused (second_fill_bound: wing_fuselage's blunt trailing
+// edges at size factor 0.02, strips [2, 48, 2, 48] sized for one quad, 101 unstructured quads
+// with 3 irregular vertices inside a strip two quads wide; t20's chamfer slivers with a 0-degree
+// cusp at size factor 0.01, where the fallback folded a quad too). Where the unstructured path
+// did no better, the pattern's fewer irregular vertices win (a small triangle face is often the
+// same three quads either way).
+void compare_stage(const Context& cx, std::vector<FaceTask>& faces,
+                   std::span<const qstruct::Pattern> patterns,
+                   std::span<const std::int64_t> fill_bound,
+                   std::span<const mesh::CurveMesh> curves) {
+  const PipelineOptions& options = cx.options;
+  if (options.pattern_compare_tolerance >= 0)
+    each_face(cx, faces, nullptr, [&](FaceTask& t) {
+      const std::optional<std::int64_t> max_quads =
+          second_fill_bound(t, fill_bound[static_cast<std::size_t>(t.face)]);
+      if (max_quads)
+        take_second_fill(t, mesh_face_fill(cx.model, t.face, curves, patterns, options.patterns,
+                                           *max_quads, true));
+    });
+  each_face(cx, faces, nullptr, [&](FaceTask& t) {
+    const FillComparison c =
+        compare_refused_fill(t, options.pattern_compare_tolerance, options.patterns);
+    if (c.kept && c.against_unstructured)
+      cx.log.debug(cat("face ", t.face, ": kept fill (", c.pattern, ", ", c.fill.quads,
+                       " quads, SICN ", c.fill.sicn_min, " / ", c.fill.sicn_avg,
+                       ") against unstructured (", c.unstructured.quads, " quads, SICN ",
+                       c.unstructured.sicn_min, " / ", c.unstructured.sicn_avg,
+                       "): ", c.fill_taken ? "fill" : "unstructured"));
+  });
+}
+
+// Gathers every face on rank 0 and assembles them (collective; faces is emptied). The assembled
+// mesh is sized first from every face's counts; the faces then arrive one rank at a time and
+// each is written in place and dropped, so that rank 0 holds the assembled mesh and one rank's
+// faces, not every face twice over. Fills result's per-face vectors and mesh on rank 0.
+void gather_stage(const Context& cx, std::vector<FaceTask>& faces,
+                  std::span<const mesh::CurveMesh> final_curves, bool quads, bool quasi,
+                  PipelineResult& result) {
+  const PipelineOptions& options = cx.options;
+  const LO nfaces = cx.model.num_faces();
   std::vector<std::int64_t> counts(3 * static_cast<std::size_t>(nfaces), 0);
   for (const FaceTask& t : faces) {
     const mesh::FaceContribution c = mesh::face_contribution(quads ? t.quad_mesh : t.background);
@@ -437,19 +381,20 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     counts[at + 1] = c.triangles;
     counts[at + 2] = c.quads;
   }
-  comm.allreduce_sum(counts);  // each face's entries are set by its owner alone
+  cx.comm.allreduce_sum(counts);  // each face's entries are set by its owner alone
   std::vector<char> buffer;
   for (FaceTask& t : faces) write_record(buffer, take_output(std::move(t), quads));
   faces.clear();
   std::optional<mesh::MeshAssembler> assembler;
+  const bool size_map = options.size_map || quads;
   const bool keep_background = size_map && !quads;  // the size map's output draws them
-  if (rank == 0) {
+  if (cx.comm.rank() == 0) {
     std::vector<mesh::FaceContribution> contributions(static_cast<std::size_t>(nfaces));
     for (LO f = 0; f < nfaces; ++f) {
       const auto at = 3 * static_cast<std::size_t>(f);
       contributions[f] = {counts[at], counts[at + 1], counts[at + 2]};
     }
-    assembler.emplace(model, final_curves, contributions);
+    assembler.emplace(cx.model, final_curves, contributions);
     const auto n = static_cast<std::size_t>(nfaces);
     result.reports.resize(n);
     if (options.cross_fields) result.cross_fields.resize(n);
@@ -462,7 +407,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     }
     if (keep_background) result.background.resize(n);
   }
-  comm.gather_bytes_each(std::move(buffer), 0, [&](int, std::vector<char>& bytes) {
+  cx.comm.gather_bytes_each(std::move(buffer), 0, [&](int, std::vector<char>& bytes) {
     std::size_t pos = 0;
     while (pos < bytes.size()) {
       FaceOutput out;
@@ -484,10 +429,117 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     }
     std::vector<char>().swap(bytes);
   });
-  if (rank == 0) result.mesh = assembler->finish();
-  end_stage("assemble", false);
+  if (cx.comm.rank() == 0) result.mesh = assembler->finish();
+}
+
+}  // namespace
+
+PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
+                            const PipelineOptions& options, const TaskArena& tasks, Logger& log,
+                            linalg::PetscLane* lane) {
+  PipelineResult result;
+  const Context cx{comm, model, options, tasks, log};
+  const int rank = comm.rank();
+  const int nranks = comm.size();
+  const LO nfaces = model.num_faces();
+  StageClock clock(comm, result.times);
+  const bool quads = options.until >= Stage::Unstructured;
+  const bool quasi = options.until >= Stage::QuasiStructured;
+  const bool size_map = options.size_map || quads;
+  const bool cf_sizes = size_map && options.sizemap.method == sizemap::Method::CrossField;
+  // The size map (it needs H at every vertex) and the frontal insertion (the crosses) keep the
+  // whole fields; the drivers that asked for them (options.cross_fields) get summaries.
+  const bool keep_fields = cf_sizes || quads;
+
+  // Curves: every rank computes the same meshes (cheap next to the faces, and no communication).
+  clock.start();
+  const std::vector<mesh::CurveMesh> curves =
+      background::mesh_curves(model, options.background.sizes, tasks);
+  std::int64_t curve_edges = 0;
+  for (const auto& c : curves) curve_edges += c.num_edges();
+  clock.end("curves", false);
+  log.info(cat("curves: ", model.num_curves(), " curves meshed, ", curve_edges, " edges (",
+               result.times.get("curves"), " s)"));
+
+  // Faces: METIS partition weighted by the estimated cost. Each face of this rank is one record
+  // (FaceTask) that the stages below fill in turn.
+  clock.start();
+  result.face_rank = partition_faces(
+      model.face2faces(), estimate_face_costs(model, options.background.sizes.size), nranks);
+  std::vector<FaceTask> faces;
+  for (LO f = 0; f < nfaces; ++f)
+    if (result.face_rank[f] == rank) faces.emplace_back().face = f;
+  clock.end("partition", false);
+  if (nranks > 1) {
+    std::vector<std::int64_t> per_rank(static_cast<std::size_t>(nranks), 0);
+    per_rank[rank] = static_cast<std::int64_t>(faces.size());
+    comm.allreduce_sum(per_rank);
+    std::string line = "partition: faces per rank";
+    for (auto n : per_rank) line += cat(" ", n);
+    log.info(line);
+  }
+
+  clock.start();
+  each_face(cx, faces, "background",
+            [&](FaceTask& t) { mesh_background(t, model, curves, options.background); });
+  clock.end("background", true);
+
+  if (options.cross_fields || keep_fields) {
+    clock.start();
+    each_face(cx, faces, "crossfield", [&](FaceTask& t) {
+      compute_cross_field(t, options.crossfield, options.cross_fields, keep_fields, lane);
+    });
+    clock.end("crossfield", true);
+  }
+
+  // The halved curve meshes of the final quantization (paper 000 Sec. 5.2), when the boundary
+  // check already placed them; else the unstructured stage places them.
+  std::vector<mesh::CurveMesh> halved_curves;
+  if (size_map) {
+    clock.start();
+    result.curve_sizes = size_map_stage(cx, curves, faces, cf_sizes);
+    clock.end("sizemap", true);
+    clock.start();
+    halved_curves = quantize_stage(cx, curves, faces, result);
+    clock.end("quantize", false);
+  }
+
+  // The coarse patterns serve both whole faces (Sec. 6.1.2) and cavities (Sec. 6.2).
+  const std::vector<qstruct::Pattern> patterns =
+      quasi ? qstruct::builtin_patterns() : std::vector<qstruct::Pattern>{};
+  std::vector<std::int64_t> fill_bound;
+  if (quasi) {
+    clock.start();
+    fill_bound = pattern_stage(cx, faces, patterns, result);
+    clock.end("patterns", true);
+  }
+  if (quads) {
+    clock.start();
+    const std::vector<mesh::CurveMesh> halved =
+        !halved_curves.empty()
+            ? std::move(halved_curves)
+            : quantize::place_vertices(model, curves, result.curve_sizes.at, result.quantization,
+                                       /*halved=*/true, tasks, options.place);
+    unstructured_stage(cx, faces, halved, result.quantized_curves, quasi);
+    clock.end("unstructured", true);
+  }
+  if (quasi) {
+    clock.start();
+    result.improvement_seconds = improvement_stage(cx, faces, patterns);
+    clock.end("improvement", true);
+    clock.start();
+    compare_stage(cx, faces, patterns, fill_bound, result.quantized_curves);
+    clock.end("pattern_compare", true);
+  }
+
+  clock.start();
+  const std::span<const mesh::CurveMesh> final_curves =
+      quads ? std::span<const mesh::CurveMesh>(result.quantized_curves)
+            : std::span<const mesh::CurveMesh>(curves);
+  gather_stage(cx, faces, final_curves, quads, quasi, result);
+  clock.end("assemble", false);
   result.rank_busy_seconds.assign(static_cast<std::size_t>(nranks), 0.0);
-  result.rank_busy_seconds[static_cast<std::size_t>(rank)] = busy;
+  result.rank_busy_seconds[static_cast<std::size_t>(rank)] = clock.busy();
   comm.allreduce_sum(result.rank_busy_seconds);
   return result;
 }

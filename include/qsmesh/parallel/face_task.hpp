@@ -1,10 +1,13 @@
-// One face's way through the pipeline: the record that carries its state from stage to stage
-// (FaceTask), the stages that act on one record, and the per-face meshing policy of the
-// quasi-structured stage (which of a pattern fill and the unstructured mesh a face keeps). All
-// serial and free of MPI: run_pipeline deals the records out over threads and ranks and moves
-// what crosses ranks (parallel/record.hpp); the policy is tested without mpirun.
+// One face's way through the pipeline: what the pipeline reports of a face (QuasiReport,
+// ImprovementReport, CrossFieldOutput: their fields declared once, here, and set by the policy
+// below or by record()), the record that carries a face's state from stage to stage (FaceTask),
+// the stages that act on one record, and the per-face meshing policy of the quasi-structured
+// stage (which of a pattern fill and the unstructured mesh a face keeps). All serial and free of
+// MPI: run_pipeline deals the records out over threads and ranks and moves what crosses ranks
+// (parallel/record.hpp); the policy is tested without mpirun.
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -18,13 +21,123 @@
 #include "qsmesh/linalg/solver.hpp"
 #include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/mesh/surface_mesh.hpp"
-#include "qsmesh/parallel/pipeline.hpp"
+#include "qsmesh/qstruct/cavity.hpp"
 #include "qsmesh/qstruct/face_pattern.hpp"
 #include "qsmesh/qstruct/patterns.hpp"
 #include "qsmesh/quad/unstructured.hpp"
+#include "qsmesh/remesh/disk_remesh.hpp"
 #include "qsmesh/sizemap/size_map.hpp"
 
 namespace qsmesh::parallel {
+
+// --- What the pipeline reports of a face --------------------------------------------------
+
+/// What the topological improvement (paper 000 Sec. 6.2-6.3) did to one unstructured face. Its
+/// fields are declared once, in fields(), each named by its total over the faces in the drivers'
+/// --stats: the exchange between ranks, the drivers' totals and their writers go through it, and
+/// the improvement fills it with record().
+struct ImprovementReport {
+  /// Cavity remeshing: interior irregular vertices before it (the unstructured mesh) and after
+  /// it, cavities remeshed by step (Steps 1-4 of Sec. 6.2.2).
+  std::int64_t irregular_before = 0, irregular_after = 0;
+  std::array<std::int64_t, 4> cavities{};
+  /// Disk remeshing: defects before/after, cavities replaced.
+  std::int64_t defects_before = 0, defects_after = 0, disk_replaced = 0;
+  /// Cavity remeshing stopped by CavityOptions::time_budget_s on this face (the mesh reached
+  /// then is kept: every accepted step is valid).
+  bool time_budget_hit = false;
+
+  /// Takes the cavity remeshing's counts (qstruct::remesh_cavities).
+  void record(const qstruct::CavityReport& r) {
+    irregular_before = r.irregular_before;
+    irregular_after = r.irregular_after;
+    cavities = r.remeshed;
+    time_budget_hit = r.time_budget_hit;
+  }
+  /// Takes the disk remeshing's counts (remesh::remesh_disk_defects).
+  void record(const remesh::DiskRemeshStats& s) {
+    defects_before = s.defects_before;
+    defects_after = s.defects_after;
+    disk_replaced = s.replaced;
+  }
+  template <class S, class V>
+  static void fields(S& self, V&& visit) {
+    visit("irregular_unstructured_before", self.irregular_before);
+    visit("irregular_unstructured_after_cavities", self.irregular_after);
+    visit("cavities_remeshed_per_step", self.cavities);
+    visit("disk_defects_before", self.defects_before);
+    visit("disk_defects_after", self.defects_after);
+    visit("disk_cavities_replaced", self.disk_replaced);
+    visit("faces_time_budget_hit", self.time_budget_hit);
+  }
+};
+
+/// How the quasi-structured stage treated one face. Its fields are declared once, in fields(), the
+/// countable ones named by their total over the faces in the drivers' --stats (as
+/// ImprovementReport).
+struct QuasiReport {
+  bool by_pattern = false;  ///< meshed by a pattern (Sec. 6.1.2); else by the unstructured path
+  std::string pattern;      ///< the pattern's name when by_pattern
+  std::string refusal;      ///< why no pattern was kept (qstruct::to_string of the refusal)
+  /// by_pattern, but only after the comparison of PipelineOptions::pattern_compare_tolerance
+  /// (`refusal` then says why the thresholds refused it first).
+  bool by_comparison = false;
+  /// A fill kept with a poor mean gave way to the face's clearly better unstructured mesh
+  /// (qstruct::unstructured_clearly_better; `refusal` is then UnstructuredBetter).
+  bool gave_way = false;
+  /// Unstructured faces only (others keep zeros).
+  ImprovementReport improvement;
+
+  /// "pattern:<name>" when meshed by a pattern, else empty.
+  [[nodiscard]] std::string pattern_method() const {
+    return by_pattern ? "pattern:" + pattern : std::string();
+  }
+  /// Why no pattern was kept (qstruct::Refusal as text); empty when one was.
+  [[nodiscard]] std::string pattern_refusal() const { return by_pattern ? std::string() : refusal; }
+  template <class S, class V>
+  static void fields(S& self, V&& visit) {
+    visit("faces_meshed_by_pattern", self.by_pattern);
+    visit("pattern", self.pattern);
+    visit("pattern_refusal", self.refusal);
+    visit("faces_meshed_by_pattern_after_comparison", self.by_comparison);
+    visit("faces_fill_gave_way_to_unstructured", self.gave_way);
+    visit("improvement", self.improvement);
+  }
+};
+
+/// What the drivers need of a face's cross field, per triangle of its background mesh in the
+/// order of the assembled mesh (triangles collapsed at poles excluded, as in assembly).
+struct CrossFieldOutput {
+  bool ok = false;
+  std::string error;
+  std::vector<std::array<Vec3, 2>> directions;  ///< two unit branches per triangle
+  std::vector<double> u_norm;                   ///< per triangle: mean |U| of its edges
+  std::vector<double> H;                        ///< per triangle: mean conformal scaling H
+  std::vector<crossfield::Singularity> singularities;
+  crossfield::EulerCheck euler;
+  int levels = 0, factorizations = 0, solves = 0;
+  double seconds = 0;
+  /// Every field, once (visit(name, member)): what the ranks exchange (parallel/record.hpp).
+  template <class S, class V>
+  static void fields(S& self, V&& visit) {
+    visit("ok", self.ok);
+    visit("error", self.error);
+    visit("directions", self.directions);
+    visit("u_norm", self.u_norm);
+    visit("H", self.H);
+    visit("singularities", self.singularities);
+    visit("euler", self.euler);
+    visit("levels", self.levels);
+    visit("factorizations", self.factorizations);
+    visit("solves", self.solves);
+    visit("seconds", self.seconds);
+  }
+};
+
+/// The driver's view of a face cross field (see CrossFieldOutput).
+[[nodiscard]] CrossFieldOutput summarize(const crossfield::FaceCrossField& cf);
+
+// --- One face's state through the stages ----------------------------------------------------
 
 /// A valid pattern fill that is not (yet) the face's mesh: refused on quality, or kept by the
 /// thresholds but with a poor mean (qstruct::fill_to_compare). It waits for the face's final
@@ -165,6 +278,9 @@ struct FillComparison {
 /// (by_comparison unless it was a kept one). task.refused is emptied either way.
 FillComparison compare_refused_fill(FaceTask& task, double tolerance,
                                     const qstruct::PatternFaceOptions& options);
+
+/// The faces the unstructured path meshes: those without a pattern mesh (take_fill).
+[[nodiscard]] bool wants_unstructured(const FaceTask& task);
 
 /// The faces the topological improvement works on: meshed by the unstructured path, all quads,
 /// valid.

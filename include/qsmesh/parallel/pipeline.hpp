@@ -16,6 +16,7 @@
 #include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/mesh/surface_mesh.hpp"
 #include "qsmesh/parallel/comm.hpp"
+#include "qsmesh/parallel/face_task.hpp"
 #include "qsmesh/qstruct/balance.hpp"
 #include "qsmesh/qstruct/cavity.hpp"
 #include "qsmesh/qstruct/face_pattern.hpp"
@@ -86,9 +87,10 @@ struct PipelineOptions {
   /// valid (t20_data's cusp slivers at size factor 0.01). A face refused on the quad bound whose
   /// unstructured mesh has more quads than the bound gets its fills of at most that many quads
   /// laid out, compared as above (wing_fuselage's blunt trailing edges at size factor 0.02: grids
-  /// [2, 48, 2, 48] instead of 101 quads with 3 irregular vertices). All count in by_comparison.
-  /// Negative: never. On Block.stp the faces this takes are small triangles (three or seven quads) that
-  /// both paths mesh alike.
+  /// [2, 48, 2, 48] instead of 101 quads with 3 irregular vertices). All count as meshed by
+  /// patterns after the comparison (QuasiReport).
+  /// Negative: never. On Block.stp the faces this takes are small triangles (three or seven quads)
+  /// that both paths mesh alike.
   double pattern_compare_tolerance = 0.01;
   /// Stage::QuasiStructured: cavity remeshing of the unstructured faces (Sec. 6.2).
   qstruct::CavityOptions cavities;
@@ -101,109 +103,6 @@ struct PipelineOptions {
   /// 0.884 -> 0.885 (min 0.093 -> 0.099) for 0.06-0.5 s; 30 iterations instead of 10 add nothing.
   bool final_smoothing = true;
   smooth::SmoothOptions final_smooth;
-};
-
-/// What the topological improvement (paper 000 Sec. 6.2-6.3) did to one unstructured face. Its
-/// fields are declared once, in fields(), each named by its total over the faces in the drivers'
-/// --stats: the exchange between ranks, the drivers' totals and their writers go through it, and
-/// the improvement fills it with record().
-struct ImprovementReport {
-  /// Cavity remeshing: interior irregular vertices before it (the unstructured mesh) and after
-  /// it, cavities remeshed by step (Steps 1-4 of Sec. 6.2.2).
-  std::int64_t irregular_before = 0, irregular_after = 0;
-  std::array<std::int64_t, 4> cavities{};
-  /// Disk remeshing: defects before/after, cavities replaced.
-  std::int64_t defects_before = 0, defects_after = 0, disk_replaced = 0;
-  /// Cavity remeshing stopped by CavityOptions::time_budget_s on this face (the mesh reached
-  /// then is kept: every accepted step is valid).
-  bool time_budget_hit = false;
-
-  /// Takes the cavity remeshing's counts (qstruct::remesh_cavities).
-  void record(const qstruct::CavityReport& r) {
-    irregular_before = r.irregular_before;
-    irregular_after = r.irregular_after;
-    cavities = r.remeshed;
-    time_budget_hit = r.time_budget_hit;
-  }
-  /// Takes the disk remeshing's counts (remesh::remesh_disk_defects).
-  void record(const remesh::DiskRemeshStats& s) {
-    defects_before = s.defects_before;
-    defects_after = s.defects_after;
-    disk_replaced = s.replaced;
-  }
-  template <class S, class V>
-  static void fields(S& self, V&& visit) {
-    visit("irregular_unstructured_before", self.irregular_before);
-    visit("irregular_unstructured_after_cavities", self.irregular_after);
-    visit("cavities_remeshed_per_step", self.cavities);
-    visit("disk_defects_before", self.defects_before);
-    visit("disk_defects_after", self.defects_after);
-    visit("disk_cavities_replaced", self.disk_replaced);
-    visit("faces_time_budget_hit", self.time_budget_hit);
-  }
-};
-
-/// How the quasi-structured stage treated one face. Its fields are declared once, in fields(), the
-/// countable ones named by their total over the faces in the drivers' --stats (as
-/// ImprovementReport).
-struct QuasiReport {
-  bool by_pattern = false;  ///< meshed by a pattern (Sec. 6.1.2); else by the unstructured path
-  std::string pattern;      ///< the pattern's name when by_pattern
-  std::string refusal;      ///< why no pattern was kept (qstruct::to_string of the refusal)
-  /// by_pattern, but only after the comparison of PipelineOptions::pattern_compare_tolerance
-  /// (`refusal` then says why the thresholds refused it first).
-  bool by_comparison = false;
-  /// A fill kept with a poor mean gave way to the face's clearly better unstructured mesh
-  /// (qstruct::unstructured_clearly_better; `refusal` is then UnstructuredBetter).
-  bool gave_way = false;
-  /// Unstructured faces only (others keep zeros).
-  ImprovementReport improvement;
-
-  /// "pattern:<name>" when meshed by a pattern, else empty.
-  [[nodiscard]] std::string pattern_method() const {
-    return by_pattern ? "pattern:" + pattern : std::string();
-  }
-  /// Why no pattern was kept (qstruct::Refusal as text); empty when one was.
-  [[nodiscard]] std::string pattern_refusal() const { return by_pattern ? std::string() : refusal; }
-  template <class S, class V>
-  static void fields(S& self, V&& visit) {
-    visit("faces_meshed_by_pattern", self.by_pattern);
-    visit("pattern", self.pattern);
-    visit("pattern_refusal", self.refusal);
-    visit("faces_meshed_by_pattern_after_comparison", self.by_comparison);
-    visit("faces_fill_gave_way_to_unstructured", self.gave_way);
-    visit("improvement", self.improvement);
-  }
-};
-
-
-/// What the drivers need of a face's cross field, per triangle of its background mesh in the
-/// order of the assembled mesh (triangles collapsed at poles excluded, as in assembly).
-struct CrossFieldOutput {
-  bool ok = false;
-  std::string error;
-  std::vector<std::array<Vec3, 2>> directions;  ///< two unit branches per triangle
-  std::vector<double> u_norm;                   ///< per triangle: mean |U| of its edges
-  std::vector<double> H;                        ///< per triangle: mean conformal scaling H
-  std::vector<crossfield::Singularity> singularities;
-  crossfield::EulerCheck euler;
-  int levels = 0, factorizations = 0, solves = 0;
-  double seconds = 0;
-  /// Every field, once (visit(name, member)): what the ranks exchange (parallel/record.hpp).
-  template <class S, class V>
-  static void fields(S& self, V&& visit) {
-    visit("ok", self.ok);
-    visit("error", self.error);
-    visit("directions", self.directions);
-    visit("u_norm", self.u_norm);
-    visit("H", self.H);
-    visit("singularities", self.singularities);
-    visit("euler", self.euler);
-    visit("levels", self.levels);
-    visit("factorizations", self.factorizations);
-    visit("solves", self.solves);
-    visit("seconds", self.seconds);
-  }
 };
 
 struct PipelineResult {
@@ -243,9 +142,6 @@ struct PipelineResult {
 [[nodiscard]] PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
                                           const PipelineOptions& options, const TaskArena& tasks,
                                           Logger& log, linalg::PetscLane* lane = nullptr);
-
-/// The driver's view of a face cross field (see CrossFieldOutput).
-[[nodiscard]] CrossFieldOutput summarize(const crossfield::FaceCrossField& cf);
 
 /// Estimated cost of meshing each face (area / size^2), the METIS vertex weights.
 [[nodiscard]] std::vector<double> estimate_face_costs(const cad::CadModel& model, double size);
