@@ -30,6 +30,7 @@
 #include "qsmesh/parallel/comm.hpp"
 #include "qsmesh/parallel/pipeline.hpp"
 #include "qsmesh/sizemap/size_map.hpp"
+#include "report_totals.hpp"
 
 namespace qsmesh::cli {
 
@@ -241,16 +242,22 @@ std::pair<std::int64_t, std::int64_t> count_failures(const parallel::PipelineRes
 
 /// How face f got its quad mesh: "pattern:<name>", "frontal" or "fallback".
 std::string quad_method(const parallel::PipelineResult& r, std::size_t f) {
-  if (f < r.quasi_reports.size() && r.quasi_reports[f].by_pattern)
-    return "pattern:" + r.quasi_reports[f].pattern;
+  if (f < r.quasi_reports.size()) {
+    std::string pattern = r.quasi_reports[f].pattern_method();
+    if (!pattern.empty()) return pattern;
+  }
   return f < r.quad_reports.size() && r.quad_reports[f].frontal ? "frontal" : "fallback";
 }
 
 /// Why face f was not meshed by a pattern (qstruct::Refusal as text); empty when it was, or when
 /// the run stopped before the quasi-structured stage.
 std::string pattern_refusal(const parallel::PipelineResult& r, std::size_t f) {
-  if (f >= r.quasi_reports.size() || r.quasi_reports[f].by_pattern) return {};
-  return r.quasi_reports[f].refusal;
+  return f < r.quasi_reports.size() ? r.quasi_reports[f].pattern_refusal() : std::string();
+}
+
+/// Whether face f's cavity remeshing stopped on --face-time-budget.
+bool time_budget_hit(const parallel::PipelineResult& r, std::size_t f) {
+  return f < r.quasi_reports.size() && r.quasi_reports[f].improvement.time_budget_hit;
 }
 
 // Largest over mean of the ranks' busy times (1 when balanced or on one rank).
@@ -270,35 +277,10 @@ std::int64_t total_irregular_boundary(const parallel::PipelineResult& r) {
   return n;
 }
 
-/// Totals of the quasi-structured stage over the faces.
-struct QuasiTotals {
-  std::int64_t by_pattern = 0;
-  std::int64_t by_comparison = 0;  // of by_pattern: kept after comparing with the unstructured mesh
-  std::int64_t irregular_before = 0, irregular_after = 0;  // cavity remeshing (Sec. 6.2)
-  std::array<std::int64_t, 4> cavities{};                  // remeshed, by step
-  std::int64_t defects_before = 0, defects_after = 0, disk_replaced = 0;  // Sec. 6.3
-  std::int64_t time_budget_hit = 0;  // faces whose cavity remeshing stopped on --face-time-budget
-  // Faces whose kept fill, with a poor mean, gave way to their unstructured mesh
-  // (qstruct::unstructured_clearly_better).
-  std::int64_t fill_gave_way = 0;
-};
-
-QuasiTotals quasi_totals(const parallel::PipelineResult& r) {
-  QuasiTotals t;
-  for (const auto& q : r.quasi_reports) {
-    t.by_pattern += q.by_pattern ? 1 : 0;
-    t.by_comparison += q.by_comparison ? 1 : 0;
-    t.irregular_before += q.irregular_before;
-    t.irregular_after += q.irregular_after;
-    for (int k = 0; k < 4; ++k) t.cavities[k] += q.cavities[k];
-    t.defects_before += q.defects_before;
-    t.defects_after += q.defects_after;
-    t.disk_replaced += q.disk_replaced;
-    t.time_budget_hit += q.time_budget_hit ? 1 : 0;
-    if (!q.by_pattern && q.refusal == qstruct::to_string(qstruct::Refusal::UnstructuredBetter))
-      ++t.fill_gave_way;
-  }
-  return t;
+/// Totals of the quasi-structured stage over the faces, by their --stats names
+/// (parallel::QuasiReport::fields).
+ReportTotals quasi_totals(const parallel::PipelineResult& r) {
+  return ReportTotals::sum(std::span<const parallel::QuasiReport>(r.quasi_reports));
 }
 
 std::string stats_json(const Arguments& args, const Session& session,
@@ -329,29 +311,9 @@ std::string stats_json(const Arguments& args, const Session& session,
     for (const auto& q : r.quad_reports) frontal += q.frontal ? 1 : 0;
     j.value("faces_frontal", frontal);  // faces meshed by the frontal path (Sec. 5.1)
   }
-  if (!r.quasi_reports.empty()) {
-    const QuasiTotals t = quasi_totals(r);
-    j.value("faces_meshed_by_pattern", t.by_pattern);  // Sec. 6.1.2
-    // Of those, the faces whose pattern mesh the quality thresholds refused but which was no
-    // worse than the unstructured path's (PipelineOptions::pattern_compare_tolerance).
-    j.value("faces_meshed_by_pattern_after_comparison", t.by_comparison);
-    // Faces whose fill passed with a poor mean but whose unstructured mesh was clearly better on
-    // average (qstruct::PatternFaceOptions::compare_below_avg, compare_avg_margin).
-    j.value("faces_fill_gave_way_to_unstructured", t.fill_gave_way);
-    // Sec. 6.2 on the other faces: interior irregular vertices of their unstructured meshes
-    // before and after cavity remeshing, cavities remeshed by step.
-    j.value("irregular_unstructured_before", t.irregular_before);
-    j.value("irregular_unstructured_after_cavities", t.irregular_after);
-    j.begin_array("cavities_remeshed_per_step");
-    for (auto c : t.cavities) j.value(std::string(), c);
-    j.end_array();
-    // Sec. 6.3 on the same faces: interior valence >= 6, curve vertices of valence != 2, corners
-    // away from their ideal valence.
-    j.value("disk_defects_before", t.defects_before);
-    j.value("disk_defects_after", t.defects_after);
-    j.value("disk_cavities_replaced", t.disk_replaced);
-    j.value("faces_time_budget_hit", t.time_budget_hit);
-  }
+  // Sec. 6.1.2-6.3: what the quasi-structured stage did, summed over the faces (the fields of
+  // parallel::QuasiReport and ImprovementReport, documented there).
+  if (!r.quasi_reports.empty()) quasi_totals(r).write(j);
   j.value("vertices", s.vertices);
   j.value("triangles", s.triangles);
   j.value("quads", s.quads);
@@ -428,23 +390,18 @@ std::string stats_json(const Arguments& args, const Session& session,
     // Per face (quad stages): how it was meshed, its statistics and the time spent on it.
     j.begin_array("face_stats");
     for (std::size_t f = 0; f < r.face_stats.size(); ++f) {
-      const auto& st = r.face_stats[f];
       j.begin_object()
           .value("face", static_cast<std::int64_t>(f))
           .value("rank", f < r.face_rank.size() ? r.face_rank[f] : 0)
           .value("method", quad_method(r, f))
-          .value("pattern_refusal", pattern_refusal(r, f))
-          .value("vertices", st.vertices)
-          .value("quads", st.quads)
-          .value("triangles", st.triangles)
-          .value("irregular_interior", st.irregular_interior)
-          .value("irregular_boundary", st.irregular_boundary)
-          .value("sicn_min", st.sicn_min)
-          .value("sicn_avg", st.sicn_avg)
-          .value("quads_sicn_below_0_1",  // not forced by a sharp CAD corner
-                 f < s.face_quads_sicn_below_0_1.size() ? s.face_quads_sicn_below_0_1[f] : 0)
+          .value("pattern_refusal", pattern_refusal(r, f));
+      // The face's statistics (mesh::FaceQuadStats::fields, documented there).
+      mesh::FaceQuadStats::fields(r.face_stats[f],
+                                  [&](const char* name, const auto& v) { j.value(name, v); });
+      j.value("quads_sicn_below_0_1",  // not forced by a sharp CAD corner
+              f < s.face_quads_sicn_below_0_1.size() ? s.face_quads_sicn_below_0_1[f] : 0)
           .value("seconds", r.face_seconds[f])
-          .value("time_budget_hit", !r.quasi_reports.empty() && r.quasi_reports[f].time_budget_hit)
+          .value("time_budget_hit", time_budget_hit(r, f))
           .end_object();
     }
     j.end_array();
@@ -479,22 +436,25 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
     os << "  curves refined because a face boundary crossed itself: " << refined << "\n";
   }
   if (!r.quasi_reports.empty()) {
-    const QuasiTotals t = quasi_totals(r);
-    os << "  faces meshed by patterns: " << t.by_pattern << " of " << model.num_faces();
-    if (t.by_comparison > 0)
-      os << " (" << t.by_comparison
+    // By their --stats names (parallel::QuasiReport::fields).
+    const ReportTotals t = quasi_totals(r);
+    const auto steps = "cavities_remeshed_per_step";
+    os << "  faces meshed by patterns: " << t("faces_meshed_by_pattern") << " of "
+       << model.num_faces();
+    if (const std::int64_t n = t("faces_meshed_by_pattern_after_comparison"); n > 0)
+      os << " (" << n
          << " of them as good as their unstructured mesh, below the pattern thresholds)";
-    if (t.fill_gave_way > 0)
-      os << "; " << t.fill_gave_way
-         << " fill(s) with a poor mean gave way to a clearly better unstructured mesh";
+    if (const std::int64_t n = t("faces_fill_gave_way_to_unstructured"); n > 0)
+      os << "; " << n << " fill(s) with a poor mean gave way to a clearly better unstructured mesh";
     os << "\n"
-       << "  cavity remeshing (other faces): irregular interior vertices " << t.irregular_before
-       << " -> " << t.irregular_after << "; cavities remeshed by step " << t.cavities[0] << ", "
-       << t.cavities[1] << ", " << t.cavities[2] << ", " << t.cavities[3] << "\n"
-       << "  disk remeshing: defects " << t.defects_before << " -> " << t.defects_after << " ("
-       << t.disk_replaced << " cavities replaced)\n";
-    if (t.time_budget_hit > 0)
-      os << "  faces stopped by --face-time-budget: " << t.time_budget_hit
+       << "  cavity remeshing (other faces): irregular interior vertices "
+       << t("irregular_unstructured_before") << " -> " << t("irregular_unstructured_after_cavities")
+       << "; cavities remeshed by step " << t(steps, 0) << ", " << t(steps, 1) << ", "
+       << t(steps, 2) << ", " << t(steps, 3) << "\n"
+       << "  disk remeshing: defects " << t("disk_defects_before") << " -> "
+       << t("disk_defects_after") << " (" << t("disk_cavities_replaced") << " cavities replaced)\n";
+    if (const std::int64_t n = t("faces_time_budget_hit"); n > 0)
+      os << "  faces stopped by --face-time-budget: " << n
          << " (kept the valid mesh reached; list with -v)\n";
   }
   if (s.triangles > 0) {
@@ -556,10 +516,7 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
          << (refusal.empty() ? "" : " (no pattern: " + refusal + ")") << ", " << st.vertices << ", "
          << st.quads << ", " << st.triangles << ", " << st.irregular_interior << " / "
          << st.irregular_boundary << ", " << st.sicn_min << " / " << st.sicn_avg << ", "
-         << r.face_seconds[f]
-         << (!r.quasi_reports.empty() && r.quasi_reports[f].time_budget_hit
-                 ? " (stopped by --face-time-budget)"
-                 : "")
+         << r.face_seconds[f] << (time_budget_hit(r, f) ? " (stopped by --face-time-budget)" : "")
          << "\n";
     }
   }

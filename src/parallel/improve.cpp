@@ -8,12 +8,13 @@
 #include <optional>
 #include <string>
 
+#include "exchange.hpp"
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/core/timer.hpp"
+#include "qsmesh/parallel/record.hpp"
 #include "qsmesh/qstruct/cavity.hpp"
 #include "qsmesh/remesh/disk_remesh.hpp"
 #include "qsmesh/smooth/smooth.hpp"
-#include "serialize.hpp"
 
 namespace qsmesh::parallel {
 
@@ -22,20 +23,45 @@ namespace {
 // A face of any rank, as this rank sees it.
 struct Work {
   LO face = kNoIndex;
-  int owner = 0;
-  std::size_t local = 0;    // index in the owner's `mine`
+  int owner = 0;            // not exchanged: the sender
+  std::size_t local = 0;    // index in the owner's `mine`; not exchanged: the order received
   std::int64_t offset = 0;  // the face's bytes in the owner's SharedBytes (several ranks)
   std::int64_t length = 0;
   std::int64_t quads = 0;
+  // What every rank learns of every face.
+  template <class S, class V>
+  static void fields(S& self, V&& visit) {
+    visit("face", self.face);
+    visit("quads", self.quads);
+    visit("offset", self.offset);
+    visit("length", self.length);
+  }
+};
+
+// What a face taken away from its owner holds: its mesh and singularities.
+struct Input {
+  mesh::FaceMesh mesh;
+  std::vector<crossfield::Singularity> singularities;
+  template <class S, class V>
+  static void fields(S& self, V&& visit) {
+    visit("mesh", self.mesh);
+    visit("singularities", self.singularities);
+  }
 };
 
 // What improving one face gives, wherever it ran.
 struct Result {
-  bool done = false;
+  bool done = false;  // not exchanged: a received result is done
   mesh::FaceMesh mesh;
-  QuasiReport fields;  // the cavity and disk fields only
+  ImprovementReport report;
   double seconds = 0;
-  std::array<double, 3> steps{};
+  std::array<double, 3> steps{};  // not exchanged: summed over all faces by a reduction
+  template <class S, class V>
+  static void fields(S& self, V&& visit) {
+    visit("mesh", self.mesh);
+    visit("report", self.report);
+    visit("seconds", self.seconds);
+  }
 };
 
 Result improve_one(const cad::CadModel& model, LO face, mesh::FaceMesh mesh,
@@ -69,10 +95,7 @@ Result improve_one(const cad::CadModel& model, LO face, mesh::FaceMesh mesh,
     qstruct::CavityReport cr;
     mesh::FaceMesh out =
         qstruct::remesh_cavities(mesh, s, singularities, settings.patterns, settings.cavities, &cr);
-    r.fields.irregular_before = cr.irregular_before;
-    r.fields.irregular_after = cr.irregular_after;
-    r.fields.cavities = cr.remeshed;
-    r.fields.time_budget_hit = cr.time_budget_hit;
+    r.report.record(cr);
     return out;
   });
   // Local clean-up (Sec. 6.3): defects remeshed with the best disk quadrangulation, each
@@ -80,9 +103,7 @@ Result improve_one(const cad::CadModel& model, LO face, mesh::FaceMesh mesh,
   step(1, "disk remeshing", [&](const cad::FaceGeometry& s) {
     remesh::DiskRemeshStats ds;
     mesh::FaceMesh out = remesh::remesh_disk_defects(mesh, s, *settings.table, settings.disk, &ds);
-    r.fields.defects_before = ds.defects_before;
-    r.fields.defects_after = ds.defects_after;
-    r.fields.disk_replaced = ds.replaced;
+    r.report.record(ds);
     return out;
   });
   if (settings.final_smoothing)
@@ -94,46 +115,10 @@ Result improve_one(const cad::CadModel& model, LO face, mesh::FaceMesh mesh,
   return r;
 }
 
-void copy_fields(const QuasiReport& from, QuasiReport& to) {
-  to.irregular_before = from.irregular_before;
-  to.irregular_after = from.irregular_after;
-  to.cavities = from.cavities;
-  to.time_budget_hit = from.time_budget_hit;
-  to.defects_before = from.defects_before;
-  to.defects_after = from.defects_after;
-  to.disk_replaced = from.disk_replaced;
-}
-
 void apply(Result&& r, ImproveFace& f) {
   *f.mesh = std::move(r.mesh);
-  copy_fields(r.fields, *f.report);
+  *f.report = r.report;
   *f.seconds += r.seconds;
-}
-
-void pack_result(LO face, const Result& r, std::vector<char>& out) {
-  put<LO>(out, face);
-  pack_mesh(r.mesh, out);
-  const QuasiReport& q = r.fields;
-  for (std::int64_t x :
-       {q.irregular_before, q.irregular_after, q.defects_before, q.defects_after, q.disk_replaced})
-    put<std::int64_t>(out, x);
-  put(out, q.cavities);
-  put<std::uint8_t>(out, q.time_budget_hit ? 1 : 0);
-  put<double>(out, r.seconds);
-}
-
-LO unpack_result(const std::vector<char>& in, std::size_t& pos, Result& r) {
-  const auto face = get<LO>(in, pos);
-  unpack_mesh(in, pos, r.mesh);
-  QuasiReport& q = r.fields;
-  for (std::int64_t* x : {&q.irregular_before, &q.irregular_after, &q.defects_before,
-                          &q.defects_after, &q.disk_replaced})
-    *x = get<std::int64_t>(in, pos);
-  q.cavities = get<std::array<std::int64_t, 4>>(in, pos);
-  q.time_budget_hit = get<std::uint8_t>(in, pos) != 0;
-  r.seconds = get<double>(in, pos);
-  r.done = true;
-  return face;
 }
 
 }  // namespace
@@ -169,9 +154,10 @@ std::array<double, 3> improve_faces(const Comm& comm, const cad::CadModel& model
     Work w{mine[i].face, rank, i, 0, 0, static_cast<std::int64_t>(mine[i].mesh->quads.size())};
     if (nranks > 1) {
       w.offset = static_cast<std::int64_t>(buffer.size());
-      pack_mesh(*mine[i].mesh, buffer);
-      put_vec(buffer, std::vector<crossfield::Singularity>(mine[i].singularities.begin(),
-                                                           mine[i].singularities.end()));
+      // Input's fields in order, without copying the mesh into one.
+      write_record(buffer, *mine[i].mesh);
+      write_record(buffer, std::vector<crossfield::Singularity>(mine[i].singularities.begin(),
+                                                                mine[i].singularities.end()));
       w.length = static_cast<std::int64_t>(buffer.size()) - w.offset;
     }
     work.push_back(w);
@@ -179,12 +165,7 @@ std::array<double, 3> improve_faces(const Comm& comm, const cad::CadModel& model
   std::optional<SharedBytes> shared;
   if (nranks > 1) {
     std::vector<char> records;
-    for (const Work& w : work) {
-      put<LO>(records, w.face);
-      put<std::int64_t>(records, w.quads);
-      put<std::int64_t>(records, w.offset);
-      put<std::int64_t>(records, w.length);
-    }
+    for (const Work& w : work) write_record(records, w);
     const auto all = comm.allgather_bytes(records);
     work.clear();
     for (int r = 0; r < nranks; ++r) {
@@ -194,10 +175,7 @@ std::array<double, 3> improve_faces(const Comm& comm, const cad::CadModel& model
         Work w;
         w.owner = r;
         w.local = i;
-        w.face = get<LO>(bytes, pos);
-        w.quads = get<std::int64_t>(bytes, pos);
-        w.offset = get<std::int64_t>(bytes, pos);
-        w.length = get<std::int64_t>(bytes, pos);
+        read_record(bytes, pos, w);
         QSMESH_CHECK(r != rank || (i < mine.size() && mine[i].face == w.face),
                      "improvement: face record " << w.face << " out of order");
         work.push_back(w);
@@ -227,13 +205,13 @@ std::array<double, 3> improve_faces(const Comm& comm, const cad::CadModel& model
     } else {
       const std::vector<char> bytes = shared->read(w.owner, w.offset, w.length);
       std::size_t pos = 0;
-      mesh::FaceMesh in;
-      std::vector<crossfield::Singularity> singularities;
-      unpack_mesh(bytes, pos, in);
-      get_vec(bytes, pos, singularities);
-      QSMESH_CHECK(in.face == w.face, "improvement: rank " << w.owner << " sent face " << in.face
-                                                           << " for face " << w.face);
-      results[w_at] = improve_one(model, w.face, std::move(in), singularities, settings, log);
+      Input in;
+      read_record(bytes, pos, in);
+      QSMESH_CHECK(in.mesh.face == w.face, "improvement: rank " << w.owner << " sent face "
+                                                                << in.mesh.face << " for face "
+                                                                << w.face);
+      results[w_at] =
+          improve_one(model, w.face, std::move(in.mesh), in.singularities, settings, log);
     }
     progress.done();
   });
@@ -241,7 +219,7 @@ std::array<double, 3> improve_faces(const Comm& comm, const cad::CadModel& model
 
   // Results to their owners only; the time of each step summed over the faces of all ranks.
   std::vector<double> steps(3, 0.0);
-  std::vector<std::vector<char>> outgoing(static_cast<std::size_t>(nranks));
+  ToOwners<Result> to_owners(nranks);
   for (std::size_t i = 0; i < work.size(); ++i) {
     Result& r = results[i];
     if (!r.done) continue;
@@ -249,7 +227,7 @@ std::array<double, 3> improve_faces(const Comm& comm, const cad::CadModel& model
     if (work[i].owner == rank) {
       apply(std::move(r), mine[work[i].local]);
     } else {
-      pack_result(work[i].face, r, outgoing[static_cast<std::size_t>(work[i].owner)]);
+      to_owners.add(work[i].owner, work[i].face, r);
       r = Result{};
     }
   }
@@ -260,18 +238,12 @@ std::array<double, 3> improve_faces(const Comm& comm, const cad::CadModel& model
       if (local_of_face.size() <= f) local_of_face.resize(f + 1, 0);
       local_of_face[f] = i + 1;
     }
-    const auto incoming = comm.alltoall_bytes(outgoing);
-    outgoing = {};
-    for (const auto& bytes : incoming) {
-      std::size_t pos = 0;
-      while (pos < bytes.size()) {
-        Result r;
-        const auto f = static_cast<std::size_t>(unpack_result(bytes, pos, r));
-        QSMESH_CHECK(f < local_of_face.size() && local_of_face[f] != 0,
-                     "improvement: the result of face " << f << " came to a rank not owning it");
-        apply(std::move(r), mine[local_of_face[f] - 1]);
-      }
-    }
+    to_owners.deliver(comm, [&](LO face, Result&& r) {
+      const auto f = static_cast<std::size_t>(face);
+      QSMESH_CHECK(face >= 0 && f < local_of_face.size() && local_of_face[f] != 0,
+                   "improvement: the result of face " << f << " came to a rank not owning it");
+      apply(std::move(r), mine[local_of_face[f] - 1]);
+    });
     comm.allreduce_sum(steps);
   }
   return {steps[0], steps[1], steps[2]};

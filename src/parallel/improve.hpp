@@ -49,7 +49,7 @@ struct ImproveFace {
   LO face = kNoIndex;
   mesh::FaceMesh* mesh = nullptr;  ///< in: the valid all-quad unstructured mesh; out: improved
   std::span<const crossfield::Singularity> singularities;  ///< of the face's cross field
-  QuasiReport* report = nullptr;                           ///< out: the cavity and disk fields
+  ImprovementReport* report = nullptr;                     ///< out: what the steps did
   double* seconds = nullptr;                               ///< out: += wall time spent on the face
 };
 

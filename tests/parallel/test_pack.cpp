@@ -1,88 +1,249 @@
+// The byte records that ranks exchange (parallel/record.hpp): every field a report declares in
+// its fields() travels, in both directions, with no MPI involved.
 #include <gtest/gtest.h>
 
+#include <string>
+#include <vector>
+
 #include "qsmesh/core/error.hpp"
-#include "qsmesh/parallel/pipeline.hpp"
+#include "qsmesh/parallel/face_task.hpp"
+#include "qsmesh/parallel/record.hpp"
 
 namespace qsmesh::parallel {
 namespace {
 
-TEST(Pack, RoundTripOfFaceMeshesAndReports) {
+mesh::FaceMesh small_mesh(LO face) {
   mesh::FaceMesh a;
-  a.face = 3;
-  a.points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0.5}};
-  a.uv = {{0, 0}, {1, 0}, {0, 1}};
+  a.face = face;
+  a.points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0.5}, {1, 1, 0}};
+  a.uv = {{0, 0}, {1, 0}, {0, 1}, {1, 1}};
   a.vclass = {mesh::VertexClass{0, 7, kNoIndex, {0, 0}}, mesh::VertexClass{1, 2, 4, {0.25, 0}},
-              mesh::VertexClass{2, 3, kNoIndex, {0, 1}}};
+              mesh::VertexClass{2, 3, kNoIndex, {0, 1}}, mesh::VertexClass{2, 3, kNoIndex, {1, 1}}};
   a.triangles = {{0, 1, 2}};
-  background::FaceReport ra;
-  ra.face = 3;
-  ra.ok = true;
-  ra.fell_back = true;
-  ra.error = "[background] face 3: refinement failed";
-  ra.seconds = 0.5;
-  mesh::FaceMesh b;
-  b.face = 9;
-  background::FaceReport rb;
-  rb.face = 9;
-
-  std::vector<char> buf;
-  pack(a, ra, buf);
-  pack(b, rb, buf);
-  std::size_t pos = 0;
-  mesh::FaceMesh a2, b2;
-  background::FaceReport ra2, rb2;
-  unpack(buf, pos, a2, ra2);
-  unpack(buf, pos, b2, rb2);
-  EXPECT_EQ(pos, buf.size());
-  EXPECT_EQ(a2.face, 3);
-  EXPECT_EQ(a2.points, a.points);
-  EXPECT_EQ(a2.uv, a.uv);
-  EXPECT_EQ(a2.triangles, a.triangles);
-  EXPECT_EQ(a2.vclass[1].entity, 2);
-  EXPECT_EQ(a2.vclass[1].index, 4);
-  EXPECT_EQ(ra2.error, ra.error);
-  EXPECT_TRUE(ra2.fell_back);
-  EXPECT_EQ(b2.face, 9);
-  EXPECT_TRUE(b2.points.empty());
-  EXPECT_FALSE(rb2.ok);
-  // A truncated buffer is an error, not a crash.
-  buf.resize(buf.size() - 3);
-  pos = 0;
-  unpack(buf, pos, a2, ra2);
-  EXPECT_THROW(unpack(buf, pos, b2, rb2), Error);
+  a.quads = {{0, 1, 3, 2}};
+  return a;
 }
 
-TEST(Pack, RoundTripOfQuadReportsAndSizes) {
-  quad::UnstructuredReport r;
-  r.ok = false;
-  r.fell_back = true;
-  r.error = "[unstructured] face 8: a quad is folded";
-  r.sicn_min = -0.25;
-  r.quads = 1234;
-  r.frontal = true;
-  r.frontal_points = 77;
-  sizemap::FaceSizes sz;
-  sz.s = {1, 2, 3};
-  sz.s_min = {0.5, 2, 3};
+// Counts the fields a record type declares (nested records counted field by field), so that a
+// field added to a report without being set below fails the round trip test.
+template <class R>
+int count_fields(const R& r) {
+  int n = 0;
+  R::fields(r, [&](const char*, const auto& field) {
+    using T = std::remove_cvref_t<decltype(field)>;
+    if constexpr (HasFields<T>)
+      n += count_fields(field);
+    else
+      ++n;
+  });
+  return n;
+}
+
+// A FaceOutput with every field away from its default.
+FaceOutput full_output() {
+  FaceOutput o;
+  o.mesh = small_mesh(3);
+  o.report.face = 3;
+  o.report.ok = true;
+  o.report.fell_back = true;
+  o.report.error = "[background] face 3: refinement failed";
+  o.report.seconds = 0.5;
+  o.cross_field.ok = true;
+  o.cross_field.error = "none";
+  o.cross_field.directions = {{Vec3{1, 0, 0}, Vec3{0, 1, 0}}};
+  o.cross_field.u_norm = {0.25};
+  o.cross_field.H = {-1.5};
+  o.cross_field.singularities = {crossfield::Singularity{{1, 2, 3}, -1}};
+  o.cross_field.euler.chi = 1;
+  o.cross_field.euler.expected = 4;
+  o.cross_field.levels = 3;
+  o.cross_field.factorizations = 2;
+  o.cross_field.solves = 9;
+  o.cross_field.seconds = 0.125;
+  o.sizes.s = {1, 2, 3};
+  o.sizes.s_min = {0.5, 2, 3};
+  o.sizes.s_cf = {4};
+  o.unstructured.ok = true;
+  o.unstructured.fell_back = true;
+  o.unstructured.frontal = true;
+  o.unstructured.frontal_points = 77;
+  o.unstructured.error = "[unstructured] face 3: a quad is folded";
+  o.unstructured.sicn_min = -0.25;
+  o.unstructured.quads = 1234;
+  o.quasi.by_pattern = true;
+  o.quasi.pattern = "grid";
+  o.quasi.refusal = "quality";
+  o.quasi.by_comparison = true;
+  o.quasi.gave_way = true;
+  o.quasi.improvement.irregular_before = 11;
+  o.quasi.improvement.irregular_after = 5;
+  o.quasi.improvement.cavities = {1, 2, 3, 4};
+  o.quasi.improvement.defects_before = 7;
+  o.quasi.improvement.defects_after = 2;
+  o.quasi.improvement.disk_replaced = 6;
+  o.quasi.improvement.time_budget_hit = true;
+  o.stats.vertices = 4;
+  o.stats.quads = 1;
+  o.stats.triangles = 1;
+  o.stats.irregular_interior = 2;
+  o.stats.irregular_boundary = 3;
+  o.stats.sicn_min = 0.75;
+  o.stats.sicn_avg = 0.875;
+  o.seconds = 2.5;
+  return o;
+}
+
+TEST(Pack, EveryFieldOfAFaceOutputRoundTrips) {
+  const FaceOutput a = full_output();
+  // 8 parts; the counts of their fields: mesh 1 (packed whole), background report 5, cross field
+  // 11, sizes 3, unstructured 7, quasi 5 + improvement 7, stats 7, seconds 1.
+  ASSERT_EQ(count_fields(a), 1 + 5 + 11 + 3 + 7 + 12 + 7 + 1)
+      << "a field was added to a report: set it in full_output() and check it here";
   std::vector<char> buf;
-  pack(r, buf);
-  pack(sz, buf);
+  write_record(buf, a);
+  write_record(buf, FaceOutput{});
   std::size_t pos = 0;
-  quad::UnstructuredReport r2;
-  sizemap::FaceSizes sz2;
-  unpack(buf, pos, r2);
-  unpack(buf, pos, sz2);
+  FaceOutput b, empty;
+  read_record(buf, pos, b);
+  read_record(buf, pos, empty);
   EXPECT_EQ(pos, buf.size());
-  EXPECT_FALSE(r2.ok);
-  EXPECT_TRUE(r2.fell_back);
-  EXPECT_EQ(r2.error, r.error);
-  EXPECT_EQ(r2.sicn_min, -0.25);
-  EXPECT_EQ(r2.quads, 1234);
-  EXPECT_TRUE(r2.frontal);
-  EXPECT_EQ(r2.frontal_points, 77);
-  EXPECT_EQ(sz2.s, sz.s);
-  EXPECT_EQ(sz2.s_min, sz.s_min);
-  EXPECT_TRUE(sz2.s_cf.empty());
+
+  EXPECT_EQ(b.mesh.face, 3);
+  EXPECT_EQ(b.mesh.points, a.mesh.points);
+  EXPECT_EQ(b.mesh.uv, a.mesh.uv);
+  EXPECT_EQ(b.mesh.triangles, a.mesh.triangles);
+  EXPECT_EQ(b.mesh.quads, a.mesh.quads);
+  EXPECT_EQ(b.mesh.vclass[1].entity, 2);
+  EXPECT_EQ(b.mesh.vclass[1].index, 4);
+  EXPECT_EQ(b.report.face, 3);
+  EXPECT_TRUE(b.report.ok);
+  EXPECT_TRUE(b.report.fell_back);
+  EXPECT_EQ(b.report.error, a.report.error);
+  EXPECT_EQ(b.report.seconds, 0.5);
+  EXPECT_TRUE(b.cross_field.ok);
+  EXPECT_EQ(b.cross_field.error, "none");
+  ASSERT_EQ(b.cross_field.directions.size(), 1U);
+  EXPECT_EQ(b.cross_field.directions[0][1].y, 1.0);
+  EXPECT_EQ(b.cross_field.u_norm, a.cross_field.u_norm);
+  EXPECT_EQ(b.cross_field.H, a.cross_field.H);
+  ASSERT_EQ(b.cross_field.singularities.size(), 1U);
+  EXPECT_EQ(b.cross_field.singularities[0].index, -1);
+  EXPECT_EQ(b.cross_field.singularities[0].position.z, 3.0);
+  EXPECT_EQ(b.cross_field.euler.chi, 1);
+  EXPECT_EQ(b.cross_field.euler.expected, 4);
+  EXPECT_EQ(b.cross_field.levels, 3);
+  EXPECT_EQ(b.cross_field.factorizations, 2);
+  EXPECT_EQ(b.cross_field.solves, 9);
+  EXPECT_EQ(b.cross_field.seconds, 0.125);
+  EXPECT_EQ(b.sizes.s, a.sizes.s);
+  EXPECT_EQ(b.sizes.s_min, a.sizes.s_min);
+  EXPECT_EQ(b.sizes.s_cf, a.sizes.s_cf);
+  EXPECT_TRUE(b.unstructured.ok);
+  EXPECT_TRUE(b.unstructured.fell_back);
+  EXPECT_TRUE(b.unstructured.frontal);
+  EXPECT_EQ(b.unstructured.frontal_points, 77);
+  EXPECT_EQ(b.unstructured.error, a.unstructured.error);
+  EXPECT_EQ(b.unstructured.sicn_min, -0.25);
+  EXPECT_EQ(b.unstructured.quads, 1234);
+  EXPECT_TRUE(b.quasi.by_pattern);
+  EXPECT_EQ(b.quasi.pattern, "grid");
+  EXPECT_EQ(b.quasi.refusal, "quality");
+  EXPECT_TRUE(b.quasi.by_comparison);
+  EXPECT_TRUE(b.quasi.gave_way);
+  const ImprovementReport& q = b.quasi.improvement;
+  EXPECT_EQ(q.irregular_before, 11);
+  EXPECT_EQ(q.irregular_after, 5);
+  EXPECT_EQ(q.cavities, (std::array<std::int64_t, 4>{1, 2, 3, 4}));
+  EXPECT_EQ(q.defects_before, 7);
+  EXPECT_EQ(q.defects_after, 2);
+  EXPECT_EQ(q.disk_replaced, 6);
+  EXPECT_TRUE(q.time_budget_hit);
+  EXPECT_EQ(b.stats.vertices, 4);
+  EXPECT_EQ(b.stats.quads, 1);
+  EXPECT_EQ(b.stats.triangles, 1);
+  EXPECT_EQ(b.stats.irregular_interior, 2);
+  EXPECT_EQ(b.stats.irregular_boundary, 3);
+  EXPECT_EQ(b.stats.sicn_min, 0.75);
+  EXPECT_EQ(b.stats.sicn_avg, 0.875);
+  EXPECT_EQ(b.seconds, 2.5);
+
+  // The record after it came back at its defaults.
+  EXPECT_TRUE(empty.mesh.points.empty());
+  EXPECT_FALSE(empty.report.ok);
+  EXPECT_TRUE(empty.report.error.empty());
+  EXPECT_FALSE(empty.quasi.by_pattern);
+  EXPECT_EQ(empty.quasi.improvement.disk_replaced, 0);
+}
+
+TEST(Pack, PatternFillRoundTrips) {
+  PatternFill a;
+  a.report.ok = false;
+  a.report.refusal = qstruct::Refusal::TooManyQuads;
+  a.report.reason = "face 5: 400 quads";
+  a.report.side_edges = {2, 4, 2, 4};
+  a.report.pattern = 3;
+  a.report.pattern_name = "transition";
+  a.report.start = 1;
+  a.report.reversed = true;
+  a.report.chords = {1, 2};
+  a.report.candidates = 6;
+  a.report.lifts = 1;
+  a.report.moves = 12;
+  a.report.sicn_min = 0.2;
+  a.report.sicn_avg = 0.7;
+  a.report.min_sicn = 0.3;
+  a.report.quads = 400;
+  a.report.refused_mesh = small_mesh(5);
+  a.mesh = small_mesh(5);
+  a.seconds = 0.75;
+  ASSERT_EQ(count_fields(a), 17 + 1 + 1)
+      << "a field was added to PatternFaceReport: set it here and check it below";
+  std::vector<char> buf;
+  write_record(buf, a);
+  std::size_t pos = 0;
+  PatternFill b;
+  read_record(buf, pos, b);
+  EXPECT_EQ(pos, buf.size());
+  EXPECT_FALSE(b.report.ok);
+  EXPECT_EQ(b.report.refusal, qstruct::Refusal::TooManyQuads);
+  EXPECT_EQ(b.report.reason, a.report.reason);
+  EXPECT_EQ(b.report.side_edges, a.report.side_edges);
+  EXPECT_EQ(b.report.pattern, 3);
+  EXPECT_EQ(b.report.pattern_name, "transition");
+  EXPECT_EQ(b.report.start, 1);
+  EXPECT_TRUE(b.report.reversed);
+  EXPECT_EQ(b.report.chords, a.report.chords);
+  EXPECT_EQ(b.report.candidates, 6);
+  EXPECT_EQ(b.report.lifts, 1);
+  EXPECT_EQ(b.report.moves, 12);
+  EXPECT_EQ(b.report.sicn_min, 0.2);
+  EXPECT_EQ(b.report.sicn_avg, 0.7);
+  EXPECT_EQ(b.report.min_sicn, 0.3);
+  EXPECT_EQ(b.report.quads, 400);
+  EXPECT_EQ(b.report.refused_mesh.quads, a.report.refused_mesh.quads);
+  EXPECT_EQ(b.mesh.points, a.mesh.points);
+  EXPECT_EQ(b.seconds, 0.75);
+}
+
+TEST(Pack, TruncatedRecordsAreErrors) {
+  std::vector<char> buf;
+  write_record(buf, full_output());
+  write_record(buf, full_output());
+  // Cut anywhere in the second record: reading it throws, the first still reads.
+  for (const std::size_t cut : {std::size_t{1}, std::size_t{9}, std::size_t{100}}) {
+    std::vector<char> bytes(buf.begin(), buf.end() - static_cast<std::ptrdiff_t>(cut));
+    std::size_t pos = 0;
+    FaceOutput o;
+    read_record(bytes, pos, o);
+    EXPECT_EQ(o.quasi.improvement.disk_replaced, 6);
+    EXPECT_THROW(read_record(bytes, pos, o), Error) << "cut " << cut;
+  }
+  // A size field far beyond the buffer does not allocate it.
+  std::vector<char> lying;
+  put<std::int64_t>(lying, std::int64_t{1} << 60);
+  std::size_t pos = 0;
+  std::vector<std::string> texts;
+  EXPECT_THROW(read_record(lying, pos, texts), Error);
 }
 
 }  // namespace

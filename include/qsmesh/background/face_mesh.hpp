@@ -27,6 +27,15 @@ struct FaceReport {
   bool fell_back = false;     ///< true: refinement failed and the boundary-only triangulation was kept
   std::string error;          ///< the error met, if any (with stage and face id)
   double seconds = 0;
+  /// Every field, once (visit(name, member)): what the ranks exchange (parallel/record.hpp).
+  template <class S, class V>
+  static void fields(S& self, V&& visit) {
+    visit("face", self.face);
+    visit("ok", self.ok);
+    visit("fell_back", self.fell_back);
+    visit("error", self.error);
+    visit("seconds", self.seconds);
+  }
 };
 
 /// The boundary loops of face f in its parameter plane, built from the curve meshes: each curve

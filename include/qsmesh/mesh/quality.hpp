@@ -65,6 +65,18 @@ struct FaceQuadStats {
   /// in this face (3D).
   std::int64_t irregular_boundary = 0;
   double sicn_min = 0, sicn_avg = 0;  ///< over quads (0 when none)
+  /// Every field, once (visit(name, member)), named as in the drivers' --stats face_stats; what
+  /// the ranks exchange (parallel/record.hpp).
+  template <class S, class V>
+  static void fields(S& self, V&& visit) {
+    visit("vertices", self.vertices);
+    visit("quads", self.quads);
+    visit("triangles", self.triangles);
+    visit("irregular_interior", self.irregular_interior);
+    visit("irregular_boundary", self.irregular_boundary);
+    visit("sicn_min", self.sicn_min);
+    visit("sicn_avg", self.sicn_avg);
+  }
 };
 
 /// Statistics of a face mesh (FaceMesh: boundary vertices classified dim 0 / 1 with their

@@ -16,6 +16,7 @@
 #include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/mesh/surface_mesh.hpp"
 #include "qsmesh/parallel/comm.hpp"
+#include "qsmesh/parallel/face_task.hpp"
 #include "qsmesh/qstruct/balance.hpp"
 #include "qsmesh/qstruct/cavity.hpp"
 #include "qsmesh/qstruct/face_pattern.hpp"
@@ -86,9 +87,10 @@ struct PipelineOptions {
   /// valid (t20_data's cusp slivers at size factor 0.01). A face refused on the quad bound whose
   /// unstructured mesh has more quads than the bound gets its fills of at most that many quads
   /// laid out, compared as above (wing_fuselage's blunt trailing edges at size factor 0.02: grids
-  /// [2, 48, 2, 48] instead of 101 quads with 3 irregular vertices). All count in by_comparison.
-  /// Negative: never. On Block.stp the faces this takes are small triangles (three or seven quads) that
-  /// both paths mesh alike.
+  /// [2, 48, 2, 48] instead of 101 quads with 3 irregular vertices). All count as meshed by
+  /// patterns after the comparison (QuasiReport).
+  /// Negative: never. On Block.stp the faces this takes are small triangles (three or seven quads)
+  /// that both paths mesh alike.
   double pattern_compare_tolerance = 0.01;
   /// Stage::QuasiStructured: cavity remeshing of the unstructured faces (Sec. 6.2).
   qstruct::CavityOptions cavities;
@@ -101,40 +103,6 @@ struct PipelineOptions {
   /// 0.884 -> 0.885 (min 0.093 -> 0.099) for 0.06-0.5 s; 30 iterations instead of 10 add nothing.
   bool final_smoothing = true;
   smooth::SmoothOptions final_smooth;
-};
-
-/// How the quasi-structured stage treated one face.
-struct QuasiReport {
-  bool by_pattern = false;  ///< meshed by a pattern (Sec. 6.1.2); else by the unstructured path
-  std::string pattern;      ///< the pattern's name when by_pattern
-  std::string refusal;      ///< why no pattern was kept (qstruct::to_string of the refusal)
-  /// by_pattern, but only after the comparison of PipelineOptions::pattern_compare_tolerance
-  /// (`refusal` then says why the thresholds refused it first).
-  bool by_comparison = false;
-  /// Cavity remeshing (unstructured faces only): interior irregular vertices before it (the
-  /// unstructured mesh) and after it, cavities remeshed by step (Steps 1-4 of Sec. 6.2.2).
-  std::int64_t irregular_before = 0, irregular_after = 0;
-  std::array<std::int64_t, 4> cavities{};
-  /// Disk remeshing (unstructured faces only): defects before/after, cavities replaced.
-  std::int64_t defects_before = 0, defects_after = 0, disk_replaced = 0;
-  /// Cavity remeshing stopped by CavityOptions::time_budget_s on this face (the mesh reached
-  /// then is kept: every accepted step is valid).
-  bool time_budget_hit = false;
-};
-
-
-/// What the drivers need of a face's cross field, per triangle of its background mesh in the
-/// order of the assembled mesh (triangles collapsed at poles excluded, as in assembly).
-struct CrossFieldOutput {
-  bool ok = false;
-  std::string error;
-  std::vector<std::array<Vec3, 2>> directions;  ///< two unit branches per triangle
-  std::vector<double> u_norm;                   ///< per triangle: mean |U| of its edges
-  std::vector<double> H;                        ///< per triangle: mean conformal scaling H
-  std::vector<crossfield::Singularity> singularities;
-  crossfield::EulerCheck euler;
-  int levels = 0, factorizations = 0, solves = 0;
-  double seconds = 0;
 };
 
 struct PipelineResult {
@@ -175,24 +143,7 @@ struct PipelineResult {
                                           const PipelineOptions& options, const TaskArena& tasks,
                                           Logger& log, linalg::PetscLane* lane = nullptr);
 
-/// The driver's view of a face cross field (see CrossFieldOutput).
-[[nodiscard]] CrossFieldOutput summarize(const crossfield::FaceCrossField& cf);
-
 /// Estimated cost of meshing each face (area / size^2), the METIS vertex weights.
 [[nodiscard]] std::vector<double> estimate_face_costs(const cad::CadModel& model, double size);
-
-/// Byte serialisation of face meshes and reports, for the gather.
-void pack(const mesh::FaceMesh& m, const background::FaceReport& r, std::vector<char>& out);
-/// Reads one record written by pack starting at `pos`; advances `pos`.
-void unpack(const std::vector<char>& in, std::size_t& pos, mesh::FaceMesh& m,
-            background::FaceReport& r);
-void pack(const CrossFieldOutput& c, std::vector<char>& out);
-void pack(const sizemap::FaceSizes& s, std::vector<char>& out);
-void unpack(const std::vector<char>& in, std::size_t& pos, sizemap::FaceSizes& s);
-void pack(const quad::UnstructuredReport& r, std::vector<char>& out);
-void unpack(const std::vector<char>& in, std::size_t& pos, quad::UnstructuredReport& r);
-void unpack(const std::vector<char>& in, std::size_t& pos, CrossFieldOutput& c);
-void pack(const QuasiReport& r, std::vector<char>& out);
-void unpack(const std::vector<char>& in, std::size_t& pos, QuasiReport& r);
 
 }  // namespace qsmesh::parallel

@@ -150,6 +150,27 @@ struct PatternFaceReport {
   /// SICN > 0), else empty. Paper 000 Sec. 6.1.1 keeps a pattern mesh when its quality is better
   /// than the mesh it replaces; a caller that has the face's other mesh can make that comparison.
   mesh::FaceMesh refused_mesh;
+  /// Every field, once (visit(name, member)): what the ranks exchange (parallel/record.hpp).
+  template <class S, class V>
+  static void fields(S& self, V&& visit) {
+    visit("ok", self.ok);
+    visit("refusal", self.refusal);
+    visit("reason", self.reason);
+    visit("side_edges", self.side_edges);
+    visit("pattern", self.pattern);
+    visit("pattern_name", self.pattern_name);
+    visit("start", self.start);
+    visit("reversed", self.reversed);
+    visit("chords", self.chords);
+    visit("candidates", self.candidates);
+    visit("lifts", self.lifts);
+    visit("moves", self.moves);
+    visit("sicn_min", self.sicn_min);
+    visit("sicn_avg", self.sicn_avg);
+    visit("min_sicn", self.min_sicn);
+    visit("quads", self.quads);
+    visit("refused_mesh", self.refused_mesh);
+  }
 };
 
 /// The boundary of a face split at its convex corners.

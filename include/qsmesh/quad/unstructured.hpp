@@ -75,6 +75,17 @@ struct UnstructuredReport {
   std::string error;        ///< the error met, with stage and face id
   double sicn_min = 0;      ///< of the face's quads
   std::int64_t quads = 0;
+  /// Every field, once (visit(name, member)): what the ranks exchange (parallel/record.hpp).
+  template <class S, class V>
+  static void fields(S& self, V&& visit) {
+    visit("ok", self.ok);
+    visit("fell_back", self.fell_back);
+    visit("frontal", self.frontal);
+    visit("frontal_points", self.frontal_points);
+    visit("error", self.error);
+    visit("sicn_min", self.sicn_min);
+    visit("quads", self.quads);
+  }
 };
 
 /// All-quad mesh of face f. `halved`: curve meshes with half the final edge counts (quantize::

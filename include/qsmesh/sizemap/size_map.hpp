@@ -131,6 +131,13 @@ struct FaceSizes {
   /// (the pure s_min when `curve` is initial_curve_sizes; after the union it includes s_cf there).
   std::vector<double> s_min;
   std::vector<double> s_cf;  ///< exp(H + C_i), ungraded (empty when no cross field is used)
+  /// Every field, once (visit(name, member)): what the ranks exchange (parallel/record.hpp).
+  template <class S, class V>
+  static void fields(S& self, V&& visit) {
+    visit("s", self.s);
+    visit("s_min", self.s_min);
+    visit("s_cf", self.s_cf);
+  }
 };
 
 /// The size field of one face at its FaceMesh vertices. Boundary vertices start from `curve` (dim

@@ -1,0 +1,289 @@
+// One face's way through the pipeline: what the pipeline reports of a face (QuasiReport,
+// ImprovementReport, CrossFieldOutput: their fields declared once, here, and set by the policy
+// below or by record()), the record that carries a face's state from stage to stage (FaceTask),
+// the stages that act on one record, and the per-face meshing policy of the quasi-structured
+// stage (which of a pattern fill and the unstructured mesh a face keeps). All serial and free of
+// MPI: run_pipeline deals the records out over threads and ranks and moves what crosses ranks
+// (parallel/record.hpp); the policy is tested without mpirun.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "qsmesh/background/face_mesh.hpp"
+#include "qsmesh/cad/model.hpp"
+#include "qsmesh/crossfield/cross_field.hpp"
+#include "qsmesh/linalg/solver.hpp"
+#include "qsmesh/mesh/quality.hpp"
+#include "qsmesh/mesh/surface_mesh.hpp"
+#include "qsmesh/qstruct/cavity.hpp"
+#include "qsmesh/qstruct/face_pattern.hpp"
+#include "qsmesh/qstruct/patterns.hpp"
+#include "qsmesh/quad/unstructured.hpp"
+#include "qsmesh/remesh/disk_remesh.hpp"
+#include "qsmesh/sizemap/size_map.hpp"
+
+namespace qsmesh::parallel {
+
+// --- What the pipeline reports of a face --------------------------------------------------
+
+/// What the topological improvement (paper 000 Sec. 6.2-6.3) did to one unstructured face. Its
+/// fields are declared once, in fields(), each named by its total over the faces in the drivers'
+/// --stats: the exchange between ranks, the drivers' totals and their writers go through it, and
+/// the improvement fills it with record().
+struct ImprovementReport {
+  /// Cavity remeshing: interior irregular vertices before it (the unstructured mesh) and after
+  /// it, cavities remeshed by step (Steps 1-4 of Sec. 6.2.2).
+  std::int64_t irregular_before = 0, irregular_after = 0;
+  std::array<std::int64_t, 4> cavities{};
+  /// Disk remeshing: defects before/after, cavities replaced.
+  std::int64_t defects_before = 0, defects_after = 0, disk_replaced = 0;
+  /// Cavity remeshing stopped by CavityOptions::time_budget_s on this face (the mesh reached
+  /// then is kept: every accepted step is valid).
+  bool time_budget_hit = false;
+
+  /// Takes the cavity remeshing's counts (qstruct::remesh_cavities).
+  void record(const qstruct::CavityReport& r) {
+    irregular_before = r.irregular_before;
+    irregular_after = r.irregular_after;
+    cavities = r.remeshed;
+    time_budget_hit = r.time_budget_hit;
+  }
+  /// Takes the disk remeshing's counts (remesh::remesh_disk_defects).
+  void record(const remesh::DiskRemeshStats& s) {
+    defects_before = s.defects_before;
+    defects_after = s.defects_after;
+    disk_replaced = s.replaced;
+  }
+  template <class S, class V>
+  static void fields(S& self, V&& visit) {
+    visit("irregular_unstructured_before", self.irregular_before);
+    visit("irregular_unstructured_after_cavities", self.irregular_after);
+    visit("cavities_remeshed_per_step", self.cavities);
+    visit("disk_defects_before", self.defects_before);
+    visit("disk_defects_after", self.defects_after);
+    visit("disk_cavities_replaced", self.disk_replaced);
+    visit("faces_time_budget_hit", self.time_budget_hit);
+  }
+};
+
+/// How the quasi-structured stage treated one face. Its fields are declared once, in fields(), the
+/// countable ones named by their total over the faces in the drivers' --stats (as
+/// ImprovementReport).
+struct QuasiReport {
+  bool by_pattern = false;  ///< meshed by a pattern (Sec. 6.1.2); else by the unstructured path
+  std::string pattern;      ///< the pattern's name when by_pattern
+  std::string refusal;      ///< why no pattern was kept (qstruct::to_string of the refusal)
+  /// by_pattern, but only after the comparison of PipelineOptions::pattern_compare_tolerance
+  /// (`refusal` then says why the thresholds refused it first).
+  bool by_comparison = false;
+  /// A fill kept with a poor mean gave way to the face's clearly better unstructured mesh
+  /// (qstruct::unstructured_clearly_better; `refusal` is then UnstructuredBetter).
+  bool gave_way = false;
+  /// Unstructured faces only (others keep zeros).
+  ImprovementReport improvement;
+
+  /// "pattern:<name>" when meshed by a pattern, else empty.
+  [[nodiscard]] std::string pattern_method() const {
+    return by_pattern ? "pattern:" + pattern : std::string();
+  }
+  /// Why no pattern was kept (qstruct::Refusal as text); empty when one was.
+  [[nodiscard]] std::string pattern_refusal() const { return by_pattern ? std::string() : refusal; }
+  template <class S, class V>
+  static void fields(S& self, V&& visit) {
+    visit("faces_meshed_by_pattern", self.by_pattern);
+    visit("pattern", self.pattern);
+    visit("pattern_refusal", self.refusal);
+    visit("faces_meshed_by_pattern_after_comparison", self.by_comparison);
+    visit("faces_fill_gave_way_to_unstructured", self.gave_way);
+    visit("improvement", self.improvement);
+  }
+};
+
+/// What the drivers need of a face's cross field, per triangle of its background mesh in the
+/// order of the assembled mesh (triangles collapsed at poles excluded, as in assembly).
+struct CrossFieldOutput {
+  bool ok = false;
+  std::string error;
+  std::vector<std::array<Vec3, 2>> directions;  ///< two unit branches per triangle
+  std::vector<double> u_norm;                   ///< per triangle: mean |U| of its edges
+  std::vector<double> H;                        ///< per triangle: mean conformal scaling H
+  std::vector<crossfield::Singularity> singularities;
+  crossfield::EulerCheck euler;
+  int levels = 0, factorizations = 0, solves = 0;
+  double seconds = 0;
+  /// Every field, once (visit(name, member)): what the ranks exchange (parallel/record.hpp).
+  template <class S, class V>
+  static void fields(S& self, V&& visit) {
+    visit("ok", self.ok);
+    visit("error", self.error);
+    visit("directions", self.directions);
+    visit("u_norm", self.u_norm);
+    visit("H", self.H);
+    visit("singularities", self.singularities);
+    visit("euler", self.euler);
+    visit("levels", self.levels);
+    visit("factorizations", self.factorizations);
+    visit("solves", self.solves);
+    visit("seconds", self.seconds);
+  }
+};
+
+/// The driver's view of a face cross field (see CrossFieldOutput).
+[[nodiscard]] CrossFieldOutput summarize(const crossfield::FaceCrossField& cf);
+
+// --- One face's state through the stages ----------------------------------------------------
+
+/// A valid pattern fill that is not (yet) the face's mesh: refused on quality, or kept by the
+/// thresholds but with a poor mean (qstruct::fill_to_compare). It waits for the face's final
+/// unstructured mesh (compare_refused_fill).
+struct RefusedFill {
+  mesh::FaceMesh mesh;  ///< empty: none
+  std::string pattern;  ///< the pattern's name
+  /// Kept by mesh_face_pattern's thresholds and held back for the comparison (fill_to_compare);
+  /// false: refused by them.
+  bool kept = false;
+};
+
+/// One face of this rank, from its background mesh to its final quad mesh. Each stage reads what
+/// the earlier ones left and writes its own part; the large per-face data (background mesh,
+/// cross field, size map) are released once the unstructured mesh is made (release_fields).
+struct FaceTask {
+  LO face = kNoIndex;
+  mesh::FaceMesh background;  ///< background triangulation (Sec. 3.1)
+  background::FaceReport background_report;
+  CrossFieldOutput field_summary;  ///< when the driver asked for cross fields, or the error met
+  std::unique_ptr<crossfield::FaceCrossField> cross_field;  ///< null: none (or released)
+  sizemap::FaceSizes sizes;                                 ///< at the background vertices
+  /// The cross field's singularities, kept for the cavity remeshing once the field is released.
+  std::vector<crossfield::Singularity> singularities;
+  mesh::FaceMesh quad_mesh;               ///< the face's quad mesh (pattern fill or unstructured)
+  quad::UnstructuredReport unstructured;  ///< of quad_mesh (set from the fill when a pattern)
+  QuasiReport quasi;
+  RefusedFill refused;
+  double seconds = 0;  ///< wall time of the quad stages on this face (s)
+};
+
+/// Background triangulation of task.face (background::mesh_face_background) into task.background
+/// and task.background_report.
+void mesh_background(FaceTask& task, const cad::CadModel& model,
+                     std::span<const mesh::CurveMesh> curves,
+                     const background::BackgroundOptions& options);
+
+/// Cross field of the task's background mesh (paper 000 Sec. 3). `summarize`: the driver wants
+/// task.field_summary; `keep`: later stages need the field (size map, frontal insertion), kept in
+/// task.cross_field (shrunk to what they read when not summarized). A face whose field throws
+/// gets field_summary.error (with stage and face id) and no field: later stages fall back.
+void compute_cross_field(FaceTask& task, const crossfield::CrossFieldOptions& options,
+                         bool summarize, bool keep, linalg::PetscLane* lane);
+
+/// The gathered view of a face: what rank 0 assembles and reports. Every field is exchanged
+/// (fields()); parts of stages that did not run stay empty.
+struct FaceOutput {
+  mesh::FaceMesh mesh;  ///< the final mesh (quad mesh, or background mesh before the quad stages)
+  background::FaceReport report;
+  CrossFieldOutput cross_field;
+  sizemap::FaceSizes sizes;
+  quad::UnstructuredReport unstructured;
+  QuasiReport quasi;
+  mesh::FaceQuadStats stats;  ///< of the quad mesh (quad stages)
+  double seconds = 0;
+  template <class S, class V>
+  static void fields(S& self, V&& visit) {
+    visit("mesh", self.mesh);
+    visit("report", self.report);
+    visit("cross_field", self.cross_field);
+    visit("sizes", self.sizes);
+    visit("unstructured", self.unstructured);
+    visit("quasi", self.quasi);
+    visit("stats", self.stats);
+    visit("seconds", self.seconds);
+  }
+};
+
+/// Moves a finished task's results into its FaceOutput (the quad mesh and its statistics when
+/// `quads`, else the background mesh). The task is left empty.
+[[nodiscard]] FaceOutput take_output(FaceTask&& task, bool quads);
+
+// --- The quasi-structured policy (paper 000 Sec. 6.1), serial, per face ------------------------
+
+/// A pattern fill of one face as mesh_face_fill makes it, wherever it ran; exchanged whole.
+struct PatternFill {
+  qstruct::PatternFaceReport report;  ///< refused_mesh kept only for the comparison
+  mesh::FaceMesh mesh;                ///< the fill when report.ok
+  double seconds = 0;
+  template <class S, class V>
+  static void fields(S& self, V&& visit) {
+    visit("report", self.report);
+    visit("mesh", self.mesh);
+    visit("seconds", self.seconds);
+  }
+};
+
+/// Pattern meshing of face f (qstruct::mesh_face_pattern, Sec. 6.1.2) with at most `max_quads`
+/// quads (0: no bound). The refused candidate is kept only when `keep_refused` (a comparison will
+/// follow) and the fill was refused.
+[[nodiscard]] PatternFill mesh_face_fill(const cad::CadModel& model, LO f,
+                                         std::span<const mesh::CurveMesh> curves,
+                                         std::span<const qstruct::Pattern> patterns,
+                                         const qstruct::PatternFaceOptions& options,
+                                         std::int64_t max_quads, bool keep_refused);
+
+/// What a face does with its pattern fill: a fill the thresholds kept becomes the face's mesh
+/// (quasi.by_pattern), unless its mean is poor (qstruct::fill_to_compare), when it waits in
+/// task.refused (kept) for the unstructured mesh; a refused fill leaves quasi.refusal and, when
+/// valid, waits in task.refused as well. Adds the fill's time to task.seconds.
+void take_fill(FaceTask& task, PatternFill&& fill, const qstruct::PatternFaceOptions& options);
+
+/// The unstructured path left the face without a valid all-quad mesh (failed, triangles left, or
+/// no quads).
+[[nodiscard]] bool no_valid_quads(const FaceTask& task);
+
+/// Whether the face needs a pattern fill but has neither: pattern fills replace the unstructured
+/// mesh only on faces whose fill was refused on the size map's quad bound (`bound`, 0: none):
+///  - a face that the unstructured path could not mesh validly takes the fill whatever its size,
+///    if valid (poor quads beat folded ones): returns 0 (no bound);
+///  - a face whose unstructured mesh has more quads than the bound (the curve counts forced its
+///    size) gets the fills of at most that many quads: returns that count.
+/// Otherwise (a pattern mesh, a fill waiting already, another refusal, or an unstructured mesh
+/// within the bound): nullopt.
+[[nodiscard]] std::optional<std::int64_t> second_fill_bound(const FaceTask& task,
+                                                            std::int64_t bound);
+
+/// Keeps the fill of second_fill_bound for the comparison (its report's refused candidate when
+/// refused and valid). Adds its time to task.seconds.
+void take_second_fill(FaceTask& task, PatternFill&& fill);
+
+/// What compare_refused_fill decided, for the log.
+struct FillComparison {
+  bool compared = false;  ///< a fill was waiting
+  bool kept = false;      ///< it was a kept fill with a poor mean (RefusedFill::kept)
+  /// The face had a valid all-quad unstructured mesh, weighed by qstruct::fill_wins (else any
+  /// valid fill is taken).
+  bool against_unstructured = false;
+  bool fill_taken = false;
+  std::string pattern;
+  mesh::FaceQuadStats fill, unstructured;  ///< unstructured: when against_unstructured
+};
+
+/// The comparison after the topological improvement (PipelineOptions::pattern_compare_tolerance,
+/// qstruct::fill_wins): a waiting fill replaces the face's mesh when the unstructured path left
+/// no valid all-quad mesh, or when fill_wins says so; a kept fill that loses marks
+/// quasi.refusal UnstructuredBetter and quasi.gave_way. The fill then counts as by_pattern
+/// (by_comparison unless it was a kept one). task.refused is emptied either way.
+FillComparison compare_refused_fill(FaceTask& task, double tolerance,
+                                    const qstruct::PatternFaceOptions& options);
+
+/// The faces the unstructured path meshes: those without a pattern mesh (take_fill).
+[[nodiscard]] bool wants_unstructured(const FaceTask& task);
+
+/// The faces the topological improvement works on: meshed by the unstructured path, all quads,
+/// valid.
+[[nodiscard]] bool wants_improvement(const FaceTask& task);
+
+}  // namespace qsmesh::parallel

@@ -1,0 +1,177 @@
+#include "qsmesh/parallel/face_task.hpp"
+
+#include <exception>
+#include <utility>
+
+#include "qsmesh/core/error.hpp"
+#include "qsmesh/core/timer.hpp"
+
+namespace qsmesh::parallel {
+
+CrossFieldOutput summarize(const crossfield::FaceCrossField& cf) {
+  CrossFieldOutput out;
+  out.ok = true;
+  const std::size_t nt = cf.triangles.size();
+  out.directions = cf.directions;
+  out.u_norm.resize(nt);
+  out.H.resize(nt);
+  for (std::size_t t = 0; t < nt; ++t) {
+    double un = 0, h = 0;
+    for (int k = 0; k < 3; ++k) {
+      un += cf.u_norm[cf.tri2edges[t][k]];
+      h += cf.H[cf.triangles[t][k]];
+    }
+    out.u_norm[t] = un / 3;
+    out.H[t] = h / 3;
+  }
+  out.singularities = cf.singularities;
+  out.euler = cf.euler;
+  out.levels = cf.stats.levels;
+  out.factorizations = cf.stats.factorizations;
+  out.solves = cf.stats.solves;
+  out.seconds = cf.stats.seconds;
+  return out;
+}
+
+void mesh_background(FaceTask& task, const cad::CadModel& model,
+                     std::span<const mesh::CurveMesh> curves,
+                     const background::BackgroundOptions& options) {
+  task.background =
+      background::mesh_face_background(model, task.face, curves, options, &task.background_report);
+}
+
+void compute_cross_field(FaceTask& task, const crossfield::CrossFieldOptions& options,
+                         bool summarize_field, bool keep, linalg::PetscLane* lane) {
+  try {
+    auto cf = std::make_unique<crossfield::FaceCrossField>(
+        crossfield::compute_face_cross_field(task.background, options, lane));
+    if (summarize_field)
+      task.field_summary = summarize(*cf);
+    else
+      crossfield::shrink_cross_field(*cf, crossfield::CrossFieldUse::SizeMapAndGuide);
+    if (keep) task.cross_field = std::move(cf);
+  } catch (const std::exception& e) {
+    // A face without a cross field keeps its background mesh; later stages fall back to methods
+    // that need no field.
+    task.field_summary = CrossFieldOutput{};
+    task.field_summary.error = Error(e.what(), ErrorContext{"crossfield", 2, task.face}).what();
+  }
+}
+
+FaceOutput take_output(FaceTask&& task, bool quads) {
+  FaceOutput out;
+  out.mesh = std::move(quads ? task.quad_mesh : task.background);
+  if (quads) out.stats = mesh::face_quad_stats(out.mesh);
+  out.report = std::move(task.background_report);
+  out.cross_field = std::move(task.field_summary);
+  out.sizes = std::move(task.sizes);
+  out.unstructured = std::move(task.unstructured);
+  out.quasi = std::move(task.quasi);
+  out.seconds = task.seconds;
+  task = FaceTask{};
+  return out;
+}
+
+PatternFill mesh_face_fill(const cad::CadModel& model, LO f,
+                           std::span<const mesh::CurveMesh> curves,
+                           std::span<const qstruct::Pattern> patterns,
+                           const qstruct::PatternFaceOptions& options, std::int64_t max_quads,
+                           bool keep_refused) {
+  const Stopwatch clock;
+  PatternFill fill;
+  qstruct::PatternFaceOptions po = options;
+  po.max_quads = max_quads;
+  fill.mesh = qstruct::mesh_face_pattern(model, f, curves, patterns, po, &fill.report);
+  // The refused candidate travels and waits only for a comparison.
+  if (fill.report.ok || !keep_refused) fill.report.refused_mesh = mesh::FaceMesh{};
+  fill.seconds = clock.seconds();
+  return fill;
+}
+
+void take_fill(FaceTask& task, PatternFill&& fill, const qstruct::PatternFaceOptions& options) {
+  qstruct::PatternFaceReport& pr = fill.report;
+  if (pr.ok && qstruct::fill_to_compare(pr.sicn_avg, pr.quads, options)) {
+    task.refused = {std::move(fill.mesh), pr.pattern_name, true};
+  } else if (pr.ok) {
+    task.quasi.by_pattern = true;
+    task.quasi.pattern = pr.pattern_name;
+    task.unstructured.ok = true;
+    task.unstructured.sicn_min = pr.sicn_min;
+    task.unstructured.quads = pr.quads;
+    task.quad_mesh = std::move(fill.mesh);
+  } else {
+    task.quasi.refusal = qstruct::to_string(pr.refusal);
+    if (!pr.refused_mesh.quads.empty())
+      task.refused = {std::move(pr.refused_mesh), pr.pattern_name, false};
+  }
+  task.seconds += fill.seconds;
+}
+
+bool no_valid_quads(const FaceTask& task) {
+  return !task.unstructured.ok || !task.quad_mesh.triangles.empty() || task.quad_mesh.quads.empty();
+}
+
+std::optional<std::int64_t> second_fill_bound(const FaceTask& task, std::int64_t bound) {
+  // Other refusals would give the same answer again.
+  if (task.quasi.by_pattern || !task.refused.mesh.quads.empty() ||
+      task.quasi.refusal != qstruct::to_string(qstruct::Refusal::TooManyQuads))
+    return std::nullopt;
+  if (no_valid_quads(task)) return 0;
+  const auto unstructured_quads = static_cast<std::int64_t>(task.quad_mesh.quads.size());
+  // The bound keeps fills from carrying a size transition across a whole face; here the curve
+  // counts forced the unstructured mesh to that size already.
+  if (bound <= 0 || unstructured_quads <= bound) return std::nullopt;
+  return unstructured_quads;
+}
+
+void take_second_fill(FaceTask& task, PatternFill&& fill) {
+  qstruct::PatternFaceReport& pr = fill.report;
+  if (pr.ok)
+    task.refused = {std::move(fill.mesh), pr.pattern_name, false};
+  else if (!pr.refused_mesh.quads.empty())
+    task.refused = {std::move(pr.refused_mesh), pr.pattern_name, false};
+  task.seconds += fill.seconds;
+}
+
+FillComparison compare_refused_fill(FaceTask& task, double tolerance,
+                                    const qstruct::PatternFaceOptions& options) {
+  FillComparison c;
+  RefusedFill& r = task.refused;
+  if (r.mesh.quads.empty()) return c;
+  c.compared = true;
+  c.kept = r.kept;
+  c.pattern = r.pattern;
+  c.fill = mesh::face_quad_stats(r.mesh);
+  // Where the unstructured path left nothing valid, any valid fill is better.
+  c.fill_taken = no_valid_quads(task);
+  if (!c.fill_taken) {
+    c.against_unstructured = true;
+    c.unstructured = mesh::face_quad_stats(task.quad_mesh);
+    c.fill_taken = qstruct::fill_wins(c.fill, c.unstructured, c.kept, tolerance, options);
+    if (c.kept && !c.fill_taken) {
+      task.quasi.refusal = qstruct::to_string(qstruct::Refusal::UnstructuredBetter);
+      task.quasi.gave_way = true;
+    }
+  }
+  if (c.fill_taken) {
+    task.quad_mesh = std::move(r.mesh);
+    task.unstructured = quad::UnstructuredReport{};
+    task.unstructured.ok = true;
+    task.unstructured.sicn_min = c.fill.sicn_min;
+    task.unstructured.quads = c.fill.quads;
+    task.quasi.by_pattern = true;
+    task.quasi.by_comparison = !c.kept;  // a kept fill passed the thresholds
+    task.quasi.pattern = r.pattern;
+    if (c.kept) task.quasi.refusal.clear();
+  }
+  r = RefusedFill{};
+  return c;
+}
+
+bool wants_unstructured(const FaceTask& task) { return !task.quasi.by_pattern; }
+
+bool wants_improvement(const FaceTask& task) {
+  return !task.quasi.by_pattern && task.unstructured.ok && task.quad_mesh.triangles.empty();
+}
+
+}  // namespace qsmesh::parallel

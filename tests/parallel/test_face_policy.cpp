@@ -1,0 +1,239 @@
+// The per-face policy of the quasi-structured stage (parallel/face_task.hpp): which of a pattern
+// fill and the unstructured mesh a face keeps. Serial; no MPI, no CAD model.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <optional>
+
+#include "qsmesh/mesh/quality.hpp"
+#include "qsmesh/parallel/face_task.hpp"
+
+namespace qsmesh::parallel {
+namespace {
+
+// An n x n grid of unit quads in the plane z = 0, sheared by `shear` (x += shear * y: every quad a
+// parallelogram, SICN below 1 as the shear grows), classified as a face: four corners, four
+// sides, the rest interior.
+mesh::FaceMesh grid(int n, double shear = 0) {
+  mesh::FaceMesh m;
+  m.face = 0;
+  const auto id = [n](int i, int j) { return static_cast<LO>(j * (n + 1) + i); };
+  for (int j = 0; j <= n; ++j)
+    for (int i = 0; i <= n; ++i) {
+      m.points.push_back({i + shear * j, static_cast<double>(j), 0.0});
+      m.uv.push_back({static_cast<double>(i), static_cast<double>(j)});
+      mesh::VertexClass c;
+      const bool side_i = i == 0 || i == n, side_j = j == 0 || j == n;
+      if (side_i && side_j) {
+        c.dim = 0;
+        c.entity = id(i, j);
+      } else if (side_i || side_j) {
+        c.dim = 1;
+        c.entity = side_j ? (j == 0 ? 0 : 2) : (i == 0 ? 3 : 1);
+        c.index = side_j ? i : j;
+      } else {
+        c.dim = 2;
+        c.entity = 0;
+      }
+      m.vclass.push_back(c);
+    }
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i)
+      m.quads.push_back({id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)});
+  return m;
+}
+
+PatternFill kept_fill(double sicn_avg, std::int64_t quads) {
+  PatternFill fill;
+  fill.report.ok = true;
+  fill.report.pattern_name = "grid";
+  fill.report.sicn_min = 0.6;
+  fill.report.sicn_avg = sicn_avg;
+  fill.report.quads = quads;
+  fill.mesh = grid(2);
+  fill.seconds = 0.5;
+  return fill;
+}
+
+// A face whose unstructured path gave a valid all-quad mesh.
+FaceTask unstructured_face(mesh::FaceMesh m) {
+  FaceTask t;
+  t.unstructured.ok = true;
+  t.unstructured.frontal = true;
+  t.quad_mesh = std::move(m);
+  return t;
+}
+
+const qstruct::PatternFaceOptions kOptions;
+
+TEST(FacePolicy, AFillWithAGoodMeanIsTheFacesMesh) {
+  FaceTask t;
+  t.seconds = 1;
+  take_fill(t, kept_fill(0.95, 400), kOptions);
+  EXPECT_TRUE(t.quasi.by_pattern);
+  EXPECT_EQ(t.quasi.pattern, "grid");
+  EXPECT_EQ(t.quasi.pattern_method(), "pattern:grid");
+  EXPECT_TRUE(t.quasi.refusal.empty());
+  EXPECT_TRUE(t.unstructured.ok);
+  EXPECT_EQ(t.unstructured.quads, 400);
+  EXPECT_EQ(t.unstructured.sicn_min, 0.6);
+  EXPECT_EQ(t.quad_mesh.quads.size(), 4U);
+  EXPECT_TRUE(t.refused.mesh.quads.empty());
+  EXPECT_DOUBLE_EQ(t.seconds, 1.5);
+  EXPECT_FALSE(wants_improvement(t));  // a pattern mesh is not improved
+}
+
+TEST(FacePolicy, AKeptFillWithAPoorMeanWaitsForTheUnstructuredMesh) {
+  FaceTask t;
+  take_fill(t, kept_fill(0.7, 400), kOptions);  // fill_to_compare: many quads, mean <= 0.8
+  EXPECT_FALSE(t.quasi.by_pattern);
+  EXPECT_TRUE(t.quad_mesh.quads.empty());
+  EXPECT_EQ(t.refused.mesh.quads.size(), 4U);
+  EXPECT_TRUE(t.refused.kept);
+  EXPECT_EQ(t.refused.pattern, "grid");
+  // A small fill is not held back, whatever its mean.
+  FaceTask small;
+  take_fill(small, kept_fill(0.7, kOptions.small_fill_quads), kOptions);
+  EXPECT_TRUE(small.quasi.by_pattern);
+}
+
+TEST(FacePolicy, ARefusedFillLeavesItsReasonAndWaitsWhenValid) {
+  PatternFill fill;
+  fill.report.refusal = qstruct::Refusal::Quality;
+  fill.report.pattern_name = "transition";
+  fill.report.refused_mesh = grid(3);
+  FaceTask t;
+  take_fill(t, std::move(fill), kOptions);
+  EXPECT_FALSE(t.quasi.by_pattern);
+  EXPECT_EQ(t.quasi.refusal, qstruct::to_string(qstruct::Refusal::Quality));
+  EXPECT_EQ(t.quasi.pattern_refusal(), t.quasi.refusal);
+  EXPECT_EQ(t.refused.mesh.quads.size(), 9U);
+  EXPECT_FALSE(t.refused.kept);
+  EXPECT_EQ(t.refused.pattern, "transition");
+
+  PatternFill none;
+  none.report.refusal = qstruct::Refusal::NoPattern;
+  FaceTask u;
+  take_fill(u, std::move(none), kOptions);
+  EXPECT_EQ(u.quasi.refusal, qstruct::to_string(qstruct::Refusal::NoPattern));
+  EXPECT_TRUE(u.refused.mesh.quads.empty());
+}
+
+TEST(FacePolicy, OnlyFillsRefusedOnTheQuadBoundGetASecondChance) {
+  const std::string over_bound = qstruct::to_string(qstruct::Refusal::TooManyQuads);
+  // Unstructured mesh of 9 quads, bound 4: the curve counts forced more quads than the bound, so
+  // the fills of at most 9 quads are laid out.
+  FaceTask t = unstructured_face(grid(3));
+  t.quasi.refusal = over_bound;
+  EXPECT_EQ(second_fill_bound(t, 4), std::optional<std::int64_t>(9));
+  // Within the bound, or without one: the refusal stands.
+  EXPECT_EQ(second_fill_bound(t, 9), std::nullopt);
+  EXPECT_EQ(second_fill_bound(t, 0), std::nullopt);
+  // No valid all-quad mesh: any valid fill, without a bound.
+  FaceTask failed = unstructured_face(grid(3));
+  failed.quasi.refusal = over_bound;
+  failed.unstructured.ok = false;
+  EXPECT_TRUE(no_valid_quads(failed));
+  EXPECT_EQ(second_fill_bound(failed, 0), std::optional<std::int64_t>(0));
+  failed.unstructured.ok = true;
+  failed.quad_mesh.triangles = {{0, 1, 5}};  // triangles left
+  EXPECT_EQ(second_fill_bound(failed, 100), std::optional<std::int64_t>(0));
+  // Other refusals would give the same answer again; a waiting fill needs no other.
+  FaceTask quality = unstructured_face(grid(3));
+  quality.quasi.refusal = qstruct::to_string(qstruct::Refusal::Quality);
+  EXPECT_EQ(second_fill_bound(quality, 4), std::nullopt);
+  FaceTask waiting = unstructured_face(grid(3));
+  waiting.quasi.refusal = over_bound;
+  waiting.refused.mesh = grid(1);
+  EXPECT_EQ(second_fill_bound(waiting, 4), std::nullopt);
+
+  // The second fill waits for the comparison, refused or not.
+  PatternFill second = kept_fill(0.9, 9);
+  take_second_fill(t, std::move(second));
+  EXPECT_EQ(t.refused.mesh.quads.size(), 4U);
+  EXPECT_FALSE(t.refused.kept);
+}
+
+TEST(FacePolicy, ARefusedFillNoWorseThanTheUnstructuredMeshReplacesIt) {
+  FaceTask t = unstructured_face(grid(3, 0.5));  // sheared: SICN below 1
+  t.quasi.refusal = qstruct::to_string(qstruct::Refusal::Quality);
+  t.refused = {grid(3), "grid", false};
+  const FillComparison c = compare_refused_fill(t, 0.01, kOptions);
+  EXPECT_TRUE(c.compared);
+  EXPECT_TRUE(c.against_unstructured);
+  EXPECT_TRUE(c.fill_taken);
+  EXPECT_TRUE(t.quasi.by_pattern);
+  EXPECT_TRUE(t.quasi.by_comparison);
+  EXPECT_EQ(t.quasi.refusal, qstruct::to_string(qstruct::Refusal::Quality));  // why it waited
+  EXPECT_EQ(t.quasi.pattern, "grid");
+  EXPECT_FALSE(t.unstructured.frontal);  // the report is the fill's now
+  EXPECT_TRUE(t.unstructured.ok);
+  EXPECT_EQ(t.unstructured.quads, 9);
+  EXPECT_NEAR(t.unstructured.sicn_min, 1.0, 1e-12);
+  EXPECT_NEAR(mesh::face_quad_stats(t.quad_mesh).sicn_min, 1.0, 1e-12);
+  EXPECT_TRUE(t.refused.mesh.quads.empty());
+}
+
+TEST(FacePolicy, ARefusedFillWorseThanTheUnstructuredMeshIsDropped) {
+  FaceTask t = unstructured_face(grid(3));
+  t.refused = {grid(3, 0.5), "grid", false};
+  const FillComparison c = compare_refused_fill(t, 0.01, kOptions);
+  EXPECT_TRUE(c.compared);
+  EXPECT_FALSE(c.fill_taken);
+  EXPECT_FALSE(t.quasi.by_pattern);
+  EXPECT_NEAR(mesh::face_quad_stats(t.quad_mesh).sicn_min, 1.0, 1e-12);
+  EXPECT_TRUE(t.refused.mesh.quads.empty());
+  // Without a valid unstructured mesh, the same fill is taken.
+  FaceTask failed = unstructured_face(grid(3));
+  failed.unstructured.ok = false;
+  failed.refused = {grid(3, 0.5), "grid", false};
+  const FillComparison f = compare_refused_fill(failed, 0.01, kOptions);
+  EXPECT_TRUE(f.fill_taken);
+  EXPECT_FALSE(f.against_unstructured);
+  EXPECT_TRUE(failed.quasi.by_pattern);
+  EXPECT_TRUE(failed.unstructured.ok);
+}
+
+TEST(FacePolicy, AKeptFillGivesWayOnlyToAClearlyBetterUnstructuredMesh) {
+  // Shear 1: parallelograms at 45 degrees, SICN about 0.71 against 1 for the unstructured grid.
+  FaceTask t = unstructured_face(grid(3));
+  t.refused = {grid(3, 1.0), "grid", true};
+  const FillComparison c = compare_refused_fill(t, 0.01, kOptions);
+  EXPECT_TRUE(c.compared && c.kept && c.against_unstructured);
+  EXPECT_FALSE(c.fill_taken);
+  EXPECT_FALSE(t.quasi.by_pattern);
+  EXPECT_TRUE(t.quasi.gave_way);
+  EXPECT_EQ(t.quasi.refusal, qstruct::to_string(qstruct::Refusal::UnstructuredBetter));
+  EXPECT_NEAR(mesh::face_quad_stats(t.quad_mesh).sicn_min, 1.0, 1e-12);  // the unstructured one
+
+  // Not clearly better (means within the margin): the kept fill stays the face's mesh, and it
+  // counts as kept by the thresholds, not by the comparison.
+  FaceTask close = unstructured_face(grid(3, 0.2));
+  close.refused = {grid(3, 0.1), "grid", true};
+  const FillComparison k = compare_refused_fill(close, 0.01, kOptions);
+  EXPECT_TRUE(k.fill_taken);
+  EXPECT_TRUE(close.quasi.by_pattern);
+  EXPECT_FALSE(close.quasi.by_comparison);
+  EXPECT_FALSE(close.quasi.gave_way);
+  EXPECT_TRUE(close.quasi.refusal.empty());
+
+  // Nothing waiting: nothing changes.
+  FaceTask plain = unstructured_face(grid(2));
+  const FillComparison n = compare_refused_fill(plain, 0.01, kOptions);
+  EXPECT_FALSE(n.compared);
+  EXPECT_FALSE(plain.quasi.by_pattern);
+  EXPECT_EQ(plain.quad_mesh.quads.size(), 4U);
+}
+
+TEST(FacePolicy, OnlyValidAllQuadUnstructuredFacesAreImproved) {
+  FaceTask t = unstructured_face(grid(2));
+  EXPECT_TRUE(wants_improvement(t));
+  t.quad_mesh.triangles = {{0, 1, 3}};
+  EXPECT_FALSE(wants_improvement(t));
+  FaceTask failed = unstructured_face(grid(2));
+  failed.unstructured.ok = false;
+  EXPECT_FALSE(wants_improvement(failed));
+}
+
+}  // namespace
+}  // namespace qsmesh::parallel
