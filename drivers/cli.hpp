@@ -77,7 +77,7 @@ struct Arguments {
 
 /// Default --field-divisions (background::SizeOptions::field_divisions): docs/benchmarks.md,
 /// "Fields at the geometry's resolution", has the measurements behind it.
-inline constexpr double kDefaultFieldDivisions = 64;
+inline constexpr double kDefaultFieldDivisions = 96;
 
 /// Default --size-factor when neither --size nor --size-factor is given: a medium mesh.
 inline constexpr double kDefaultSizeFactor = 0.02;
