@@ -25,6 +25,7 @@
 #include "qsmesh/io/atomic_file.hpp"
 #include "qsmesh/io/writer.hpp"
 #include "qsmesh/layout/quad_layout.hpp"
+#include "qsmesh/linalg/solver.hpp"
 #include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/mesh/validate.hpp"
 #include "qsmesh/parallel/comm.hpp"
@@ -718,8 +719,12 @@ int run_mesh(const Arguments& args) {
   options.until = until;
   if (until >= parallel::Stage::Unstructured) note_sliver_curves(s, options.sizemap);
   options.cavities.time_budget_s = args.face_time_budget;
+  // A face whose field system is above SolverOptions::petsc_threshold is solved by PETSc; with the
+  // background at the geometry's resolution that takes a face far larger than its neighbours, or
+  // --field-divisions 0 on a large one.
+  linalg::PetscLane lane;
   parallel::PipelineResult result =
-      parallel::run_pipeline(s.comm, s.model, options, *s.tasks, s.log);
+      parallel::run_pipeline(s.comm, s.model, options, *s.tasks, s.log, &lane);
   for (const auto& [stage, sec] : result.times.entries()) s.times.add(stage, sec);
   // Before rank 0 works alone: a collective after its writing would hang the others if it failed.
   std::vector<double> peak_mb(static_cast<std::size_t>(s.ranks), 0.0);
