@@ -277,9 +277,6 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
   // ranks, their union on shared curves by an MPI min-reduction, then quantization (Sec. 4.3)
   // computed identically on every rank.
   std::vector<sizemap::FaceSizes> sizes(size_map ? mine.size() : 0);
-  // The halved curve meshes of the final quantization (paper 000 Sec. 5.2), when the boundary
-  // check already placed them; else the unstructured stage places them.
-  std::vector<mesh::CurveMesh> halved_curves;
   if (size_map) {
     clock.reset();
     const sizemap::SizeMapOptions& so = options.sizemap;
@@ -338,13 +335,16 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     for (int round = 0; round < options.boundary_repair_rounds; ++round) {
       std::vector<std::int64_t> flags(static_cast<std::size_t>(model.num_curves()), 0);
       std::vector<std::vector<LO>> found(mine.size());
+      // The final curve meshes, and the halved boundaries made from them (paper 000 Sec. 5.2).
+      result.quantized_curves =
+          quantize::place_vertices(model, curves, result.curve_sizes.at, result.quantization,
+                                   /*halved=*/false, tasks, options.place);
       for (const bool halved : {true, false}) {
-        std::vector<mesh::CurveMesh> placed =
-            quantize::place_vertices(model, curves, result.curve_sizes.at, result.quantization,
-                                     halved, tasks, options.place);
         tasks.parallel_for(static_cast<std::int64_t>(mine.size()), [&](std::int64_t i) {
           try {
-            const auto c = quantize::crossing_curves(model, mine[i], placed);
+            const auto c =
+                halved ? quantize::crossing_curves_halved(model, mine[i], result.quantized_curves)
+                       : quantize::crossing_curves(model, mine[i], result.quantized_curves);
             found[i].insert(found[i].end(), c.begin(), c.end());
           } catch (const std::exception& e) {
             // The face's own stages report its geometry errors; this check only looks for
@@ -352,7 +352,6 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
             log.debug(Error(e.what(), ErrorContext{"quantize", 2, mine[i]}).what());
           }
         });
-        (halved ? halved_curves : result.quantized_curves) = std::move(placed);
       }
       placed_final = true;
       for (const auto& list : found)
@@ -366,7 +365,6 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
       quantize::refine_curves(result.quantization, flagged, fixed);
       if (result.quantization.total_edges == before) break;  // only fixed curves are involved
       placed_final = false;
-      halved_curves.clear();
       result.curves_refined_for_crossings.push_back(static_cast<LO>(flagged.size()));
       log.info(
           cat("quantize: ", flagged.size(),
@@ -522,11 +520,6 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
   }
   if (quads) {
     clock.reset();
-    const std::vector<mesh::CurveMesh> halved =
-        !halved_curves.empty()
-            ? std::move(halved_curves)
-            : quantize::place_vertices(model, curves, result.curve_sizes.at, result.quantization,
-                                       /*halved=*/true, tasks, options.place);
     quad::UnstructuredOptions qo;
     qo.size = options.background.sizes.size;
     auto mesh_unstructured = [&](std::int64_t i) {
@@ -537,7 +530,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
         face_fields.cross_field = full[i].get();
         face_fields.sizes = sizes[i].s;
       }
-      quad_meshes[i] = quad::mesh_face_unstructured(model, mine[i], halved, result.quantized_curves,
+      quad_meshes[i] = quad::mesh_face_unstructured(model, mine[i], result.quantized_curves,
                                                     face_fields, qo, &quad_reports[i]);
       face_seconds[i] += face_clock.seconds();
     };
