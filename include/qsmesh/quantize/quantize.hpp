@@ -50,8 +50,10 @@ struct QuantizeOptions {
 struct Quantization {
   /// Per curve: the floating number of edges, integral of dl / s (from ideal_edge_counts).
   std::vector<double> ideal;
-  /// Per curve: the final number of edges. Even and >= 2 when options.even (>= 4 on closed curves);
-  /// >= 1 otherwise (>= 3 closed, >= 2 when another curve joins the same two corners).
+  /// Per curve: the final number of edges. When options.even: even and >= 2 (>= 4 on closed
+  /// curves) but for prescriptions and the curves that parity (or odd_slivers) makes odd, and
+  /// every face loop's sum even; >= 1 otherwise (>= 3 closed, >= 2 when another curve joins the
+  /// same two corners).
   /// Degenerate curves (poles): 0; place_vertices keeps their single background edge.
   std::vector<int> edges;
   /// Chord id per curve (0 .. num_chords-1, numbered by increasing smallest curve id), kNoIndex
