@@ -200,6 +200,8 @@ Arguments parse(const std::vector<std::string>& args) {
       a.curvature_edges = *n;
     } else if (opt == "--face-curvature" && sizing) {
       a.face_curvature = true;
+    } else if (opt == "--odd-slivers" && sizing) {
+      a.odd_slivers = true;
     } else if (opt == "--feature-ratio" && sizing) {
       const std::string& v = value();
       const auto r = parse_double(v);
@@ -232,12 +234,6 @@ Arguments parse(const std::vector<std::string>& args) {
         if (v > std::numeric_limits<int>::max())
           throw InputError(opt + ": curve " + std::to_string(id) + ": " + item_text(v) +
                            " edges is more than any mesh can hold");
-        // Refused here, before any work, rather than by the quantization after the cross fields.
-        if (static_cast<long>(v) % 2 != 0)
-          throw InputError(
-              opt + ": curve " + std::to_string(id) + ": " + std::to_string(static_cast<long>(v)) +
-              " edges prescribed, but all-quad meshing by midpoint subdivision needs an even count "
-              "(odd counts are not supported yet)");
         a.curve_edges.emplace_back(id, static_cast<int>(v));
       }
     } else if (opt == "--face-quads" && sizing)
@@ -278,7 +274,7 @@ Arguments parse(const std::vector<std::string>& args) {
                             a.curvature_edges || a.face_curvature || a.feature_ratio ||
                             a.size_min || a.size_min_ratio || !a.curve_edges.empty() ||
                             !a.face_quads.empty() || !a.corner_sizes.empty() ||
-                            !a.curve_sizes.empty() || !a.face_sizes.empty();
+                            !a.curve_sizes.empty() || !a.face_sizes.empty() || a.odd_slivers;
   if (a.command == Command::Mesh && sizing_given && a.until == "background")
     throw InputError(
         "size-map options act on the quad mesh: with --until background only --size or "
@@ -378,8 +374,9 @@ std::string help(const std::string& topic) {
           "                        paper 002 Sec. III.A), joined by 1-to-1 connectivity; faces\n"
           "                        that do not split into blocks go to one unstructured zone\n"
           "  --quads N, --curvature-edges N, --face-curvature, --feature-ratio R, --size-min H,\n"
-          "  --size-min-ratio R, --sizing RULES, --curve-edges C:N,.., --face-quads F:N,..,\n"
-          "  --corner-size K:H,.., --curve-size C:H,.., --face-size F:H,.., --sizemap METHOD\n"
+          "  --size-min-ratio R, --sizing RULES, --curve-edges C:N,.., --odd-slivers,\n"
+          "  --face-quads F:N,.., --corner-size K:H,.., --curve-size C:H,.., --face-size F:H,..,\n"
+          "  --sizemap METHOD\n"
           "                        size-map controls, as for sizemap (see qsmesh sizemap --help);\n"
           "                        they act on the quad mesh, not with --until background\n"
           "  --field-divisions N   the background triangulation, on which the cross fields and "
@@ -477,7 +474,11 @@ std::string help(const std::string& topic) {
           "                        flat. paper: paper 000 Sec. 4.1, a sliver curve refines the\n"
           "                        mesh around it down to its length, with curvature sizes of\n"
           "                        16 edges per turn and the floor the size cap / 100\n"
-          "  --curve-edges C:N,..  prescribe the (even) number of edges of curves; kept exactly\n"
+          "  --curve-edges C:N,..  prescribe the number of edges of curves, kept exactly (odd\n"
+          "                        too: each face loop must stay even; refused when none can)\n"
+          "  --odd-slivers         a curve nearer 1 edge than 2 (its size map's count below\n"
+          "                        sqrt 2) takes 1 edge, the loops kept even by other curves;\n"
+          "                        off by default (measured: docs/benchmarks.md)\n"
           "  --face-quads F:N,..   prescribe the number of quads of faces\n"
           "  --corner-size K:H,.., --curve-size C:H,.., --face-size F:H,..\n"
           "                        size constraints at corners, on curves, on faces (model units)\n"

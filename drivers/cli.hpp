@@ -49,6 +49,8 @@ struct Arguments {
   /// --face-curvature: the curvature sizes also from the faces' principal curvatures
   /// (sizemap::SizeMapOptions::face_curvature).
   bool face_curvature = false;
+  /// --odd-slivers: curves nearer 1 edge than 2 take 1 (quantize::QuantizeOptions::odd_slivers).
+  bool odd_slivers = false;
   /// --feature-ratio R: how far small features refine (sizemap::SizeMapOptions::feature_ratio;
   /// unset: its default).
   std::optional<double> feature_ratio;

@@ -30,6 +30,7 @@
 #include "qsmesh/mesh/validate.hpp"
 #include "qsmesh/parallel/comm.hpp"
 #include "qsmesh/parallel/pipeline.hpp"
+#include "qsmesh/quantize/quantize.hpp"
 #include "qsmesh/sizemap/size_map.hpp"
 #include "report_totals.hpp"
 
@@ -655,6 +656,10 @@ void apply_size_options(const Arguments& args, const Session& s,
   for (const auto& [id, v] : args.curve_sizes) so.curve_sizes.emplace_back(id, v);
   for (const auto& [id, v] : args.face_sizes) so.face_sizes.emplace_back(id, v);
   for (const auto& [id, n] : args.curve_edges) options.quantize.prescribed.emplace_back(id, n);
+  options.quantize.odd_slivers = args.odd_slivers;
+  // Odd counts are fine as long as every face loop can stay even (midpoint subdivision): what
+  // no choice of the other curves allows is refused now, naming the loop, not after the sizes.
+  quantize::check_prescription_parity(s.model, options.quantize.prescribed);
 }
 
 namespace {

@@ -1,5 +1,9 @@
 #include "qsmesh/background/face_mesh.hpp"
 
+#include <array>
+#include <cmath>
+#include <numbers>
+
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/core/timer.hpp"
 
@@ -45,9 +49,91 @@ std::vector<mesh::BoundaryLoop> face_boundary(const cad::CadModel& model, LO f,
   return loops;
 }
 
-mesh::FaceMesh mesh_face_background(const cad::CadModel& model, LO f,
-                                    std::span<const mesh::CurveMesh> curves,
-                                    const BackgroundOptions& options, FaceReport* report) {
+HalvedBoundary halved_face_boundary(const cad::CadModel& model, LO f,
+                                    const cad::FaceGeometry& surface,
+                                    std::span<const mesh::CurveMesh> full) {
+  const cad::Face& face = model.faces()[f];
+  const std::vector<mesh::BoundaryLoop> loops = face_boundary(model, f, surface, full);
+  HalvedBoundary out;
+  for (LO l = 0; l < static_cast<LO>(loops.size()); ++l) {
+    // The full loop with a third copy of each pole on its degenerate curve, as subdivision makes
+    // it: one entry per full vertex, with the curve use of the edge leaving it.
+    struct Full {
+      mesh::BoundaryPoint p;
+      LO use = kNoIndex;
+      bool degenerate = false;  // the edge leaving this vertex lies on a degenerate curve
+      bool pole = false;        // the first image of a pole (a degenerate curve starts here)
+    };
+    std::vector<Full> F;
+    const auto& uses = face.loops[l].uses;
+    const auto& pts = loops[l].points;
+    std::size_t k = 0;
+    for (LO u = 0; u < static_cast<LO>(uses.size()); ++u) {
+      const LO n = full[uses[u].curve].num_edges();
+      const bool deg = model.curves()[uses[u].curve].degenerate;
+      for (LO e = 0; e < n && k < pts.size(); ++e, ++k) {
+        F.push_back({pts[k], u, deg, deg && e == 0});
+        if (deg) {
+          // The copy between the two images; its uv is set once the next image is known.
+          F.push_back({pts[k], u, true, false});
+          F.back().p.uv = Vec2{std::nan(""), std::nan("")};
+        }
+      }
+    }
+    const auto N = static_cast<LO>(F.size());
+    for (LO i = 0; i < N; ++i)
+      if (std::isnan(F[i].p.uv.u)) F[i].p.uv = 0.5 * (F[i - 1].p.uv + F[(i + 1) % N].p.uv);
+    QSMESH_CHECK(N % 2 == 0, "face " << f << ", loop " << l << ": " << N
+                                     << " boundary edges; midpoint subdivision needs an even loop");
+    // Cost of leaving a corner at a midpoint, for each offset.
+    std::array<double, 2> cost{0, 0};
+    std::array<bool, 2> allowed{true, true};
+    for (LO i = 0; i < N; ++i) {
+      if (F[i].p.vclass.dim != 0) continue;
+      const int odd_offset = (i % 2 == 0) ? 1 : 0;  // the offset that leaves vertex i a midpoint
+      if (F[i].pole || (i > 0 && F[i - 1].degenerate) || (i == 0 && F[N - 1].degenerate)) {
+        // A pole image (or the copy between them): its degenerate curve must be one segment.
+        if (F[i].pole) allowed[odd_offset] = false;
+        continue;
+      }
+      const Vec3 a = F[(i + N - 1) % N].p.xyz - F[i].p.xyz;
+      const Vec3 b = F[(i + 1) % N].p.xyz - F[i].p.xyz;
+      const double angle = std::atan2(norm(cross(a, b)), dot(a, b));
+      cost[odd_offset] += std::abs(angle / (0.5 * std::numbers::pi) - 2.0);
+    }
+    QSMESH_CHECK(allowed[0] || allowed[1],
+                 "face " << f << ", loop " << l
+                         << ": its poles are an odd number of edges apart; midpoint subdivision "
+                            "cannot keep every pole on a vertex");
+    const int offset = !allowed[0] ? 1 : !allowed[1] ? 0 : (cost[1] < cost[0] ? 1 : 0);
+    mesh::BoundaryLoop halved;
+    std::vector<HalvedSegment> segments;
+    for (LO h = 0; h < N / 2; ++h) {
+      const LO i = offset + 2 * h;
+      const Full& a = F[i];
+      const Full& m = F[(i + 1) % N];
+      halved.points.push_back(a.p);
+      halved.degenerate.push_back(a.degenerate && m.degenerate ? 1 : 0);
+      HalvedSegment s;
+      s.mid = m.p;
+      s.forward = !uses[m.use].reversed;
+      s.curve_before = uses[a.use].curve;
+      s.curve_after = uses[m.use].curve;
+      segments.push_back(s);
+    }
+    out.loops.push_back(std::move(halved));
+    out.segments.push_back(std::move(segments));
+    out.offsets.push_back(offset);
+  }
+  return out;
+}
+
+namespace {
+
+mesh::FaceMesh mesh_face_background_impl(const cad::CadModel& model, LO f,
+                                         std::span<const mesh::CurveMesh> curves,
+                                         const std::span<const mesh::BoundaryLoop>* given,
+                                         const BackgroundOptions& options, FaceReport* report) {
   const Stopwatch clock;
   FaceReport local;
   FaceReport& rep = report != nullptr ? *report : local;
@@ -58,7 +144,9 @@ mesh::FaceMesh mesh_face_background(const cad::CadModel& model, LO f,
   out.face = f;
   try {
     const auto surface = model.face_geometry(f);
-    const auto loops = face_boundary(model, f, *surface, curves);
+    const std::vector<mesh::BoundaryLoop> loops =
+        given != nullptr ? std::vector<mesh::BoundaryLoop>(given->begin(), given->end())
+                         : face_boundary(model, f, *surface, curves);
     std::vector<Vec3> bpoints;
     std::vector<double> bsizes;
     for (const auto& loop : loops) {
@@ -109,6 +197,20 @@ mesh::FaceMesh mesh_face_background(const cad::CadModel& model, LO f,
   }
   rep.seconds = clock.seconds();
   return out;
+}
+
+}  // namespace
+
+mesh::FaceMesh mesh_face_background(const cad::CadModel& model, LO f,
+                                    std::span<const mesh::CurveMesh> curves,
+                                    const BackgroundOptions& options, FaceReport* report) {
+  return mesh_face_background_impl(model, f, curves, nullptr, options, report);
+}
+
+mesh::FaceMesh mesh_face_background(const cad::CadModel& model, LO f,
+                                    std::span<const mesh::BoundaryLoop> loops,
+                                    const BackgroundOptions& options, FaceReport* report) {
+  return mesh_face_background_impl(model, f, {}, &loops, options, report);
 }
 
 }  // namespace qsmesh::background

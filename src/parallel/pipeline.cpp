@@ -130,9 +130,9 @@ sizemap::CurveSizes size_map_stage(const Context& cx, std::span<const mesh::Curv
 
 // Quantization (paper 000 Sec. 4.3), balanced against the patterns and repaired where a face
 // boundary crosses itself, computed identically on every rank: fills result.quantization,
-// balance, curves_refined_for_crossings and quantized_curves. Returns the halved curve meshes of
-// the final quantization when the boundary check placed them (else empty).
-std::vector<mesh::CurveMesh> quantize_stage(const Context& cx,
+// balance, curves_refined_for_crossings and quantized_curves (the final curve meshes; each face
+// halves its own loops from them, background::halved_face_boundary).
+void quantize_stage(const Context& cx,
                                             std::span<const mesh::CurveMesh> curves,
                                             const std::vector<FaceTask>& faces,
                                             PipelineResult& result) {
@@ -158,19 +158,21 @@ std::vector<mesh::CurveMesh> quantize_stage(const Context& cx,
   // Boundary repair: a face whose boundary crosses itself in its parameter plane cannot be
   // triangulated. Each rank checks its own faces; the flags are summed, so every rank refines
   // the same curves and keeps the same quantization.
-  std::vector<mesh::CurveMesh> halved_curves;
   bool placed_final = false;  // result.quantized_curves holds the final quantization's meshes
   for (int round = 0; round < options.boundary_repair_rounds; ++round) {
     std::vector<std::int64_t> flags(static_cast<std::size_t>(model.num_curves()), 0);
     std::vector<std::vector<LO>> found(faces.size());
+    // The final curve meshes, and the halved boundaries made from them (paper 000 Sec. 5.2).
+    result.quantized_curves =
+        quantize::place_vertices(model, curves, result.curve_sizes.at, result.quantization,
+                                 /*halved=*/false, cx.tasks, options.place);
     for (const bool halved : {true, false}) {
-      std::vector<mesh::CurveMesh> placed =
-          quantize::place_vertices(model, curves, result.curve_sizes.at, result.quantization,
-                                   halved, cx.tasks, options.place);
       cx.tasks.parallel_for(static_cast<std::int64_t>(faces.size()), [&](std::int64_t i) {
         const LO f = faces[static_cast<std::size_t>(i)].face;
         try {
-          const auto c = quantize::crossing_curves(model, f, placed);
+          const auto c =
+              halved ? quantize::crossing_curves_halved(model, f, result.quantized_curves)
+                     : quantize::crossing_curves(model, f, result.quantized_curves);
           found[i].insert(found[i].end(), c.begin(), c.end());
         } catch (const std::exception& e) {
           // The face's own stages report its geometry errors; this check only looks for
@@ -178,7 +180,6 @@ std::vector<mesh::CurveMesh> quantize_stage(const Context& cx,
           cx.log.debug(Error(e.what(), ErrorContext{"quantize", 2, f}).what());
         }
       });
-      (halved ? halved_curves : result.quantized_curves) = std::move(placed);
     }
     placed_final = true;
     for (const auto& list : found)
@@ -192,7 +193,6 @@ std::vector<mesh::CurveMesh> quantize_stage(const Context& cx,
     quantize::refine_curves(result.quantization, flagged, fixed);
     if (result.quantization.total_edges == before) break;  // only fixed curves are involved
     placed_final = false;
-    halved_curves.clear();
     result.curves_refined_for_crossings.push_back(static_cast<LO>(flagged.size()));
     cx.log.info(
         cat("quantize: ", flagged.size(),
@@ -204,7 +204,6 @@ std::vector<mesh::CurveMesh> quantize_stage(const Context& cx,
                                  /*halved=*/false, cx.tasks, options.place);
   cx.log.info(cat("quantize: ", model.num_curves(), " curves, ", result.quantization.num_chords,
                   " chords, ", result.quantization.total_edges, " edges"));
-  return halved_curves;
 }
 
 // Simple CAD faces meshed directly by a pattern (paper 000 Sec. 6.1.2, pipeline step 4); the
@@ -280,7 +279,6 @@ std::vector<std::int64_t> pattern_stage(const Context& cx, std::vector<FaceTask>
 // (Block.stp at its reference count, one rank: peak heap 131 -> 101 MB, and 74 MB with
 // crossfield::shrink_cross_field; docs/benchmarks.md).
 void unstructured_stage(const Context& cx, std::vector<FaceTask>& faces,
-                        std::span<const mesh::CurveMesh> halved,
                         std::span<const mesh::CurveMesh> full, bool keep_singularities) {
   quad::UnstructuredOptions qo;
   qo.size = cx.options.background.sizes.size;
@@ -293,8 +291,8 @@ void unstructured_stage(const Context& cx, std::vector<FaceTask>& faces,
         face_fields.cross_field = t.cross_field.get();
         face_fields.sizes = t.sizes.s;
       }
-      t.quad_mesh = quad::mesh_face_unstructured(cx.model, t.face, halved, full, face_fields, qo,
-                                                 &t.unstructured);
+      t.quad_mesh =
+          quad::mesh_face_unstructured(cx.model, t.face, full, face_fields, qo, &t.unstructured);
       t.seconds += face_clock.seconds();
     }
     if (t.cross_field != nullptr && keep_singularities)
@@ -492,15 +490,12 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     clock.end("crossfield", true);
   }
 
-  // The halved curve meshes of the final quantization (paper 000 Sec. 5.2), when the boundary
-  // check already placed them; else the unstructured stage places them.
-  std::vector<mesh::CurveMesh> halved_curves;
   if (size_map) {
     clock.start();
     result.curve_sizes = size_map_stage(cx, curves, faces, cf_sizes);
     clock.end("sizemap", true);
     clock.start();
-    halved_curves = quantize_stage(cx, curves, faces, result);
+    quantize_stage(cx, curves, faces, result);
     clock.end("quantize", false);
   }
 
@@ -515,12 +510,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
   }
   if (quads) {
     clock.start();
-    const std::vector<mesh::CurveMesh> halved =
-        !halved_curves.empty()
-            ? std::move(halved_curves)
-            : quantize::place_vertices(model, curves, result.curve_sizes.at, result.quantization,
-                                       /*halved=*/true, tasks, options.place);
-    unstructured_stage(cx, faces, halved, result.quantized_curves, quasi);
+    unstructured_stage(cx, faces, result.quantized_curves, quasi);
     clock.end("unstructured", true);
   }
   if (quasi) {

@@ -128,7 +128,7 @@ std::vector<int> balance_curve_counts(const cad::CadModel& model,
   rep.grids_before = count_grids();
 
   const auto allowed = [&](LO c, int n) {
-    const int lo = cads[c].corners[0] == cads[c].corners[1] ? 4 : 2;
+    const int lo = (cads[c].corners[0] == cads[c].corners[1] ? 4 : 2) - edges[c] % 2;
     if (n < lo) return false;
     const double ideal = q.ideal[c];
     const double now = std::abs(edges[c] - ideal), next = std::abs(n - ideal);
@@ -201,8 +201,9 @@ std::vector<int> balance_curve_counts(const cad::CadModel& model,
       const auto n = side_counts(t, edges);
       // Candidate moves: (variable, delta) pairs that shrink the failing differences.
       std::vector<std::pair<LO, int>> moves;
+      // Only even moves: an odd one would make the loops of the moved curves odd.
       const auto add = [&](int side, int delta) {
-        if (delta == 0) return;
+        if (delta == 0 || delta % 2 != 0) return;
         for (const LO v : side_vars(t, side)) moves.emplace_back(v, delta);
       };
       if (t.num_sides == 4) {
@@ -261,7 +262,7 @@ std::vector<int> balance_curve_counts(const cad::CadModel& model,
       double best_rel = 0;
       for (int a = 0; a < 2; ++a) {
         const int d = n[a] - n[a + 2];
-        if (d == 0) continue;
+        if (d == 0 || d % 2 != 0) continue;
         const std::array<std::pair<int, int>, 2> side_moves{{{a, -d}, {a + 2, d}}};
         for (const auto& [side, delta] : side_moves)
           for (const LO var : side_vars(t, side)) {

@@ -50,14 +50,30 @@ std::uint64_t edge_key(LO a, LO b) {
 // where a smooth curve is about twice as flat as here, and no smoothing can open it: its corners
 // on the curve do not move.
 double flat_fixed_corner(const mesh::FaceMesh& m, const std::array<LO, 4>& q,
-                         const std::unordered_set<std::uint64_t>& fixed) {
+                         const std::unordered_set<std::uint64_t>& fixed,
+                         const std::map<std::pair<LO, LO>, Vec3>* corner_mids) {
+  // Where subdivision puts a corner at the middle of a boundary edge (odd counts), the sub-quad
+  // runs to that corner instead.
+  const auto toward = [&](LO v, LO w) -> Vec3 {
+    if (corner_mids != nullptr) {
+      const auto it = corner_mids->find(std::minmax(v, w));
+      if (it != corner_mids->end()) return it->second;
+    }
+    return m.points[w];
+  };
   double worst = 0;
   for (int k = 0; k < 4; ++k) {
     const LO v = q[k], prev = q[(k + 3) % 4], next = q[(k + 1) % 4];
     if (m.vclass[v].dim > 1 || !fixed.contains(edge_key(prev, v)) ||
         !fixed.contains(edge_key(v, next)))
       continue;
-    const Vec3 a = m.points[prev] - m.points[v], b = m.points[next] - m.points[v];
+    // A curve vertex beside a corner at a midpoint is flat (its sub-quad runs along its smooth
+    // curve both ways), however the halved mesh turns there.
+    if (corner_mids != nullptr && m.vclass[v].dim == 1 &&
+        (corner_mids->contains(std::minmax(prev, v)) ||
+         corner_mids->contains(std::minmax(v, next))))
+      return std::numbers::pi;
+    const Vec3 a = toward(v, prev) - m.points[v], b = toward(v, next) - m.points[v];
     worst = std::max(worst, std::atan2(norm(cross(a, b)), dot(a, b)));
   }
   return worst;
@@ -128,7 +144,8 @@ void augment(const std::vector<Candidate>& candidates, const RecombineOptions& o
 
 mesh::FaceMesh recombine(const mesh::FaceMesh& mesh,
                          std::span<const std::array<Vec3, 2>> directions,
-                         const RecombineOptions& options, RecombineStats* stats) {
+                         const RecombineOptions& options, RecombineStats* stats,
+                         const std::map<std::pair<LO, LO>, Vec3>* corner_mids) {
   const auto nt = static_cast<LO>(mesh.triangles.size());
   QSMESH_CHECK(directions.empty() || directions.size() == mesh.triangles.size(),
                "face " << mesh.face << ": " << directions.size() << " cross directions for " << nt
@@ -148,8 +165,9 @@ mesh::FaceMesh recombine(const mesh::FaceMesh& mesh,
   const auto on_curve = [&](LO a, LO b) {
     const auto& ca = mesh.vclass[a];
     const auto& cb = mesh.vclass[b];
+    // Halved meshes carry full-mesh indices: consecutive halved vertices of a curve are 2 apart.
     return ca.dim == 1 && cb.dim == 1 && ca.entity == cb.entity &&
-           std::abs(ca.index - cb.index) == 1;
+           (std::abs(ca.index - cb.index) == 1 || std::abs(ca.index - cb.index) == 2);
   };
   // Edges that stay where they are: the face boundary (one triangle) and curves inside the face.
   std::unordered_set<std::uint64_t> fixed;
@@ -178,7 +196,7 @@ mesh::FaceMesh recombine(const mesh::FaceMesh& mesh,
       // An edge along a CAD curve inside the face (both ends consecutive on one curve) stays.
       const std::array<LO, 4> q{a, d, b, c};
       if (opposite && !on_curve(a, b) && c != d &&
-          !(flat_fixed_corner(mesh, q, fixed) > max_flat)) {
+          !(flat_fixed_corner(mesh, q, fixed, corner_mids) > max_flat)) {
         const double sicn = mesh::quad_sicn(
             {mesh.points[q[0]], mesh.points[q[1]], mesh.points[q[2]], mesh.points[q[3]]});
         if (sicn > options.min_sicn) {

@@ -23,107 +23,70 @@ struct EdgeUse {
   }
 };
 
-// Where a boundary edge lies: curve `curve`, between its halved vertices i and i+1.
-struct CurveSpot {
-  LO curve = kNoIndex;
-  LO i = kNoIndex;
-  bool a_first = true;  // vertex a is halved vertex i
+// What lies at the middle of a boundary edge of the halved mesh: segment `k` of loop `loop` of
+// the halved boundary, and whether vertex a of the edge is the segment's first end.
+struct Spot {
+  LO loop = kNoIndex;
+  LO k = kNoIndex;
+  bool a_first = true;
 };
+
+// Boundary vertices are known by their classification: a corner by its id, a curve vertex by its
+// curve and index in the full curve mesh.
+using Key = std::tuple<int, LO, LO>;
+Key key_of(const mesh::VertexClass& vc) {
+  return {vc.dim, vc.entity, vc.dim == 0 ? kNoIndex : vc.index};
+}
 
 class BoundaryResolver {
  public:
-  BoundaryResolver(const mesh::FaceMesh& m, std::span<const mesh::CurveMesh> curves)
-      : m_(m), curves_(curves) {}
-
-  // Resolves boundary edge (a, b); returns false for an edge of a degenerate curve (two copies of
-  // one corner at the same point).
-  bool resolve(LO a, LO b, CurveSpot* spot) const {
-    const auto& ca = m_.vclass[a];
-    const auto& cb = m_.vclass[b];
-    const Vec3 mid = 0.5 * (m_.points[a] + m_.points[b]);
-    QSMESH_CHECK(ca.dim <= 1 && cb.dim <= 1, "face " << m_.face << ": boundary edge " << a << "-"
-                                                     << b << " has a vertex inside the face");
-    if (ca.dim == 1 && cb.dim == 1) {
-      QSMESH_CHECK(ca.entity == cb.entity && std::abs(ca.index - cb.index) == 1,
-                   "face " << m_.face << ": boundary edge " << a << "-" << b
-                           << " joins two curves or non-consecutive curve vertices");
-      const LO c = ca.entity;
-      check_curve(c);
-      *spot = {c, std::min(ca.index, cb.index), ca.index < cb.index};
-      return true;
+  BoundaryResolver(const mesh::FaceMesh& m, const background::HalvedBoundary& boundary)
+      : m_(m), b_(boundary) {
+    for (LO l = 0; l < static_cast<LO>(b_.loops.size()); ++l) {
+      const auto& pts = b_.loops[l].points;
+      const auto n = static_cast<LO>(pts.size());
+      for (LO k = 0; k < n; ++k)
+        by_ends_[std::minmax(key_of(pts[k].vclass), key_of(pts[(k + 1) % n].vclass))].push_back(
+            {l, k, true});
     }
-    if (ca.dim == 1 || cb.dim == 1) {
-      const bool a_curve = ca.dim == 1;
-      const auto& cv = a_curve ? ca : cb;
-      const LO c = cv.entity;
-      check_curve(c);
-      const LO n = curves_[c].num_edges() / 2;
-      // The corner is halved vertex 0 (edge 0) or n (edge n-1); a curve of 2 halved edges that
-      // closes on one corner allows both: the nearer full midpoint decides.
-      CurveSpot best;
-      double best_d = std::numeric_limits<double>::infinity();
-      if (cv.index == 1) consider(c, 0, /*curve vertex first=*/false, a_curve, mid, &best, &best_d);
-      if (cv.index == n - 1) consider(c, n - 1, true, a_curve, mid, &best, &best_d);
-      QSMESH_CHECK(best.curve != kNoIndex, "face " << m_.face << ": boundary edge " << a << "-" << b
-                                                   << " from a corner to vertex " << cv.index
-                                                   << " of curve " << c << " (" << n
-                                                   << " halved edges)");
-      *spot = best;
-      return true;
-    }
-    // Two corners.
-    const Vec3& pa = m_.points[a];
-    const Vec3& pb = m_.points[b];
-    if (ca.entity == cb.entity) {
-      const double scale = std::max({std::abs(pa.x), std::abs(pa.y), std::abs(pa.z), 1.0});
-      if (distance(pa, pb) <= 1e-12 * scale) return false;
-    }
-    double best_d = std::numeric_limits<double>::infinity();
-    CurveSpot best;
-    for (std::size_t c = 0; c < curves_.size(); ++c) {
-      const auto& cm = curves_[c];
-      if (cm.num_edges() != 2) continue;
-      const Vec3& s = cm.points.front();
-      const Vec3& e = cm.points.back();
-      const double tol = 1e-9 * std::max(distance(s, e), distance(s, cm.points[1]));
-      const bool forward = distance(s, pa) <= tol && distance(e, pb) <= tol;
-      const bool backward = distance(s, pb) <= tol && distance(e, pa) <= tol;
-      if (!forward && !backward) continue;
-      const double d = distance(cm.points[1], mid);
-      if (d < best_d) {
-        best_d = d;
-        best = {static_cast<LO>(c), 0, forward};
-      }
-    }
-    QSMESH_CHECK(best.curve != kNoIndex, "face " << m_.face
-                                                 << ": no curve of one halved edge joins corners "
-                                                 << ca.entity << " and " << cb.entity);
-    *spot = best;
-    return true;
   }
 
-  void check_curve(LO c) const {
-    QSMESH_CHECK(c >= 0 && static_cast<std::size_t>(c) < curves_.size(),
-                 "face " << m_.face << ": curve " << c << " has no full mesh");
-    QSMESH_CHECK(curves_[c].num_edges() >= 2 && curves_[c].num_edges() % 2 == 0,
-                 "face " << m_.face << ": full mesh of curve " << c << " has "
-                         << curves_[c].num_edges() << " edges (an even count >= 2 is needed)");
+  // The halved segment under boundary edge (a, b). Where several segments join vertices of the
+  // same classification (the two banks of a seam, two curves of two halved edges joining the
+  // same corners) the one nearest in (u, v) is taken.
+  Spot resolve(LO a, LO b) const {
+    const auto& ca = m_.vclass[a];
+    const auto& cb = m_.vclass[b];
+    QSMESH_CHECK(ca.dim <= 1 && cb.dim <= 1, "face " << m_.face << ": boundary edge " << a << "-"
+                                                     << b << " has a vertex inside the face");
+    const auto it = by_ends_.find(std::minmax(key_of(ca), key_of(cb)));
+    QSMESH_CHECK(it != by_ends_.end(), "face " << m_.face << ": boundary edge " << a << "-" << b
+                                               << " is no segment of the halved boundary");
+    Spot best;
+    double best_d = std::numeric_limits<double>::infinity();
+    for (const Spot& s : it->second) {
+      const auto& pts = b_.loops[s.loop].points;
+      const Vec2& p = pts[s.k].uv;
+      const Vec2& q = pts[(s.k + 1) % pts.size()].uv;
+      const double fwd = norm(m_.uv[a] - p) + norm(m_.uv[b] - q);
+      const double bwd = norm(m_.uv[a] - q) + norm(m_.uv[b] - p);
+      const bool same_keys = key_of(ca) == key_of(cb);
+      // The classification decides the direction unless both ends have the same one.
+      const bool a_first = same_keys ? fwd <= bwd : key_of(ca) == key_of(pts[s.k].vclass);
+      const double d = a_first ? fwd : bwd;
+      if (d < best_d) {
+        best_d = d;
+        best = {s.loop, s.k, a_first};
+      }
+    }
+    return best;
   }
 
  private:
-  void consider(LO c, LO i, bool curve_vertex_first, bool a_curve, const Vec3& mid, CurveSpot* best,
-                double* best_d) const {
-    const double d = distance(curves_[c].points[2 * i + 1], mid);
-    if (d < *best_d) {
-      *best_d = d;
-      *best = {c, i, curve_vertex_first == a_curve};
-    }
-  }
-
   const mesh::FaceMesh& m_;
-  std::span<const mesh::CurveMesh> curves_;
+  const background::HalvedBoundary& b_;
+  std::map<std::pair<Key, Key>, std::vector<Spot>> by_ends_;
 };
-
 
 // A boundary vertex X whose only element is a triangle (A, X, B) with both XA and XB on the
 // boundary keeps a single sub-quad after subdivision, with the boundary's angle at X: about 180
@@ -140,8 +103,15 @@ double uv_area(const mesh::FaceMesh& m, LO a, LO b, LO c) {
   return cross(m.uv[b] - m.uv[a], m.uv[c] - m.uv[a]);
 }
 
-std::int64_t refan_flat_boundary_strips(const mesh::FaceMesh& m, const std::vector<std::array<LO, 4>>& quads,
-                                        std::vector<std::array<LO, 3>>& tris) {
+std::int64_t refan_flat_boundary_strips(const mesh::FaceMesh& m,
+                                        const std::vector<std::array<LO, 4>>& quads,
+                                        std::vector<std::array<LO, 3>>& tris,
+                                        const std::map<std::pair<LO, LO>, Vec3>& corner_mids) {
+  // The sub-quad at X runs to the corner that subdivision puts at the middle of XA (odd counts).
+  const auto toward = [&](LO x, LO a) -> Vec3 {
+    const auto it = corner_mids.find(std::minmax(x, a));
+    return it != corner_mids.end() ? it->second : m.points[a];
+  };
   using Edge = std::pair<LO, LO>;
   std::map<Edge, int> uses;  // over all elements
   for (const auto& q : quads)
@@ -162,8 +132,14 @@ std::int64_t refan_flat_boundary_strips(const mesh::FaceMesh& m, const std::vect
       const auto& t = tris[t0];
       const LO a = t[k], x = t[(k + 1) % 3], b = t[(k + 2) % 3];
       if (m.vclass[x].dim > 1 || !boundary(a, x) || !boundary(x, b)) continue;
-      const Vec3 xa = m.points[a] - m.points[x], xb = m.points[b] - m.points[x];
-      if (std::atan2(norm(cross(xa, xb)), dot(xa, xb)) < kFlatBoundaryAngle) continue;
+      const Vec3 xa = toward(x, a) - m.points[x], xb = toward(x, b) - m.points[x];
+      // A curve vertex beside a corner at a midpoint is flat whatever the halved mesh shows: its
+      // sub-quad runs along its smooth curve to the corner on one side, to the next full vertex
+      // on the other.
+      const bool beside_corner = m.vclass[x].dim == 1 && (corner_mids.contains(std::minmax(x, a)) ||
+                                                          corner_mids.contains(std::minmax(x, b)));
+      if (!beside_corner && std::atan2(norm(cross(xa, xb)), dot(xa, xb)) < kFlatBoundaryAngle)
+        continue;
       const double sign = uv_area(m, a, x, b) > 0 ? 1.0 : -1.0;
       // Grow the strip: polygon kept as a cycle; its one interior edge (p, q) is crossed.
       std::vector<LO> strip{t0};
@@ -217,14 +193,52 @@ std::int64_t refan_flat_boundary_strips(const mesh::FaceMesh& m, const std::vect
   return done;
 }
 
+// Boundary edges of a quad-dominant mesh: sorted vertex pairs used by one element.
+std::vector<std::pair<LO, LO>> boundary_edges(const mesh::FaceMesh& m,
+                                              const std::vector<std::array<LO, 3>>& tris) {
+  std::map<std::pair<LO, LO>, int> uses;
+  for (const auto& q : m.quads)
+    for (int k = 0; k < 4; ++k) ++uses[std::minmax(q[k], q[(k + 1) % 4])];
+  for (const auto& t : tris)
+    for (int k = 0; k < 3; ++k) ++uses[std::minmax(t[k], t[(k + 1) % 3])];
+  std::vector<std::pair<LO, LO>> out;
+  for (const auto& [e, n] : uses)
+    if (n == 1) out.push_back(e);
+  return out;
+}
+
+bool has_corner_mids(const background::HalvedBoundary& boundary) {
+  for (std::size_t l = 0; l < boundary.segments.size(); ++l)
+    for (std::size_t k = 0; k < boundary.segments[l].size(); ++k)
+      if (boundary.segments[l][k].mid.vclass.dim == 0 && boundary.loops[l].degenerate[k] == 0)
+        return true;
+  return false;
+}
+
 }  // namespace
 
+std::map<std::pair<LO, LO>, Vec3> corner_midpoints(const mesh::FaceMesh& mesh,
+                                                   const background::HalvedBoundary& boundary) {
+  std::map<std::pair<LO, LO>, Vec3> out;
+  if (!has_corner_mids(boundary)) return out;
+  const BoundaryResolver resolver(mesh, boundary);
+  for (const auto& [a, b] : boundary_edges(mesh, mesh.triangles)) {
+    const Spot s = resolver.resolve(a, b);
+    const background::HalvedSegment& seg = boundary.segments[s.loop][s.k];
+    if (seg.mid.vclass.dim == 0 && boundary.loops[s.loop].degenerate[s.k] == 0)
+      out[{a, b}] = seg.mid.xyz;
+  }
+  return out;
+}
+
 mesh::FaceMesh subdivide(const mesh::FaceMesh& mesh, const cad::FaceGeometry& surface,
-                         std::span<const mesh::CurveMesh> full_curves, SubdivideStats* stats) {
+                         std::span<const mesh::CurveMesh> full_curves,
+                         const background::HalvedBoundary& boundary, SubdivideStats* stats) {
   // Elements: quads first, then triangles.
   const std::vector<std::array<LO, 4>>& in_quads = mesh.quads;
   std::vector<std::array<LO, 3>> in_tris = mesh.triangles;
-  const std::int64_t flat_splits = refan_flat_boundary_strips(mesh, in_quads, in_tris);
+  const std::int64_t flat_splits =
+      refan_flat_boundary_strips(mesh, in_quads, in_tris, corner_midpoints(mesh, boundary));
   std::vector<std::array<LO, 4>> elems;
   std::vector<int> sides;
   for (const auto& q : in_quads) {
@@ -250,18 +264,17 @@ mesh::FaceMesh subdivide(const mesh::FaceMesh& mesh, const cad::FaceGeometry& su
   out.points = mesh.points;
   out.uv = mesh.uv;
   out.vclass = mesh.vclass;
-  // Curve vertices: index doubled, and the full mesh's t and point (the same values by
-  // construction, taken from the full mesh so that every face agrees bit for bit).
+  // Curve vertices: the full mesh's t and point (the same values by construction, taken from the
+  // full mesh so that every face agrees bit for bit).
   for (LO v = 0; v < mesh.num_vertices(); ++v) {
     auto& vc = out.vclass[v];
     if (vc.dim != 1) continue;
     QSMESH_CHECK(vc.entity >= 0 && static_cast<std::size_t>(vc.entity) < full_curves.size(),
                  "face " << mesh.face << ": curve " << vc.entity << " has no full mesh");
     const auto& cm = full_curves[vc.entity];
-    QSMESH_CHECK(2 * vc.index < cm.num_edges(), "face " << mesh.face << ": vertex " << v
-                                                        << " index " << vc.index << " of curve "
-                                                        << vc.entity << " outside the halved mesh");
-    vc.index *= 2;
+    QSMESH_CHECK(vc.index > 0 && vc.index < cm.num_edges(),
+                 "face " << mesh.face << ": vertex " << v << " index " << vc.index << " of curve "
+                         << vc.entity << " outside its full mesh");
     vc.param = {cm.t[vc.index], 0};
     out.points[v] = cm.points[vc.index];
   }
@@ -274,7 +287,7 @@ mesh::FaceMesh subdivide(const mesh::FaceMesh& mesh, const cad::FaceGeometry& su
   };
   std::vector<Snap> snaps;
 
-  const BoundaryResolver resolver(mesh, full_curves);
+  const BoundaryResolver resolver(mesh, boundary);
   // Poles (a corner where the parametrization is singular) have an arbitrary uv on their
   // degenerate line: what touches them is placed in 3D and projected, guided by the other vertices.
   std::vector<char> pole(mesh.vclass.size(), 0);
@@ -292,18 +305,27 @@ mesh::FaceMesh subdivide(const mesh::FaceMesh& mesh, const cad::FaceGeometry& su
     mesh::VertexClass vc;
     Vec3 p;
     Vec2 uv = uv_mid;
-    CurveSpot spot;
-    if (j - i == 1 && resolver.resolve(a, b, &spot)) {
-      const auto& cm = full_curves[spot.curve];
-      const LO k = 2 * spot.i + 1;
+    const Spot spot = j - i == 1 ? resolver.resolve(a, b) : Spot{};
+    const background::HalvedSegment* seg =
+        spot.loop == kNoIndex ? nullptr : &boundary.segments[spot.loop][spot.k];
+    if (seg != nullptr && seg->mid.vclass.dim == 1) {
+      const LO c = seg->mid.vclass.entity;
+      QSMESH_CHECK(c >= 0 && static_cast<std::size_t>(c) < full_curves.size(),
+                   "face " << mesh.face << ": curve " << c << " has no full mesh");
+      const auto& cm = full_curves[c];
+      const LO k = seg->mid.vclass.index;
+      QSMESH_CHECK(k > 0 && k < cm.num_edges(), "face " << mesh.face << ": midpoint " << k
+                                                        << " of curve " << c
+                                                        << " outside its full mesh");
+      const bool a_first = spot.a_first == seg->forward;  // vertex a is full vertex k - 1
       vc.dim = 1;
-      vc.entity = spot.curve;
+      vc.entity = c;
       vc.index = k;
       vc.param = {cm.t[k], 0};
       p = cm.points[k];
       // uv along the edge in proportion of t (exact for linear pcurves), then projected.
-      const Vec2 uv0 = spot.a_first ? mesh.uv[a] : mesh.uv[b];
-      const Vec2 uv1 = spot.a_first ? mesh.uv[b] : mesh.uv[a];
+      const Vec2 uv0 = a_first ? mesh.uv[a] : mesh.uv[b];
+      const Vec2 uv1 = a_first ? mesh.uv[b] : mesh.uv[a];
       const double dt = cm.t[k + 1] - cm.t[k - 1];
       const double s = dt != 0 ? (cm.t[k] - cm.t[k - 1]) / dt : 0.5;
       uv = uv0 + s * (uv1 - uv0);
@@ -316,7 +338,13 @@ mesh::FaceMesh subdivide(const mesh::FaceMesh& mesh, const cad::FaceGeometry& su
         const Vec2 alt = surface.project(p, from, nullptr);
         if (distance(surface.eval(alt).p, p) < distance(surface.eval(uv).p, p)) uv = alt;
       }
-    } else if (j - i == 1) {
+    } else if (seg != nullptr && !boundary.loops[spot.loop].degenerate[spot.k]) {
+      // A corner where its loop takes an odd count up to it: the corner itself, at its pcurve
+      // image of the loop.
+      vc = seg->mid.vclass;
+      p = seg->mid.xyz;
+      uv = seg->mid.uv;
+    } else if (seg != nullptr) {
       // Edge of a degenerate curve (pole): another copy of the corner.
       vc = mesh.vclass[a];
       p = out.points[a];

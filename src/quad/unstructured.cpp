@@ -40,12 +40,16 @@ mesh::FaceMesh optimise(mesh::FaceMesh m, const cad::FaceGeometry& surface) {
 mesh::FaceMesh quads_from(const mesh::FaceMesh& tri,
                           std::span<const std::array<Vec3, 2>> directions,
                           const cad::FaceGeometry& surface, std::span<const mesh::CurveMesh> full,
+                          const background::HalvedBoundary& halved,
                           const UnstructuredOptions& options, bool& fell_back) {
+  const std::map<std::pair<LO, LO>, Vec3> corner_mids = corner_midpoints(tri, halved);
   mesh::FaceMesh out =
-      optimise(subdivide(recombine(tri, directions, options.recombine), surface, full), surface);
+      optimise(subdivide(recombine(tri, directions, options.recombine, nullptr, &corner_mids),
+                         surface, full, halved),
+               surface);
   if (valid(out)) return out;
   fell_back = true;
-  mesh::FaceMesh alt = optimise(subdivide(tri, surface, full), surface);
+  mesh::FaceMesh alt = optimise(subdivide(tri, surface, full, halved), surface);
   return out.quads.empty() || min_sicn(alt) > min_sicn(out) ? alt : out;
 }
 
@@ -64,11 +68,11 @@ bool has_long_edge(const mesh::FaceMesh& tri, const mesh::SizeFunction& size, do
 // Sec. 5.1-5.2: frontal points, their triangulation, recombination along the cross, subdivision.
 // Returns an empty mesh when neither the recombined nor the plain subdivided triangles are valid.
 mesh::FaceMesh frontal_quads(const cad::CadModel& model, LO f, const cad::FaceGeometry& surface,
-                             std::span<const mesh::CurveMesh> halved,
+                             const background::HalvedBoundary& halved,
                              std::span<const mesh::CurveMesh> full, const FaceFields& fields,
                              const UnstructuredOptions& options, UnstructuredReport& rep) {
   const FaceGuide guide(*fields.background, *fields.cross_field, fields.sizes);
-  const auto loops = background::face_boundary(model, f, surface, halved);
+  const std::vector<mesh::BoundaryLoop>& loops = halved.loops;
   const std::vector<Vec2> points = frontal_points(surface, loops, guide, options.frontal);
   rep.frontal_points = static_cast<std::int64_t>(points.size());
   const double factor = options.frontal.spacing_factor;
@@ -115,7 +119,7 @@ mesh::FaceMesh frontal_quads(const cad::CadModel& model, LO f, const cad::FaceGe
     for (const auto& tr : moved.triangles)
       directions.push_back(
           guide.at((moved.uv[tr[0]] + moved.uv[tr[1]] + moved.uv[tr[2]]) / 3.0).cross);
-    return quads_from(moved, directions, surface, full, options, fell_back);
+    return quads_from(moved, directions, surface, full, halved, options, fell_back);
   };
   bool fell_back = false;
   mesh::FaceMesh out = to_quads(tri, fell_back);
@@ -140,7 +144,6 @@ mesh::FaceMesh frontal_quads(const cad::CadModel& model, LO f, const cad::FaceGe
 }  // namespace
 
 mesh::FaceMesh mesh_face_unstructured(const cad::CadModel& model, LO f,
-                                      std::span<const mesh::CurveMesh> halved,
                                       std::span<const mesh::CurveMesh> full,
                                       const FaceFields& fields, const UnstructuredOptions& options,
                                       UnstructuredReport* report) {
@@ -150,6 +153,8 @@ mesh::FaceMesh mesh_face_unstructured(const cad::CadModel& model, LO f,
   const ErrorContext context{"unstructured", 2, f};
   try {
     const auto surface = model.face_geometry(f);
+    const background::HalvedBoundary halved =
+        background::halved_face_boundary(model, f, *surface, full);
     mesh::FaceMesh out;
     const bool want_frontal = options.use_frontal;
     if (want_frontal && fields.background != nullptr && fields.cross_field != nullptr &&
@@ -171,8 +176,8 @@ mesh::FaceMesh mesh_face_unstructured(const cad::CadModel& model, LO f,
       tri_options.sizes.size = 2 * options.size;
       tri_options.sizes.edges_per_turn = 8;
       background::FaceReport tri_report;
-      const mesh::FaceMesh tri =
-          background::mesh_face_background(model, f, halved, tri_options, &tri_report);
+      const mesh::FaceMesh tri = background::mesh_face_background(
+          model, f, std::span<const mesh::BoundaryLoop>(halved.loops), tri_options, &tri_report);
       if (!tri_report.ok) {
         rep.error = tri_report.error;
         mesh::FaceMesh empty;
@@ -180,11 +185,11 @@ mesh::FaceMesh mesh_face_unstructured(const cad::CadModel& model, LO f,
         return empty;
       }
       try {
-        out = quads_from(tri, {}, *surface, full, options, rep.fell_back);
+        out = quads_from(tri, {}, *surface, full, halved, options, rep.fell_back);
       } catch (const Error& e) {
         rep.error = e.with_context(context).what();
         rep.fell_back = true;
-        out = optimise(subdivide(tri, *surface, full), *surface);
+        out = optimise(subdivide(tri, *surface, full, halved), *surface);
       }
     }
     out.face = f;

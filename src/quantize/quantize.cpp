@@ -2,9 +2,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
+#include <numbers>
 #include <numeric>
+#include <queue>
 #include <sstream>
+#include <string>
 
 #include "qsmesh/background/face_mesh.hpp"
 #include "qsmesh/core/error.hpp"
@@ -203,8 +207,281 @@ std::vector<double> ideal_edge_counts(std::span<const mesh::CurveMesh> curves,
   return ideal;
 }
 
-Quantization quantize_curves(const cad::CadModel& model, std::span<const double> ideal,
-                             const QuantizeOptions& options) {
+namespace {
+
+// One parity condition of the halved boundaries (paper 000 Sec. 5.2): the curve uses of a loop,
+// or of the stretch of a loop between two of its poles, whose counts must sum to an even number
+// (background::halved_face_boundary keeps every pole on a halved vertex).
+struct ParityRow {
+  LO face = kNoIndex, loop = kNoIndex;
+  bool between_poles = false;
+  std::vector<LO> curves;  // one entry per use (a seam twice)
+};
+
+std::vector<ParityRow> parity_rows(const cad::CadModel& model) {
+  std::vector<ParityRow> rows;
+  for (LO f = 0; f < model.num_faces(); ++f) {
+    const cad::Face& face = model.faces()[f];
+    for (LO l = 0; l < static_cast<LO>(face.loops.size()); ++l) {
+      const auto& uses = face.loops[l].uses;
+      std::vector<std::size_t> poles;
+      for (std::size_t u = 0; u < uses.size(); ++u)
+        if (model.curves()[uses[u].curve].degenerate) poles.push_back(u);
+      if (poles.size() <= 1) {
+        ParityRow row{f, l, false, {}};
+        for (const cad::CurveUse& use : uses)
+          if (!model.curves()[use.curve].degenerate) row.curves.push_back(use.curve);
+        rows.push_back(std::move(row));
+        continue;
+      }
+      for (std::size_t i = 0; i < poles.size(); ++i) {
+        ParityRow row{f, l, true, {}};
+        const std::size_t from = poles[i], to = poles[(i + 1) % poles.size()];
+        for (std::size_t u = (from + 1) % uses.size(); u != to; u = (u + 1) % uses.size())
+          row.curves.push_back(uses[u].curve);
+        rows.push_back(std::move(row));
+      }
+    }
+  }
+  return rows;
+}
+
+// Variables of the parity problem: groups of curves that share one count (a chord, or a curve
+// alone), each with the rows where it appears an odd number of times and the cost of changing
+// its parity.
+struct ParityProblem {
+  std::vector<ParityRow> rows;
+  std::vector<char> odd;                  // per row: the parity of its sum now
+  std::vector<std::vector<LO>> var_rows;  // per variable, sorted
+  std::vector<double> cost;               // per variable, >= 0
+};
+
+// The variables to flip so that every row is even, or, when none can, the rows whose sum is a
+// contradiction (every variable an even number of times, the fixed counts odd in total).
+struct ParitySolution {
+  std::vector<char> flip;
+  std::vector<LO> conflict;  // non-empty: no solution
+};
+
+ParitySolution solve_parity(const ParityProblem& pb) {
+  const auto nr = static_cast<LO>(pb.rows.size());
+  const auto nv = static_cast<LO>(pb.var_rows.size());
+  ParitySolution out;
+  out.flip.assign(static_cast<std::size_t>(nv), 0);
+  std::vector<char> odd = pb.odd;
+  std::vector<std::vector<LO>> row_vars(static_cast<std::size_t>(nr));
+  for (LO v = 0; v < nv; ++v)
+    for (const LO r : pb.var_rows[v]) row_vars[r].push_back(v);
+  const auto flip = [&](LO v) {
+    out.flip[v] ^= 1;
+    for (const LO r : pb.var_rows[v]) odd[r] ^= 1;
+  };
+  // A loop whose curves are all prescribed is the plainest contradiction to name (on a closed
+  // shell, the other loops together contradict too).
+  for (LO r = 0; r < nr; ++r)
+    if (odd[r] != 0 && row_vars[r].empty()) {
+      out.conflict = {r};
+      return out;
+    }
+  // Each odd row is paired with the nearest other odd row, or with an open boundary (a variable
+  // in one row only), along the cheapest chain of variables that each appear in two rows: a
+  // shortest path, so the counts that change are few and near the prescriptions.
+  const LO sink = nr;
+  std::vector<double> dist(static_cast<std::size_t>(nr) + 1,
+                           std::numeric_limits<double>::infinity());
+  std::vector<LO> via(static_cast<std::size_t>(nr) + 1, kNoIndex),
+      from(static_cast<std::size_t>(nr) + 1, kNoIndex);
+  std::vector<LO> touched;
+  for (LO t = 0; t < nr; ++t) {
+    if (odd[t] == 0) continue;
+    for (const LO x : touched) {
+      dist[x] = std::numeric_limits<double>::infinity();
+      via[x] = from[x] = kNoIndex;
+    }
+    touched.clear();
+    using Item = std::pair<double, LO>;
+    std::priority_queue<Item, std::vector<Item>, std::greater<>> queue;
+    dist[t] = 0;
+    touched.push_back(t);
+    queue.push({0.0, t});
+    LO target = kNoIndex;
+    while (!queue.empty()) {
+      const auto [d, r] = queue.top();
+      queue.pop();
+      if (d > dist[r]) continue;
+      if (r == sink || (r != t && odd[r] != 0)) {
+        target = r;
+        break;
+      }
+      for (const LO v : row_vars[r]) {
+        const auto& vr = pb.var_rows[v];
+        if (vr.size() > 2) continue;  // a variable of three or more rows: the dense step
+        const LO next = vr.size() == 1 ? sink : (vr[0] == r ? vr[1] : vr[0]);
+        const double nd = d + pb.cost[v];
+        if (nd < dist[next]) {
+          if (std::isinf(dist[next])) touched.push_back(next);
+          dist[next] = nd;
+          via[next] = v;
+          from[next] = r;
+          queue.push({nd, next});
+        }
+      }
+    }
+    if (target != kNoIndex) {
+      for (LO r = target; r != t; r = from[r]) flip(via[r]);
+      continue;
+    }
+    // No chain: the rows reachable from t through any variable, solved exactly (Gaussian
+    // elimination over GF(2), cheapest variables first as pivots), or shown contradictory.
+    std::vector<LO> comp_rows{t}, comp_vars;
+    std::vector<char> row_seen(static_cast<std::size_t>(nr), 0),
+        var_seen(static_cast<std::size_t>(nv), 0);
+    row_seen[t] = 1;
+    for (std::size_t i = 0; i < comp_rows.size(); ++i)
+      for (const LO v : row_vars[comp_rows[i]]) {
+        if (var_seen[v] != 0) continue;
+        var_seen[v] = 1;
+        comp_vars.push_back(v);
+        for (const LO r : pb.var_rows[v])
+          if (row_seen[r] == 0) {
+            row_seen[r] = 1;
+            comp_rows.push_back(r);
+          }
+      }
+    std::stable_sort(comp_vars.begin(), comp_vars.end(),
+                     [&](LO a, LO b) { return pb.cost[a] < pb.cost[b]; });
+    const std::size_t nvc = comp_vars.size(), nrc = comp_rows.size();
+    const std::size_t bits = nvc + nrc + 1, words = (bits + 63) / 64;
+    std::vector<std::vector<std::uint64_t>> m(nrc, std::vector<std::uint64_t>(words, 0));
+    const auto set = [&](std::vector<std::uint64_t>& row, std::size_t b) {
+      row[b / 64] ^= std::uint64_t{1} << (b % 64);
+    };
+    const auto get = [&](const std::vector<std::uint64_t>& row, std::size_t b) {
+      return ((row[b / 64] >> (b % 64)) & 1U) != 0;
+    };
+    std::vector<std::size_t> col_of(static_cast<std::size_t>(nv), 0);
+    for (std::size_t j = 0; j < nvc; ++j) col_of[comp_vars[j]] = j;
+    std::vector<std::size_t> local_row(static_cast<std::size_t>(nr), 0);
+    for (std::size_t i = 0; i < nrc; ++i) local_row[comp_rows[i]] = i;
+    for (std::size_t j = 0; j < nvc; ++j)
+      for (const LO r : pb.var_rows[comp_vars[j]]) set(m[local_row[r]], j);
+    for (std::size_t i = 0; i < nrc; ++i) {
+      set(m[i], nvc + i);
+      if (odd[comp_rows[i]] != 0) set(m[i], bits - 1);
+    }
+    std::vector<std::size_t> pivot_row_of_col(nvc, nrc);
+    std::size_t rank = 0;
+    for (std::size_t j = 0; j < nvc && rank < nrc; ++j) {
+      std::size_t p = rank;
+      while (p < nrc && !get(m[p], j)) ++p;
+      if (p == nrc) continue;
+      std::swap(m[p], m[rank]);
+      for (std::size_t i = 0; i < nrc; ++i)
+        if (i != rank && get(m[i], j))
+          for (std::size_t w = 0; w < words; ++w) m[i][w] ^= m[rank][w];
+      pivot_row_of_col[j] = rank++;
+    }
+    for (std::size_t i = rank; i < nrc; ++i)
+      if (get(m[i], bits - 1)) {
+        for (std::size_t k = 0; k < nrc; ++k)
+          if (get(m[i], nvc + k)) out.conflict.push_back(comp_rows[k]);
+        std::sort(out.conflict.begin(), out.conflict.end());
+        return out;
+      }
+    for (std::size_t j = 0; j < nvc; ++j)
+      if (pivot_row_of_col[j] < nrc && get(m[pivot_row_of_col[j]], bits - 1)) flip(comp_vars[j]);
+  }
+  return out;
+}
+
+// The message for rows that no counts of the free curves can make even.
+std::string parity_conflict_message(const cad::CadModel& model, const ParityProblem& pb,
+                                    const std::vector<LO>& rows,
+                                    const std::vector<int>& prescribed) {
+  // The prescribed curves an odd number of times in these rows, with their counts.
+  std::map<LO, int> times;
+  for (const LO r : rows)
+    for (const LO c : pb.rows[r].curves)
+      if (prescribed[c] != 0) times[c] += 1;
+  std::ostringstream os;
+  const auto where = [&](const ParityRow& row) {
+    os << "face " << row.face << " (loop " << row.loop
+       << (row.between_poles ? ", between two poles" : "") << ")";
+  };
+  std::ostringstream curves;
+  int total = 0, listed = 0;
+  for (const auto& [c, k] : times) {
+    if (k % 2 == 0) continue;
+    total += prescribed[c];
+    if (listed++ > 0) curves << ", ";
+    curves << c << ":" << prescribed[c];
+  }
+  (void)model;
+  if (rows.size() == 1) {
+    where(pb.rows[rows[0]]);
+    os << ": its prescribed curves " << curves.str() << " sum to " << total
+       << " edges and no other curve of it can make the count even";
+  } else {
+    os << "the loops of ";
+    for (std::size_t i = 0; i < rows.size() && i < 6; ++i) {
+      if (i > 0) os << ", ";
+      where(pb.rows[rows[i]]);
+    }
+    if (rows.size() > 6) os << " and " << rows.size() - 6 << " more";
+    os << " cannot all have even counts: together they hold the prescribed curves " << curves.str()
+       << " (" << total
+       << " edges) an odd number of times and every other curve an even number of times";
+  }
+  os << "; all-quad meshing by midpoint subdivision needs an even count on every loop";
+  return os.str();
+}
+
+// Thrown by quantize_level when the parities cannot be met with the chords it was given.
+struct ParityConflict {
+  std::string message;
+};
+
+}  // namespace
+
+void check_prescription_parity(const cad::CadModel& model,
+                               std::span<const std::pair<LO, int>> prescribed) {
+  const LO nc = model.num_curves();
+  std::vector<int> fixed(static_cast<std::size_t>(nc), 0);
+  for (const auto& [c, n] : prescribed)
+    if (c >= 0 && c < nc && n > 0 && fixed[c] == 0) fixed[c] = n;
+  ParityProblem pb;
+  pb.rows = parity_rows(model);
+  // Every curve not prescribed is a variable of its own, starting even.
+  std::vector<LO> var_of(static_cast<std::size_t>(nc), kNoIndex);
+  for (LO c = 0; c < nc; ++c)
+    if (fixed[c] == 0 && !model.curves()[c].degenerate) {
+      var_of[c] = static_cast<LO>(pb.var_rows.size());
+      pb.var_rows.emplace_back();
+      pb.cost.push_back(1.0);
+    }
+  pb.odd.assign(pb.rows.size(), 0);
+  for (LO r = 0; r < static_cast<LO>(pb.rows.size()); ++r) {
+    std::map<LO, int> times;
+    for (const LO c : pb.rows[r].curves) {
+      if (var_of[c] != kNoIndex)
+        times[var_of[c]] ^= 1;
+      else
+        pb.odd[r] ^= static_cast<char>(fixed[c] % 2);
+    }
+    for (const auto& [v, t] : times)
+      if (t != 0) pb.var_rows[v].push_back(r);
+  }
+  const ParitySolution sol = solve_parity(pb);
+  if (!sol.conflict.empty())
+    throw InputError(parity_conflict_message(model, pb, sol.conflict, fixed));
+}
+
+namespace {
+
+// quantize_curves with the chords of `level`: 0 all, 1 only those holding a prescribed curve,
+// 2 none. Throws ParityConflict when the loops cannot all be even so.
+Quantization quantize_level(const cad::CadModel& model, std::span<const double> ideal,
+                            const QuantizeOptions& options, int level) {
   const LO nc = model.num_curves();
   const auto curves = model.curves();
   QSMESH_CHECK(static_cast<LO>(ideal.size()) == nc,
@@ -263,6 +540,15 @@ Quantization quantize_curves(const cad::CadModel& model, std::span<const double>
       in_chord[a] = in_chord[b] = true;
     }
   }
+  if (level > 0) {
+    // Relaxed chords: a prescribed curve keeps its chord at level 1, nothing at level 2.
+    std::vector<char> keep(static_cast<std::size_t>(nc), 0);
+    if (level == 1)
+      for (const auto& [c, n] : options.prescribed)
+        if (c >= 0 && c < nc) keep[uf.find(c)] = 1;
+    for (LO c = 0; c < nc; ++c)
+      if (keep[uf.find(c)] == 0) in_chord[c] = false;
+  }
   std::vector<LO> root2chord(static_cast<std::size_t>(nc), kNoIndex);
   std::vector<std::vector<LO>> chords;
   for (LO c = 0; c < nc; ++c) {
@@ -297,10 +583,6 @@ Quantization quantize_curves(const cad::CadModel& model, std::span<const double>
     if (n <= 0)
       throw InputError("curve " + std::to_string(c) + ": " + std::to_string(n) +
                        " edges prescribed, but a curve needs at least 1");
-    if (options.even && n % 2 != 0)
-      throw InputError("curve " + std::to_string(c) + ": " + std::to_string(n) +
-                       " edges prescribed, but all-quad meshing by midpoint subdivision needs an "
-                       "even count (odd counts are not supported yet)");
     for (const LO m : members(c)) {
       if (fixed[m] != 0 && fixed[m] != n) {
         const LO other = fixed_by[m];
@@ -349,8 +631,93 @@ Quantization quantize_curves(const cad::CadModel& model, std::span<const double>
       for (const LO m : chord) q.edges[m] = n;
     }
   }
+  if (options.even) {
+    // Midpoint subdivision needs every loop even (and every stretch between two poles), not
+    // every curve: the variables are the free chords and curves; each starts at its even count
+    // (1 for a sliver with options.odd_slivers) and may move to the nearest odd one (or back).
+    ParityProblem pb;
+    pb.rows = parity_rows(model);
+    std::vector<LO> var_of(static_cast<std::size_t>(nc), kNoIndex);
+    std::vector<std::vector<LO>> var_members;
+    for (LO c = 0; c < nc; ++c) {
+      if (curves[c].degenerate || fixed[c] != 0) continue;
+      const LO chord = q.curve2chord[c];
+      if (chord != kNoIndex && chords[chord].front() != c) {
+        var_of[c] = var_of[chords[chord].front()];
+        continue;
+      }
+      var_of[c] = static_cast<LO>(var_members.size());
+      var_members.push_back(members(c));
+    }
+    const auto nv = static_cast<LO>(var_members.size());
+    std::vector<int> alternative(static_cast<std::size_t>(nv), 0);
+    pb.var_rows.resize(static_cast<std::size_t>(nv));
+    pb.cost.assign(static_cast<std::size_t>(nv), 0.0);
+    for (LO v = 0; v < nv; ++v) {
+      const auto& mem = var_members[v];
+      const int now = q.edges[mem.front()];
+      int lo = 0;
+      for (const LO m : mem) lo = std::max(lo, minimum(m));
+      int hard = 0;
+      for (const LO m : mem) hard = std::max(hard, hard_minimum(m));
+      // The count of the other parity nearest to the ideal (the members' mean), not below what
+      // the members need.
+      double mean = 0;
+      for (const LO m : mem) mean += ideal[m];
+      mean /= static_cast<double>(mem.size());
+      const int down = now - 1, up = now + 1;
+      const int other = (down >= std::max(hard, lo - 1) && mean - down < up - mean) ? down : up;
+      const auto error = [&](int n) {
+        double e = 0;
+        for (const LO m : mem) e += std::abs(n - ideal[m]) / std::max(ideal[m], 1.0);
+        return e;
+      };
+      // A sliver (options.odd_slivers): 1 edge rather than 2 when the ideal count is nearer 1
+      // (in ratio: below sqrt 2), so that a strip is one quad across.
+      if (options.odd_slivers && other == 1 && mean < std::numbers::sqrt2) {
+        for (const LO m : mem) q.edges[m] = 1;
+        alternative[v] = now;
+      } else {
+        alternative[v] = other;
+      }
+      pb.cost[v] = std::max(0.0, error(alternative[v]) - error(q.edges[mem.front()])) +
+                   1e-6 * static_cast<double>(mem.size());
+    }
+    pb.odd.assign(pb.rows.size(), 0);
+    for (LO r = 0; r < static_cast<LO>(pb.rows.size()); ++r) {
+      std::map<LO, int> times;
+      for (const LO c : pb.rows[r].curves) {
+        pb.odd[r] ^= static_cast<char>(q.edges[c] % 2);
+        if (var_of[c] != kNoIndex) times[var_of[c]] ^= 1;
+      }
+      for (const auto& [v, t] : times)
+        if (t != 0) pb.var_rows[v].push_back(r);
+    }
+    const ParitySolution sol = solve_parity(pb);
+    if (!sol.conflict.empty())
+      throw ParityConflict{parity_conflict_message(model, pb, sol.conflict, fixed)};
+    for (LO v = 0; v < nv; ++v)
+      if (sol.flip[v] != 0)
+        for (const LO m : var_members[v]) q.edges[m] = alternative[v];
+  }
   q.total_edges = std::accumulate(q.edges.begin(), q.edges.end(), std::int64_t{0});
   return q;
+}
+
+}  // namespace
+
+Quantization quantize_curves(const cad::CadModel& model, std::span<const double> ideal,
+                             const QuantizeOptions& options) {
+  // Chords are a preference; where they make the loops' parities impossible, first the chords
+  // without a prescription, then all, are given up, so that what check_prescription_parity
+  // accepts is always met.
+  for (int level = 0;; ++level) {
+    try {
+      return quantize_level(model, ideal, options, level);
+    } catch (const ParityConflict& e) {
+      if (level == 2) throw InputError(e.message);
+    }
+  }
 }
 
 std::vector<mesh::CurveMesh> place_vertices(const cad::CadModel& model,
@@ -441,34 +808,23 @@ std::vector<mesh::CurveMesh> place_vertices(const cad::CadModel& model,
   return out;
 }
 
-std::vector<LO> crossing_curves(const cad::CadModel& model, LO f,
-                                std::span<const mesh::CurveMesh> curves) {
-  const auto surface = model.face_geometry(f);
-  const auto loops = background::face_boundary(model, f, *surface, curves);
-  // Segments of every loop, with their curve (face_boundary gives each use its curve mesh's
-  // edges in order) and their loop position (neighbours share a vertex and are not tested).
-  struct Segment {
-    Vec2 a, b;
-    LO curve;
-    LO loop, index, loop_size;
-  };
-  std::vector<Segment> segments;
-  const cad::Face& face = model.faces()[f];
-  for (LO l = 0; l < static_cast<LO>(loops.size()); ++l) {
-    const auto& pts = loops[l].points;
-    const auto n = static_cast<LO>(pts.size());
-    LO k = 0;
-    for (const cad::CurveUse& use : face.loops[l].uses)
-      for (LO e = 0; e < curves[use.curve].num_edges() && k < n; ++e, ++k)
-        segments.push_back({pts[k].uv, pts[(k + 1) % n].uv, use.curve, l, k, n});
-  }
-  std::vector<LO> out;
-  // A loop of one or two segments encloses nothing (two curves joining the same corners, one
-  // edge each on the halved meshes).
-  for (std::size_t l = 0; l < loops.size(); ++l)
-    if (!loops[l].points.empty() && loops[l].points.size() < 3)
-      for (const cad::CurveUse& use : face.loops[l].uses) out.push_back(use.curve);
+namespace {
+
+// A boundary segment of a face in its parameter plane, with the curves it lies on (two for a
+// halved segment across a corner) and its place in its loop.
+struct Segment {
+  Vec2 a, b;
+  LO curve, curve2;
+  LO loop, index, loop_size;
+};
+
+// The curves of crossing or overlapping segments, and those of loops of fewer than three
+// segments (`small_loop_curves`), sorted, each once.
+std::vector<LO> crossing_segments(const std::vector<Segment>& segments,
+                                  std::vector<LO> small_loop_curves) {
+  std::vector<LO> out = std::move(small_loop_curves);
   const auto sorted_once = [&] {
+    out.erase(std::remove(out.begin(), out.end(), kNoIndex), out.end());
     std::sort(out.begin(), out.end());
     out.erase(std::unique(out.begin(), out.end()), out.end());
     return out;
@@ -527,11 +883,59 @@ std::vector<LO> crossing_curves(const cad::CadModel& model, LO f,
         const bool crossing = !neighbours(x, y) && o1 * o2 < 0 && o3 * o4 < 0;
         const bool folded = o1 == 0 && o2 == 0 && o3 == 0 && o4 == 0 && overlap(x, y);
         if (crossing || folded) {
-          out.push_back(x.curve);
-          out.push_back(y.curve);
+          for (const LO c : {x.curve, x.curve2, y.curve, y.curve2}) out.push_back(c);
         }
       }
   return sorted_once();
+}
+
+}  // namespace
+
+std::vector<LO> crossing_curves(const cad::CadModel& model, LO f,
+                                std::span<const mesh::CurveMesh> curves) {
+  const auto surface = model.face_geometry(f);
+  const auto loops = background::face_boundary(model, f, *surface, curves);
+  // Segments of every loop, with their curve (face_boundary gives each use its curve mesh's
+  // edges in order) and their loop position (neighbours share a vertex and are not tested).
+  std::vector<Segment> segments;
+  const cad::Face& face = model.faces()[f];
+  for (LO l = 0; l < static_cast<LO>(loops.size()); ++l) {
+    const auto& pts = loops[l].points;
+    const auto n = static_cast<LO>(pts.size());
+    LO k = 0;
+    for (const cad::CurveUse& use : face.loops[l].uses)
+      for (LO e = 0; e < curves[use.curve].num_edges() && k < n; ++e, ++k)
+        segments.push_back({pts[k].uv, pts[(k + 1) % n].uv, use.curve, kNoIndex, l, k, n});
+  }
+  // A loop of one or two segments encloses nothing (two curves joining the same corners, one
+  // edge each on the halved meshes).
+  std::vector<LO> small;
+  for (std::size_t l = 0; l < loops.size(); ++l)
+    if (!loops[l].points.empty() && loops[l].points.size() < 3)
+      for (const cad::CurveUse& use : face.loops[l].uses) small.push_back(use.curve);
+  return crossing_segments(segments, std::move(small));
+}
+
+std::vector<LO> crossing_curves_halved(const cad::CadModel& model, LO f,
+                                       std::span<const mesh::CurveMesh> full) {
+  const auto surface = model.face_geometry(f);
+  const background::HalvedBoundary halved =
+      background::halved_face_boundary(model, f, *surface, full);
+  std::vector<Segment> segments;
+  std::vector<LO> small;
+  const cad::Face& face = model.faces()[f];
+  for (LO l = 0; l < static_cast<LO>(halved.loops.size()); ++l) {
+    const auto& pts = halved.loops[l].points;
+    const auto n = static_cast<LO>(pts.size());
+    for (LO k = 0; k < n; ++k) {
+      const background::HalvedSegment& s = halved.segments[l][k];
+      segments.push_back({pts[k].uv, pts[(k + 1) % n].uv, s.curve_before,
+                          s.curve_after == s.curve_before ? kNoIndex : s.curve_after, l, k, n});
+    }
+    if (n > 0 && n < 3)
+      for (const cad::CurveUse& use : face.loops[l].uses) small.push_back(use.curve);
+  }
+  return crossing_segments(segments, std::move(small));
 }
 
 void refine_curves(Quantization& q, std::span<const LO> curves, std::span<const LO> fixed) {
@@ -552,7 +956,8 @@ void refine_curves(Quantization& q, std::span<const LO> curves, std::span<const 
     if (chords && q.curve2chord[c] >= 0 && q.curve2chord[c] < q.num_chords &&
         frozen_chord[q.curve2chord[c]] != 0)
       continue;
-    const int doubled = 2 * q.edges[c];
+    // An odd count stays odd: the loops through the curve keep their parity.
+    const int doubled = 2 * q.edges[c] + q.edges[c] % 2;
     target[c] = std::max(target[c], doubled);
     if (chords && q.curve2chord[c] != kNoIndex) {
       int& t = chord_target[q.curve2chord[c]];

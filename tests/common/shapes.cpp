@@ -9,6 +9,7 @@
 #include <BRepFilletAPI_MakeFillet.hxx>
 #include <BRepPrimAPI_MakeBox.hxx>
 #include <BRepPrimAPI_MakeCylinder.hxx>
+#include <BRepPrimAPI_MakePrism.hxx>
 #include <BRepPrimAPI_MakeSphere.hxx>
 #include <BRepTools.hxx>
 #include <BRep_Builder.hxx>
@@ -24,6 +25,7 @@
 #include <TopoDS_Wire.hxx>
 #include <cmath>
 #include <gp_Ax2.hxx>
+#include <gp_Vec.hxx>
 #include <stdexcept>
 #include <string_view>
 #include <vector>
@@ -152,6 +154,21 @@ std::string write_half_disk(double radius, const std::string& path) {
   wire.Add(BRepBuilderAPI_MakeEdge(gp_Pnt(-r, 0, 0), gp_Pnt(r, 0, 0)).Edge());
   if (!wire.IsDone()) throw std::runtime_error("half disk wire construction failed");
   return write_planar_face(wire.Wire(), "half disk", path);
+}
+
+std::string write_l_prism(const std::string& path) {
+  BRepBuilderAPI_MakePolygon poly;
+  for (const auto& [x, y] :
+       std::vector<std::pair<double, double>>{{0, 0}, {8, 0}, {8, 3}, {3, 3}, {3, 6}, {0, 6}})
+    poly.Add(gp_Pnt(x, y, 0));
+  poly.Close();
+  const TopoDS_Face base = BRepBuilderAPI_MakeFace(poly.Wire(), /*OnlyPlane=*/true).Face();
+  const TopoDS_Shape prism = BRepPrimAPI_MakePrism(base, gp_Vec(0, 0, 2)).Shape();
+  STEPControl_Writer w;
+  if (w.Transfer(prism, STEPControl_AsIs) != IFSelect_RetDone ||
+      w.Write(path.c_str()) != IFSelect_RetDone)
+    throw std::runtime_error("cannot write " + path);
+  return path;
 }
 
 std::string write_filleted_box(const std::string& path) {

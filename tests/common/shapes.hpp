@@ -41,6 +41,9 @@ std::string write_half_annulus(double inner, double outer, const std::string& pa
 /// Writes the planar half disk of this radius about the origin, y >= 0: two curves (the arc and
 /// the diameter) joining the same two corners.
 std::string write_half_disk(double radius, const std::string& path);
+/// Writes the L-shaped prism: the hexagon (0,0) (8,0) (8,3) (3,3) (3,6) (0,6) extruded by 2 along
+/// z: two six-sided faces (z = 0 and z = 2) and six rectangles, as STEP.
+std::string write_l_prism(const std::string& path);
 /// Writes a box with filleted edges (radius 1), as STEP.
 std::string write_filleted_box(const std::string& path);
 /// Writes a T of three plates meeting along one curve (non-manifold: three faces border it): the

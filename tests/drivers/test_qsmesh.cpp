@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <sstream>
 #include <string>
 #include <vector>
@@ -493,16 +494,120 @@ TEST_F(Qsmesh, SizeMapWritesFieldsAndHonoursPrescriptions) {
     EXPECT_EQ(run("sizemap " + model_ + " -o " + out + " --size 0.8 -q --sizemap " + method).code,
               0)
         << method;
-  // An odd prescription cannot be honoured yet: refused, nothing written.
+  // An odd prescription is kept too (the loops through curve 0 stay even by other curves).
   const std::string odd_out = tmp("e2e_sm_odd.vtu");
-  const ExeResult odd = run("sizemap " + model_ + " -o " + odd_out + " --curve-edges 0:7");
-  EXPECT_EQ(odd.code, 2);
-  EXPECT_EQ(lines(odd.err), 1) << odd.err;
-  EXPECT_NE(odd.err.find("even"), std::string::npos) << odd.err;
-  EXPECT_FALSE(fs::exists(odd_out));
+  const std::string odd_stats = tmp("e2e_sm_odd.json");
+  const ExeResult odd = run("sizemap " + model_ + " -o " + odd_out +
+                            " --size 0.8 -q --curve-edges 0:7 --stats " + odd_stats);
+  ASSERT_EQ(odd.code, 0) << odd.err;
+  const std::string odd_json = slurp(odd_stats);
+  const auto odd_list = odd_json.find("\"curve_edges\": [");
+  ASSERT_NE(odd_list, std::string::npos) << odd_json;
+  EXPECT_EQ(odd_json.substr(odd_json.find_first_not_of(" \n", odd_list + 16), 2), "7,")
+      << odd_json.substr(odd_list, 60);
   const ExeResult bad_id = run("sizemap " + model_ + " -o " + odd_out + " --curve-edges 100000:8");
   EXPECT_EQ(bad_id.code, 2);
   EXPECT_NE(bad_id.err.find("curve 100000 does not exist"), std::string::npos) << bad_id.err;
+}
+
+// Edges per curve of a .msh file (4.1): the element blocks of dimension 1, by curve id (tag - 1).
+std::map<int, int> msh_curve_edges(const std::string& msh) {
+  std::map<int, int> out;
+  std::istringstream in(msh.substr(msh.find("$Elements")));
+  std::string line;
+  std::getline(in, line);  // $Elements
+  std::size_t blocks = 0, total = 0, lo = 0, hi = 0;
+  in >> blocks >> total >> lo >> hi;
+  for (std::size_t b = 0; b < blocks; ++b) {
+    int dim = 0, tag = 0, type = 0;
+    std::size_t n = 0;
+    in >> dim >> tag >> type >> n;
+    std::getline(in, line);
+    for (std::size_t i = 0; i < n; ++i) std::getline(in, line);
+    if (dim == 1) out[tag - 1] += static_cast<int>(n);
+  }
+  return out;
+}
+
+// Odd --curve-edges (issue 29): on an L-shaped prism, three curves of the bottom loop (a
+// six-sided face) are prescribed 7, 5 and 9 (an odd sum: another curve of the loop turns odd)
+// and a vertical curve 3 (every side rectangle is four-sided: its opposite side takes 3 too).
+// All are kept exactly, the mesh is all quads and conforming; a loop whose curves are all
+// prescribed to an odd total is refused before any work, naming it.
+TEST_F(Qsmesh, OddCurveEdgesAreHonouredOrRefusedByLoop) {
+  const std::string model = qsmesh::test::write_l_prism(tmp("e2e_l_prism.step"));
+  const qsmesh::cad::CadModel cad = qsmesh::cad::load_cad(model);
+  // Curves by their corners' points.
+  const auto curve_between = [&](qsmesh::Vec3 a, qsmesh::Vec3 b) {
+    for (qsmesh::LO c = 0; c < cad.num_curves(); ++c) {
+      const auto& cv = cad.curves()[c];
+      const auto p = cad.corners()[cv.corners[0]].point, q = cad.corners()[cv.corners[1]].point;
+      if ((distance(p, a) < 1e-6 && distance(q, b) < 1e-6) ||
+          (distance(p, b) < 1e-6 && distance(q, a) < 1e-6))
+        return static_cast<int>(c);
+    }
+    ADD_FAILURE() << "no curve";
+    return -1;
+  };
+  const int a = curve_between({0, 0, 0}, {8, 0, 0}), b = curve_between({8, 0, 0}, {8, 3, 0});
+  const int c = curve_between({0, 6, 0}, {0, 0, 0}), v = curve_between({8, 3, 0}, {8, 3, 2});
+  const int a_top = curve_between({0, 0, 2}, {8, 0, 2}),
+            b_top = curve_between({8, 0, 2}, {8, 3, 2});
+  const std::string prescribed = std::to_string(a) + ":7," + std::to_string(b) + ":5," +
+                                 std::to_string(c) + ":9," + std::to_string(v) + ":3";
+  const auto [r, json] =
+      mesh_with_stats(model, "--size 0.5 --curve-edges " + prescribed, "e2e_odd_edges");
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(json_number(json, "triangles"), 0);
+  EXPECT_NE(json.find("\"conforming\": true"), std::string::npos);
+  EXPECT_GT(json_number(json, "sicn_min"), 0.3);
+  EXPECT_GT(json_number(json, "sicn_avg"), 0.8);
+  const auto edges = msh_curve_edges(slurp(tmp("e2e_odd_edges.msh")));
+  EXPECT_EQ(edges.at(a), 7);
+  EXPECT_EQ(edges.at(b), 5);
+  EXPECT_EQ(edges.at(c), 9);
+  EXPECT_EQ(edges.at(a_top), 7);  // opposite sides of the side rectangles
+  EXPECT_EQ(edges.at(b_top), 5);
+  int bottom = 0, odd_free = 0;
+  for (int k = 0; k < cad.num_curves(); ++k) {
+    const auto& cv = cad.curves()[k];
+    const double z0 = cad.corners()[cv.corners[0]].point.z,
+                 z1 = cad.corners()[cv.corners[1]].point.z;
+    if (z0 != z1) {
+      EXPECT_EQ(edges.at(k), 3) << "vertical curve " << k;
+    }
+    if (z0 == 0 && z1 == 0) {
+      bottom += edges.at(k);
+      odd_free += (k != a && k != b && k != c && edges.at(k) % 2 != 0) ? 1 : 0;
+    }
+  }
+  EXPECT_EQ(bottom % 2, 0);
+  EXPECT_EQ(odd_free, 1);  // 7 + 5 + 9 is odd: one more curve of the loop took an odd count
+
+  // The whole bottom loop prescribed to 27 edges: refused in one line, nothing written.
+  std::string all;
+  qsmesh::LO bottom_face = -1;
+  for (qsmesh::LO f = 0; f < cad.num_faces(); ++f)
+    if (cad.faces()[f].loops[0].uses.size() == 6 &&
+        cad.corners()[cad.curves()[cad.faces()[f].loops[0].uses[0].curve].corners[0]].point.z == 0)
+      bottom_face = f;
+  ASSERT_NE(bottom_face, -1);
+  for (const auto& use : cad.faces()[bottom_face].loops[0].uses) {
+    const bool first = all.empty();
+    if (!first) all += ',';
+    all += std::to_string(use.curve);
+    all += first ? ":7" : ":4";
+  }
+  const std::string out = tmp("e2e_odd_refused.msh");
+  const ExeResult refused =
+      run("mesh " + model + " -o " + out + " --size 0.5 --curve-edges " + all);
+  EXPECT_EQ(refused.code, 2);
+  EXPECT_EQ(lines(refused.err), 1) << refused.err;
+  EXPECT_NE(refused.err.find("face " + std::to_string(bottom_face) + " (loop 0)"),
+            std::string::npos)
+      << refused.err;
+  EXPECT_NE(refused.err.find("sum to 27 edges"), std::string::npos) << refused.err;
+  EXPECT_FALSE(fs::exists(out));
 }
 
 // The size-map controls of `sizemap` act on `qsmesh mesh` too.

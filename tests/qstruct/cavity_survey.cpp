@@ -75,12 +75,7 @@ int main(int argc, char** argv) {
     const TaskArena tasks(args.threads);
     const test::SurveyRun run = test::run_survey_pipeline(model, size_factor, /*cross_fields=*/true, tasks);
     const parallel::PipelineResult& result = run.result;
-    const parallel::PipelineOptions& options = run.options;
     const double size = run.size;
-    const std::vector<mesh::CurveMesh> curves =
-        background::mesh_curves(model, options.background.sizes, tasks);
-    const std::vector<mesh::CurveMesh> halved = quantize::place_vertices(
-        model, curves, result.curve_sizes.at, result.quantization, /*halved=*/true, tasks);
     quad::UnstructuredOptions qo;
     qo.size = size;
 
@@ -94,8 +89,8 @@ int main(int argc, char** argv) {
     const LO nf = std::min(first, model.num_faces());
     for (LO f = 0; f < nf; ++f) {
       quad::UnstructuredReport ur;
-      const mesh::FaceMesh in =
-          quad::mesh_face_unstructured(model, f, halved, result.quantized_curves, quad::FaceFields{}, qo, &ur);
+      const mesh::FaceMesh in = quad::mesh_face_unstructured(model, f, result.quantized_curves,
+                                                             quad::FaceFields{}, qo, &ur);
       if (in.quads.empty()) continue;
       const auto surface = model.face_geometry(f);
       std::vector<crossfield::Singularity> s;

@@ -138,7 +138,7 @@ mesh::FaceMesh run_face(const cad::CadModel& model, const Prepared& p, Unstructu
   FaceFields fields{&p.background, &p.cf, p.sizes};
   UnstructuredOptions options;
   options.size = p.sizes.front();
-  return mesh_face_unstructured(model, 0, p.halved, p.full, fields, options, &rep);
+  return mesh_face_unstructured(model, 0, p.full, fields, options, &rep);
 }
 
 // What frontal_points needs on a disk of radius 3 with a uniform size map `size`. Not copyable:
@@ -312,7 +312,8 @@ TEST(Unstructured, DiskHasIrregularVerticesAtTheSingularitiesAndFewerThanWithout
   UnstructuredOptions options;
   options.size = size;
   UnstructuredReport plain_rep;
-  const mesh::FaceMesh plain = mesh_face_unstructured(model, 0, p.halved, p.full, FaceFields{}, options, &plain_rep);
+  const mesh::FaceMesh plain =
+      mesh_face_unstructured(model, 0, p.full, FaceFields{}, options, &plain_rep);
   const auto plain_irr = irregular_interior(plain);
   std::printf("[frontal] disk without cross field: %zu quads, %zu irregular interior vertices\n", plain.quads.size(),
               plain_irr.size());
@@ -370,7 +371,7 @@ TEST(Unstructured, WithoutCrossFieldFallsBackToTheUniformPath) {
   UnstructuredOptions options;
   options.size = 0.25;
   UnstructuredReport rep;
-  const mesh::FaceMesh m = mesh_face_unstructured(model, 0, p.halved, p.full, FaceFields{}, options, &rep);
+  const mesh::FaceMesh m = mesh_face_unstructured(model, 0, p.full, FaceFields{}, options, &rep);
   EXPECT_TRUE(rep.ok) << rep.error;
   EXPECT_FALSE(rep.frontal);
   EXPECT_TRUE(rep.fell_back);

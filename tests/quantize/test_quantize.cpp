@@ -12,6 +12,7 @@
 #include <iostream>
 #include <map>
 #include <set>
+#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -190,19 +191,230 @@ TEST(Quantize, PrescribedEvenCountFixesItsChord) {
   EXPECT_EQ(odd.edges[partner], 7);
 }
 
-TEST(Quantize, OddPrescriptionIsRefused) {
-  const auto& model = box();
+// Every loop of every face even, and every stretch of a loop between two of its poles: what
+// midpoint subdivision of the halved boundaries needs.
+void expect_even_loops(const cad::CadModel& model, const Quantization& q, const char* what) {
+  for (LO f = 0; f < model.num_faces(); ++f)
+    for (std::size_t l = 0; l < model.faces()[f].loops.size(); ++l) {
+      const auto& uses = model.faces()[f].loops[l].uses;
+      int sum = 0;
+      std::vector<int> between_poles{0};
+      for (const auto& use : uses) {
+        sum += q.edges[use.curve];
+        if (model.curves()[use.curve].degenerate)
+          between_poles.push_back(0);
+        else
+          between_poles.back() += q.edges[use.curve];
+      }
+      EXPECT_EQ(sum % 2, 0) << what << ": face " << f << " loop " << l;
+      if (between_poles.size() > 2) {
+        between_poles.front() += between_poles.back();  // the stretch through the loop's start
+        between_poles.pop_back();
+        for (const int s : between_poles) EXPECT_EQ(s % 2, 0) << what << ": face " << f;
+      }
+    }
+}
+
+const cad::CadModel& pentagon() {
+  static const cad::CadModel model =
+      polygon_face({{0, 0}, {10, 0}, {12, 5}, {5, 9}, {-2, 5}}, "q_pentagon.brep");
+  return model;
+}
+
+TEST(Quantize, OddPrescriptionsOnTwoCurvesOfOneLoopAreKept) {
+  const auto& model = pentagon();
+  const auto ideal = ideal_by_use(model, {6.2, 8.1, 5.9, 7.0, 6.4});
+  const auto loop = loop_curves(model);
+  EXPECT_EQ(edges_by_use(model, quantize_curves(model, ideal, {})),
+            (std::vector<int>{6, 8, 6, 8, 6}));
   QuantizeOptions options;
-  options.prescribed = {{3, 7}};
-  try {
-    (void)quantize_curves(model, box_ideals(model), options);
-    FAIL() << "odd prescription accepted";
-  } catch (const InputError& e) {
-    EXPECT_STREQ(
-        e.what(),
-        "curve 3: 7 edges prescribed, but all-quad meshing by midpoint subdivision needs an "
-        "even count (odd counts are not supported yet)");
+  // Two odd counts: the loop is even as it stands, the other curves keep their even counts.
+  options.prescribed = {{loop[0], 7}, {loop[2], 5}};
+  const Quantization two = quantize_curves(model, ideal, options);
+  EXPECT_EQ(edges_by_use(model, two), (std::vector<int>{7, 8, 5, 8, 6}));
+  // One odd count: the curve that changes least for it takes an odd count too (7.0 ideal: 7).
+  options.prescribed = {{loop[0], 7}};
+  const Quantization one = quantize_curves(model, ideal, options);
+  EXPECT_EQ(edges_by_use(model, one), (std::vector<int>{7, 8, 6, 7, 6}));
+  // Without parity (odd counts everywhere allowed) nothing is adjusted.
+  options.even = false;
+  EXPECT_EQ(edges_by_use(model, quantize_curves(model, ideal, options)),
+            (std::vector<int>{7, 8, 6, 7, 6}));
+}
+
+TEST(Quantize, OddCountOnAFourSidedFaceIsHonouredByItsOppositeSide) {
+  const auto& model = rectangle();
+  const auto loop = loop_curves(model);
+  QuantizeOptions options;
+  options.prescribed = {{loop[1], 5}};
+  // Joined opposite sides (a chord): the opposite side takes the prescription.
+  const Quantization joined =
+      quantize_curves(model, ideal_by_use(model, {9.4, 4.1, 10.6, 3.9}), options);
+  EXPECT_EQ(edges_by_use(model, joined), (std::vector<int>{10, 5, 10, 5}));
+  // Sides too different to be joined (3.1 against 7.4 ideal edges): parity alone makes the
+  // opposite side odd, at the odd count nearest its ideal, rather than a long side.
+  options.prescribed = {{loop[1], 3}};
+  const Quantization apart =
+      quantize_curves(model, ideal_by_use(model, {10.2, 3.1, 9.8, 7.4}), options);
+  EXPECT_EQ(apart.curve2chord[loop[1]], kNoIndex);
+  EXPECT_EQ(edges_by_use(model, apart), (std::vector<int>{10, 3, 10, 7}));
+}
+
+TEST(Quantize, OddPrescriptionsOnABoxKeepEveryLoopEven) {
+  const auto& model = box();
+  const auto ideal = box_ideals(model);
+  const Quantization free = quantize_curves(model, ideal, {});
+  // Curve 0 and a curve of another chord, both odd.
+  LO other = kNoIndex;
+  for (LO c = 1; c < model.num_curves() && other == kNoIndex; ++c)
+    if (free.curve2chord[c] != free.curve2chord[0]) other = c;
+  ASSERT_NE(other, kNoIndex);
+  QuantizeOptions options;
+  options.prescribed = {{0, 7}, {other, 5}};
+  const Quantization q = quantize_curves(model, ideal, options);
+  EXPECT_EQ(q.edges[0], 7);
+  EXPECT_EQ(q.edges[other], 5);
+  for (LO c = 0; c < model.num_curves(); ++c) {
+    if (q.curve2chord[c] == q.curve2chord[0]) {
+      EXPECT_EQ(q.edges[c], 7) << "curve " << c;
+    }
+    if (q.curve2chord[c] == q.curve2chord[other]) {
+      EXPECT_EQ(q.edges[c], 5) << "curve " << c;
+    }
   }
+  expect_even_loops(model, q, "box");
+  EXPECT_NO_THROW(check_prescription_parity(model, options.prescribed));
+}
+
+// The message of quantize_curves and of check_prescription_parity for `prescribed`.
+std::pair<std::string, std::string> refusals(const cad::CadModel& model,
+                                             const std::vector<std::pair<LO, int>>& prescribed,
+                                             const std::vector<double>& ideal) {
+  std::pair<std::string, std::string> out;
+  QuantizeOptions options;
+  options.prescribed = prescribed;
+  try {
+    (void)quantize_curves(model, ideal, options);
+  } catch (const InputError& e) {
+    out.first = e.what();
+  }
+  try {
+    check_prescription_parity(model, prescribed);
+  } catch (const InputError& e) {
+    out.second = e.what();
+  }
+  return out;
+}
+
+TEST(Quantize, OddPrescriptionNoEvenLoopCanHoldIsRefusedNamingTheLoop) {
+  // A triangle whose three curves are prescribed 7, 4 and 4: an odd loop whatever happens.
+  const auto tri = polygon_face({{0, 0}, {10, 0}, {4, 7}}, "q_triangle.brep");
+  const auto loop = loop_curves(tri);
+  const auto ideal = ideal_by_use(tri, {8, 8, 8});
+  std::vector<std::pair<LO, int>> all{{loop[0], 7}, {loop[1], 4}, {loop[2], 4}};
+  const auto [late, early] = refusals(tri, all, ideal);
+  std::ostringstream want;
+  std::vector<LO> sorted = loop;
+  std::sort(sorted.begin(), sorted.end());
+  std::map<LO, int> count{{loop[0], 7}, {loop[1], 4}, {loop[2], 4}};
+  want << "face 0 (loop 0): its prescribed curves " << sorted[0] << ":" << count[sorted[0]] << ", "
+       << sorted[1] << ":" << count[sorted[1]] << ", " << sorted[2] << ":" << count[sorted[2]]
+       << " sum to 15 edges and no other curve of it can make the count even; all-quad meshing "
+          "by midpoint subdivision needs an even count on every loop";
+  EXPECT_EQ(late, want.str());
+  EXPECT_EQ(early, want.str());
+  // Two of them prescribed: the third takes what the loop needs.
+  QuantizeOptions options;
+  options.prescribed = {{loop[0], 7}, {loop[1], 4}};
+  EXPECT_EQ(quantize_curves(tri, ideal, options).edges[loop[2]] % 2, 1);
+  // Two faces of a box sharing the one curve that neither prescribes: the first needs it odd, the
+  // second even. No single loop is at fault; the message names both.
+  const auto& box_model = box();
+  const auto& faces = box_model.faces();
+  LO shared = kNoIndex, other_face = kNoIndex;
+  for (LO g = 1; g < box_model.num_faces() && shared == kNoIndex; ++g)
+    for (const auto& u : faces[0].loops[0].uses)
+      for (const auto& w : faces[g].loops[0].uses)
+        if (u.curve == w.curve) {
+          shared = u.curve;
+          other_face = g;
+        }
+  ASSERT_NE(shared, kNoIndex);
+  std::vector<std::pair<LO, int>> split;
+  int k = 0;
+  for (const LO f : {LO{0}, other_face})
+    for (const auto& u : faces[f].loops[0].uses)
+      if (u.curve != shared) split.emplace_back(u.curve, f == 0 && k++ == 0 ? 3 : 2);
+  try {
+    check_prescription_parity(box_model, split);
+    ADD_FAILURE() << "two loops of opposite needs accepted";
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_EQ(msg.rfind("the loops of face 0 (loop 0), face " + std::to_string(other_face) +
+                            " (loop 0) cannot all have even counts",
+                        0),
+              0u)
+        << msg;
+    EXPECT_NE(msg.find("(13 edges)"), std::string::npos) << msg;
+  }
+}
+
+TEST(Quantize, SeamBetweenTwoPolesMustBeEven) {
+  // A sphere: one loop (seam, pole, seam, pole); each pole must sit on a halved vertex, so the
+  // seam's count alone must be even.
+  const auto sphere = cad::load_cad(test::write_sphere(tmp("q_sphere.brep")));
+  LO seam = kNoIndex;
+  for (LO c = 0; c < sphere.num_curves(); ++c)
+    if (!sphere.curves()[c].degenerate) seam = c;
+  ASSERT_NE(seam, kNoIndex);
+  const auto [late, early] =
+      refusals(sphere, {{seam, 7}}, std::vector<double>(sphere.num_curves(), 6.0));
+  EXPECT_NE(late.find("between two poles"), std::string::npos) << late;
+  EXPECT_EQ(late, early);
+  EXPECT_TRUE(
+      refusals(sphere, {{seam, 8}}, std::vector<double>(sphere.num_curves(), 6.0)).first.empty());
+}
+
+TEST(Quantize, CylinderTakesAnOddCircleOnBothOfItsCircles) {
+  // The side of a cylinder: its loop holds both circles once and the seam twice, so an odd
+  // bottom circle makes the top one odd; each disk, though, is bounded by its circle alone.
+  const auto cyl = cad::load_cad(test::write_cylinder(tmp("q_cyl.brep")));
+  LO circle = kNoIndex;
+  for (LO c = cyl.num_curves() - 1; c >= 0; --c)
+    if (cyl.curves()[c].corners[0] == cyl.curves()[c].corners[1] && !cyl.curves()[c].degenerate)
+      circle = c;
+  ASSERT_NE(circle, kNoIndex);
+  const auto [late, early] =
+      refusals(cyl, {{circle, 9}}, std::vector<double>(cyl.num_curves(), 8.0));
+  EXPECT_NE(late.find("(loop 0)"), std::string::npos) << late;
+  EXPECT_EQ(late, early);
+}
+
+TEST(Quantize, SliversTakeOneEdgeWithTheOption) {
+  // A strip 10 x 0.3 sized 1: its ends are slivers (0.3 ideal edges).
+  const auto strip = polygon_face({{0, 0}, {10, 0}, {10, 0.3}, {0, 0.3}}, "q_strip.brep");
+  const auto ideal = ideal_by_use(strip, {10.0, 0.3, 10.0, 0.3});
+  EXPECT_EQ(edges_by_use(strip, quantize_curves(strip, ideal, {})),
+            (std::vector<int>{10, 2, 10, 2}));
+  QuantizeOptions options;
+  options.odd_slivers = true;
+  EXPECT_EQ(edges_by_use(strip, quantize_curves(strip, ideal, options)),
+            (std::vector<int>{10, 1, 10, 1}));
+  // A pentagon with one sliver: another curve becomes odd with it.
+  const auto& model = pentagon();
+  const auto pent = ideal_by_use(model, {6.2, 0.4, 5.9, 7.0, 6.4});
+  const Quantization q = quantize_curves(model, pent, options);
+  EXPECT_EQ(edges_by_use(model, q), (std::vector<int>{6, 1, 6, 7, 6}));
+  expect_even_loops(model, q, "pentagon with a sliver");
+}
+
+TEST(Quantize, RefinementKeepsEachCountsParity) {
+  Quantization q;
+  q.edges = {7, 4, 1};
+  q.curve2chord = {kNoIndex, kNoIndex, kNoIndex};
+  refine_curves(q, std::vector<LO>{0, 1, 2});
+  EXPECT_EQ(q.edges, (std::vector<int>{15, 8, 3}));
+  EXPECT_EQ(q.total_edges, 26);
 }
 
 TEST(Quantize, ConflictingPrescriptionsAreRefused) {

@@ -61,7 +61,6 @@ void run_model(const std::string& name, double size_factor) {
   const auto q =
       quantize::quantize_curves(model, quantize::ideal_edge_counts(curves, united.at), {});
   const auto full = quantize::place_vertices(model, curves, united.at, q, false, one);
-  const auto halved = quantize::place_vertices(model, curves, united.at, q, true, one);
   quad::UnstructuredOptions qo;
   qo.size = bo.sizes.size;
 
@@ -71,7 +70,8 @@ void run_model(const std::string& name, double size_factor) {
   double sicn_min_before = 1, sicn_min_after = 1;
   for (LO f = 0; f < model.num_faces(); ++f) {
     quad::UnstructuredReport report;
-    const mesh::FaceMesh m = quad::mesh_face_unstructured(model, f, halved, full, quad::FaceFields{}, qo, &report);
+    const mesh::FaceMesh m =
+        quad::mesh_face_unstructured(model, f, full, quad::FaceFields{}, qo, &report);
     if (!report.ok || !m.triangles.empty() || m.quads.empty()) continue;
     const auto surface = model.face_geometry(f);
     DiskRemeshStats stats;

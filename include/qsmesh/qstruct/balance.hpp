@@ -46,9 +46,10 @@ struct BalanceReport {
   int passes = 0;
 };
 
-/// Takes the quantization q of the model (even counts, chords of Sec. 4.3) and returns new edge
+/// Takes the quantization q of the model (even loops, chords of Sec. 4.3) and returns new edge
 /// counts, one per curve, such that
-///  - every count stays even, at least 2 (4 on a closed curve), and the curves of one chord of q
+///  - every count moves by even steps (every loop stays even; an odd count stays odd), at least
+///    2 (4 on a closed curve; one less for an odd count), and the curves of one chord of q
 ///    stay equal (a chord moves as one variable); curves in `fixed` (user prescriptions) and
 ///    degenerate curves keep their count;
 ///  - faces with one closed loop, no degenerate curve and 2..6 sides (split at the corners below

@@ -3,7 +3,9 @@
 
 #include <array>
 #include <cstdint>
+#include <map>
 #include <span>
+#include <utility>
 
 #include "qsmesh/core/types.hpp"
 #include "qsmesh/mesh/surface_mesh.hpp"
@@ -56,9 +58,12 @@ struct RecombineStats {
 /// Returns the mesh with the same vertices (points, uv, classification unchanged), the input quads
 /// followed by the new ones (each oriented like its triangles), and the remaining triangles in
 /// their input order. Deterministic. Throws qsmesh::Error when `directions` has the wrong size.
-[[nodiscard]] mesh::FaceMesh recombine(const mesh::FaceMesh& mesh,
-                                       std::span<const std::array<Vec3, 2>> directions,
-                                       const RecombineOptions& options,
-                                       RecombineStats* stats = nullptr);
+/// `corner_mids` (optional): the corners that subdivision will put at the middle of boundary
+/// edges (quad::corner_midpoints, for loops with odd counts), by sorted vertex pair; the angle
+/// of a corner on the curves is then measured to that corner, as the sub-quad will have it.
+[[nodiscard]] mesh::FaceMesh recombine(
+    const mesh::FaceMesh& mesh, std::span<const std::array<Vec3, 2>> directions,
+    const RecombineOptions& options, RecombineStats* stats = nullptr,
+    const std::map<std::pair<LO, LO>, Vec3>* corner_mids = nullptr);
 
 }  // namespace qsmesh::quad

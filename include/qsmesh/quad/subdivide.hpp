@@ -2,8 +2,11 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <span>
+#include <utility>
 
+#include "qsmesh/background/face_mesh.hpp"
 #include "qsmesh/cad/geometry.hpp"
 #include "qsmesh/mesh/surface_mesh.hpp"
 
@@ -15,6 +18,13 @@ struct SubdivideStats {
   std::int64_t flat_boundary_splits = 0;  ///< strips re-triangulated at flat boundary vertices
 };
 
+/// The corners that subdivide puts at the middle of boundary edges of `mesh` (where a loop has
+/// an odd count up to the corner: see background::halved_face_boundary), by sorted vertex pair
+/// of the edge. Empty when every loop of the face has corners on halved vertices only (all
+/// counts even). Throws what subdivide throws on an edge it cannot match.
+[[nodiscard]] std::map<std::pair<LO, LO>, Vec3> corner_midpoints(
+    const mesh::FaceMesh& mesh, const background::HalvedBoundary& boundary);
+
 /// Midpoint subdivision (paper 000 Sec. 5.2): each quad into 4 quads, each triangle into 3.
 /// New vertices are the edge midpoints and the element centres.
 ///  - First, a triangle (A, X, B) whose two edges at the boundary vertex X are boundary edges
@@ -22,26 +32,31 @@ struct SubdivideStats {
 ///    angle, which nothing can make valid. Such triangles form strips along slightly concave
 ///    boundaries; the strip (grown across its one interior edge, at most 8 triangles) up to the
 ///    first triangle with a vertex Z inside the face is triangulated again as a fan from Z, when
-///    every fan triangle is oriented like the old ones in (u, v). Counted in stats->flat_boundary_splits; the element counts do not change.
-///  - `mesh` is a face mesh whose boundary lies on the halved curve meshes
-///  (quantize::place_vertices
-///    with halved = true); `full_curves` are the full meshes of all curves (halved = false),
-///    indexed by curve id, with twice the edges.
-///  - A boundary edge (used by one element) on curve c between halved vertices i and i+1 gets
-///    vertex 2i+1 of full_curves[c] (its t and point exactly, so every face sharing c gets the same
-///    point); its uv is interpolated along the edge in t and refined by projection.
-///    Curve vertices keep their classification with index doubled; corners are unchanged.
-///    A boundary edge of a degenerate curve (two copies of one corner) gets another copy of it.
+///    every fan triangle is oriented like the old ones in (u, v). Where a corner goes to the
+///    middle of XA or XB (corner_midpoints), the angle is measured to that corner. Counted in
+///    stats->flat_boundary_splits; the element counts do not change.
+///  - `mesh` is a face mesh whose boundary is `boundary` (background::halved_face_boundary of its
+///    face on `full_curves`, the final meshes of all curves, indexed by curve id): its curve
+///    vertices carry their index in the full curve mesh.
+///  - A boundary edge (used by one element) gets the full vertex its halved segment holds: on
+///    curve c, vertex k of full_curves[c] (its t and point exactly, so every face sharing c gets
+///    the same point), with uv interpolated along the edge in t and refined by projection; a
+///    corner where its loop has an odd count up to it, at its pcurve image (it gets two
+///    sub-quads); on a degenerate curve (two copies of one corner), another copy of it.
+///    The edge's segment is found by the classification of its ends, the nearest in (u, v)
+///    where several match (the banks of a seam). Curve vertices and corners keep their
+///    classification.
 ///  - Interior edge midpoints and centres are placed at the uv midpoint / centroid of the element's
 ///    corners (uv of the element's own vertex copies: the chart of the element at seams) and
 ///    evaluated with surface.eval; when such a point leaves an adjacent quad with SICN <= 0, it is
 ///    moved to the 3D midpoint / centroid projected with surface.project if that is better, and
 ///    counted in stats->snaps_reverted.
 /// Returns an all-quad FaceMesh oriented like the input: the old vertices first (same order), then
-/// the edge midpoints, then the centres. Throws qsmesh::Error when a boundary edge cannot be
-/// matched with full_curves (wrong or inconsistent curve meshes).
+/// the edge midpoints, then the centres. Throws qsmesh::Error when a boundary edge matches no
+/// segment of `boundary` or a curve vertex lies outside full_curves (inconsistent inputs).
 [[nodiscard]] mesh::FaceMesh subdivide(const mesh::FaceMesh& mesh, const cad::FaceGeometry& surface,
                                        std::span<const mesh::CurveMesh> full_curves,
+                                       const background::HalvedBoundary& boundary,
                                        SubdivideStats* stats = nullptr);
 
 }  // namespace qsmesh::quad

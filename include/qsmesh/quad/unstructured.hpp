@@ -88,9 +88,10 @@ struct UnstructuredReport {
   }
 };
 
-/// All-quad mesh of face f. `halved`: curve meshes with half the final edge counts (quantize::
-/// place_vertices(..., halved=true)); `full`: the final curve meshes, whose odd vertices the
-/// subdivision uses on the boundary. `fields`: the face's background mesh, cross field and size
+/// All-quad mesh of face f on `full`, the final curve meshes (every loop of the face even: see
+/// quantize::quantize_curves). The triangulation is made on the face's halved boundary
+/// (background::halved_face_boundary: every other full boundary vertex) and subdivided back onto
+/// the full one. `fields`: the face's background mesh, cross field and size
 /// map; with all three (and options.use_frontal) the triangulation is the frontal one (Sec. 5.1,
 /// spacing options.frontal.spacing_factor x size map) and the recombination is weighted by the
 /// cross at each triangle. If that path throws, or neither its recombined nor its subdivided
@@ -98,7 +99,6 @@ struct UnstructuredReport {
 /// options.size. Never throws for a face-level failure: the report says what happened and an
 /// empty mesh is returned when nothing valid could be made.
 [[nodiscard]] mesh::FaceMesh mesh_face_unstructured(const cad::CadModel& model, LO f,
-                                                    std::span<const mesh::CurveMesh> halved,
                                                     std::span<const mesh::CurveMesh> full,
                                                     const FaceFields& fields,
                                                     const UnstructuredOptions& options,

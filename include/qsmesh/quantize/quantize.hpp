@@ -30,9 +30,16 @@ struct QuantizeOptions {
   /// the size map asks (mambo_s34's fillets [62, 6, 62, 6]: arcs 1.51 long, ideal 4.0 edges, got
   /// 6 through a tapered face from arcs 3.14 long, ideal 6.3, and cells 0.5 x 0.25). Must be >= 1.
   double chord_length_ratio_limit = 2.0;
-  /// Final counts even: all-quad meshing by midpoint subdivision (paper 000 Sec. 5.2) halves them
-  /// before the quad mesher and subdivides afterwards.
+  /// Counts for all-quad meshing by midpoint subdivision (paper 000 Sec. 5.2), which halves each
+  /// face loop before the quad mesher and subdivides afterwards: every loop even (and every
+  /// stretch of a loop between two poles), not every curve. Curves are rounded to even counts,
+  /// then as few as possible move to the nearest odd count where prescriptions (or slivers)
+  /// make a loop odd. false: each curve the nearest integer, no parity.
   bool even = true;
+  /// With `even`: a free curve (or chord) whose ideal count is below sqrt 2 (nearer 1 edge than
+  /// 2 in ratio) takes 1 edge, and the loops it makes odd get a neighbouring curve odd too. A
+  /// strip between two such curves is then one quad across (a grid fill).
+  bool odd_slivers = false;
   /// When `even`, also make the halved meshes (place_vertices with halved = true) valid boundaries:
   /// closed curves at least 6 (3 before subdivision) and curves joining the same two corners at
   /// least 4 (2 before subdivision, so the two halved curves never coincide). Off by default: the
@@ -43,8 +50,10 @@ struct QuantizeOptions {
 struct Quantization {
   /// Per curve: the floating number of edges, integral of dl / s (from ideal_edge_counts).
   std::vector<double> ideal;
-  /// Per curve: the final number of edges. Even and >= 2 when options.even (>= 4 on closed curves);
-  /// >= 1 otherwise (>= 3 closed, >= 2 when another curve joins the same two corners).
+  /// Per curve: the final number of edges. When options.even: even and >= 2 (>= 4 on closed
+  /// curves) but for prescriptions and the curves that parity (or odd_slivers) makes odd, and
+  /// every face loop's sum even; >= 1 otherwise (>= 3 closed, >= 2 when another curve joins the
+  /// same two corners).
   /// Degenerate curves (poles): 0; place_vertices keeps their single background edge.
   std::vector<int> edges;
   /// Chord id per curve (0 .. num_chords-1, numbered by increasing smallest curve id), kNoIndex
@@ -66,7 +75,7 @@ struct Quantization {
                                                     std::span<const std::vector<double>> sizes);
 
 /// Paper 000 Sec. 4.3, topological constraints on quadrilateral patches, and Sec. 5.2 (even
-/// counts).
+/// loops).
 ///  - Chords: for every face with one loop of exactly four curve uses (a conformal four-sided
 ///  face),
 ///    uses 0-2 and 1-3 are opposite; each opposite pair of non-degenerate curves is joined
@@ -78,16 +87,34 @@ struct Quantization {
 ///  - Rounding: to the nearest even number when options.even (at least 2), else to the nearest
 ///    integer (at least 1); closed curves at least 4 (even) / 3; curves joining the same two
 ///    corners at least 2 each. A chord takes the largest minimum of its curves so it stays equal.
-///  - Prescriptions are kept exactly and fix their whole chord. InputError for: an unknown or
-///    degenerate curve, a count <= 0, an odd count while options.even ("curve C: N edges
-///    prescribed, but all-quad meshing by midpoint subdivision needs an even count (odd counts are
-///    not supported yet)"), two different counts in one chord (naming both curves), a count below
-///    what a closed curve (3) or a pair of curves joining the same corners (2) needs.
+///  - Prescriptions are kept exactly, odd ones too, and fix their whole chord.
+///  - Parity (options.even): every face loop must have an even count, and where a loop has two
+///    or more poles (degenerate curves), each stretch between two of them (background::
+///    halved_face_boundary keeps poles on halved vertices). Free chords and curves (and slivers
+///    with options.odd_slivers) change parity where a loop needs it: for each odd loop, the
+///    cheapest chain of curves shared with the next odd loop (or reaching an open boundary) in
+///    relative change of count, each moved to the nearest count of the other parity (a Gaussian
+///    elimination over GF(2) where no chain exists, through curves of three or more faces).
+///    Where the chords make that impossible, the chords without a prescription, then all
+///    chords, are given up (curve2chord says which are kept).
+///  - InputError for: an unknown or degenerate curve, a count <= 0, two different counts in one
+///    chord (naming both curves), a count below what a closed curve (3) or a pair of curves joining
+///    the same corners (2) needs, and prescriptions that leave a loop odd whatever the other
+///    curves take (the message names the loop, or the loops, and the prescribed curves in them;
+///    check_prescription_parity says the same before any work).
 /// `ideal` has one value per curve (model.num_curves()), finite and >= 0.
 /// Sequential and deterministic: the result depends only on the model, `ideal` and `options`.
 [[nodiscard]] Quantization quantize_curves(const cad::CadModel& model,
                                            std::span<const double> ideal,
                                            const QuantizeOptions& options);
+
+/// The parity check of quantize_curves for user prescriptions alone, before any sizes exist:
+/// throws InputError (the message quantize_curves would give) when the prescribed counts
+/// (curve id, count) leave some face loop, or stretch of a loop between two poles, odd whatever
+/// counts the other curves take. Unknown ids and counts <= 0 are skipped (quantize_curves
+/// refuses them). Whatever passes here, quantize_curves can meet.
+void check_prescription_parity(const cad::CadModel& model,
+                               std::span<const std::pair<LO, int>> prescribed);
 
 struct PlaceOptions {
   /// Opposite curves of the four-sided faces whose two pairs of opposite sides are joined in
@@ -111,10 +138,12 @@ struct PlaceOptions {
 
 /// Paper 000 Eq. 11: the final curve meshes, one per curve, indexed by curve id. Curve c gets
 /// n = q.edges[c] edges (n = q.edges[c] / 2 when `halved`: the meshes the quad mesher uses before
-/// midpoint subdivision; q.edges[c] must then be even). Vertex i sits where the integral of dl / s
-/// (s linear along the background polyline curves[c], as in ideal_edge_counts) reaches i/n of the
-/// total; its parameter is interpolated linearly between the two background vertices around it and
-/// its point is evaluated on the CAD curve (model.curve_geometry(c)). With
+/// midpoint subdivision when every count is even; q.edges[c] must then be even: the quad stage
+/// builds them per face from the full meshes with background::halved_face_boundary, which gives
+/// the same vertices for even counts and also handles odd ones). Vertex i sits where the integral
+/// of dl / s (s linear along the background polyline curves[c], as in ideal_edge_counts) reaches
+/// i/n of the total; its parameter is interpolated linearly between the two background vertices
+/// around it and its point is evaluated on the CAD curve (model.curve_geometry(c)). With
 /// options.align_chords, the curves of a set of aligned opposite sides (see PlaceOptions) use the
 /// set's mean profile instead of their own, sampled at options.profile_samples + 1 arc-length
 /// fractions and interpolated linearly; their vertex i sits where that profile reaches i/n, at
@@ -139,8 +168,14 @@ struct PlaceOptions {
 [[nodiscard]] std::vector<LO> crossing_curves(const cad::CadModel& model, LO f,
                                               std::span<const mesh::CurveMesh> curves);
 
-/// Doubles the count of each curve in `curves` and gives every curve of its chord at least that
-/// count (so chords stay equal), keeping counts even; updates total_edges. Curves without edges
+/// crossing_curves on the halved boundary of face f (background::halved_face_boundary of the
+/// final curve meshes `full`): a halved segment across a corner names both curves beside it.
+[[nodiscard]] std::vector<LO> crossing_curves_halved(const cad::CadModel& model, LO f,
+                                                     std::span<const mesh::CurveMesh> full);
+
+/// Doubles the count of each curve in `curves` (2n + 1 when n is odd, so that every loop keeps
+/// its parity) and gives every curve of its chord at least that count (so chords stay equal);
+/// updates total_edges. Curves without edges
 /// (degenerate), unknown ids and the chords of the curves in `fixed` (user prescriptions, kept
 /// exactly) are left alone.
 void refine_curves(Quantization& q, std::span<const LO> curves, std::span<const LO> fixed = {});
