@@ -11,9 +11,9 @@
 # run of the first configuration (one rank) with scripts/simulate_scaling.py (the faces' METIS
 # partitions from `qsmesh info --partition`, the costs of messages measured by scripts/mpi_costs.c
 # where mpicc exists), compares its predictions with the configurations run, and then --png plots
-# the predicted speedup instead.
+# the predicted speedup instead. --keep DIR keeps the runs' --stats (CONFIG.REPEAT.json) there.
 # Usage: scripts/scaling_study.sh MODEL [--size-factor F] [--until STAGE] [--configs "PxT ..."]
-#                                 [--repeat N] [--csv FILE] [--png FILE] [--simulate LIST]
+#                                 [--repeat N] [--csv FILE] [--png FILE] [--simulate LIST] [--keep DIR]
 #   defaults: --size-factor 0.02, --until quasi-structured, --configs "1x1 1x2 2x1" (and 2x2, 4x1,
 #   4x2, 8x1, 8x2, 16x1 where the machine has that many cores), --repeat 3.
 # Wall time is that of the whole command (mpiexec, loading and writing included); the median of an
@@ -22,7 +22,7 @@
 # nothing of scaling.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-usage() { sed -n '14,17p' "$0" | sed 's/^# \{0,1\}//' >&2; exit 2; }
+usage() { sed -n '15,18p' "$0" | sed 's/^# \{0,1\}//' >&2; exit 2; }
 [ $# -ge 1 ] || usage
 model=$1; shift
 [ -f "$model" ] || { echo "scaling_study: no such model file: $model" >&2; exit 2; }
@@ -32,6 +32,7 @@ repeat=3
 csv=
 png=
 simulate=
+keep=
 cores=$(nproc)
 configs=
 while [ $# -gt 0 ]; do
@@ -43,6 +44,7 @@ while [ $# -gt 0 ]; do
     --csv) csv=$2; shift 2 ;;
     --png) png=$2; shift 2 ;;
     --simulate) simulate=$2; shift 2 ;;
+    --keep) keep=$2; shift 2 ;;
     *) echo "scaling_study: unknown option $1" >&2; usage ;;
   esac
 done
@@ -84,6 +86,7 @@ for c in $configs; do
       -o "$out/$c.$k.msh" --size-factor "$factor" --until "$until" --threads "$t" -q \
       --stats "$out/$c.$k.json" >/dev/null
     read -r wall kb < <(tail -n1 "$out/time")
+    [ -z "$keep" ] || { mkdir -p "$keep" && cp "$out/$c.$k.json" "$keep/"; }
     echo "$c $k $wall $kb $out/$c.$k.json $out/$c.$k.msh" >> "$runs"
     # Only the first repeat's mesh is compared; drop the others to keep the folder small.
     [ "$k" -eq 1 ] || rm -f "$out/$c.$k.msh"
@@ -168,7 +171,7 @@ for c, rs in runs.items():
 PY
   base_stats=$(head -n1 "$out/medians.txt" | cut -d' ' -f2)
   ranks_list=$(echo "$simulate,$(cut -d' ' -f1 "$out/medians.txt" | tr '\n' ',')" | tr ',' '\n' |
-               sed -n 's/^\([0-9]*\).*/\1/p' | sort -nu | paste -sd, -)
+               sed -n 's/^\([0-9][0-9]*\).*/\1/p' | sort -nu | paste -sd, -)
   "$exe" info "$model" --json --partition "$ranks_list" --size-factor "$factor" > "$out/partitions.json"
   comm_args=()
   if command -v mpicc >/dev/null && mpicc -O2 -o "$out/mpi_costs" scripts/mpi_costs.c 2>/dev/null &&
@@ -187,7 +190,7 @@ PY
   [ -z "$csv" ] || cp "$out/simulated.csv" "${csv%.csv}.simulated.csv"
   if [ -n "$png" ]; then
     /usr/bin/python3 scripts/plot_table.py "$out/simulated.csv" -o "$png" --x "ranks x threads" \
-      --y "predicted speedup,ideal speedup,unlimited ranks speedup" \
+      --y "predicted speedup,unlimited ranks speedup,efficiency" \
       --title "$(basename "$model"), --size-factor $factor: simulated speedup against ${configs%% *}"
   fi
 elif [ -n "$png" ]; then

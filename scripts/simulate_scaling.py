@@ -89,8 +89,8 @@ def levels(p):
 class Run:
     """What the simulation reads of one --stats JSON."""
 
-    def __init__(self, stats, name="stats"):
-        if stats.get("ranks", 1) != 1:
+    def __init__(self, stats, name="stats", any_ranks=False):
+        if stats.get("ranks", 1) != 1 and not any_ranks:
             raise InputError(f"{name}: the base run must be on one rank (it has {stats['ranks']})")
         faces = stats.get("face_stats")
         if not faces or "stage_seconds" not in faces[0]:
@@ -107,10 +107,11 @@ class Run:
         self.improve_quads = [f["stage_seconds"].get("improvement_quads", 0) for f in self.faces]
         self.bytes = [f["stage_seconds"].get("bytes", 0) for f in self.faces]
         self.by_pattern = [f.get("method", "").startswith("pattern") for f in self.faces]
+        self.face_rank = [f.get("rank", 0) for f in self.faces]
 
 
 class Simulator:
-    def __init__(self, run, partitions=None, comm=None):
+    def __init__(self, run, partitions=None, comm=None, residual=None):
         self.run = run
         self.partitions = partitions or {}
         self.comm = dict(DEFAULT_COMM)
@@ -119,6 +120,10 @@ class Simulator:
         self.greedy = []  # rank counts partitioned greedily
         # What each stage spent outside its faces in the measured run.
         self.residual = {}
+        self.busy = []
+        if residual is not None:  # a replay: the base run's
+            self.residual = residual
+            return
         base = self.compute(1, run.threads)
         for s, v in run.seconds.items():
             self.residual[s] = max(0.0, v - base.get(s, 0.0)) if s in base else None
@@ -149,11 +154,14 @@ class Simulator:
         run = self.run
         part = self.partition(p)
         out = {}
+        self.busy = [0.0] * p  # each rank's own time in the split stages (rank_busy_seconds)
         for s in PARTITIONED:
             worst = 0.0
             for r in range(p):
                 mine = [run.t[s][f] for f in range(run.n) if part[f] == r]
-                worst = max(worst, list_schedule(mine, t)[0])
+                span = list_schedule(mine, t)[0]
+                self.busy[r] += span
+                worst = max(worst, span)
             out[s] = worst
         out.update(self.dealt(p, t, part, messages=False)[0])
         return out
@@ -177,8 +185,11 @@ class Simulator:
                         d += self.get_cost(run.bytes[f])
                     return d
                 return c
-            span, assigned, _ = list_schedule([cost(f) for f in order], p * t)
+            span, assigned, end = list_schedule([cost(f) for f in order], p * t)
             times[s] = span
+            if not messages:
+                for r in range(p):
+                    self.busy[r] += max(end[r * t:(r + 1) * t])
             if not messages or p == 1:
                 extra[s] = 0.0
                 continue
@@ -224,6 +235,12 @@ class Simulator:
                 v = measured  # rank 0 after the pipeline (statistics, writing, ...)
             out[s] = v
         return out
+
+    def imbalance(self, p, t):
+        """Predicted load imbalance (max / mean of the ranks' busy time, as --stats reports)."""
+        self.compute(p, t)
+        mean = sum(self.busy) / p
+        return max(self.busy) / mean if mean > 0 else 1.0
 
     def largest_faces(self):
         """The largest face's share of the per-face work, per stage and over the split stages."""
@@ -295,6 +312,7 @@ def main(argv):
         for c in reals:
             if c not in configs:
                 configs.append(c)
+        configs.sort(key=lambda c: (c[0] * c[1], c[1]))
         sim = Simulator(run, partitions, comm)
     except InputError as e:
         print(f"{TOOL}: {e}", file=sys.stderr)
@@ -343,11 +361,23 @@ def main(argv):
           f"{base_total / b:.2f}")
 
     status = 0
+    replayed = {}
+    for c, st in reals.items():
+        # The same rules on the real run's own per-face times and partition (face_stats' rank):
+        # what is left of the error is the per-face times' change between the runs.
+        try:
+            rr = Run(st, f"{c[0]}x{c[1]}", any_ranks=True)
+        except InputError:
+            continue
+        if rr.n != run.n:
+            continue
+        rs = Simulator(rr, {str(c[0]): rr.face_rank}, sim.comm, sim.residual)
+        replayed[c] = sum(rs.predict(*c).values())
     if reals:
         print()
-        print("| config | real total s | predicted s | error | " + " | ".join(
+        print("| config | real total s | predicted s | error | replayed s | error | load imbalance real / predicted | " + " | ".join(
             f"{s} real / predicted" for s in stages if s in PARTITIONED or s in DEALT) + " |")
-        print("|---|---|---|---|" + "---|" * sum(1 for s in stages if s in PARTITIONED or s in DEALT))
+        print("|---|---|---|---|---|---|---|" + "---|" * sum(1 for s in stages if s in PARTITIONED or s in DEALT))
         for c, st in reals.items():
             real_total = st["seconds"].get("total", 0.0)
             pred = totals[c]
@@ -356,7 +386,11 @@ def main(argv):
             for s in stages:
                 if s in PARTITIONED or s in DEALT:
                     cells.append(f"{st['seconds'].get(s, 0.0):.2f} / {preds[c][s]:.2f}")
-            print(f"| {c[0]}x{c[1]} | {real_total:.2f} | {pred:.2f} | {100 * err:+.1f}% | "
+            imb = f"{st.get('load_imbalance', 1.0):.2f} / {sim.imbalance(*c):.2f}"
+            rep = replayed.get(c)
+            rep_cells = (f"{rep:.2f} | {100 * (rep - real_total) / real_total:+.1f}%" if rep and real_total > 0
+                         else "- | -")
+            print(f"| {c[0]}x{c[1]} | {real_total:.2f} | {pred:.2f} | {100 * err:+.1f}% | {rep_cells} | {imb} | "
                   + " | ".join(cells) + " |")
     if args.csv:
         with open(args.csv, "w") as f:

@@ -96,6 +96,14 @@ class Stages(unittest.TestCase):
         # Patterns by expected quads: 4 faces of 0.1 on 3 workers -> 0.2.
         self.assertAlmostEqual(s.predict(3, 1)["patterns"], 0.2, places=6)
 
+    def test_imbalance(self):
+        # Ranks {0, 1} / {2, 3}: background 3 | 7, patterns (dealt by expected quads 40, 30, 20,
+        # 10: faces 1, 2, 3, 0) 0.2 | 0.2, unstructured 2 | 2, improvement (face 2 to rank 0, then
+        # faces 0 and 1 to rank 1) 4 | 2: busy 9.2 | 11.2, max / mean = 11.2 / 10.2.
+        s = sim.Simulator(self.run, partitions={"2": [0, 0, 1, 1]}, comm=NO_COMM)
+        self.assertAlmostEqual(s.imbalance(2, 1), 11.2 / 10.2, places=6)
+        self.assertAlmostEqual(s.imbalance(1, 2), 1.0)
+
     def test_messages_cost_time(self):
         comm = dict(NO_COMM, fetch_and_add_s=0.01, allreduce_s=0.001)
         s = sim.Simulator(self.run, partitions={"2": [0, 0, 1, 1]}, comm=comm)
