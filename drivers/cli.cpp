@@ -167,8 +167,10 @@ Arguments parse(const std::vector<std::string>& args) {
       return help_only;
     }
     if (opt == "-o" || opt == "--output") a.output = value();
-    else if (opt == "--size" && meshing) a.size = parse_positive(opt, value());
-    else if (opt == "--size-factor" && meshing) a.size_factor = parse_positive(opt, value());
+    else if (opt == "--size" && (meshing || a.command == Command::Info))
+      a.size = parse_positive(opt, value());
+    else if (opt == "--size-factor" && (meshing || a.command == Command::Info))
+      a.size_factor = parse_positive(opt, value());
     else if (opt == "--until" && a.command == Command::Mesh) a.until = value();
     else if (opt == "--threads") a.threads = parse_threads(value());
     else if (opt == "--face-time-budget" && a.command == Command::Mesh)
@@ -252,7 +254,27 @@ Arguments parse(const std::vector<std::string>& args) {
       a.max_quads = *n;
     } else if (opt == "--json" && a.command == Command::Info)
       a.json = true;
-    else if (opt == "--sew") a.sew = true;
+    else if (opt == "--partition" && a.command == Command::Info) {
+      const std::string& v = value();
+      std::size_t start = 0;
+      while (start <= v.size()) {
+        const std::size_t end = std::min(v.find(',', start), v.size());
+        const std::string item = v.substr(start, end - start);
+        std::size_t used = 0;
+        int p = 0;
+        try {
+          p = std::stoi(item, &used);
+        } catch (const std::exception&) {
+          used = 0;
+        }
+        if (used == 0 || used != item.size() || p < 1)
+          throw InputError(opt + ": '" + item +
+                           "' is not a number of ranks (e.g. --partition 2,4,64)");
+        a.partition.push_back(p);
+        start = end + 1;
+      }
+    } else if (opt == "--sew")
+      a.sew = true;
     else if (opt == "--quiet" || opt == "-q") a.quiet = true;
     else if (opt == "--verbose" || opt == "-v") a.verbose = true;
     else if (!opt.empty() && opt[0] == '-' && opt.size() > 1)
@@ -325,14 +347,20 @@ Arguments parse(const std::vector<std::string>& args) {
 std::string help(const std::string& topic) {
   std::ostringstream os;
   if (topic == "info") {
-    os << "usage: qsmesh info MODEL [--json] [--sew]\n\n"
+    os << "usage: qsmesh info MODEL [--json] [--sew] [--partition P,... [--size H | --size-factor "
+          "F]]\n\n"
           "Reads a CAD model (STEP .step/.stp, IGES .iges/.igs, BREP .brep/.brp) and prints its "
           "topology:\n"
           "the numbers of corners, curves and faces, the bounding box, and one line per face\n"
           "(surface type, loops, curve uses, seams, area).\n\n"
-          "  --json    print the same as one JSON object (keys: corners, curves, faces, face_list, "
-          "...)\n"
-          "  --sew     sew faces that arrive disconnected before building the topology\n";
+          "  --json           print the same as one JSON object (keys: corners, curves, faces, "
+          "face_list, ...)\n"
+          "  --sew            sew faces that arrive disconnected before building the topology\n"
+          "  --partition P,...  also the METIS partition of the faces over P ranks that\n"
+          "                   `mpirun -np P qsmesh mesh` uses at the same size (--size or "
+          "--size-factor,\n"
+          "                   default 0.02): per P, faces per rank and estimated cost max / mean;\n"
+          "                   with --json each face's rank (key partitions, by P)\n";
   } else if (topic == "mesh") {
     os << "usage: [mpirun -np P] qsmesh mesh MODEL -o OUT [options]\n\n"
           "Meshes every face of a CAD model and writes the surface mesh to OUT; the extension "

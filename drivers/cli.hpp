@@ -34,6 +34,9 @@ struct Arguments {
   /// (highorder::make_quadratic); 1: linear.
   int order = 1;
   bool json = false;                   ///< info --json
+  /// info --partition P,...: the METIS partition of the faces that `mpirun -np P qsmesh mesh`
+  /// with the same --size/--size-factor uses, for each P (scripts/simulate_scaling.py).
+  std::vector<int> partition;
   bool check = false;                  ///< crossfield --check
   std::string sizemap = "crossfield";  ///< --sizemap features|crossfield
   /// --sizing clamped|paper (gmsh: an alias of clamped, recorded as "clamped"). "clamped", the

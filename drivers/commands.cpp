@@ -29,6 +29,7 @@
 #include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/mesh/validate.hpp"
 #include "qsmesh/parallel/comm.hpp"
+#include "qsmesh/parallel/partition.hpp"
 #include "qsmesh/parallel/pipeline.hpp"
 #include "qsmesh/quantize/quantize.hpp"
 #include "qsmesh/sizemap/size_map.hpp"
@@ -113,6 +114,47 @@ std::int64_t trimmed_curves(const cad::CadModel& model) {
 
 int run_info(const Arguments& args) {
   const cad::CadModel model = cad::load_cad(args.model, cad::LoadOptions{args.sew, 0});
+  // --partition: the faces over P ranks as run_pipeline partitions them (same weights, same METIS
+  // call), at the size a mesh run with the same --size / --size-factor has.
+  const double size =
+      args.size ? *args.size : model.diagonal() * args.size_factor.value_or(kDefaultSizeFactor);
+  std::vector<std::vector<int>> parts;
+  std::vector<double> costs;
+  if (!args.partition.empty()) {
+    if (!(size > 0))
+      throw InputError("size: the model '" + args.model + "' has an empty bounding box");
+    costs = parallel::estimate_face_costs(model, size);
+    // METIS prints its complaints (more parts than a graph bisects well) on stdout, which holds
+    // the JSON: they go to stderr instead.
+    std::cout.flush();
+    std::fflush(stdout);
+    const int saved = ::dup(STDOUT_FILENO);
+    if (saved >= 0) ::dup2(STDERR_FILENO, STDOUT_FILENO);
+    for (const int p : args.partition)
+      parts.push_back(parallel::partition_faces(model.face2faces(), costs, p));
+    std::fflush(stdout);
+    if (saved >= 0) {
+      ::dup2(saved, STDOUT_FILENO);
+      ::close(saved);
+    }
+  }
+  // Per part: faces and estimated cost; returns "faces min-max, cost max / mean".
+  const auto balance = [&](int p, const std::vector<int>& part) {
+    std::vector<std::int64_t> n(static_cast<std::size_t>(p), 0);
+    std::vector<double> w(static_cast<std::size_t>(p), 0.0);
+    for (std::size_t f = 0; f < part.size(); ++f) {
+      ++n[static_cast<std::size_t>(part[f])];
+      w[static_cast<std::size_t>(part[f])] += costs[f];
+    }
+    double total = 0;
+    for (const double x : w) total += x;
+    const double mean = total / p;
+    std::ostringstream os;
+    os << *std::min_element(n.begin(), n.end()) << "-" << *std::max_element(n.begin(), n.end())
+       << " faces per rank, estimated cost max / mean "
+       << (mean > 0 ? *std::max_element(w.begin(), w.end()) / mean : 1.0);
+    return os.str();
+  };
   if (args.json) {
     JsonWriter j;
     j.begin_object();
@@ -151,6 +193,16 @@ int run_info(const Arguments& args) {
           .end_object();
     }
     j.end_array();
+    if (!parts.empty()) {
+      j.value("partition_size", size);
+      j.begin_object("partitions");
+      for (std::size_t k = 0; k < parts.size(); ++k) {
+        j.begin_array(std::to_string(args.partition[k]));
+        for (const int r : parts[k]) j.value("", r);
+        j.end_array();
+      }
+      j.end_object();
+    }
     j.end_object();
     std::cout << j.str();
     return 0;
@@ -175,6 +227,12 @@ int run_info(const Arguments& args) {
               << face.loops.size() << std::setw(7) << uses << std::setw(7) << face.seams.size()
               << std::setw(15) << std::setprecision(6) << face.area
               << (face.reversed ? "  reversed" : "") << "\n";
+  }
+  if (!parts.empty()) {
+    std::cout << "\nMETIS partition at size " << size << " (weights area / size^2):\n";
+    for (std::size_t k = 0; k < parts.size(); ++k)
+      std::cout << "  " << args.partition[k] << " ranks: " << balance(args.partition[k], parts[k])
+                << "\n";
   }
   return 0;
 }
@@ -403,8 +461,16 @@ std::string stats_json(const Arguments& args, const Session& session,
       j.value("quads_sicn_below_0_1",  // not forced by a sharp CAD corner
               f < s.face_quads_sicn_below_0_1.size() ? s.face_quads_sicn_below_0_1[f] : 0)
           .value("seconds", r.face_seconds[f])
-          .value("time_budget_hit", time_budget_hit(r, f))
-          .end_object();
+          .value("time_budget_hit", time_budget_hit(r, f));
+      // Per stage, and the dealt stages' order keys (parallel::FaceTimes, documented there;
+      // scripts/simulate_scaling.py replays them).
+      if (f < r.face_times.size()) {
+        j.begin_object("stage_seconds");
+        parallel::FaceTimes::fields(r.face_times[f],
+                                    [&](const char* name, const auto& v) { j.value(name, v); });
+        j.end_object();
+      }
+      j.end_object();
     }
     j.end_array();
   }

@@ -7,8 +7,13 @@
 # and whether the mesh is byte-identical to the first configuration's (it must be: the mesh does
 # not depend on the numbers of ranks and threads). Prints a markdown table; --csv also writes the
 # rows as CSV, --png plots speedup and efficiency per configuration (scripts/plot_table.py).
+# --simulate LIST predicts the configurations of LIST (P or PxT, comma-separated) from the median
+# run of the first configuration (one rank) with scripts/simulate_scaling.py (the faces' METIS
+# partitions from `qsmesh info --partition`, the costs of messages measured by scripts/mpi_costs.c
+# where mpicc exists), compares its predictions with the configurations run, and then --png plots
+# the predicted speedup instead. --keep DIR keeps the runs' --stats (CONFIG.REPEAT.json) there.
 # Usage: scripts/scaling_study.sh MODEL [--size-factor F] [--until STAGE] [--configs "PxT ..."]
-#                                 [--repeat N] [--csv FILE] [--png FILE]   (after scripts/build.sh)
+#                                 [--repeat N] [--csv FILE] [--png FILE] [--simulate LIST] [--keep DIR]
 #   defaults: --size-factor 0.02, --until quasi-structured, --configs "1x1 1x2 2x1" (and 2x2, 4x1,
 #   4x2, 8x1, 8x2, 16x1 where the machine has that many cores), --repeat 3.
 # Wall time is that of the whole command (mpiexec, loading and writing included); the median of an
@@ -17,7 +22,7 @@
 # nothing of scaling.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-usage() { sed -n '9,12p' "$0" | sed 's/^# \{0,1\}//' >&2; exit 2; }
+usage() { sed -n '15,18p' "$0" | sed 's/^# \{0,1\}//' >&2; exit 2; }
 [ $# -ge 1 ] || usage
 model=$1; shift
 [ -f "$model" ] || { echo "scaling_study: no such model file: $model" >&2; exit 2; }
@@ -26,6 +31,8 @@ until=quasi-structured
 repeat=3
 csv=
 png=
+simulate=
+keep=
 cores=$(nproc)
 configs=
 while [ $# -gt 0 ]; do
@@ -36,6 +43,8 @@ while [ $# -gt 0 ]; do
     --repeat) repeat=$2; shift 2 ;;
     --csv) csv=$2; shift 2 ;;
     --png) png=$2; shift 2 ;;
+    --simulate) simulate=$2; shift 2 ;;
+    --keep) keep=$2; shift 2 ;;
     *) echo "scaling_study: unknown option $1" >&2; usage ;;
   esac
 done
@@ -50,6 +59,12 @@ fi
 for c in $configs; do
   [[ "$c" =~ ^[1-9][0-9]*x[1-9][0-9]*$ ]] || { echo "scaling_study: configuration '$c' is not PxT (ranks x threads)" >&2; exit 2; }
 done
+if [ -n "$simulate" ]; then
+  first=${configs%% *}
+  [ "${first%x*}" = 1 ] || { echo "scaling_study: --simulate replays a run on one rank: the first configuration must be 1xT" >&2; exit 2; }
+  [[ "$simulate" =~ ^[1-9][0-9]*(x[1-9][0-9]*)?(,[1-9][0-9]*(x[1-9][0-9]*)?)*$ ]] ||
+    { echo "scaling_study: --simulate takes P or PxT, comma-separated (e.g. 4,8,16x2)" >&2; exit 2; }
+fi
 exe=./build/drivers/qsmesh
 [ -x "$exe" ] || { echo "scaling_study: $exe missing; run scripts/build.sh first" >&2; exit 2; }
 if [ -n "$png" ]; then
@@ -71,6 +86,7 @@ for c in $configs; do
       -o "$out/$c.$k.msh" --size-factor "$factor" --until "$until" --threads "$t" -q \
       --stats "$out/$c.$k.json" >/dev/null
     read -r wall kb < <(tail -n1 "$out/time")
+    [ -z "$keep" ] || { mkdir -p "$keep" && cp "$out/$c.$k.json" "$keep/"; }
     echo "$c $k $wall $kb $out/$c.$k.json $out/$c.$k.msh" >> "$runs"
     # Only the first repeat's mesh is compared; drop the others to keep the folder small.
     [ "$k" -eq 1 ] || rm -f "$out/$c.$k.msh"
@@ -142,7 +158,42 @@ if any(r[-1] == "NO" for r in rows):
     print("\nscaling_study: the mesh differs between configurations", file=sys.stderr)
     sys.exit(1)
 PY
-if [ -n "$png" ]; then
+if [ -n "$simulate" ]; then
+  # The median run of each configuration (as in the table), the first one the simulation's base.
+  python3 - "$runs" > "$out/medians.txt" <<'PY'
+import sys
+runs = {}
+for line in open(sys.argv[1]):
+    c, k, wall, kb, stats, mesh = line.split()
+    runs.setdefault(c, []).append((float(wall), stats))
+for c, rs in runs.items():
+    print(c, sorted(rs)[(len(rs) - 1) // 2][1])
+PY
+  base_stats=$(head -n1 "$out/medians.txt" | cut -d' ' -f2)
+  ranks_list=$(echo "$simulate,$(cut -d' ' -f1 "$out/medians.txt" | tr '\n' ',')" | tr ',' '\n' |
+               sed -n 's/^\([0-9][0-9]*\).*/\1/p' | sort -nu | paste -sd, -)
+  "$exe" info "$model" --json --partition "$ranks_list" --size-factor "$factor" > "$out/partitions.json"
+  comm_args=()
+  if command -v mpicc >/dev/null && mpicc -O2 -o "$out/mpi_costs" scripts/mpi_costs.c 2>/dev/null &&
+     mpiexec --oversubscribe --bind-to none -n 2 "$out/mpi_costs" > "$out/comm.json"; then
+    comm_args=(--comm "$out/comm.json")
+  else
+    echo "scaling_study: no mpicc or mpi_costs failed: the simulation takes its default costs of messages" >&2
+  fi
+  real_args=()
+  while read -r c stats; do real_args+=(--real "$c=$stats"); done < <(tail -n +2 "$out/medians.txt")
+  echo
+  echo "simulated from the median ${configs%% *} run (scripts/simulate_scaling.py):"
+  echo
+  python3 scripts/simulate_scaling.py "$base_stats" --configs "$simulate" --partitions "$out/partitions.json" \
+    "${comm_args[@]}" "${real_args[@]}" --csv "$out/simulated.csv" || status=$?
+  [ -z "$csv" ] || cp "$out/simulated.csv" "${csv%.csv}.simulated.csv"
+  if [ -n "$png" ]; then
+    /usr/bin/python3 scripts/plot_table.py "$out/simulated.csv" -o "$png" --x "ranks x threads" \
+      --y "predicted speedup,unlimited ranks speedup,efficiency" \
+      --title "$(basename "$model"), --size-factor $factor: simulated speedup against ${configs%% *}"
+  fi
+elif [ -n "$png" ]; then
   /usr/bin/python3 scripts/plot_table.py "$table_csv" -o "$png" --x "ranks x threads" --y speedup,efficiency \
     --title "$(basename "$model"), --size-factor $factor: speedup and efficiency against ${configs%% *}"
 fi

@@ -68,6 +68,7 @@ FaceOutput take_output(FaceTask&& task, bool quads) {
   out.unstructured = std::move(task.unstructured);
   out.quasi = std::move(task.quasi);
   out.seconds = task.seconds;
+  out.times = task.times;
   task = FaceTask{};
   return out;
 }

@@ -105,8 +105,10 @@ sizemap::CurveSizes size_map_stage(const Context& cx, std::span<const mesh::Curv
   const std::vector<double> targets = sizemap::face_quad_targets(cx.model, so);
   const auto face_pass = [&](const sizemap::CurveSizes& on_curves) {
     each_face(cx, faces, nullptr, [&](FaceTask& t) {
+      const Stopwatch face_clock;
       t.sizes = sizemap::face_sizes(t.background, cf_sizes ? t.cross_field.get() : nullptr, curves,
                                     on_curves, targets[t.face], so);
+      t.times.sizemap += face_clock.seconds();
     });
   };
   face_pass(initial);
@@ -122,8 +124,10 @@ sizemap::CurveSizes size_map_stage(const Context& cx, std::span<const mesh::Curv
   // The frontal insertion reads only the crosses of each field; the rest was for the size map.
   if (!cx.options.cross_fields)
     each_face(cx, faces, nullptr, [&](FaceTask& t) {
+      const Stopwatch face_clock;
       if (t.cross_field != nullptr)
         crossfield::shrink_cross_field(*t.cross_field, crossfield::CrossFieldUse::Guide);
+      t.times.sizemap += face_clock.seconds();
     });
   return united;
 }
@@ -219,8 +223,9 @@ std::vector<std::int64_t> pattern_stage(const Context& cx, std::vector<FaceTask>
   const PipelineOptions& options = cx.options;
   const LO nfaces = cx.model.num_faces();
   std::vector<double> expected(static_cast<std::size_t>(nfaces), 0.0);
-  each_face(cx, faces, nullptr, [&](const FaceTask& t) {
+  each_face(cx, faces, nullptr, [&](FaceTask& t) {
     expected[static_cast<std::size_t>(t.face)] = sizemap::expected_quads(t.background, t.sizes.s);
+    t.times.expected_quads = expected[static_cast<std::size_t>(t.face)];
   });
   cx.comm.allreduce_sum(expected);  // each face's entry is set by its owner alone
   std::vector<std::int64_t> fill_bound(static_cast<std::size_t>(nfaces), 0);
@@ -254,9 +259,10 @@ std::vector<std::int64_t> pattern_stage(const Context& cx, std::vector<FaceTask>
     if (filled[static_cast<std::size_t>(f)] == 0) continue;
     PatternFill& fill = fills[static_cast<std::size_t>(f)];
     const std::int64_t i = local_of[static_cast<std::size_t>(f)];
-    if (i >= 0)
+    if (i >= 0) {
+      faces[static_cast<std::size_t>(i)].times.patterns = fill.seconds;
       take_fill(faces[static_cast<std::size_t>(i)], std::move(fill), options.patterns);
-    else
+    } else
       to_owners.add(result.face_rank[f], f, fill);
     fill = PatternFill{};
   }
@@ -264,8 +270,9 @@ std::vector<std::int64_t> pattern_stage(const Context& cx, std::vector<FaceTask>
     QSMESH_CHECK(f >= 0 && f < nfaces && local_of[static_cast<std::size_t>(f)] >= 0,
                  "pattern fill of face " << f << " sent to rank " << cx.comm.rank()
                                          << ", which does not own it");
-    take_fill(faces[static_cast<std::size_t>(local_of[static_cast<std::size_t>(f)])],
-              std::move(fill), options.patterns);
+    FaceTask& t = faces[static_cast<std::size_t>(local_of[static_cast<std::size_t>(f)])];
+    t.times.patterns = fill.seconds;
+    take_fill(t, std::move(fill), options.patterns);
   });
   return fill_bound;
 }
@@ -293,7 +300,8 @@ void unstructured_stage(const Context& cx, std::vector<FaceTask>& faces,
       }
       t.quad_mesh =
           quad::mesh_face_unstructured(cx.model, t.face, full, face_fields, qo, &t.unstructured);
-      t.seconds += face_clock.seconds();
+      t.times.unstructured = face_clock.seconds();
+      t.seconds += t.times.unstructured;
     }
     if (t.cross_field != nullptr && keep_singularities)
       t.singularities = std::move(t.cross_field->singularities);
@@ -309,8 +317,12 @@ void unstructured_stage(const Context& cx, std::vector<FaceTask>& faces,
 std::array<double, 3> improvement_stage(const Context& cx, std::vector<FaceTask>& faces,
                                         std::span<const qstruct::Pattern> patterns) {
   std::vector<ImproveFace> to_improve;
+  // The face's time in the stage is what improve_faces adds to its seconds.
+  std::vector<double> before(faces.size());
+  for (std::size_t i = 0; i < faces.size(); ++i) before[i] = faces[i].seconds;
   for (FaceTask& t : faces) {
     if (!wants_improvement(t)) continue;
+    t.times.improvement_quads = static_cast<std::int64_t>(t.quad_mesh.quads.size());
     ImproveFace f;
     f.face = t.face;
     f.mesh = &t.quad_mesh;
@@ -327,7 +339,11 @@ std::array<double, 3> improvement_stage(const Context& cx, std::vector<FaceTask>
   settings.disk = cx.options.disk;
   settings.final_smoothing = cx.options.final_smoothing;
   settings.final_smooth = cx.options.final_smooth;
-  return improve_faces(cx.comm, cx.model, to_improve, settings, cx.tasks, cx.log);
+  const std::array<double, 3> steps =
+      improve_faces(cx.comm, cx.model, to_improve, settings, cx.tasks, cx.log);
+  for (std::size_t i = 0; i < faces.size(); ++i)
+    faces[i].times.improvement = faces[i].seconds - before[i];
+  return steps;
 }
 
 // The fills that wait for the face's final mesh (compare_refused_fill), after a second chance for
@@ -344,13 +360,16 @@ void compare_stage(const Context& cx, std::vector<FaceTask>& faces,
   const PipelineOptions& options = cx.options;
   if (options.pattern_compare_tolerance >= 0)
     each_face(cx, faces, nullptr, [&](FaceTask& t) {
+      const Stopwatch face_clock;
       const std::optional<std::int64_t> max_quads =
           second_fill_bound(t, fill_bound[static_cast<std::size_t>(t.face)]);
       if (max_quads)
         take_second_fill(t, mesh_face_fill(cx.model, t.face, curves, patterns, options.patterns,
                                            *max_quads, true));
+      t.times.compare += face_clock.seconds();
     });
   each_face(cx, faces, nullptr, [&](FaceTask& t) {
+    const Stopwatch face_clock;
     const FillComparison c =
         compare_refused_fill(t, options.pattern_compare_tolerance, options.patterns);
     if (c.kept && c.against_unstructured)
@@ -359,6 +378,7 @@ void compare_stage(const Context& cx, std::vector<FaceTask>& faces,
                        ") against unstructured (", c.unstructured.quads, " quads, SICN ",
                        c.unstructured.sicn_min, " / ", c.unstructured.sicn_avg,
                        "): ", c.fill_taken ? "fill" : "unstructured"));
+    t.times.compare += face_clock.seconds();
   });
 }
 
@@ -402,6 +422,7 @@ void gather_stage(const Context& cx, std::vector<FaceTask>& faces,
     if (quads) {
       result.face_stats.resize(n);
       result.face_seconds.resize(n);
+      result.face_times.resize(n);
     }
     if (keep_background) result.background.resize(n);
   }
@@ -409,7 +430,9 @@ void gather_stage(const Context& cx, std::vector<FaceTask>& faces,
     std::size_t pos = 0;
     while (pos < bytes.size()) {
       FaceOutput out;
+      const std::size_t at = pos;
       read_record(bytes, pos, out);
+      out.times.bytes = static_cast<std::int64_t>(pos - at);
       const LO f = out.report.face;
       QSMESH_CHECK(f >= 0 && f < nfaces, "gathered report for unknown face " << f);
       result.reports[f] = std::move(out.report);
@@ -423,6 +446,7 @@ void gather_stage(const Context& cx, std::vector<FaceTask>& faces,
       if (quads) {
         result.face_stats[f] = out.stats;
         result.face_seconds[f] = out.seconds;
+        result.face_times[f] = out.times;
       }
     }
     std::vector<char>().swap(bytes);
@@ -478,14 +502,19 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
   }
 
   clock.start();
-  each_face(cx, faces, "background",
-            [&](FaceTask& t) { mesh_background(t, model, curves, options.background); });
+  each_face(cx, faces, "background", [&](FaceTask& t) {
+    const Stopwatch face_clock;
+    mesh_background(t, model, curves, options.background);
+    t.times.background = face_clock.seconds();
+  });
   clock.end("background", true);
 
   if (options.cross_fields || keep_fields) {
     clock.start();
     each_face(cx, faces, "crossfield", [&](FaceTask& t) {
+      const Stopwatch face_clock;
       compute_cross_field(t, options.crossfield, options.cross_fields, keep_fields, lane);
+      t.times.crossfield = face_clock.seconds();
     });
     clock.end("crossfield", true);
   }

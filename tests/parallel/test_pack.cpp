@@ -90,14 +90,15 @@ FaceOutput full_output() {
   o.stats.sicn_min = 0.75;
   o.stats.sicn_avg = 0.875;
   o.seconds = 2.5;
+  o.times = {0.5, 1.5, 2.5, 3.5, 4.5, 5.5, 6.5, 77.5, 42, 1001};
   return o;
 }
 
 TEST(Pack, EveryFieldOfAFaceOutputRoundTrips) {
   const FaceOutput a = full_output();
-  // 8 parts; the counts of their fields: mesh 1 (packed whole), background report 5, cross field
-  // 11, sizes 3, unstructured 7, quasi 5 + improvement 7, stats 7, seconds 1.
-  ASSERT_EQ(count_fields(a), 1 + 5 + 11 + 3 + 7 + 12 + 7 + 1)
+  // 9 parts; the counts of their fields: mesh 1 (packed whole), background report 5, cross field
+  // 11, sizes 3, unstructured 7, quasi 5 + improvement 7, stats 7, seconds 1, times 10.
+  ASSERT_EQ(count_fields(a), 1 + 5 + 11 + 3 + 7 + 12 + 7 + 1 + 10)
       << "a field was added to a report: set it in full_output() and check it here";
   std::vector<char> buf;
   write_record(buf, a);
@@ -166,6 +167,16 @@ TEST(Pack, EveryFieldOfAFaceOutputRoundTrips) {
   EXPECT_EQ(b.stats.sicn_min, 0.75);
   EXPECT_EQ(b.stats.sicn_avg, 0.875);
   EXPECT_EQ(b.seconds, 2.5);
+  EXPECT_EQ(b.times.background, 0.5);
+  EXPECT_EQ(b.times.crossfield, 1.5);
+  EXPECT_EQ(b.times.sizemap, 2.5);
+  EXPECT_EQ(b.times.patterns, 3.5);
+  EXPECT_EQ(b.times.unstructured, 4.5);
+  EXPECT_EQ(b.times.improvement, 5.5);
+  EXPECT_EQ(b.times.compare, 6.5);
+  EXPECT_EQ(b.times.expected_quads, 77.5);
+  EXPECT_EQ(b.times.improvement_quads, 42);
+  EXPECT_EQ(b.times.bytes, 1001);
 
   // The record after it came back at its defaults.
   EXPECT_TRUE(empty.mesh.points.empty());

@@ -137,6 +137,41 @@ struct CrossFieldOutput {
 /// The driver's view of a face cross field (see CrossFieldOutput).
 [[nodiscard]] CrossFieldOutput summarize(const crossfield::FaceCrossField& cf);
 
+/// Where a face's time went, stage by stage (wall seconds of the thread that ran it, on whichever
+/// rank), and the keys by which the dealt stages order the faces: what scripts/simulate_scaling.py
+/// replays to predict other rank and thread counts. Written per face in --stats (face_stats'
+/// "stage_seconds"); fields declared once, in fields().
+struct FaceTimes {
+  double background = 0;    ///< background triangulation (METIS partition)
+  double crossfield = 0;    ///< cross field (METIS partition)
+  double sizemap = 0;       ///< the size map's two passes over the face (METIS partition)
+  double patterns = 0;      ///< the face's pattern fill (dealt out)
+  double unstructured = 0;  ///< the unstructured mesh (METIS partition)
+  double improvement = 0;   ///< cavity, disk remeshing, final smoothing (dealt out)
+  double compare = 0;       ///< second fill and comparison (METIS partition)
+  /// The pattern stage deals the faces out by this, largest first (the size map's quads).
+  double expected_quads = 0;
+  /// The improvement deals its faces out by this, largest first (the unstructured mesh's quads;
+  /// 0: the face is not improved).
+  std::int64_t improvement_quads = 0;
+  /// Bytes of the face's gathered record (its mesh and reports): the size of what crosses ranks
+  /// for the face at the gather, and about that of its improvement's input and result.
+  std::int64_t bytes = 0;
+  template <class S, class V>
+  static void fields(S& self, V&& visit) {
+    visit("background", self.background);
+    visit("crossfield", self.crossfield);
+    visit("sizemap", self.sizemap);
+    visit("patterns", self.patterns);
+    visit("unstructured", self.unstructured);
+    visit("improvement", self.improvement);
+    visit("pattern_compare", self.compare);
+    visit("expected_quads", self.expected_quads);
+    visit("improvement_quads", self.improvement_quads);
+    visit("bytes", self.bytes);
+  }
+};
+
 // --- One face's state through the stages ----------------------------------------------------
 
 /// A valid pattern fill that is not (yet) the face's mesh: refused on quality, or kept by the
@@ -167,6 +202,7 @@ struct FaceTask {
   QuasiReport quasi;
   RefusedFill refused;
   double seconds = 0;  ///< wall time of the quad stages on this face (s)
+  FaceTimes times;     ///< per stage
 };
 
 /// Background triangulation of task.face (background::mesh_face_background) into task.background
@@ -193,6 +229,7 @@ struct FaceOutput {
   QuasiReport quasi;
   mesh::FaceQuadStats stats;  ///< of the quad mesh (quad stages)
   double seconds = 0;
+  FaceTimes times;
   template <class S, class V>
   static void fields(S& self, V&& visit) {
     visit("mesh", self.mesh);
@@ -203,6 +240,7 @@ struct FaceOutput {
     visit("quasi", self.quasi);
     visit("stats", self.stats);
     visit("seconds", self.seconds);
+    visit("times", self.times);
   }
 };
 

@@ -123,6 +123,8 @@ struct PipelineResult {
   /// on the face in the quad stages (patterns, unstructured, disk remeshing), seconds.
   std::vector<mesh::FaceQuadStats> face_stats;
   std::vector<double> face_seconds;
+  /// By face, quad stages (rank 0): the face's time per stage and the dealt stages' keys.
+  std::vector<FaceTimes> face_times;
   std::vector<int> face_rank;                   ///< rank that meshed each face (every rank)
   /// Wall time (s) each rank spent in the stages split by faces (background to the comparison of
   /// refused pattern fills), its own work without its waits for the others (every rank). Their

@@ -1,0 +1,411 @@
+#!/usr/bin/env python3
+"""Predicts the time of `qsmesh mesh` on P ranks x T threads from the --stats of one real run on one
+rank, by replaying its measured per-face, per-stage times through the pipeline's scheduling rules
+(docs/architecture.md, "Parallel model"):
+
+- replicated stages (load, curves, partition, quantize): every rank does the same work; as measured.
+- partitioned stages (background, crossfield, sizemap, unstructured, pattern_compare): each rank
+  runs the faces the METIS partition gives it, as TBB tasks in face order on T threads (list
+  scheduling in that order); the stage ends when the slowest rank is done.
+- dealt stages (patterns, improvement): all P x T threads take the next face from one shared
+  counter, largest first by the pipeline's own keys (expected quads; the unstructured mesh's
+  quads), i.e. list scheduling in that order over P x T workers; a face taken away from its owner
+  is read from it first (MPI_Get), and each result goes back to its owner.
+- assemble: rank 0 unpacks and assembles every face (as measured) after receiving the other ranks'
+  faces (bytes / bandwidth); the driver's later stages (statistics, write, ...) on rank 0 as
+  measured.
+- what a stage spent outside its faces in the measured run (setup, serial parts such as the size
+  map's curve sizes and gradation) is added as measured, on every configuration.
+- messages and reductions: each stage ends with an all-reduce (latency x ceil(log2 P)); the size
+  map and the pattern stage add one each, the improvement an all-gather of 28 bytes a face and two
+  window collectives; each dealt face costs one fetch-and-add; bytes moved cost bytes / bandwidth.
+  Latencies and bandwidth come from --comm (scripts/mpi_costs.c's output), else the defaults below.
+
+The faces' partition over P ranks is the real one when --partitions gives the JSON of
+`qsmesh info MODEL --json --partition P,... --size-factor F` (the same METIS call and weights as
+the run); otherwise a greedy longest-first partition of the faces by expected quads (said so in the
+output).
+
+Usage: python3 scripts/simulate_scaling.py STATS.json --configs 2x1,4,8,64x2 [--partitions INFO.json]
+                 [--comm COSTS.json] [--real PxT=STATS.json ...] [--csv FILE] [--markdown]
+A config "P" means P ranks x 1 thread. Exit codes: 0 success, 2 bad input."""
+import argparse
+import heapq
+import json
+import math
+import sys
+
+TOOL = "simulate_scaling"
+REPLICATED = ["load", "curves", "partition", "quantize"]
+PARTITIONED = ["background", "crossfield", "sizemap", "unstructured", "pattern_compare"]
+DEALT = ["patterns", "improvement"]
+GATHER = ["assemble"]
+# On-node defaults where no --comm is given (Open MPI, shared memory; mpi_costs on the 2-core
+# development machine measured them of this order): seconds, bytes per second.
+DEFAULT_COMM = {"allreduce_s": 5e-6, "fetch_and_add_s": 1e-6, "get_64k_s": 1e-5,
+                "bandwidth_bytes_per_s": 5e9}
+RECORD_BYTES = 28  # what every rank learns of every face before the improvement (improve.cpp)
+
+
+class InputError(Exception):
+    pass
+
+
+def list_schedule(durations, workers):
+    """Greedy list scheduling: each item, in the given order, goes to the worker that is free
+    first (ties: the lowest worker). durations: a list of seconds, or of functions worker ->
+    seconds (the cost may depend on who runs it). Returns (makespan, worker of each item, finish
+    time of each worker)."""
+    if workers < 1:
+        raise ValueError("list_schedule: at least one worker")
+    free = [(0.0, w) for w in range(workers)]
+    heapq.heapify(free)
+    assigned = []
+    end = [0.0] * workers
+    for d in durations:
+        t, w = heapq.heappop(free)
+        t += d(w) if callable(d) else d
+        end[w] = t
+        assigned.append(w)
+        heapq.heappush(free, (t, w))
+    return max(end) if end else 0.0, assigned, end
+
+
+def greedy_partition(weights, parts):
+    """Longest-first greedy partition (the stand-in for METIS without --partitions): each face, by
+    decreasing weight, to the part with the least weight so far."""
+    order = sorted(range(len(weights)), key=lambda f: (-weights[f], f))
+    _, assigned, _ = list_schedule([weights[f] for f in order], parts)
+    part = [0] * len(weights)
+    for f, p in zip(order, assigned):
+        part[f] = p
+    return part
+
+
+def levels(p):
+    return math.ceil(math.log2(p)) if p > 1 else 0
+
+
+class Run:
+    """What the simulation reads of one --stats JSON."""
+
+    def __init__(self, stats, name="stats", any_ranks=False):
+        if stats.get("ranks", 1) != 1 and not any_ranks:
+            raise InputError(f"{name}: the base run must be on one rank (it has {stats['ranks']})")
+        faces = stats.get("face_stats")
+        if not faces or "stage_seconds" not in faces[0]:
+            raise InputError(f"{name}: no per-face stage times (face_stats[].stage_seconds): a "
+                             "quad-stage run of a qsmesh built with them is needed")
+        self.threads = int(stats.get("threads", 1))
+        self.seconds = {k: v for k, v in stats["seconds"].items() if k != "total"}
+        self.total = stats["seconds"].get("total", sum(self.seconds.values()))
+        self.faces = sorted(faces, key=lambda f: f["face"])
+        self.n = len(self.faces)
+        self.t = {s: [f["stage_seconds"].get(s, 0.0) for f in self.faces]
+                  for s in PARTITIONED + DEALT}
+        self.expected = [f["stage_seconds"].get("expected_quads", 0.0) for f in self.faces]
+        self.improve_quads = [f["stage_seconds"].get("improvement_quads", 0) for f in self.faces]
+        self.bytes = [f["stage_seconds"].get("bytes", 0) for f in self.faces]
+        self.by_pattern = [f.get("method", "").startswith("pattern") for f in self.faces]
+        self.face_rank = [f.get("rank", 0) for f in self.faces]
+
+
+class Simulator:
+    def __init__(self, run, partitions=None, comm=None, residual=None):
+        self.run = run
+        self.partitions = partitions or {}
+        self.comm = dict(DEFAULT_COMM)
+        if comm:
+            self.comm.update({k: v for k, v in comm.items() if k in DEFAULT_COMM and v and v > 0})
+        self.greedy = []  # rank counts partitioned greedily
+        # What each stage spent outside its faces in the measured run.
+        self.residual = {}
+        self.busy = []
+        if residual is not None:  # a replay: the base run's
+            self.residual = residual
+            return
+        base = self.compute(1, run.threads)
+        for s, v in run.seconds.items():
+            self.residual[s] = max(0.0, v - base.get(s, 0.0)) if s in base else None
+
+    def partition(self, p):
+        if p == 1:
+            return [0] * self.run.n
+        part = self.partitions.get(str(p))
+        if part is not None:
+            if len(part) != self.run.n:
+                raise InputError(f"partition for {p} ranks has {len(part)} faces, the run "
+                                 f"{self.run.n}")
+            return part
+        if p not in self.greedy:
+            self.greedy.append(p)
+        return greedy_partition([max(1.0, e) for e in self.run.expected], p)
+
+    def allreduce(self, p):
+        return self.comm["allreduce_s"] * levels(p)
+
+    def get_cost(self, nbytes):
+        # A face read from its owner: one lock/get/unlock round, its bytes at the bandwidth.
+        return self.comm["fetch_and_add_s"] + nbytes / self.comm["bandwidth_bytes_per_s"]
+
+    def compute(self, p, t):
+        """The per-face part of each split stage on p ranks x t threads (no residuals, no
+        messages): {stage: seconds}."""
+        run = self.run
+        part = self.partition(p)
+        out = {}
+        self.busy = [0.0] * p  # each rank's own time in the split stages (rank_busy_seconds)
+        for s in PARTITIONED:
+            worst = 0.0
+            for r in range(p):
+                mine = [run.t[s][f] for f in range(run.n) if part[f] == r]
+                span = list_schedule(mine, t)[0]
+                self.busy[r] += span
+                worst = max(worst, span)
+            out[s] = worst
+        out.update(self.dealt(p, t, part, messages=False)[0])
+        return out
+
+    def dealt(self, p, t, part, messages=True):
+        """Dealt stages: ({stage: seconds}, {stage: seconds of messages after the dealing})."""
+        run = self.run
+        bw = self.comm["bandwidth_bytes_per_s"]
+        fetch = self.comm["fetch_and_add_s"] if (messages and p > 1) else 0.0
+        times, extra = {}, {}
+        for s, key, items in (
+                ("patterns", run.expected, range(run.n)),
+                ("improvement", run.improve_quads,
+                 [f for f in range(run.n) if run.improve_quads[f] > 0])):
+            order = sorted(items, key=lambda f: (-key[f], f))
+
+            def cost(f):
+                def c(w):
+                    d = run.t[s][f] + fetch
+                    if messages and p > 1 and s == "improvement" and w // t != part[f]:
+                        d += self.get_cost(run.bytes[f])
+                    return d
+                return c
+            span, assigned, end = list_schedule([cost(f) for f in order], p * t)
+            times[s] = span
+            if not messages:
+                for r in range(p):
+                    self.busy[r] += max(end[r * t:(r + 1) * t])
+            if not messages or p == 1:
+                extra[s] = 0.0
+                continue
+            # Results (fills, improved meshes) back to their owners: each rank's traffic in and
+            # out at the bandwidth, pairwise (latency per peer it talks to).
+            out_b = [0.0] * p
+            in_b = [0.0] * p
+            for f, w in zip(order, assigned):
+                r = w // t
+                if r != part[f] and (s == "improvement" or run.by_pattern[f]):
+                    out_b[r] += run.bytes[f]
+                    in_b[part[f]] += run.bytes[f]
+            move = max(a + b for a, b in zip(out_b, in_b)) / bw + self.comm["allreduce_s"] * levels(p)
+            if s == "patterns":  # the expected quads summed over ranks first
+                move += self.allreduce(p) + 8 * run.n / bw
+            else:  # the face records gathered, the faces packed, two window collectives
+                mine = max(sum(run.bytes[f] for f in range(run.n) if part[f] == r and run.improve_quads[f] > 0)
+                           for r in range(p))
+                move += self.allreduce(p) + RECORD_BYTES * run.n / bw + mine / bw + 2 * self.allreduce(p)
+            extra[s] = move
+        return times, extra
+
+    def predict(self, p, t):
+        """{stage: predicted seconds} on p ranks x t threads, in the measured run's stage order."""
+        run = self.run
+        part = self.partition(p)
+        comp = self.compute(p, t)
+        dealt, extra = self.dealt(p, t, part, messages=True)
+        comp.update(dealt)  # with the counter's and the reads' costs
+        bw = self.comm["bandwidth_bytes_per_s"]
+        out = {}
+        for s, measured in run.seconds.items():
+            if s in comp:
+                v = comp[s] + self.residual[s] + extra.get(s, 0.0) + self.allreduce(p)
+                if s == "sizemap":
+                    v += self.allreduce(p)  # the curve sizes' min-reduction
+            elif s in GATHER:
+                away = sum(b for f, b in enumerate(run.bytes) if part[f] != 0)
+                v = measured + away / bw + self.allreduce(p) * 2 + self.comm["allreduce_s"] * (p - 1)
+            elif s in REPLICATED:
+                v = measured + self.allreduce(p)
+            else:
+                v = measured  # rank 0 after the pipeline (statistics, writing, ...)
+            out[s] = v
+        return out
+
+    def imbalance(self, p, t):
+        """Predicted load imbalance (max / mean of the ranks' busy time, as --stats reports)."""
+        self.compute(p, t)
+        mean = sum(self.busy) / p
+        return max(self.busy) / mean if mean > 0 else 1.0
+
+    def largest_faces(self):
+        """The largest face's share of the per-face work, per stage and over the split stages."""
+        run = self.run
+        res = {}
+        for s in PARTITIONED + DEALT:
+            tot = sum(run.t[s])
+            if tot > 0:
+                f = max(range(run.n), key=lambda i: run.t[s][i])
+                res[s] = (run.faces[f]["face"], run.t[s][f], run.t[s][f] / tot)
+        per_face = [sum(run.t[s][f] for s in PARTITIONED + DEALT) for f in range(run.n)]
+        tot = sum(per_face)
+        f = max(range(run.n), key=lambda i: per_face[i])
+        res["all"] = (run.faces[f]["face"], per_face[f], per_face[f] / tot if tot else 0.0)
+        return res
+
+    def bound(self):
+        """Time with unlimited ranks: what is not split, plus each split stage's largest face."""
+        run = self.run
+        v = 0.0
+        for s, measured in run.seconds.items():
+            if s in PARTITIONED or s in DEALT:
+                v += max(run.t[s]) + self.residual[s]
+            else:
+                v += measured
+        return v
+
+
+def parse_config(text):
+    text = text.strip()
+    if "x" in text:
+        p, t = text.split("x", 1)
+    else:
+        p, t = text, "1"
+    if not (p.isdigit() and t.isdigit()) or int(p) < 1 or int(t) < 1:
+        raise InputError(f"configuration '{text}' is not P or PxT (ranks x threads)")
+    return int(p), int(t)
+
+
+def load_json(path):
+    try:
+        with open(path) as f:
+            return json.load(f)
+    except (OSError, ValueError) as e:
+        raise InputError(f"cannot read {path}: {e}")
+
+
+def main(argv):
+    ap = argparse.ArgumentParser(prog="simulate_scaling.py", description=__doc__.split("\n\n")[0])
+    ap.add_argument("stats", help="--stats JSON of a run on one rank (quad stages)")
+    ap.add_argument("--configs", required=True, help="comma-separated P or PxT")
+    ap.add_argument("--partitions", help="JSON of qsmesh info --json --partition P,...")
+    ap.add_argument("--comm", help="JSON of scripts/mpi_costs.c (latencies, bandwidth)")
+    ap.add_argument("--real", action="append", default=[], metavar="PxT=STATS.json",
+                    help="a real run to compare with (its --stats); repeatable")
+    ap.add_argument("--csv", help="write the predictions as CSV (one row per configuration)")
+    args = ap.parse_args(argv)
+    try:
+        run = Run(load_json(args.stats), args.stats)
+        partitions = load_json(args.partitions).get("partitions", {}) if args.partitions else {}
+        comm = load_json(args.comm) if args.comm else None
+        configs = [parse_config(c) for c in args.configs.split(",") if c.strip()]
+        reals = {}
+        for item in args.real:
+            if "=" not in item:
+                raise InputError(f"--real: '{item}' is not PxT=STATS.json")
+            c, path = item.split("=", 1)
+            reals[parse_config(c)] = load_json(path)
+        for c in reals:
+            if c not in configs:
+                configs.append(c)
+        configs.sort(key=lambda c: (c[0] * c[1], c[1]))
+        sim = Simulator(run, partitions, comm)
+    except InputError as e:
+        print(f"{TOOL}: {e}", file=sys.stderr)
+        return 2
+
+    base_cores = run.threads
+    base = (1, run.threads)
+    stages = list(run.seconds)
+    preds = {c: sim.predict(*c) for c in configs}
+    kind = {s: ("replicated" if s in REPLICATED else "METIS partition" if s in PARTITIONED
+                else "dealt" if s in DEALT else "gather on rank 0" if s in GATHER else "rank 0")
+            for s in stages}
+    labels = [f"{p}x{t}" for p, t in configs]
+    print(f"base run: {args.stats} (1x{run.threads}, {run.n} faces, total {run.total:.2f} s)")
+    print(f"partition: {'METIS (qsmesh info --partition)' if partitions else 'greedy'}"
+          + (f"; greedy for {sorted(sim.greedy)} ranks (not in --partitions)" if partitions and sim.greedy else ""))
+    print("messages: " + ", ".join(f"{k} {v:.3g}" for k, v in sim.comm.items()))
+    print()
+    print("| stage | kind | measured 1x%d s | " % run.threads + " | ".join(f"{l} s" for l in labels) + " |")
+    print("|---|---|---|" + "---|" * len(labels))
+    for s in stages:
+        print(f"| {s} | {kind[s]} | {run.seconds[s]:.3f} | "
+              + " | ".join(f"{preds[c][s]:.3f}" for c in configs) + " |")
+    totals = {c: sum(preds[c].values()) for c in configs}
+    base_total = sum(run.seconds.values())
+    print(f"| **total** | | {base_total:.3f} | " + " | ".join(f"**{totals[c]:.3f}**" for c in configs) + " |")
+    print(f"| speedup | | 1.00 | " + " | ".join(f"{base_total / totals[c]:.2f}" for c in configs) + " |")
+    print(f"| efficiency | | 1.00 | " + " | ".join(
+        f"{base_total / totals[c] * base_cores / (c[0] * c[1]):.2f}" for c in configs) + " |")
+    # Per-stage speedups of the split stages.
+    print()
+    print("| stage speedup | " + " | ".join(labels) + " |")
+    print("|---|" + "---|" * len(labels))
+    for s in stages:
+        if s in PARTITIONED or s in DEALT:
+            print(f"| {s} | " + " | ".join(
+                f"{run.seconds[s] / preds[c][s]:.2f}" if preds[c][s] > 0 else "-" for c in configs) + " |")
+
+    big = sim.largest_faces()
+    print()
+    print("largest face per stage (face, seconds, share of the stage's per-face work):")
+    for s, (f, sec, share) in big.items():
+        print(f"  {s}: face {f}, {sec:.3f} s, {share:.4f} (1/{1 / share:.1f})" if share > 0 else f"  {s}: -")
+    b = sim.bound()
+    print(f"unlimited ranks (each split stage takes its largest face): {b:.3f} s, speedup "
+          f"{base_total / b:.2f}")
+
+    status = 0
+    replayed = {}
+    for c, st in reals.items():
+        # The same rules on the real run's own per-face times and partition (face_stats' rank):
+        # what is left of the error is the per-face times' change between the runs.
+        try:
+            rr = Run(st, f"{c[0]}x{c[1]}", any_ranks=True)
+        except InputError:
+            continue
+        if rr.n != run.n:
+            continue
+        rs = Simulator(rr, {str(c[0]): rr.face_rank}, sim.comm, sim.residual)
+        replayed[c] = sum(rs.predict(*c).values())
+    if reals:
+        print()
+        print("| config | real total s | predicted s | error | replayed s | error | load imbalance real / predicted | " + " | ".join(
+            f"{s} real / predicted" for s in stages if s in PARTITIONED or s in DEALT) + " |")
+        print("|---|---|---|---|---|---|---|" + "---|" * sum(1 for s in stages if s in PARTITIONED or s in DEALT))
+        for c, st in reals.items():
+            real_total = st["seconds"].get("total", 0.0)
+            pred = totals[c]
+            err = (pred - real_total) / real_total if real_total > 0 else float("nan")
+            cells = []
+            for s in stages:
+                if s in PARTITIONED or s in DEALT:
+                    cells.append(f"{st['seconds'].get(s, 0.0):.2f} / {preds[c][s]:.2f}")
+            imb = f"{st.get('load_imbalance', 1.0):.2f} / {sim.imbalance(*c):.2f}"
+            rep = replayed.get(c)
+            rep_cells = (f"{rep:.2f} | {100 * (rep - real_total) / real_total:+.1f}%" if rep and real_total > 0
+                         else "- | -")
+            print(f"| {c[0]}x{c[1]} | {real_total:.2f} | {pred:.2f} | {100 * err:+.1f}% | {rep_cells} | {imb} | "
+                  + " | ".join(cells) + " |")
+    if args.csv:
+        with open(args.csv, "w") as f:
+            f.write("ranks x threads,cores,predicted s,predicted speedup,ideal speedup,efficiency,"
+                    "unlimited ranks speedup\n")
+            f.write(f"1x{run.threads},{run.threads},{base_total:.3f},1.00,1.00,1.00,{base_total / b:.2f}\n")
+            for c in configs:
+                if c == base:
+                    continue
+                n = c[0] * c[1]
+                f.write(f"{c[0]}x{c[1]},{n},{totals[c]:.3f},{base_total / totals[c]:.2f},"
+                        f"{n / base_cores:.2f},{base_total / totals[c] * base_cores / n:.2f},"
+                        f"{base_total / b:.2f}\n")
+    return status
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
