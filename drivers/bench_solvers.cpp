@@ -1,6 +1,7 @@
 // Benchmark of the linear-solver backends (scripts/bench_solvers.sh): analyze, factorize and
-// solve times of Eigen vs PETSc/MUMPS on SPD matrices of the kinds the cross-field stage builds.
-// One rank, one thread (the script pins OMP/BLAS threads to 1). Prints markdown table rows.
+// solve times of Eigen vs PETSc/MUMPS vs CG with PETSc's GAMG on SPD matrices of the kinds the
+// cross-field stage builds. One rank, one thread (the script pins OMP/BLAS threads to 1). Prints
+// markdown table rows.
 //
 // Usage: qsmesh_bench_solvers [N ...]   (default: 1000 10000 100000 500000)
 //   poisson: 5-point Laplacian on a sqrt(N) x sqrt(N) grid + 0.01 * identity;
@@ -79,9 +80,11 @@ struct Times {
   std::string name;
 };
 
-Times run(const SparseMatrix& A, Backend backend, qsmesh::linalg::PetscLane* lane) {
+Times run(const SparseMatrix& A, Backend backend, qsmesh::linalg::PetscLane* lane,
+          int block_size = 1) {
   qsmesh::linalg::SolverOptions options;
   options.backend = backend;
+  options.block_size = block_size;
   auto solver = qsmesh::linalg::make_solver(A.size(), options, lane);
   Times t;
   Stopwatch w;
@@ -130,26 +133,29 @@ int main(int argc, char** argv) {
     std::printf(
         "| matrix | n | nonzeros | backend | analyze (s) | factorize (s) | refactorize (s) "
         "| solve (s) | rel. residual | Eigen/PETSc: factorize | refactorize | solve | "
-        "analyze+2 fact.+10 solves |\n");
-    std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+        "analyze+2 fact.+10 solves | Eigen/CG-GAMG: analyze+2 fact.+10 solves |\n");
+    std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
     for (const char* kind : {"poisson", "cr"}) {
       for (LO target : sizes) {
         const SparseMatrix A =
             std::string(kind) == "poisson" ? poisson(target) : crouzeix_raviart(target);
         const Times e = run(A, Backend::Eigen, &lane);
         const Times p = run(A, Backend::Petsc, &lane);
+        // The CR matrices hold 2 unknowns per edge: GAMG is told so.
+        const Times g = run(A, Backend::PetscMultigrid, &lane, std::string(kind) == "cr" ? 2 : 1);
         const auto total = [](const Times& t) {
           return t.analyze + t.factorize + t.refactorize + 10 * t.solve;
         };
-        for (const Times* t : {&e, &p}) {
+        for (const Times* t : {&e, &p, &g}) {
           std::printf("| %s | %d | %lld | %s | %.4f | %.4f | %.4f | %.5f | %.1e |", kind, A.size(),
                       static_cast<long long>(A.nonzeros()), t->name.c_str(), t->analyze,
                       t->factorize, t->refactorize, t->solve, t->residual);
           if (t == &e)
-            std::printf(" %.2f | %.2f | %.2f | %.2f |\n", e.factorize / p.factorize,
-                        e.refactorize / p.refactorize, e.solve / p.solve, total(e) / total(p));
+            std::printf(" %.2f | %.2f | %.2f | %.2f | %.2f |\n", e.factorize / p.factorize,
+                        e.refactorize / p.refactorize, e.solve / p.solve, total(e) / total(p),
+                        total(e) / total(g));
           else
-            std::printf("  |  |  |  |\n");
+            std::printf("  |  |  |  |  |\n");
         }
         std::fflush(stdout);
       }

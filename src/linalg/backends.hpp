@@ -40,4 +40,10 @@ std::unique_ptr<LinearSolver> make_eigen_solver();
 /// factorization, as fallbacks). Every PETSc call is made while holding lane.mutex().
 std::unique_ptr<LinearSolver> make_petsc_solver(PetscLane& lane);
 
+/// PETSc SeqAIJ on PETSC_COMM_SELF solved by CG with GAMG to relative residual `rtol`: analyze
+/// builds the matrix and the Krylov solver, factorize sets the values up the multigrid hierarchy,
+/// solve iterates (throws when CG does not converge). `block_size` unknowns per node (>= 1).
+std::unique_ptr<LinearSolver> make_petsc_multigrid_solver(PetscLane& lane, double rtol,
+                                                          int block_size);
+
 }  // namespace qsmesh::linalg::detail

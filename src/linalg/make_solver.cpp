@@ -11,6 +11,10 @@ std::unique_ptr<LinearSolver> make_solver(LO n, const SolverOptions& options, Pe
       QSMESH_CHECK(lane != nullptr,
                    "make_solver: Backend::Petsc needs a PetscLane, and none was given");
       return detail::make_petsc_solver(*lane);
+    case Backend::PetscMultigrid:
+      QSMESH_CHECK(lane != nullptr,
+                   "make_solver: Backend::PetscMultigrid needs a PetscLane, and none was given");
+      return detail::make_petsc_multigrid_solver(*lane, options.multigrid_rtol, options.block_size);
     case Backend::Automatic:
       if (lane != nullptr && n >= options.petsc_threshold) return detail::make_petsc_solver(*lane);
       return detail::make_eigen_solver();

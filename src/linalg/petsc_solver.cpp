@@ -7,6 +7,7 @@
 // internally, and the direct calls map one to one onto analyze / factorize / solve, so the
 // symbolic analysis runs once per pattern and never depends on the values of the pattern matrix.
 #include <mpi.h>
+#include <petscksp.h>
 #include <petscmat.h>
 #include <petscsys.h>
 
@@ -297,12 +298,143 @@ class PetscSolver final : public LinearSolver {
   MatFactorInfo info_{};
 };
 
+// CG + GAMG: the iterative alternative measured against the factorizations.
+class PetscMultigridSolver final : public LinearSolver {
+ public:
+  PetscMultigridSolver(PetscLane& lane, double rtol, int block_size)
+      : lane_(&lane), rtol_(rtol), block_size_(block_size) {
+    QSMESH_CHECK(block_size >= 1, "petsc multigrid: block size " << block_size << " is below 1");
+    QSMESH_CHECK(rtol > 0 && rtol < 1,
+                 "petsc multigrid: relative tolerance " << rtol << " is not in (0, 1)");
+  }
+  ~PetscMultigridSolver() override {
+    std::lock_guard lock(lane_->mutex());
+    destroy_all();
+  }
+  PetscMultigridSolver(const PetscMultigridSolver&) = delete;
+  PetscMultigridSolver& operator=(const PetscMultigridSolver&) = delete;
+
+  void analyze(const SparseMatrix& A) override {
+    std::lock_guard lock(lane_->mutex());
+    destroy_all();
+    pattern_ = Pattern();
+    ready_ = false;
+    try {
+      build(A);
+    } catch (const Error&) {
+      destroy_all();
+      throw;
+    }
+    pattern_ = Pattern(A);
+  }
+
+  void factorize(const SparseMatrix& A) override {
+    pattern_.check(A, "petsc multigrid");
+    std::lock_guard lock(lane_->mutex());
+    ready_ = false;
+    if (A.size() == 0) {
+      ready_ = true;
+      return;
+    }
+    PetscScalar* values = nullptr;
+    QSMESH_PETSC_CALL(MatSeqAIJGetArray(matrix_, &values));
+    std::copy(A.values().begin(), A.values().end(), values);
+    QSMESH_PETSC_CALL(MatSeqAIJRestoreArray(matrix_, &values));
+    // New values: the hierarchy is rebuilt here, once per level, not at the first solve.
+    QSMESH_PETSC_CALL(KSPSetOperators(ksp_, matrix_, matrix_));
+    QSMESH_PETSC_CALL(KSPSetUp(ksp_));
+    ready_ = true;
+  }
+
+  void solve(std::span<const double> b, std::span<double> x) override {
+    QSMESH_CHECK(ready_, "petsc multigrid: solve() without a successful factorize()");
+    const auto n = static_cast<std::size_t>(pattern_.size());
+    QSMESH_CHECK(b.size() == n && x.size() == n, "petsc multigrid: solve() with vectors of "
+                                                     << b.size() << " and " << x.size()
+                                                     << " entries for a system of size " << n);
+    if (n == 0) return;
+    std::lock_guard lock(lane_->mutex());
+    PetscScalar* bp = nullptr;
+    QSMESH_PETSC_CALL(VecGetArrayWrite(b_, &bp));
+    std::copy(b.begin(), b.end(), bp);
+    QSMESH_PETSC_CALL(VecRestoreArrayWrite(b_, &bp));
+    QSMESH_PETSC_CALL(KSPSolve(ksp_, b_, x_));
+    KSPConvergedReason reason = KSP_CONVERGED_ITERATING;
+    QSMESH_PETSC_CALL(KSPGetConvergedReason(ksp_, &reason));
+    PetscInt iterations = 0;
+    QSMESH_PETSC_CALL(KSPGetIterationNumber(ksp_, &iterations));
+    QSMESH_CHECK(reason > 0, "petsc multigrid: CG did not converge on a system of size "
+                                 << n << " (reason " << static_cast<int>(reason) << " after "
+                                 << iterations << " iterations)");
+    const PetscScalar* xp = nullptr;
+    QSMESH_PETSC_CALL(VecGetArrayRead(x_, &xp));
+    std::copy(xp, xp + n, x.begin());
+    QSMESH_PETSC_CALL(VecRestoreArrayRead(x_, &xp));
+  }
+
+  [[nodiscard]] const char* name() const override { return "petsc/cg-gamg"; }
+
+ private:
+  void build(const SparseMatrix& A) {
+    const LO n = A.size();
+    if (n == 0) return;
+    QSMESH_CHECK(n % block_size_ == 0, "petsc multigrid: system size "
+                                           << n << " is not a multiple of the block size "
+                                           << block_size_);
+    std::vector<PetscInt> ia(static_cast<std::size_t>(n) + 1);
+    for (std::size_t i = 0; i < ia.size(); ++i)
+      ia[i] = to_petsc_int(A.row_offsets()[i], "nonzero count");
+    const std::vector<PetscInt> ja(A.columns().begin(), A.columns().end());
+    QSMESH_PETSC_CALL(MatCreate(PETSC_COMM_SELF, &matrix_));
+    QSMESH_PETSC_CALL(MatSetSizes(matrix_, n, n, n, n));
+    QSMESH_PETSC_CALL(MatSetType(matrix_, MATSEQAIJ));
+    QSMESH_PETSC_CALL(MatSetBlockSize(matrix_, block_size_));
+    QSMESH_PETSC_CALL(
+        MatSeqAIJSetPreallocationCSR(matrix_, ia.data(), ja.data(), A.values().data()));
+    QSMESH_PETSC_CALL(MatSetOption(matrix_, MAT_NEW_NONZERO_LOCATION_ERR, PETSC_TRUE));
+    QSMESH_PETSC_CALL(MatSetOption(matrix_, MAT_SYMMETRIC, PETSC_TRUE));
+    QSMESH_PETSC_CALL(MatSetOption(matrix_, MAT_SPD, PETSC_TRUE));
+    QSMESH_PETSC_CALL(MatCreateVecs(matrix_, &x_, &b_));
+    QSMESH_PETSC_CALL(KSPCreate(PETSC_COMM_SELF, &ksp_));
+    QSMESH_PETSC_CALL(KSPSetType(ksp_, KSPCG));
+    PC pc = nullptr;
+    QSMESH_PETSC_CALL(KSPGetPC(ksp_, &pc));
+    QSMESH_PETSC_CALL(PCSetType(pc, PCGAMG));
+    // The true residual, so the tolerance means the same as the direct solvers' residuals.
+    QSMESH_PETSC_CALL(KSPSetNormType(ksp_, KSP_NORM_UNPRECONDITIONED));
+    QSMESH_PETSC_CALL(KSPSetTolerances(ksp_, rtol_, 0.0, PETSC_DEFAULT, 10000));
+  }
+
+  void destroy_all() noexcept {
+    KSPDestroy(&ksp_);
+    VecDestroy(&b_);
+    VecDestroy(&x_);
+    MatDestroy(&matrix_);
+    lane_->last_error().clear();
+  }
+
+  PetscLane* lane_;
+  double rtol_;
+  int block_size_;
+  Pattern pattern_;
+  bool ready_ = false;
+  Mat matrix_ = nullptr;
+  Vec b_ = nullptr;
+  Vec x_ = nullptr;
+  KSP ksp_ = nullptr;
+};
+
 #undef QSMESH_PETSC_CALL
 
 }  // namespace
 
 std::unique_ptr<LinearSolver> make_petsc_solver(PetscLane& lane) {
   return std::make_unique<PetscSolver>(lane);
+}
+
+std::unique_ptr<LinearSolver> make_petsc_multigrid_solver(PetscLane& lane, double rtol,
+                                                          int block_size) {
+  return std::make_unique<PetscMultigridSolver>(lane, rtol, block_size);
 }
 
 }  // namespace detail

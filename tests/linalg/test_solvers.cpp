@@ -222,6 +222,49 @@ TEST(Solvers, AutomaticPicksBySize) {
   EXPECT_EQ(std::string(make_solver(1000, options, nullptr)->name()).rfind("eigen", 0), 0u);
 }
 
+TEST(Solvers, MultigridSolvesToItsToleranceAndAgreesWithTheFactorization) {
+  SolverOptions options;
+  options.backend = Backend::PetscMultigrid;
+  options.multigrid_rtol = 1e-10;
+  auto gamg = make_solver(1600, options, &lane());
+  EXPECT_STREQ(gamg->name(), "petsc/cg-gamg");
+  EXPECT_THROW((void)make_solver(10, options, nullptr), Error);  // no lane
+  SparseMatrix A = poisson(40, 0.2);
+  std::vector<double> x(static_cast<std::size_t>(A.size()));
+  EXPECT_THROW(gamg->factorize(A), Error);  // before analyze
+  gamg->analyze(A);
+  EXPECT_THROW(gamg->solve(rhs(A.size(), 0), x), Error);  // before factorize
+  auto eigen = make(Backend::Eigen);
+  eigen->analyze(A);
+  for (double shift : {0.2, 5.0}) {  // two levels: new values, same pattern
+    for (LO i = 0; i < A.size(); ++i)
+      A.values()[static_cast<std::size_t>(A.find(i, i))] = 4.0 + shift;
+    gamg->factorize(A);
+    eigen->factorize(A);
+    for (int k = 0; k < 2; ++k) {
+      const auto b = rhs(A.size(), k);
+      std::vector<double> xe(b.size());
+      gamg->solve(b, x);
+      eigen->solve(b, xe);
+      EXPECT_LT(relative_residual(A, x, b), 1e-9) << "shift " << shift;
+      double diff = 0, size = 0;
+      for (std::size_t i = 0; i < x.size(); ++i) {
+        diff = std::max(diff, std::abs(x[i] - xe[i]));
+        size = std::max(size, std::abs(xe[i]));
+      }
+      EXPECT_LT(diff, 1e-8 * size) << "shift " << shift;
+    }
+  }
+  // CG cannot converge on an indefinite matrix: an error, not a wrong answer.
+  const SparseMatrix indefinite = poisson(40, -1.0);
+  EXPECT_THROW(
+      {
+        gamg->factorize(indefinite);
+        gamg->solve(rhs(indefinite.size(), 1), x);
+      },
+      Error);
+}
+
 TEST(Solvers, SecondLaneIsRejected) { EXPECT_THROW(PetscLane second, Error); }
 
 TEST(Solvers, EmptySystem) {

@@ -80,7 +80,11 @@ class PetscLane {
   std::string last_error_;
 };
 
-enum class Backend { Automatic, Eigen, Petsc };
+/// Eigen: sparse LDLT. Petsc: MUMPS Cholesky. PetscMultigrid: conjugate gradients preconditioned
+/// by PETSc's algebraic multigrid (GAMG), to SolverOptions::multigrid_rtol: its cost per solve
+/// grows linearly with n, a factorization's more than linearly, but every right-hand side pays the
+/// iterations (docs/benchmarks.md, "Linear solvers", has where each wins).
+enum class Backend { Automatic, Eigen, Petsc, PetscMultigrid };
 
 struct SolverOptions {
   Backend backend = Backend::Automatic;
@@ -89,6 +93,11 @@ struct SolverOptions {
   /// thread, analyze + 2 factorizations + 10 solves cost the same in both at about 5e5-6.5e5
   /// unknowns (Eigen's solves are 2x faster; MUMPS factorizes faster from 2e5-3e5 unknowns).
   LO petsc_threshold = 500000;
+  /// Backend::PetscMultigrid: relative residual (unpreconditioned 2-norm) at which CG stops.
+  double multigrid_rtol = 1e-10;
+  /// Backend::PetscMultigrid: unknowns per node (the cross field's 2 per edge), so that GAMG
+  /// aggregates nodes rather than separate components. The system size must be a multiple of it.
+  int block_size = 1;
 };
 
 /// A direct solver for symmetric positive definite systems.
