@@ -370,6 +370,44 @@ TEST(Pipeline, CrossingBoundaryIsRepairedAlikeOnEveryRank) {
 
 TEST(Pipeline, QuadMeshDoesNotDependOnRanks) { check_quads_do_not_depend_on_ranks(Stage::Unstructured, "pipe_quads"); }
 
+// With the background at the geometry's resolution (the program's default): on an L-shaped
+// plate 30 wide the caps (diagonal / 8, about 5) bind against the size 1, and the background is
+// coarser than the quads.
+TEST(Pipeline, QuadMeshWithFieldsAtTheGeometrysResolutionDoesNotDependOnRanks) {
+  const Comm comm = Comm::world();
+  const std::string path = tmp("pipe_l_plate_np" + std::to_string(comm.size()) + ".brep");
+  if (comm.rank() == 0)
+    test::write_polygon_face({{0, 0}, {30, 0}, {30, 10}, {10, 10}, {10, 30}, {0, 30}}, path);
+  comm.barrier();
+  const cad::CadModel model = cad::load_cad(path);
+  PipelineOptions options;
+  options.background.sizes.size = 1.0;
+  options.background.sizes.field_divisions = 8;
+  options.sizemap.size_max = 1.0;
+  options.until = Stage::QuasiStructured;
+  std::ostringstream sink;
+  Logger log(sink, LogLevel::Quiet);
+  const PipelineResult dist = run_pipeline(comm, model, options, TaskArena(2), log);
+  if (comm.rank() != 0) return;
+  const PipelineResult serial = run_pipeline(Comm::self(), model, options, TaskArena(1), log);
+  ASSERT_EQ(dist.mesh.points.size(), serial.mesh.points.size());
+  for (std::size_t i = 0; i < serial.mesh.points.size(); ++i)
+    ASSERT_EQ(dist.mesh.points[i], serial.mesh.points[i]);
+  EXPECT_EQ(dist.mesh.quads, serial.mesh.quads);
+  EXPECT_GT(dist.mesh.quads.size(), 300u);
+  EXPECT_TRUE(dist.mesh.triangles.empty());
+  const auto conformity = mesh::check_conformity(dist.mesh, model);
+  EXPECT_TRUE(conformity.ok()) << conformity.summary();
+  for (const auto& f : dist.face_stats) EXPECT_GT(f.sicn_min, 0.3);
+  // The cap binds: the background at the target's resolution has more vertices.
+  options.background.sizes.field_divisions = 0;
+  options.until = Stage::Background;
+  const PipelineResult target = run_pipeline(Comm::self(), model, options, TaskArena(1), log);
+  options.background.sizes.field_divisions = 8;
+  const PipelineResult coarse = run_pipeline(Comm::self(), model, options, TaskArena(1), log);
+  EXPECT_GT(target.mesh.points.size(), 2 * coarse.mesh.points.size());
+}
+
 TEST(Pipeline, QuasiStructuredMeshDoesNotDependOnRanks) {
   check_quads_do_not_depend_on_ranks(Stage::QuasiStructured, "pipe_quasi");
 }
