@@ -28,7 +28,11 @@ void check(const qsmesh::cli::Arguments& a) {
   require(a.order == 1 || a.order == 2);
   require(a.sizemap == "features" || a.sizemap == "crossfield");
   require(a.sizing == "paper" || a.sizing == "clamped");
-  for (const auto& [id, n] : a.curve_edges) require(id >= 0 && n > 0 && n % 2 == 0);
+  // Odd counts are honoured (each face loop is halved, not each curve); their parity is checked
+  // against the model's loops later, not by the parser.
+  for (const auto& [id, n] : a.curve_edges) require(id >= 0 && n > 0);
+  if (a.field_divisions)
+    require(*a.field_divisions == 0 || (*a.field_divisions >= 1 && *a.field_divisions <= 1e6));
   for (const auto* list : {&a.face_quads, &a.corner_sizes, &a.curve_sizes, &a.face_sizes})
     for (const auto& [id, v] : *list) require(id >= 0 && std::isfinite(v) && v > 0);
   if (a.command == Command::Mesh || a.command == Command::SizeMap) require(!a.output.empty());
