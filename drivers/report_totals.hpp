@@ -14,16 +14,10 @@
 
 #include "json.hpp"
 #include "qsmesh/core/error.hpp"
+#include "qsmesh/core/types.hpp"
 #include "qsmesh/parallel/record.hpp"
 
 namespace qsmesh::cli {
-
-namespace report_detail {
-template <class T>
-struct IsArray : std::false_type {};
-template <class T, std::size_t N>
-struct IsArray<std::array<T, N>> : std::true_type {};
-}  // namespace report_detail
 
 /// The sum of one field over the faces.
 struct FieldTotal {
@@ -90,7 +84,7 @@ class ReportTotals {
         add_value(name, at, {field ? std::int64_t{1} : std::int64_t{0}}, false);
       } else if constexpr (std::is_integral_v<T>) {
         add_value(name, at, {static_cast<std::int64_t>(field)}, false);
-      } else if constexpr (report_detail::IsArray<T>::value) {
+      } else if constexpr (IsStdArray<T>::value) {
         if constexpr (std::is_integral_v<typename T::value_type>)
           add_value(name, at, std::vector<std::int64_t>(field.begin(), field.end()), true);
       }

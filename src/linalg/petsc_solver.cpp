@@ -108,9 +108,69 @@ PetscInt to_petsc_int(std::int64_t value, const char* what) {
   return static_cast<PetscInt>(value);
 }
 
+// The SeqAIJ matrix of one pattern (PETSC_COMM_SELF) and its right-hand side and solution
+// vectors, as both PETSc backends hold them. Every method runs under the lane's lock.
+struct SeqSystem {
+  PetscLane* lane_;
+  Mat matrix = nullptr;
+  Vec b = nullptr;
+  Vec x = nullptr;
+
+  // Preallocates exactly and assembles the pattern of A with its values; marks it SPD (MUMPS then
+  // runs its SPD variant, SYM=1, no pivoting, reading only the upper triangle).
+  void create(const SparseMatrix& A, int block_size) {
+    const LO n = A.size();
+    std::vector<PetscInt> ia(static_cast<std::size_t>(n) + 1);
+    for (std::size_t i = 0; i < ia.size(); ++i)
+      ia[i] = to_petsc_int(A.row_offsets()[i], "nonzero count");
+    const std::vector<PetscInt> ja(A.columns().begin(), A.columns().end());
+    QSMESH_PETSC_CALL(MatCreate(PETSC_COMM_SELF, &matrix));
+    QSMESH_PETSC_CALL(MatSetSizes(matrix, n, n, n, n));
+    QSMESH_PETSC_CALL(MatSetType(matrix, MATSEQAIJ));
+    QSMESH_PETSC_CALL(MatSetBlockSize(matrix, block_size));
+    QSMESH_PETSC_CALL(
+        MatSeqAIJSetPreallocationCSR(matrix, ia.data(), ja.data(), A.values().data()));
+    QSMESH_PETSC_CALL(MatSetOption(matrix, MAT_NEW_NONZERO_LOCATION_ERR, PETSC_TRUE));
+    QSMESH_PETSC_CALL(MatSetOption(matrix, MAT_SYMMETRIC, PETSC_TRUE));
+    QSMESH_PETSC_CALL(MatSetOption(matrix, MAT_SYMMETRY_ETERNAL, PETSC_TRUE));
+    QSMESH_PETSC_CALL(MatSetOption(matrix, MAT_SPD, PETSC_TRUE));
+    QSMESH_PETSC_CALL(MatSetOption(matrix, MAT_SPD_ETERNAL, PETSC_TRUE));
+    QSMESH_PETSC_CALL(MatCreateVecs(matrix, &x, &b));
+  }
+
+  // New values of the same pattern: sorted columns, so SeqAIJ stores them in exactly our CSR order.
+  void set_values(const SparseMatrix& A) {
+    PetscScalar* values = nullptr;
+    QSMESH_PETSC_CALL(MatSeqAIJGetArray(matrix, &values));
+    std::copy(A.values().begin(), A.values().end(), values);
+    QSMESH_PETSC_CALL(MatSeqAIJRestoreArray(matrix, &values));
+  }
+
+  void load(std::span<const double> rhs) {
+    PetscScalar* bp = nullptr;
+    QSMESH_PETSC_CALL(VecGetArrayWrite(b, &bp));
+    std::copy(rhs.begin(), rhs.end(), bp);
+    QSMESH_PETSC_CALL(VecRestoreArrayWrite(b, &bp));
+  }
+
+  void store(std::span<double> solution) {
+    const PetscScalar* xp = nullptr;
+    QSMESH_PETSC_CALL(VecGetArrayRead(x, &xp));
+    std::copy(xp, xp + solution.size(), solution.begin());
+    QSMESH_PETSC_CALL(VecRestoreArrayRead(x, &xp));
+  }
+
+  // Never throws (runs in destructors); a failing destroy leaks at worst.
+  void destroy() noexcept {
+    VecDestroy(&b);
+    VecDestroy(&x);
+    MatDestroy(&matrix);
+  }
+};
+
 class PetscSolver final : public LinearSolver {
  public:
-  explicit PetscSolver(PetscLane& lane) : lane_(&lane) {}
+  explicit PetscSolver(PetscLane& lane) : lane_(&lane), sys_{&lane} {}
   ~PetscSolver() override {
     std::lock_guard lock(lane_->mutex());
     destroy_all();
@@ -143,16 +203,12 @@ class PetscSolver final : public LinearSolver {
     // A failed MUMPS factorization leaves MUMPS in an error state that PETSc does not reset:
     // redo the symbolic phase on a fresh factor before trying new values.
     if (factor_ == nullptr) symbolic();
-    PetscScalar* values = nullptr;
-    QSMESH_PETSC_CALL(MatSeqAIJGetArray(matrix_, &values));
-    // Same pattern, sorted columns: SeqAIJ stores the values in exactly our CSR order.
-    std::copy(A.values().begin(), A.values().end(), values);
-    QSMESH_PETSC_CALL(MatSeqAIJRestoreArray(matrix_, &values));
+    sys_.set_values(A);
     try {
       if (type_ == MAT_FACTOR_CHOLESKY)
-        QSMESH_PETSC_CALL(MatCholeskyFactorNumeric(factor_, matrix_, &info_));
+        QSMESH_PETSC_CALL(MatCholeskyFactorNumeric(factor_, sys_.matrix, &info_));
       else
-        QSMESH_PETSC_CALL(MatLUFactorNumeric(factor_, matrix_, &info_));
+        QSMESH_PETSC_CALL(MatLUFactorNumeric(factor_, sys_.matrix, &info_));
       check_factor(A.size());
     } catch (const Error&) {
       MatDestroy(&factor_);  // rebuilt by the next factorize(); its own error would add nothing
@@ -163,26 +219,8 @@ class PetscSolver final : public LinearSolver {
 
   // Under the lock: matrix, vectors and symbolic factorization for the pattern of A.
   void build(const SparseMatrix& A) {
-    const LO n = A.size();
-    if (n == 0) return;
-    std::vector<PetscInt> ia(static_cast<std::size_t>(n) + 1);
-    for (std::size_t i = 0; i < ia.size(); ++i)
-      ia[i] = to_petsc_int(A.row_offsets()[i], "nonzero count");
-    const std::vector<PetscInt> ja(A.columns().begin(), A.columns().end());
-
-    QSMESH_PETSC_CALL(MatCreate(PETSC_COMM_SELF, &matrix_));
-    QSMESH_PETSC_CALL(MatSetSizes(matrix_, n, n, n, n));
-    QSMESH_PETSC_CALL(MatSetType(matrix_, MATSEQAIJ));
-    // Preallocates exactly and assembles: the values are replaced in place by factorize().
-    QSMESH_PETSC_CALL(
-        MatSeqAIJSetPreallocationCSR(matrix_, ia.data(), ja.data(), A.values().data()));
-    QSMESH_PETSC_CALL(MatSetOption(matrix_, MAT_NEW_NONZERO_LOCATION_ERR, PETSC_TRUE));
-    // SPD makes MUMPS run its SPD variant (SYM=1, no pivoting); only the upper triangle is read.
-    QSMESH_PETSC_CALL(MatSetOption(matrix_, MAT_SYMMETRIC, PETSC_TRUE));
-    QSMESH_PETSC_CALL(MatSetOption(matrix_, MAT_SYMMETRY_ETERNAL, PETSC_TRUE));
-    QSMESH_PETSC_CALL(MatSetOption(matrix_, MAT_SPD, PETSC_TRUE));
-    QSMESH_PETSC_CALL(MatSetOption(matrix_, MAT_SPD_ETERNAL, PETSC_TRUE));
-    QSMESH_PETSC_CALL(MatCreateVecs(matrix_, &x_, &b_));
+    if (A.size() == 0) return;
+    sys_.create(A, 1);
 
     // MUMPS Cholesky; MUMPS LU when a PETSc build lacks the Cholesky path; PETSc's own
     // factorizations when MUMPS is missing altogether.
@@ -195,7 +233,7 @@ class PetscSolver final : public LinearSolver {
     bool found = false;
     for (const auto& [package, type] : kChoices) {
       PetscBool available = PETSC_FALSE;
-      QSMESH_PETSC_CALL(MatGetFactorAvailable(matrix_, package, type, &available));
+      QSMESH_PETSC_CALL(MatGetFactorAvailable(sys_.matrix, package, type, &available));
       if (available == PETSC_TRUE) {
         package_ = package;
         type_ = type;
@@ -207,7 +245,7 @@ class PetscSolver final : public LinearSolver {
     name_ = std::string("petsc/") + package_ + (type_ == MAT_FACTOR_CHOLESKY ? "-cholesky" : "-lu");
     // MUMPS orders the matrix itself; PETSc's own factorization needs a fill-reducing ordering.
     QSMESH_PETSC_CALL(MatGetOrdering(
-        matrix_, package_ == std::string(MATSOLVERMUMPS) ? MATORDERINGNATURAL : MATORDERINGND,
+        sys_.matrix, package_ == std::string(MATSOLVERMUMPS) ? MATORDERINGNATURAL : MATORDERINGND,
         &row_order_, &col_order_));
     symbolic();
   }
@@ -220,32 +258,26 @@ class PetscSolver final : public LinearSolver {
                                                      << " entries for a system of size " << n);
     if (n == 0) return;
     std::lock_guard lock(lane_->mutex());
-    PetscScalar* bp = nullptr;
-    QSMESH_PETSC_CALL(VecGetArrayWrite(b_, &bp));
-    std::copy(b.begin(), b.end(), bp);
-    QSMESH_PETSC_CALL(VecRestoreArrayWrite(b_, &bp));
-    QSMESH_PETSC_CALL(MatSolve(factor_, b_, x_));
-    const PetscScalar* xp = nullptr;
-    QSMESH_PETSC_CALL(VecGetArrayRead(x_, &xp));
-    std::copy(xp, xp + n, x.begin());
-    QSMESH_PETSC_CALL(VecRestoreArrayRead(x_, &xp));
+    sys_.load(b);
+    QSMESH_PETSC_CALL(MatSolve(factor_, sys_.b, sys_.x));
+    sys_.store(x);
   }
 
   [[nodiscard]] const char* name() const override { return name_.c_str(); }
 
  private:
-  // Under the lock: a fresh factor matrix and its symbolic analysis of matrix_'s pattern.
+  // Under the lock: a fresh factor matrix and its symbolic analysis of the matrix's pattern.
   void symbolic() {
-    QSMESH_PETSC_CALL(MatGetFactor(matrix_, package_, type_, &factor_));
+    QSMESH_PETSC_CALL(MatGetFactor(sys_.matrix, package_, type_, &factor_));
     if (package_ == std::string(MATSOLVERMUMPS)) {
       // Quiet: no MUMPS diagnostics on stdout (ICNTL 1-4), whatever PETSC_OPTIONS says.
       QSMESH_PETSC_CALL(MatMumpsSetIcntl(factor_, 4, 0));
     }
     QSMESH_PETSC_CALL(MatFactorInfoInitialize(&info_));
     if (type_ == MAT_FACTOR_CHOLESKY)
-      QSMESH_PETSC_CALL(MatCholeskyFactorSymbolic(factor_, matrix_, row_order_, &info_));
+      QSMESH_PETSC_CALL(MatCholeskyFactorSymbolic(factor_, sys_.matrix, row_order_, &info_));
     else
-      QSMESH_PETSC_CALL(MatLUFactorSymbolic(factor_, matrix_, row_order_, col_order_, &info_));
+      QSMESH_PETSC_CALL(MatLUFactorSymbolic(factor_, sys_.matrix, row_order_, col_order_, &info_));
   }
 
   // Under the lock: PETSc reports a failed numeric factorization through the factor, not the
@@ -277,24 +309,20 @@ class PetscSolver final : public LinearSolver {
     MatDestroy(&factor_);
     ISDestroy(&row_order_);
     ISDestroy(&col_order_);
-    VecDestroy(&b_);
-    VecDestroy(&x_);
-    MatDestroy(&matrix_);
+    sys_.destroy();
     lane_->last_error().clear();
   }
 
   PetscLane* lane_;
+  SeqSystem sys_;
   Pattern pattern_;
   bool factorized_ = false;
   std::string name_ = "petsc";
   const char* package_ = MATSOLVERMUMPS;
   MatFactorType type_ = MAT_FACTOR_CHOLESKY;
-  Mat matrix_ = nullptr;
   Mat factor_ = nullptr;
   IS row_order_ = nullptr;
   IS col_order_ = nullptr;
-  Vec b_ = nullptr;
-  Vec x_ = nullptr;
   MatFactorInfo info_{};
 };
 
@@ -302,7 +330,7 @@ class PetscSolver final : public LinearSolver {
 class PetscMultigridSolver final : public LinearSolver {
  public:
   PetscMultigridSolver(PetscLane& lane, double rtol, int block_size)
-      : lane_(&lane), rtol_(rtol), block_size_(block_size) {
+      : lane_(&lane), rtol_(rtol), block_size_(block_size), sys_{&lane} {
     QSMESH_CHECK(block_size >= 1, "petsc multigrid: block size " << block_size << " is below 1");
     QSMESH_CHECK(rtol > 0 && rtol < 1,
                  "petsc multigrid: relative tolerance " << rtol << " is not in (0, 1)");
@@ -336,12 +364,9 @@ class PetscMultigridSolver final : public LinearSolver {
       ready_ = true;
       return;
     }
-    PetscScalar* values = nullptr;
-    QSMESH_PETSC_CALL(MatSeqAIJGetArray(matrix_, &values));
-    std::copy(A.values().begin(), A.values().end(), values);
-    QSMESH_PETSC_CALL(MatSeqAIJRestoreArray(matrix_, &values));
+    sys_.set_values(A);
     // New values: the hierarchy is rebuilt here, once per level, not at the first solve.
-    QSMESH_PETSC_CALL(KSPSetOperators(ksp_, matrix_, matrix_));
+    QSMESH_PETSC_CALL(KSPSetOperators(ksp_, sys_.matrix, sys_.matrix));
     QSMESH_PETSC_CALL(KSPSetUp(ksp_));
     ready_ = true;
   }
@@ -354,11 +379,8 @@ class PetscMultigridSolver final : public LinearSolver {
                                                      << " entries for a system of size " << n);
     if (n == 0) return;
     std::lock_guard lock(lane_->mutex());
-    PetscScalar* bp = nullptr;
-    QSMESH_PETSC_CALL(VecGetArrayWrite(b_, &bp));
-    std::copy(b.begin(), b.end(), bp);
-    QSMESH_PETSC_CALL(VecRestoreArrayWrite(b_, &bp));
-    QSMESH_PETSC_CALL(KSPSolve(ksp_, b_, x_));
+    sys_.load(b);
+    QSMESH_PETSC_CALL(KSPSolve(ksp_, sys_.b, sys_.x));
     KSPConvergedReason reason = KSP_CONVERGED_ITERATING;
     QSMESH_PETSC_CALL(KSPGetConvergedReason(ksp_, &reason));
     PetscInt iterations = 0;
@@ -366,10 +388,7 @@ class PetscMultigridSolver final : public LinearSolver {
     QSMESH_CHECK(reason > 0, "petsc multigrid: CG did not converge on a system of size "
                                  << n << " (reason " << static_cast<int>(reason) << " after "
                                  << iterations << " iterations)");
-    const PetscScalar* xp = nullptr;
-    QSMESH_PETSC_CALL(VecGetArrayRead(x_, &xp));
-    std::copy(xp, xp + n, x.begin());
-    QSMESH_PETSC_CALL(VecRestoreArrayRead(x_, &xp));
+    sys_.store(x);
   }
 
   [[nodiscard]] const char* name() const override { return "petsc/cg-gamg"; }
@@ -381,20 +400,7 @@ class PetscMultigridSolver final : public LinearSolver {
     QSMESH_CHECK(n % block_size_ == 0, "petsc multigrid: system size "
                                            << n << " is not a multiple of the block size "
                                            << block_size_);
-    std::vector<PetscInt> ia(static_cast<std::size_t>(n) + 1);
-    for (std::size_t i = 0; i < ia.size(); ++i)
-      ia[i] = to_petsc_int(A.row_offsets()[i], "nonzero count");
-    const std::vector<PetscInt> ja(A.columns().begin(), A.columns().end());
-    QSMESH_PETSC_CALL(MatCreate(PETSC_COMM_SELF, &matrix_));
-    QSMESH_PETSC_CALL(MatSetSizes(matrix_, n, n, n, n));
-    QSMESH_PETSC_CALL(MatSetType(matrix_, MATSEQAIJ));
-    QSMESH_PETSC_CALL(MatSetBlockSize(matrix_, block_size_));
-    QSMESH_PETSC_CALL(
-        MatSeqAIJSetPreallocationCSR(matrix_, ia.data(), ja.data(), A.values().data()));
-    QSMESH_PETSC_CALL(MatSetOption(matrix_, MAT_NEW_NONZERO_LOCATION_ERR, PETSC_TRUE));
-    QSMESH_PETSC_CALL(MatSetOption(matrix_, MAT_SYMMETRIC, PETSC_TRUE));
-    QSMESH_PETSC_CALL(MatSetOption(matrix_, MAT_SPD, PETSC_TRUE));
-    QSMESH_PETSC_CALL(MatCreateVecs(matrix_, &x_, &b_));
+    sys_.create(A, block_size_);
     QSMESH_PETSC_CALL(KSPCreate(PETSC_COMM_SELF, &ksp_));
     QSMESH_PETSC_CALL(KSPSetType(ksp_, KSPCG));
     PC pc = nullptr;
@@ -407,20 +413,16 @@ class PetscMultigridSolver final : public LinearSolver {
 
   void destroy_all() noexcept {
     KSPDestroy(&ksp_);
-    VecDestroy(&b_);
-    VecDestroy(&x_);
-    MatDestroy(&matrix_);
+    sys_.destroy();
     lane_->last_error().clear();
   }
 
   PetscLane* lane_;
   double rtol_;
   int block_size_;
+  SeqSystem sys_;
   Pattern pattern_;
   bool ready_ = false;
-  Mat matrix_ = nullptr;
-  Vec b_ = nullptr;
-  Vec x_ = nullptr;
   KSP ksp_ = nullptr;
 };
 

@@ -220,6 +220,13 @@ mesh::FaceMesh move_irregular_vertices(LO f, const cad::Face& face,
   const auto score = [&](const smooth::QualityReport& r) {
     return r.sicn_avg + 2 * std::min(0.0, r.sicn_min - min_sicn);
   };
+  // Whether fill `a` beats fill `b`: passing the thresholds first, then the score by more than
+  // `margin`.
+  const auto beats = [&](const smooth::QualityReport& a, const smooth::QualityReport& b,
+                         double margin) {
+    const bool good_a = passes(a, min_sicn, options), good_b = passes(b, min_sicn, options);
+    return good_a != good_b ? good_a : score(a) > score(b) + margin;
+  };
   // Lays out the best candidate moved by t along v; true (and best, mesh, q updated) when better.
   const auto try_move = [&](const std::vector<LO>& v, LO t) {
     if (t == 0 || evaluations >= options.move_evaluations) return false;
@@ -240,8 +247,7 @@ mesh::FaceMesh move_irregular_vertices(LO f, const cad::Face& face,
     mesh::FaceMesh m = smooth::smooth_face(build_mesh(f, face, surface, fs, c), surface, search);
     const smooth::QualityReport mq = smooth::measure(m);
     if (mq.invalid != 0) return false;
-    const bool good_new = passes(mq, min_sicn, options), good_old = passes(q, min_sicn, options);
-    if (good_new != good_old ? !good_new : score(mq) <= score(q) + 1e-4) return false;
+    if (!beats(mq, q, 1e-4)) return false;
     best = std::move(c);
     mesh = std::move(m);
     q = mq;
@@ -285,11 +291,7 @@ mesh::FaceMesh move_irregular_vertices(LO f, const cad::Face& face,
     const smooth::QualityReport fq = smooth::measure(full);
     // The given mesh may have been lifted (untangled) where the light start was not: the moved
     // fill wins only when it is also better smoothed fully.
-    const bool good_new = passes(fq, min_sicn, options);
-    const bool good_old = passes(given_q, min_sicn, options);
-    const bool wins =
-        fq.invalid == 0 &&
-        (given_q.invalid != 0 || (good_new != good_old ? good_new : score(fq) > score(given_q)));
+    const bool wins = fq.invalid == 0 && (given_q.invalid != 0 || beats(fq, given_q, 0.0));
     if (wins) {
       mesh = std::move(full);
       q = fq;

@@ -301,6 +301,30 @@ void check_size_map(const Comm& comm, const cad::CadModel& model, double size,
   EXPECT_EQ(all[0], mine * comm.size());
 }
 
+// On rank 0: `dist` (the run on every rank) equals the run of the same options on one rank and
+// one thread, point for point, and is a conforming all-quad mesh of at least `min_quads` quads
+// whose every face has SICN min above `min_sicn`. Returns the one-rank run.
+PipelineResult expect_quads_as_on_one_rank(const PipelineResult& dist, const cad::CadModel& model,
+                                           const PipelineOptions& options, Logger& log,
+                                           std::size_t min_quads, double min_sicn) {
+  PipelineResult serial = run_pipeline(Comm::self(), model, options, TaskArena(1), log);
+  EXPECT_EQ(dist.mesh.points.size(), serial.mesh.points.size());
+  if (dist.mesh.points.size() != serial.mesh.points.size()) return serial;
+  for (std::size_t i = 0; i < serial.mesh.points.size(); ++i) {
+    EXPECT_EQ(dist.mesh.points[i], serial.mesh.points[i]) << i;
+    if (dist.mesh.points[i] != serial.mesh.points[i]) break;
+  }
+  EXPECT_EQ(dist.mesh.quads, serial.mesh.quads);
+  EXPECT_TRUE(dist.mesh.triangles.empty());
+  EXPECT_GT(dist.mesh.quads.size(), min_quads);
+  const auto conformity = mesh::check_conformity(dist.mesh, model);
+  EXPECT_TRUE(conformity.ok()) << conformity.summary();
+  for (const auto& q : dist.quad_reports) EXPECT_TRUE(q.ok) << q.error;
+  for (std::size_t f = 0; f < dist.face_stats.size(); ++f)
+    EXPECT_GT(dist.face_stats[f].sicn_min, min_sicn) << "face " << f;
+  return serial;
+}
+
 void check_quads_do_not_depend_on_ranks(Stage until, const std::string& name) {
   const Comm comm = Comm::world();
   const cad::CadModel model = shared_model(comm, name);
@@ -312,16 +336,7 @@ void check_quads_do_not_depend_on_ranks(Stage until, const std::string& name) {
   Logger log(sink, LogLevel::Quiet);
   const PipelineResult dist = run_pipeline(comm, model, options, TaskArena(2), log);
   if (comm.rank() != 0) return;
-  const PipelineResult serial = run_pipeline(Comm::self(), model, options, TaskArena(1), log);
-  ASSERT_EQ(dist.mesh.points.size(), serial.mesh.points.size());
-  for (std::size_t i = 0; i < serial.mesh.points.size(); ++i) ASSERT_EQ(dist.mesh.points[i], serial.mesh.points[i]);
-  EXPECT_EQ(dist.mesh.quads, serial.mesh.quads);
-  EXPECT_TRUE(dist.mesh.triangles.empty());
-  EXPECT_GT(dist.mesh.quads.size(), 500u);
-  const auto conformity = mesh::check_conformity(dist.mesh, model);
-  EXPECT_TRUE(conformity.ok()) << conformity.summary();
-  for (const auto& q : dist.quad_reports) EXPECT_TRUE(q.ok) << q.error;
-  for (std::size_t f = 0; f < dist.face_stats.size(); ++f) EXPECT_GT(dist.face_stats[f].sicn_min, 0) << "face " << f;
+  const PipelineResult serial = expect_quads_as_on_one_rank(dist, model, options, log, 500, 0.0);
   if (until == Stage::QuasiStructured) {
     ASSERT_EQ(dist.quasi_reports.size(), serial.quasi_reports.size());
     int by_pattern = 0;
@@ -389,16 +404,7 @@ TEST(Pipeline, QuadMeshWithFieldsAtTheGeometrysResolutionDoesNotDependOnRanks) {
   Logger log(sink, LogLevel::Quiet);
   const PipelineResult dist = run_pipeline(comm, model, options, TaskArena(2), log);
   if (comm.rank() != 0) return;
-  const PipelineResult serial = run_pipeline(Comm::self(), model, options, TaskArena(1), log);
-  ASSERT_EQ(dist.mesh.points.size(), serial.mesh.points.size());
-  for (std::size_t i = 0; i < serial.mesh.points.size(); ++i)
-    ASSERT_EQ(dist.mesh.points[i], serial.mesh.points[i]);
-  EXPECT_EQ(dist.mesh.quads, serial.mesh.quads);
-  EXPECT_GT(dist.mesh.quads.size(), 300u);
-  EXPECT_TRUE(dist.mesh.triangles.empty());
-  const auto conformity = mesh::check_conformity(dist.mesh, model);
-  EXPECT_TRUE(conformity.ok()) << conformity.summary();
-  for (const auto& f : dist.face_stats) EXPECT_GT(f.sicn_min, 0.3);
+  (void)expect_quads_as_on_one_rank(dist, model, options, log, 300, 0.3);
   // The cap binds: the background at the target's resolution has more vertices.
   options.background.sizes.field_divisions = 0;
   options.until = Stage::Background;

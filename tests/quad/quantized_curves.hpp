@@ -7,6 +7,7 @@
 
 #include "qsmesh/cad/model.hpp"
 #include "qsmesh/mesh/surface_mesh.hpp"
+#include "qsmesh/quantize/quantize.hpp"
 
 namespace qsmesh::test {
 
@@ -17,5 +18,11 @@ struct QuantizedCurves {
 
 /// Every curve of `model` at edge length `size` (model units, > 0).
 [[nodiscard]] QuantizedCurves quantized_curves(const cad::CadModel& model, double size);
+
+/// The final curve meshes only, quantized with `options` (prescriptions, odd ones included, whose
+/// halved curve meshes would not exist); `edges`, when given, receives the counts.
+[[nodiscard]] std::vector<mesh::CurveMesh> quantized_full_curves(
+    const cad::CadModel& model, double size, const quantize::QuantizeOptions& options,
+    std::vector<int>* edges = nullptr);
 
 }  // namespace qsmesh::test

@@ -466,17 +466,9 @@ TEST(HalvedBoundary, EvenCountsGiveTheHalvedCurveMeshes) {
 std::vector<mesh::CurveMesh> prescribed_meshes(const cad::CadModel& model, double size,
                                                const std::vector<std::pair<LO, int>>& prescribed,
                                                std::vector<int>* edges = nullptr) {
-  const TaskArena tasks(1);
-  background::SizeOptions sizes;
-  sizes.size = size;
-  const auto bg = background::mesh_curves(model, sizes, tasks);
-  std::vector<std::vector<double>> at;
-  for (const auto& m : bg) at.emplace_back(m.points.size(), size);
   quantize::QuantizeOptions qo;
   qo.prescribed = prescribed;
-  const auto q = quantize::quantize_curves(model, quantize::ideal_edge_counts(bg, at), qo);
-  if (edges != nullptr) *edges = q.edges;
-  return quantize::place_vertices(model, bg, at, q, false, tasks);
+  return test::quantized_full_curves(model, size, qo, edges);
 }
 
 // Boundary edges of a face mesh (used by one quad), and the quads at each vertex.

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <type_traits>
 
 namespace qsmesh {
 
@@ -89,5 +90,12 @@ struct Box2 {
   }
   [[nodiscard]] bool valid() const { return lo.u <= hi.u; }
 };
+
+/// True for std::array<T, N>: code that walks a record's declared fields (parallel/record.hpp,
+/// the drivers' report totals) treats fixed arrays element by element.
+template <class T>
+struct IsStdArray : std::false_type {};
+template <class T, std::size_t N>
+struct IsStdArray<std::array<T, N>> : std::true_type {};
 
 }  // namespace qsmesh

@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "qsmesh/core/error.hpp"
+#include "qsmesh/core/types.hpp"
 #include "qsmesh/mesh/surface_mesh.hpp"
 
 namespace qsmesh::parallel {
@@ -34,10 +35,6 @@ template <class T>
 struct IsVector : std::false_type {};
 template <class T, class A>
 struct IsVector<std::vector<T, A>> : std::true_type {};
-template <class T>
-struct IsArray : std::false_type {};
-template <class T, std::size_t N>
-struct IsArray<std::array<T, N>> : std::true_type {};
 }  // namespace detail
 
 /// A type that lists its fields with a static fields(self, visit) (see the top of this file).
@@ -131,7 +128,7 @@ void write_record(std::vector<char>& out, const T& v) {
       put<std::int64_t>(out, static_cast<std::int64_t>(v.size()));
       for (const auto& e : v) write_record(out, e);
     }
-  } else if constexpr (detail::IsArray<T>::value) {
+  } else if constexpr (IsStdArray<T>::value) {
     for (const auto& e : v) write_record(out, e);
   } else {
     put(out, v);
@@ -160,7 +157,7 @@ void read_record(const std::vector<char>& in, std::size_t& pos, T& v) {
       v.assign(n, E{});
       for (auto& e : v) read_record(in, pos, e);
     }
-  } else if constexpr (detail::IsArray<T>::value) {
+  } else if constexpr (IsStdArray<T>::value) {
     for (auto& e : v) read_record(in, pos, e);
   } else {
     v = get<T>(in, pos);
