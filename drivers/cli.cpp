@@ -186,6 +186,10 @@ Arguments parse(const std::vector<std::string>& args) {
       a.field_divisions = *n;
     } else if (opt == "--block-structured" && a.command == Command::Mesh)
       a.block_structured = true;
+    else if (opt == "--plot3d-stream" && a.command == Command::Mesh)
+      a.plot3d_stream = true;
+    else if (opt == "--plot3d-single" && a.command == Command::Mesh)
+      a.plot3d_single = true;
     else if (opt == "--order" && a.command == Command::Mesh) {
       const std::string& v = value();
       if (v != "1" && v != "2") throw InputError("--order: '" + v + "' is not 1 or 2");
@@ -324,10 +328,27 @@ Arguments parse(const std::vector<std::string>& args) {
       throw InputError(cmd + ": unexpected argument '" + positional[1] + "'");
     a.model = positional[0];
     if (a.command == Command::Mesh && a.output.empty())
-      throw InputError("mesh: missing -o OUT (.cgns, .vtu, .msh or .h5)");
+      throw InputError("mesh: missing -o OUT (.cgns, .vtu, .msh, .h5 or .xyz)");
+    const bool plot3d =
+        a.command == Command::Mesh && io::output_format(a.output) == io::Format::kPlot3d;
+    if ((a.plot3d_stream || a.plot3d_single) && !plot3d)
+      throw InputError(std::string(a.plot3d_stream ? "--plot3d-stream" : "--plot3d-single") +
+                       ": only for PLOT3D output (-o FILE.xyz or FILE.p3d)");
+    if (plot3d) {
+      // PLOT3D holds structured blocks only: the layout is what it writes.
+      if (a.until == "background")
+        throw InputError("-o " + a.output +
+                         ": PLOT3D holds the blocks of a quad mesh; not with --until background");
+      if (a.order == 2)
+        throw InputError("-o " + a.output +
+                         " with --order 2: PLOT3D blocks of second-order quads are not written");
+      a.block_structured = true;
+    }
     if (a.block_structured) {
-      if (io::output_format(a.output) != io::Format::kCgns)
-        throw InputError("--block-structured: the blocks are written as CGNS; give -o FILE.cgns");
+      if (io::output_format(a.output) != io::Format::kCgns && !plot3d)
+        throw InputError(
+            "--block-structured: the blocks are written as CGNS or PLOT3D; give -o FILE.cgns or "
+            "FILE.xyz");
       if (a.until == "background")
         throw InputError("--block-structured needs a quad mesh: not with --until background");
       if (a.order == 2)
@@ -370,7 +391,12 @@ std::string help(const std::string& topic) {
           ".vtu (VTK XML, opens in ParaView; cell data cad_face), .msh (Gmsh 4.1 with entities),\n"
           ".h5 (HDF5 datasets for solvers: coordinates, quads, CAD ids and parameters of every\n"
           "vertex; an XDMF file of the same name, .xdmf, is written beside it to open in "
-          "ParaView).\n"
+          "ParaView),\n"
+          ".xyz or .p3d (multi-block PLOT3D of the quad layout's blocks, as --block-structured:\n"
+          "whole, binary, double precision, little-endian, each block ni+1 x nj+1 x 1 points in\n"
+          "Fortran unformatted records, as CFL3D and ParaView's PLOT3D reader read; beside it\n"
+          "OUT.json lists each block's 1-to-1 interfaces and its free sides with their CGNS\n"
+          "family names. Faces that do not split into blocks are left out, with a warning).\n"
           "Faces are distributed over the MPI ranks (METIS) and over threads inside a rank; the "
           "mesh\n"
           "is the same whatever the numbers of ranks and threads.\n\n"
@@ -401,6 +427,9 @@ std::string help(const std::string& topic) {
           "                        quad layout (traces from irregular vertices and CAD corners,\n"
           "                        paper 002 Sec. III.A), joined by 1-to-1 connectivity; faces\n"
           "                        that do not split into blocks go to one unstructured zone\n"
+          "  --plot3d-stream       PLOT3D output without the Fortran record lengths (C stream\n"
+          "                        binary: the same bytes, nothing between the records)\n"
+          "  --plot3d-single       PLOT3D coordinates in single precision (float32)\n"
           "  --quads N, --curvature-edges N, --face-curvature, --feature-ratio R, --size-min H,\n"
           "  --size-min-ratio R, --sizing RULES, --curve-edges C:N,.., --odd-slivers,\n"
           "  --face-quads F:N,.., --corner-size K:H,.., --curve-size C:H,.., --face-size F:H,..,\n"
@@ -524,7 +553,7 @@ std::string help(const std::string& topic) {
           "usage: qsmesh COMMAND [options]\n\n"
           "commands:\n"
           "  info MODEL            print the CAD topology (corners, curves, faces)\n"
-          "  mesh MODEL -o OUT     mesh the model and write OUT (.cgns, .vtu, .msh, .h5)\n"
+          "  mesh MODEL -o OUT     mesh the model and write OUT (.cgns, .vtu, .msh, .h5, .xyz)\n"
           "  crossfield MODEL -o OUT.vtu\n"
           "                        cross fields, singularities and scaling of every face\n"
           "  sizemap MODEL -o OUT.vtu\n"

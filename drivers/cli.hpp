@@ -29,7 +29,12 @@ struct Arguments {
   std::string stats;  ///< --stats FILE.json
   /// --block-structured: write the CGNS file as structured blocks of the quad layout
   /// (layout::extract_quad_layout, io::write_cgns_blocks) instead of one unstructured zone.
+  /// Implied by a PLOT3D output (-o FILE.xyz / .p3d: io::write_plot3d).
   bool block_structured = false;
+  /// --plot3d-stream: PLOT3D without Fortran record lengths (C stream; WriteOptions).
+  bool plot3d_stream = false;
+  /// --plot3d-single: PLOT3D coordinates in single precision.
+  bool plot3d_single = false;
   /// --order 2: second-order quads (9 nodes) and bars (3 nodes) on the CAD
   /// (highorder::make_quadratic); 1: linear.
   int order = 1;

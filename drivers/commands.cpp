@@ -63,6 +63,9 @@ std::vector<RunOutput> run_outputs(const Arguments& args) {
     outputs.push_back({"-o", args.output, ""});
     if (args.command != Command::Example && io::output_format(args.output) == io::Format::kHdf5)
       outputs.push_back({"the .xdmf file", io::xdmf_path_for(args.output), " written beside -o"});
+    if (args.command == Command::Mesh && io::output_format(args.output) == io::Format::kPlot3d)
+      outputs.push_back(
+          {"the .json file", io::plot3d_connections_path(args.output), " written beside -o"});
   }
   if (!args.stats.empty()) outputs.push_back({"--stats", args.stats, ""});
   return outputs;
@@ -261,6 +264,8 @@ struct Checks {
   struct Blocks {
     std::int64_t blocks = 0, quads = 0, largest = 0;
     LO unblocked_faces = 0, extended_faces = 0;
+    /// PLOT3D output: what it could not hold (the unblocked faces with elements).
+    std::optional<io::Plot3dReport> plot3d;
     [[nodiscard]] double mean_quads() const {
       return blocks > 0 ? static_cast<double>(quads) / static_cast<double>(blocks) : 0.0;
     }
@@ -421,6 +426,12 @@ std::string stats_json(const Arguments& args, const Session& session,
     j.value("block_quads_largest", checks.blocks->largest);
     j.value("faces_not_in_blocks", static_cast<std::int64_t>(checks.blocks->unblocked_faces));
     j.value("faces_with_extended_traces", static_cast<std::int64_t>(checks.blocks->extended_faces));
+    if (checks.blocks->plot3d) {
+      const io::Plot3dReport& p = *checks.blocks->plot3d;
+      j.value("plot3d_left_out_faces", static_cast<std::int64_t>(p.skipped_faces.size()));
+      j.value("plot3d_left_out_triangles", static_cast<std::int64_t>(p.skipped_triangles));
+      j.value("plot3d_left_out_quads", static_cast<std::int64_t>(p.skipped_quads));
+    }
   }
   if (!checks.rank_peak_mb.empty()) {
     j.begin_array("rank_peak_memory_mb");
@@ -559,6 +570,10 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
        << " quads each on average, largest " << b.largest << "; faces not in blocks "
        << b.unblocked_faces << "; faces traced again with extended traces " << b.extended_faces
        << "\n";
+    if (b.plot3d && !b.plot3d->skipped_faces.empty())
+      os << "  left out of the PLOT3D file (not blocks): " << b.plot3d->skipped_faces.size()
+         << " faces, " << b.plot3d->skipped_triangles << " triangles, " << b.plot3d->skipped_quads
+         << " quads\n";
   }
   if (!checks.rank_peak_mb.empty()) {
     const std::vector<double>& mb = checks.rank_peak_mb;
@@ -827,17 +842,41 @@ int run_mesh(const Arguments& args) {
       }
       b.unblocked_faces = static_cast<LO>(lay.unblocked_faces.size());
       b.extended_faces = lay.faces_with_extended_traces;
-      checks.blocks = b;
       s.times.add("layout", clock.seconds());
       clock.reset();
-      io::write_cgns_blocks(result.mesh, lay, args.output);
+      if (io::output_format(args.output) == io::Format::kPlot3d) {
+        io::WriteOptions wo;
+        wo.plot3d_fortran_records = !args.plot3d_stream;
+        wo.plot3d_single_precision = args.plot3d_single;
+        b.plot3d = io::write_plot3d(result.mesh, lay, args.output, wo);
+        const io::Plot3dReport& p = *b.plot3d;
+        if (!p.skipped_faces.empty()) {
+          std::string faces;
+          for (std::size_t i = 0; i < p.skipped_faces.size() && i < 10; ++i)
+            faces += (i > 0 ? " " : "") + std::to_string(p.skipped_faces[i]);
+          if (p.skipped_faces.size() > 10) faces += " ...";
+          s.log.warn(cat("PLOT3D holds structured blocks only: ", p.skipped_faces.size(),
+                         " faces that do not split into blocks (", p.skipped_triangles,
+                         " triangles, ", p.skipped_quads, " quads; faces ", faces, ") are not in ",
+                         args.output,
+                         "; the sidecar lists them and the block sides along them (-o FILE.cgns "
+                         "--block-structured writes them as an unstructured zone)"));
+        }
+      } else {
+        io::write_cgns_blocks(result.mesh, lay, args.output);
+      }
+      checks.blocks = b;
     } else {
       io::write_mesh(result.mesh, args.output);
     }
     s.times.add("write", clock.seconds());
-    s.log.info(io::output_format(args.output) == io::Format::kHdf5
+    const io::Format format = io::output_format(args.output);
+    s.log.info(format == io::Format::kHdf5
                    ? cat("wrote ", args.output, " and ", io::xdmf_path_for(args.output),
                          " (open it in ParaView)")
+               : format == io::Format::kPlot3d
+                   ? cat("wrote ", args.output, " and ", io::plot3d_connections_path(args.output),
+                         " (the blocks' connections)")
                    : cat("wrote ", args.output));
     peak_mb.front() = peak_resident_mb();
     checks.rank_peak_mb = std::move(peak_mb);

@@ -24,6 +24,7 @@
 #include "detail.hpp"
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/io/atomic_file.hpp"
+#include "qsmesh/io/block_connections.hpp"
 #include "qsmesh/io/writer.hpp"
 #include "qsmesh/layout/quad_layout.hpp"
 #include "qsmesh/mesh/edges.hpp"
@@ -384,14 +385,6 @@ void write_cgns(const mesh::SurfaceMesh& mesh, const std::string& path,
 
 namespace {
 
-// One side of a block: its vertices in order, and where it lies in the block's index space.
-struct Side {
-  int tangent;  // index (0: i, 1: j) that runs along the side
-  bool at_max;  // the side is at the largest value of the other index
-};
-constexpr std::array<Side, 4> kSides{
-    {{0, false}, {1, true}, {0, true}, {1, false}}};  // jmin imax jmax imin
-
 // The zone of the faces the layout left out.
 constexpr const char* kUnstructuredZone = "Unstructured";
 
@@ -406,7 +399,9 @@ void new_node(int cgio, double parent, const std::string& name, const char* labe
                                 t[CGIO_MAX_DATATYPE_LENGTH + 1] = {};
   std::strncpy(n, name.c_str(), CGIO_MAX_NAME_LENGTH);
   std::strncpy(l, label, CGIO_MAX_LABEL_LENGTH);
-  std::strncpy(t, type, CGIO_MAX_DATATYPE_LENGTH);
+  // memcpy: GCC's -Wstringop-truncation takes strncpy of a 2-character type into 2 bytes (the
+  // array's last byte stays zero) for a lost terminator.
+  std::memcpy(t, type, std::min<std::size_t>(std::strlen(type), CGIO_MAX_DATATYPE_LENGTH));
   QSMESH_CGIO(cgio_new_node(cgio, parent, n, l, t, ndims, dims, data, id));
 }
 
@@ -445,44 +440,6 @@ void write_abutment(int cgio, double parent, const std::string& name, const std:
            &child, path);
 }
 
-// The 1-based (i, j) of position p on side s of block b.
-std::array<cgsize_t, 2> side_index(const layout::Block& b, int s, LO p) {
-  const Side& side = kSides[static_cast<std::size_t>(s)];
-  std::array<cgsize_t, 2> ij{};
-  ij[static_cast<std::size_t>(side.tangent)] = p + 1;
-  const LO n = side.tangent == 0 ? b.nj : b.ni;  // the other index's cell count
-  ij[static_cast<std::size_t>(1 - side.tangent)] = side.at_max ? n + 1 : 1;
-  return ij;
-}
-
-GO side_vertex(const layout::Block& b, int s, LO p, const std::vector<GO>& vertices) {
-  const auto ij = side_index(b, s, p);
-  return b.vertex(static_cast<LO>(ij[0] - 1), static_cast<LO>(ij[1] - 1), vertices);
-}
-
-LO side_edges(const layout::Block& b, int s) {
-  return kSides[static_cast<std::size_t>(s)].tangent == 0 ? b.ni : b.nj;
-}
-
-// The vertex range (i0, j0, i1, j1) of edges p..q of side s of block b.
-std::array<cgsize_t, 4> side_range(const layout::Block& b, int s, LO p, LO q) {
-  const auto a = side_index(b, s, p), c = side_index(b, s, q + 1);
-  return {a[0], a[1], c[0], c[1]};
-}
-
-// Calls f(p, q, key) for every maximal run p..q of positions in [0, n) with the same key(x),
-// other than kNoIndex.
-template <typename Key, typename F>
-void for_each_run(LO n, const Key& key, const F& f) {
-  for (LO p = 0; p < n;) {
-    const LO k = key(p);
-    LO q = p;
-    while (q + 1 < n && key(q + 1) == k) ++q;
-    if (k != kNoIndex) f(p, q, k);
-    p = q + 1;
-  }
-}
-
 // The name of connectivity node number n of a zone ("C1", "C2", ...).
 std::string connection_name(int n) {
   // Appended rather than "C" + ...: GCC 12 reports a false -Wrestrict on that concatenation.
@@ -503,53 +460,22 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
                "CGNS block output " << path << ": blocks of second-order quads are not written");
   const auto unit = length_unit(mesh.length_unit);
   const auto nb = static_cast<GO>(layout.blocks.size());
-  for (const layout::Block& b : layout.blocks) {
-    QSMESH_CHECK(b.ni > 0 && b.nj > 0 && b.face >= 0 && b.face < mesh.num_cad_faces &&
-                     b.first >= 0 &&
-                     b.first + static_cast<std::int64_t>(b.ni + 1) * (b.nj + 1) <=
-                         static_cast<std::int64_t>(layout.vertices.size()),
-                 "CGNS block output " << path << ": a block does not fit the layout's arrays");
-  }
-  for (GO v : layout.vertices)
-    QSMESH_CHECK(v >= 0 && v < mesh.num_vertices(),
-                 "CGNS block output " << path << ": vertex " << v << " out of range");
-
-  // Block sides sharing a mesh edge: edge -> (block, side, position along the side).
-  struct Use {
-    GO block;
-    int side;
-    LO p;
-  };
-  std::unordered_map<std::uint64_t, std::vector<Use>> edge_uses;
-  using mesh::edge_key;
-  for (GO k = 0; k < nb; ++k) {
-    const layout::Block& b = layout.blocks[static_cast<std::size_t>(k)];
-    for (int s = 0; s < 4; ++s)
-      for (LO p = 0; p < side_edges(b, s); ++p)
-        edge_uses[edge_key(side_vertex(b, s, p, layout.vertices),
-                           side_vertex(b, s, p + 1, layout.vertices))]
-            .push_back({k, s, p});
-  }
+  check_layout_for_output(mesh, layout, "CGNS block output " + path);
+  const BlockConnections joined = block_connections(mesh, layout);
 
   // The faces left out go into one unstructured zone; its vertices are numbered in the order its
-  // elements first use them, and its element edges are where blocks abut it.
+  // elements first use them.
   const detail::ElementGroups groups = detail::group_elements(mesh);
   std::vector<GO> local(static_cast<std::size_t>(mesh.num_vertices()), -1);
   std::vector<GO> used;
-  std::unordered_set<std::uint64_t> unstructured_edges;
   GO unstructured_cells = 0;
   {
-    auto use = [&](GO v) {
-      if (local[static_cast<std::size_t>(v)] < 0) {
-        local[static_cast<std::size_t>(v)] = static_cast<GO>(used.size());
-        used.push_back(v);
-      }
-    };
     auto element = [&](const auto& vertices) {
-      const std::size_t n = vertices.size();
-      for (std::size_t i = 0; i < n; ++i) {
-        use(vertices[i]);
-        unstructured_edges.insert(edge_key(vertices[i], vertices[(i + 1) % n]));
+      for (GO v : vertices) {
+        if (local[static_cast<std::size_t>(v)] < 0) {
+          local[static_cast<std::size_t>(v)] = static_cast<GO>(used.size());
+          used.push_back(v);
+        }
       }
     };
     for (LO f : layout.unblocked_faces) {
@@ -561,27 +487,6 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
                                             groups.face2quads[static_cast<std::size_t>(f)].size());
     }
   }
-  // Which block sides a side edge is joined to. On a CAD curve: every other block side along it,
-  // and the unstructured zone when one of its faces has the edge; where three or more faces border
-  // the curve (non-manifold), every pair of sides at the edge is thus joined, once each way. Off
-  // the curves only sides of the same face: two faces on one surface with one boundary (a face
-  // given twice) may have edges between the same boundary vertices, but they meet on their curves
-  // only.
-  const std::unordered_map<std::uint64_t, LO> edge_curve = mesh::bar_curves(mesh);
-  auto joins = [&](GO k, std::uint64_t e, const Use& u) {
-    return edge_curve.count(e) > 0 || layout.blocks[static_cast<std::size_t>(u.block)].face ==
-                                          layout.blocks[static_cast<std::size_t>(k)].face;
-  };
-  auto abuts_unstructured = [&](std::uint64_t e) {
-    return edge_curve.count(e) > 0 && unstructured_edges.count(e) > 0;
-  };
-  // A block edge (of block k, at side s, position p) is free (a BC) when no other block side it
-  // joins and no element of the unstructured zone has it.
-  auto is_free = [&](GO k, int s, LO p, std::uint64_t e) {
-    for (const Use& u : edge_uses.at(e))
-      if (!(u.block == k && u.side == s && u.p == p) && joins(k, e, u)) return false;
-    return !abuts_unstructured(e);
-  };
   // What the unstructured zone's connectivity to the blocks needs: per run of block side edges on
   // it, the block and the points' (i, j) and unstructured ids, in the same order.
   struct Abutment {
@@ -609,12 +514,9 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
   // family and BCs on those edges, as in write_cgns.
   {
     std::vector<char> free_curve(static_cast<std::size_t>(mesh.num_cad_curves), 0);
-    for (const auto& [e, uses] : edge_uses) {
-      const auto it = edge_curve.find(e);
-      if (it == edge_curve.end()) continue;
-      for (const Use& u : uses)
-        if (is_free(u.block, u.side, u.p, e)) free_curve[static_cast<std::size_t>(it->second)] = 1;
-    }
+    for (const BlockLinks& links : joined.blocks)
+      for (const BlockBoundary& r : links.boundaries)
+        free_curve[static_cast<std::size_t>(r.curve)] = 1;
     for (LO c = 0; c < mesh.num_cad_curves; ++c) {
       if (!free_curve[static_cast<std::size_t>(c)]) continue;
       int family = 0, fambc = 0;
@@ -627,20 +529,7 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
   double root = 0;
   QSMESH_CG(cg_get_cgio(fn, &cgio));
   QSMESH_CG(cg_root_id(fn, &root));
-  // Zero-padded, so that the zones sort by name (cgnslib's order) as the blocks do.
-  const int width = std::max<int>(
-      6, static_cast<int>(std::to_string(std::max<GO>(nb, mesh.num_cad_faces)).size()));
-  auto padded = [width](GO x) {
-    std::string t = std::to_string(x);
-    return std::string(
-               static_cast<std::size_t>(std::max<int>(0, width - static_cast<int>(t.size()))),
-               '0') +
-           t;
-  };
-  auto zone_name = [&](GO k) {
-    return "Block_" + padded(k) + "_Face_" +
-           padded(layout.blocks[static_cast<std::size_t>(k)].face);
-  };
+  auto zone_name = [&](GO k) { return block_name(layout, k, mesh.num_cad_faces); };
   for (GO k = 0; k < nb; ++k) {
     const layout::Block& b = layout.blocks[static_cast<std::size_t>(k)];
     const std::string name = zone_name(k);
@@ -660,8 +549,7 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
     QSMESH_CG(cg_goto(fn, base, "Zone_t", zone, "end"));
     QSMESH_CG(cg_famname_write(("Face_" + std::to_string(b.face)).c_str()));
 
-    // 1-to-1 interfaces: maximal runs of side edges shared with the same side of the same block,
-    // the donor positions moving by one edge per edge.
+    // Per side: its 1-to-1 interfaces, its runs along the unstructured zone, its BCs.
     int connections = 0, boundaries = 0;
     double zgc_id = 0;  // the zone's ZoneGridConnectivity node, made with its first interface
     // The name of the zone's next connectivity node, the ZoneGridConnectivity made with the first.
@@ -670,126 +558,55 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
         zgc_id = new_zone_grid_connectivity(cgio, root, options.cgns_base_name, name, path);
       return connection_name(++connections);
     };
+    const BlockLinks& links = joined.blocks[static_cast<std::size_t>(k)];
     for (int s = 0; s < 4; ++s) {
-      auto edge_at = [&](LO q) {
-        return edge_key(side_vertex(b, s, q, layout.vertices),
-                        side_vertex(b, s, q + 1, layout.vertices));
-      };
-      struct Run {
-        GO block;
-        int side;
-        LO p0, p1;  // this side's edges p0..p1
-        LO d0, d1;  // the donor side's edges matching p0 and p1
-      };
-      std::vector<Run> open, done;
-      for (LO p = 0; p < side_edges(b, s); ++p) {
-        std::vector<Run> next;
-        const std::uint64_t e = edge_at(p);
-        for (const Use& u : edge_uses.at(e)) {
-          // The edge itself; another position of this same side (a side running along both
-          // banks of a seam) is an interface of the block with itself.
-          if ((u.block == k && u.side == s && u.p == p) || !joins(k, e, u)) continue;
-          auto it = std::find_if(open.begin(), open.end(), [&](const Run& r) {
-            if (r.block != u.block || r.side != u.side || r.p1 != p - 1) return false;
-            const LO step = r.p1 > r.p0 ? (r.d1 - r.d0) / (r.p1 - r.p0) : u.p - r.d1;
-            return (step == 1 || step == -1) && u.p == r.d1 + step;
-          });
-          if (it != open.end()) {
-            Run r = *it;
-            r.p1 = p;
-            r.d1 = u.p;
-            open.erase(it);
-            next.push_back(r);
-          } else {
-            next.push_back({u.block, u.side, p, p, u.p, u.p});
-          }
-        }
-        for (const Run& r : open) done.push_back(r);
-        open.swap(next);
-      }
-      for (const Run& r : open) done.push_back(r);
-      std::sort(done.begin(), done.end(), [](const Run& x, const Run& y) {
-        return std::tie(x.p0, x.block, x.side) < std::tie(y.p0, y.block, y.side);
-      });
-      for (const Run& r : done) {
-        const layout::Block& d = layout.blocks[static_cast<std::size_t>(r.block)];
-        // Vertex ends: this side's p0 and p1 + 1; the donor's are whichever end of its matching
-        // edges carries the same vertex.
-        const GO first_vertex = side_vertex(b, s, r.p0, layout.vertices);
-        const LO dir =
-            r.p1 > r.p0 ? (r.d1 - r.d0) / (r.p1 - r.p0)
-                        : (side_vertex(d, r.side, r.d0, layout.vertices) == first_vertex ? 1 : -1);
-        const LO dv0 = dir > 0 ? r.d0 : r.d0 + 1;
-        const LO dv1 = dir > 0 ? r.d1 + 1 : r.d1;
-        QSMESH_CHECK(side_vertex(d, r.side, dv0, layout.vertices) == first_vertex &&
-                         side_vertex(d, r.side, dv1, layout.vertices) ==
-                             side_vertex(b, s, r.p1 + 1, layout.vertices),
-                     "CGNS block output " << path << ": blocks " << k << " and " << r.block
-                                          << " do not match along their interface");
-        const auto range = side_range(b, s, r.p0, r.p1);
-        const auto j0 = side_index(d, r.side, dv0), j1 = side_index(d, r.side, dv1);
-        const cgsize_t donor[4] = {j0[0], j0[1], j1[0], j1[1]};
-        const Side& me = kSides[static_cast<std::size_t>(s)];
-        const Side& them = kSides[static_cast<std::size_t>(r.side)];
-        int transform[2] = {0, 0};
-        transform[me.tangent] = dir * (them.tangent + 1);
-        // Leaving this block across the side is entering the donor across its side.
-        const int normal = 1 - me.tangent, donor_normal = 1 - them.tangent;
-        transform[normal] = (me.at_max == them.at_max ? -1 : 1) * (donor_normal + 1);
+      for (const BlockInterface& r : links.interfaces) {
+        if (r.side != s) continue;
         const std::string cname = next_connection();
-        const std::string donor_name = zone_name(r.block);
+        const std::string donor_name = zone_name(r.donor);
         const cgsize_t name_size[1] = {static_cast<cgsize_t>(donor_name.size())};
         double conn_id = 0, child = 0;
         new_node(cgio, zgc_id, cname.c_str(), "GridConnectivity1to1_t", "C1", 1, name_size,
                  donor_name.data(), &conn_id, path);
         const cgsize_t range_dims[2] = {2, 2}, transform_dims[1] = {2};
         new_node(cgio, conn_id, "Transform", "\"int[IndexDimension]\"", "I4", 1, transform_dims,
-                 transform, &child, path);
-        new_node(cgio, conn_id, "PointRange", "IndexRange_t", "I4", 2, range_dims, range.data(),
+                 r.transform.data(), &child, path);
+        new_node(cgio, conn_id, "PointRange", "IndexRange_t", "I4", 2, range_dims, r.range.data(),
                  &child, path);
-        new_node(cgio, conn_id, "PointRangeDonor", "IndexRange_t", "I4", 2, range_dims, donor,
-                 &child, path);
+        new_node(cgio, conn_id, "PointRangeDonor", "IndexRange_t", "I4", 2, range_dims,
+                 r.donor_range.data(), &child, path);
       }
       // Runs of side edges on the unstructured zone: a GridConnectivity (Abutting1to1, vertex
       // ranges here, vertex lists there), written as cgio nodes beside the 1-to-1 ones.
-      for_each_run(
-          side_edges(b, s), [&](LO q) { return abuts_unstructured(edge_at(q)) ? LO{0} : kNoIndex; },
-          [&](LO p, LO q, LO) {
-            Abutment a{k, {}, {}};
-            for (LO x = p; x <= q + 1; ++x) {
-              const auto ij = side_index(b, s, x);
-              a.ij.insert(a.ij.end(), ij.begin(), ij.end());
-              a.local.push_back(static_cast<cgsize_t>(
-                  local[static_cast<std::size_t>(side_vertex(b, s, x, layout.vertices))] + 1));
-            }
-            const auto range = side_range(b, s, p, q);
-            const std::string cname = next_connection();  // makes zgc_id with the first
-            write_abutment(cgio, zgc_id, cname, kUnstructuredZone, "PointRange", "IndexRange_t",
-                           {2, 2}, range.data(), {1, static_cast<cgsize_t>(a.local.size())},
-                           a.local.data(), path);
-            abutments.push_back(std::move(a));
-          });
+      for (const BlockAbutment& r : links.abutments) {
+        if (r.side != s) continue;
+        Abutment a{k, {}, {}};
+        for (std::size_t x = 0; x < r.ij.size(); ++x) {
+          a.ij.insert(a.ij.end(), r.ij[x].begin(), r.ij[x].end());
+          a.local.push_back(
+              static_cast<cgsize_t>(local[static_cast<std::size_t>(r.vertices[x])] + 1));
+        }
+        const std::string cname = next_connection();  // makes zgc_id with the first
+        write_abutment(cgio, zgc_id, cname, kUnstructuredZone, "PointRange", "IndexRange_t", {2, 2},
+                       r.range.data(), {1, static_cast<cgsize_t>(a.local.size())}, a.local.data(),
+                       path);
+        abutments.push_back(std::move(a));
+      }
       // Free edges: one BC per run of them on one curve.
-      auto curve_of_free = [&](LO q) -> LO {
-        const std::uint64_t e = edge_at(q);
-        if (!is_free(k, s, q, e)) return kNoIndex;
-        const auto it = edge_curve.find(e);
-        return it == edge_curve.end() ? kNoIndex : it->second;
-      };
-      for_each_run(side_edges(b, s), curve_of_free, [&](LO p, LO q, LO c) {
-        const auto range = side_range(b, s, p, q);
+      for (const BlockBoundary& r : links.boundaries) {
+        if (r.side != s) continue;
         std::string bcname("BC");
         bcname += std::to_string(++boundaries);
         int bc = 0;
         QSMESH_CG(cg_boco_write(fn, base, zone, bcname.c_str(), CGNS_ENUMV(FamilySpecified),
-                                CGNS_ENUMV(PointRange), 2, range.data(), &bc));
+                                CGNS_ENUMV(PointRange), 2, r.range.data(), &bc));
         std::string node(1, '/');
         node.append(options.cgns_base_name).append("/").append(name).append("/ZoneBC/");
         node.append(bcname).append("/PointRange");
         fix_range_label(cgio, root, node, path);
         QSMESH_CG(cg_goto(fn, base, "Zone_t", zone, "ZoneBC_t", 1, "BC_t", bc, "end"));
-        QSMESH_CG(cg_famname_write(("Curve_" + std::to_string(c)).c_str()));
-      });
+        QSMESH_CG(cg_famname_write(("Curve_" + std::to_string(r.curve)).c_str()));
+      }
     }
   }
 

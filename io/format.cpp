@@ -24,6 +24,7 @@ Format output_format(const std::string& path) {
   if (ext == ".vtu") return Format::kVtu;
   if (ext == ".msh") return Format::kMsh;
   if (ext == ".h5") return Format::kHdf5;
+  if (ext == ".xyz" || ext == ".p3d") return Format::kPlot3d;
   return Format::kNone;
 }
 

@@ -14,6 +14,7 @@
 #include "detail.hpp"
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/io/atomic_file.hpp"
+#include "qsmesh/layout/quad_layout.hpp"
 
 namespace qsmesh::io {
 
@@ -21,8 +22,9 @@ namespace fs = std::filesystem;
 
 void check_output_path(const std::string& path) {
   if (!is_supported_output(path)) {
-    throw InputError("output '" + path +
-                     "': unsupported format (the extension must be .cgns, .vtu, .msh or .h5)");
+    throw InputError(
+        "output '" + path +
+        "': unsupported format (the extension must be .cgns, .vtu, .msh, .h5, .xyz or .p3d)");
   }
   check_output_file("output", path);
   if (output_format(path) == Format::kHdf5) {
@@ -33,6 +35,8 @@ void check_output_path(const std::string& path) {
                        "could not refer to it); rename it");
     check_output_file("output", xdmf_path_for(path));
   }
+  if (output_format(path) == Format::kPlot3d)
+    check_output_file("output", plot3d_connections_path(path));
 }
 
 void check_output_file(const std::string& what, const std::string& path) {
@@ -156,6 +160,9 @@ void write_mesh(const mesh::SurfaceMesh& mesh, const std::string& path, const Wr
     case Format::kMsh: write_msh(mesh, path, options); return;
     case Format::kHdf5:
       write_hdf5(mesh, path, options);
+      return;
+    case Format::kPlot3d:
+      (void)write_plot3d(mesh, layout::extract_quad_layout(mesh), path, options);
       return;
     case Format::kNone: break;
   }

@@ -1,5 +1,6 @@
-// Mesh output: CGNS (cgnslib), VTK XML UnstructuredGrid (.vtu), Gmsh MSH 4.1 ASCII (.msh) and plain
-// HDF5 datasets for solvers (.h5, with an XDMF description beside it for ParaView).
+// Mesh output: CGNS (cgnslib), VTK XML UnstructuredGrid (.vtu), Gmsh MSH 4.1 ASCII (.msh), plain
+// HDF5 datasets for solvers (.h5, with an XDMF description beside it for ParaView) and
+// multi-block PLOT3D grids of the quad layout (.xyz / .p3d, with a JSON connectivity sidecar).
 //
 // Every writer writes to a temporary file in the destination folder and renames it to the requested
 // name only once the file is complete (io/atomic_file.hpp): a failed write leaves nothing under the
@@ -8,10 +9,13 @@
 //
 // Numbering shared by the writers (SurfaceMesh documents the mesh itself):
 //  - vertex v of the mesh is vertex v+1 in CGNS and node v+1 in MSH, point v in VTU;
-//  - CAD face f / curve c / corner k is CGNS section and family "Face_<f>" / "Curve_<c>", MSH entity
+//  - CAD face f / curve c / corner k is CGNS section and family "Face_<f>" / "Curve_<c>", MSH
+//  entity
 //    tag f+1 / c+1 / k+1 of dimension 2 / 1 / 0;
-//  - CGNS elements: one section per non-empty CAD face in increasing face id (the face's triangles in
-//    mesh order, then its quads), then one BAR_2 section per non-empty CAD curve; ids 1..n contiguous.
+//  - CGNS elements: one section per non-empty CAD face in increasing face id (the face's triangles
+//  in
+//    mesh order, then its quads), then one BAR_2 section per non-empty CAD curve; ids 1..n
+//    contiguous.
 //  - VTU cells: the triangles in mesh order, then the quads, then (optionally) the bars, then one
 //    VTK_VERTEX per marker (WriteOptions::vtu_markers; their points follow the mesh vertices).
 // CAD faces and curves without elements get no section, family, BC nor element block.
@@ -53,16 +57,23 @@ struct WriteOptions {
   std::vector<Field> cell_fields;          ///< one value (or 3) per VTU cell (see above), markers last
   // MSH
   bool msh_corner_elements = true;         ///< write one point element (type 15) per meshed corner
+  // PLOT3D
+  /// Fortran unformatted sequential records (a 4-byte length before and after each record: what
+  /// CFL3D and most PLOT3D tools read), or false: the same bytes without them (C stream).
+  bool plot3d_fortran_records = true;
+  bool plot3d_single_precision = false;  ///< float32 coordinates instead of float64
 };
 
-/// Writes `mesh` to `path`, the format chosen from the extension (.cgns .vtu .msh .h5, any case).
+/// Writes `mesh` to `path`, the format chosen from the extension (.cgns .vtu .msh .h5, any case;
+/// .xyz / .p3d: write_plot3d of layout::extract_quad_layout(mesh)).
 /// Throws InputError (one line naming the path) when the extension is not supported or the folder
 /// does not exist or is not writable, before any work; qsmesh::Error when the mesh is inconsistent
 /// (check_mesh_for_output) or writing fails.
 void write_mesh(const mesh::SurfaceMesh& mesh, const std::string& path, const WriteOptions& options = {});
 
-/// Output formats, from the extension of the path (case-insensitive): .cgns, .vtu, .msh, .h5.
-enum class Format { kNone, kCgns, kVtu, kMsh, kHdf5 };
+/// Output formats, from the extension of the path (case-insensitive): .cgns, .vtu, .msh, .h5,
+/// .xyz or .p3d (PLOT3D).
+enum class Format { kNone, kCgns, kVtu, kMsh, kHdf5, kPlot3d };
 [[nodiscard]] Format output_format(const std::string& path);
 /// The extension of `path` in lower case, with its dot (".h5"; "" when it has none).
 [[nodiscard]] std::string lowercase_extension(const std::string& path);
@@ -78,7 +89,8 @@ void prepare_output_libraries();
 
 /// For the CLI at start-up, before meshing: throws InputError (one line naming the path) unless the
 /// extension is supported and check_output_file("output", ...) passes for it (and for .h5 its
-/// XDMF description, whose file name then may have no ':', which XDMF could not refer to).
+/// XDMF description, whose file name then may have no ':', which XDMF could not refer to; for
+/// PLOT3D its sidecar plot3d_connections_path(path)).
 void check_output_path(const std::string& path);
 
 /// For the CLI at start-up, before any work, for any file a run writes (`what` names it in the
@@ -120,6 +132,39 @@ void write_cgns(const mesh::SurfaceMesh& mesh, const std::string& path, const Wr
 /// `layout` must come from extract_quad_layout(mesh).
 void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& layout,
                        const std::string& path, const WriteOptions& options = {});
+
+/// What write_plot3d wrote, and what PLOT3D could not hold.
+struct Plot3dReport {
+  GO blocks = 0;
+  std::vector<LO> skipped_faces;  ///< faces of layout.unblocked_faces with elements, not written
+  GO skipped_triangles = 0, skipped_quads = 0;  ///< their elements
+};
+
+/// The JSON sidecar written beside the PLOT3D grid `grid_path`: the same name with ".json" added.
+[[nodiscard]] std::string plot3d_connections_path(const std::string& grid_path);
+
+/// Multi-block PLOT3D grid of the blocks of `layout` (from layout::extract_quad_layout(mesh); paper
+/// 002's block-structured output as write_cgns_blocks writes it), whole (not planes), 3D, no
+/// IBLANK, little-endian: the block count (int32), then idim, jdim, kdim (int32) of every block,
+/// then per block x, y, z (each over its points, i fastest; float64, or float32 with
+/// options.plot3d_single_precision). A block of ni x nj quads is an (ni + 1) x (nj + 1) x 1 grid,
+/// the points of its vertex grid in order (i x j is along the CAD face's normal). With
+/// options.plot3d_fortran_records (the default) every one of these three parts (counts,
+/// dimensions, each block's coordinates) is one Fortran unformatted sequential record (int32 byte
+/// count before and after), else the bytes follow each other with nothing between (C stream).
+/// Beside it, plot3d_connections_path(path), JSON ("format": "qsmesh plot3d connectivity",
+/// "format_version": 1): per block (1-based "block" as in the grid file, "name" as the CGNS zone,
+/// CAD "face", "family" "Face_<f>", idim, jdim, kdim) its 1-to-1 "interfaces" (side, 1-based
+/// (i, j) "range", "donor" block, "donor_side", "donor_range", CGNS "transform"; k = 1 throughout),
+/// its free "boundaries" (side, range, "family" "Curve_<c>", "curve", "bc": "BCWall") and the
+/// runs of its sides "against_left_out_faces"; at the end the "left_out_faces" and their
+/// element counts. Interfaces and boundaries are those of write_cgns_blocks (block_connections).
+/// PLOT3D holds structured blocks only: the faces in layout.unblocked_faces (triangles, patches
+/// that are not grids) are not written (the report and the sidecar list them). Both files are
+/// written under temporary names and renamed together (commit_together). Throws qsmesh::Error on an
+/// inconsistent mesh or layout, qsmesh::OutputError when the files cannot be written.
+Plot3dReport write_plot3d(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& layout,
+                          const std::string& path, const WriteOptions& options = {});
 
 /// VTK XML UnstructuredGrid: triangles (VTK type 5), quads (9), optionally bars (3); cell data Int32
 /// "cad_face" (and "cad_curve" with bars; -1 where not applicable), point data Int32 "cad_dim" and
