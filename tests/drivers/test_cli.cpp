@@ -70,6 +70,27 @@ TEST(Cli, BlockStructuredNeedsCgnsAndQuads) {
       std::string::npos);
 }
 
+TEST(Cli, Plot3dIsTheBlockLayout) {
+  // A PLOT3D output is the quad layout's blocks, with or without --block-structured.
+  EXPECT_TRUE(p({"mesh", "m.step", "-o", "o.xyz"}).block_structured);
+  EXPECT_TRUE(p({"mesh", "m.step", "-o", "o.P3D", "--block-structured"}).block_structured);
+  const Arguments a = p({"mesh", "m.step", "-o", "o.xyz", "--plot3d-stream", "--plot3d-single"});
+  EXPECT_TRUE(a.plot3d_stream);
+  EXPECT_TRUE(a.plot3d_single);
+  EXPECT_FALSE(p({"mesh", "m.step", "-o", "o.xyz"}).plot3d_stream);
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.xyz", "--until", "background"}).find("PLOT3D"),
+            std::string::npos);
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.xyz", "--order", "2"}).find("second-order"),
+            std::string::npos);
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.cgns", "--plot3d-stream"}).find("PLOT3D output"),
+            std::string::npos);
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--plot3d-single"}).find("PLOT3D output"),
+            std::string::npos);
+  EXPECT_NE(
+      error_of({"sizemap", "m.step", "-o", "s.vtu", "--plot3d-stream"}).find("unknown option"),
+      std::string::npos);
+}
+
 TEST(Cli, HelpEverywhere) {
   EXPECT_EQ(p({}).command, Command::Help);
   EXPECT_EQ(p({"--help"}).command, Command::Help);
