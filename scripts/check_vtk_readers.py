@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """Opens qsmesh outputs with the VTK readers ParaView uses (vtkCGNSReader for .cgns,
-vtkXMLUnstructuredGridReader for .vtu) and prints, per file, the blocks, cells, points and cell
+vtkXMLUnstructuredGridReader for .vtu, vtkMultiBlockPLOT3DReader for .xyz / .p3d with its format
+detection on, as ParaView's "Auto Detect Format") and prints, per file, the blocks, cells, points and cell
 types VTK sees. Needs VTK's Python module (Debian: python3-vtk9; not installed by scripts/setup.sh,
 this is a developer check). Exit 1 when a file gives no cells.
 Usage: scripts/check_vtk_readers.py FILE...   (with /usr/bin/python3)"""
@@ -9,6 +10,7 @@ from collections import Counter
 
 try:
     from vtkmodules.vtkIOCGNSReader import vtkCGNSReader
+    from vtkmodules.vtkIOParallel import vtkMultiBlockPLOT3DReader
     from vtkmodules.vtkIOXML import vtkXMLUnstructuredGridReader
 except ImportError:
     sys.exit("check_vtk_readers: VTK's Python module is missing (Debian package python3-vtk9)")
@@ -22,6 +24,13 @@ def datasets(path):
         r.SetFileName(path)
         r.Update()
         return [r.GetOutput()]
+    if path.lower().endswith((".xyz", ".p3d")):
+        r = vtkMultiBlockPLOT3DReader()
+        r.SetXYZFileName(path)
+        r.AutoDetectFormatOn()
+        r.Update()
+        out = r.GetOutput()
+        return [out.GetBlock(i) for i in range(out.GetNumberOfBlocks()) if out.GetBlock(i)]
     r = vtkCGNSReader()
     r.SetFileName(path)
     r.UpdateInformation()

@@ -23,6 +23,8 @@ packages=(
   # Pictures (scripts/render_mesh.py, scripts/plot_table.py): Debian's VTK renders through X even
   # offscreen, so a virtual X server (xvfb-run) with Mesa's software OpenGL.
   python3-vtk9 python3-numpy xvfb xauth libgl1-mesa-dri
+  # scripts/check_plot3d.py reads the block-structured CGNS file (HDF5) to compare with PLOT3D
+  python3-h5py
 )
 
 missing=()
