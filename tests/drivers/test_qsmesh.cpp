@@ -806,6 +806,7 @@ TEST_F(Qsmesh, OutputsNeverOverwriteTheModelOrEachOther) {
        "names the same file as the model"},
       {"-o " + tmp("distinct_d.msh") + " --stats " + tmp("distinct_hard.step"),
        "names the same file as the model"},
+      {"-o " + tmp("distinct_e.xyz") + " --stats " + tmp("distinct_e.xyz.json"), "the .json file"},
   };
   for (const Case& c : cases) {
     const ExeResult r = run("mesh " + model + " " + c.args);
@@ -815,7 +816,8 @@ TEST_F(Qsmesh, OutputsNeverOverwriteTheModelOrEachOther) {
   }
   EXPECT_EQ(slurp(model), before);
   EXPECT_EQ(slurp(tmp("distinct_mesh.cgns")), "earlier mesh");
-  for (const char* name : {"distinct_a.cgns", "distinct_b.h5", "distinct_c.msh", "distinct_d.msh"})
+  for (const char* name :
+       {"distinct_a.cgns", "distinct_b.h5", "distinct_c.msh", "distinct_d.msh", "distinct_e.xyz"})
     EXPECT_FALSE(fs::exists(tmp(name))) << name;
 }
 
