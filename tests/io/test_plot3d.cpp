@@ -2,8 +2,10 @@
 // sidecar's interfaces checked point by point on the coordinates read, and the same connections
 // as the block-structured CGNS writer's (both come from io::block_connections).
 #include <gtest/gtest.h>
+#include <sys/resource.h>
 
 #include <array>
+#include <csignal>
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
@@ -361,6 +363,35 @@ TEST(Plot3d, NothingIsLeftWhenTheFolderIsMissing) {
   bad.vertices.back() = m.num_vertices();
   EXPECT_THROW((void)write_plot3d(m, bad, (dir / "x.xyz").string()), Error);
   EXPECT_TRUE(dir_entries(dir).empty());
+}
+
+TEST(Plot3d, FullDiskIsOneOutputErrorAndLeavesTheEarlierPair) {
+  // A file size limit below the grid file's size fails the write as a full disk does: one
+  // OutputError naming the file, no temporary left, the earlier grid and sidecar untouched.
+  const fs::path dir = fresh_dir("plot3d_full");
+  std::ofstream(dir / "m.xyz") << "an earlier grid";
+  std::ofstream(dir / "m.xyz.json") << "an earlier sidecar";
+  const mesh::SurfaceMesh m = two_faces(60, 60, 60);  // 7381 points: 177 kB of coordinates
+  const layout::QuadLayout l = layout::extract_quad_layout(m);
+  const auto old_handler = std::signal(SIGXFSZ, SIG_IGN);
+  rlimit old{};
+  ASSERT_EQ(getrlimit(RLIMIT_FSIZE, &old), 0);
+  rlimit small = old;
+  small.rlim_cur = 64 * 1024;
+  ASSERT_EQ(setrlimit(RLIMIT_FSIZE, &small), 0);
+  std::string message;
+  try {
+    (void)write_plot3d(m, l, (dir / "m.xyz").string());
+  } catch (const OutputError& e) {
+    message = e.what();
+  }
+  setrlimit(RLIMIT_FSIZE, &old);
+  std::signal(SIGXFSZ, old_handler);
+  EXPECT_NE(message.find("m.xyz"), std::string::npos) << message;
+  EXPECT_EQ(message.find('\n'), std::string::npos) << message;
+  EXPECT_EQ(dir_entries(dir), (std::vector<std::string>{"m.xyz", "m.xyz.json"}));
+  EXPECT_EQ(read_all(dir / "m.xyz"), "an earlier grid");
+  EXPECT_EQ(read_all(dir / "m.xyz.json"), "an earlier sidecar");
 }
 
 }  // namespace

@@ -40,6 +40,8 @@ TEST(Writer, SupportedExtensionsAnyCase) {
   EXPECT_TRUE(is_supported_output("a.Vtu"));
   EXPECT_TRUE(is_supported_output("a.msh"));
   EXPECT_TRUE(is_supported_output("a.H5"));
+  EXPECT_TRUE(is_supported_output("a.xyz"));
+  EXPECT_TRUE(is_supported_output("a.P3D"));
   EXPECT_FALSE(is_supported_output("a.stl"));
   EXPECT_FALSE(is_supported_output("a"));
   EXPECT_FALSE(is_supported_output("a.msh.gz"));
@@ -180,7 +182,7 @@ TEST(AtomicFile, WriterFailingMidwayLeavesNothing) {
 
 TEST(Writer, SameMeshGivesIdenticalBytes) {
   const fs::path dir = fresh_dir("determinism");
-  for (const char* ext : {".cgns", ".vtu", ".msh", ".h5"}) {
+  for (const char* ext : {".cgns", ".vtu", ".msh", ".h5", ".xyz"}) {
     const std::string a = (dir / (std::string("a") + ext)).string();
     const std::string b = (dir / (std::string("b") + ext)).string();
     write_mesh(make_test_mesh(), a);
@@ -192,7 +194,8 @@ TEST(Writer, SameMeshGivesIdenticalBytes) {
     write_mesh(make_test_mesh(), a);
     EXPECT_TRUE(ca == read_all(a)) << ext;
   }
-  EXPECT_EQ(dir_entries(dir).size(), 10u);  // no temporaries left (.h5 comes with .xdmf)
+  // No temporaries left (.h5 comes with .xdmf, .xyz with .xyz.json).
+  EXPECT_EQ(dir_entries(dir).size(), 14u);
 }
 
 TEST(Writer, UpperCaseExtensionDispatches) {
