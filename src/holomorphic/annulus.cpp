@@ -197,6 +197,54 @@ FinalBoundary merge_final(std::span<const mesh::BoundaryLoop> loops, std::string
   return F;
 }
 
+// u at grid point (i, j), i in [0, N], j in [0, M], row-major by j: the rows' ends on the two
+// loops (a and b, N + 1 unwrapped values each, the last one period beyond the first), rows at the
+// levels `rows` (M + 1 increasing values of v), interior values solved from the 5-point Laplacian
+// of the grid with column spacing period / N and the rows' spacings (SOR; u of column N is u of
+// column 0 plus the period; `seam_u`, when not empty, fixes column 0: the seam's vertices).
+std::vector<double> grid_u(const std::vector<double>& a, const std::vector<double>& b,
+                           const std::vector<double>& rows, double period,
+                           const std::vector<double>& seam_u, const GridOptions& options) {
+  const std::size_t N = a.size() - 1, M = rows.size() - 1;
+  const bool seam = !seam_u.empty();
+  const double height = rows.back() - rows.front();
+  std::vector<double> u((M + 1) * (N + 1));
+  for (std::size_t j = 0; j <= M; ++j)
+    for (std::size_t i = 0; i <= N; ++i) {
+      const double t = (rows[j] - rows.front()) / height;
+      u[j * (N + 1) + i] = a[i] + t * (b[i] - a[i]);
+    }
+  if (seam)
+    for (std::size_t j = 0; j <= M; ++j) {
+      u[j * (N + 1)] = seam_u[j];
+      u[j * (N + 1) + N] = seam_u[j] + period;
+    }
+  if (M < 2 || options.max_sweeps <= 0) return u;
+  const double du = period / double(N);
+  const double wi = 1 / (du * du);
+  const double omega = options.relaxation;
+  for (int sweep = 0; sweep < options.max_sweeps; ++sweep) {
+    double change = 0;
+    for (std::size_t j = 1; j < M; ++j) {
+      const double hm = rows[j] - rows[j - 1], hp = rows[j + 1] - rows[j];
+      const double wm = 2 / (hm * (hm + hp)), wp = 2 / (hp * (hm + hp));
+      for (std::size_t i = seam ? 1 : 0; i < N; ++i) {
+        const double left = i > 0 ? u[j * (N + 1) + i - 1] : u[j * (N + 1) + N - 1] - period;
+        const double right = u[j * (N + 1) + i + 1];
+        const double target =
+            (wi * (left + right) + wm * u[(j - 1) * (N + 1) + i] + wp * u[(j + 1) * (N + 1) + i]) /
+            (2 * wi + wm + wp);
+        const double delta = omega * (target - u[j * (N + 1) + i]);
+        u[j * (N + 1) + i] += delta;
+        change = std::max(change, std::abs(delta));
+        if (i == 0 && !seam) u[j * (N + 1) + N] = u[j * (N + 1)] + period;
+      }
+    }
+    if (change < options.tolerance * du) break;
+  }
+  return u;
+}
+
 }  // namespace
 
 mesh::FaceMesh mesh_annulus(const mesh::FaceMesh& background,
@@ -256,6 +304,24 @@ mesh::FaceMesh mesh_annulus(const mesh::FaceMesh& background,
     if (!why.empty()) return fail(why);
     if (F.cycles.size() != 2)
       return fail("the final boundary has " + std::to_string(F.cycles.size()) + " cycles, not 2");
+    // Each loop is a horizontal trajectory, straight in the form's flat metric: a CAD corner on
+    // it is flattened, and a grid with two quads at every boundary vertex folds next to it (a
+    // sharp corner needs one or three quads, a boundary singularity the grid does not have).
+    for (const auto& cycle : F.cycles)
+      for (std::size_t i = 0; i < cycle.size(); ++i) {
+        const auto& p = F.points[static_cast<std::size_t>(cycle[i])];
+        if (p.vclass.dim != 0) continue;
+        const Vec3& a =
+            F.points[static_cast<std::size_t>(cycle[(i + cycle.size() - 1) % cycle.size()])].xyz;
+        const Vec3& b = F.points[static_cast<std::size_t>(cycle[(i + 1) % cycle.size()])].xyz;
+        const double turn =
+            std::acos(std::clamp(dot(normalized(p.xyz - a), normalized(b - p.xyz)), -1.0, 1.0));
+        if (turn > options.max_corner_turn_deg * std::numbers::pi / 180)
+          return fail("a loop turns by " +
+                      std::to_string(std::lround(turn * 180 / std::numbers::pi)) +
+                      " degrees at corner " + std::to_string(p.vclass.entity) +
+                      ": the grid would fold there");
+      }
 
     // (u, v) of every final boundary point: on the nearest background boundary edge.
     std::vector<C> uv_of(F.points.size());
@@ -390,12 +456,69 @@ mesh::FaceMesh mesh_annulus(const mesh::FaceMesh& background,
       out.vclass.push_back(vc);
       return static_cast<LO>(out.points.size() - 1);
     };
+    // u of the grid points: rows are the levels of v (horizontal trajectories), columns start
+    // straight between the two loops' points, then u is made discrete-harmonic over the grid
+    // (boundary rows and the seam column fixed), which spreads a difference between the two
+    // loops' spacings over the rows instead of shearing each column.
+    // Row levels: equal steps of v, or the seam's vertices' levels (its curve mesh is graded as
+    // the quantization placed it, and a row must pass through each of its vertices).
+    std::vector<double> rows(M + 1), seam_u;
+    for (std::size_t j = 0; j <= M; ++j) rows[j] = v[0] + height * double(j) / double(M);
+    if (seam) {
+      const LO seam_curve =
+          F.points[static_cast<std::size_t>(seam_chain[1 % seam_chain.size()])].vclass.entity;
+      std::vector<char> on_seam(s.points.size(), 0);
+      for (std::size_t w = 0; w < background.vclass.size(); ++w) {
+        const auto& vc = background.vclass[w];
+        if (vc.dim == 0 || (vc.dim == 1 && vc.entity == seam_curve))
+          on_seam[static_cast<std::size_t>(s.face2merged[w])] = 1;
+      }
+      for (std::size_t j = 1; j < M; ++j) {
+        const Vec3& x = F.points[static_cast<std::size_t>(seam_chain[j])].xyz;
+        double best = 1e300, useam = 0;
+        for (std::size_t e = 0; e < s.edges.size(); ++e) {
+          const auto& ed = s.edges[e];
+          if (on_seam[static_cast<std::size_t>(ed[0])] == 0 ||
+              on_seam[static_cast<std::size_t>(ed[1])] == 0)
+            continue;
+          const Vec3& p = s.points[static_cast<std::size_t>(ed[0])];
+          const Vec3 ab = s.points[static_cast<std::size_t>(ed[1])] - p;
+          const double l2 = dot(ab, ab);
+          const double w = l2 > 0 ? std::clamp(dot(x - p, ab) / l2, 0.0, 1.0) : 0.0;
+          const double d = norm2(p + ab * w - x);
+          if (d < best) {
+            best = d;
+            // Both ends' values from one triangle of the edge: one branch of u.
+            const auto t = static_cast<std::size_t>(s.edge_tris[e][0]);
+            const auto& c = s.triangles[t];
+            const auto k0 =
+                static_cast<std::size_t>(std::find(c.begin(), c.end(), ed[0]) - c.begin());
+            const auto k1 =
+                static_cast<std::size_t>(std::find(c.begin(), c.end(), ed[1]) - c.begin());
+            const C z = U[t][k0] + w * (U[t][k1] - U[t][k0]);
+            rows[j] = z.imag();
+            useam = z.real();
+          }
+        }
+        seam_u.push_back(useam);
+        if (!(rows[j] > rows[j - 1])) return fail("the seam's vertices are not in order along it");
+      }
+      if (!(rows[M] > rows[M - 1])) return fail("the seam's vertices are not in order along it");
+      // The seam's u on the branch of the loops' column 0, continued along it.
+      seam_u.insert(seam_u.begin(), uu[0][0]);
+      for (std::size_t j = 1; j < M; ++j)
+        seam_u[j] = seam_u[j - 1] + wrap(seam_u[j] - seam_u[j - 1], period);
+      seam_u.push_back(seam_u.back() + wrap(uu[1][0] - seam_u.back(), period));
+      if (std::abs(seam_u.back() - uu[1][0]) > 1e-6 * period)
+        return fail("the seam does not end where the second loop's column 0 is");
+    }
+    const std::vector<double> ugrid = grid_u(uu[0], uu[1], rows, period, seam_u, options.grid);
+    auto u_at = [&](std::size_t i, std::size_t j) { return ugrid[j * (N + 1) + i]; };
     // Interior grid points first (the seam column's copies take their uv from them).
     for (std::size_t j = 1; j < M; ++j) {
-      const double tj = double(j) / double(M);
       for (std::size_t i = seam ? 1 : 0; i < N; ++i) {
-        const double uq = uu[0][i] + tj * (uu[1][i] - uu[0][i]);
-        const double vq = v[0] + tj * height;
+        const double uq = u_at(i, j);
+        const double vq = rows[j];
         const auto [t, b] = locator.locate(uq, vq);
         if (t == kNoIndex) return fail("a grid point could not be located");
         const auto& ft = background.triangles[static_cast<std::size_t>(t)];

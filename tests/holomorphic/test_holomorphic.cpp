@@ -113,6 +113,25 @@ TEST(Holomorphic, AnnulusWithDifferentLoopCountsFallsBack) {
   EXPECT_TRUE(q.quads.empty());
 }
 
+// A square plate with a round hole is an annulus, but its square loop turns by 90 degrees at each
+// corner, where a grid of two quads per boundary vertex would fold: it falls back.
+TEST(Holomorphic, AnnulusWithSharpCornersFallsBack) {
+  MeshedFace m =
+      mesh_face(test::write_plate_with_holes(4, 4, {{{2.0, 2.0, 1.0}}}, tmp("square_hole.brep")),
+                cad::SurfaceType::Plane, 0.2);
+  for (LO c = 0; c < static_cast<LO>(m.curves.size()); ++c) {
+    const auto& curve = m.model.curves()[static_cast<std::size_t>(c)];
+    m.curves[static_cast<std::size_t>(c)] =
+        test::uniform_curve_mesh(m.model, c, curve.corners[0] == curve.corners[1] ? 40 : 10);
+  }
+  m.loops = background::face_boundary(m.model, m.face, *m.surface, m.curves);
+  HolomorphicReport report;
+  const mesh::FaceMesh q = mesh_annulus(m.background, m.loops, *m.surface, {}, &report);
+  EXPECT_FALSE(report.ok);
+  EXPECT_NE(report.reason.find("turns by 90 degrees"), std::string::npos) << report.reason;
+  EXPECT_TRUE(q.quads.empty());
+}
+
 TEST(Holomorphic, CylinderBetweenTwoCirclesIsAGridAlongTheSeam) {
   const MeshedFace m =
       mesh_face(test::write_cylinder(tmp("cyl.brep")), cad::SurfaceType::Cylinder, 0.4);

@@ -152,9 +152,20 @@ struct ZeroReport {
 [[nodiscard]] ZeroReport find_zeros(const PolyAnnulus& surface,
                                     std::span<const std::complex<double>> phi);
 
+/// The grid of mesh_annulus: u of its interior points is discrete-harmonic over the grid (SOR).
+struct GridOptions {
+  int max_sweeps = 20000;   ///< 0: columns straight between the two loops' points
+  double relaxation = 1.9;  ///< SOR factor in (0, 2)
+  double tolerance = 1e-6;  ///< stop when no point moves by more than this fraction of a column
+};
+
 struct HolomorphicOptions {
   BasisOptions basis;
   EnergyOptions energy;
+  GridOptions grid;
+  /// mesh_annulus refuses a loop that turns by more than this at a CAD corner (3D angle between
+  /// its edges there, degrees).
+  double max_corner_turn_deg = 30;
 };
 
 /// What the holomorphic path did on one face.
@@ -173,14 +184,16 @@ struct HolomorphicReport {
 /// each boundary), the N points of each final boundary loop are placed on it, and the grid has N
 /// columns and M = round(height / (period / N)) rows (at least 1), so its quads are as square as
 /// the counts allow; a seam curve crossing the face becomes one column and sets M to its count.
-/// Interior grid points are mapped back through the background triangle that contains them and
+/// Rows are levels of v; along them u is discrete-harmonic over the grid (GridOptions), so that a
+/// difference between the two loops' spacings spreads over the rows. Interior grid points are
+/// mapped back through the background triangle that contains them and
 /// projected on `surface`.
 ///  - `background`: the face's background triangulation; `loops`: the face's final boundary
 ///    (background::face_boundary on the final curve meshes).
 /// Returns an all-quad FaceMesh oriented like the background (seam vertices in two copies), or an
 /// empty mesh with report->reason when the face is not an annulus, its two loops have different
-/// counts, a seam's count cannot match, or a point cannot be located. Never throws for a face-level
-/// failure.
+/// counts or a sharp corner (HolomorphicOptions::max_corner_turn_deg), a seam's count cannot match,
+/// or a point cannot be located. Never throws for a face-level failure.
 [[nodiscard]] mesh::FaceMesh mesh_annulus(const mesh::FaceMesh& background,
                                           std::span<const mesh::BoundaryLoop> loops,
                                           const cad::FaceGeometry& surface,
