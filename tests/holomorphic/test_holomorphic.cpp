@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -189,6 +190,26 @@ void check_plate(const std::vector<std::array<double, 3>>& holes, const std::str
   for (const Zero& zero : z.interior) EXPECT_EQ(zero.order, 1);  // valence 8 in the quad mesh
   EXPECT_TRUE(z.boundary.empty());
   EXPECT_NEAR(z.index_sum, b - 2, 1e-6);
+  // Critical trajectories: 2 (order + 1) = 4 horizontal and 4 vertical prongs per simple zero;
+  // the boundary is horizontal, so vertical prongs end on it and horizontal ones at zeros.
+  const auto traj = critical_trajectories(s, combine(B, E.lambda), z, {});
+  EXPECT_EQ(static_cast<LO>(traj.size()), 8 * (b - 2));
+  int vertical_on_boundary = 0, horizontal_at_zero = 0;
+  for (const auto& t : traj) {
+    if (!t.horizontal && t.end == Trajectory::End::Boundary) ++vertical_on_boundary;
+    if (t.horizontal && t.end == Trajectory::End::Zero) ++horizontal_at_zero;
+  }
+  EXPECT_EQ(vertical_on_boundary, 4 * (b - 2));
+  EXPECT_EQ(horizontal_at_zero, 4 * (b - 2));
+  // The critical graph cuts the plate into rectangles (paper 004 Fig. 5): every hole is reached
+  // by a vertical prong.
+  for (LO l = 1; l < b; ++l)
+    EXPECT_TRUE(std::any_of(traj.begin(), traj.end(),
+                            [&](const Trajectory& t) {
+                              return !t.horizontal && t.end == Trajectory::End::Boundary &&
+                                     t.end_loop == l;
+                            }))
+        << "loop " << l;
   // b >= 3: the patch meshing is not done; the face falls back with a reason.
   HolomorphicReport report;
   const mesh::FaceMesh q = mesh_annulus(m.background, m.loops, *m.surface, {}, &report);

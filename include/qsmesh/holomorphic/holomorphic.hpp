@@ -159,6 +159,33 @@ struct GridOptions {
   double tolerance = 1e-6;  ///< stop when no point moves by more than this fraction of a column
 };
 
+/// A critical trajectory (paper 004 Sec. 4, "Quad-mesh generation"): a prong of the horizontal
+/// (Im of the integral of phi constant) or vertical (Re constant) trajectory through a zero,
+/// traced triangle by triangle in the flat charts of phi.
+struct Trajectory {
+  std::size_t zero = 0;  ///< index in ZeroReport::interior of the zero it leaves
+  bool horizontal = true;
+  std::vector<Vec3> points;  ///< polyline on the triangulation, from the zero's neighbourhood
+  enum class End { Boundary, Zero, Limit };
+  End end = End::Limit;      ///< a boundary loop, a zero's neighbourhood, or max_steps reached
+  LO end_loop = kNoIndex;    ///< the loop hit (End::Boundary)
+  std::size_t end_zero = 0;  ///< the zero reached (End::Zero)
+};
+
+struct TraceOptions {
+  int max_steps = 100000;  ///< triangles crossed by one trajectory at most
+};
+
+/// The critical trajectories of phi from each zero of `zeros` (ZeroReport::interior with order
+/// >= 1). Around a zero, the boundary of the triangles touching it (its vertex, or the flipped
+/// triangle's three) is immersed by integrating phi from the zero: the polygon winds order + 1
+/// times, and each crossing of the real (imaginary) axis starts a horizontal (vertical) prong,
+/// 2 (order + 1) of each, traced outwards until it meets a boundary loop or the neighbourhood of
+/// a zero.
+[[nodiscard]] std::vector<Trajectory> critical_trajectories(
+    const PolyAnnulus& surface, std::span<const std::complex<double>> phi, const ZeroReport& zeros,
+    const TraceOptions& options);
+
 struct HolomorphicOptions {
   BasisOptions basis;
   EnergyOptions energy;
