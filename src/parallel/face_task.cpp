@@ -222,6 +222,10 @@ bool choose_face_method(FaceTask& task, holomorphic::Method method, double sicn_
   }
   task.quad_mesh = std::move(candidate);
   task.unstructured.ok = true;
+  // The face counts as meshed by its form, not by the pattern it may have had.
+  task.quasi.by_pattern = false;
+  task.quasi.by_comparison = false;
+  task.quasi.pattern.clear();
   task.quasi.by_holomorphic = true;
   task.quasi.holomorphic = "kept";
   return true;

@@ -42,7 +42,11 @@ TEST(FaceMethod, HolomorphicReplacesTheDefaultMeshOfAnAnnulus) {
   make_holomorphic_candidate(b.task, b.model, b.curves, {});
   EXPECT_FALSE(choose_face_method(b.task, holomorphic::Method::Default, 0.02));
   EXPECT_TRUE(b.task.quad_mesh.quads.empty());
+  a.task.quasi.by_pattern = true;  // as if a pattern had meshed it: the form's mesh replaces it
+  a.task.quasi.pattern = "grid";
   EXPECT_TRUE(choose_face_method(a.task, holomorphic::Method::Holomorphic, 0.02));
+  EXPECT_FALSE(a.task.quasi.by_pattern);
+  EXPECT_TRUE(a.task.quasi.pattern.empty());
   EXPECT_TRUE(a.task.quasi.by_holomorphic);
   EXPECT_EQ(a.task.quasi.holomorphic, "kept");
   EXPECT_TRUE(a.task.holomorphic_mesh.quads.empty());  // released

@@ -338,7 +338,8 @@ void make_holomorphic_candidate(FaceTask& task, const cad::CadModel& model,
 /// Per-face dispatch once the default mesh is final: the holomorphic mesh replaces task.quad_mesh
 /// when holomorphic::keep_holomorphic says so against the default mesh's statistics (or the
 /// default path left no valid all-quad mesh); task.quasi records it (by_holomorphic, holomorphic:
-/// "kept" or why not). The candidate is released either way. Returns whether it was kept.
+/// "kept" or why not; a kept one clears by_pattern, by_comparison and pattern). The candidate is
+/// released either way. Returns whether it was kept.
 bool choose_face_method(FaceTask& task, holomorphic::Method method, double sicn_tolerance);
 
 /// The faces the unstructured path meshes: those without a pattern mesh (take_fill).
