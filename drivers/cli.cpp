@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "qsmesh/core/error.hpp"
+#include "qsmesh/holomorphic/holomorphic.hpp"
 #include "qsmesh/io/writer.hpp"
 
 namespace qsmesh::cli {
@@ -172,7 +173,11 @@ Arguments parse(const std::vector<std::string>& args) {
     else if (opt == "--size-factor" && (meshing || a.command == Command::Info))
       a.size_factor = parse_positive(opt, value());
     else if (opt == "--until" && a.command == Command::Mesh) a.until = value();
-    else if (opt == "--threads") a.threads = parse_threads(value());
+    else if (opt == "--method" && a.command == Command::Mesh) {
+      a.method = value();
+      (void)holomorphic::parse_method(a.method);
+    } else if (opt == "--threads")
+      a.threads = parse_threads(value());
     else if (opt == "--face-time-budget" && a.command == Command::Mesh)
       a.face_time_budget = parse_positive(opt, value());
     else if (opt == "--stats" && meshing) a.stats = value();
@@ -357,6 +362,8 @@ Arguments parse(const std::vector<std::string>& args) {
     }
     if (a.order == 2 && a.until == "background")
       throw InputError("--order 2 needs a quad mesh: not with --until background");
+    if (a.method != "default" && a.until == "background")
+      throw InputError("--method " + a.method + " needs a quad mesh: not with --until background");
     if (a.command == Command::CrossField && a.output.empty() && !a.check)
       throw InputError("crossfield: missing -o OUT.vtu (or --check)");
     if (a.command == Command::SizeMap && a.output.empty())
@@ -420,6 +427,15 @@ std::string help(const std::string& topic) {
           "                        among the ranks running on it; more than the cores a rank may\n"
           "                        run on are not granted, and the run says so)\n"
           "  --stats FILE.json     also write the run statistics as JSON\n"
+          "  --method M            per-face method of the quad stages: default; holomorphic "
+          "(faces\n"
+          "                        that are topological annuli, such as cylinders between two\n"
+          "                        circles, meshed as a grid without singularity from their\n"
+          "                        holomorphic 1-form, paper 004, when both loops have the same\n"
+          "                        count); auto (that grid only where it has fewer interior\n"
+          "                        irregular vertices and SICN min and avg at most 0.02 below the\n"
+          "                        default mesh's). Other faces keep the default mesh, the reason\n"
+          "                        in the face_stats of --stats (\"holomorphic\")\n"
           "  --order 2             second-order elements: 9-node quads and 3-node bars, the new\n"
           "                        nodes on the CAD (CGNS QUAD_9/BAR_3, VTU, MSH; in .h5 the\n"
           "                        datasets quad9 and bar3)\n"

@@ -22,6 +22,9 @@ struct Arguments {
   /// Last stage to run. `unstructured` exists but still fails on some faces of the shared models
   /// (reported per face), so the default stays the furthest stage that is complete.
   std::string until = "quasi-structured";
+  /// --method: the per-face method of the quad stages (default, holomorphic, auto; see
+  /// parallel::PipelineOptions::face_method).
+  std::string method = "default";
   int threads = 0;  ///< 0: automatic
   /// --face-time-budget S: wall-clock seconds the topological improvement (cavity remeshing,
   /// paper 000 Sec. 6.2) may spend on one face (0: no bound; the result is then reproducible).

@@ -22,6 +22,7 @@
 #include "qsmesh/core/tasks.hpp"
 #include "qsmesh/core/timer.hpp"
 #include "qsmesh/highorder/quadratic.hpp"
+#include "qsmesh/holomorphic/holomorphic.hpp"
 #include "qsmesh/io/atomic_file.hpp"
 #include "qsmesh/io/writer.hpp"
 #include "qsmesh/layout/quad_layout.hpp"
@@ -308,6 +309,7 @@ std::pair<std::int64_t, std::int64_t> count_failures(const parallel::PipelineRes
 /// How face f got its quad mesh: "pattern:<name>", "frontal" or "fallback".
 std::string quad_method(const parallel::PipelineResult& r, std::size_t f) {
   if (f < r.quasi_reports.size()) {
+    if (r.quasi_reports[f].by_holomorphic) return "holomorphic";
     std::string pattern = r.quasi_reports[f].pattern_method();
     if (!pattern.empty()) return pattern;
   }
@@ -465,7 +467,9 @@ std::string stats_json(const Arguments& args, const Session& session,
           .value("face", static_cast<std::int64_t>(f))
           .value("rank", f < r.face_rank.size() ? r.face_rank[f] : 0)
           .value("method", quad_method(r, f))
-          .value("pattern_refusal", pattern_refusal(r, f));
+          .value("pattern_refusal", pattern_refusal(r, f))
+          .value("holomorphic",
+                 f < r.quasi_reports.size() ? r.quasi_reports[f].holomorphic : std::string());
       // The face's statistics (mesh::FaceQuadStats::fields, documented there).
       mesh::FaceQuadStats::fields(r.face_stats[f],
                                   [&](const char* name, const auto& v) { j.value(name, v); });
@@ -803,6 +807,7 @@ int run_mesh(const Arguments& args) {
   if (until >= parallel::Stage::Unstructured) apply_size_options(args, s, options);
   s.announce(args, "mesh");
   options.until = until;
+  options.face_method = holomorphic::parse_method(args.method);
   if (until >= parallel::Stage::Unstructured) note_sliver_curves(s, options.sizemap);
   options.cavities.time_budget_s = args.face_time_budget;
   // A face whose field system is above SolverOptions::petsc_threshold is solved by PETSc; with the

@@ -1,8 +1,10 @@
 #include "qsmesh/parallel/face_task.hpp"
 
 #include <exception>
+#include <string>
 #include <utility>
 
+#include "qsmesh/background/face_mesh.hpp"
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/core/timer.hpp"
 
@@ -173,6 +175,60 @@ bool wants_unstructured(const FaceTask& task) { return !task.quasi.by_pattern; }
 
 bool wants_improvement(const FaceTask& task) {
   return !task.quasi.by_pattern && task.unstructured.ok && task.quad_mesh.triangles.empty();
+}
+
+void make_holomorphic_candidate(FaceTask& task, const cad::CadModel& model,
+                                std::span<const mesh::CurveMesh> full,
+                                const holomorphic::HolomorphicOptions& options) {
+  task.holomorphic_mesh = mesh::FaceMesh{};
+  if (!task.background_report.ok || task.background.triangles.empty()) {
+    task.quasi.holomorphic = "no background mesh";
+    return;
+  }
+  try {
+    const auto surface = model.face_geometry(task.face);
+    const auto loops = background::face_boundary(model, task.face, *surface, full);
+    task.holomorphic_mesh =
+        holomorphic::mesh_annulus(task.background, loops, *surface, options, &task.holomorphic);
+  } catch (const std::exception& e) {
+    task.holomorphic.ok = false;
+    task.holomorphic.reason = std::string("boundary: ") + e.what();
+  }
+  if (!task.holomorphic.ok) task.quasi.holomorphic = task.holomorphic.reason;
+}
+
+bool choose_face_method(FaceTask& task, holomorphic::Method method, double sicn_tolerance) {
+  mesh::FaceMesh candidate = std::move(task.holomorphic_mesh);
+  task.holomorphic_mesh = mesh::FaceMesh{};
+  if (candidate.quads.empty()) return false;  // the reason is recorded already
+  const mesh::FaceQuadStats mine = mesh::face_quad_stats(candidate);
+  // A face the default path left without a valid all-quad mesh has nothing to compare with.
+  const bool no_default = no_valid_quads(task);
+  const mesh::FaceQuadStats theirs =
+      no_default ? mesh::FaceQuadStats{} : mesh::face_quad_stats(task.quad_mesh);
+  const bool keep =
+      no_default
+          ? holomorphic::keep_holomorphic(holomorphic::Method::Holomorphic, task.holomorphic, mine,
+                                          theirs, sicn_tolerance) &&
+                method != holomorphic::Method::Default
+          : holomorphic::keep_holomorphic(method, task.holomorphic, mine, theirs, sicn_tolerance);
+  if (!keep) {
+    task.quasi.holomorphic =
+        "default mesh kept (" + std::to_string(theirs.irregular_interior) + " irregular, SICN " +
+        std::to_string(theirs.sicn_min) + " / " + std::to_string(theirs.sicn_avg) +
+        "; holomorphic " + std::to_string(mine.irregular_interior) + ", " +
+        std::to_string(mine.sicn_min) + " / " + std::to_string(mine.sicn_avg) + ")";
+    return false;
+  }
+  task.quad_mesh = std::move(candidate);
+  task.unstructured.ok = true;
+  // The face counts as meshed by its form, not by the pattern it may have had.
+  task.quasi.by_pattern = false;
+  task.quasi.by_comparison = false;
+  task.quasi.pattern.clear();
+  task.quasi.by_holomorphic = true;
+  task.quasi.holomorphic = "kept";
+  return true;
 }
 
 }  // namespace qsmesh::parallel

@@ -537,6 +537,11 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     fill_bound = pattern_stage(cx, faces, patterns, result);
     clock.end("patterns", true);
   }
+  const bool by_holomorphic = quads && options.face_method != holomorphic::Method::Default;
+  if (by_holomorphic)  // before the unstructured stage releases the background meshes
+    each_face(cx, faces, "holomorphic", [&](FaceTask& t) {
+      make_holomorphic_candidate(t, model, result.quantized_curves, options.holomorphic);
+    });
   if (quads) {
     clock.start();
     unstructured_stage(cx, faces, result.quantized_curves, quasi);
@@ -551,6 +556,10 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     clock.end("pattern_compare", true);
   }
 
+  if (by_holomorphic)
+    each_face(cx, faces, nullptr, [&](FaceTask& t) {
+      choose_face_method(t, options.face_method, options.holomorphic_sicn_tolerance);
+    });
   clock.start();
   const std::span<const mesh::CurveMesh> final_curves =
       quads ? std::span<const mesh::CurveMesh>(result.quantized_curves)

@@ -75,6 +75,8 @@ FaceOutput full_output() {
   o.quasi.refusal = "quality";
   o.quasi.by_comparison = true;
   o.quasi.gave_way = true;
+  o.quasi.by_holomorphic = true;
+  o.quasi.holomorphic = "kept";
   o.quasi.improvement.irregular_before = 11;
   o.quasi.improvement.irregular_after = 5;
   o.quasi.improvement.cavities = {1, 2, 3, 4};
@@ -97,8 +99,8 @@ FaceOutput full_output() {
 TEST(Pack, EveryFieldOfAFaceOutputRoundTrips) {
   const FaceOutput a = full_output();
   // 9 parts; the counts of their fields: mesh 1 (packed whole), background report 5, cross field
-  // 11, sizes 3, unstructured 7, quasi 5 + improvement 7, stats 7, seconds 1, times 10.
-  ASSERT_EQ(count_fields(a), 1 + 5 + 11 + 3 + 7 + 12 + 7 + 1 + 10)
+  // 11, sizes 3, unstructured 7, quasi 7 + improvement 7, stats 7, seconds 1, times 10.
+  ASSERT_EQ(count_fields(a), 1 + 5 + 11 + 3 + 7 + 14 + 7 + 1 + 10)
       << "a field was added to a report: set it in full_output() and check it here";
   std::vector<char> buf;
   write_record(buf, a);
@@ -151,6 +153,8 @@ TEST(Pack, EveryFieldOfAFaceOutputRoundTrips) {
   EXPECT_EQ(b.quasi.refusal, "quality");
   EXPECT_TRUE(b.quasi.by_comparison);
   EXPECT_TRUE(b.quasi.gave_way);
+  EXPECT_TRUE(b.quasi.by_holomorphic);
+  EXPECT_EQ(b.quasi.holomorphic, "kept");
   const ImprovementReport& q = b.quasi.improvement;
   EXPECT_EQ(q.irregular_before, 11);
   EXPECT_EQ(q.irregular_after, 5);

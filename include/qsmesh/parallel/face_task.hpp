@@ -18,6 +18,7 @@
 #include "qsmesh/background/face_mesh.hpp"
 #include "qsmesh/cad/model.hpp"
 #include "qsmesh/crossfield/cross_field.hpp"
+#include "qsmesh/holomorphic/holomorphic.hpp"
 #include "qsmesh/linalg/solver.hpp"
 #include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/mesh/surface_mesh.hpp"
@@ -87,6 +88,10 @@ struct QuasiReport {
   bool gave_way = false;
   /// Unstructured faces only (others keep zeros).
   ImprovementReport improvement;
+  /// Meshed from its holomorphic 1-form (PipelineOptions::face_method, choose_face_method).
+  bool by_holomorphic = false;
+  /// With --method holomorphic or auto: "kept", or why the face kept its default mesh.
+  std::string holomorphic;
 
   /// "pattern:<name>" when meshed by a pattern, else empty.
   [[nodiscard]] std::string pattern_method() const {
@@ -102,6 +107,8 @@ struct QuasiReport {
     visit("faces_meshed_by_pattern_after_comparison", self.by_comparison);
     visit("faces_fill_gave_way_to_unstructured", self.gave_way);
     visit("improvement", self.improvement);
+    visit("faces_meshed_by_holomorphic", self.by_holomorphic);
+    visit("holomorphic", self.holomorphic);
   }
 };
 
@@ -203,6 +210,9 @@ struct FaceTask {
   RefusedFill refused;
   double seconds = 0;  ///< wall time of the quad stages on this face (s)
   FaceTimes times;     ///< per stage
+  /// The face's holomorphic mesh until choose_face_method weighs it (empty: none).
+  mesh::FaceMesh holomorphic_mesh;
+  holomorphic::HolomorphicReport holomorphic;
 };
 
 /// Background triangulation of task.face (background::mesh_face_background) into task.background
@@ -316,6 +326,21 @@ struct FillComparison {
 /// (by_comparison unless it was a kept one). task.refused is emptied either way.
 FillComparison compare_refused_fill(FaceTask& task, double tolerance,
                                     const qstruct::PatternFaceOptions& options);
+
+/// The holomorphic mesh of the task's face (holomorphic::mesh_annulus on its background mesh and
+/// its boundary on the final curve meshes `full`) into task.holomorphic_mesh, the report into
+/// task.holomorphic; a failure leaves the reason in task.quasi.holomorphic. Needs the background
+/// mesh (before the unstructured stage releases it). Depends on the face's data only.
+void make_holomorphic_candidate(FaceTask& task, const cad::CadModel& model,
+                                std::span<const mesh::CurveMesh> full,
+                                const holomorphic::HolomorphicOptions& options);
+
+/// Per-face dispatch once the default mesh is final: the holomorphic mesh replaces task.quad_mesh
+/// when holomorphic::keep_holomorphic says so against the default mesh's statistics (or the
+/// default path left no valid all-quad mesh); task.quasi records it (by_holomorphic, holomorphic:
+/// "kept" or why not; a kept one clears by_pattern, by_comparison and pattern). The candidate is
+/// released either way. Returns whether it was kept.
+bool choose_face_method(FaceTask& task, holomorphic::Method method, double sicn_tolerance);
 
 /// The faces the unstructured path meshes: those without a pattern mesh (take_fill).
 [[nodiscard]] bool wants_unstructured(const FaceTask& task);

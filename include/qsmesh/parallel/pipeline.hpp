@@ -13,6 +13,7 @@
 #include "qsmesh/core/tasks.hpp"
 #include "qsmesh/core/timer.hpp"
 #include "qsmesh/crossfield/cross_field.hpp"
+#include "qsmesh/holomorphic/holomorphic.hpp"
 #include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/mesh/surface_mesh.hpp"
 #include "qsmesh/parallel/comm.hpp"
@@ -103,6 +104,16 @@ struct PipelineOptions {
   /// 0.884 -> 0.885 (min 0.093 -> 0.099) for 0.06-0.5 s; 30 iterations instead of 10 add nothing.
   bool final_smoothing = true;
   smooth::SmoothOptions final_smooth;
+  /// Quad stages: the per-face method (`--method`). Holomorphic and Auto also mesh each face whose
+  /// background triangulation is a topological annulus from its holomorphic 1-form (paper 004,
+  /// holomorphic::mesh_annulus) and choose between that and the default mesh with
+  /// holomorphic::keep_holomorphic (choose_face_method); a face where the construction fails
+  /// keeps the default mesh, the reason in QuasiReport::holomorphic.
+  holomorphic::Method face_method = holomorphic::Method::Default;
+  holomorphic::HolomorphicOptions holomorphic;
+  /// Method::Auto: how much lower the holomorphic mesh's SICN min and avg may each be than the
+  /// default mesh's (it must have fewer interior irregular vertices).
+  double holomorphic_sicn_tolerance = 0.02;
 };
 
 struct PipelineResult {

@@ -1,0 +1,57 @@
+// Run by ctest at 1, 2 and 4 ranks: with --method holomorphic the distributed pipeline gives, on
+// rank 0, exactly the mesh of a serial run, and the cylinder's side (a topological annulus whose
+// two circles share their counts with the disks) is the grid of its holomorphic 1-form.
+#include <gtest/gtest.h>
+
+#include <sstream>
+
+#include "qsmesh/mesh/validate.hpp"
+#include "qsmesh/parallel/comm.hpp"
+#include "qsmesh/parallel/pipeline.hpp"
+#include "shapes.hpp"
+
+namespace qsmesh::parallel {
+namespace {
+
+TEST(HolomorphicPipeline, CylinderSideIsAGridOnEveryRankCount) {
+  const Comm comm = Comm::world();
+  const std::string path =
+      std::string(QSMESH_TEST_TMP_DIR) + "/holo_cyl_np" + std::to_string(comm.size()) + ".brep";
+  if (comm.rank() == 0) test::write_cylinder(path);
+  comm.barrier();
+  const cad::CadModel model = cad::load_cad(path);
+  PipelineOptions options;
+  options.background.sizes.size = 0.5;
+  options.sizemap.size_max = 0.5;
+  options.until = Stage::QuasiStructured;
+  options.face_method = holomorphic::Method::Holomorphic;
+  std::ostringstream sink;
+  Logger log(sink, LogLevel::Quiet);
+  const PipelineResult dist = run_pipeline(comm, model, options, TaskArena(2), log);
+  if (comm.rank() != 0) return;
+  const PipelineResult serial = run_pipeline(Comm::self(), model, options, TaskArena(1), log);
+  EXPECT_EQ(dist.mesh.points, serial.mesh.points);
+  EXPECT_EQ(dist.mesh.quads, serial.mesh.quads);
+  EXPECT_TRUE(dist.mesh.triangles.empty());
+  const auto conformity = mesh::check_conformity(dist.mesh, model);
+  EXPECT_TRUE(conformity.ok()) << conformity.summary();
+  int kept = 0;
+  for (LO f = 0; f < model.num_faces(); ++f) {
+    const auto& q = dist.quasi_reports[static_cast<std::size_t>(f)];
+    EXPECT_EQ(q.by_holomorphic, serial.quasi_reports[static_cast<std::size_t>(f)].by_holomorphic);
+    if (model.faces()[static_cast<std::size_t>(f)].type == cad::SurfaceType::Cylinder) {
+      EXPECT_TRUE(q.by_holomorphic) << q.holomorphic;
+      EXPECT_EQ(dist.face_stats[static_cast<std::size_t>(f)].irregular_interior, 0);
+      EXPECT_EQ(dist.face_stats[static_cast<std::size_t>(f)].irregular_boundary, 0);
+      EXPECT_GT(dist.face_stats[static_cast<std::size_t>(f)].sicn_min, 0.3);
+    } else {
+      EXPECT_FALSE(q.by_holomorphic);  // the disks have one loop
+      EXPECT_NE(q.holomorphic.find("not a poly-annulus"), std::string::npos) << q.holomorphic;
+    }
+    kept += q.by_holomorphic ? 1 : 0;
+  }
+  EXPECT_EQ(kept, 1);
+}
+
+}  // namespace
+}  // namespace qsmesh::parallel
