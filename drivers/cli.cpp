@@ -186,12 +186,19 @@ Arguments parse(const std::vector<std::string>& args) {
       a.field_divisions = *n;
     } else if (opt == "--block-structured" && a.command == Command::Mesh)
       a.block_structured = true;
-    else if (opt == "--order" && a.command == Command::Mesh) {
+    // Paper 003 (fieldmesh): meshing from a given cross field, or from the mesher's own one.
+    else if (opt == "--cross-field" && a.command == Command::Mesh)
+      a.cross_field = value();
+    else if (opt == "--method" && a.command == Command::Mesh) {
+      const std::string& v = value();
+      if (v != "separatrix") throw InputError("--method: '" + v + "' is not separatrix");
+      a.separatrix_method = true;
+    } else if (opt == "--order" && a.command == Command::Mesh) {
       const std::string& v = value();
       if (v != "1" && v != "2") throw InputError("--order: '" + v + "' is not 1 or 2");
       a.order = v == "2" ? 2 : 1;
-    }
-    else if (opt == "--check" && a.command == Command::CrossField) a.check = true;
+    } else if (opt == "--check" && a.command == Command::CrossField)
+      a.check = true;
     else if (opt == "--curvature-edges" && sizing) {
       const std::string& v = value();
       const auto n = parse_double(v);
@@ -336,6 +343,9 @@ Arguments parse(const std::vector<std::string>& args) {
     }
     if (a.order == 2 && a.until == "background")
       throw InputError("--order 2 needs a quad mesh: not with --until background");
+    if ((!a.cross_field.empty() || a.separatrix_method) && a.until == "background")
+      throw InputError(std::string(a.separatrix_method ? "--method separatrix" : "--cross-field") +
+                       " needs a quad mesh: not with --until background");
     if (a.command == Command::CrossField && a.output.empty() && !a.check)
       throw InputError("crossfield: missing -o OUT.vtu (or --check)");
     if (a.command == Command::SizeMap && a.output.empty())
@@ -401,6 +411,13 @@ std::string help(const std::string& topic) {
           "                        quad layout (traces from irregular vertices and CAD corners,\n"
           "                        paper 002 Sec. III.A), joined by 1-to-1 connectivity; faces\n"
           "                        that do not split into blocks go to one unstructured zone\n"
+          "  --cross-field FIELD   mesh the faces FIELD gives a cross field for from that field\n"
+          "                        (paper 003: compatibility, alignment, separatrices, four-sided\n"
+          "                        regions, transfinite filling); FIELD is a list of singular\n"
+          "                        points per face or a `qsmesh crossfield` VTU (docs/usage.md).\n"
+          "                        A face whose field is refused keeps the default mesh\n"
+          "  --method separatrix   the same partition on the mesher's own cross field for the\n"
+          "                        other faces (a face where it fails keeps the default mesh)\n"
           "  --quads N, --curvature-edges N, --face-curvature, --feature-ratio R, --size-min H,\n"
           "  --size-min-ratio R, --sizing RULES, --curve-edges C:N,.., --odd-slivers,\n"
           "  --face-quads F:N,.., --corner-size K:H,.., --curve-size C:H,.., --face-size F:H,..,\n"

@@ -190,7 +190,8 @@ GivenFields read_vtu(const std::string& text, const std::string& path, LO num_fa
   } catch (const InputError& e) {
     throw InputError("--cross-field: " + path + ": " + e.what());
   }
-  for (const char* name : {"Points", "connectivity", "offsets", "types", "cad_face", "cross_u"})
+  for (const char* name :
+       {"Points", "connectivity", "offsets", "types", "cad_face", "cross_u", "singularity_index"})
     if (a.count(name) == 0)
       throw InputError("--cross-field: " + path + ": no array '" + name +
                        "' (a VTU file written by `qsmesh crossfield -o` is expected)");
@@ -200,8 +201,9 @@ GivenFields read_vtu(const std::string& text, const std::string& path, LO num_fa
   const auto& types = a["types"];
   const auto& face = a["cad_face"];
   const auto& cu = a["cross_u"];
+  const auto& index = a["singularity_index"];
   const std::size_t nc = types.size();
-  if (offsets.size() != nc || face.size() != nc || cu.size() != 3 * nc)
+  if (offsets.size() != nc || face.size() != nc || cu.size() != 3 * nc || index.size() != nc)
     throw InputError("--cross-field: " + path + ": cell arrays of different lengths");
   std::map<LO, GivenFaceField> faces;
   std::size_t begin = 0;
@@ -228,9 +230,18 @@ GivenFields read_vtu(const std::string& text, const std::string& path, LO num_fa
       gf.samples.positions.push_back(centre);
       gf.samples.directions.push_back(d);
     }
+    if (types[c] == 1 && end - begin == 1 && index[c] != 0 && f >= 0 && f < num_faces) {
+      const auto v = static_cast<std::size_t>(conn[begin]);
+      if (3 * v + 2 >= xyz.size())
+        throw InputError("--cross-field: " + path + ": bad connectivity");
+      // Paper 000's index +1 is a valence-3 point, index 1/4 in paper 003's terms.
+      faces[f].samples.singular.push_back(
+          {{xyz[3 * v], xyz[3 * v + 1], xyz[3 * v + 2]}, static_cast<int>(index[c])});
+    }
     begin = end;
   }
-  for (auto& [f, ff] : faces) g.faces.push_back(std::move(ff));
+  for (auto& [f, ff] : faces)
+    if (ff.sampled) g.faces.push_back(std::move(ff));
   return g;
 }
 
@@ -287,7 +298,27 @@ std::vector<double> field_from_samples(const mesh::FaceMesh& tri, const Frame& f
     }
     dirs[v] = samples.directions[best];
   }
-  return field_from_directions(frame, dirs);
+  std::vector<double> theta = field_from_directions(frame, dirs);
+  std::vector<std::vector<LO>> nbr(tri.points.size());
+  for (const auto& t : tri.triangles)
+    for (int k = 0; k < 3; ++k) {
+      nbr[t[k]].push_back(t[(k + 1) % 3]);
+      nbr[t[(k + 1) % 3]].push_back(t[k]);
+    }
+  for (int pass = 0; pass < 3; ++pass) {
+    std::vector<double> next = theta;
+    for (std::size_t v = 0; v < theta.size(); ++v) {
+      if (tri.vclass[v].dim != 2 || nbr[v].empty()) continue;
+      double c = std::cos(4 * theta[v]), sn = std::sin(4 * theta[v]);
+      for (LO w : nbr[v]) {
+        c += std::cos(4 * theta[w]);
+        sn += std::sin(4 * theta[w]);
+      }
+      if (std::hypot(c, sn) > 1e-9) next[v] = std::atan2(sn, c) / 4;
+    }
+    theta = std::move(next);
+  }
+  return theta;
 }
 
 mesh::FaceMesh mesh_face_by_method(const cad::CadModel& model, LO f,

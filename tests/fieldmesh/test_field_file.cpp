@@ -92,7 +92,8 @@ TEST(FieldFile, ReadsTheVtuOfQsmeshCrossfieldBinaryAndAscii) {
     io::WriteOptions opt;
     opt.vtu_binary = binary;
     opt.vtu_markers.push_back({{0.5, 0.5, 0}, 1});
-    opt.cell_fields = {{"cross_u", 3, {1, 0, 0, 0, 1, 0, 0.6, 0.8, 0, 0, 0, 0}}};
+    opt.cell_fields = {{"cross_u", 3, {1, 0, 0, 0, 1, 0, 0.6, 0.8, 0, 0, 0, 0}},
+                       {"singularity_index", 1, {0, 0, 0, -1}}};
     const std::string path = test::tmp_dir() + (binary ? "/b.vtu" : "/a.vtu");
     io::write_vtu(m, path, opt);
     const auto g = fieldmesh::read_cross_field_file(path, 2);
@@ -103,6 +104,10 @@ TEST(FieldFile, ReadsTheVtuOfQsmeshCrossfieldBinaryAndAscii) {
     EXPECT_NEAR(g.faces[1].samples.positions[0].x, 2.0 / 3, 1e-12);
     EXPECT_EQ(g.faces[1].samples.directions[1].y, 1.0);
     EXPECT_EQ(g.faces[0].samples.directions[0].x, 0.6);
+    ASSERT_EQ(g.faces[1].samples.singular.size(), 1u);
+    EXPECT_EQ(g.faces[1].samples.singular[0].d, -1);
+    EXPECT_EQ(g.faces[1].samples.singular[0].position.y, 0.5);
+    EXPECT_TRUE(g.faces[0].samples.singular.empty());
     EXPECT_NE(input_error(path, 1).find("face 1 is not a face of the model"), std::string::npos);
   }
 }

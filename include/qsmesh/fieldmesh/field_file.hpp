@@ -11,9 +11,11 @@
 
 namespace qsmesh::fieldmesh {
 
-/// Crosses sampled at points of a face: one branch per sample (3D, any length > 0).
+/// Crosses sampled at points of a face: one branch per sample (3D, any length > 0), and the
+/// field's interior singular points when known (otherwise they are detected on the sampled field).
 struct FieldSamples {
   std::vector<Vec3> positions, directions;
+  std::vector<SingularPoint> singular;
 };
 
 /// The given field of one face: either singular points (Eq. 2; `points`, possibly empty for a
@@ -33,8 +35,9 @@ struct GivenFields {
 
 /// Reads FIELD: a text file starting with the line `qsmesh-cross-field singular-points 1`, or the
 /// VTU file `qsmesh crossfield -o` writes (ASCII or binary data arrays; the cell arrays cad_face
-/// and cross_u of its triangles are read, each triangle one sample at its centroid). Throws
-/// qsmesh::InputError, one line naming the file and, for text files, the line, when the file
+/// and cross_u of its triangles are read, each triangle one sample at its centroid, and its
+/// singularity markers, vertex cells with singularity_index +1 / -1, as the singular points).
+/// Throws qsmesh::InputError, one line naming the file and, for text files, the line, when the file
 /// cannot be read, is of neither form, or names a face outside [0, num_faces).
 [[nodiscard]] GivenFields read_cross_field_file(const std::string& path, LO num_faces);
 
@@ -53,7 +56,9 @@ enum class FaceMethod {
 [[nodiscard]] FaceMethod face_method(LO f, const GivenFields* given, bool separatrix);
 
 /// Angles (modulo pi/2, from frame.ref) at the vertices of `tri` of the nearest sample's cross
-/// (3D distance; the sample's branch projected on the vertex's tangent plane).
+/// (3D distance; the sample's branch projected on the vertex's tangent plane), then three Jacobi
+/// passes of averaging the representation vectors (cos 4 theta, sin 4 theta) over the interior
+/// vertices' neighbours, which removes the steps of the nearest-sample field.
 [[nodiscard]] std::vector<double> field_from_samples(const mesh::FaceMesh& tri, const Frame& frame,
                                                      const FieldSamples& samples);
 

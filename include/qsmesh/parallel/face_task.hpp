@@ -87,6 +87,13 @@ struct QuasiReport {
   bool gave_way = false;
   /// Unstructured faces only (others keep zeros).
   ImprovementReport improvement;
+  /// Paper 003 (fieldmesh): meshed from a cross field by the separatrix partition; the method
+  /// tried ("given-field", "separatrix", empty: none), the regions of the partition, and why the
+  /// face kept the default mesh when it failed ("stage: reason").
+  bool by_field = false;
+  std::string field_method;
+  std::int64_t field_regions = 0;
+  std::string field_refusal;
 
   /// "pattern:<name>" when meshed by a pattern, else empty.
   [[nodiscard]] std::string pattern_method() const {
@@ -102,6 +109,10 @@ struct QuasiReport {
     visit("faces_meshed_by_pattern_after_comparison", self.by_comparison);
     visit("faces_fill_gave_way_to_unstructured", self.gave_way);
     visit("improvement", self.improvement);
+    visit("faces_meshed_by_field", self.by_field);
+    visit("field_method", self.field_method);
+    visit("field_regions", self.field_regions);
+    visit("field_refusal", self.field_refusal);
   }
 };
 

@@ -13,6 +13,7 @@
 #include "qsmesh/core/tasks.hpp"
 #include "qsmesh/core/timer.hpp"
 #include "qsmesh/crossfield/cross_field.hpp"
+#include "qsmesh/fieldmesh/field_file.hpp"
 #include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/mesh/surface_mesh.hpp"
 #include "qsmesh/parallel/comm.hpp"
@@ -103,6 +104,12 @@ struct PipelineOptions {
   /// 0.884 -> 0.885 (min 0.093 -> 0.099) for 0.06-0.5 s; 30 iterations instead of 10 add nothing.
   bool final_smoothing = true;
   smooth::SmoothOptions final_smooth;
+  /// Paper 003 (fieldmesh::face_method per face): faces of `given_fields` (--cross-field; null:
+  /// none) are meshed from their field, the others from the mesher's own cross field when
+  /// `separatrix_method` (--method separatrix); a valid result replaces the face's default mesh.
+  const fieldmesh::GivenFields* given_fields = nullptr;
+  bool separatrix_method = false;
+  fieldmesh::FieldMeshOptions fieldmesh;
 };
 
 struct PipelineResult {
