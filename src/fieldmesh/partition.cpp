@@ -128,7 +128,38 @@ Polyline trace(const Context& c, std::vector<Node>& nodes, LO origin, const Vec2
   while (true) {
     Vec3 w1, w2;
     Vec2 d1, d2;
-    if (!branch(c, p, prev, w1, d1)) fail("separatrices", "a separatrix left the triangulation");
+    if (!branch(c, p, prev, w1, d1)) {
+      // Outside by round-off, past the last boundary test: the end is the nearest boundary point.
+      LO loop = kNoIndex;
+      double pos = 0, best = 1e300;
+      Vec2 x;
+      for (LO l = 0; l < static_cast<LO>(c.loops.loops.size()); ++l) {
+        const auto& pts = c.loops.loops[l].points;
+        for (std::size_t i = 0; i < pts.size(); ++i) {
+          const Vec2 a = pts[i].uv, e = pts[(i + 1) % pts.size()].uv - a;
+          const double t = std::clamp(dot(p - a, e) / std::max(dot(e, e), 1e-300), 0.0, 1.0);
+          const double d = norm(a + e * t - p);
+          if (d < best) {
+            best = d;
+            loop = l;
+            pos = static_cast<double>(i) + t;
+            x = a + e * t;
+          }
+        }
+      }
+      if (loop == kNoIndex || best > 2 * norm(out.uv.back() - out.uv[out.uv.size() - 2]) + 1e-12)
+        fail("separatrices", "a separatrix left the triangulation");
+      Node hit;
+      hit.kind = Node::Hit;
+      hit.uv = x;
+      hit.xyz = at(c, x);
+      hit.loop = loop;
+      hit.pos = pos;
+      out.to = static_cast<LO>(nodes.size());
+      nodes.push_back(hit);
+      out.uv.back() = x;
+      return out;
+    }
     const Vec2 p1 = p + d1 * c.step;
     if (!branch(c, p1, w1, w2, d2)) {
       w2 = w1;
@@ -218,36 +249,53 @@ std::vector<Edge> separatrix_edges(const Context& c, std::vector<Node>& nodes,
         if (distance(at(c, x), nodes[n].xyz) < 0.5 * c.rho) return true;
     return false;
   };
+  // Segments binned on a grid of the parameter plane; a crossing counts in the cell holding it.
+  std::vector<double> lengths;
+  for (const auto& sp : seps)
+    for (std::size_t k = 0; k + 1 < sp.uv.size(); ++k)
+      lengths.push_back(norm(sp.uv[k + 1] - sp.uv[k]));
+  if (lengths.empty()) return {};
+  std::nth_element(lengths.begin(),
+                   lengths.begin() + static_cast<std::ptrdiff_t>(lengths.size() / 2),
+                   lengths.end());
+  const double cell = std::max(4 * lengths[lengths.size() / 2], 1e-300);
+  auto cell_of = [&](double x) { return static_cast<long long>(std::floor(x / cell)); };
+  std::map<std::pair<long long, long long>, std::vector<std::pair<std::size_t, std::size_t>>> grid;
   for (std::size_t i = 0; i < seps.size(); ++i)
-    for (std::size_t j = i + 1; j < seps.size(); ++j) {
-      const auto& A = seps[i].uv;
-      const auto& B = seps[j].uv;
-      for (std::size_t s = 0; s + 1 < A.size(); ++s) {
-        const Vec2 p = A[s], r = A[s + 1] - A[s];
-        const Vec2 lo{std::min(A[s].u, A[s + 1].u), std::min(A[s].v, A[s + 1].v)};
-        const Vec2 hi{std::max(A[s].u, A[s + 1].u), std::max(A[s].v, A[s + 1].v)};
-        for (std::size_t t = 0; t + 1 < B.size(); ++t) {
-          if (std::max(B[t].u, B[t + 1].u) < lo.u || std::min(B[t].u, B[t + 1].u) > hi.u ||
-              std::max(B[t].v, B[t + 1].v) < lo.v || std::min(B[t].v, B[t + 1].v) > hi.v)
-            continue;
-          const Vec2 q = B[t], sv = B[t + 1] - B[t];
-          const double den = cross(r, sv);
-          if (std::abs(den) < 1e-300) continue;
-          const double a = cross(q - p, sv) / den, b = cross(q - p, r) / den;
-          if (a < 0 || a >= 1 || b < 0 || b >= 1) continue;
-          const Vec2 x = p + r * a;
-          if (near_shared_end(seps[i], seps[j], x)) continue;
-          Node n;
-          n.kind = Node::Crossing;
-          n.uv = x;
-          n.xyz = at(c, x);
-          const LO id = static_cast<LO>(nodes.size());
-          nodes.push_back(n);
-          cuts[i].push_back({static_cast<double>(s) + a, id, x});
-          cuts[j].push_back({static_cast<double>(t) + b, id, x});
-        }
-      }
+    for (std::size_t k = 0; k + 1 < seps[i].uv.size(); ++k) {
+      const Vec2 p = seps[i].uv[k], q = seps[i].uv[k + 1];
+      for (long long x = cell_of(std::min(p.u, q.u)); x <= cell_of(std::max(p.u, q.u)); ++x)
+        for (long long y = cell_of(std::min(p.v, q.v)); y <= cell_of(std::max(p.v, q.v)); ++y)
+          grid[{x, y}].emplace_back(i, k);
     }
+  for (const auto& [key, segs] : grid)
+    for (std::size_t m = 0; m < segs.size(); ++m)
+      for (std::size_t n = m + 1; n < segs.size(); ++n) {
+        auto [i, s] = segs[m];
+        auto [j, t] = segs[n];
+        if (i == j) continue;
+        if (i > j) {
+          std::swap(i, j);
+          std::swap(s, t);
+        }
+        const Vec2 p = seps[i].uv[s], r = seps[i].uv[s + 1] - p;
+        const Vec2 q = seps[j].uv[t], sv = seps[j].uv[t + 1] - q;
+        const double den = cross(r, sv);
+        if (std::abs(den) < 1e-300) continue;
+        const double a = cross(q - p, sv) / den, b = cross(q - p, r) / den;
+        if (a < 0 || a >= 1 || b < 0 || b >= 1) continue;
+        const Vec2 x = p + r * a;
+        if (std::pair(cell_of(x.u), cell_of(x.v)) != key) continue;
+        if (near_shared_end(seps[i], seps[j], x)) continue;
+        Node nd;
+        nd.kind = Node::Crossing;
+        nd.uv = x;
+        nd.xyz = at(c, x);
+        const LO id = static_cast<LO>(nodes.size());
+        nodes.push_back(nd);
+        cuts[i].push_back({static_cast<double>(s) + a, id, x});
+        cuts[j].push_back({static_cast<double>(t) + b, id, x});
+      }
   std::vector<Edge> edges;
   for (std::size_t i = 0; i < seps.size(); ++i) {
     auto& cs = cuts[i];

@@ -35,12 +35,12 @@ FieldFace mesh_task_by_field(const FaceTask& task, const cad::CadModel& model,
 void take_field_mesh(FaceTask& task, FieldFace&& face) {
   if (face.method == fieldmesh::FaceMethod::Default) return;
   task.quasi.field_method = fieldmesh::to_string(face.method);
-  task.quasi.field_regions = face.report.regions;
   if (!face.report.ok) {
     task.quasi.field_refusal = face.report.stage + ": " + face.report.reason;
     return;
   }
   task.quasi.by_field = true;
+  task.quasi.field_regions = face.report.regions;
   task.quasi.by_pattern = false;
   task.quad_mesh = std::move(face.mesh);
   task.unstructured.ok = true;
