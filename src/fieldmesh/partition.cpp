@@ -864,6 +864,9 @@ mesh::FaceMesh mesh_face_from_field(const cad::CadModel& model, LO f,
     if (worst <= 0)
       fail("filling",
            "the filled regions hold invalid quads (SICN min " + std::to_string(worst) + ")");
+    if (worst < options.min_sicn)
+      fail("filling",
+           "SICN min " + std::to_string(worst) + " below " + std::to_string(options.min_sicn));
     rep.ok = true;
     return quads;
   } catch (const Failure& e) {

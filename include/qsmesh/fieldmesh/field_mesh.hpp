@@ -77,6 +77,11 @@ struct FieldMeshOptions {
   /// singular vertices fixed (they stay where the field puts them); with move_singular_points,
   /// also smooth::smooth_face (Winslow / angle-based kernels) that moves them too.
   bool move_singular_points = false;
+  /// A result whose SICN min is below this is refused (stage "filling"): the face keeps its
+  /// default mesh. On the shared models with --method separatrix, the faces below 0.2 were long
+  /// regions bent by separatrices that pass close to a corner or to each other (mambo_s34:
+  /// SICN min 0.005 of the model with them, docs/benchmarks.md).
+  double min_sicn = 0.2;
   int smooth_iterations = 10;
   linalg::SolverOptions solver;
 };
