@@ -641,6 +641,10 @@ mesh::FaceMesh partition_and_fill(Context& c, std::span<const SingularPoint> sin
     n.ipos = kNoIndex;
   };
   search(0, 0.0);
+  if (!found && budget < 0)
+    fail("quantization", "the search for the places of " + std::to_string(hits.size()) +
+                             " separatrix ends ran out of steps before finding equal counts on "
+                             "opposite region sides");
   if (!found)
     fail("quantization", "no placement of the separatrix ends within " +
                              std::to_string(c.options.snap_range) +
