@@ -8,7 +8,6 @@
 #include <sstream>
 
 #include "qsmesh/core/error.hpp"
-#include "qsmesh/holomorphic/holomorphic.hpp"
 #include "qsmesh/io/writer.hpp"
 
 namespace qsmesh::cli {
@@ -175,7 +174,12 @@ Arguments parse(const std::vector<std::string>& args) {
     else if (opt == "--until" && a.command == Command::Mesh) a.until = value();
     else if (opt == "--method" && a.command == Command::Mesh) {
       a.method = value();
-      (void)holomorphic::parse_method(a.method);
+      // separatrix: paper 003's partition (fieldmesh); the others: paper 004's dispatch.
+      a.separatrix_method = a.method == "separatrix";
+      if (!a.separatrix_method && a.method != "default" && a.method != "holomorphic" &&
+          a.method != "auto")
+        throw InputError("--method: expected default, holomorphic, auto or separatrix, got '" +
+                         a.method + "'");
     } else if (opt == "--threads")
       a.threads = parse_threads(value());
     else if (opt == "--face-time-budget" && a.command == Command::Mesh)
@@ -195,12 +199,15 @@ Arguments parse(const std::vector<std::string>& args) {
       a.plot3d_stream = true;
     else if (opt == "--plot3d-single" && a.command == Command::Mesh)
       a.plot3d_single = true;
+    // Paper 003 (fieldmesh): meshing from a given cross field.
+    else if (opt == "--cross-field" && a.command == Command::Mesh)
+      a.cross_field = value();
     else if (opt == "--order" && a.command == Command::Mesh) {
       const std::string& v = value();
       if (v != "1" && v != "2") throw InputError("--order: '" + v + "' is not 1 or 2");
       a.order = v == "2" ? 2 : 1;
-    }
-    else if (opt == "--check" && a.command == Command::CrossField) a.check = true;
+    } else if (opt == "--check" && a.command == Command::CrossField)
+      a.check = true;
     else if (opt == "--curvature-edges" && sizing) {
       const std::string& v = value();
       const auto n = parse_double(v);
@@ -364,6 +371,8 @@ Arguments parse(const std::vector<std::string>& args) {
       throw InputError("--order 2 needs a quad mesh: not with --until background");
     if (a.method != "default" && a.until == "background")
       throw InputError("--method " + a.method + " needs a quad mesh: not with --until background");
+    if (!a.cross_field.empty() && a.until == "background")
+      throw InputError("--cross-field needs a quad mesh: not with --until background");
     if (a.command == Command::CrossField && a.output.empty() && !a.check)
       throw InputError("crossfield: missing -o OUT.vtu (or --check)");
     if (a.command == Command::SizeMap && a.output.empty())
@@ -435,7 +444,10 @@ std::string help(const std::string& topic) {
           "                        count); auto (that grid only where it has fewer interior\n"
           "                        irregular vertices and SICN min and avg at most 0.02 below the\n"
           "                        default mesh's). Other faces keep the default mesh, the reason\n"
-          "                        in the face_stats of --stats (\"holomorphic\")\n"
+          "                        in the face_stats of --stats (\"holomorphic\"); separatrix\n"
+          "                        (paper 003's partition into four-sided regions on the mesher's\n"
+          "                        own cross field, filled by transfinite interpolation; a face\n"
+          "                        where it fails keeps the default mesh, \"field_refusal\")\n"
           "  --order 2             second-order elements: 9-node quads and 3-node bars, the new\n"
           "                        nodes on the CAD (CGNS QUAD_9/BAR_3, VTU, MSH; in .h5 the\n"
           "                        datasets quad9 and bar3)\n"
@@ -446,6 +458,11 @@ std::string help(const std::string& topic) {
           "  --plot3d-stream       PLOT3D output without the Fortran record lengths (C stream\n"
           "                        binary: the same bytes, nothing between the records)\n"
           "  --plot3d-single       PLOT3D coordinates in single precision (float32)\n"
+          "  --cross-field FIELD   mesh the faces FIELD gives a cross field for from that field\n"
+          "                        (paper 003: compatibility, alignment, separatrices, four-sided\n"
+          "                        regions, transfinite filling); FIELD is a list of singular\n"
+          "                        points per face or a `qsmesh crossfield` VTU (docs/usage.md).\n"
+          "                        A face whose field is refused keeps the default mesh\n"
           "  --quads N, --curvature-edges N, --face-curvature, --feature-ratio R, --size-min H,\n"
           "  --size-min-ratio R, --sizing RULES, --curve-edges C:N,.., --odd-slivers,\n"
           "  --face-quads F:N,.., --corner-size K:H,.., --curve-size C:H,.., --face-size F:H,..,\n"

@@ -38,6 +38,11 @@ struct Arguments {
   bool plot3d_stream = false;
   /// --plot3d-single: PLOT3D coordinates in single precision.
   bool plot3d_single = false;
+  /// Paper 003 (fieldmesh): --cross-field FIELD, the user's cross field of some faces (read by
+  /// fieldmesh::read_cross_field_file), and --method separatrix, the separatrix partition on the
+  /// mesher's own cross field for the other faces.
+  std::string cross_field;
+  bool separatrix_method = false;
   /// --order 2: second-order quads (9 nodes) and bars (3 nodes) on the CAD
   /// (highorder::make_quadratic); 1: linear.
   int order = 1;

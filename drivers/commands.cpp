@@ -308,6 +308,8 @@ std::pair<std::int64_t, std::int64_t> count_failures(const parallel::PipelineRes
 
 /// How face f got its quad mesh: "pattern:<name>", "frontal" or "fallback".
 std::string quad_method(const parallel::PipelineResult& r, std::size_t f) {
+  if (f < r.quasi_reports.size() && r.quasi_reports[f].by_field)
+    return "field:" + r.quasi_reports[f].field_method;
   if (f < r.quasi_reports.size()) {
     if (r.quasi_reports[f].by_holomorphic) return "holomorphic";
     std::string pattern = r.quasi_reports[f].pattern_method();
@@ -469,7 +471,9 @@ std::string stats_json(const Arguments& args, const Session& session,
           .value("method", quad_method(r, f))
           .value("pattern_refusal", pattern_refusal(r, f))
           .value("holomorphic",
-                 f < r.quasi_reports.size() ? r.quasi_reports[f].holomorphic : std::string());
+                 f < r.quasi_reports.size() ? r.quasi_reports[f].holomorphic : std::string())
+          .value("field_refusal",
+                 f < r.quasi_reports.size() ? r.quasi_reports[f].field_refusal : std::string());
       // The face's statistics (mesh::FaceQuadStats::fields, documented there).
       mesh::FaceQuadStats::fields(r.face_stats[f],
                                   [&](const char* name, const auto& v) { j.value(name, v); });
@@ -807,9 +811,17 @@ int run_mesh(const Arguments& args) {
   if (until >= parallel::Stage::Unstructured) apply_size_options(args, s, options);
   s.announce(args, "mesh");
   options.until = until;
-  options.face_method = holomorphic::parse_method(args.method);
+  options.face_method = args.separatrix_method ? holomorphic::Method::Default
+                                               : holomorphic::parse_method(args.method);
   if (until >= parallel::Stage::Unstructured) note_sliver_curves(s, options.sizemap);
   options.cavities.time_budget_s = args.face_time_budget;
+  // Paper 003: read before any work, so that a bad file is one InputError line up front.
+  fieldmesh::GivenFields given_fields;
+  if (!args.cross_field.empty()) {
+    given_fields = fieldmesh::read_cross_field_file(args.cross_field, s.model.num_faces());
+    options.given_fields = &given_fields;
+  }
+  options.separatrix_method = args.separatrix_method;
   // A face whose field system is above SolverOptions::petsc_threshold is solved by PETSc; with the
   // background at the geometry's resolution that takes a face far larger than its neighbours, or
   // --field-divisions 0 on a large one.

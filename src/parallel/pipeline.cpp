@@ -9,6 +9,7 @@
 #include <span>
 
 #include "exchange.hpp"
+#include "field_stage.hpp"
 #include "improve.hpp"
 #include "qsmesh/background/curve_mesh.hpp"
 #include "qsmesh/core/error.hpp"
@@ -528,6 +529,16 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     clock.end("quantize", false);
   }
 
+  // Paper 003: faces meshed from a cross field, kept aside until the default stages are done.
+  std::vector<FieldFace> by_field(faces.size());
+  if (quads && (options.given_fields != nullptr || options.separatrix_method)) {
+    clock.start();
+    cx.tasks.parallel_for(static_cast<std::int64_t>(faces.size()), [&](std::int64_t i) {
+      by_field[i] = mesh_task_by_field(faces[i], model, result.quantized_curves, options, lane);
+    });
+    clock.end("fieldmesh", true);
+  }
+
   // The coarse patterns serve both whole faces (Sec. 6.1.2) and cavities (Sec. 6.2).
   const std::vector<qstruct::Pattern> patterns =
       quasi ? qstruct::builtin_patterns() : std::vector<qstruct::Pattern>{};
@@ -560,6 +571,8 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     each_face(cx, faces, nullptr, [&](FaceTask& t) {
       choose_face_method(t, options.face_method, options.holomorphic_sicn_tolerance);
     });
+  for (std::size_t i = 0; i < faces.size(); ++i) take_field_mesh(faces[i], std::move(by_field[i]));
+
   clock.start();
   const std::span<const mesh::CurveMesh> final_curves =
       quads ? std::span<const mesh::CurveMesh>(result.quantized_curves)

@@ -42,6 +42,24 @@ TEST(Cli, MeshOptions) {
   EXPECT_NE(help("mesh").find("--face-time-budget"), std::string::npos);
 }
 
+TEST(Cli, CrossFieldAndSeparatrixMethod) {
+  const Arguments a =
+      p({"mesh", "m.step", "-o", "o.vtu", "--cross-field", "f.txt", "--method", "separatrix"});
+  EXPECT_EQ(a.cross_field, "f.txt");
+  EXPECT_TRUE(a.separatrix_method);
+  EXPECT_FALSE(p({"mesh", "m.step", "-o", "o.vtu"}).separatrix_method);
+  EXPECT_EQ(error_of({"mesh", "m.step", "-o", "o.vtu", "--method", "other"}),
+            "--method: expected default, holomorphic, auto or separatrix, got 'other'");
+  EXPECT_FALSE(p({"mesh", "m.step", "-o", "o.vtu", "--method", "auto"}).separatrix_method);
+  EXPECT_NE(
+      error_of({"mesh", "m.step", "-o", "o.vtu", "--cross-field", "f.txt", "--until", "background"})
+          .find("--cross-field needs a quad mesh"),
+      std::string::npos);
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--cross-field"}).find("missing value"),
+            std::string::npos);
+  EXPECT_NE(help("mesh").find("--cross-field FIELD"), std::string::npos);
+}
+
 TEST(Cli, SecondOrder) {
   EXPECT_EQ(p({"mesh", "m.step", "-o", "o.cgns"}).order, 1);
   EXPECT_EQ(p({"mesh", "m.step", "-o", "o.msh", "--order", "2"}).order, 2);

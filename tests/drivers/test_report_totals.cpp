@@ -56,14 +56,16 @@ TEST(ReportTotals, WritesEveryTotalInTheOrderOfTheFields) {
                           "faces_fill_gave_way_to_unstructured", "irregular_unstructured_before",
                           "irregular_unstructured_after_cavities", "cavities_remeshed_per_step",
                           "disk_defects_before", "disk_defects_after", "disk_cavities_replaced",
-                          "faces_time_budget_hit", "faces_meshed_by_holomorphic"}) {
+                          "faces_time_budget_hit", "faces_meshed_by_holomorphic",
+                          "faces_meshed_by_field", "field_regions"}) {
     const std::size_t found = json.find(std::string("\"") + key + "\"", at);
     ASSERT_NE(found, std::string::npos) << key << " in " << json;
     at = found;
   }
-  EXPECT_EQ(t.fields().size(), 11U);
+  EXPECT_EQ(t.fields().size(), 13U);
   EXPECT_EQ(json.find("\"pattern\""), std::string::npos);
   EXPECT_EQ(json.find("\"holomorphic\""), std::string::npos);  // text is per face
+  EXPECT_EQ(json.find("\"field_refusal\""), std::string::npos);
 }
 
 }  // namespace

@@ -668,3 +668,33 @@ TEST(Pipeline, SizeMapOnSharedModels) {
 
 }  // namespace
 }  // namespace qsmesh::parallel
+
+namespace qsmesh::parallel {
+namespace {
+
+// Paper 003 (--method separatrix): the faces meshed from the mesher's own cross field do not
+// depend on the ranks either, and some faces of the filleted box take that path.
+TEST(Pipeline, SeparatrixMethodDoesNotDependOnRanks) {
+  const Comm comm = Comm::world();
+  const cad::CadModel model = shared_model(comm, "pipe_sep");
+  PipelineOptions options;
+  options.background.sizes.size = 0.7;
+  options.sizemap.size_max = 0.7;
+  options.until = Stage::QuasiStructured;
+  options.separatrix_method = true;
+  std::ostringstream sink;
+  Logger log(sink, LogLevel::Quiet);
+  const PipelineResult dist = run_pipeline(comm, model, options, TaskArena(2), log);
+  if (comm.rank() != 0) return;
+  const PipelineResult serial = expect_quads_as_on_one_rank(dist, model, options, log, 500, 0.0);
+  int by_field = 0;
+  for (std::size_t f = 0; f < dist.quasi_reports.size(); ++f) {
+    EXPECT_EQ(dist.quasi_reports[f].by_field, serial.quasi_reports[f].by_field);
+    EXPECT_EQ(dist.quasi_reports[f].field_refusal, serial.quasi_reports[f].field_refusal);
+    by_field += dist.quasi_reports[f].by_field ? 1 : 0;
+  }
+  EXPECT_GT(by_field, 0);
+}
+
+}  // namespace
+}  // namespace qsmesh::parallel

@@ -92,6 +92,13 @@ struct QuasiReport {
   bool by_holomorphic = false;
   /// With --method holomorphic or auto: "kept", or why the face kept its default mesh.
   std::string holomorphic;
+  /// Paper 003 (fieldmesh): meshed from a cross field by the separatrix partition; the method
+  /// tried ("given-field", "separatrix", empty: none), the regions of the partition, and why the
+  /// face kept the default mesh when it failed ("stage: reason").
+  bool by_field = false;
+  std::string field_method;
+  std::int64_t field_regions = 0;
+  std::string field_refusal;
 
   /// "pattern:<name>" when meshed by a pattern, else empty.
   [[nodiscard]] std::string pattern_method() const {
@@ -109,6 +116,10 @@ struct QuasiReport {
     visit("improvement", self.improvement);
     visit("faces_meshed_by_holomorphic", self.by_holomorphic);
     visit("holomorphic", self.holomorphic);
+    visit("faces_meshed_by_field", self.by_field);
+    visit("field_method", self.field_method);
+    visit("field_regions", self.field_regions);
+    visit("field_refusal", self.field_refusal);
   }
 };
 

@@ -14,6 +14,7 @@
 #include "qsmesh/core/timer.hpp"
 #include "qsmesh/crossfield/cross_field.hpp"
 #include "qsmesh/holomorphic/holomorphic.hpp"
+#include "qsmesh/fieldmesh/field_file.hpp"
 #include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/mesh/surface_mesh.hpp"
 #include "qsmesh/parallel/comm.hpp"
@@ -114,6 +115,12 @@ struct PipelineOptions {
   /// Method::Auto: how much lower the holomorphic mesh's SICN min and avg may each be than the
   /// default mesh's (it must have fewer interior irregular vertices).
   double holomorphic_sicn_tolerance = 0.02;
+  /// Paper 003 (fieldmesh::face_method per face): faces of `given_fields` (--cross-field; null:
+  /// none) are meshed from their field, the others from the mesher's own cross field when
+  /// `separatrix_method` (--method separatrix); a valid result replaces the face's default mesh.
+  const fieldmesh::GivenFields* given_fields = nullptr;
+  bool separatrix_method = false;
+  fieldmesh::FieldMeshOptions fieldmesh;
 };
 
 struct PipelineResult {

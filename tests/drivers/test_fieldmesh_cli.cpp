@@ -1,0 +1,117 @@
+// `qsmesh mesh --cross-field` and `--method separatrix` (paper 003) on a plate with a hole: the
+// round trip of `qsmesh crossfield`'s VTU, a list of singular points, the separatrix method, and
+// bad files refused up front.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <BRepBuilderAPI_MakeEdge.hxx>
+#include <BRepBuilderAPI_MakeFace.hxx>
+#include <BRepBuilderAPI_MakePolygon.hxx>
+#include <BRepBuilderAPI_MakeWire.hxx>
+#include <BRepTools.hxx>
+#include <TopoDS_Face.hxx>
+#include <TopoDS_Wire.hxx>
+#include <cstdlib>
+#include <fstream>
+#include <gp_Circ.hxx>
+#include <string>
+
+#include "tmp_dir.hpp"
+
+namespace {
+
+using qsmesh::test::slurp;
+using qsmesh::test::tmp;
+
+int qsmesh(const std::string& args, const std::string& log) {
+  const std::string cmd = std::string(QSMESH_EXE) + " " + args + " >" + log + " 2>&1";
+  const int status = std::system(cmd.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+// The square [-2, 2]^2 with a hole of radius 0.8 about the origin.
+std::string plate_with_hole() {
+  BRepBuilderAPI_MakePolygon poly;
+  for (auto [x, y] : {std::pair{-2.0, -2.0}, {2.0, -2.0}, {2.0, 2.0}, {-2.0, 2.0}})
+    poly.Add(gp_Pnt(x, y, 0));
+  poly.Close();
+  BRepBuilderAPI_MakeFace face(poly.Wire(), true);
+  TopoDS_Wire hole =
+      BRepBuilderAPI_MakeWire(
+          BRepBuilderAPI_MakeEdge(gp_Circ(gp_Ax2(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), 0.8)).Edge())
+          .Wire();
+  hole.Reverse();
+  face.Add(hole);
+  const std::string path = tmp("plate_hole.brep");
+  const TopoDS_Face f = face.Face();
+  if (!BRepTools::Write(f, path.c_str())) throw std::runtime_error("cannot write " + path);
+  return path;
+}
+
+bool has(const std::string& json, const std::string& what) {
+  return json.find(what) != std::string::npos;
+}
+
+TEST(FieldMeshCli, CrossfieldOutputFedBackAndSingularPoints) {
+  const std::string model = plate_with_hole(), log = tmp("fm.log");
+  const std::string field = tmp("cf.vtu"), stats = tmp("rt.json");
+  ASSERT_EQ(qsmesh("crossfield " + model + " --size 0.2 -o " + field, log), 0) << slurp(log);
+  ASSERT_EQ(qsmesh("mesh " + model + " --size 0.2 --cross-field " + field + " -o " + tmp("rt.msh") +
+                       " --stats " + stats,
+                   log),
+            0)
+      << slurp(log);
+  std::string json = slurp(stats);
+  EXPECT_TRUE(has(json, "\"faces_meshed_by_field\": 1")) << json;
+  EXPECT_TRUE(has(json, "\"method\": \"field:given-field\""));
+  EXPECT_TRUE(has(json, "\"conforming\": true"));
+  EXPECT_TRUE(has(json, "\"triangles\": 0"));
+
+  // Four valence-5 points of Eq. 2 near the diagonals: Eq. 17 fails around the hole, corrected.
+  const std::string points = tmp("pts.txt");
+  std::ofstream(points) << "qsmesh-cross-field singular-points 1\nface 0\n"
+                           "point 1.15 1.15 0 -1\npoint -1.15 1.15 0 -1\npoint -1.15 -1.15 0 -1\n"
+                           "point 1.15 -1.15 0 -1\n";
+  ASSERT_EQ(qsmesh("mesh " + model + " --size 0.2 --cross-field " + points + " -o " + tmp("p.vtu") +
+                       " --stats " + stats,
+                   log),
+            0)
+      << slurp(log);
+  json = slurp(stats);
+  EXPECT_TRUE(has(json, "\"faces_meshed_by_field\": 1")) << json;
+  EXPECT_TRUE(has(json, "\"irregular_interior\": 4"));
+  EXPECT_TRUE(has(json, "\"field_refusal\": \"\""));
+}
+
+TEST(FieldMeshCli, SeparatrixMethodAndRefusals) {
+  const std::string model = plate_with_hole(), log = tmp("fm2.log"), stats = tmp("s.json");
+  ASSERT_EQ(qsmesh("mesh " + model + " --size 0.2 --method separatrix -o " + tmp("s.vtu") +
+                       " --stats " + stats,
+                   log),
+            0)
+      << slurp(log);
+  EXPECT_TRUE(has(slurp(stats), "\"method\": \"field:separatrix\"")) << slurp(stats);
+
+  // An incompatible field keeps the default mesh and says why, naming the equation.
+  const std::string two = tmp("two.txt");
+  std::ofstream(two) << "qsmesh-cross-field singular-points 1\nface 0\npoint 1.15 1.15 0 -1\n";
+  ASSERT_EQ(qsmesh("mesh " + model + " --size 0.2 --cross-field " + two + " -o " + tmp("t.vtu") +
+                       " --stats " + stats,
+                   log),
+            0);
+  const std::string json = slurp(stats);
+  EXPECT_TRUE(has(json, "\"faces_meshed_by_field\": 0")) << json;
+  EXPECT_TRUE(has(json, "compatibility: Eq. 16 violated")) << json;
+
+  // Bad files: exit 2, one line, before any output.
+  const std::string bad = tmp("bad.txt");
+  std::ofstream(bad) << "qsmesh-cross-field singular-points 1\nface 7\n";
+  EXPECT_EQ(qsmesh("mesh " + model + " --cross-field " + bad + " -o " + tmp("b.vtu"), log), 2);
+  EXPECT_TRUE(has(slurp(log), "line 2: 'face ID' with ID in [0, 1)")) << slurp(log);
+  EXPECT_EQ(
+      qsmesh("mesh " + model + " --cross-field " + tmp("none.txt") + " -o " + tmp("b.vtu"), log),
+      2);
+  EXPECT_EQ(qsmesh("mesh " + model + " --method other -o " + tmp("b.vtu"), log), 2);
+}
+
+}  // namespace
