@@ -869,8 +869,10 @@ int run_mesh(const Arguments& args) {
         const io::Plot3dReport& p = *b.plot3d;
         if (!p.skipped_faces.empty()) {
           std::string faces;
-          for (std::size_t i = 0; i < p.skipped_faces.size() && i < 10; ++i)
-            faces += (i > 0 ? " " : "") + std::to_string(p.skipped_faces[i]);
+          for (std::size_t i = 0; i < p.skipped_faces.size() && i < 10; ++i) {
+            if (i > 0) faces += ' ';
+            faces += std::to_string(p.skipped_faces[i]);
+          }
           if (p.skipped_faces.size() > 10) faces += " ...";
           s.log.warn(cat("PLOT3D holds structured blocks only: ", p.skipped_faces.size(),
                          " faces that do not split into blocks (", p.skipped_triangles,
