@@ -77,6 +77,10 @@ FaceOutput full_output() {
   o.quasi.gave_way = true;
   o.quasi.by_holomorphic = true;
   o.quasi.holomorphic = "kept";
+  o.quasi.by_field = true;
+  o.quasi.field_method = "separatrix";
+  o.quasi.field_regions = 17;
+  o.quasi.field_refusal = "partition: a region has 5 corners";
   o.quasi.improvement.irregular_before = 11;
   o.quasi.improvement.irregular_after = 5;
   o.quasi.improvement.cavities = {1, 2, 3, 4};
@@ -99,8 +103,8 @@ FaceOutput full_output() {
 TEST(Pack, EveryFieldOfAFaceOutputRoundTrips) {
   const FaceOutput a = full_output();
   // 9 parts; the counts of their fields: mesh 1 (packed whole), background report 5, cross field
-  // 11, sizes 3, unstructured 7, quasi 7 + improvement 7, stats 7, seconds 1, times 10.
-  ASSERT_EQ(count_fields(a), 1 + 5 + 11 + 3 + 7 + 14 + 7 + 1 + 10)
+  // 11, sizes 3, unstructured 7, quasi 11 + improvement 7, stats 7, seconds 1, times 10.
+  ASSERT_EQ(count_fields(a), 1 + 5 + 11 + 3 + 7 + 18 + 7 + 1 + 10)
       << "a field was added to a report: set it in full_output() and check it here";
   std::vector<char> buf;
   write_record(buf, a);
@@ -155,6 +159,10 @@ TEST(Pack, EveryFieldOfAFaceOutputRoundTrips) {
   EXPECT_TRUE(b.quasi.gave_way);
   EXPECT_TRUE(b.quasi.by_holomorphic);
   EXPECT_EQ(b.quasi.holomorphic, "kept");
+  EXPECT_TRUE(b.quasi.by_field);
+  EXPECT_EQ(b.quasi.field_method, "separatrix");
+  EXPECT_EQ(b.quasi.field_regions, 17);
+  EXPECT_EQ(b.quasi.field_refusal, "partition: a region has 5 corners");
   const ImprovementReport& q = b.quasi.improvement;
   EXPECT_EQ(q.irregular_before, 11);
   EXPECT_EQ(q.irregular_after, 5);
