@@ -188,8 +188,9 @@ Arguments parse(const std::vector<std::string>& args) {
       a.block_structured = true;
     else if (opt == "--order" && a.command == Command::Mesh) {
       const std::string& v = value();
-      if (v != "1" && v != "2") throw InputError("--order: '" + v + "' is not 1 or 2");
-      a.order = v == "2" ? 2 : 1;
+      if (v.size() != 1 || v[0] < '1' || v[0] > '5')
+        throw InputError("--order: '" + v + "' is not 1, 2, 3, 4 or 5");
+      a.order = v[0] - '0';
     }
     else if (opt == "--check" && a.command == Command::CrossField) a.check = true;
     else if (opt == "--curvature-edges" && sizing) {
@@ -330,12 +331,17 @@ Arguments parse(const std::vector<std::string>& args) {
         throw InputError("--block-structured: the blocks are written as CGNS; give -o FILE.cgns");
       if (a.until == "background")
         throw InputError("--block-structured needs a quad mesh: not with --until background");
-      if (a.order == 2)
-        throw InputError(
-            "--block-structured with --order 2: blocks of second-order quads are not written yet");
+      if (a.order > 1)
+        throw InputError("--block-structured with --order " + std::to_string(a.order) +
+                         ": blocks of high-order quads are not written yet");
     }
-    if (a.order == 2 && a.until == "background")
-      throw InputError("--order 2 needs a quad mesh: not with --until background");
+    if (a.order > 1 && a.until == "background")
+      throw InputError("--order " + std::to_string(a.order) +
+                       " needs a quad mesh: not with --until background");
+    if (a.order > 4 && io::output_format(a.output) == io::Format::kCgns)
+      throw InputError("--order " + std::to_string(a.order) +
+                       ": CGNS has no elements of order 5 (QUAD_25, order 4, is the highest); "
+                       "write .vtu, .msh or .h5");
     if (a.command == Command::CrossField && a.output.empty() && !a.check)
       throw InputError("crossfield: missing -o OUT.vtu (or --check)");
     if (a.command == Command::SizeMap && a.output.empty())
@@ -394,9 +400,12 @@ std::string help(const std::string& topic) {
           "                        among the ranks running on it; more than the cores a rank may\n"
           "                        run on are not granted, and the run says so)\n"
           "  --stats FILE.json     also write the run statistics as JSON\n"
-          "  --order 2             second-order elements: 9-node quads and 3-node bars, the new\n"
-          "                        nodes on the CAD (CGNS QUAD_9/BAR_3, VTU, MSH; in .h5 the\n"
-          "                        datasets quad9 and bar3)\n"
+          "  --order N             high-order elements, N = 2..5: Lagrange quads of (N+1)^2 nodes\n"
+          "                        and bars of N+1 nodes, the new nodes on the CAD, quads that\n"
+          "                        would fold straightened (CGNS QUAD_9/16/25 and BAR_3/4/5, so\n"
+          "                        N <= 4 there; VTU Lagrange cells; MSH; in .h5 the datasets\n"
+          "                        quadM and barN+1, and the .xdmf shows order 2 curved, higher\n"
+          "                        orders as the linear quads of their corners)\n"
           "  --block-structured    write the .cgns file as structured zones, one per block of the\n"
           "                        quad layout (traces from irregular vertices and CAD corners,\n"
           "                        paper 002 Sec. III.A), joined by 1-to-1 connectivity; faces\n"

@@ -30,8 +30,8 @@ struct Arguments {
   /// --block-structured: write the CGNS file as structured blocks of the quad layout
   /// (layout::extract_quad_layout, io::write_cgns_blocks) instead of one unstructured zone.
   bool block_structured = false;
-  /// --order 2: second-order quads (9 nodes) and bars (3 nodes) on the CAD
-  /// (highorder::make_quadratic); 1: linear.
+  /// --order N, 2..5: Lagrange quads ((N + 1)^2 nodes) and bars (N + 1 nodes) on the CAD
+  /// (highorder::make_high_order); 1: linear.
   int order = 1;
   bool json = false;                   ///< info --json
   /// info --partition P,...: the METIS partition of the faces that `mpirun -np P qsmesh mesh`
