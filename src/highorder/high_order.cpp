@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <span>
 #include <unordered_map>
 #include <vector>
 
@@ -304,10 +305,29 @@ HighOrderReport make_high_order(mesh::SurfaceMesh& m, const cad::CadModel& model
         return images.empty() ? ref : nearest(images, ref);
       };
       // Node `node` at the projection of `target` on the face, or at `target` itself when the
-      // projection lands further than `reach` from it.
-      auto place = [&](std::size_t node, const Vec3& target, const Vec2& guess, double reach) {
+      // projection lands further than `reach` from it. The projection is Newton's in (u, v),
+      // which stalls next to a singular point of the parametrization (a sphere's pole: there u
+      // hardly moves the point) on a point of the surface that is not the nearest: a node off
+      // its place along the surface, which costs the element its order. When the residual is
+      // not along the normal, the projection starts again from `more` guesses (the element's
+      // corners) and the nearest foot wins.
+      auto place = [&](std::size_t node, const Vec3& target, const Vec2& guess, double reach,
+                       std::span<const Vec2> more) {
         Vec3 foot{};
-        const Vec2 uv = geom->project(target, guess, &foot);
+        Vec2 uv = geom->project(target, guess, &foot);
+        auto converged = [&](const Vec2& at, const Vec3& p) {
+          const Vec3 r = target - p;
+          const Vec3 nrm = geom->normal(at);
+          return norm(r - dot(r, nrm) * nrm) <= 1e-9 * reach;
+        };
+        for (std::size_t k = 0; k < more.size() && !converged(uv, foot); ++k) {
+          Vec3 other{};
+          const Vec2 w = geom->project(target, more[k], &other);
+          if (distance(other, target) < distance(foot, target)) {
+            foot = other;
+            uv = w;
+          }
+        }
         if (distance(foot, target) <= reach) {
           points[node] = foot;
           vclass[node] = {2, f, kNoIndex, {uv.u, uv.v}};
@@ -322,12 +342,13 @@ HighOrderReport make_high_order(mesh::SurfaceMesh& m, const cad::CadModel& model
           const Edge& x = edges[static_cast<std::size_t>(e)];
           const Vec2 ref = reference(x.quad);
           const Vec2 ua = uv_near(x.a, ref), ub = uv_near(x.b, ref);
+          const std::array<Vec2, 2> ends{ua, ub};
           const Vec3 pa = m.points[static_cast<std::size_t>(x.a)],
                      pb = m.points[static_cast<std::size_t>(x.b)];
           for (GO s = 0; s < per_edge; ++s) {
             const double r = fraction(s);
             place(static_cast<std::size_t>(e * per_edge + s), pa + r * (pb - pa),
-                  ua + r * (ub - ua), distance(pa, pb));
+                  ua + r * (ub - ua), distance(pa, pb), ends);
           }
         }
         return;
@@ -367,7 +388,7 @@ HighOrderReport make_high_order(mesh::SurfaceMesh& m, const cad::CadModel& model
                                (1 - r) * t * uv[3];
             place(static_cast<std::size_t>(first_interior + q * per_interior + (i - 1) +
                                            per_edge * (j - 1)),
-                  x, guess, reach);
+                  x, guess, reach, uv);
           }
       }
     });
