@@ -267,6 +267,8 @@ struct Checks {
   };
   std::optional<Blocks> blocks;
   std::optional<highorder::HighOrderReport> high_order;  ///< with --order 2..5
+  /// With --order 2..5: highorder::max_element_distance_to_cad / the model's diagonal.
+  double high_order_distance = 0;
 };
 
 /// How one face ended at the last stage run.
@@ -414,6 +416,7 @@ std::string stats_json(const Arguments& args, const Session& session,
     j.value("high_order_straightened_quads", checks.high_order->straightened);
     j.value("high_order_curve_straightened_quads", checks.high_order->curve_straightened);
     j.value("high_order_invalid_quads", checks.high_order->invalid);
+    j.value("high_order_max_element_distance_to_cad", checks.high_order_distance);
   }
   if (checks.blocks) {
     j.value("blocks", checks.blocks->blocks);
@@ -551,7 +554,9 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
        << " off the CAD: no CAD point near, or put back straight); quads whose face nodes went "
           "back "
        << "straight to stay valid " << q.straightened << ", made entirely straight "
-       << q.curve_straightened << ", still invalid " << q.invalid << "\n";
+       << q.curve_straightened << ", still invalid " << q.invalid
+       << "; curved elements' largest distance to the CAD / diagonal " << checks.high_order_distance
+       << "\n";
   }
   if (checks.blocks) {
     const Checks::Blocks& b = *checks.blocks;
@@ -814,6 +819,11 @@ int run_mesh(const Arguments& args) {
     if (args.order > 1) {
       checks.high_order = highorder::make_high_order(result.mesh, s.model, args.order, *s.tasks);
       s.times.add("high_order", clock.seconds());
+      clock.reset();
+      checks.high_order_distance =
+          highorder::max_element_distance_to_cad(result.mesh, s.model, *s.tasks) /
+          s.model.diagonal();
+      s.times.add("high_order_check", clock.seconds());
       clock.reset();
     }
     if (args.block_structured) {

@@ -528,4 +528,49 @@ HighOrderReport make_high_order(mesh::SurfaceMesh& m, const cad::CadModel& model
   return report;
 }
 
+double max_element_distance_to_cad(const mesh::SurfaceMesh& m, const cad::CadModel& model,
+                                   const TaskArena& tasks) {
+  QSMESH_CHECK(m.order > 1 && m.order <= kMaxOrder,
+               "element distance to the CAD: the mesh is of order " << m.order);
+  const int n = m.order;
+  const auto per_quad = static_cast<std::size_t>(m.quad_nodes_per_quad());
+  const auto positions = mesh::quad_grid_positions(n);
+  // Interior node (i, j) is quad_nodes entry 4 (n - 1) + (i - 1) + (n - 1) (j - 1).
+  auto interior = [n](int i, int j) {
+    return static_cast<std::size_t>(4 * (n - 1) + (i - 1) + (n - 1) * (j - 1));
+  };
+  const std::array<std::array<int, 2>, 4> near{{{1, 1}, {n - 1, 1}, {n - 1, n - 1}, {1, n - 1}}};
+  const double lo = 0.5 / n, hi = 1 - 0.5 / n;
+  const std::array<std::array<double, 2>, 4> at{{{lo, lo}, {hi, lo}, {hi, hi}, {lo, hi}}};
+  std::vector<std::vector<std::size_t>> face_quads(static_cast<std::size_t>(model.num_faces()));
+  for (std::size_t q = 0; q < m.quads.size(); ++q)
+    face_quads[static_cast<std::size_t>(m.quad_face[q])].push_back(q);
+  std::vector<double> worst(face_quads.size(), 0.0);
+  tasks.parallel_for(model.num_faces(), [&](std::int64_t fi) {
+    const auto f = static_cast<std::size_t>(fi);
+    if (face_quads[f].empty()) return;
+    const auto geom = model.face_geometry(static_cast<LO>(f));
+    std::vector<Vec3> x(positions.size());
+    for (std::size_t q : face_quads[f]) {
+      const GO* ho = m.quad_nodes.data() + q * per_quad;
+      bool curved = true;
+      for (std::size_t k = 0; k < per_quad; ++k)
+        curved = curved && !std::isnan(m.vclass[static_cast<std::size_t>(ho[k])].param[0]);
+      if (!curved) continue;
+      for (std::size_t k = 0; k < 4; ++k) x[k] = m.points[static_cast<std::size_t>(m.quads[q][k])];
+      for (std::size_t k = 0; k < per_quad; ++k)
+        x[4 + k] = m.points[static_cast<std::size_t>(ho[k])];
+      for (std::size_t c = 0; c < 4; ++c) {
+        const mesh::VertexClass& g =
+            m.vclass[static_cast<std::size_t>(ho[interior(near[c][0], near[c][1])])];
+        const Vec3 p = lagrange_quad_point(n, x, at[c][0], at[c][1]);
+        Vec3 foot{};
+        (void)geom->project(p, {g.param[0], g.param[1]}, &foot);
+        worst[f] = std::max(worst[f], distance(p, foot));
+      }
+    }
+  });
+  return worst.empty() ? 0.0 : *std::max_element(worst.begin(), worst.end());
+}
+
 }  // namespace qsmesh::highorder

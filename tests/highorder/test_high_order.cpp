@@ -240,6 +240,13 @@ void expect_rates(const cad::CadModel& model, const std::vector<double>& sizes, 
       }
       errors.push_back(
           geometric_error(m, [&](std::size_t q, const Vec3& p) { return exact(m, q, p); }));
+      if (n > 1) {
+        // The library's own measure: four other points per curved quad, as large within a factor.
+        const double d = max_element_distance_to_cad(m, model, tasks);
+        EXPECT_GT(d, 0.0);
+        EXPECT_LE(d, 2 * errors.back());
+        EXPECT_GE(d, 0.05 * errors.back());
+      }
     }
     // Between the two finer meshes: the coarsest (a dozen edges around a circle) is not yet
     // asymptotic, and the worst element of an unstructured mesh changes shape from size to size.

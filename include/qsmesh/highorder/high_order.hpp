@@ -58,6 +58,16 @@ struct HighOrderReport {
 HighOrderReport make_high_order(mesh::SurfaceMesh& mesh, const cad::CadModel& model, int order,
                                 const TaskArena& tasks);
 
+/// The geometric error of a mesh of order > 1 made by make_high_order: the largest distance, in
+/// model units, between the Lagrange map of a curved quad (no node put back straight) at the
+/// centres of its four corner cells of the node grid ((1 / 2N, 1 / 2N) and its mirror images) and
+/// their projections on the quad's CAD face (from the (u, v) of the interior node next to each).
+/// Quads with a node off the CAD are skipped (their straight form misses the CAD by about the
+/// sagitta, as the linear mesh does). Deterministic; threads by face.
+[[nodiscard]] double max_element_distance_to_cad(const mesh::SurfaceMesh& mesh,
+                                                 const cad::CadModel& model,
+                                                 const TaskArena& tasks);
+
 /// Whether the Lagrange quad of `order` with nodes `nodes` ((order + 1)^2 points in qsmesh's order,
 /// mesh::quad_grid_positions) has a positive Jacobian along `normal` at each point of the
 /// (2 order + 1) x (2 order + 1) grid of its reference square (its nodes and the points halfway
