@@ -283,7 +283,7 @@ cgsize_t write_face_sections(int fn, int base, int zone, const mesh::SurfaceMesh
                              const std::function<cgsize_t(GO)>& id, cgsize_t next, bool families,
                              const std::string& path) {
   const std::vector<int> perm =
-      mesh::quad_permutation(mesh.order, mesh::quad_grid_positions_recursive(mesh.order));
+      mesh::quad_permutation(mesh.order, mesh::quad_grid_positions_cgns(mesh.order));
   std::vector<cgsize_t> conn, offsets;
   for (LO f : faces) {
     const auto& tris = groups.face2tris[static_cast<std::size_t>(f)];

@@ -261,9 +261,9 @@ void write_hdf5(const mesh::SurfaceMesh& mesh, const std::string& path,
     h5.dataset("bar_cad_curve", H5T_STD_I32LE, nb, 0, mesh.bar_curve.data());
     h5.dataset("curve_corners", H5T_STD_I32LE, nc, 2, mesh.curve_corners.data());
     if (order > 1) {
-      // Whole high-order connectivities, corners first in CGNS's order (quad9 / bar3 for order
-      // 2, quad16 / bar4 for order 3, ...), so that a reader (and XDMF) needs one dataset per
-      // element kind.
+      // Whole high-order connectivities, corners first in Gmsh's order (quad9 / bar3 for order
+      // 2, quad16 / bar4 for order 3, ...; defined for every order, where CGNS stops at 4), so
+      // that a reader (and XDMF) needs one dataset per element kind.
       const std::vector<int> perm =
           mesh::quad_permutation(order, mesh::quad_grid_positions_recursive(order));
       std::vector<GO> quad_conn, bar_conn;

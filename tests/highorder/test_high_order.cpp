@@ -83,8 +83,9 @@ TEST(LagrangeQuad, ReproducesPolynomialsOfItsOrder) {
 // corners and the first edge, and differ where their conventions do.
 TEST(NodeLayouts, ArePermutationsOfTheGrid) {
   for (int n = 1; n <= kMaxOrder; ++n) {
-    for (const auto& layout : {mesh::quad_grid_positions(n), mesh::quad_grid_positions_recursive(n),
-                               mesh::quad_grid_positions_vtk(n)}) {
+    for (const auto& layout :
+         {mesh::quad_grid_positions(n), mesh::quad_grid_positions_recursive(n),
+          mesh::quad_grid_positions_cgns(n), mesh::quad_grid_positions_vtk(n)}) {
       ASSERT_EQ(static_cast<int>(layout.size()), (n + 1) * (n + 1));
       const std::set<std::array<int, 2>> unique(layout.begin(), layout.end());
       EXPECT_EQ(unique.size(), layout.size());
@@ -104,6 +105,13 @@ TEST(NodeLayouts, ArePermutationsOfTheGrid) {
   EXPECT_EQ(q25[18], (std::array<int, 2>{3, 3}));
   EXPECT_EQ(q25[20], (std::array<int, 2>{2, 1}));
   EXPECT_EQ(q25[24], (std::array<int, 2>{2, 2}));
+  // CGNS QUAD_25: the interior as a ring from (1, 1), counter-clockwise, then the centre.
+  const auto c25 = mesh::quad_grid_positions_cgns(4);
+  EXPECT_EQ(c25[17], (std::array<int, 2>{2, 1}));
+  EXPECT_EQ(c25[19], (std::array<int, 2>{3, 2}));
+  EXPECT_EQ(c25[23], (std::array<int, 2>{1, 2}));
+  EXPECT_EQ(c25[24], (std::array<int, 2>{2, 2}));
+  EXPECT_EQ(mesh::quad_grid_positions_cgns(3), mesh::quad_grid_positions_recursive(3));
   // VTK: edge 2-3 as (1, N) .. (N-1, N), i increasing.
   const auto v4 = mesh::quad_grid_positions_vtk(4);
   EXPECT_EQ(v4[10], (std::array<int, 2>{1, 4}));

@@ -69,6 +69,11 @@ mesh::SurfaceMesh lattice_mesh(int n) {
 // CGNS QUAD_16 and Gmsh's 16-node quad: corners, edges in their direction, interior
 // counter-clockwise from the node next to corner 0.
 const std::vector<GO> kCgnsQuad16{0, 3, 24, 21, 1, 2, 10, 17, 23, 22, 14, 7, 8, 9, 16, 15};
+// The first quad of lattice_mesh(4) (lattice width 9): corners, edges, then the interior, which
+// Gmsh numbers as a 9-node quad and CGNS QUAD_25 as a ring from (1,1), then the centre.
+const std::vector<GO> kQuad25Outer{0, 4, 40, 36, 1, 2, 3, 13, 22, 31, 39, 38, 37, 27, 18, 9};
+const std::vector<GO> kGmshQuad25Inner{10, 12, 30, 28, 11, 21, 29, 19, 20};
+const std::vector<GO> kCgnsQuad25Inner{10, 11, 12, 21, 30, 29, 28, 19, 20};
 // VTK's Lagrange quadrilateral: edges 2-3 and 3-0 with i and j increasing, interior row by row.
 const std::vector<GO> kVtkQuad16{0, 3, 24, 21, 1, 2, 10, 17, 22, 23, 7, 14, 8, 9, 15, 16};
 
@@ -102,6 +107,12 @@ TEST(HighOrderOutput, MshTypesAndGmshNodeOrder) {
           if (n == 3 && e == 0)
             for (std::size_t k = 0; k < kCgnsQuad16.size(); ++k)
               EXPECT_EQ(ids[k + 1], kCgnsQuad16[k] + 1) << k;
+          if (n == 4 && e == 0) {
+            std::vector<GO> expected = kQuad25Outer;
+            expected.insert(expected.end(), kGmshQuad25Inner.begin(), kGmshQuad25Inner.end());
+            for (std::size_t k = 0; k < expected.size(); ++k)
+              EXPECT_EQ(ids[k + 1], expected[k] + 1) << k;
+          }
           quads = true;
         } else if (dim == 1) {
           EXPECT_EQ(type, line_type[n]);
@@ -207,6 +218,11 @@ TEST(HighOrderOutput, CgnsSectionsUpToOrderFour) {
       if (face && n == 3)
         for (std::size_t k = 0; k < kCgnsQuad16.size(); ++k)
           EXPECT_EQ(conn[k], kCgnsQuad16[k] + 1) << k;
+      if (face && n == 4) {
+        std::vector<GO> expected = kQuad25Outer;
+        expected.insert(expected.end(), kCgnsQuad25Inner.begin(), kCgnsQuad25Inner.end());
+        for (std::size_t k = 0; k < expected.size(); ++k) EXPECT_EQ(conn[k], expected[k] + 1) << k;
+      }
     }
     CG(cg_close(fn));
 #ifdef QSMESH_CGNSCHECK

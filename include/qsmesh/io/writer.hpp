@@ -153,9 +153,10 @@ void write_vtu(const mesh::SurfaceMesh& mesh, const std::string& path, const Wri
 ///                       face_curves[face_curve_offsets[f] .. face_curve_offsets[f + 1])
 ///   quad<M>, bar<N+1>   int64 [n_quads, M = (N + 1)^2], [n_bars, N + 1]: only for meshes of
 ///                       order N > 1 (quad9 / bar3, quad16 / bar4, quad25 / bar5, quad36 / bar6):
-///                       the whole elements in the node order of CGNS QUAD_9 / QUAD_16 /
-///                       QUAD_25 (corners, edge nodes edge by edge, then the interior ring by
-///                       ring; Gmsh's order too) and BAR_n (ends, then the interior). For order 2
+///                       the whole elements in Gmsh's node order (corners, edge nodes edge by
+///                       edge, then the interior numbered the same way again,
+///                       mesh::quad_grid_positions_recursive; CGNS's too up to order 3, not for
+///                       QUAD_25) and the bars' (ends, then the interior). For order 2
 ///                       the XDMF file shows these (Quadrilateral_9, Edge_3) instead of the
 ///                       linear quads and bars; XDMF has no higher-order quads, so for order 3
 ///                       and up it shows the linear quads and bars of the corners. A node put

@@ -27,9 +27,9 @@ namespace qsmesh::mesh {
   return ij;
 }
 
-/// The same positions in the order of CGNS QUAD_9 / QUAD_16 / QUAD_25 and of Gmsh's quads of
-/// order N (MSH types 10, 36, 37, 38): corners and edge nodes as qsmesh's, then the interior nodes
-/// numbered the same way again, ring by ring (the interior of a QUAD_25 is a QUAD_9).
+/// The same positions in the order of Gmsh's quads of order N (MSH types 10, 36, 37, 38): corners
+/// and edge nodes as qsmesh's, then the interior nodes numbered the same way again, ring by ring
+/// (the interior of a 25-node quad is a 9-node quad: its corners, its edge nodes, its centre).
 [[nodiscard]] inline std::vector<std::array<int, 2>> quad_grid_positions_recursive(int order) {
   QSMESH_CHECK(order >= 1, "quad nodes: order " << order << " is not positive");
   std::vector<std::array<int, 2>> ij;
@@ -43,6 +43,26 @@ namespace qsmesh::mesh {
     for (int k = lo + 1; k < hi; ++k) ij.push_back({hi, k});
     for (int k = lo + 1; k < hi; ++k) ij.push_back({lo + hi - k, hi});
     for (int k = lo + 1; k < hi; ++k) ij.push_back({lo, lo + hi - k});
+  }
+  return ij;
+}
+
+/// The same positions in the order of CGNS QUAD_9 / QUAD_16 / QUAD_25: corners and edge nodes as
+/// qsmesh's, then the interior nodes ring by ring, each ring walked counter-clockwise from its
+/// corner next to corner 0 (QUAD_25: (1,1), (2,1), (3,1), (3,2), (3,3), (2,3), (1,3), (1,2), then
+/// the centre; for QUAD_16 and QUAD_9 the same as Gmsh's).
+[[nodiscard]] inline std::vector<std::array<int, 2>> quad_grid_positions_cgns(int order) {
+  std::vector<std::array<int, 2>> ij = quad_grid_positions(order);
+  ij.resize(static_cast<std::size_t>(4 * order));
+  for (int lo = 1, hi = order - 1; lo <= hi; ++lo, --hi) {
+    if (lo == hi) {
+      ij.push_back({lo, lo});
+      break;
+    }
+    for (int k = lo; k < hi; ++k) ij.push_back({k, lo});
+    for (int k = lo; k < hi; ++k) ij.push_back({hi, k});
+    for (int k = hi; k > lo; --k) ij.push_back({k, hi});
+    for (int k = hi; k > lo; --k) ij.push_back({lo, k});
   }
   return ij;
 }
