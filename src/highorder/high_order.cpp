@@ -240,6 +240,22 @@ HighOrderReport make_high_order(mesh::SurfaceMesh& m, const cad::CadModel& model
   for (GO q = 0; q < nq; ++q)
     face_quads[static_cast<std::size_t>(m.quad_face[static_cast<std::size_t>(q)])].push_back(q);
 
+  // Whether the nodes of an edge from pa to pb (all placed on the CAD) are unevenly apart: the
+  // longest of the per_edge + 1 steps over 1.25 times the shortest.
+  auto uneven = [&](const Vec3& pa, const Vec3& pb, const Vec3* nodes, const char* on_cad) {
+    double shortest = std::numeric_limits<double>::max(), longest = 0;
+    Vec3 prev = pa;
+    for (GO s = 0; s <= per_edge; ++s) {
+      if (s < per_edge && on_cad[s] == 0) return false;
+      const Vec3& p = s < per_edge ? nodes[s] : pb;
+      shortest = std::min(shortest, distance(prev, p));
+      longest = std::max(longest, distance(prev, p));
+      prev = p;
+    }
+    return longest > 1.25 * shortest;
+  };
+  constexpr std::size_t kSamples = 8;  // samples per node step to measure arc lengths
+
   // Curve nodes: at equispaced parameters between the bar's ends. A parameter point further from
   // the chord than the chord is long (a closed curve's wrong end, a wild parametrization) gives
   // way to the projection of the chord's point, and that to the chord's point itself.
@@ -280,6 +296,31 @@ HighOrderReport make_high_order(mesh::SurfaceMesh& m, const cad::CadModel& model
           projected[node] = 0;
         }
       }
+      // Where the parametrization runs at an uneven speed along the bar, equal parameter steps
+      // are uneven 3D steps, and a Lagrange edge through unevenly spread nodes swings (its end
+      // tangent can turn back and fold the quad): the nodes go to equal arc lengths instead.
+      const std::size_t first = static_cast<std::size_t>(e * per_edge);
+      if (!uneven(pa, pb, &points[first], &projected[first])) continue;
+      std::vector<double> ts(kSamples * static_cast<std::size_t>(n) + 1), len(ts.size(), 0.0);
+      Vec3 prev = pa;
+      for (std::size_t k = 0; k < ts.size(); ++k) {
+        ts[k] = ta + (tb - ta) * static_cast<double>(k) / static_cast<double>(ts.size() - 1);
+        const Vec3 p = k + 1 < ts.size() ? geom->point(ts[k]) : pb;
+        if (k > 0) len[k] = len[k - 1] + distance(prev, p);
+        prev = p;
+      }
+      for (GO s = 0; s < per_edge; ++s) {
+        const double want = fraction(s) * len.back();
+        const auto k = static_cast<std::size_t>(std::upper_bound(len.begin(), len.end(), want) -
+                                                len.begin() - 1);
+        const std::size_t k1 = std::min(k + 1, len.size() - 1);
+        const double w = len[k1] > len[k] ? (want - len[k]) / (len[k1] - len[k]) : 0.0;
+        const double t = ts[k] + w * (ts[k1] - ts[k]);
+        const Vec3 p = geom->point(t);
+        if (distance(p, pa + fraction(s) * (pb - pa)) > chord) continue;
+        points[first + static_cast<std::size_t>(s)] = p;
+        vclass[first + static_cast<std::size_t>(s)] = {1, c, kNoIndex, {t, 0}};
+      }
     }
   });
 
@@ -311,9 +352,8 @@ HighOrderReport make_high_order(mesh::SurfaceMesh& m, const cad::CadModel& model
       // its place along the surface, which costs the element its order. When the residual is
       // not along the normal, the projection starts again from `more` guesses (the element's
       // corners) and the nearest foot wins.
-      auto place = [&](std::size_t node, const Vec3& target, const Vec2& guess, double reach,
-                       std::span<const Vec2> more) {
-        Vec3 foot{};
+      auto nearest_foot = [&](const Vec3& target, const Vec2& guess, double reach,
+                              std::span<const Vec2> more, Vec3& foot) {
         Vec2 uv = geom->project(target, guess, &foot);
         auto converged = [&](const Vec2& at, const Vec3& p) {
           const Vec3 r = target - p;
@@ -328,6 +368,12 @@ HighOrderReport make_high_order(mesh::SurfaceMesh& m, const cad::CadModel& model
             uv = w;
           }
         }
+        return uv;
+      };
+      auto place = [&](std::size_t node, const Vec3& target, const Vec2& guess, double reach,
+                       std::span<const Vec2> more) {
+        Vec3 foot{};
+        const Vec2 uv = nearest_foot(target, guess, reach, more, foot);
         if (distance(foot, target) <= reach) {
           points[node] = foot;
           vclass[node] = {2, f, kNoIndex, {uv.u, uv.v}};
@@ -345,10 +391,44 @@ HighOrderReport make_high_order(mesh::SurfaceMesh& m, const cad::CadModel& model
           const std::array<Vec2, 2> ends{ua, ub};
           const Vec3 pa = m.points[static_cast<std::size_t>(x.a)],
                      pb = m.points[static_cast<std::size_t>(x.b)];
+          const double chord = distance(pa, pb);
           for (GO s = 0; s < per_edge; ++s) {
             const double r = fraction(s);
             place(static_cast<std::size_t>(e * per_edge + s), pa + r * (pb - pa),
-                  ua + r * (ub - ua), distance(pa, pb), ends);
+                  ua + r * (ub - ua), chord, ends);
+          }
+          // On a surface curved strongly across the edge (a small radius spanned by a few
+          // elements) the chord's projected points bunch up, and a Lagrange edge through them
+          // swings and folds its quads: the nodes go to equal arc lengths along the projected
+          // chord instead.
+          const std::size_t first = static_cast<std::size_t>(e * per_edge);
+          if (!uneven(pa, pb, &points[first], &projected[first])) continue;
+          const std::size_t ns = kSamples * static_cast<std::size_t>(n) + 1;
+          std::vector<Vec3> sp(ns);
+          std::vector<Vec2> suv(ns);
+          std::vector<double> len(ns, 0.0);
+          bool on_surface = true;
+          for (std::size_t k = 0; k < ns && on_surface; ++k) {
+            const double r = static_cast<double>(k) / static_cast<double>(ns - 1);
+            if (k == 0 || k + 1 == ns) {
+              sp[k] = k == 0 ? pa : pb;
+              suv[k] = k == 0 ? ua : ub;
+            } else {
+              const Vec3 target = pa + r * (pb - pa);
+              suv[k] = nearest_foot(target, ua + r * (ub - ua), chord, ends, sp[k]);
+              on_surface = distance(sp[k], target) <= chord;
+            }
+            if (k > 0) len[k] = len[k - 1] + distance(sp[k - 1], sp[k]);
+          }
+          if (!on_surface) continue;
+          for (GO s = 0; s < per_edge; ++s) {
+            const double want = fraction(s) * len.back();
+            const auto k = static_cast<std::size_t>(std::upper_bound(len.begin(), len.end(), want) -
+                                                    len.begin() - 1);
+            const std::size_t k1 = std::min(k + 1, ns - 1);
+            const double w = len[k1] > len[k] ? (want - len[k]) / (len[k1] - len[k]) : 0.0;
+            place(first + static_cast<std::size_t>(s), sp[k] + w * (sp[k1] - sp[k]),
+                  suv[k] + w * (suv[k1] - suv[k]), chord, ends);
           }
         }
         return;
