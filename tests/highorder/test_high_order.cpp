@@ -296,6 +296,40 @@ TEST(MakeHighOrder, CylinderConvergesAtOrderPlusOne) {
   expect_rates(model, {1.2, 0.6, 0.3}, exact, "cylinder");
 }
 
+// A cylinder of radius 2 meshed at h = 2.5: edges across a quarter turn and more, where the
+// chord's points projected on the side (and so the nodes of a plain projection) bunch up. The
+// nodes of every edge are evenly apart along it, and no quad stays invalid.
+TEST(MakeHighOrder, EdgeNodesEvenlyApartOnACoarseCurvedMesh) {
+  const cad::CadModel model = cad::load_cad(test::write_cylinder(test::tmp("ho_cyl_coarse.brep")));
+  const TaskArena tasks(2);
+  const mesh::SurfaceMesh lin = quad_mesh(model, 2.5);
+  for (int n = 3; n <= kMaxOrder; ++n) {
+    mesh::SurfaceMesh m = lin;
+    const HighOrderReport r = make_high_order(m, model, n, tasks);
+    EXPECT_EQ(r.invalid, 0);
+    const auto per = static_cast<std::size_t>(m.quad_nodes_per_quad());
+    double worst = 1;
+    for (std::size_t q = 0; q < m.quads.size(); ++q) {
+      if (straightened(m, q)) continue;
+      for (std::size_t k = 0; k < 4; ++k) {
+        std::vector<Vec3> x{m.points[static_cast<std::size_t>(m.quads[q][k])]};
+        for (int s = 0; s < n - 1; ++s)
+          x.push_back(m.points[static_cast<std::size_t>(
+              m.quad_nodes[q * per + k * static_cast<std::size_t>(n - 1) +
+                           static_cast<std::size_t>(s)])]);
+        x.push_back(m.points[static_cast<std::size_t>(m.quads[q][(k + 1) % 4])]);
+        double lo = 1e300, hi = 0;
+        for (std::size_t i = 1; i < x.size(); ++i) {
+          lo = std::min(lo, distance(x[i - 1], x[i]));
+          hi = std::max(hi, distance(x[i - 1], x[i]));
+        }
+        worst = std::max(worst, hi / lo);
+      }
+    }
+    EXPECT_LE(worst, 1.25 * 1.02) << "order " << n;
+  }
+}
+
 TEST(MakeHighOrder, RefusesTrianglesAndOrdersOutOfRange) {
   const cad::CadModel model = cad::load_cad(test::write_cylinder(test::tmp("ho_cyl_refuse.brep")));
   const TaskArena tasks(1);
