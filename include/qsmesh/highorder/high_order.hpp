@@ -49,6 +49,11 @@ struct HighOrderReport {
 ///    seams do not mislead the guess);
 ///  - inside a quad, (N - 1)^2 nodes: the transfinite (Coons) interpolation of its four curved
 ///    sides, projected on the face.
+/// An edge whose nodes come out unevenly apart (longest step over 1.25 times the shortest: a
+/// surface curved strongly across the edge, a curve's uneven parameter speed) gets them at equal
+/// arc lengths along the same curve instead (through which a Lagrange edge does not swing). Face
+/// projections that stall next to a singular point of the parametrization (a pole) are started
+/// again from the element's corners.
 /// Each is classified on its entity (dim 1 with the curve parameter, dim 2 with (u, v); index
 /// kNoIndex; parameters NaN for the nodes left off the CAD, see unprojected). Quads whose curved
 /// form is not valid get their face nodes back on the straight (bilinear) positions, and then
