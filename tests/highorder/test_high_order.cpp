@@ -330,6 +330,20 @@ TEST(MakeHighOrder, EdgeNodesEvenlyApartOnACoarseCurvedMesh) {
   }
 }
 
+TEST(MakeHighOrder, SameResultWhateverTheThreads) {
+  const cad::CadModel model =
+      cad::load_cad(test::write_sphere(test::tmp("ho_sphere_threads.brep")));
+  const mesh::SurfaceMesh lin = quad_mesh(model, 0.8);
+  mesh::SurfaceMesh one = lin, three = lin;
+  const HighOrderReport a = make_high_order(one, model, 4, TaskArena(1));
+  const HighOrderReport b = make_high_order(three, model, 4, TaskArena(3));
+  EXPECT_EQ(a.straightened, b.straightened);
+  EXPECT_EQ(a.unprojected, b.unprojected);
+  EXPECT_EQ(one.quad_nodes, three.quad_nodes);
+  EXPECT_EQ(one.bar_nodes, three.bar_nodes);
+  EXPECT_EQ(one.points, three.points);
+}
+
 TEST(MakeHighOrder, RefusesTrianglesAndOrdersOutOfRange) {
   const cad::CadModel model = cad::load_cad(test::write_cylinder(test::tmp("ho_cyl_refuse.brep")));
   const TaskArena tasks(1);
