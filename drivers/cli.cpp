@@ -204,10 +204,11 @@ Arguments parse(const std::vector<std::string>& args) {
       a.cross_field = value();
     else if (opt == "--order" && a.command == Command::Mesh) {
       const std::string& v = value();
-      if (v != "1" && v != "2") throw InputError("--order: '" + v + "' is not 1 or 2");
-      a.order = v == "2" ? 2 : 1;
-    } else if (opt == "--check" && a.command == Command::CrossField)
-      a.check = true;
+      if (v.size() != 1 || v[0] < '1' || v[0] > '5')
+        throw InputError("--order: '" + v + "' is not 1, 2, 3, 4 or 5");
+      a.order = v[0] - '0';
+    }
+    else if (opt == "--check" && a.command == Command::CrossField) a.check = true;
     else if (opt == "--curvature-edges" && sizing) {
       const std::string& v = value();
       const auto n = parse_double(v);
@@ -351,9 +352,9 @@ Arguments parse(const std::vector<std::string>& args) {
       if (a.until == "background")
         throw InputError("-o " + a.output +
                          ": PLOT3D holds the blocks of a quad mesh; not with --until background");
-      if (a.order == 2)
-        throw InputError("-o " + a.output +
-                         " with --order 2: PLOT3D blocks of second-order quads are not written");
+      if (a.order > 1)
+        throw InputError("-o " + a.output + " with --order " + std::to_string(a.order) +
+                         ": PLOT3D blocks of high-order quads are not written");
       a.block_structured = true;
     }
     if (a.block_structured) {
@@ -363,12 +364,17 @@ Arguments parse(const std::vector<std::string>& args) {
             "FILE.xyz");
       if (a.until == "background")
         throw InputError("--block-structured needs a quad mesh: not with --until background");
-      if (a.order == 2)
-        throw InputError(
-            "--block-structured with --order 2: blocks of second-order quads are not written yet");
+      if (a.order > 1)
+        throw InputError("--block-structured with --order " + std::to_string(a.order) +
+                         ": blocks of high-order quads are not written yet");
     }
-    if (a.order == 2 && a.until == "background")
-      throw InputError("--order 2 needs a quad mesh: not with --until background");
+    if (a.order > 1 && a.until == "background")
+      throw InputError("--order " + std::to_string(a.order) +
+                       " needs a quad mesh: not with --until background");
+    if (a.order > 4 && io::output_format(a.output) == io::Format::kCgns)
+      throw InputError("--order " + std::to_string(a.order) +
+                       ": CGNS has no elements of order 5 (QUAD_25, order 4, is the highest); "
+                       "write .vtu, .msh or .h5");
     if (a.method != "default" && a.until == "background")
       throw InputError("--method " + a.method + " needs a quad mesh: not with --until background");
     if (!a.cross_field.empty() && a.until == "background")
@@ -448,9 +454,12 @@ std::string help(const std::string& topic) {
           "                        (paper 003's partition into four-sided regions on the mesher's\n"
           "                        own cross field, filled by transfinite interpolation; a face\n"
           "                        where it fails keeps the default mesh, \"field_refusal\")\n"
-          "  --order 2             second-order elements: 9-node quads and 3-node bars, the new\n"
-          "                        nodes on the CAD (CGNS QUAD_9/BAR_3, VTU, MSH; in .h5 the\n"
-          "                        datasets quad9 and bar3)\n"
+          "  --order N             high-order elements, N = 2..5: Lagrange quads of (N+1)^2 nodes\n"
+          "                        and bars of N+1 nodes, the new nodes on the CAD, quads that\n"
+          "                        would fold straightened (CGNS QUAD_9/16/25 and BAR_3/4/5, so\n"
+          "                        N <= 4 there; VTU Lagrange cells; MSH; in .h5 the datasets\n"
+          "                        quadM and barN+1, and the .xdmf shows order 2 curved, higher\n"
+          "                        orders as the linear quads of their corners)\n"
           "  --block-structured    write the .cgns file as structured zones, one per block of the\n"
           "                        quad layout (traces from irregular vertices and CAD corners,\n"
           "                        paper 002 Sec. III.A), joined by 1-to-1 connectivity; faces\n"

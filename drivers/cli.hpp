@@ -43,8 +43,8 @@ struct Arguments {
   /// mesher's own cross field for the other faces.
   std::string cross_field;
   bool separatrix_method = false;
-  /// --order 2: second-order quads (9 nodes) and bars (3 nodes) on the CAD
-  /// (highorder::make_quadratic); 1: linear.
+  /// --order N, 2..5: Lagrange quads ((N + 1)^2 nodes) and bars (N + 1 nodes) on the CAD
+  /// (highorder::make_high_order); 1: linear.
   int order = 1;
   bool json = false;                   ///< info --json
   /// info --partition P,...: the METIS partition of the faces that `mpirun -np P qsmesh mesh`

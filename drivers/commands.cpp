@@ -21,7 +21,7 @@
 #include "qsmesh/core/log.hpp"
 #include "qsmesh/core/tasks.hpp"
 #include "qsmesh/core/timer.hpp"
-#include "qsmesh/highorder/quadratic.hpp"
+#include "qsmesh/highorder/high_order.hpp"
 #include "qsmesh/holomorphic/holomorphic.hpp"
 #include "qsmesh/io/atomic_file.hpp"
 #include "qsmesh/io/writer.hpp"
@@ -272,7 +272,9 @@ struct Checks {
     }
   };
   std::optional<Blocks> blocks;
-  std::optional<highorder::QuadraticReport> quadratic;  ///< with --order 2
+  std::optional<highorder::HighOrderReport> high_order;  ///< with --order 2..5
+  /// With --order 2..5: highorder::max_element_distance_to_cad / the model's diagonal.
+  double high_order_distance = 0;
 };
 
 /// How one face ended at the last stage run.
@@ -415,14 +417,15 @@ std::string stats_json(const Arguments& args, const Session& session,
     j.end_array();
     j.value("load_imbalance", load_imbalance(r.rank_busy_seconds));
   }
-  if (checks.quadratic) {
-    j.value("order", 2);
-    j.value("high_order_curve_nodes", checks.quadratic->curve_nodes);
-    j.value("high_order_face_nodes", checks.quadratic->face_nodes);
-    j.value("high_order_unprojected_nodes", checks.quadratic->unprojected);
-    j.value("high_order_straightened_quads", checks.quadratic->straightened);
-    j.value("high_order_curve_straightened_quads", checks.quadratic->curve_straightened);
-    j.value("high_order_invalid_quads", checks.quadratic->invalid);
+  if (checks.high_order) {
+    j.value("order", checks.high_order->order);
+    j.value("high_order_curve_nodes", checks.high_order->curve_nodes);
+    j.value("high_order_face_nodes", checks.high_order->face_nodes);
+    j.value("high_order_unprojected_nodes", checks.high_order->unprojected);
+    j.value("high_order_straightened_quads", checks.high_order->straightened);
+    j.value("high_order_curve_straightened_quads", checks.high_order->curve_straightened);
+    j.value("high_order_invalid_quads", checks.high_order->invalid);
+    j.value("high_order_max_element_distance_to_cad", checks.high_order_distance);
   }
   if (checks.blocks) {
     j.value("blocks", checks.blocks->blocks);
@@ -563,14 +566,16 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
     os << "  ranks' time in the per-face stages (s): min " << *lo << ", max " << *hi
        << "; load imbalance (max / mean) " << load_imbalance(r.rank_busy_seconds) << "\n";
   }
-  if (checks.quadratic) {
-    const highorder::QuadraticReport& q = *checks.quadratic;
-    os << "  second-order nodes: " << q.curve_nodes << " on curves, " << q.face_nodes
-       << " in faces (" << q.unprojected
+  if (checks.high_order) {
+    const highorder::HighOrderReport& q = *checks.high_order;
+    os << "  high-order nodes (order " << q.order << "): " << q.curve_nodes << " on curves, "
+       << q.face_nodes << " in faces (" << q.unprojected
        << " off the CAD: no CAD point near, or put back straight); quads whose face nodes went "
           "back "
        << "straight to stay valid " << q.straightened << ", made entirely straight "
-       << q.curve_straightened << ", still invalid " << q.invalid << "\n";
+       << q.curve_straightened << ", still invalid " << q.invalid
+       << "; curved elements' largest distance to the CAD / diagonal " << checks.high_order_distance
+       << "\n";
   }
   if (checks.blocks) {
     const Checks::Blocks& b = *checks.blocks;
@@ -843,9 +848,14 @@ int run_mesh(const Arguments& args) {
         mesh::max_distance_to_cad(result.mesh, s.model) / s.model.diagonal();
     s.times.add("statistics", clock.seconds());
     clock.reset();
-    if (args.order == 2) {
-      checks.quadratic = highorder::make_quadratic(result.mesh, s.model, *s.tasks);
+    if (args.order > 1) {
+      checks.high_order = highorder::make_high_order(result.mesh, s.model, args.order, *s.tasks);
       s.times.add("high_order", clock.seconds());
+      clock.reset();
+      checks.high_order_distance =
+          highorder::max_element_distance_to_cad(result.mesh, s.model, *s.tasks) /
+          s.model.diagonal();
+      s.times.add("high_order_check", clock.seconds());
       clock.reset();
     }
     if (args.block_structured) {

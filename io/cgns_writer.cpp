@@ -28,6 +28,7 @@
 #include "qsmesh/io/writer.hpp"
 #include "qsmesh/layout/quad_layout.hpp"
 #include "qsmesh/mesh/edges.hpp"
+#include "qsmesh/mesh/high_order_nodes.hpp"
 
 namespace qsmesh::io {
 
@@ -241,15 +242,49 @@ void write_coordinates(int fn, int base, int zone, std::size_t n,
   }
 }
 
-// One section "Face_<f>" per face of `faces` with elements (TRI_3, QUAD_4 or QUAD_9, MIXED when
-// both), element ids from `next` on, vertex v written as id(v); also the face's family when
-// `families`. Returns the next free element id. cgnslib 3.4 refuses FamilyName_t under
-// Elements_t, so a section is tied to its family by the shared name only.
+// The CGNS element types of quads and bars of `order`; CGNS 3.4 defines them up to order 4.
+CGNS_ENUMT(ElementType_t) quad_type(int order, const std::string& path) {
+  switch (order) {
+    case 1:
+      return CGNS_ENUMV(QUAD_4);
+    case 2:
+      return CGNS_ENUMV(QUAD_9);
+    case 3:
+      return CGNS_ENUMV(QUAD_16);
+    case 4:
+      return CGNS_ENUMV(QUAD_25);
+    default:
+      throw InputError("CGNS output " + path + ": CGNS has no quads of order " +
+                       std::to_string(order) + " (QUAD_25, order 4, is the highest)");
+  }
+}
+CGNS_ENUMT(ElementType_t) bar_type(int order, const std::string& path) {
+  switch (order) {
+    case 1:
+      return CGNS_ENUMV(BAR_2);
+    case 2:
+      return CGNS_ENUMV(BAR_3);
+    case 3:
+      return CGNS_ENUMV(BAR_4);
+    case 4:
+      return CGNS_ENUMV(BAR_5);
+    default:
+      throw InputError("CGNS output " + path + ": CGNS has no bars of order " +
+                       std::to_string(order) + " (BAR_5, order 4, is the highest)");
+  }
+}
+
+// One section "Face_<f>" per face of `faces` with elements (TRI_3, QUAD_4 / QUAD_9 / QUAD_16 /
+// QUAD_25 by the mesh order, MIXED when both), element ids from `next` on, vertex v written as
+// id(v); also the face's family when `families`. Returns the next free element id. cgnslib 3.4
+// refuses FamilyName_t under Elements_t, so a section is tied to its family by the shared name
+// only.
 cgsize_t write_face_sections(int fn, int base, int zone, const mesh::SurfaceMesh& mesh,
                              const detail::ElementGroups& groups, const std::vector<LO>& faces,
                              const std::function<cgsize_t(GO)>& id, cgsize_t next, bool families,
                              const std::string& path) {
-  const bool quadratic = !mesh.quad_nodes.empty();
+  const std::vector<int> perm =
+      mesh::quad_permutation(mesh.order, mesh::quad_grid_positions_cgns(mesh.order));
   std::vector<cgsize_t> conn, offsets;
   for (LO f : faces) {
     const auto& tris = groups.face2tris[static_cast<std::size_t>(f)];
@@ -268,9 +303,8 @@ cgsize_t write_face_sections(int fn, int base, int zone, const mesh::SurfaceMesh
     }
     for (GO q : quads) {
       if (mixed) conn.push_back(CGNS_ENUMV(QUAD_4));
-      for (GO v : mesh.quads[static_cast<std::size_t>(q)]) conn.push_back(id(v));
-      if (quadratic)
-        for (GO v : mesh.quad_nodes[static_cast<std::size_t>(q)]) conn.push_back(id(v));
+      for (int k : perm)
+        conn.push_back(id(detail::quad_node(mesh, static_cast<std::size_t>(q), k)));
       offsets.push_back(static_cast<cgsize_t>(conn.size()));
     }
     int section = 0;
@@ -278,10 +312,9 @@ cgsize_t write_face_sections(int fn, int base, int zone, const mesh::SurfaceMesh
       QSMESH_CG(cg_poly_section_write(fn, base, zone, name.c_str(), CGNS_ENUMV(MIXED), next,
                                       next + n - 1, 0, conn.data(), offsets.data(), &section));
     } else {
-      QSMESH_CG(cg_section_write(
-          fn, base, zone, name.c_str(),
-          tris.empty() ? (quadratic ? CGNS_ENUMV(QUAD_9) : CGNS_ENUMV(QUAD_4)) : CGNS_ENUMV(TRI_3),
-          next, next + n - 1, 0, conn.data(), &section));
+      QSMESH_CG(cg_section_write(fn, base, zone, name.c_str(),
+                                 tris.empty() ? quad_type(mesh.order, path) : CGNS_ENUMV(TRI_3),
+                                 next, next + n - 1, 0, conn.data(), &section));
     }
     if (families) {
       int family = 0;
@@ -304,9 +337,9 @@ void write_cgns(const mesh::SurfaceMesh& mesh, const std::string& path,
   (void)to_cg(nv, path);
   (void)to_cg(ncells + static_cast<GO>(mesh.bars.size()), path);
   const detail::ElementGroups groups = detail::group_elements(mesh);
-  const bool quadratic = !mesh.quad_nodes.empty();
-  QSMESH_CHECK(!quadratic || mesh.triangles.empty(),
-               "CGNS output " << path << ": second-order quads with triangles");
+  QSMESH_CHECK(mesh.order == 1 || mesh.triangles.empty(),
+               "CGNS output " << path << ": high-order quads with triangles");
+  (void)quad_type(mesh.order, path);
 
   AtomicFile out(path);
   CgFile file;
@@ -342,13 +375,12 @@ void write_cgns(const mesh::SurfaceMesh& mesh, const std::string& path,
     const auto n = static_cast<cgsize_t>(bars.size());
     conn.clear();
     for (GO b : bars) {
-      for (GO v : mesh.bars[static_cast<std::size_t>(b)]) conn.push_back(static_cast<cgsize_t>(v + 1));
-      if (quadratic)
-        conn.push_back(static_cast<cgsize_t>(mesh.bar_nodes[static_cast<std::size_t>(b)] + 1));
+      for (int k = 0; k <= mesh.order; ++k)
+        conn.push_back(
+            static_cast<cgsize_t>(detail::bar_node(mesh, static_cast<std::size_t>(b), k) + 1));
     }
     int section = 0;
-    QSMESH_CG(cg_section_write(fn, base, zone, name.c_str(),
-                               quadratic ? CGNS_ENUMV(BAR_3) : CGNS_ENUMV(BAR_2), next,
+    QSMESH_CG(cg_section_write(fn, base, zone, name.c_str(), bar_type(mesh.order, path), next,
                                next + n - 1, 0, conn.data(), &section));
     int family = 0;
     QSMESH_CG(cg_family_write(fn, base, name.c_str(), &family));
@@ -456,8 +488,8 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
                 "point ranges and lists are written as I4 cgio nodes from cgsize_t arrays");
   detail::check_output_folder(path);
   check_mesh_for_output(mesh);
-  QSMESH_CHECK(mesh.quad_nodes.empty(),
-               "CGNS block output " << path << ": blocks of second-order quads are not written");
+  QSMESH_CHECK(mesh.order == 1,
+               "CGNS block output " << path << ": blocks of high-order quads are not written");
   const auto unit = length_unit(mesh.length_unit);
   const auto nb = static_cast<GO>(layout.blocks.size());
   check_layout_for_output(mesh, layout, "CGNS block output " + path);

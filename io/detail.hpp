@@ -27,4 +27,20 @@ void check_output_folder(const std::string& path, const std::string& what = "out
 /// Groups the elements of a mesh that passed check_mesh_for_output.
 ElementGroups group_elements(const mesh::SurfaceMesh& mesh);
 
+/// Node k of quad q in qsmesh's order (mesh::quad_grid_positions): corner k for k < 4, else
+/// quad_nodes entry k - 4 of the quad.
+[[nodiscard]] inline GO quad_node(const mesh::SurfaceMesh& mesh, std::size_t q, int k) {
+  return k < 4 ? mesh.quads[q][static_cast<std::size_t>(k)]
+               : mesh.quad_nodes[q * static_cast<std::size_t>(mesh.quad_nodes_per_quad()) +
+                                 static_cast<std::size_t>(k - 4)];
+}
+
+/// Node k of bar b: its ends for k < 2, then its interior nodes in its direction (the order of
+/// CGNS BAR_n, Gmsh's lines and VTK's Lagrange curves).
+[[nodiscard]] inline GO bar_node(const mesh::SurfaceMesh& mesh, std::size_t b, int k) {
+  return k < 2 ? mesh.bars[b][static_cast<std::size_t>(k)]
+               : mesh.bar_nodes[b * static_cast<std::size_t>(mesh.bar_nodes_per_bar()) +
+                                static_cast<std::size_t>(k - 2)];
+}
+
 }  // namespace qsmesh::io::detail

@@ -15,6 +15,7 @@
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/io/atomic_file.hpp"
 #include "qsmesh/io/writer.hpp"
+#include "qsmesh/mesh/high_order_nodes.hpp"
 
 namespace qsmesh::io {
 
@@ -223,12 +224,15 @@ void write_hdf5(const mesh::SurfaceMesh& mesh, const std::string& path,
   const std::string xdmf = xdmf_path_for(path);
   AtomicFile h5_out(path);
   AtomicFile xdmf_out(xdmf);
-  const bool quadratic = !mesh.quad_nodes.empty();
+  const int order = mesh.order;
+  const std::string quad_dataset = "quad" + std::to_string((order + 1) * (order + 1));
+  const std::string bar_dataset = "bar" + std::to_string(order + 1);
   {
     const QuietHdf5Errors quiet;
     H5Writer h5(h5_out.temp_path(), path);
     h5.attribute("format", std::string("qsmesh surface mesh"));
     h5.attribute("format_version", std::int64_t{2});
+    h5.attribute("order", std::int64_t{order});
     h5.attribute("length_unit", mesh.length_unit);
     h5.attribute("num_cad_corners", std::int64_t{mesh.num_cad_corners});
     h5.attribute("num_cad_curves", std::int64_t{mesh.num_cad_curves});
@@ -256,19 +260,22 @@ void write_hdf5(const mesh::SurfaceMesh& mesh, const std::string& path,
     h5.dataset("bars", H5T_STD_I64LE, nb, 2, mesh.bars.data());
     h5.dataset("bar_cad_curve", H5T_STD_I32LE, nb, 0, mesh.bar_curve.data());
     h5.dataset("curve_corners", H5T_STD_I32LE, nc, 2, mesh.curve_corners.data());
-    if (quadratic) {
-      // Whole second-order connectivities, corners first, so that a reader (and XDMF) needs one
-      // dataset per element kind.
-      std::vector<std::array<GO, 9>> quad9(static_cast<std::size_t>(nq));
-      for (std::size_t q = 0; q < quad9.size(); ++q) {
-        std::copy(mesh.quads[q].begin(), mesh.quads[q].end(), quad9[q].begin());
-        std::copy(mesh.quad_nodes[q].begin(), mesh.quad_nodes[q].end(), quad9[q].begin() + 4);
-      }
-      std::vector<std::array<GO, 3>> bar3(static_cast<std::size_t>(nb));
-      for (std::size_t b = 0; b < bar3.size(); ++b)
-        bar3[b] = {mesh.bars[b][0], mesh.bars[b][1], mesh.bar_nodes[b]};
-      h5.dataset("quad9", H5T_STD_I64LE, nq, 9, quad9.data());
-      h5.dataset("bar3", H5T_STD_I64LE, nb, 3, bar3.data());
+    if (order > 1) {
+      // Whole high-order connectivities, corners first in Gmsh's order (quad9 / bar3 for order
+      // 2, quad16 / bar4 for order 3, ...; defined for every order, where CGNS stops at 4), so
+      // that a reader (and XDMF) needs one dataset per element kind.
+      const std::vector<int> perm =
+          mesh::quad_permutation(order, mesh::quad_grid_positions_recursive(order));
+      std::vector<GO> quad_conn, bar_conn;
+      quad_conn.reserve(mesh.quads.size() * perm.size());
+      for (std::size_t q = 0; q < mesh.quads.size(); ++q)
+        for (int k : perm) quad_conn.push_back(detail::quad_node(mesh, q, k));
+      bar_conn.reserve(mesh.bars.size() * static_cast<std::size_t>(order + 1));
+      for (std::size_t b = 0; b < mesh.bars.size(); ++b)
+        for (int k = 0; k <= order; ++k) bar_conn.push_back(detail::bar_node(mesh, b, k));
+      h5.dataset(quad_dataset.c_str(), H5T_STD_I64LE, nq, static_cast<int>(perm.size()),
+                 quad_conn.data());
+      h5.dataset(bar_dataset.c_str(), H5T_STD_I64LE, nb, order + 1, bar_conn.data());
     }
     {
       std::vector<std::int64_t> offsets(mesh.face2curves.offsets.begin(),
@@ -313,7 +320,7 @@ void write_hdf5(const mesh::SurfaceMesh& mesh, const std::string& path,
       }
       x << "   </Grid>\n";
     };
-    if (quadratic) {
+    if (order == 2) {
       grid("quads", "Quadrilateral_9", 9, nq, "quad9", "cad_face", "quad_cad_face");
       grid("curves", "Edge_3", 3, nb, "bar3", "cad_curve", "bar_cad_curve");
     } else {

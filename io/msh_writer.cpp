@@ -9,6 +9,7 @@
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/io/atomic_file.hpp"
 #include "qsmesh/io/writer.hpp"
+#include "qsmesh/mesh/high_order_nodes.hpp"
 
 namespace qsmesh::io {
 
@@ -156,7 +157,13 @@ void write_msh(const mesh::SurfaceMesh& mesh, const std::string& path, const Wri
   out << "$Elements\n"
       << elem_blocks << ' ' << num_elems << ' ' << (num_elems > 0 ? 1 : 0) << ' ' << num_elems << '\n';
   GO tag = 1;
-  const bool quadratic = !mesh.quad_nodes.empty();
+  // Gmsh's element types of quads and lines of order 1..5, and its node order of quads (the
+  // recursive one of CGNS).
+  static constexpr std::array<int, 6> kQuadType{0, 3, 10, 36, 37, 38},
+      kLineType{0, 1, 8, 26, 27, 28};
+  const int order = mesh.order;
+  const std::vector<int> perm =
+      mesh::quad_permutation(order, mesh::quad_grid_positions_recursive(order));
   if (options.msh_corner_elements) {
     for (std::size_t k = 0; k < entity2nodes[0].size(); ++k) {
       const auto& nodes = entity2nodes[0][k];
@@ -167,11 +174,12 @@ void write_msh(const mesh::SurfaceMesh& mesh, const std::string& path, const Wri
   for (std::size_t c = 0; c < groups.curve2bars.size(); ++c) {
     const auto& bars = groups.curve2bars[c];
     if (bars.empty()) continue;
-    out << "1 " << c + 1 << (quadratic ? " 8 " : " 1 ") << bars.size() << '\n';
+    out << "1 " << c + 1 << ' ' << kLineType[static_cast<std::size_t>(order)] << ' ' << bars.size()
+        << '\n';
     for (GO e : bars) {
-      const auto& b = mesh.bars[static_cast<std::size_t>(e)];
-      out << tag++ << ' ' << b[0] + 1 << ' ' << b[1] + 1;
-      if (quadratic) out << ' ' << mesh.bar_nodes[static_cast<std::size_t>(e)] + 1;
+      out << tag++;
+      for (int k = 0; k <= order; ++k)
+        out << ' ' << detail::bar_node(mesh, static_cast<std::size_t>(e), k) + 1;
       out << '\n';
     }
   }
@@ -186,12 +194,12 @@ void write_msh(const mesh::SurfaceMesh& mesh, const std::string& path, const Wri
     }
     const auto& quads = groups.face2quads[static_cast<std::size_t>(f)];
     if (!quads.empty()) {
-      out << "2 " << f + 1 << (quadratic ? " 10 " : " 3 ") << quads.size() << '\n';
+      out << "2 " << f + 1 << ' ' << kQuadType[static_cast<std::size_t>(order)] << ' '
+          << quads.size() << '\n';
       for (GO e : quads) {
-        const auto& q = mesh.quads[static_cast<std::size_t>(e)];
-        out << tag++ << ' ' << q[0] + 1 << ' ' << q[1] + 1 << ' ' << q[2] + 1 << ' ' << q[3] + 1;
-        if (quadratic)
-          for (GO v : mesh.quad_nodes[static_cast<std::size_t>(e)]) out << ' ' << v + 1;
+        out << tag++;
+        for (int k : perm)
+          out << ' ' << detail::quad_node(mesh, static_cast<std::size_t>(e), k) + 1;
         out << '\n';
       }
     }

@@ -10,6 +10,7 @@
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/io/atomic_file.hpp"
 #include "qsmesh/io/writer.hpp"
+#include "qsmesh/mesh/high_order_nodes.hpp"
 
 namespace qsmesh::io {
 
@@ -182,18 +183,22 @@ void write_vtu(const mesh::SurfaceMesh& mesh, const std::string& path, const Wri
       offsets.push_back(static_cast<std::int64_t>(conn.size()));
       types.push_back(5);  // VTK_TRIANGLE
     }
-    const bool quadratic = !mesh.quad_nodes.empty();
+    // Order 2 as VTK's biquadratic quad and quadratic edge (28, 21), higher orders as Lagrange
+    // cells (70, 68), whose order VTK reads from the node count.
+    const int order = mesh.order;
+    const std::vector<int> perm = mesh::quad_permutation(
+        order, order == 2 ? mesh::quad_grid_positions(2) : mesh::quad_grid_positions_vtk(order));
+    const std::uint8_t quad_type = order == 1 ? 9 : (order == 2 ? 28 : 70);
+    const std::uint8_t bar_type = order == 1 ? 3 : (order == 2 ? 21 : 68);
     for (std::size_t e = 0; e < mesh.quads.size(); ++e) {
-      conn.insert(conn.end(), mesh.quads[e].begin(), mesh.quads[e].end());
-      if (quadratic) conn.insert(conn.end(), mesh.quad_nodes[e].begin(), mesh.quad_nodes[e].end());
+      for (int k : perm) conn.push_back(detail::quad_node(mesh, e, k));
       offsets.push_back(static_cast<std::int64_t>(conn.size()));
-      types.push_back(quadratic ? 28 : 9);  // VTK_BIQUADRATIC_QUAD, VTK_QUAD
+      types.push_back(quad_type);
     }
     for (std::size_t e = 0; e < nb; ++e) {
-      conn.insert(conn.end(), mesh.bars[e].begin(), mesh.bars[e].end());
-      if (quadratic) conn.push_back(mesh.bar_nodes[e]);
+      for (int k = 0; k <= order; ++k) conn.push_back(detail::bar_node(mesh, e, k));
       offsets.push_back(static_cast<std::int64_t>(conn.size()));
-      types.push_back(quadratic ? 21 : 3);  // VTK_QUADRATIC_EDGE, VTK_LINE
+      types.push_back(bar_type);
     }
     for (std::size_t m = 0; m < nm; ++m) {
       conn.push_back(static_cast<std::int64_t>(nmesh + m));

@@ -127,16 +127,24 @@ void check_mesh_for_output(const mesh::SurfaceMesh& m) {
       }
     }
   };
-  QSMESH_CHECK(m.quad_nodes.empty() || (m.quad_nodes.size() == m.quads.size() &&
-                                        m.bar_nodes.size() == m.bars.size() && m.triangles.empty()),
-               "output: second-order nodes for " << m.quad_nodes.size() << " of " << m.quads.size()
-                                                 << " quads and " << m.bar_nodes.size() << " of "
-                                                 << m.bars.size() << " bars, " << m.triangles.size()
-                                                 << " triangles");
-  check_vertices(m.quad_nodes, "quad");
-  for (std::size_t e = 0; e < m.bar_nodes.size(); ++e)
-    QSMESH_CHECK(m.bar_nodes[e] >= 0 && m.bar_nodes[e] < nv,
-                 "output: bar " << e << " has node " << m.bar_nodes[e] << " out of range");
+  QSMESH_CHECK(m.order >= 1 && m.order <= 5, "output: element order " << m.order);
+  const auto per_quad = static_cast<std::size_t>(m.quad_nodes_per_quad());
+  const auto per_bar = static_cast<std::size_t>(m.bar_nodes_per_bar());
+  QSMESH_CHECK((m.order == 1 && m.quad_nodes.empty() && m.bar_nodes.empty()) ||
+                   (m.order > 1 && m.quad_nodes.size() == m.quads.size() * per_quad &&
+                    m.bar_nodes.size() == m.bars.size() * per_bar && m.triangles.empty()),
+               "output: order " << m.order << " with " << m.quad_nodes.size()
+                                << " high-order nodes for " << m.quads.size() << " quads and "
+                                << m.bar_nodes.size() << " for " << m.bars.size() << " bars, "
+                                << m.triangles.size() << " triangles");
+  for (std::size_t k = 0; k < m.quad_nodes.size(); ++k)
+    QSMESH_CHECK(
+        m.quad_nodes[k] >= 0 && m.quad_nodes[k] < nv,
+        "output: quad " << k / per_quad << " has node " << m.quad_nodes[k] << " out of range");
+  for (std::size_t k = 0; k < m.bar_nodes.size(); ++k)
+    QSMESH_CHECK(
+        m.bar_nodes[k] >= 0 && m.bar_nodes[k] < nv,
+        "output: bar " << k / per_bar << " has node " << m.bar_nodes[k] << " out of range");
   check_vertices(m.triangles, "triangle");
   check_vertices(m.quads, "quad");
   check_vertices(m.bars, "bar");

@@ -63,7 +63,14 @@ TEST(Cli, CrossFieldAndSeparatrixMethod) {
 TEST(Cli, SecondOrder) {
   EXPECT_EQ(p({"mesh", "m.step", "-o", "o.cgns"}).order, 1);
   EXPECT_EQ(p({"mesh", "m.step", "-o", "o.msh", "--order", "2"}).order, 2);
-  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.msh", "--order", "3"}).find("--order"),
+  for (const char* n : {"3", "4", "5"})
+    EXPECT_EQ(p({"mesh", "m.step", "-o", "o.vtu", "--order", n}).order, std::stoi(n));
+  EXPECT_EQ(p({"mesh", "m.step", "-o", "o.cgns", "--order", "4"}).order, 4);
+  for (const char* n : {"0", "6", "2.5", "22"})
+    EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.msh", "--order", n}).find("--order"),
+              std::string::npos);
+  // CGNS has no elements of order 5.
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.cgns", "--order", "5"}).find("order 5"),
             std::string::npos);
   EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.msh", "--order", "2", "--until", "background"})
                 .find("quad mesh"),

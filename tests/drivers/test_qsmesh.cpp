@@ -200,36 +200,42 @@ MshNodes read_msh_nodes(const std::string& path, int type) {
 }
 
 TEST_F(Qsmesh, SecondOrderNodesLieOnTheCad) {
-  // A sphere of radius 3 and a cylinder of radius 2, height 5: every node of the 9-node quads (the
-  // edge midpoints and centres included, which a straight midpoint would put inside) is on them.
+  // A sphere of radius 3 and a cylinder of radius 2, height 5: every node of the quads of order 2
+  // and 4 (the edge and interior nodes included, which straight ones would put inside) is on them.
   const std::string sphere = qsmesh::test::write_sphere(tmp("ho_sphere.brep"));
   const std::string cylinder = qsmesh::test::write_cylinder(tmp("ho_cylinder.brep"));
-  for (const std::string& model : {sphere, cylinder}) {
-    const bool is_sphere = model == sphere;
-    const std::string out = tmp(is_sphere ? "ho_sphere.msh" : "ho_cylinder.msh");
-    const std::string stats = tmp(is_sphere ? "ho_sphere.json" : "ho_cylinder.json");
-    const ExeResult r = run("mesh " + model + " -o " + out +
-                            " --order 2 --size 0.9 -q --threads 2 --stats " + stats);
-    ASSERT_EQ(r.code, 0) << r.err;
-    const std::string json = slurp(stats);
-    EXPECT_EQ(json_number(json, "order"), 2);
-    EXPECT_EQ(json_number(json, "high_order_unprojected_nodes"), 0);
-    EXPECT_EQ(json_number(json, "high_order_invalid_quads"), 0);
-    const MshNodes m = read_msh_nodes(out, 10);
-    EXPECT_EQ(static_cast<double>(m.elements_of_type), json_number(json, "quads"));
-    // vertices + one node per edge + one per quad: V + E + Q, E = 2 Q on a closed all-quad surface.
-    EXPECT_EQ(static_cast<double>(m.xyz.size()),
-              json_number(json, "vertices") + 3 * json_number(json, "quads"));
-    int off = 0;
-    for (const auto& p : m.xyz) {
-      const double r_xy = std::hypot(p[0], p[1]);
-      const bool on = is_sphere ? std::abs(std::hypot(r_xy, p[2]) - 3.0) < 1e-7
-                                : (std::abs(r_xy - 2.0) < 1e-7 || std::abs(p[2]) < 1e-9 ||
-                                   std::abs(p[2] - 5.0) < 1e-9);
-      off += on ? 0 : 1;
+  for (const int order : {2, 4})
+    for (const std::string& model : {sphere, cylinder}) {
+      const bool is_sphere = model == sphere;
+      const std::string name =
+          std::string(is_sphere ? "ho_sphere" : "ho_cylinder") + std::to_string(order);
+      const std::string out = tmp(name + ".msh");
+      const std::string stats = tmp(name + ".json");
+      const ExeResult r = run("mesh " + model + " -o " + out + " --order " + std::to_string(order) +
+                              " --size 0.9 -q --threads 2 --stats " + stats);
+      ASSERT_EQ(r.code, 0) << r.err;
+      const std::string json = slurp(stats);
+      EXPECT_EQ(json_number(json, "order"), order);
+      EXPECT_EQ(json_number(json, "high_order_unprojected_nodes"), 0);
+      EXPECT_EQ(json_number(json, "high_order_invalid_quads"), 0);
+      EXPECT_LT(json_number(json, "high_order_max_element_distance_to_cad"), 1e-3);
+      const MshNodes m = read_msh_nodes(out, order == 2 ? 10 : 37);
+      EXPECT_EQ(static_cast<double>(m.elements_of_type), json_number(json, "quads"));
+      // Vertices, order - 1 nodes per edge, (order - 1)^2 per quad; E = 2 Q on a closed all-quad
+      // surface.
+      EXPECT_EQ(static_cast<double>(m.xyz.size()),
+                json_number(json, "vertices") +
+                    (2 * (order - 1) + (order - 1) * (order - 1)) * json_number(json, "quads"));
+      int off = 0;
+      for (const auto& p : m.xyz) {
+        const double r_xy = std::hypot(p[0], p[1]);
+        const bool on = is_sphere ? std::abs(std::hypot(r_xy, p[2]) - 3.0) < 1e-7
+                                  : (std::abs(r_xy - 2.0) < 1e-7 || std::abs(p[2]) < 1e-9 ||
+                                     std::abs(p[2] - 5.0) < 1e-9);
+        off += on ? 0 : 1;
+      }
+      EXPECT_EQ(off, 0) << model;
     }
-    EXPECT_EQ(off, 0) << model;
-  }
 }
 
 // A whole dataset of the HDF5 file `file` as doubles (HDF5 converts), empty when it is missing.

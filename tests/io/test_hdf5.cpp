@@ -199,7 +199,8 @@ mesh::SurfaceMesh make_quadratic_mesh() {
     m.vclass[v] = {2, 0, kNoIndex, {0.25, 0.25}};
   m.quads = {{0, 1, 4, 3}, {1, 2, 5, 4}};
   m.quad_face = {0, 0};
-  m.quad_nodes = {{6, 7, 8, 9, 13}, {10, 11, 12, 7, 14}};
+  m.order = 2;
+  m.quad_nodes = {6, 7, 8, 9, 13, 10, 11, 12, 7, 14};
   m.bars = {{0, 1}, {1, 2}, {2, 5}, {5, 4}, {4, 3}, {3, 0}};
   m.bar_curve.assign(m.bars.size(), 0);
   m.bar_nodes = {6, 10, 11, 12, 8, 9};

@@ -107,9 +107,12 @@ void check_output_file(const std::string& what, const std::string& path);
 void check_mesh_for_output(const mesh::SurfaceMesh& mesh);
 
 /// CGNS/HDF5: one base (CellDimension 2, PhysicalDimension 3, SI-like units with the mesh's length
-/// unit "mm" or "m"), one unstructured zone, a TRI_3/QUAD_4/MIXED section and a family per CAD face,
-/// a BAR_2 section, a family and an EdgeCenter BC (FamilySpecified) per CAD curve.
-/// Limit: Debian's cgnslib uses 32-bit ids; larger meshes throw Error.
+/// unit "mm" or "m"), one unstructured zone, a TRI_3/QUAD_4/MIXED section and a family per CAD
+/// face, a BAR_2 section, a family and an EdgeCenter BC (FamilySpecified) per CAD curve. A mesh of
+/// order N > 1 (SurfaceMesh::order) has QUAD_9 / QUAD_16 / QUAD_25 and BAR_3 / BAR_4 / BAR_5
+/// sections instead (CGNS's node order, mesh::quad_grid_positions_recursive); CGNS defines no
+/// elements of order 5: that throws InputError. Limit: Debian's cgnslib uses 32-bit ids; larger
+/// meshes throw Error.
 void write_cgns(const mesh::SurfaceMesh& mesh, const std::string& path, const WriteOptions& options = {});
 
 /// Block-structured CGNS/HDF5 (paper 002's block-structured output, from the layout as it is): one
@@ -133,6 +136,7 @@ void write_cgns(const mesh::SurfaceMesh& mesh, const std::string& path, const Wr
 void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& layout,
                        const std::string& path, const WriteOptions& options = {});
 
+<<<<<<< HEAD
 /// What write_plot3d wrote, and what PLOT3D could not hold.
 struct Plot3dReport {
   GO blocks = 0;
@@ -169,6 +173,14 @@ Plot3dReport write_plot3d(const mesh::SurfaceMesh& mesh, const layout::QuadLayou
 /// VTK XML UnstructuredGrid: triangles (VTK type 5), quads (9), optionally bars (3); cell data Int32
 /// "cad_face" (and "cad_curve" with bars; -1 where not applicable), point data Int32 "cad_dim" and
 /// "cad_entity" (the vertex classification), plus options.point_fields / cell_fields.
+=======
+/// VTK XML UnstructuredGrid: triangles (VTK type 5), quads (9), optionally bars (3); cell data
+/// Int32 "cad_face" (and "cad_curve" with bars; -1 where not applicable), point data Int32
+/// "cad_dim" and "cad_entity" (the vertex classification), plus options.point_fields / cell_fields.
+/// A mesh of order 2 has biquadratic quads (28) and quadratic edges (21), of order 3 to 5 Lagrange
+/// quadrilaterals (70) and Lagrange curves (68) in VTK's node order
+/// (mesh::quad_grid_positions_vtk).
+>>>>>>> horder
 void write_vtu(const mesh::SurfaceMesh& mesh, const std::string& path, const WriteOptions& options = {});
 
 /// HDF5 (format_version 2) for solvers, plus the XDMF 3 file xdmf_path_for(path) describing it
@@ -190,11 +202,17 @@ void write_vtu(const mesh::SurfaceMesh& mesh, const std::string& path, const Wri
 ///   curve_corners       int32 [n_curves, 2]: end corners of each curve (-1: none)
 ///   face_curve_offsets  int64 [n_faces + 1]; face_curves int32: the curves bounding face f are
 ///                       face_curves[face_curve_offsets[f] .. face_curve_offsets[f + 1])
-///   quad9               int64 [n_quads, 9], bar3 int64 [n_bars, 3]: only for second-order meshes,
-///                       the corners then the nodes (SurfaceMesh::quad_nodes: the order of CGNS
-///                       QUAD_9 / BAR_3); the XDMF file then shows these (Quadrilateral_9,
-///                       Edge_3) instead of the linear quads and bars. A node put back on its
-///                       straight position (off the CAD) has vertex_cad_param NaN.
+///   quad<M>, bar<N+1>   int64 [n_quads, M = (N + 1)^2], [n_bars, N + 1]: only for meshes of
+///                       order N > 1 (quad9 / bar3, quad16 / bar4, quad25 / bar5, quad36 / bar6):
+///                       the whole elements in Gmsh's node order (corners, edge nodes edge by
+///                       edge, then the interior numbered the same way again,
+///                       mesh::quad_grid_positions_recursive; CGNS's too up to order 3, not for
+///                       QUAD_25) and the bars' (ends, then the interior). For order 2
+///                       the XDMF file shows these (Quadrilateral_9, Edge_3) instead of the
+///                       linear quads and bars; XDMF has no higher-order quads, so for order 3
+///                       and up it shows the linear quads and bars of the corners. A node put
+///                       back on its straight position (off the CAD) has vertex_cad_param NaN.
+///                       Root attribute order: N (1 for linear meshes).
 /// (format_version 1, of the seventeenth session, had quad_nodes [n_quads, 5] and bar_nodes
 /// [n_bars] instead of quad9 and bar3.)
 /// Empty element kinds are zero-row datasets. Objects carry no timestamps: the same mesh gives the
@@ -209,7 +227,8 @@ void write_hdf5(const mesh::SurfaceMesh& mesh, const std::string& path,
 [[nodiscard]] std::string xdmf_path_for(const std::string& h5_path);
 
 /// Gmsh MSH 4.1 ASCII: $Entities (corners, curves with their end corners, faces with their bounding
-/// curves), $Nodes and $Elements grouped by CAD entity (parametric 0).
+/// curves), $Nodes and $Elements grouped by CAD entity (parametric 0). A mesh of order N has
+/// Gmsh's quads and lines of order N (types 10, 36, 37, 38 and 8, 26, 27, 28; Gmsh's node order).
 void write_msh(const mesh::SurfaceMesh& mesh, const std::string& path, const WriteOptions& options = {});
 
 }  // namespace qsmesh::io

@@ -55,11 +55,19 @@ struct SurfaceMesh {
   std::vector<LO> quad_face;                  ///< CAD face of each quad
   std::vector<std::array<GO, 2>> bars;        ///< curve edges
   std::vector<LO> bar_curve;                  ///< CAD curve of each bar
-  /// Second-order nodes (empty for linear elements; highorder::make_quadratic): per quad the
-  /// midpoints of its edges 0-1, 1-2, 2-3, 3-0, then its centre (the order of CGNS QUAD_9, VTK 28
-  /// and MSH type 10 after the four corners); per bar its midpoint.
-  std::vector<std::array<GO, 5>> quad_nodes;
+  /// Order of the elements: 1 linear; 2..5 with the nodes below (highorder::make_high_order).
+  int order = 1;
+  /// High-order nodes, flat (empty when order is 1). Per quad, quad_nodes_per_quad() =
+  /// (order + 1)^2 - 4 nodes after its four corners: the order - 1 nodes of each edge 0-1, 1-2,
+  /// 2-3, 3-0 in turn, each edge's in its direction (from its first corner), then the
+  /// (order - 1)^2 interior nodes row by row: node (i, j), 0 < i, j < order, at position
+  /// (i - 1) + (order - 1) (j - 1), i along corner 0 -> 1 and j along 0 -> 3. For order 2 this is
+  /// the order of CGNS QUAD_9, VTK 28 and MSH type 10 after the corners; for higher orders each
+  /// writer permutes it. Per bar, its order - 1 interior nodes from bars[b][0] to bars[b][1].
+  std::vector<GO> quad_nodes;
   std::vector<GO> bar_nodes;
+  [[nodiscard]] int quad_nodes_per_quad() const { return (order + 1) * (order + 1) - 4; }
+  [[nodiscard]] int bar_nodes_per_bar() const { return order - 1; }
   LO num_cad_faces = 0;
   LO num_cad_curves = 0;
   LO num_cad_corners = 0;
