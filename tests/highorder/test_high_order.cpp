@@ -198,7 +198,9 @@ void expect_nodes_on_cad_and_shared(const mesh::SurfaceMesh& m, GO linear_vertic
       std::reverse(nodes.begin(), nodes.end());
     }
     const auto [it, fresh] = edge_nodes.try_emplace({a, b}, nodes);
-    if (!fresh) EXPECT_EQ(it->second, nodes) << "edge " << a << "-" << b;
+    if (!fresh) {
+      EXPECT_EQ(it->second, nodes) << "edge " << a << "-" << b;
+    }
   };
   for (std::size_t q = 0; q < m.quads.size(); ++q)
     for (std::size_t k = 0; k < 4; ++k) {

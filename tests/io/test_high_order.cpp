@@ -104,9 +104,10 @@ TEST(HighOrderOutput, MshTypesAndGmshNodeOrder) {
         if (dim == 2) {
           EXPECT_EQ(type, quad_type[n]);
           ASSERT_EQ(static_cast<int>(ids.size()), 1 + (n + 1) * (n + 1));
-          if (n == 3 && e == 0)
+          if (n == 3 && e == 0) {
             for (std::size_t k = 0; k < kCgnsQuad16.size(); ++k)
               EXPECT_EQ(ids[k + 1], kCgnsQuad16[k] + 1) << k;
+          }
           if (n == 4 && e == 0) {
             std::vector<GO> expected = kQuad25Outer;
             expected.insert(expected.end(), kGmshQuad25Inner.begin(), kGmshQuad25Inner.end());
@@ -117,9 +118,10 @@ TEST(HighOrderOutput, MshTypesAndGmshNodeOrder) {
         } else if (dim == 1) {
           EXPECT_EQ(type, line_type[n]);
           ASSERT_EQ(static_cast<int>(ids.size()), 2 + n);
-          if (e == 0)  // the bar (0,0) -> (n,0): ends, then 1 .. n - 1
+          if (e == 0) {  // the bar (0,0) -> (n,0): ends, then 1 .. n - 1
             for (int k = 0; k < n + 1; ++k)
               EXPECT_EQ(ids[static_cast<std::size_t>(k + 1)], (k == 0 ? 1 : (k == 1 ? n + 1 : k)));
+          }
           lines = true;
         }
       }
@@ -215,9 +217,10 @@ TEST(HighOrderOutput, CgnsSectionsUpToOrderFour) {
       EXPECT_EQ(npe, face ? (n + 1) * (n + 1) : n + 1);
       std::vector<cgsize_t> conn(static_cast<std::size_t>((end - start + 1) * npe));
       CG(cg_elements_read(fn, 1, 1, s, conn.data(), nullptr));
-      if (face && n == 3)
+      if (face && n == 3) {
         for (std::size_t k = 0; k < kCgnsQuad16.size(); ++k)
           EXPECT_EQ(conn[k], kCgnsQuad16[k] + 1) << k;
+      }
       if (face && n == 4) {
         std::vector<GO> expected = kQuad25Outer;
         expected.insert(expected.end(), kCgnsQuad25Inner.begin(), kCgnsQuad25Inner.end());

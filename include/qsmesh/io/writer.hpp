@@ -136,7 +136,6 @@ void write_cgns(const mesh::SurfaceMesh& mesh, const std::string& path, const Wr
 void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& layout,
                        const std::string& path, const WriteOptions& options = {});
 
-<<<<<<< HEAD
 /// What write_plot3d wrote, and what PLOT3D could not hold.
 struct Plot3dReport {
   GO blocks = 0;
@@ -170,17 +169,12 @@ struct Plot3dReport {
 Plot3dReport write_plot3d(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& layout,
                           const std::string& path, const WriteOptions& options = {});
 
-/// VTK XML UnstructuredGrid: triangles (VTK type 5), quads (9), optionally bars (3); cell data Int32
-/// "cad_face" (and "cad_curve" with bars; -1 where not applicable), point data Int32 "cad_dim" and
-/// "cad_entity" (the vertex classification), plus options.point_fields / cell_fields.
-=======
 /// VTK XML UnstructuredGrid: triangles (VTK type 5), quads (9), optionally bars (3); cell data
 /// Int32 "cad_face" (and "cad_curve" with bars; -1 where not applicable), point data Int32
 /// "cad_dim" and "cad_entity" (the vertex classification), plus options.point_fields / cell_fields.
 /// A mesh of order 2 has biquadratic quads (28) and quadratic edges (21), of order 3 to 5 Lagrange
 /// quadrilaterals (70) and Lagrange curves (68) in VTK's node order
 /// (mesh::quad_grid_positions_vtk).
->>>>>>> horder
 void write_vtu(const mesh::SurfaceMesh& mesh, const std::string& path, const WriteOptions& options = {});
 
 /// HDF5 (format_version 2) for solvers, plus the XDMF 3 file xdmf_path_for(path) describing it
