@@ -22,7 +22,7 @@ struct Arguments {
   /// Last stage to run. `unstructured` exists but still fails on some faces of the shared models
   /// (reported per face), so the default stays the furthest stage that is complete.
   std::string until = "quasi-structured";
-  /// --method: the per-face method of the quad stages (default, holomorphic, auto; see
+  /// --method: the per-face method of the quad stages (default, holomorphic, auto, separatrix; see
   /// parallel::PipelineOptions::face_method).
   std::string method = "default";
   int threads = 0;  ///< 0: automatic

@@ -10,6 +10,7 @@
 #include "cli.hpp"
 #include "fuzz_input.hpp"
 #include "qsmesh/core/error.hpp"
+#include "qsmesh/io/writer.hpp"
 
 namespace {
 
@@ -25,7 +26,16 @@ void check(const qsmesh::cli::Arguments& a) {
   if (a.size) require(std::isfinite(*a.size) && *a.size > 0);
   if (a.size_factor) require(std::isfinite(*a.size_factor) && *a.size_factor > 0);
   require(a.threads >= 0);
-  require(a.order == 1 || a.order == 2);
+  require(a.order >= 1 && a.order <= 5);
+  // CGNS has no order-5 elements; PLOT3D holds linear blocks only (and is always the layout).
+  if (a.command == Command::Mesh && a.order > 4)
+    require(qsmesh::io::output_format(a.output) != qsmesh::io::Format::kCgns);
+  if (a.command == Command::Mesh &&
+      qsmesh::io::output_format(a.output) == qsmesh::io::Format::kPlot3d)
+    require(a.block_structured && a.order == 1);
+  require(a.method == "default" || a.method == "holomorphic" || a.method == "auto" ||
+          a.method == "separatrix");
+  require(a.separatrix_method == (a.method == "separatrix"));
   require(a.sizemap == "features" || a.sizemap == "crossfield");
   require(a.sizing == "paper" || a.sizing == "clamped");
   // Odd counts are honoured (each face loop is halved, not each curve); their parity is checked
