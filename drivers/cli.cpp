@@ -153,6 +153,7 @@ Arguments parse(const std::vector<std::string>& args) {
   bool sizing_rules_given = false;  // --sizing on the line
 
   std::vector<std::string> positional;
+  bool layout_given = false;
   for (std::size_t i = 1; i < args.size(); ++i) {
     const std::string& opt = args[i];
     auto value = [&]() -> const std::string& {
@@ -186,12 +187,18 @@ Arguments parse(const std::vector<std::string>& args) {
       a.field_divisions = *n;
     } else if (opt == "--block-structured" && a.command == Command::Mesh)
       a.block_structured = true;
-    else if (opt == "--order" && a.command == Command::Mesh) {
+    else if (opt == "--layout" && a.command == Command::Mesh) {
+      const std::string& v = value();
+      if (v != "coarse" && v != "dense")
+        throw InputError("--layout: '" + v + "' is not coarse or dense");
+      a.coarse_layout = v == "coarse";
+      layout_given = true;
+    } else if (opt == "--order" && a.command == Command::Mesh) {
       const std::string& v = value();
       if (v != "1" && v != "2") throw InputError("--order: '" + v + "' is not 1 or 2");
       a.order = v == "2" ? 2 : 1;
-    }
-    else if (opt == "--check" && a.command == Command::CrossField) a.check = true;
+    } else if (opt == "--check" && a.command == Command::CrossField)
+      a.check = true;
     else if (opt == "--curvature-edges" && sizing) {
       const std::string& v = value();
       const auto n = parse_double(v);
@@ -325,6 +332,8 @@ Arguments parse(const std::vector<std::string>& args) {
     a.model = positional[0];
     if (a.command == Command::Mesh && a.output.empty())
       throw InputError("mesh: missing -o OUT (.cgns, .vtu, .msh or .h5)");
+    if (layout_given && !a.block_structured)
+      throw InputError("--layout: only with --block-structured");
     if (a.block_structured) {
       if (io::output_format(a.output) != io::Format::kCgns)
         throw InputError("--block-structured: the blocks are written as CGNS; give -o FILE.cgns");
@@ -397,10 +406,16 @@ std::string help(const std::string& topic) {
           "  --order 2             second-order elements: 9-node quads and 3-node bars, the new\n"
           "                        nodes on the CAD (CGNS QUAD_9/BAR_3, VTU, MSH; in .h5 the\n"
           "                        datasets quad9 and bar3)\n"
-          "  --block-structured    write the .cgns file as structured zones, one per block of the\n"
-          "                        quad layout (traces from irregular vertices and CAD corners,\n"
-          "                        paper 002 Sec. III.A), joined by 1-to-1 connectivity; faces\n"
-          "                        that do not split into blocks go to one unstructured zone\n"
+          "  --block-structured    write the .cgns file as structured zones, one per block,\n"
+          "                        joined by 1-to-1 connectivity (see --layout)\n"
+          "  --layout coarse|dense the blocks of --block-structured. coarse (default): a new mesh\n"
+          "                        on a coarse conforming layout (paper 002 Sec. III-IV: T-mesh,\n"
+          "                        ILP, subdivision, smoothing), every CAD curve a block side;\n"
+          "                        when it fails, one log line and the dense layout. dense: the\n"
+          "                        layout of the quad mesh as it is (traces from irregular "
+          "vertices\n"
+          "                        and CAD corners, Sec. III.A); faces that do not split into\n"
+          "                        blocks go to one unstructured zone\n"
           "  --quads N, --curvature-edges N, --face-curvature, --feature-ratio R, --size-min H,\n"
           "  --size-min-ratio R, --sizing RULES, --curve-edges C:N,.., --odd-slivers,\n"
           "  --face-quads F:N,.., --corner-size K:H,.., --curve-size C:H,.., --face-size F:H,..,\n"

@@ -30,6 +30,10 @@ struct Arguments {
   /// --block-structured: write the CGNS file as structured blocks of the quad layout
   /// (layout::extract_quad_layout, io::write_cgns_blocks) instead of one unstructured zone.
   bool block_structured = false;
+  /// --layout coarse|dense (with --block-structured): the coarse conforming layout of paper 002
+  /// Sec. III-IV (layout::build_coarse_layout, a new mesh) or the dense layout of the mesh as it
+  /// is.
+  bool coarse_layout = true;
   /// --order 2: second-order quads (9 nodes) and bars (3 nodes) on the CAD
   /// (highorder::make_quadratic); 1: linear.
   int order = 1;

@@ -24,6 +24,7 @@
 #include "qsmesh/highorder/quadratic.hpp"
 #include "qsmesh/io/atomic_file.hpp"
 #include "qsmesh/io/writer.hpp"
+#include "qsmesh/layout/coarse_layout.hpp"
 #include "qsmesh/layout/quad_layout.hpp"
 #include "qsmesh/linalg/solver.hpp"
 #include "qsmesh/mesh/quality.hpp"
@@ -261,6 +262,10 @@ struct Checks {
   struct Blocks {
     std::int64_t blocks = 0, quads = 0, largest = 0;
     LO unblocked_faces = 0, extended_faces = 0;
+    /// --layout coarse: asked for; fallback: it failed and the dense layout was written.
+    bool coarse = false, fallback = false;
+    std::int64_t ilp_variables = 0, ilp_constraints = 0, fine_quads = 0;
+    double ilp_seconds = 0, layout_seconds = 0, sicn_min = 0, sicn_avg = 0;
     [[nodiscard]] double mean_quads() const {
       return blocks > 0 ? static_cast<double>(quads) / static_cast<double>(blocks) : 0.0;
     }
@@ -421,6 +426,19 @@ std::string stats_json(const Arguments& args, const Session& session,
     j.value("block_quads_largest", checks.blocks->largest);
     j.value("faces_not_in_blocks", static_cast<std::int64_t>(checks.blocks->unblocked_faces));
     j.value("faces_with_extended_traces", static_cast<std::int64_t>(checks.blocks->extended_faces));
+    j.value("block_layout",
+            std::string(checks.blocks->coarse
+                            ? (checks.blocks->fallback ? "dense (coarse failed)" : "coarse")
+                            : "dense"));
+    if (checks.blocks->coarse) {
+      j.value("ilp_variables", checks.blocks->ilp_variables);
+      j.value("ilp_constraints", checks.blocks->ilp_constraints);
+      j.value("ilp_seconds", checks.blocks->ilp_seconds);
+      j.value("coarse_layout_seconds", checks.blocks->layout_seconds);
+      j.value("block_mesh_quads", checks.blocks->fine_quads);
+      j.value("block_mesh_sicn_min", checks.blocks->sicn_min);
+      j.value("block_mesh_sicn_avg", checks.blocks->sicn_avg);
+    }
   }
   if (!checks.rank_peak_mb.empty()) {
     j.begin_array("rank_peak_memory_mb");
@@ -559,6 +577,11 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
        << " quads each on average, largest " << b.largest << "; faces not in blocks "
        << b.unblocked_faces << "; faces traced again with extended traces " << b.extended_faces
        << "\n";
+    if (b.coarse && !b.fallback)
+      os << "  coarse layout: ILP " << b.ilp_variables << " variables, " << b.ilp_constraints
+         << " constraints, " << b.ilp_seconds << " s; layout " << b.layout_seconds << " s; "
+         << b.fine_quads << " quads, SICN min " << b.sicn_min << " avg " << b.sicn_avg << "\n";
+    if (b.fallback) os << "  coarse layout failed: the dense layout was written\n";
   }
   if (!checks.rank_peak_mb.empty()) {
     const std::vector<double>& mb = checks.rank_peak_mb;
@@ -817,8 +840,30 @@ int run_mesh(const Arguments& args) {
       clock.reset();
     }
     if (args.block_structured) {
-      const layout::QuadLayout lay = layout::extract_quad_layout(result.mesh);
       Checks::Blocks b;
+      std::optional<layout::CoarseResult> coarse;
+      if (args.coarse_layout) {
+        coarse = layout::build_coarse_layout(result.mesh, s.model);
+        const layout::CoarseStats& c = coarse->stats;
+        b.coarse = true;
+        b.ilp_variables = c.ilp_variables;
+        b.ilp_constraints = c.ilp_constraints;
+        b.ilp_seconds = c.ilp_seconds;
+        b.layout_seconds = c.seconds;
+        if (coarse->ok) {
+          b.fine_quads = c.fine_quads;
+          b.sicn_min = c.sicn_min;
+          b.sicn_avg = c.sicn_avg;
+        } else {
+          b.fallback = true;
+          s.log.warn(cat("coarse layout failed (", coarse->failure,
+                         "): writing the dense layout instead"));
+          coarse.reset();
+        }
+      }
+      const mesh::SurfaceMesh& written = coarse ? coarse->mesh : result.mesh;
+      const layout::QuadLayout lay =
+          coarse ? std::move(coarse->layout) : layout::extract_quad_layout(result.mesh);
       b.blocks = static_cast<std::int64_t>(lay.blocks.size());
       for (const layout::Block& k : lay.blocks) {
         const std::int64_t n = static_cast<std::int64_t>(k.ni) * k.nj;
@@ -830,7 +875,7 @@ int run_mesh(const Arguments& args) {
       checks.blocks = b;
       s.times.add("layout", clock.seconds());
       clock.reset();
-      io::write_cgns_blocks(result.mesh, lay, args.output);
+      io::write_cgns_blocks(written, lay, args.output);
     } else {
       io::write_mesh(result.mesh, args.output);
     }
