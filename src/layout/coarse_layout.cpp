@@ -22,6 +22,7 @@
 #include "qsmesh/mesh/edges.hpp"
 #include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/smooth/smooth.hpp"
+#include "qsmesh/smooth/untangle.hpp"
 
 namespace qsmesh::layout {
 
@@ -29,6 +30,7 @@ namespace {
 
 constexpr LO kNever = std::numeric_limits<LO>::max();
 constexpr int kMaxRounds = 12;
+constexpr int kMaxRepairs = 8;
 
 // Thrown inside the stage when the result cannot be built; turned into CoarseResult::failure.
 struct Reject {
@@ -166,39 +168,54 @@ class Builder {
       // merged, an irregular vertex collapsed on a curve, a unit quad with a repeated corner): each
       // such merge found in a solution adds "the zero-length path between them is >= 1" and the
       // program is solved again.
-      for (int round = 0;; ++round) {
-        const IlpResult sol = solve_integer_program(ilp, opt_.ilp);
-        out.stats.ilp_seconds += sol.seconds;
-        out.stats.ilp_status = sol.status;
-        out.stats.ilp_rounds = round + 1;
-        if (!sol.feasible) throw Reject{cat("the ILP gave no solution (", sol.status, ")")};
-        q_ = sol.x;
-        split_and_merge();
-        const auto rows = conflicts();
-        if (std::getenv("QSMESH_COARSE_DEBUG") != nullptr) {
-          int sat = 0;
-          for (const auto& r : rows) {
-            double v = 0;
-            for (const auto& [a, c] : r.terms)
-              v += c * static_cast<double>(q_[static_cast<std::size_t>(a)]);
-            sat += v >= 1 ? 1 : 0;
+      for (int repair = 0;; ++repair) {
+        for (int round = 0;; ++round) {
+          const IlpResult sol = solve_integer_program(ilp, opt_.ilp);
+          out.stats.ilp_seconds += sol.seconds;
+          out.stats.ilp_status = sol.status;
+          ++out.stats.ilp_rounds;
+          if (!sol.feasible) throw Reject{cat("the ILP gave no solution (", sol.status, ")")};
+          q_ = sol.x;
+          split_and_merge();
+          auto rows = conflicts();
+          if (std::getenv("QSMESH_COARSE_DEBUG") != nullptr) {
+            int sat = 0;
+            for (const auto& r : rows) {
+              double v = 0;
+              for (const auto& [a, c] : r.terms)
+                v += c * static_cast<double>(q_[static_cast<std::size_t>(a)]);
+              sat += v >= 1 ? 1 : 0;
+            }
+            std::fprintf(stderr, "coarse: conflicts kinds %d %d %d %d, rows already met %d\n",
+                         dbg_[0], dbg_[1], dbg_[2], dbg_[3], sat);
           }
-          std::fprintf(stderr, "coarse: conflicts kinds %d %d %d %d, rows already met %d\n",
-                       dbg_[0], dbg_[1], dbg_[2], dbg_[3], sat);
+          if (std::getenv("QSMESH_COARSE_DEBUG") != nullptr)
+            std::fprintf(
+                stderr, "coarse: round %d arcs %zu rows %zu conflicts %zu ilp %.3f s obj %g\n",
+                round, arcs_.size(), ilp.rows.size(), rows.size(), sol.seconds, sol.objective);
+          if (rows.empty()) {
+            coarse_mesh();
+            rows = flat_corners();
+            if (rows.empty()) break;
+          }
+          if (round + 1 >= kMaxRounds)
+            throw Reject{cat("CAD entities still merge after ", kMaxRounds, " ILP rounds")};
+          for (const auto& r : rows) ilp.rows.push_back(r);
         }
-        if (std::getenv("QSMESH_COARSE_DEBUG") != nullptr)
-          std::fprintf(
-              stderr, "coarse: round %d arcs %zu rows %zu conflicts %zu ilp %.3f s obj %g\n", round,
-              arcs_.size(), ilp.rows.size(), rows.size(), sol.seconds, sol.objective);
-        if (rows.empty()) break;
-        if (round + 1 >= kMaxRounds)
-          throw Reject{cat("CAD entities still merge after ", kMaxRounds, " ILP rounds")};
-        for (const auto& r : rows) ilp.rows.push_back(r);
+        out.stats.ilp_variables = ilp.num_variables();
+        out.stats.ilp_constraints = static_cast<std::int64_t>(ilp.rows.size());
+        out.mesh = {};
+        out.layout = {};
+        fine_mesh(out);
+        if (bad_cquads_.empty()) break;
+        if (repair + 1 >= kMaxRepairs)
+          throw Reject{
+              cat(bad_quads_, " fine quads invalid or folded after ", kMaxRepairs, " repairs")};
+        // Where the fine mesh is invalid, the patches that made those coarse quads keep their
+        // input lengths (the input layout is valid), and all is solved again.
+        for (const auto& r : restore_rows()) ilp.rows.push_back(r);
+        out.stats.repairs = repair + 1;
       }
-      out.stats.ilp_variables = ilp.num_variables();
-      out.stats.ilp_constraints = static_cast<std::int64_t>(ilp.rows.size());
-      coarse_mesh();
-      fine_mesh(out);
       out.stats.coarse_quads = static_cast<std::int64_t>(out.layout.blocks.size());
       out.stats.fine_quads = static_cast<std::int64_t>(out.mesh.quads.size());
       out.ok = true;
@@ -832,6 +849,70 @@ class Builder {
     return rows;
   }
 
+  // Rows q_a >= l_a for the side arcs of every patch touching a corner group of a bad coarse
+  // quad, and of the patch it was cut from.
+  [[nodiscard]] std::vector<IntegerProgram::Row> restore_rows() const {
+    std::vector<char> bad_group(static_cast<std::size_t>(ng_), 0);
+    std::vector<LO> patches;
+    for (std::size_t k : bad_cquads_) {
+      for (GO g : cquads_[k].v) bad_group[static_cast<std::size_t>(g)] = 1;
+      patches.push_back(cells_[static_cast<std::size_t>(cquads_[k].cell)].patch);
+    }
+    for (std::size_t x = 0; x < rep_.size(); ++x)
+      if (bad_group[static_cast<std::size_t>(group_[x])])
+        patches.insert(patches.end(), point_patches_[x].begin(), point_patches_[x].end());
+    std::sort(patches.begin(), patches.end());
+    patches.erase(std::unique(patches.begin(), patches.end()), patches.end());
+    std::vector<LO> arcs;
+    for (LO p : patches)
+      for (int s = 0; s < 4; ++s)
+        for (LO a : side_arcs(static_cast<std::size_t>(p), s)) arcs.push_back(a);
+    std::sort(arcs.begin(), arcs.end());
+    arcs.erase(std::unique(arcs.begin(), arcs.end()), arcs.end());
+    std::vector<IntegerProgram::Row> rows;
+    for (LO a : arcs) {
+      IntegerProgram::Row r;
+      r.terms.emplace_back(a, 1.0);
+      r.lo = arcs_[static_cast<std::size_t>(a)].length();
+      r.hi = std::numeric_limits<double>::infinity();
+      rows.push_back(std::move(r));
+    }
+    return rows;
+  }
+
+  // A coarse quad corner between two edges on CAD curves away from a CAD corner is flat (an
+  // interior node merged onto the curve made it): the row separating them.
+  [[nodiscard]] std::vector<IntegerProgram::Row> flat_corners() {
+    std::vector<IntegerProgram::Row> rows;
+    std::vector<char> flat(static_cast<std::size_t>(ng_), 0);
+    for (const CQuad& q : cquads_)
+      for (int k = 0; k < 4; ++k) {
+        const GO g = q.v[static_cast<std::size_t>(k)];
+        if (vc(center_[static_cast<std::size_t>(g)]).dim == 0) continue;
+        if (cedges_[static_cast<std::size_t>(q.e[static_cast<std::size_t>(k)])].curve != kNoIndex &&
+            cedges_[static_cast<std::size_t>(q.e[static_cast<std::size_t>((k + 3) % 4)])].curve !=
+                kNoIndex)
+          flat[static_cast<std::size_t>(g)] = 1;
+      }
+    std::vector<GO> inner(static_cast<std::size_t>(ng_), -1),
+        on_curve(static_cast<std::size_t>(ng_), -1);
+    for (const auto& [v, x] : node_point_) {
+      const GO g = group_[static_cast<std::size_t>(x)];
+      if (!flat[static_cast<std::size_t>(g)]) continue;
+      GO& slot = vc(v).dim == 2 ? inner[static_cast<std::size_t>(g)]
+                                : on_curve[static_cast<std::size_t>(g)];
+      if (slot < 0 || x < slot) slot = x;
+    }
+    for (GO g = 0; g < ng_; ++g) {
+      if (!flat[static_cast<std::size_t>(g)]) continue;
+      if (inner[static_cast<std::size_t>(g)] < 0 || on_curve[static_cast<std::size_t>(g)] < 0)
+        throw Reject{"a coarse quad has a flat corner on a CAD curve"};
+      rows.push_back(
+          separation(inner[static_cast<std::size_t>(g)], on_curve[static_cast<std::size_t>(g)]));
+    }
+    return rows;
+  }
+
   void split_and_merge() {
     // Points: nodes, then the inner points of arcs of length >= 2, then the inner points of the
     // patches, each with a representative input vertex.
@@ -852,6 +933,7 @@ class Builder {
     dsu_ = {};
     dsu_.resize(static_cast<GO>(rep_.size()));
     links_.assign(rep_.size(), {});
+    point_patches_.assign(rep_.size(), {});
     labels_.clear();
     for (std::size_t a = 0; a < arcs_.size(); ++a)
       if (q_[a] == 0)
@@ -861,6 +943,8 @@ class Builder {
     for (std::size_t p = 0; p < grids_.size(); ++p) {
       std::array<std::vector<GO>, 4> sp;
       for (int s = 0; s < 4; ++s) sp[static_cast<std::size_t>(s)] = side_points(p, s);
+      for (const auto& side : sp)
+        for (GO x : side) point_patches_[static_cast<std::size_t>(x)].push_back(static_cast<LO>(p));
       const auto a = static_cast<LO>(sp[0].size()) - 1, b = static_cast<LO>(sp[1].size()) - 1;
       if (a != static_cast<LO>(sp[2].size()) - 1 || b != static_cast<LO>(sp[3].size()) - 1)
         throw Reject{cat("patch ", p, " is not consistent in the solution")};
@@ -896,6 +980,7 @@ class Builder {
         for (LO x = 1; x < a; ++x) {
           at(x, y) = dsu_.add();
           links_.emplace_back();
+          point_patches_.emplace_back();
           rep_.push_back(g.at(static_cast<LO>(std::lround(static_cast<double>(x) * g.ni / a)),
                               static_cast<LO>(std::lround(static_cast<double>(y) * g.nj / b))));
         }
@@ -1342,13 +1427,37 @@ class Builder {
         p[static_cast<std::size_t>(c)] =
             sm.points[static_cast<std::size_t>(sm.quads[i][static_cast<std::size_t>(c)])];
       const double s = mesh::quad_sicn(p);
+      if (s <= 0 && std::getenv("QSMESH_COARSE_DEBUG") != nullptr) {
+        std::fprintf(stderr, "bad quad face %d sicn %g:", sm.quad_face[i], s);
+        for (int c = 0; c < 4; ++c) {
+          const auto& k =
+              sm.vclass[static_cast<std::size_t>(sm.quads[i][static_cast<std::size_t>(c)])];
+          std::fprintf(stderr, " (%d %d %.3g %.3g)", k.dim, k.entity, k.param[0], k.param[1]);
+        }
+        std::fprintf(stderr, " block %ld %dx%d\n", (long)out.layout.quad2block[i],
+                     out.layout.blocks[out.layout.quad2block[i]].ni,
+                     out.layout.blocks[out.layout.quad2block[i]].nj);
+      }
       smin = std::min(smin, s);
       ssum += s;
     }
     out.stats.sicn_min = sm.quads.empty() ? 0 : smin;
     out.stats.sicn_avg = sm.quads.empty() ? 0 : ssum / static_cast<double>(sm.quads.size());
-    if (folded_ > 0) throw Reject{cat(folded_, " fine quads fold against their face")};
-    if (!(smin > 0)) throw Reject{cat("a fine quad is invalid (SICN ", smin, ")")};
+    bad_cquads_.clear();
+    bad_quads_ = 0;
+    for (std::size_t i = 0; i < sm.quads.size(); ++i) {
+      std::array<Vec3, 4> p{};
+      for (int c = 0; c < 4; ++c)
+        p[static_cast<std::size_t>(c)] =
+            sm.points[static_cast<std::size_t>(sm.quads[i][static_cast<std::size_t>(c)])];
+      const std::size_t k = block_order[static_cast<std::size_t>(out.layout.quad2block[i])];
+      if (mesh::quad_sicn(p) <= 0 || bad_fine_cquad_[k]) {
+        bad_cquads_.push_back(k);
+        ++bad_quads_;
+      }
+    }
+    std::sort(bad_cquads_.begin(), bad_cquads_.end());
+    bad_cquads_.erase(std::unique(bad_cquads_.begin(), bad_cquads_.end()), bad_cquads_.end());
   }
 
   // Winslow smoothing face by face (smooth::smooth_face: boundary locked, every move kept only
@@ -1358,7 +1467,7 @@ class Builder {
   void smooth_nodes(std::vector<FineNode>& nodes, const std::vector<FQ>& fq) {
     std::map<LO, std::vector<std::size_t>> by_face;
     for (std::size_t i = 0; i < fq.size(); ++i) by_face[fq[i].face].push_back(i);
-    folded_ = 0;
+    bad_fine_cquad_.assign(cquads_.size(), 0);
     std::vector<LO> local(nodes.size(), -1);
     for (const auto& [f, list] : by_face) {
       mesh::FaceMesh fm;
@@ -1419,6 +1528,9 @@ class Builder {
       so.laplacian_uv = false;
       mesh::FaceMesh sm =
           opt_.smoothing_iterations > 0 ? smooth::smooth_face(fm, face_geom(f), so) : fm;
+      // Concave corners may leave folded quads (paper 002 Sec. IV.E): local untangling there.
+      if (smooth::measure(sm).invalid > 0 || folded(sm, f) > 0)
+        sm = smooth::untangle_face(sm, face_geom(f), smooth::UntangleOptions{});
       for (std::size_t l = 0; l < global.size(); ++l) {
         FineNode& n = nodes[static_cast<std::size_t>(global[l])];
         if (n.c.dim == 2) {
@@ -1427,16 +1539,36 @@ class Builder {
         }
         local[static_cast<std::size_t>(global[l])] = -1;
       }
-      for (const auto& lq : sm.quads) {
-        Vec3 nsum{0, 0, 0};
-        for (LO c : lq) nsum += face_geom(f).normal(sm.uv[static_cast<std::size_t>(c)]);
-        const Vec3 d1 =
-            sm.points[static_cast<std::size_t>(lq[2])] - sm.points[static_cast<std::size_t>(lq[0])];
-        const Vec3 d2 =
-            sm.points[static_cast<std::size_t>(lq[3])] - sm.points[static_cast<std::size_t>(lq[1])];
-        if (norm2(nsum) > 0 && dot(cross(d1, d2), nsum) <= 0) ++folded_;
-      }
+      for (std::size_t qi = 0; qi < sm.quads.size(); ++qi)
+        if (folded_quad(sm, f, qi))
+          bad_fine_cquad_[static_cast<std::size_t>(fq[list[qi]].block)] = 1;
     }
+  }
+
+  // Quads of face mesh fm turning against the normal of face f (at their corners).
+  bool folded_quad(const mesh::FaceMesh& fm, LO f, std::size_t qi) {
+    const auto& lq = fm.quads[qi];
+    Vec3 nsum{0, 0, 0};
+    for (LO c : lq) nsum += face_geom(f).normal(fm.uv[static_cast<std::size_t>(c)]);
+    const Vec3 d1 =
+        fm.points[static_cast<std::size_t>(lq[2])] - fm.points[static_cast<std::size_t>(lq[0])];
+    const Vec3 d2 =
+        fm.points[static_cast<std::size_t>(lq[3])] - fm.points[static_cast<std::size_t>(lq[1])];
+    return norm2(nsum) > 0 && dot(cross(d1, d2), nsum) <= 0;
+  }
+
+  std::int64_t folded(const mesh::FaceMesh& fm, LO f) {
+    std::int64_t n = 0;
+    for (const auto& lq : fm.quads) {
+      Vec3 nsum{0, 0, 0};
+      for (LO c : lq) nsum += face_geom(f).normal(fm.uv[static_cast<std::size_t>(c)]);
+      const Vec3 d1 =
+          fm.points[static_cast<std::size_t>(lq[2])] - fm.points[static_cast<std::size_t>(lq[0])];
+      const Vec3 d2 =
+          fm.points[static_cast<std::size_t>(lq[3])] - fm.points[static_cast<std::size_t>(lq[1])];
+      if (norm2(nsum) > 0 && dot(cross(d1, d2), nsum) <= 0) ++n;
+    }
+    return n;
   }
 
   struct CQuad {
@@ -1480,7 +1612,10 @@ class Builder {
   std::unordered_map<std::uint64_t, GO> edge_id_;
   std::map<LO, std::unique_ptr<cad::FaceGeometry>> face_geom_;
   std::map<LO, std::unique_ptr<cad::CurveGeometry>> curve_geom_;
-  std::int64_t folded_ = 0;
+  std::vector<char> bad_fine_cquad_;
+  std::vector<std::size_t> bad_cquads_;
+  std::int64_t bad_quads_ = 0;
+  std::vector<std::vector<LO>> point_patches_;
 };
 
 }  // namespace

@@ -28,7 +28,10 @@ struct CoarseStats {
   std::int64_t tmesh_nodes = 0, tmesh_arcs = 0, tmesh_patches = 0, traces = 0;
   std::int64_t ilp_variables = 0, ilp_constraints = 0;
   double ilp_seconds = 0;  ///< all rounds
-  int ilp_rounds = 0;      ///< solves (each after rows forbidding the CAD merges of the last one)
+  int ilp_rounds = 0;
+  /// Solves again after an invalid fine mesh: the patches that made the bad coarse quads kept
+  /// their input lengths.
+  int repairs = 0;  ///< solves (each after rows forbidding the CAD merges of the last one)
   std::string ilp_status;
   std::int64_t coarse_quads = 0;  ///< blocks
   std::int64_t fine_quads = 0;
