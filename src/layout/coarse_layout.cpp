@@ -4,8 +4,6 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
-#include <cstdio>
-#include <cstdlib>
 #include <limits>
 #include <map>
 #include <memory>
@@ -178,21 +176,6 @@ class Builder {
           q_ = sol.x;
           split_and_merge();
           auto rows = conflicts();
-          if (std::getenv("QSMESH_COARSE_DEBUG") != nullptr) {
-            int sat = 0;
-            for (const auto& r : rows) {
-              double v = 0;
-              for (const auto& [a, c] : r.terms)
-                v += c * static_cast<double>(q_[static_cast<std::size_t>(a)]);
-              sat += v >= 1 ? 1 : 0;
-            }
-            std::fprintf(stderr, "coarse: conflicts kinds %d %d %d %d, rows already met %d\n",
-                         dbg_[0], dbg_[1], dbg_[2], dbg_[3], sat);
-          }
-          if (std::getenv("QSMESH_COARSE_DEBUG") != nullptr)
-            std::fprintf(
-                stderr, "coarse: round %d arcs %zu rows %zu conflicts %zu ilp %.3f s obj %g\n",
-                round, arcs_.size(), ilp.rows.size(), rows.size(), sol.seconds, sol.objective);
           if (rows.empty()) {
             coarse_mesh();
             rows = flat_corners();
@@ -775,7 +758,6 @@ class Builder {
   // Merges of the current solution that break the CAD (see run()), as rows that forbid them.
   [[nodiscard]] std::vector<IntegerProgram::Row> conflicts() {
     std::vector<IntegerProgram::Row> rows;
-    dbg_ = {0, 0, 0, 0};
     const auto np = static_cast<GO>(rep_.size());
     // Per group: its first corner, first curve point, first irregular interior point.
     std::unordered_map<GO, std::array<GO, 3>> first;
@@ -788,13 +770,13 @@ class Builder {
       const int d = vc(v).dim;
       if (d == 0) {
         if (f[0] >= 0 && rep_[static_cast<std::size_t>(f[0])] != v)
-          rows.push_back(separation(f[0], x)), ++dbg_[0];
+          rows.push_back(separation(f[0], x));
         else if (f[0] < 0)
           f[0] = x;
       } else if (d == 1) {
         if (f[1] >= 0 && vc(rep_[static_cast<std::size_t>(f[1])]).entity != vc(v).entity &&
             f[0] < 0)
-          rows.push_back(separation(f[1], x)), ++dbg_[1];
+          rows.push_back(separation(f[1], x));
         else if (f[1] < 0)
           f[1] = x;
       } else if (irregular(v) && f[2] < 0) {
@@ -803,7 +785,7 @@ class Builder {
     }
     for (const auto& [r, f] : first) {
       const GO b = f[0] >= 0 ? f[0] : f[1];
-      if (f[2] >= 0 && b >= 0) rows.push_back(separation(f[2], b)), ++dbg_[2];
+      if (f[2] >= 0 && b >= 0) rows.push_back(separation(f[2], b));
     }
     for (const Cell& c : cells_)
       for (int i = 0; i < 4; ++i)
@@ -811,8 +793,7 @@ class Builder {
           if (dsu_.find(c.pts[static_cast<std::size_t>(i)]) ==
               dsu_.find(c.pts[static_cast<std::size_t>(j)]))
             rows.push_back(
-                separation(c.pts[static_cast<std::size_t>(i)], c.pts[static_cast<std::size_t>(j)])),
-                ++dbg_[3];
+                separation(c.pts[static_cast<std::size_t>(i)], c.pts[static_cast<std::size_t>(j)]));
     // A CAD corner in no unit quad (every patch at it collapsed): the first patch with a corner
     // there keeps both its sides at the corner (so an area >= 1).
     std::vector<char> in_cell(static_cast<std::size_t>(np), 0);
@@ -1318,22 +1299,6 @@ class Builder {
       mesh::VertexClass c = nodes[static_cast<std::size_t>(o)].c;
       if (c.dim == 0) {
         if (c.entity != k) {
-          if (std::getenv("QSMESH_COARSE_DEBUG") != nullptr) {
-            GO v = -1;
-            for (GO x = 0; x < nv_; ++x)
-              if (vc(x).dim == 0 && vc(x).entity == k) v = x;
-            std::fprintf(stderr, "corner %ld vertex %ld valence %d node %d\n", (long)k, (long)v,
-                         v >= 0 ? valence(v) : -1, v >= 0 ? node_[v] : -1);
-            if (v >= 0) {
-              auto it = node_point_.find(v);
-              if (it != node_point_.end()) {
-                GO g = group_[it->second];
-                std::fprintf(stderr, " group %ld center %ld dim %d\n", (long)g, (long)center_[g],
-                             vc(center_[g]).dim);
-              } else
-                std::fprintf(stderr, " not a node point\n");
-            }
-          }
           throw Reject{cat("CAD corner ", k, " is missing")};
         }
         ++corners;
@@ -1354,15 +1319,7 @@ class Builder {
     std::iota(qorder.begin(), qorder.end(), 0);
     std::stable_sort(qorder.begin(), qorder.end(),
                      [&](std::size_t a, std::size_t b) { return fq[a].face < fq[b].face; });
-    std::vector<std::size_t> block_order(cquads_.size());
-    std::iota(block_order.begin(), block_order.end(), 0);
-    std::stable_sort(block_order.begin(), block_order.end(), [&](std::size_t a, std::size_t b) {
-      return cquads_[a].face < cquads_[b].face;
-    });
-    std::vector<GO> block_index(cquads_.size());
-    for (std::size_t i = 0; i < block_order.size(); ++i)
-      block_index[block_order[i]] = static_cast<GO>(i);
-    out.layout.quad2block.assign(fq.size(), -1);
+    std::vector<std::size_t> cq_of_fine(fq.size(), 0);
     for (std::size_t i = 0; i < qorder.size(); ++i) {
       const FineQuad& f = fq[qorder[i]];
       std::array<GO, 4> v{};
@@ -1371,7 +1328,7 @@ class Builder {
             renum[static_cast<std::size_t>(f.v[static_cast<std::size_t>(c)])];
       sm.quads.push_back(v);
       sm.quad_face.push_back(f.face);
-      out.layout.quad2block[i] = block_index[static_cast<std::size_t>(f.block)];
+      cq_of_fine[i] = static_cast<std::size_t>(f.block);
     }
     // Bars: the fine edges of the coarse edges on curves, by curve and parameter.
     struct BarRec {
@@ -1407,18 +1364,6 @@ class Builder {
     sm.curve_corners = m_.curve_corners;
     sm.face2curves = m_.face2curves;
     sm.length_unit = m_.length_unit;
-    // Blocks.
-    for (std::size_t i = 0; i < block_order.size(); ++i) {
-      const std::size_t k = block_order[i];
-      const CQuad& q = cquads_[k];
-      Block b;
-      b.face = q.face;
-      b.ni = cedges_[static_cast<std::size_t>(q.e[0])].n;
-      b.nj = cedges_[static_cast<std::size_t>(q.e[1])].n;
-      b.first = static_cast<std::int64_t>(out.layout.vertices.size());
-      for (GO v : block_grid[k]) out.layout.vertices.push_back(renum[static_cast<std::size_t>(v)]);
-      out.layout.blocks.push_back(b);
-    }
     // Validity: no quad folded against the face (normal at its corners) and SICN > 0.
     double smin = 2, ssum = 0;
     for (std::size_t i = 0; i < sm.quads.size(); ++i) {
@@ -1427,17 +1372,6 @@ class Builder {
         p[static_cast<std::size_t>(c)] =
             sm.points[static_cast<std::size_t>(sm.quads[i][static_cast<std::size_t>(c)])];
       const double s = mesh::quad_sicn(p);
-      if (s <= 0 && std::getenv("QSMESH_COARSE_DEBUG") != nullptr) {
-        std::fprintf(stderr, "bad quad face %d sicn %g:", sm.quad_face[i], s);
-        for (int c = 0; c < 4; ++c) {
-          const auto& k =
-              sm.vclass[static_cast<std::size_t>(sm.quads[i][static_cast<std::size_t>(c)])];
-          std::fprintf(stderr, " (%d %d %.3g %.3g)", k.dim, k.entity, k.param[0], k.param[1]);
-        }
-        std::fprintf(stderr, " block %ld %dx%d\n", (long)out.layout.quad2block[i],
-                     out.layout.blocks[out.layout.quad2block[i]].ni,
-                     out.layout.blocks[out.layout.quad2block[i]].nj);
-      }
       smin = std::min(smin, s);
       ssum += s;
     }
@@ -1450,7 +1384,7 @@ class Builder {
       for (int c = 0; c < 4; ++c)
         p[static_cast<std::size_t>(c)] =
             sm.points[static_cast<std::size_t>(sm.quads[i][static_cast<std::size_t>(c)])];
-      const std::size_t k = block_order[static_cast<std::size_t>(out.layout.quad2block[i])];
+      const std::size_t k = cq_of_fine[i];
       if (mesh::quad_sicn(p) <= 0 || bad_fine_cquad_[k]) {
         bad_cquads_.push_back(k);
         ++bad_quads_;
@@ -1458,6 +1392,200 @@ class Builder {
     }
     std::sort(bad_cquads_.begin(), bad_cquads_.end());
     bad_cquads_.erase(std::unique(bad_cquads_.begin(), bad_cquads_.end()), bad_cquads_.end());
+    if (!bad_cquads_.empty()) return;
+    blocks(block_grid, renum, cq_of_fine, out.layout);
+  }
+
+  // Blocks: the coarse quads joined across the chords that can go (closed loops of coarse edges
+  // off the CAD curves through vertices of four quads, away from CAD corners: removing one joins
+  // the quads on its two sides pairwise, and the layout stays conforming), each as one grid.
+  void blocks(const std::vector<std::vector<GO>>& block_grid, const std::vector<GO>& renum,
+              const std::vector<std::size_t>& cq_of_fine, QuadLayout& lay) {
+    const std::size_t nq = cquads_.size(), ne = cedges_.size();
+    std::vector<std::vector<std::pair<std::size_t, int>>> at(static_cast<std::size_t>(ng_));
+    for (std::size_t q = 0; q < nq; ++q)
+      for (int k = 0; k < 4; ++k)
+        at[static_cast<std::size_t>(cquads_[q].v[static_cast<std::size_t>(k)])].emplace_back(q, k);
+    // The edge across vertex g from edge e (-1: g is no regular crossing).
+    auto opposite = [&](GO g, GO e) -> GO {
+      const auto& list = at[static_cast<std::size_t>(g)];
+      if (list.size() != 4 || vc(center_[static_cast<std::size_t>(g)]).dim == 0) return -1;
+      std::vector<GO> edges;
+      std::vector<std::pair<GO, GO>> paired;
+      for (const auto& [q, k] : list) {
+        const GO a = cquads_[q].e[static_cast<std::size_t>(k)];
+        const GO b = cquads_[q].e[static_cast<std::size_t>((k + 3) % 4)];
+        edges.push_back(a);
+        edges.push_back(b);
+        paired.emplace_back(a, b);
+      }
+      std::sort(edges.begin(), edges.end());
+      edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+      if (edges.size() != 4) return -1;
+      GO out = -1;
+      for (GO x : edges) {
+        if (x == e) continue;
+        bool with_e = false;
+        for (const auto& [a, b] : paired)
+          with_e = with_e || (a == e && b == x) || (a == x && b == e);
+        if (!with_e) {
+          if (out >= 0) return -1;
+          out = x;
+        }
+      }
+      return out;
+    };
+    std::vector<char> removed(ne, 0), seen(ne, 0);
+    for (std::size_t e0 = 0; e0 < ne; ++e0) {
+      if (seen[e0] || cedges_[e0].curve != kNoIndex) continue;
+      std::vector<GO> chain{static_cast<GO>(e0)};
+      std::vector<GO> verts{cedges_[e0].a};
+      seen[e0] = 1;
+      bool closed = false, ok = true;
+      GO e = static_cast<GO>(e0), g = cedges_[e0].b;
+      while (ok) {
+        const GO next = opposite(g, e);
+        if (next < 0 || cedges_[static_cast<std::size_t>(next)].curve != kNoIndex) {
+          ok = false;
+          break;
+        }
+        if (std::find(verts.begin(), verts.end(), g) != verts.end() && g != verts.front()) {
+          ok = false;
+          break;
+        }
+        verts.push_back(g);
+        if (next == static_cast<GO>(e0)) {
+          closed = g == verts.front();
+          break;
+        }
+        if (seen[static_cast<std::size_t>(next)]) {
+          ok = false;
+          break;
+        }
+        seen[static_cast<std::size_t>(next)] = 1;
+        chain.push_back(next);
+        const CEdge& ce = cedges_[static_cast<std::size_t>(next)];
+        g = ce.a == g ? ce.b : ce.a;
+        e = next;
+      }
+      if (ok && closed)
+        for (GO x : chain) removed[static_cast<std::size_t>(x)] = 1;
+    }
+    // Components across removed edges, each walked as a grid of (quad, orientation).
+    Dsu comp;
+    comp.resize(static_cast<GO>(nq));
+    for (std::size_t e = 0; e < ne; ++e)
+      if (removed[e] && cedges_[e].uses.size() == 2)
+        comp.unite(cedges_[e].uses[0].first, cedges_[e].uses[1].first);
+    std::map<GO, std::vector<std::size_t>> members;
+    for (std::size_t q = 0; q < nq; ++q) members[comp.find(static_cast<GO>(q))].push_back(q);
+    struct Ori {
+      std::size_t q;
+      int k;
+    };
+    auto edge_of = [&](Ori o, int side) {
+      return cquads_[o.q].e[static_cast<std::size_t>((o.k + side) % 4)];
+    };
+    auto across = [&](Ori o, int side, int new_side) -> std::optional<Ori> {
+      const GO e = edge_of(o, side);
+      if (!removed[static_cast<std::size_t>(e)]) return std::nullopt;
+      const CEdge& ce = cedges_[static_cast<std::size_t>(e)];
+      for (const auto& [q, m] : ce.uses)
+        if (q != static_cast<GO>(o.q)) {
+          const Ori n{static_cast<std::size_t>(q), ((m - new_side) % 4 + 4) % 4};
+          // The shared edge runs the other way in the neighbour (consistent orientation).
+          if (cquads_[n.q].v[static_cast<std::size_t>((n.k + new_side) % 4)] !=
+              cquads_[o.q].v[static_cast<std::size_t>((o.k + side + 1) % 4)])
+            return std::nullopt;
+          return n;
+        }
+      return std::nullopt;
+    };
+    auto own = [](int k, LO il, LO jl, LO n0, LO n1) -> std::pair<LO, LO> {
+      if (k == 0) return {il, jl};
+      if (k == 1) return {n0 - jl, il};
+      if (k == 2) return {n0 - il, n1 - jl};
+      return {jl, n1 - il};
+    };
+    std::vector<GO> block_of(nq, -1);
+    std::vector<std::pair<LO, std::size_t>> order;  // (face, first quad) of each component
+    for (const auto& [r, list] : members)
+      order.emplace_back(cquads_[list.front()].face, list.front());
+    std::sort(order.begin(), order.end());
+    for (const auto& [face, first] : order) {
+      const std::vector<std::size_t>& list = members[comp.find(static_cast<GO>(first))];
+      // Rows of the component's grid, or each quad alone when it is not one.
+      std::vector<std::vector<Ori>> rows;
+      bool grid = false;
+      for (std::size_t q : list) {
+        for (int k = 0; k < 4 && !grid; ++k) {
+          const Ori o{q, k};
+          if (removed[static_cast<std::size_t>(edge_of(o, 0))] ||
+              removed[static_cast<std::size_t>(edge_of(o, 3))])
+            continue;
+          rows.clear();
+          std::size_t count = 0;
+          bool bad = false;
+          for (std::optional<Ori> row = o; row && !bad; row = across(*row, 2, 0)) {
+            rows.emplace_back();
+            for (std::optional<Ori> c = row; c && !bad; c = across(*c, 1, 3)) {
+              rows.back().push_back(*c);
+              if (++count > list.size()) bad = true;
+            }
+            if (rows.back().size() != rows.front().size()) bad = true;
+          }
+          grid = !bad && count == list.size();
+        }
+        if (grid) break;
+      }
+      auto emit = [&](const std::vector<std::vector<Ori>>& g) {
+        const auto b = static_cast<GO>(lay.blocks.size());
+        std::vector<LO> widths_i, widths_j;
+        for (const Ori& o : g.front())
+          widths_i.push_back(cedges_[static_cast<std::size_t>(edge_of(o, 0))].n);
+        for (const auto& row : g)
+          widths_j.push_back(cedges_[static_cast<std::size_t>(edge_of(row.front(), 3))].n);
+        Block blk;
+        blk.face = face;
+        blk.ni = std::accumulate(widths_i.begin(), widths_i.end(), 0);
+        blk.nj = std::accumulate(widths_j.begin(), widths_j.end(), 0);
+        blk.first = static_cast<std::int64_t>(lay.vertices.size());
+        std::vector<GO> grid_v(static_cast<std::size_t>(blk.ni + 1) *
+                               static_cast<std::size_t>(blk.nj + 1));
+        LO j0 = 0;
+        for (std::size_t r = 0; r < g.size(); ++r) {
+          LO i0 = 0;
+          for (std::size_t c = 0; c < g[r].size(); ++c) {
+            const Ori o = g[r][c];
+            const CQuad& cq = cquads_[o.q];
+            const LO n0 = cedges_[static_cast<std::size_t>(cq.e[0])].n;
+            const LO n1 = cedges_[static_cast<std::size_t>(cq.e[1])].n;
+            for (LO jl = 0; jl <= widths_j[r]; ++jl)
+              for (LO il = 0; il <= widths_i[c]; ++il) {
+                const auto [i, j] = own(o.k, il, jl, n0, n1);
+                grid_v[static_cast<std::size_t>(j0 + jl) * static_cast<std::size_t>(blk.ni + 1) +
+                       static_cast<std::size_t>(i0 + il)] =
+                    renum[static_cast<std::size_t>(
+                        block_grid[o.q]
+                                  [static_cast<std::size_t>(j) * static_cast<std::size_t>(n0 + 1) +
+                                   static_cast<std::size_t>(i)])];
+              }
+            block_of[o.q] = b;
+            i0 += widths_i[c];
+          }
+          j0 += widths_j[r];
+        }
+        lay.vertices.insert(lay.vertices.end(), grid_v.begin(), grid_v.end());
+        lay.blocks.push_back(blk);
+      };
+      if (grid) {
+        emit(rows);
+      } else {
+        for (std::size_t q : list) emit({{Ori{q, 0}}});
+      }
+    }
+    lay.quad2block.resize(cq_of_fine.size());
+    for (std::size_t i = 0; i < cq_of_fine.size(); ++i) lay.quad2block[i] = block_of[cq_of_fine[i]];
   }
 
   // Winslow smoothing face by face (smooth::smooth_face: boundary locked, every move kept only
@@ -1601,7 +1729,6 @@ class Builder {
   std::unordered_map<GO, GO> node_point_;
   std::vector<GO> arc_base_, rep_;
   Dsu dsu_;
-  std::array<int, 4> dbg_{};
   std::vector<std::vector<std::pair<GO, LO>>> links_;  // zero-length links of each point
   std::vector<std::vector<LO>> labels_;                // the arcs whose lengths make each link
   std::vector<Cell> cells_;
