@@ -264,7 +264,8 @@ struct Checks {
     LO unblocked_faces = 0, extended_faces = 0;
     /// --layout coarse: asked for; fallback: it failed and the dense layout was written.
     bool coarse = false, fallback = false;
-    std::int64_t ilp_variables = 0, ilp_constraints = 0, fine_quads = 0;
+    std::int64_t ilp_variables = 0, ilp_constraints = 0, fine_quads = 0, tmesh_patches = 0;
+    int ilp_rounds = 0, repairs = 0;
     double ilp_seconds = 0, layout_seconds = 0, sicn_min = 0, sicn_avg = 0;
     [[nodiscard]] double mean_quads() const {
       return blocks > 0 ? static_cast<double>(quads) / static_cast<double>(blocks) : 0.0;
@@ -434,6 +435,9 @@ std::string stats_json(const Arguments& args, const Session& session,
       j.value("ilp_variables", checks.blocks->ilp_variables);
       j.value("ilp_constraints", checks.blocks->ilp_constraints);
       j.value("ilp_seconds", checks.blocks->ilp_seconds);
+      j.value("ilp_rounds", static_cast<std::int64_t>(checks.blocks->ilp_rounds));
+      j.value("tmesh_patches", checks.blocks->tmesh_patches);
+      j.value("coarse_layout_repairs", static_cast<std::int64_t>(checks.blocks->repairs));
       j.value("coarse_layout_seconds", checks.blocks->layout_seconds);
       j.value("block_mesh_quads", checks.blocks->fine_quads);
       j.value("block_mesh_sicn_min", checks.blocks->sicn_min);
@@ -850,6 +854,9 @@ int run_mesh(const Arguments& args) {
         b.ilp_constraints = c.ilp_constraints;
         b.ilp_seconds = c.ilp_seconds;
         b.layout_seconds = c.seconds;
+        b.tmesh_patches = c.tmesh_patches;
+        b.ilp_rounds = c.ilp_rounds;
+        b.repairs = c.repairs;
         if (coarse->ok) {
           b.fine_quads = c.fine_quads;
           b.sicn_min = c.sicn_min;
