@@ -28,7 +28,7 @@ namespace {
 
 constexpr LO kNever = std::numeric_limits<LO>::max();
 constexpr int kMaxRounds = 12;
-constexpr int kMaxRepairs = 8;
+constexpr int kMaxRepairs = 12;
 
 // Thrown inside the stage when the result cannot be built; turned into CoarseResult::failure.
 struct Reject {
@@ -832,7 +832,7 @@ class Builder {
 
   // Rows q_a >= l_a for the side arcs of every patch touching a corner group of a bad coarse
   // quad, and of the patch it was cut from.
-  [[nodiscard]] std::vector<IntegerProgram::Row> restore_rows() const {
+  [[nodiscard]] std::vector<IntegerProgram::Row> restore_rows() {
     std::vector<char> bad_group(static_cast<std::size_t>(ng_), 0);
     std::vector<LO> patches;
     for (std::size_t k : bad_cquads_) {
@@ -844,17 +844,23 @@ class Builder {
         patches.insert(patches.end(), point_patches_[x].begin(), point_patches_[x].end());
     std::sort(patches.begin(), patches.end());
     patches.erase(std::unique(patches.begin(), patches.end()), patches.end());
-    std::vector<LO> arcs;
-    for (LO p : patches)
+    // A patch's first repair only forbids its arcs to collapse; its next ones restore the input
+    // lengths (which keeps more of the input's split lines, hence more blocks).
+    repair_level_.resize(grids_.size(), 0);
+    std::map<LO, double> arcs;  // arc -> lower bound
+    for (LO p : patches) {
+      const int level = ++repair_level_[static_cast<std::size_t>(p)];
       for (int s = 0; s < 4; ++s)
-        for (LO a : side_arcs(static_cast<std::size_t>(p), s)) arcs.push_back(a);
-    std::sort(arcs.begin(), arcs.end());
-    arcs.erase(std::unique(arcs.begin(), arcs.end()), arcs.end());
+        for (LO a : side_arcs(static_cast<std::size_t>(p), s)) {
+          const double lo = level == 1 ? 1.0 : arcs_[static_cast<std::size_t>(a)].length();
+          arcs[a] = std::max(arcs[a], lo);
+        }
+    }
     std::vector<IntegerProgram::Row> rows;
-    for (LO a : arcs) {
+    for (const auto& [a, lo] : arcs) {
       IntegerProgram::Row r;
       r.terms.emplace_back(a, 1.0);
-      r.lo = arcs_[static_cast<std::size_t>(a)].length();
+      r.lo = lo;
       r.hi = std::numeric_limits<double>::infinity();
       rows.push_back(std::move(r));
     }
@@ -1740,6 +1746,7 @@ class Builder {
   std::map<LO, std::unique_ptr<cad::FaceGeometry>> face_geom_;
   std::map<LO, std::unique_ptr<cad::CurveGeometry>> curve_geom_;
   std::vector<char> bad_fine_cquad_;
+  std::vector<int> repair_level_;
   std::vector<std::size_t> bad_cquads_;
   std::int64_t bad_quads_ = 0;
   std::vector<std::vector<LO>> point_patches_;
