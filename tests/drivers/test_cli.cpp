@@ -55,6 +55,20 @@ TEST(Cli, SecondOrder) {
             std::string::npos);
 }
 
+TEST(Cli, LayoutCoarseIsTheDefaultOfBlockStructured) {
+  EXPECT_TRUE(p({"mesh", "m.step", "-o", "o.cgns", "--block-structured"}).coarse_layout);
+  EXPECT_FALSE(p({"mesh", "m.step", "-o", "o.cgns", "--block-structured", "--layout", "dense"})
+                   .coarse_layout);
+  EXPECT_TRUE(p({"mesh", "m.step", "-o", "o.cgns", "--block-structured", "--layout", "coarse"})
+                  .coarse_layout);
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.cgns", "--block-structured", "--layout", "fine"})
+                .find("not coarse or dense"),
+            std::string::npos);
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.cgns", "--layout", "dense"})
+                .find("only with --block-structured"),
+            std::string::npos);
+}
+
 TEST(Cli, BlockStructuredNeedsCgnsAndQuads) {
   EXPECT_TRUE(p({"mesh", "m.step", "-o", "o.cgns", "--block-structured"}).block_structured);
   EXPECT_FALSE(p({"mesh", "m.step", "-o", "o.cgns"}).block_structured);
