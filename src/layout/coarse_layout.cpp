@@ -27,7 +27,7 @@ namespace qsmesh::layout {
 namespace {
 
 constexpr LO kNever = std::numeric_limits<LO>::max();
-constexpr int kMaxRounds = 12;
+constexpr int kMaxRounds = 40;
 constexpr int kMaxRepairs = 12;
 
 // Thrown inside the stage when the result cannot be built; turned into CoarseResult::failure.
