@@ -28,10 +28,11 @@ struct CoarseStats {
   std::int64_t tmesh_nodes = 0, tmesh_arcs = 0, tmesh_patches = 0, traces = 0;
   std::int64_t ilp_variables = 0, ilp_constraints = 0;
   double ilp_seconds = 0;  ///< all rounds
+  /// Solves, each after rows forbidding the CAD merges of the last one (at most 40 per repair).
   int ilp_rounds = 0;
-  /// Solves again after an invalid fine mesh: the patches that made the bad coarse quads kept
-  /// their input lengths.
-  int repairs = 0;  ///< solves (each after rows forbidding the CAD merges of the last one)
+  /// Solves again after an invalid fine mesh, the patches that made the bad coarse quads kept from
+  /// collapsing, then at their input lengths (at most 12).
+  int repairs = 0;
   std::string ilp_status;
   std::int64_t coarse_quads = 0;  ///< blocks
   std::int64_t fine_quads = 0;
@@ -43,16 +44,19 @@ struct CoarseResult {
   bool ok = false;         ///< mesh and layout hold a valid conforming block-structured mesh
   std::string failure;     ///< why not, when !ok (one line)
   mesh::SurfaceMesh mesh;  ///< the new all-quad mesh (SurfaceMesh numbering and classification)
-  QuadLayout layout;       ///< its blocks: one per coarse quad, sides shared whole
+  /// Its blocks: the coarse quads, joined across chords that can go (closed loops of coarse edges
+  /// through regular vertices, off the curves); every side shared whole with one other side.
+  QuadLayout layout;
   CoarseStats stats;
 };
 
 /// Builds the coarse block-structured mesh of `input`.
 /// Preconditions: `input` is an assembled SurfaceMesh of `model` (bars on every CAD curve, each
 /// face's quads oriented along its normal). A mesh with triangles, a T-mesh patch that is not a
-/// grid, an ILP without solution, or a result that does not validate (a coarse quad with a repeated
-/// corner, a non-manifold coarse edge, two CAD corners merged, a folded fine quad) gives ok = false
-/// and the reason; nothing is thrown for those. Deterministic: the same input gives the same mesh.
+/// grid, an ILP without solution, or a result that does not validate after the rounds and repairs
+/// (a coarse quad with a repeated corner, a non-manifold coarse edge, two CAD corners merged, a
+/// folded fine quad) gives ok = false and the reason; nothing is thrown for those. Deterministic:
+/// the same input gives the same mesh.
 [[nodiscard]] CoarseResult build_coarse_layout(const mesh::SurfaceMesh& input,
                                                const cad::CadModel& model,
                                                const CoarseOptions& options = {});
