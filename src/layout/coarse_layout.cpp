@@ -181,6 +181,13 @@ class Builder {
             rows = flat_corners();
             if (rows.empty()) break;
           }
+          // A row the solution already meets would not change the next solve: stop here.
+          for (const auto& r : rows) {
+            double sum = 0;
+            for (const auto& [a, c] : r.terms)
+              sum += c * static_cast<double>(q_[static_cast<std::size_t>(a)]);
+            if (sum >= r.lo) throw Reject{"a CAD merge that no row on the arc lengths cuts"};
+          }
           if (round + 1 >= kMaxRounds)
             throw Reject{cat("CAD entities still merge after ", kMaxRounds, " ILP rounds")};
           for (const auto& r : rows) ilp.rows.push_back(r);
