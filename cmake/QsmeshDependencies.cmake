@@ -67,6 +67,10 @@ qsmesh_find_plain(qsmesh_metis metis.h metis "METIS" "libmetis-dev")
 # table (src/remesh/tools); its header sits in a multiarch folder, hence the nauty/ prefix.
 qsmesh_find_plain(qsmesh_nauty nauty/nauty.h nauty "nauty" "libnauty2-dev")
 
+# COIN-OR CBC (its C interface), the integer program solver of the coarse block layout
+# (src/layout/ilp_cbc.cpp; docs/architecture.md says why CBC)
+qsmesh_find_plain(qsmesh_cbc coin/Cbc_C_Interface.h CbcSolver "COIN-OR CBC" "coinor-libcbc-dev")
+
 # HDF5 (serial: Debian's libcgns is built against it)
 pkg_check_modules(HDF5S QUIET IMPORTED_TARGET hdf5-serial)
 qsmesh_require(HDF5S_FOUND "HDF5 (serial)" "libhdf5-dev")

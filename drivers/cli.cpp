@@ -153,6 +153,7 @@ Arguments parse(const std::vector<std::string>& args) {
   bool sizing_rules_given = false;  // --sizing on the line
 
   std::vector<std::string> positional;
+  bool layout_given = false;
   for (std::size_t i = 1; i < args.size(); ++i) {
     const std::string& opt = args[i];
     auto value = [&]() -> const std::string& {
@@ -202,7 +203,13 @@ Arguments parse(const std::vector<std::string>& args) {
     // Paper 003 (fieldmesh): meshing from a given cross field.
     else if (opt == "--cross-field" && a.command == Command::Mesh)
       a.cross_field = value();
-    else if (opt == "--order" && a.command == Command::Mesh) {
+    else if (opt == "--layout" && a.command == Command::Mesh) {
+      const std::string& v = value();
+      if (v != "coarse" && v != "dense")
+        throw InputError("--layout: '" + v + "' is not coarse or dense");
+      a.coarse_layout = v == "coarse";
+      layout_given = true;
+    } else if (opt == "--order" && a.command == Command::Mesh) {
       const std::string& v = value();
       if (v.size() != 1 || v[0] < '1' || v[0] > '5')
         throw InputError("--order: '" + v + "' is not 1, 2, 3, 4 or 5");
@@ -357,6 +364,8 @@ Arguments parse(const std::vector<std::string>& args) {
                          ": PLOT3D blocks of high-order quads are not written");
       a.block_structured = true;
     }
+    if (layout_given && !a.block_structured)
+      throw InputError("--layout: only with --block-structured (or -o FILE.xyz)");
     if (a.block_structured) {
       if (io::output_format(a.output) != io::Format::kCgns && !plot3d)
         throw InputError(
@@ -460,10 +469,18 @@ std::string help(const std::string& topic) {
           "                        N <= 4 there; VTU Lagrange cells; MSH; in .h5 the datasets\n"
           "                        quadM and barN+1, and the .xdmf shows order 2 curved, higher\n"
           "                        orders as the linear quads of their corners)\n"
-          "  --block-structured    write the .cgns file as structured zones, one per block of the\n"
-          "                        quad layout (traces from irregular vertices and CAD corners,\n"
-          "                        paper 002 Sec. III.A), joined by 1-to-1 connectivity; faces\n"
-          "                        that do not split into blocks go to one unstructured zone\n"
+          "  --block-structured    write the .cgns file as structured zones, one per block,\n"
+          "                        joined by 1-to-1 connectivity (see --layout)\n"
+          "  --layout dense|coarse the blocks of --block-structured (and of .xyz). dense (default):\n"
+          "                        the layout of the quad mesh as it is (traces from irregular\n"
+          "                        vertices and CAD corners, paper 002 Sec. III.A; blocks may meet\n"
+          "                        along part of a side); faces that do not split into blocks go\n"
+          "                        to one unstructured zone. coarse: a new mesh on a conforming\n"
+          "                        layout (paper 002 Sec. III-IV: T-mesh, ILP, subdivision,\n"
+          "                        smoothing), every block side shared whole, every CAD curve a\n"
+          "                        block side; its quads are still worse than the mesh it comes\n"
+          "                        from (docs/benchmarks.md); when it fails, one log line and\n"
+          "                        the dense layout\n"
           "  --plot3d-stream       PLOT3D output without the Fortran record lengths (C stream\n"
           "                        binary: the same bytes, nothing between the records)\n"
           "  --plot3d-single       PLOT3D coordinates in single precision (float32)\n"

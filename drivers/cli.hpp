@@ -43,6 +43,10 @@ struct Arguments {
   /// mesher's own cross field for the other faces.
   std::string cross_field;
   bool separatrix_method = false;
+  /// --layout coarse|dense (with --block-structured): the coarse conforming layout of paper 002
+  /// Sec. III-IV (layout::build_coarse_layout, a new mesh) or the dense layout of the mesh as it
+  /// is (the default: see --help for why).
+  bool coarse_layout = false;
   /// --order N, 2..5: Lagrange quads ((N + 1)^2 nodes) and bars (N + 1 nodes) on the CAD
   /// (highorder::make_high_order); 1: linear.
   int order = 1;

@@ -25,6 +25,7 @@
 #include "qsmesh/holomorphic/holomorphic.hpp"
 #include "qsmesh/io/atomic_file.hpp"
 #include "qsmesh/io/writer.hpp"
+#include "qsmesh/layout/coarse_layout.hpp"
 #include "qsmesh/layout/quad_layout.hpp"
 #include "qsmesh/linalg/solver.hpp"
 #include "qsmesh/mesh/quality.hpp"
@@ -267,6 +268,11 @@ struct Checks {
     LO unblocked_faces = 0, extended_faces = 0;
     /// PLOT3D output: what it could not hold (the unblocked faces with elements).
     std::optional<io::Plot3dReport> plot3d;
+    /// --layout coarse: asked for; fallback: it failed and the dense layout was written.
+    bool coarse = false, fallback = false;
+    std::int64_t ilp_variables = 0, ilp_constraints = 0, fine_quads = 0, tmesh_patches = 0;
+    int ilp_rounds = 0, repairs = 0;
+    double ilp_seconds = 0, layout_seconds = 0, sicn_min = 0, sicn_avg = 0;
     [[nodiscard]] double mean_quads() const {
       return blocks > 0 ? static_cast<double>(quads) / static_cast<double>(blocks) : 0.0;
     }
@@ -433,6 +439,22 @@ std::string stats_json(const Arguments& args, const Session& session,
     j.value("block_quads_largest", checks.blocks->largest);
     j.value("faces_not_in_blocks", static_cast<std::int64_t>(checks.blocks->unblocked_faces));
     j.value("faces_with_extended_traces", static_cast<std::int64_t>(checks.blocks->extended_faces));
+    j.value("block_layout",
+            std::string(checks.blocks->coarse
+                            ? (checks.blocks->fallback ? "dense (coarse failed)" : "coarse")
+                            : "dense"));
+    if (checks.blocks->coarse) {
+      j.value("ilp_variables", checks.blocks->ilp_variables);
+      j.value("ilp_constraints", checks.blocks->ilp_constraints);
+      j.value("ilp_seconds", checks.blocks->ilp_seconds);
+      j.value("ilp_rounds", static_cast<std::int64_t>(checks.blocks->ilp_rounds));
+      j.value("tmesh_patches", checks.blocks->tmesh_patches);
+      j.value("coarse_layout_repairs", static_cast<std::int64_t>(checks.blocks->repairs));
+      j.value("coarse_layout_seconds", checks.blocks->layout_seconds);
+      j.value("block_mesh_quads", checks.blocks->fine_quads);
+      j.value("block_mesh_sicn_min", checks.blocks->sicn_min);
+      j.value("block_mesh_sicn_avg", checks.blocks->sicn_avg);
+    }
     if (checks.blocks->plot3d) {
       const io::Plot3dReport& p = *checks.blocks->plot3d;
       j.value("plot3d_left_out_faces", static_cast<std::int64_t>(p.skipped_faces.size()));
@@ -587,6 +609,11 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
       os << "  left out of the PLOT3D file (not blocks): " << b.plot3d->skipped_faces.size()
          << " faces, " << b.plot3d->skipped_triangles << " triangles, " << b.plot3d->skipped_quads
          << " quads\n";
+    if (b.coarse && !b.fallback)
+      os << "  coarse layout: ILP " << b.ilp_variables << " variables, " << b.ilp_constraints
+         << " constraints, " << b.ilp_seconds << " s; layout " << b.layout_seconds << " s; "
+         << b.fine_quads << " quads, SICN min " << b.sicn_min << " avg " << b.sicn_avg << "\n";
+    if (b.fallback) os << "  coarse layout failed: the dense layout was written\n";
   }
   if (!checks.rank_peak_mb.empty()) {
     const std::vector<double>& mb = checks.rank_peak_mb;
@@ -859,8 +886,33 @@ int run_mesh(const Arguments& args) {
       clock.reset();
     }
     if (args.block_structured) {
-      const layout::QuadLayout lay = layout::extract_quad_layout(result.mesh);
       Checks::Blocks b;
+      std::optional<layout::CoarseResult> coarse;
+      if (args.coarse_layout) {
+        coarse = layout::build_coarse_layout(result.mesh, s.model);
+        const layout::CoarseStats& c = coarse->stats;
+        b.coarse = true;
+        b.ilp_variables = c.ilp_variables;
+        b.ilp_constraints = c.ilp_constraints;
+        b.ilp_seconds = c.ilp_seconds;
+        b.layout_seconds = c.seconds;
+        b.tmesh_patches = c.tmesh_patches;
+        b.ilp_rounds = c.ilp_rounds;
+        b.repairs = c.repairs;
+        if (coarse->ok) {
+          b.fine_quads = c.fine_quads;
+          b.sicn_min = c.sicn_min;
+          b.sicn_avg = c.sicn_avg;
+        } else {
+          b.fallback = true;
+          s.log.warn(cat("coarse layout failed (", coarse->failure,
+                         "): writing the dense layout instead"));
+          coarse.reset();
+        }
+      }
+      const mesh::SurfaceMesh& written = coarse ? coarse->mesh : result.mesh;
+      const layout::QuadLayout lay =
+          coarse ? std::move(coarse->layout) : layout::extract_quad_layout(result.mesh);
       b.blocks = static_cast<std::int64_t>(lay.blocks.size());
       for (const layout::Block& k : lay.blocks) {
         const std::int64_t n = static_cast<std::int64_t>(k.ni) * k.nj;
@@ -875,7 +927,7 @@ int run_mesh(const Arguments& args) {
         io::WriteOptions wo;
         wo.plot3d_fortran_records = !args.plot3d_stream;
         wo.plot3d_single_precision = args.plot3d_single;
-        b.plot3d = io::write_plot3d(result.mesh, lay, args.output, wo);
+        b.plot3d = io::write_plot3d(written, lay, args.output, wo);
         const io::Plot3dReport& p = *b.plot3d;
         if (!p.skipped_faces.empty()) {
           std::string faces;
@@ -892,7 +944,7 @@ int run_mesh(const Arguments& args) {
                          "--block-structured writes them as an unstructured zone)"));
         }
       } else {
-        io::write_cgns_blocks(result.mesh, lay, args.output);
+        io::write_cgns_blocks(written, lay, args.output);
       }
       checks.blocks = b;
     } else {

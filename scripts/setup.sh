@@ -13,6 +13,7 @@ packages=(
   libeigen3-dev
   libmetis-dev
   libnauty2-dev
+  coinor-libcbc-dev
   libhdf5-dev
   libcgns-dev cgns-convert
   libgtest-dev

@@ -44,7 +44,9 @@ struct BlockFileSummary {
   std::int64_t abutments = 0;  ///< general connectivities between a block and the unstructured zone
 };
 
-inline BlockFileSummary check_block_file(const std::string& path) {
+/// whole_sides: also every 1-to-1 interface spans a whole side of its zone and of its donor (a
+/// conforming layout: no T-junction; the dense layout of `--layout dense` has them).
+inline BlockFileSummary check_block_file(const std::string& path, bool whole_sides = false) {
   BlockFileSummary out;
   std::ostringstream err;
   int fn = 0;
@@ -261,6 +263,16 @@ inline BlockFileSummary check_block_file(const std::string& path) {
       }
       links.insert({z - 1, normal(range), it->second, normal(donor)});
       const Zone& dz = zones[static_cast<std::size_t>(it->second)];
+      if (whole_sides) {
+        auto whole = [](const Zone& zz, const cgsize_t r[4]) {
+          const bool along_i = r[1] == r[3];
+          const cgsize_t lo = std::min(r[along_i ? 0 : 1], r[along_i ? 2 : 3]);
+          const cgsize_t hi = std::max(r[along_i ? 0 : 1], r[along_i ? 2 : 3]);
+          return lo == 1 && hi == (along_i ? zz.ni : zz.nj);
+        };
+        if (!whole(zone, range) || !whole(dz, donor))
+          err << zone.name << "/" << cname << ": not a whole side to a whole side (T-junction); ";
+      }
       if (std::abs(transform[0]) == std::abs(transform[1]) || std::abs(transform[0]) < 1 ||
           std::abs(transform[0]) > 2 || std::abs(transform[1]) < 1 || std::abs(transform[1]) > 2) {
         err << zone.name << "/" << cname << ": transform is not a signed permutation; ";

@@ -80,6 +80,22 @@ TEST(Cli, SecondOrder) {
             std::string::npos);
 }
 
+TEST(Cli, LayoutDenseIsTheDefaultOfBlockStructured) {
+  EXPECT_FALSE(p({"mesh", "m.step", "-o", "o.cgns", "--block-structured"}).coarse_layout);
+  EXPECT_FALSE(p({"mesh", "m.step", "-o", "o.xyz"}).coarse_layout);
+  EXPECT_TRUE(p({"mesh", "m.step", "-o", "o.xyz", "--layout", "coarse"}).coarse_layout);
+  EXPECT_FALSE(p({"mesh", "m.step", "-o", "o.cgns", "--block-structured", "--layout", "dense"})
+                   .coarse_layout);
+  EXPECT_TRUE(p({"mesh", "m.step", "-o", "o.cgns", "--block-structured", "--layout", "coarse"})
+                  .coarse_layout);
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.cgns", "--block-structured", "--layout", "fine"})
+                .find("not coarse or dense"),
+            std::string::npos);
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.cgns", "--layout", "dense"})
+                .find("only with --block-structured"),
+            std::string::npos);
+}
+
 TEST(Cli, BlockStructuredNeedsCgnsAndQuads) {
   EXPECT_TRUE(p({"mesh", "m.step", "-o", "o.cgns", "--block-structured"}).block_structured);
   EXPECT_FALSE(p({"mesh", "m.step", "-o", "o.cgns"}).block_structured);

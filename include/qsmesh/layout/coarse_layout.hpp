@@ -1,0 +1,64 @@
+// Coarse, conforming block layout of an all-quad mesh (paper 002 Sec. III and IV.A-E): a T-mesh
+// of traces with the cone stopping rule, the ILP of its quantization (constraints (1)-(4),
+// objective (6)), then the coarse quad mesh extracted from the solution (patch splitting, merging
+// of zero-length groups, placement with CAD priorities), subdivided by quad loops and smoothed on
+// the CAD. Every CAD curve is a wall here: traces stop at curves and blocks end on them (crossing
+// smooth curves, as the paper does on aircraft skins, is not done).
+#pragma once
+
+#include <cstdint>
+#include <string>
+
+#include "qsmesh/cad/model.hpp"
+#include "qsmesh/layout/ilp.hpp"
+#include "qsmesh/layout/quad_layout.hpp"
+#include "qsmesh/mesh/surface_mesh.hpp"
+
+namespace qsmesh::layout {
+
+struct CoarseOptions {
+  /// Half-angle of the cone of the stopping rule and of the geometric consistency (4), radians.
+  double alpha = 0.785398163397448;  // pi/4
+  IlpOptions ilp;
+  /// Passes of the smoother (smooth::smooth_face, Winslow kernels) on each face of the new mesh.
+  int smoothing_iterations = 10;
+};
+
+struct CoarseStats {
+  std::int64_t tmesh_nodes = 0, tmesh_arcs = 0, tmesh_patches = 0, traces = 0;
+  std::int64_t ilp_variables = 0, ilp_constraints = 0;
+  double ilp_seconds = 0;  ///< all rounds
+  /// Solves, each after rows forbidding the CAD merges of the last one (at most 40 per repair).
+  int ilp_rounds = 0;
+  /// Solves again after an invalid fine mesh, the patches that made the bad coarse quads kept from
+  /// collapsing, then at their input lengths (at most 12).
+  int repairs = 0;
+  std::string ilp_status;
+  std::int64_t coarse_quads = 0;  ///< blocks
+  std::int64_t fine_quads = 0;
+  double sicn_min = 0, sicn_avg = 0;  ///< of the new mesh (after smoothing)
+  double seconds = 0;                 ///< the whole stage
+};
+
+struct CoarseResult {
+  bool ok = false;         ///< mesh and layout hold a valid conforming block-structured mesh
+  std::string failure;     ///< why not, when !ok (one line)
+  mesh::SurfaceMesh mesh;  ///< the new all-quad mesh (SurfaceMesh numbering and classification)
+  /// Its blocks: the coarse quads, joined across chords that can go (closed loops of coarse edges
+  /// through regular vertices, off the curves); every side shared whole with one other side.
+  QuadLayout layout;
+  CoarseStats stats;
+};
+
+/// Builds the coarse block-structured mesh of `input`.
+/// Preconditions: `input` is an assembled SurfaceMesh of `model` (bars on every CAD curve, each
+/// face's quads oriented along its normal). A mesh with triangles, a T-mesh patch that is not a
+/// grid, an ILP without solution, or a result that does not validate after the rounds and repairs
+/// (a coarse quad with a repeated corner, a non-manifold coarse edge, two CAD corners merged, a
+/// folded fine quad) gives ok = false and the reason; nothing is thrown for those. Deterministic:
+/// the same input gives the same mesh.
+[[nodiscard]] CoarseResult build_coarse_layout(const mesh::SurfaceMesh& input,
+                                               const cad::CadModel& model,
+                                               const CoarseOptions& options = {});
+
+}  // namespace qsmesh::layout

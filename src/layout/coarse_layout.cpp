@@ -1,0 +1,1774 @@
+#include "qsmesh/layout/coarse_layout.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <map>
+#include <memory>
+#include <numeric>
+#include <optional>
+#include <sstream>
+#include <unordered_map>
+#include <utility>
+#include <vector>
+
+#include "qsmesh/cad/geometry.hpp"
+#include "qsmesh/core/error.hpp"
+#include "qsmesh/core/timer.hpp"
+#include "qsmesh/mesh/edges.hpp"
+#include "qsmesh/mesh/quality.hpp"
+#include "qsmesh/smooth/smooth.hpp"
+#include "qsmesh/smooth/untangle.hpp"
+
+namespace qsmesh::layout {
+
+namespace {
+
+constexpr LO kNever = std::numeric_limits<LO>::max();
+constexpr int kMaxRounds = 40;
+constexpr int kMaxRepairs = 12;
+
+// Thrown inside the stage when the result cannot be built; turned into CoarseResult::failure.
+struct Reject {
+  std::string why;
+};
+
+struct Dsu {
+  std::vector<GO> parent;
+  GO add() {
+    parent.push_back(static_cast<GO>(parent.size()));
+    return parent.back();
+  }
+  void resize(GO n) {
+    const auto old = static_cast<GO>(parent.size());
+    parent.resize(static_cast<std::size_t>(n));
+    for (GO i = old; i < n; ++i) parent[static_cast<std::size_t>(i)] = i;
+  }
+  GO find(GO x) {
+    while (parent[static_cast<std::size_t>(x)] != x) {
+      parent[static_cast<std::size_t>(x)] =
+          parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(x)])];
+      x = parent[static_cast<std::size_t>(x)];
+    }
+    return x;
+  }
+  // The smaller root stays: groups do not depend on the order of the unions.
+  void unite(GO a, GO b) {
+    a = find(a);
+    b = find(b);
+    if (a == b) return;
+    if (b < a) std::swap(a, b);
+    parent[static_cast<std::size_t>(b)] = a;
+  }
+};
+
+struct EdgeRec {
+  std::array<GO, 2> q{-1, -1};
+  int count = 0;
+  LO curve = kNoIndex;  // a bar of this curve
+  bool traced = false;
+};
+
+// A trace through the mesh: path[0] its origin, path[s] the vertex reached after s edges.
+struct Trace {
+  std::vector<GO> path;
+  double tan_alpha = 1;
+  // Crossings met: (step of this trace there, true when the other trace's origin lies in the pi/4
+  // cone of this one, true when the two origins form a 3-5 pair).
+  struct Hit {
+    LO step;
+    bool in_quarter_cone;
+    bool pair35;
+  };
+  std::vector<Hit> hits;
+  LO separate = kNever;  // the prefix up to this step must keep a length >= 1 (constraints 3, 4)
+};
+
+struct Passage {
+  LO trace;
+  LO step;
+  GO prev;
+};
+
+// A T-mesh patch: a grid of ni x nj input quads of one face.
+struct Grid {
+  LO face = kNoIndex;
+  LO ni = 0, nj = 0;
+  std::vector<GO> v;  // (ni + 1) x (nj + 1), i fastest
+  [[nodiscard]] GO at(LO i, LO j) const {
+    return v[static_cast<std::size_t>(j) * static_cast<std::size_t>(ni + 1) +
+             static_cast<std::size_t>(i)];
+  }
+  // Side s, counter-clockwise: 0 = j min (i up), 1 = i max (j up), 2 = j max (i down), 3 = i min.
+  [[nodiscard]] std::vector<GO> side(int s) const {
+    std::vector<GO> out;
+    if (s == 0)
+      for (LO i = 0; i <= ni; ++i) out.push_back(at(i, 0));
+    if (s == 1)
+      for (LO j = 0; j <= nj; ++j) out.push_back(at(ni, j));
+    if (s == 2)
+      for (LO i = ni; i >= 0; --i) out.push_back(at(i, nj));
+    if (s == 3)
+      for (LO j = nj; j >= 0; --j) out.push_back(at(0, j));
+    return out;
+  }
+};
+
+struct Arc {
+  std::vector<GO> verts;  // input mesh vertices, node to node
+  LO curve = kNoIndex;
+  [[nodiscard]] LO length() const { return static_cast<LO>(verts.size()) - 1; }
+};
+
+struct SideArc {
+  LO arc;
+  bool forward;
+};
+
+// A unit quad of the split patches (Sec. IV.A): lattice cell (x, y) of a patch of a x b.
+struct Cell {
+  std::array<GO, 4> pts;  // lattice points, counter-clockwise
+  LO patch;
+  LO x, y, a, b;
+};
+
+class Builder {
+ public:
+  Builder(const mesh::SurfaceMesh& m, const cad::CadModel& model, const CoarseOptions& o)
+      : m_(m), model_(model), opt_(o), nv_(m.num_vertices()) {}
+
+  CoarseResult run() {
+    CoarseResult out;
+    Stopwatch clock;
+    try {
+      if (!m_.triangles.empty()) throw Reject{"the mesh has triangles"};
+      if (m_.quads.empty()) throw Reject{"the mesh has no quad"};
+      adjacency();
+      std::vector<char> extra(static_cast<std::size_t>(std::max<LO>(m_.num_cad_faces, 1)), 0);
+      std::vector<LO> failed = tmesh(extra);
+      if (!failed.empty()) {
+        // A patch that is not a grid (an annulus between two closed curves, say): those faces are
+        // traced again with traces from their CAD corners too.
+        for (LO f : failed) extra[static_cast<std::size_t>(f)] = 1;
+        failed = tmesh(extra);
+        if (!failed.empty())
+          throw Reject{cat("a T-mesh patch of face ", failed.front(), " is not a grid")};
+      }
+      arcs();
+      out.stats.traces = static_cast<std::int64_t>(traces_.size());
+      out.stats.tmesh_patches = static_cast<std::int64_t>(grids_.size());
+      out.stats.tmesh_arcs = static_cast<std::int64_t>(arcs_.size());
+      out.stats.tmesh_nodes = std::count(node_.begin(), node_.end(), 1);
+      IntegerProgram ilp = program();
+      // CAD compliance the constraints of the paper do not ensure (two CAD corners or curves
+      // merged, an irregular vertex collapsed on a curve, a unit quad with a repeated corner): each
+      // such merge found in a solution adds "the zero-length path between them is >= 1" and the
+      // program is solved again.
+      for (int repair = 0;; ++repair) {
+        for (int round = 0;; ++round) {
+          const IlpResult sol = solve_integer_program(ilp, opt_.ilp);
+          out.stats.ilp_seconds += sol.seconds;
+          out.stats.ilp_status = sol.status;
+          ++out.stats.ilp_rounds;
+          if (!sol.feasible) throw Reject{cat("the ILP gave no solution (", sol.status, ")")};
+          q_ = sol.x;
+          split_and_merge();
+          auto rows = conflicts();
+          if (rows.empty()) {
+            coarse_mesh();
+            rows = flat_corners();
+            if (rows.empty()) break;
+          }
+          // A row the solution already meets would not change the next solve: stop here.
+          for (const auto& r : rows) {
+            double sum = 0;
+            for (const auto& [a, c] : r.terms)
+              sum += c * static_cast<double>(q_[static_cast<std::size_t>(a)]);
+            if (sum >= r.lo) throw Reject{"a CAD merge that no row on the arc lengths cuts"};
+          }
+          if (round + 1 >= kMaxRounds)
+            throw Reject{cat("CAD entities still merge after ", kMaxRounds, " ILP rounds")};
+          for (const auto& r : rows) ilp.rows.push_back(r);
+        }
+        out.stats.ilp_variables = ilp.num_variables();
+        out.stats.ilp_constraints = static_cast<std::int64_t>(ilp.rows.size());
+        out.mesh = {};
+        out.layout = {};
+        fine_mesh(out);
+        if (bad_cquads_.empty()) break;
+        if (repair + 1 >= kMaxRepairs)
+          throw Reject{
+              cat(bad_quads_, " fine quads invalid or folded after ", kMaxRepairs, " repairs")};
+        // Where the fine mesh is invalid, the patches that made those coarse quads keep their
+        // input lengths (the input layout is valid), and all is solved again.
+        for (const auto& r : restore_rows()) ilp.rows.push_back(r);
+        out.stats.repairs = repair + 1;
+      }
+      out.stats.coarse_quads = static_cast<std::int64_t>(out.layout.blocks.size());
+      out.stats.fine_quads = static_cast<std::int64_t>(out.mesh.quads.size());
+      out.ok = true;
+    } catch (const Reject& r) {
+      out.ok = false;
+      out.failure = r.why;
+      out.mesh = {};
+      out.layout = {};
+    }
+    out.stats.seconds = clock.seconds();
+    return out;
+  }
+
+ private:
+  template <typename... A>
+  static std::string cat(const A&... a) {
+    std::ostringstream s;
+    (s << ... << a);
+    return s.str();
+  }
+
+  // ---------------------------------------------------------------- adjacency
+  void adjacency() {
+    const auto nq = static_cast<GO>(m_.quads.size());
+    v2q_off_.assign(static_cast<std::size_t>(nv_) + 1, 0);
+    for (const auto& q : m_.quads)
+      for (GO v : q) ++v2q_off_[static_cast<std::size_t>(v) + 1];
+    std::partial_sum(v2q_off_.begin(), v2q_off_.end(), v2q_off_.begin());
+    v2q_.resize(static_cast<std::size_t>(v2q_off_.back()));
+    std::vector<GO> fill(v2q_off_.begin(), v2q_off_.end() - 1);
+    for (GO q = 0; q < nq; ++q)
+      for (GO v : m_.quads[static_cast<std::size_t>(q)])
+        v2q_[static_cast<std::size_t>(fill[static_cast<std::size_t>(v)]++)] = q;
+    edges_.reserve(static_cast<std::size_t>(2 * nq + static_cast<GO>(m_.bars.size())));
+    for (GO q = 0; q < nq; ++q) {
+      const auto& quad = m_.quads[static_cast<std::size_t>(q)];
+      for (int k = 0; k < 4; ++k) {
+        EdgeRec& e = edges_[mesh::edge_key(quad[k], quad[(k + 1) % 4])];
+        if (e.count < 2) e.q[static_cast<std::size_t>(e.count)] = q;
+        ++e.count;
+      }
+    }
+    for (std::size_t b = 0; b < m_.bars.size(); ++b) {
+      const auto it = edges_.find(mesh::edge_key(m_.bars[b][0], m_.bars[b][1]));
+      if (it != edges_.end()) it->second.curve = m_.bar_curve[b];
+    }
+  }
+
+  [[nodiscard]] LO valence(GO v) const {
+    return static_cast<LO>(v2q_off_[static_cast<std::size_t>(v) + 1] -
+                           v2q_off_[static_cast<std::size_t>(v)]);
+  }
+  [[nodiscard]] const mesh::VertexClass& vc(GO v) const {
+    return m_.vclass[static_cast<std::size_t>(v)];
+  }
+  [[nodiscard]] bool regular_interior(GO v) const { return vc(v).dim == 2 && valence(v) == 4; }
+  [[nodiscard]] const EdgeRec& edge(GO a, GO b) const { return edges_.at(mesh::edge_key(a, b)); }
+  [[nodiscard]] EdgeRec& edge(GO a, GO b) { return edges_.at(mesh::edge_key(a, b)); }
+
+  // An edge inside one face: traces follow it, patches are crossed through it.
+  [[nodiscard]] bool interior(const EdgeRec& e) const {
+    return e.curve == kNoIndex && e.count == 2 &&
+           m_.quad_face[static_cast<std::size_t>(e.q[0])] ==
+               m_.quad_face[static_cast<std::size_t>(e.q[1])];
+  }
+  [[nodiscard]] bool crossable(const EdgeRec& e) const { return interior(e) && !e.traced; }
+
+  [[nodiscard]] std::array<GO, 2> neighbours_in_quad(GO q, GO v) const {
+    const auto& quad = m_.quads[static_cast<std::size_t>(q)];
+    for (int k = 0; k < 4; ++k)
+      if (quad[k] == v) return {quad[(k + 1) % 4], quad[(k + 3) % 4]};
+    throw Reject{cat("vertex ", v, " not in quad ", q)};
+  }
+
+  // At a regular vertex c reached from prev: the vertex across c on the same grid line, and the
+  // two across it (left first: the side of the quads' interior when they run c -> next).
+  struct Cross {
+    GO next, left, right;
+  };
+  [[nodiscard]] Cross cross_at(GO c, GO prev) const {
+    std::vector<GO> nb;
+    for (auto i = v2q_off_[static_cast<std::size_t>(c)];
+         i < v2q_off_[static_cast<std::size_t>(c) + 1]; ++i)
+      for (GO w : neighbours_in_quad(v2q_[static_cast<std::size_t>(i)], c))
+        if (std::find(nb.begin(), nb.end(), w) == nb.end()) nb.push_back(w);
+    if (nb.size() != 4) throw Reject{cat("vertex ", c, " has ", nb.size(), " neighbours")};
+    const EdgeRec& e = edge(c, prev);
+    std::array<GO, 2> side{-1, -1};
+    for (int s = 0; s < 2; ++s) {
+      const auto n = neighbours_in_quad(e.q[static_cast<std::size_t>(s)], c);
+      side[static_cast<std::size_t>(s)] = n[0] == prev ? n[1] : n[0];
+    }
+    GO next = -1;
+    for (GO w : nb)
+      if (w != prev && w != side[0] && w != side[1]) next = w;
+    if (next < 0) throw Reject{cat("no straight continuation at vertex ", c)};
+    // The quad with c followed by next: its vertex before c is on the left.
+    GO left = side[0];
+    for (auto i = v2q_off_[static_cast<std::size_t>(c)];
+         i < v2q_off_[static_cast<std::size_t>(c) + 1]; ++i) {
+      const auto& quad = m_.quads[static_cast<std::size_t>(v2q_[static_cast<std::size_t>(i)])];
+      for (int k = 0; k < 4; ++k)
+        if (quad[k] == c && quad[(k + 1) % 4] == next) left = quad[(k + 3) % 4];
+    }
+    return {next, left, left == side[0] ? side[1] : side[0]};
+  }
+
+  // ---------------------------------------------------------------- T-mesh (Sec. III.A)
+  struct Start {
+    GO v, w;
+    auto operator<=>(const Start&) const = default;
+  };
+
+  // Trace starts: edges leaving irregular interior vertices, and the interior edges of the sides
+  // of other than two quads of boundary vertices (as quad_layout.cpp); in the faces of `extra`,
+  // every interior edge at a CAD corner too.
+  [[nodiscard]] std::vector<Start> starts(const std::vector<char>& extra) const {
+    std::vector<Start> out;
+    std::vector<GO> quads, parent;
+    for (GO v = 0; v < nv_; ++v) {
+      const auto& c = vc(v);
+      quads.assign(v2q_.begin() + v2q_off_[static_cast<std::size_t>(v)],
+                   v2q_.begin() + v2q_off_[static_cast<std::size_t>(v) + 1]);
+      if (quads.empty() || (c.dim == 2 && quads.size() == 4)) continue;
+      parent.resize(quads.size());
+      std::iota(parent.begin(), parent.end(), 0);
+      auto find = [&](GO i) {
+        while (parent[static_cast<std::size_t>(i)] != i) i = parent[static_cast<std::size_t>(i)];
+        return i;
+      };
+      std::vector<std::pair<GO, std::size_t>> inner;
+      for (std::size_t a = 0; a < quads.size(); ++a)
+        for (GO w : neighbours_in_quad(quads[a], v)) {
+          const EdgeRec& e = edge(v, w);
+          if (!interior(e)) continue;
+          inner.emplace_back(w, a);
+          const GO other = e.q[0] == quads[a] ? e.q[1] : e.q[0];
+          const auto b = static_cast<std::size_t>(std::find(quads.begin(), quads.end(), other) -
+                                                  quads.begin());
+          parent[static_cast<std::size_t>(find(static_cast<GO>(a)))] = find(static_cast<GO>(b));
+        }
+      std::vector<int> side_size(quads.size(), 0);
+      for (std::size_t a = 0; a < quads.size(); ++a)
+        ++side_size[static_cast<std::size_t>(find(static_cast<GO>(a)))];
+      for (const auto& [w, a] : inner) {
+        const bool irregular_side =
+            side_size[static_cast<std::size_t>(find(static_cast<GO>(a)))] != 2;
+        const LO f = m_.quad_face[static_cast<std::size_t>(quads[a])];
+        if (c.dim == 2 || irregular_side || (c.dim == 0 && extra[static_cast<std::size_t>(f)]))
+          out.push_back({v, w});
+      }
+    }
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
+  }
+
+  [[nodiscard]] bool pair35(GO a, GO b) const {
+    if (vc(a).dim != 2 || vc(b).dim != 2) return false;
+    const LO x = valence(a), y = valence(b);
+    return (x == 3 && y == 5) || (x == 5 && y == 3);
+  }
+
+  // Motorcycle traces with the cone stopping rule: a trace stops when it has crossed, on each of
+  // its sides, a trace whose origin lies in its cone of half-angle alpha (l_ji <= tan(alpha) l_ij),
+  // at an irregular or boundary vertex, or where its line is traced already. All traces advance
+  // one edge per round in a fixed order. Returns the faces with a patch that is not a grid.
+  std::vector<LO> tmesh(const std::vector<char>& extra) {
+    for (auto& [k, e] : edges_) e.traced = false;
+    traces_.clear();
+    std::vector<std::vector<Passage>> pass(static_cast<std::size_t>(nv_));
+    const double tan_alpha = std::tan(opt_.alpha);
+    std::vector<LO> live;
+    for (const auto& [v, w] : starts(extra)) {
+      EdgeRec& e = edge(v, w);
+      if (e.traced) continue;
+      e.traced = true;
+      Trace t;
+      t.path = {v, w};
+      t.tan_alpha = tan_alpha;
+      traces_.push_back(std::move(t));
+      live.push_back(static_cast<LO>(traces_.size()) - 1);
+    }
+    std::vector<LO> next_live;
+    auto hit = [&](LO t, LO step, LO other, LO other_step) {
+      Trace& a = traces_[static_cast<std::size_t>(t)];
+      const Trace& b = traces_[static_cast<std::size_t>(other)];
+      a.hits.push_back({step, other_step <= step, pair35(a.path[0], b.path[0])});
+      // Geometric consistency (4): b's origin outside a's cone separates b from the crossing.
+      if (static_cast<double>(other_step) > a.tan_alpha * step)
+        traces_[static_cast<std::size_t>(other)].separate =
+            std::min(traces_[static_cast<std::size_t>(other)].separate, other_step);
+    };
+    while (!live.empty()) {
+      next_live.clear();
+      for (LO t : live) {
+        Trace& tr = traces_[static_cast<std::size_t>(t)];
+        const GO cur = tr.path.back(), prev = tr.path[tr.path.size() - 2];
+        const auto step = static_cast<LO>(tr.path.size()) - 1;
+        if (!regular_interior(cur)) {
+          // The end: another irregular vertex (in the cone at distance 0) or a CAD curve, which
+          // the origin must not reach (a face cannot pinch, an interior vertex stays inside).
+          if (vc(cur).dim == 2)
+            tr.hits.push_back({step, true, pair35(tr.path[0], cur)});
+          else
+            tr.separate = std::min(tr.separate, step);
+          continue;
+        }
+        const Cross c = cross_at(cur, prev);
+        bool stop = false, left = false, right = false;
+        for (const Passage& p : pass[static_cast<std::size_t>(cur)]) {
+          if (p.prev == prev || p.prev == c.next) {
+            stop = true;  // the same line, traced already
+            continue;
+          }
+          hit(t, step, p.trace, p.step);
+          hit(p.trace, p.step, t, step);
+          if (static_cast<double>(p.step) <= tr.tan_alpha * step)
+            (p.prev == c.left ? left : right) = true;
+        }
+        if (stop || (left && right)) continue;
+        EdgeRec& e = edge(cur, c.next);
+        if (e.traced) continue;
+        e.traced = true;
+        pass[static_cast<std::size_t>(cur)].push_back({t, step, prev});
+        tr.path.push_back(c.next);
+        next_live.push_back(t);
+      }
+      live.swap(next_live);
+    }
+    // Validity (3): the first crossing with an origin in the pi/4 cone is separated, unless the
+    // two origins are a 3-5 pair (their collapse leaves a regular vertex).
+    for (Trace& t : traces_) {
+      std::stable_sort(t.hits.begin(), t.hits.end(),
+                       [](const Trace::Hit& a, const Trace::Hit& b) { return a.step < b.step; });
+      for (const Trace::Hit& h : t.hits)
+        if (h.in_quarter_cone) {
+          if (!h.pair35) t.separate = std::min(t.separate, h.step);
+          break;
+        }
+    }
+    return patches();
+  }
+
+  // Patches: quads joined across untraced interior edges, each as a grid.
+  std::vector<LO> patches() {
+    grids_.clear();
+    const auto nq = static_cast<GO>(m_.quads.size());
+    std::vector<char> seen(static_cast<std::size_t>(nq), 0);
+    std::vector<GO> members, stack;
+    std::vector<LO> failed;
+    for (GO seed = 0; seed < nq; ++seed) {
+      if (seen[static_cast<std::size_t>(seed)]) continue;
+      members.clear();
+      stack.assign(1, seed);
+      seen[static_cast<std::size_t>(seed)] = 1;
+      while (!stack.empty()) {
+        const GO q = stack.back();
+        stack.pop_back();
+        members.push_back(q);
+        const auto& quad = m_.quads[static_cast<std::size_t>(q)];
+        for (int k = 0; k < 4; ++k) {
+          const EdgeRec& e = edge(quad[k], quad[(k + 1) % 4]);
+          if (!crossable(e)) continue;
+          const GO other = e.q[0] == q ? e.q[1] : e.q[0];
+          if (seen[static_cast<std::size_t>(other)]) continue;
+          seen[static_cast<std::size_t>(other)] = 1;
+          stack.push_back(other);
+        }
+      }
+      std::sort(members.begin(), members.end());
+      const LO f = m_.quad_face[static_cast<std::size_t>(seed)];
+      if (auto g = grid(members, f)) {
+        grids_.push_back(std::move(*g));
+      } else {
+        failed.push_back(f);
+      }
+    }
+    std::sort(failed.begin(), failed.end());
+    failed.erase(std::unique(failed.begin(), failed.end()), failed.end());
+    return failed;
+  }
+
+  [[nodiscard]] int position(GO q, GO v) const {
+    const auto& quad = m_.quads[static_cast<std::size_t>(q)];
+    for (int k = 0; k < 4; ++k)
+      if (quad[k] == v) return k;
+    return -1;
+  }
+
+  // The patch `members` (sorted quad ids) as an ni x nj grid; none when it is not one.
+  [[nodiscard]] std::optional<Grid> grid(const std::vector<GO>& members, LO face) const {
+    auto in_patch = [&](GO q) { return std::binary_search(members.begin(), members.end(), q); };
+    auto across = [&](GO q, GO a, GO b) -> GO {
+      const EdgeRec& e = edge(a, b);
+      if (!crossable(e)) return -1;
+      const GO other = e.q[0] == q ? e.q[1] : e.q[0];
+      return in_patch(other) ? other : -1;
+    };
+    struct Oriented {
+      GO q;
+      int k;
+    };
+    auto corner = [&](Oriented o, int c) {
+      return m_.quads[static_cast<std::size_t>(o.q)][(o.k + c) % 4];
+    };
+    Oriented start{-1, 0};
+    for (GO q : members) {
+      const auto& quad = m_.quads[static_cast<std::size_t>(q)];
+      for (int k = 0; k < 4 && start.q < 0; ++k)
+        if (across(q, quad[k], quad[(k + 1) % 4]) < 0 && across(q, quad[(k + 3) % 4], quad[k]) < 0)
+          start = {q, k};
+      if (start.q >= 0) break;
+    }
+    if (start.q < 0) return std::nullopt;
+    auto step_i = [&](Oriented o) -> Oriented {
+      const GO b = corner(o, 1), c = corner(o, 2);
+      const GO n = across(o.q, b, c);
+      return n < 0 ? Oriented{-1, 0} : Oriented{n, position(n, b)};
+    };
+    auto step_j = [&](Oriented o) -> Oriented {
+      const GO d = corner(o, 3), c = corner(o, 2);
+      const GO n = across(o.q, d, c);
+      return n < 0 ? Oriented{-1, 0} : Oriented{n, position(n, d)};
+    };
+    LO ni = 0;
+    for (Oriented o = start; o.q >= 0; o = step_i(o))
+      if (++ni > static_cast<LO>(members.size())) return std::nullopt;
+    std::vector<GO> gv;
+    std::vector<GO> seen;
+    LO nj = 0;
+    for (Oriented row = start; row.q >= 0; row = step_j(row)) {
+      if (static_cast<GO>(nj + 1) * ni > static_cast<GO>(members.size())) return std::nullopt;
+      gv.resize(static_cast<std::size_t>(ni + 1) * static_cast<std::size_t>(nj + 2), -1);
+      Oriented o = row;
+      for (LO i = 0; i < ni; ++i) {
+        if (o.q < 0) return std::nullopt;
+        seen.push_back(o.q);
+        const std::array<std::pair<LO, LO>, 4> at{
+            {{i, nj}, {i + 1, nj}, {i + 1, nj + 1}, {i, nj + 1}}};
+        for (int c = 0; c < 4; ++c) {
+          GO& slot = gv[static_cast<std::size_t>(at[c].second) * static_cast<std::size_t>(ni + 1) +
+                        static_cast<std::size_t>(at[c].first)];
+          if (slot >= 0 && slot != corner(o, c)) return std::nullopt;
+          slot = corner(o, c);
+        }
+        o = step_i(o);
+      }
+      if (o.q >= 0) return std::nullopt;
+      ++nj;
+    }
+    std::sort(seen.begin(), seen.end());
+    if (seen != members) return std::nullopt;
+    return Grid{face, ni, nj, std::move(gv)};
+  }
+
+  // Nodes (irregular and boundary-turning vertices, trace crossings and ends, patch corners) and
+  // the arcs between them, with each patch's four sides as arc sequences.
+  void arcs() {
+    node_.assign(static_cast<std::size_t>(nv_), 0);
+    std::vector<LO> degree(static_cast<std::size_t>(nv_), 0);
+    for (const auto& [k, e] : edges_) {
+      if (interior(e) && !e.traced) continue;
+      ++degree[static_cast<std::size_t>(k >> 32)];
+      ++degree[static_cast<std::size_t>(k & 0xffffffffULL)];
+    }
+    for (GO v = 0; v < nv_; ++v)
+      if (vc(v).dim == 0 || (vc(v).dim == 2 && valence(v) != 4) ||
+          (degree[static_cast<std::size_t>(v)] != 0 && degree[static_cast<std::size_t>(v)] != 2))
+        node_[static_cast<std::size_t>(v)] = 1;
+    for (const Grid& g : grids_)
+      for (GO c : {g.at(0, 0), g.at(g.ni, 0), g.at(g.ni, g.nj), g.at(0, g.nj)})
+        node_[static_cast<std::size_t>(c)] = 1;
+    arcs_.clear();
+    edge_arc_.clear();
+    sides_.assign(grids_.size(), {});
+    for (std::size_t p = 0; p < grids_.size(); ++p)
+      for (int s = 0; s < 4; ++s) {
+        const std::vector<GO> seq = grids_[p].side(s);
+        std::size_t k0 = 0;
+        for (std::size_t k = 1; k < seq.size(); ++k) {
+          if (!node_[static_cast<std::size_t>(seq[k])] && k + 1 < seq.size()) continue;
+          const std::uint64_t key = mesh::edge_key(seq[k0], seq[k0 + 1]);
+          auto it = edge_arc_.find(key);
+          LO a;
+          if (it == edge_arc_.end()) {
+            a = static_cast<LO>(arcs_.size());
+            Arc arc;
+            arc.verts.assign(seq.begin() + static_cast<std::ptrdiff_t>(k0),
+                             seq.begin() + static_cast<std::ptrdiff_t>(k) + 1);
+            arc.curve = edge(seq[k0], seq[k0 + 1]).curve;
+            for (std::size_t i = k0; i < k; ++i) edge_arc_[mesh::edge_key(seq[i], seq[i + 1])] = a;
+            arcs_.push_back(std::move(arc));
+          } else {
+            a = it->second;
+          }
+          const Arc& arc = arcs_[static_cast<std::size_t>(a)];
+          if (arc.length() != static_cast<LO>(k - k0))
+            throw Reject{cat("arc of ", arc.length(), " edges met as ", k - k0)};
+          const bool fwd = arc.verts[0] == seq[k0] && arc.verts[1] == seq[k0 + 1];
+          sides_[p][static_cast<std::size_t>(s)].push_back({a, fwd});
+          k0 = k;
+        }
+      }
+  }
+
+  // Arcs of trace t over its first `steps` edges.
+  [[nodiscard]] std::vector<LO> prefix_arcs(const Trace& t, LO steps) const {
+    std::vector<LO> out;
+    for (LO s = 0; s < steps && s + 1 < static_cast<LO>(t.path.size()); ++s) {
+      const auto it = edge_arc_.find(mesh::edge_key(t.path[static_cast<std::size_t>(s)],
+                                                    t.path[static_cast<std::size_t>(s) + 1]));
+      if (it != edge_arc_.end() && (out.empty() || out.back() != it->second))
+        out.push_back(it->second);
+    }
+    std::sort(out.begin(), out.end());
+    out.erase(std::unique(out.begin(), out.end()), out.end());
+    return out;
+  }
+
+  // ---------------------------------------------------------------- ILP (Sec. III.B-C)
+  [[nodiscard]] IntegerProgram program() const {
+    IntegerProgram p;
+    const auto na = arcs_.size();
+    const double inf = std::numeric_limits<double>::infinity();
+    for (const Arc& a : arcs_) {
+      p.objective.push_back(1.0 / a.length());  // (6)
+      p.lower.push_back(0);                     // (1)
+      // At most the input length: then the split points of an arc or patch (Sec. IV.A) stand on
+      // distinct input vertices strictly inside it, which places them (Sec. IV.C).
+      p.upper.push_back(a.length());
+    }
+    std::vector<double> coef(na, 0);
+    std::vector<int> used;
+    auto flush = [&](double lo, double hi) {
+      IntegerProgram::Row r;
+      std::sort(used.begin(), used.end());
+      used.erase(std::unique(used.begin(), used.end()), used.end());
+      for (int v : used)
+        if (coef[static_cast<std::size_t>(v)] != 0)
+          r.terms.emplace_back(v, coef[static_cast<std::size_t>(v)]);
+      for (int v : used) coef[static_cast<std::size_t>(v)] = 0;
+      used.clear();
+      if (!r.terms.empty()) {
+        r.lo = lo;
+        r.hi = hi;
+        p.rows.push_back(std::move(r));
+      }
+    };
+    for (const auto& sides : sides_)  // (2)
+      for (int s = 0; s < 2; ++s) {
+        for (const SideArc& x : sides[static_cast<std::size_t>(s)]) {
+          coef[static_cast<std::size_t>(x.arc)] += 1;
+          used.push_back(x.arc);
+        }
+        for (const SideArc& x : sides[static_cast<std::size_t>(s) + 2]) {
+          coef[static_cast<std::size_t>(x.arc)] -= 1;
+          used.push_back(x.arc);
+        }
+        flush(0, 0);
+      }
+    for (const Trace& t : traces_) {  // (3), (4) and the ends on CAD curves
+      if (t.separate == kNever) continue;
+      for (LO a : prefix_arcs(t, t.separate)) {
+        coef[static_cast<std::size_t>(a)] = 1;
+        used.push_back(a);
+      }
+      flush(1, inf);
+    }
+    // A curve cannot vanish (a closed one keeps three edges, so that its coarse edges join
+    // distinct vertices).
+    std::map<LO, std::vector<int>> by_curve;
+    for (std::size_t a = 0; a < na; ++a)
+      if (arcs_[a].curve != kNoIndex) by_curve[arcs_[a].curve].push_back(static_cast<int>(a));
+    for (const auto& [c, list] : by_curve) {
+      for (int a : list) {
+        coef[static_cast<std::size_t>(a)] = 1;
+        used.push_back(a);
+      }
+      const auto& ends = m_.curve_corners[static_cast<std::size_t>(c)];
+      flush(ends[0] == ends[1] ? 3 : 1, inf);
+    }
+    return p;
+  }
+
+  // ---------------------------------------------------------------- Sec. IV.A-B
+  [[nodiscard]] GO arc_point(LO a, LO t) const {
+    const Arc& arc = arcs_[static_cast<std::size_t>(a)];
+    const long q = q_[static_cast<std::size_t>(a)];
+    if (t == 0) return node_point_.at(arc.verts.front());
+    if (t == q) return node_point_.at(arc.verts.back());
+    return arc_base_[static_cast<std::size_t>(a)] + t - 1;
+  }
+
+  // Lattice points of side s of patch p, from its first corner to its last.
+  [[nodiscard]] std::vector<GO> side_points(std::size_t p, int s,
+                                            std::vector<LO>* from_arc = nullptr) const {
+    std::vector<GO> out;
+    for (const SideArc& x : sides_[p][static_cast<std::size_t>(s)]) {
+      const auto q = static_cast<LO>(q_[static_cast<std::size_t>(x.arc)]);
+      if (out.empty()) out.push_back(arc_point(x.arc, x.forward ? 0 : q));
+      for (LO t = 1; t <= q; ++t) {
+        out.push_back(arc_point(x.arc, x.forward ? t : q - t));
+        if (from_arc != nullptr) from_arc->push_back(x.arc);
+      }
+    }
+    if (out.empty()) {
+      const SideArc& x = sides_[p][static_cast<std::size_t>(s)].front();
+      out.push_back(arc_point(x.arc, 0));
+    }
+    return out;
+  }
+
+  [[nodiscard]] std::vector<LO> side_arcs(std::size_t p, int s) const {
+    std::vector<LO> out;
+    for (const SideArc& x : sides_[p][static_cast<std::size_t>(s)]) out.push_back(x.arc);
+    return out;
+  }
+
+  // Points x and y are one (zero distance); the distance between them is the sum of `arcs`.
+  void link(GO x, GO y, std::vector<LO> arcs) {
+    if (x == y) return;
+    dsu_.unite(x, y);
+    const auto l = static_cast<LO>(labels_.size());
+    labels_.push_back(std::move(arcs));
+    links_[static_cast<std::size_t>(x)].emplace_back(y, l);
+    links_[static_cast<std::size_t>(y)].emplace_back(x, l);
+  }
+
+  // The row "the zero-length path from x to y keeps a length >= 1" (breadth-first over links).
+  [[nodiscard]] IntegerProgram::Row separation(GO x, GO y) const {
+    std::vector<std::pair<GO, LO>> from(rep_.size(), {-1, -1});
+    std::vector<GO> queue{x};
+    from[static_cast<std::size_t>(x)] = {x, -1};
+    for (std::size_t h = 0; h < queue.size() && from[static_cast<std::size_t>(y)].first < 0; ++h)
+      for (const auto& [z, l] : links_[static_cast<std::size_t>(queue[h])])
+        if (from[static_cast<std::size_t>(z)].first < 0) {
+          from[static_cast<std::size_t>(z)] = {queue[h], l};
+          queue.push_back(z);
+        }
+    if (from[static_cast<std::size_t>(y)].first < 0) throw Reject{"no zero-length path to cut"};
+    std::vector<LO> arcs;
+    for (GO z = y; z != x; z = from[static_cast<std::size_t>(z)].first) {
+      const auto& l = labels_[static_cast<std::size_t>(from[static_cast<std::size_t>(z)].second)];
+      arcs.insert(arcs.end(), l.begin(), l.end());
+    }
+    std::sort(arcs.begin(), arcs.end());
+    arcs.erase(std::unique(arcs.begin(), arcs.end()), arcs.end());
+    if (arcs.empty()) throw Reject{"a merge no arc length can undo"};
+    IntegerProgram::Row r;
+    for (LO a : arcs) r.terms.emplace_back(a, 1.0);
+    r.lo = 1;
+    r.hi = std::numeric_limits<double>::infinity();
+    return r;
+  }
+
+  // Merges of the current solution that break the CAD (see run()), as rows that forbid them.
+  [[nodiscard]] std::vector<IntegerProgram::Row> conflicts() {
+    std::vector<IntegerProgram::Row> rows;
+    const auto np = static_cast<GO>(rep_.size());
+    // Per group: its first corner, first curve point, first irregular interior point.
+    std::unordered_map<GO, std::array<GO, 3>> first;
+    auto irregular = [&](GO v) { return vc(v).dim == 2 && valence(v) != 4; };
+    for (GO x = 0; x < np; ++x) {
+      const GO r = dsu_.find(x);
+      const GO v = rep_[static_cast<std::size_t>(x)];
+      const auto it = first.try_emplace(r, std::array<GO, 3>{-1, -1, -1}).first;
+      auto& f = it->second;
+      const int d = vc(v).dim;
+      if (d == 0) {
+        if (f[0] >= 0 && rep_[static_cast<std::size_t>(f[0])] != v)
+          rows.push_back(separation(f[0], x));
+        else if (f[0] < 0)
+          f[0] = x;
+      } else if (d == 1) {
+        if (f[1] >= 0 && vc(rep_[static_cast<std::size_t>(f[1])]).entity != vc(v).entity &&
+            f[0] < 0)
+          rows.push_back(separation(f[1], x));
+        else if (f[1] < 0)
+          f[1] = x;
+      } else if (irregular(v) && f[2] < 0) {
+        f[2] = x;
+      }
+    }
+    for (const auto& [r, f] : first) {
+      const GO b = f[0] >= 0 ? f[0] : f[1];
+      if (f[2] >= 0 && b >= 0) rows.push_back(separation(f[2], b));
+    }
+    for (const Cell& c : cells_)
+      for (int i = 0; i < 4; ++i)
+        for (int j = i + 1; j < 4; ++j)
+          if (dsu_.find(c.pts[static_cast<std::size_t>(i)]) ==
+              dsu_.find(c.pts[static_cast<std::size_t>(j)]))
+            rows.push_back(
+                separation(c.pts[static_cast<std::size_t>(i)], c.pts[static_cast<std::size_t>(j)]));
+    // A CAD corner in no unit quad (every patch at it collapsed): the first patch with a corner
+    // there keeps both its sides at the corner (so an area >= 1).
+    std::vector<char> in_cell(static_cast<std::size_t>(np), 0);
+    for (const Cell& c : cells_)
+      for (GO x : c.pts) in_cell[static_cast<std::size_t>(dsu_.find(x))] = 1;
+    for (const auto& [v, x] : node_point_) {
+      if (vc(v).dim != 0 || in_cell[static_cast<std::size_t>(dsu_.find(x))]) continue;
+      bool done = false;
+      for (std::size_t p = 0; p < grids_.size() && !done; ++p) {
+        const Grid& g = grids_[p];
+        const std::array<GO, 4> corner{g.at(0, 0), g.at(g.ni, 0), g.at(g.ni, g.nj), g.at(0, g.nj)};
+        for (int k = 0; k < 4 && !done; ++k) {
+          if (corner[static_cast<std::size_t>(k)] != v) continue;
+          for (int s = k; s <= k + 1; ++s) {
+            IntegerProgram::Row r;
+            for (LO a : side_arcs(p, s % 4)) r.terms.emplace_back(a, 1.0);
+            std::sort(r.terms.begin(), r.terms.end());
+            r.terms.erase(std::unique(r.terms.begin(), r.terms.end()), r.terms.end());
+            r.lo = 1;
+            r.hi = std::numeric_limits<double>::infinity();
+            rows.push_back(std::move(r));
+          }
+          done = true;
+        }
+      }
+      if (!done) throw Reject{cat("CAD corner ", vc(v).entity, " is no patch corner")};
+    }
+    // Distinct rows only, in a fixed order.
+    std::sort(rows.begin(), rows.end(),
+              [](const auto& a, const auto& b) { return a.terms < b.terms; });
+    rows.erase(std::unique(rows.begin(), rows.end(),
+                           [](const auto& a, const auto& b) { return a.terms == b.terms; }),
+               rows.end());
+    return rows;
+  }
+
+  // Rows q_a >= l_a for the side arcs of every patch touching a corner group of a bad coarse
+  // quad, and of the patch it was cut from.
+  [[nodiscard]] std::vector<IntegerProgram::Row> restore_rows() {
+    std::vector<char> bad_group(static_cast<std::size_t>(ng_), 0);
+    std::vector<LO> patches;
+    for (std::size_t k : bad_cquads_) {
+      for (GO g : cquads_[k].v) bad_group[static_cast<std::size_t>(g)] = 1;
+      patches.push_back(cells_[static_cast<std::size_t>(cquads_[k].cell)].patch);
+    }
+    for (std::size_t x = 0; x < rep_.size(); ++x)
+      if (bad_group[static_cast<std::size_t>(group_[x])])
+        patches.insert(patches.end(), point_patches_[x].begin(), point_patches_[x].end());
+    std::sort(patches.begin(), patches.end());
+    patches.erase(std::unique(patches.begin(), patches.end()), patches.end());
+    // A patch's first repair only forbids its arcs to collapse; its next ones restore the input
+    // lengths (which keeps more of the input's split lines, hence more blocks).
+    repair_level_.resize(grids_.size(), 0);
+    std::map<LO, double> arcs;  // arc -> lower bound
+    for (LO p : patches) {
+      const int level = ++repair_level_[static_cast<std::size_t>(p)];
+      for (int s = 0; s < 4; ++s)
+        for (LO a : side_arcs(static_cast<std::size_t>(p), s)) {
+          const double lo = level == 1 ? 1.0 : arcs_[static_cast<std::size_t>(a)].length();
+          arcs[a] = std::max(arcs[a], lo);
+        }
+    }
+    std::vector<IntegerProgram::Row> rows;
+    for (const auto& [a, lo] : arcs) {
+      IntegerProgram::Row r;
+      r.terms.emplace_back(a, 1.0);
+      r.lo = lo;
+      r.hi = std::numeric_limits<double>::infinity();
+      rows.push_back(std::move(r));
+    }
+    return rows;
+  }
+
+  // A coarse quad corner between two edges on CAD curves away from a CAD corner is flat (an
+  // interior node merged onto the curve made it): the row separating them.
+  [[nodiscard]] std::vector<IntegerProgram::Row> flat_corners() {
+    std::vector<IntegerProgram::Row> rows;
+    std::vector<char> flat(static_cast<std::size_t>(ng_), 0);
+    for (const CQuad& q : cquads_)
+      for (int k = 0; k < 4; ++k) {
+        const GO g = q.v[static_cast<std::size_t>(k)];
+        if (vc(center_[static_cast<std::size_t>(g)]).dim == 0) continue;
+        if (cedges_[static_cast<std::size_t>(q.e[static_cast<std::size_t>(k)])].curve != kNoIndex &&
+            cedges_[static_cast<std::size_t>(q.e[static_cast<std::size_t>((k + 3) % 4)])].curve !=
+                kNoIndex)
+          flat[static_cast<std::size_t>(g)] = 1;
+      }
+    std::vector<GO> inner(static_cast<std::size_t>(ng_), -1),
+        on_curve(static_cast<std::size_t>(ng_), -1);
+    for (const auto& [v, x] : node_point_) {
+      const GO g = group_[static_cast<std::size_t>(x)];
+      if (!flat[static_cast<std::size_t>(g)]) continue;
+      GO& slot = vc(v).dim == 2 ? inner[static_cast<std::size_t>(g)]
+                                : on_curve[static_cast<std::size_t>(g)];
+      if (slot < 0 || x < slot) slot = x;
+    }
+    for (GO g = 0; g < ng_; ++g) {
+      if (!flat[static_cast<std::size_t>(g)]) continue;
+      if (inner[static_cast<std::size_t>(g)] < 0 || on_curve[static_cast<std::size_t>(g)] < 0)
+        throw Reject{"a coarse quad has a flat corner on a CAD curve"};
+      rows.push_back(
+          separation(inner[static_cast<std::size_t>(g)], on_curve[static_cast<std::size_t>(g)]));
+    }
+    return rows;
+  }
+
+  void split_and_merge() {
+    // Points: nodes, then the inner points of arcs of length >= 2, then the inner points of the
+    // patches, each with a representative input vertex.
+    node_point_.clear();
+    rep_.clear();
+    for (const Arc& a : arcs_)
+      for (GO v : {a.verts.front(), a.verts.back()})
+        if (node_point_.emplace(v, static_cast<GO>(rep_.size())).second) rep_.push_back(v);
+    arc_base_.assign(arcs_.size(), 0);
+    for (std::size_t a = 0; a < arcs_.size(); ++a) {
+      arc_base_[a] = static_cast<GO>(rep_.size());
+      const long q = q_[a];
+      const LO l = arcs_[a].length();
+      for (long t = 1; t < q; ++t)
+        rep_.push_back(arcs_[a].verts[static_cast<std::size_t>(
+            std::lround(static_cast<double>(t) * l / static_cast<double>(q)))]);
+    }
+    dsu_ = {};
+    dsu_.resize(static_cast<GO>(rep_.size()));
+    links_.assign(rep_.size(), {});
+    point_patches_.assign(rep_.size(), {});
+    labels_.clear();
+    for (std::size_t a = 0; a < arcs_.size(); ++a)
+      if (q_[a] == 0)
+        link(node_point_.at(arcs_[a].verts.front()), node_point_.at(arcs_[a].verts.back()),
+             {static_cast<LO>(a)});
+    cells_.clear();
+    for (std::size_t p = 0; p < grids_.size(); ++p) {
+      std::array<std::vector<GO>, 4> sp;
+      for (int s = 0; s < 4; ++s) sp[static_cast<std::size_t>(s)] = side_points(p, s);
+      for (const auto& side : sp)
+        for (GO x : side) point_patches_[static_cast<std::size_t>(x)].push_back(static_cast<LO>(p));
+      const auto a = static_cast<LO>(sp[0].size()) - 1, b = static_cast<LO>(sp[1].size()) - 1;
+      if (a != static_cast<LO>(sp[2].size()) - 1 || b != static_cast<LO>(sp[3].size()) - 1)
+        throw Reject{cat("patch ", p, " is not consistent in the solution")};
+      // Sides meet at the corners (a side of length 0 is a single point).
+      for (int k = 0; k < 4; ++k)
+        link(sp[static_cast<std::size_t>(k)].back(),
+             sp[static_cast<std::size_t>((k + 1) % 4)].front(), side_arcs(p, k));
+      if (a == 0 || b == 0) {
+        // A patch of zero area: its opposite sides' points merge (Sec. IV.A-B).
+        for (LO k = 0; a == 0 && k <= b; ++k)
+          link(sp[1][static_cast<std::size_t>(k)], sp[3][static_cast<std::size_t>(b - k)],
+               side_arcs(p, 0));
+        for (LO k = 0; b == 0 && k <= a; ++k)
+          link(sp[0][static_cast<std::size_t>(k)], sp[2][static_cast<std::size_t>(a - k)],
+               side_arcs(p, 1));
+        continue;
+      }
+      const Grid& g = grids_[p];
+      std::vector<GO> lat(static_cast<std::size_t>(a + 1) * static_cast<std::size_t>(b + 1), -1);
+      auto at = [&](LO x, LO y) -> GO& {
+        return lat[static_cast<std::size_t>(y) * static_cast<std::size_t>(a + 1) +
+                   static_cast<std::size_t>(x)];
+      };
+      for (LO x = 0; x <= a; ++x) {
+        at(x, 0) = sp[0][static_cast<std::size_t>(x)];
+        at(a - x, b) = sp[2][static_cast<std::size_t>(x)];
+      }
+      for (LO y = 0; y <= b; ++y) {
+        at(a, y) = sp[1][static_cast<std::size_t>(y)];
+        at(0, b - y) = sp[3][static_cast<std::size_t>(y)];
+      }
+      for (LO y = 1; y < b; ++y)
+        for (LO x = 1; x < a; ++x) {
+          at(x, y) = dsu_.add();
+          links_.emplace_back();
+          point_patches_.emplace_back();
+          rep_.push_back(g.at(static_cast<LO>(std::lround(static_cast<double>(x) * g.ni / a)),
+                              static_cast<LO>(std::lround(static_cast<double>(y) * g.nj / b))));
+        }
+      for (LO y = 0; y < b; ++y)
+        for (LO x = 0; x < a; ++x)
+          cells_.push_back({{at(x, y), at(x + 1, y), at(x + 1, y + 1), at(x, y + 1)},
+                            static_cast<LO>(p),
+                            x,
+                            y,
+                            a,
+                            b});
+    }
+  }
+
+  // ---------------------------------------------------------------- Sec. IV.B-D
+  void coarse_mesh() {
+    // Groups, numbered in the order of their smallest point.
+    const auto np = static_cast<GO>(rep_.size());
+    group_.assign(static_cast<std::size_t>(np), -1);
+    std::vector<GO> root_group(static_cast<std::size_t>(np), -1);
+    ng_ = 0;
+    for (GO x = 0; x < np; ++x) {
+      const GO r = dsu_.find(x);
+      if (root_group[static_cast<std::size_t>(r)] < 0)
+        root_group[static_cast<std::size_t>(r)] = ng_++;
+      group_[static_cast<std::size_t>(x)] = root_group[static_cast<std::size_t>(r)];
+    }
+    // Only the groups used by a cell are coarse vertices.
+    std::vector<char> used(static_cast<std::size_t>(ng_), 0);
+    for (const Cell& c : cells_)
+      for (GO x : c.pts) used[static_cast<std::size_t>(group_[static_cast<std::size_t>(x)])] = 1;
+    // Centres (Sec. IV.C): a CAD corner, else a vertex on a curve, else the member nearest the
+    // group's centroid.
+    center_.assign(static_cast<std::size_t>(ng_), -1);
+    std::vector<Vec3> sum(static_cast<std::size_t>(ng_), Vec3{0, 0, 0});
+    std::vector<double> cnt(static_cast<std::size_t>(ng_), 0);
+    std::vector<LO> curve_of(static_cast<std::size_t>(ng_), kNoIndex);
+    for (GO x = 0; x < np; ++x) {
+      const GO g = group_[static_cast<std::size_t>(x)];
+      const GO v = rep_[static_cast<std::size_t>(x)];
+      sum[static_cast<std::size_t>(g)] += m_.points[static_cast<std::size_t>(v)];
+      cnt[static_cast<std::size_t>(g)] += 1;
+      GO& c = center_[static_cast<std::size_t>(g)];
+      const int dv = vc(v).dim;
+      if (dv == 0) {
+        if (c >= 0 && vc(c).dim == 0 && c != v && used[static_cast<std::size_t>(g)])
+          throw Reject{cat("CAD corners ", c, " and ", v, " merge")};
+        c = v;
+      } else if (dv == 1) {
+        LO& cv = curve_of[static_cast<std::size_t>(g)];
+        if (cv != kNoIndex && cv != vc(v).entity) cv = -2;  // two curves
+        if (cv == kNoIndex) cv = vc(v).entity;
+        if (c < 0 || vc(c).dim == 2) c = v;
+      }
+    }
+    for (GO g = 0; g < ng_; ++g) {
+      GO& c = center_[static_cast<std::size_t>(g)];
+      if (used[static_cast<std::size_t>(g)] && curve_of[static_cast<std::size_t>(g)] == -2 &&
+          (c < 0 || vc(c).dim != 0))
+        throw Reject{"two CAD curves merge away from a corner"};
+    }
+    for (GO x = 0; x < np; ++x) {
+      const GO g = group_[static_cast<std::size_t>(x)];
+      const GO v = rep_[static_cast<std::size_t>(x)];
+      GO& c = center_[static_cast<std::size_t>(g)];
+      if (c >= 0 && vc(c).dim < 2) continue;
+      const Vec3 centroid = sum[static_cast<std::size_t>(g)] / cnt[static_cast<std::size_t>(g)];
+      if (c < 0 || distance(m_.points[static_cast<std::size_t>(v)], centroid) <
+                       distance(m_.points[static_cast<std::size_t>(c)], centroid))
+        c = v;
+    }
+    // Coarse quads and edges.
+    cquads_.clear();
+    edge_id_.clear();
+    cedges_.clear();
+    for (std::size_t k = 0; k < cells_.size(); ++k) {
+      std::array<GO, 4> v{};
+      for (int i = 0; i < 4; ++i)
+        v[static_cast<std::size_t>(i)] =
+            group_[static_cast<std::size_t>(cells_[k].pts[static_cast<std::size_t>(i)])];
+      for (int i = 0; i < 4; ++i)
+        for (int j = i + 1; j < 4; ++j)
+          if (v[static_cast<std::size_t>(i)] == v[static_cast<std::size_t>(j)])
+            throw Reject{"a coarse quad has a repeated corner"};
+      CQuad cq;
+      cq.v = v;
+      cq.face = grids_[static_cast<std::size_t>(cells_[k].patch)].face;
+      cq.cell = static_cast<LO>(k);
+      for (int e = 0; e < 4; ++e) {
+        const GO a = v[static_cast<std::size_t>(e)], b = v[static_cast<std::size_t>((e + 1) % 4)];
+        const std::uint64_t key = mesh::edge_key(a, b);
+        auto [it, fresh] = edge_id_.emplace(key, static_cast<GO>(cedges_.size()));
+        if (fresh) cedges_.push_back({std::min(a, b), std::max(a, b)});
+        CEdge& ce = cedges_[static_cast<std::size_t>(it->second)];
+        ce.uses.emplace_back(static_cast<GO>(cquads_.size()), e);
+        const Grid& g = grids_[static_cast<std::size_t>(cells_[k].patch)];
+        ce.target += e % 2 == 0 ? static_cast<double>(g.ni) / cells_[k].a
+                                : static_cast<double>(g.nj) / cells_[k].b;
+        ce.target_count += 1;
+        cq.e[static_cast<std::size_t>(e)] = it->second;
+      }
+      cquads_.push_back(cq);
+    }
+    // Curves of the coarse edges: those of the arcs their lattice steps came from.
+    for (std::size_t p = 0; p < grids_.size(); ++p)
+      for (int s = 0; s < 4; ++s) {
+        std::vector<LO> from;
+        const std::vector<GO> pts = side_points(p, s, &from);
+        for (std::size_t k = 0; k + 1 < pts.size(); ++k) {
+          const LO c = arcs_[static_cast<std::size_t>(from[k])].curve;
+          if (c == kNoIndex) continue;
+          const GO a = group_[static_cast<std::size_t>(pts[k])],
+                   b = group_[static_cast<std::size_t>(pts[k + 1])];
+          const auto it = edge_id_.find(mesh::edge_key(a, b));
+          if (a != b && it != edge_id_.end())
+            cedges_[static_cast<std::size_t>(it->second)].curve = c;
+        }
+      }
+    for (const CEdge& e : cedges_) {
+      if (e.curve == kNoIndex && e.uses.size() != 2)
+        throw Reject{cat("a coarse edge off the curves has ", e.uses.size(), " quads")};
+      if (e.uses.size() == 2 && e.curve == kNoIndex) {
+        const CQuad& a = cquads_[static_cast<std::size_t>(e.uses[0].first)];
+        const CQuad& b = cquads_[static_cast<std::size_t>(e.uses[1].first)];
+        if (a.v[static_cast<std::size_t>(e.uses[0].second)] ==
+            b.v[static_cast<std::size_t>(e.uses[1].second)])
+          throw Reject{"two coarse quads run the same way along an edge"};
+      }
+    }
+    // Quad loops (Sec. IV.D): opposite edges of a coarse quad share a width, the rounded mean
+    // of the loop's target lengths, at least 1.
+    Dsu loops;
+    loops.resize(static_cast<GO>(cedges_.size()));
+    for (const CQuad& q : cquads_) {
+      if (q.e[0] == q.e[2] || q.e[1] == q.e[3] || q.e[0] == q.e[1] || q.e[1] == q.e[2])
+        throw Reject{"a coarse quad uses an edge twice"};
+      loops.unite(q.e[0], q.e[2]);
+      loops.unite(q.e[1], q.e[3]);
+    }
+    std::vector<double> lsum(cedges_.size(), 0), lcnt(cedges_.size(), 0);
+    for (std::size_t e = 0; e < cedges_.size(); ++e) {
+      const auto r = static_cast<std::size_t>(loops.find(static_cast<GO>(e)));
+      lsum[r] += cedges_[e].target / cedges_[e].target_count;
+      lcnt[r] += 1;
+    }
+    for (std::size_t e = 0; e < cedges_.size(); ++e) {
+      const auto r = static_cast<std::size_t>(loops.find(static_cast<GO>(e)));
+      cedges_[e].n = std::max<LO>(1, static_cast<LO>(std::lround(lsum[r] / lcnt[r])));
+    }
+  }
+
+  // ---------------------------------------------------------------- fine mesh (Sec. IV.D-E)
+  cad::FaceGeometry& face_geom(LO f) {
+    auto& g = face_geom_[f];
+    if (!g) g = model_.face_geometry(f);
+    return *g;
+  }
+  cad::CurveGeometry& curve_geom(LO c) {
+    auto& g = curve_geom_[c];
+    if (!g) g = model_.curve_geometry(c);
+    return *g;
+  }
+
+  // Parameter of coarse vertex g on curve c.
+  double param_on(GO g, LO c, double other) const {
+    const auto& k = vc(center_[static_cast<std::size_t>(g)]);
+    if (k.dim == 1 && k.entity == c) return k.param[0];
+    const cad::Curve& cc = model_.curves()[static_cast<std::size_t>(c)];
+    if (k.dim == 0 && (cc.corners[0] == k.entity || cc.corners[1] == k.entity)) {
+      if (cc.corners[0] != cc.corners[1]) return cc.corners[0] == k.entity ? cc.t0 : cc.t1;
+      return std::abs(other - cc.t0) < std::abs(other - cc.t1) ? cc.t0 : cc.t1;
+    }
+    throw Reject{cat("a coarse edge along curve ", c, " ends off it")};
+  }
+
+  // (u, v) guesses of coarse quad k: the face vertices of its cell's part of the input patch.
+  std::vector<std::pair<Vec3, Vec2>> guesses(std::size_t k) const {
+    const Cell& c = cells_[static_cast<std::size_t>(cquads_[k].cell)];
+    const Grid& g = grids_[static_cast<std::size_t>(c.patch)];
+    std::vector<std::pair<Vec3, Vec2>> out;
+    auto collect = [&](LO i0, LO i1, LO j0, LO j1) {
+      for (int sj = 0; sj <= 4; ++sj)
+        for (int si = 0; si <= 4; ++si) {
+          const LO i = i0 + (i1 - i0) * si / 4, j = j0 + (j1 - j0) * sj / 4;
+          const GO v = g.at(i, j);
+          if (vc(v).dim == 2)
+            out.emplace_back(m_.points[static_cast<std::size_t>(v)],
+                             Vec2{vc(v).param[0], vc(v).param[1]});
+        }
+    };
+    collect(static_cast<LO>(std::floor(static_cast<double>(c.x) * g.ni / c.a)),
+            static_cast<LO>(std::ceil(static_cast<double>(c.x + 1) * g.ni / c.a)),
+            static_cast<LO>(std::floor(static_cast<double>(c.y) * g.nj / c.b)),
+            static_cast<LO>(std::ceil(static_cast<double>(c.y + 1) * g.nj / c.b)));
+    if (out.empty()) collect(0, g.ni, 0, g.nj);
+    if (out.empty())
+      for (GO v = 0; v < nv_ && out.size() < 64; ++v)
+        if (vc(v).dim == 2 && vc(v).entity == g.face)
+          out.emplace_back(m_.points[static_cast<std::size_t>(v)],
+                           Vec2{vc(v).param[0], vc(v).param[1]});
+    if (out.empty()) out.emplace_back(Vec3{0, 0, 0}, Vec2{0, 0});
+    return out;
+  }
+
+  static Vec2 nearest_guess(const std::vector<std::pair<Vec3, Vec2>>& gs, const Vec3& p) {
+    std::size_t best = 0;
+    for (std::size_t i = 1; i < gs.size(); ++i)
+      if (norm2(gs[i].first - p) < norm2(gs[best].first - p)) best = i;
+    return gs[best].second;
+  }
+
+  struct FineNode {
+    Vec3 p;
+    mesh::VertexClass c;
+  };
+
+  void fine_mesh(CoarseResult& out) {
+    std::vector<FineNode> nodes;
+    // Coarse vertices.
+    std::vector<GO> vnode(static_cast<std::size_t>(ng_), -1);
+    for (const CQuad& q : cquads_)
+      for (GO g : q.v) {
+        GO& id = vnode[static_cast<std::size_t>(g)];
+        if (id >= 0) continue;
+        id = static_cast<GO>(nodes.size());
+        const GO c = center_[static_cast<std::size_t>(g)];
+        nodes.push_back({m_.points[static_cast<std::size_t>(c)], vc(c)});
+      }
+    // Edge nodes, from the edge's smaller vertex to its larger.
+    std::vector<GO> ebase(cedges_.size(), -1);
+    for (std::size_t e = 0; e < cedges_.size(); ++e) {
+      const CEdge& ce = cedges_[e];
+      ebase[e] = static_cast<GO>(nodes.size());
+      const Vec3 pa = nodes[static_cast<std::size_t>(vnode[static_cast<std::size_t>(ce.a)])].p;
+      const Vec3 pb = nodes[static_cast<std::size_t>(vnode[static_cast<std::size_t>(ce.b)])].p;
+      if (ce.curve != kNoIndex) {
+        const double tb0 = vc(center_[static_cast<std::size_t>(ce.b)]).dim == 1
+                               ? vc(center_[static_cast<std::size_t>(ce.b)]).param[0]
+                               : 0.5 * (model_.curves()[static_cast<std::size_t>(ce.curve)].t0 +
+                                        model_.curves()[static_cast<std::size_t>(ce.curve)].t1);
+        const double ta = param_on(ce.a, ce.curve, tb0);
+        const double tb = param_on(ce.b, ce.curve, ta);
+        for (LO k = 1; k < ce.n; ++k) {
+          const double t = ta + (tb - ta) * k / ce.n;
+          nodes.push_back({curve_geom(ce.curve).point(t), {1, ce.curve, kNoIndex, {t, 0}}});
+        }
+      } else {
+        const std::size_t k = static_cast<std::size_t>(ce.uses.front().first);
+        const LO f = cquads_[k].face;
+        const auto gs = guesses(k);
+        for (LO i = 1; i < ce.n; ++i) {
+          const Vec3 target = pa + (pb - pa) * (static_cast<double>(i) / ce.n);
+          Vec3 foot{};
+          const Vec2 uv = face_geom(f).project(target, nearest_guess(gs, target), &foot);
+          nodes.push_back({foot, {2, f, kNoIndex, {uv.u, uv.v}}});
+        }
+      }
+    }
+    // Quad grids: boundary from the vertex and edge nodes, inside by transfinite interpolation
+    // projected on the face.
+    struct FineQuad {
+      std::array<GO, 4> v;
+      LO face;
+      GO block;
+    };
+    std::vector<FineQuad> fq;
+    std::vector<std::vector<GO>> block_grid(cquads_.size());
+    for (std::size_t k = 0; k < cquads_.size(); ++k) {
+      const CQuad& q = cquads_[k];
+      const LO n0 = cedges_[static_cast<std::size_t>(q.e[0])].n;
+      const LO n1 = cedges_[static_cast<std::size_t>(q.e[1])].n;
+      if (cedges_[static_cast<std::size_t>(q.e[2])].n != n0 ||
+          cedges_[static_cast<std::size_t>(q.e[3])].n != n1)
+        throw Reject{"opposite coarse edges with different widths"};
+      std::vector<GO>& G = block_grid[k];
+      G.assign(static_cast<std::size_t>(n0 + 1) * static_cast<std::size_t>(n1 + 1), -1);
+      auto at = [&](LO i, LO j) -> GO& {
+        return G[static_cast<std::size_t>(j) * static_cast<std::size_t>(n0 + 1) +
+                 static_cast<std::size_t>(i)];
+      };
+      // Node t (0..n) of coarse edge e walked from coarse vertex `from`.
+      auto edge_node = [&](GO e, GO from, LO t) -> GO {
+        const CEdge& ce = cedges_[static_cast<std::size_t>(e)];
+        const LO s = from == ce.a ? t : ce.n - t;
+        if (s == 0) return vnode[static_cast<std::size_t>(ce.a)];
+        if (s == ce.n) return vnode[static_cast<std::size_t>(ce.b)];
+        return ebase[static_cast<std::size_t>(e)] + s - 1;
+      };
+      for (LO i = 0; i <= n0; ++i) {
+        at(i, 0) = edge_node(q.e[0], q.v[0], i);
+        at(n0 - i, n1) = edge_node(q.e[2], q.v[2], i);
+      }
+      for (LO j = 0; j <= n1; ++j) {
+        at(n0, j) = edge_node(q.e[1], q.v[1], j);
+        at(0, n1 - j) = edge_node(q.e[3], q.v[3], j);
+      }
+      const auto gs = (n0 > 1 && n1 > 1) ? guesses(k) : std::vector<std::pair<Vec3, Vec2>>{};
+      auto P = [&](LO i, LO j) { return nodes[static_cast<std::size_t>(at(i, j))].p; };
+      for (LO j = 1; j < n1; ++j)
+        for (LO i = 1; i < n0; ++i) {
+          const double s = static_cast<double>(i) / n0, t = static_cast<double>(j) / n1;
+          const Vec3 target = (1 - t) * P(i, 0) + t * P(i, n1) + (1 - s) * P(0, j) + s * P(n0, j) -
+                              ((1 - s) * (1 - t) * P(0, 0) + s * (1 - t) * P(n0, 0) +
+                               (1 - s) * t * P(0, n1) + s * t * P(n0, n1));
+          Vec3 foot{};
+          const Vec2 uv = face_geom(q.face).project(target, nearest_guess(gs, target), &foot);
+          at(i, j) = static_cast<GO>(nodes.size());
+          nodes.push_back({foot, {2, q.face, kNoIndex, {uv.u, uv.v}}});
+        }
+      for (LO j = 0; j < n1; ++j)
+        for (LO i = 0; i < n0; ++i)
+          fq.push_back({{at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)},
+                        q.face,
+                        static_cast<GO>(k)});
+    }
+    smooth_nodes(nodes, fq);
+    // SurfaceMesh numbering: corners (id = corner id), curve vertices by curve then parameter,
+    // face vertices by face then creation.
+    const auto nn = static_cast<GO>(nodes.size());
+    std::vector<GO> order(static_cast<std::size_t>(nn));
+    std::iota(order.begin(), order.end(), 0);
+    std::stable_sort(order.begin(), order.end(), [&](GO x, GO y) {
+      const auto& a = nodes[static_cast<std::size_t>(x)].c;
+      const auto& b = nodes[static_cast<std::size_t>(y)].c;
+      if (a.dim != b.dim) return a.dim < b.dim;
+      if (a.entity != b.entity) return a.entity < b.entity;
+      return a.dim == 1 && a.param[0] < b.param[0];
+    });
+    std::vector<GO> renum(static_cast<std::size_t>(nn));
+    mesh::SurfaceMesh& sm = out.mesh;
+    LO corners = 0;
+    for (GO k = 0; k < nn; ++k) {
+      const GO o = order[static_cast<std::size_t>(k)];
+      renum[static_cast<std::size_t>(o)] = k;
+      mesh::VertexClass c = nodes[static_cast<std::size_t>(o)].c;
+      if (c.dim == 0) {
+        if (c.entity != k) {
+          throw Reject{cat("CAD corner ", k, " is missing")};
+        }
+        ++corners;
+      }
+      sm.points.push_back(nodes[static_cast<std::size_t>(o)].p);
+      sm.vclass.push_back(c);
+    }
+    if (corners != m_.num_cad_corners) throw Reject{"a CAD corner is missing"};
+    for (GO k = 0; k < nn;) {  // curve vertex indices: 1, 2, ... along each curve
+      GO e = k;
+      while (e < nn && sm.vclass[static_cast<std::size_t>(e)].dim == 1 &&
+             sm.vclass[static_cast<std::size_t>(e)].entity ==
+                 sm.vclass[static_cast<std::size_t>(k)].entity)
+        sm.vclass[static_cast<std::size_t>(e)].index = static_cast<LO>(e - k + 1), ++e;
+      k = e == k ? k + 1 : e;
+    }
+    std::vector<std::size_t> qorder(fq.size());
+    std::iota(qorder.begin(), qorder.end(), 0);
+    std::stable_sort(qorder.begin(), qorder.end(),
+                     [&](std::size_t a, std::size_t b) { return fq[a].face < fq[b].face; });
+    std::vector<std::size_t> cq_of_fine(fq.size(), 0);
+    for (std::size_t i = 0; i < qorder.size(); ++i) {
+      const FineQuad& f = fq[qorder[i]];
+      std::array<GO, 4> v{};
+      for (int c = 0; c < 4; ++c)
+        v[static_cast<std::size_t>(c)] =
+            renum[static_cast<std::size_t>(f.v[static_cast<std::size_t>(c)])];
+      sm.quads.push_back(v);
+      sm.quad_face.push_back(f.face);
+      cq_of_fine[i] = static_cast<std::size_t>(f.block);
+    }
+    // Bars: the fine edges of the coarse edges on curves, by curve and parameter.
+    struct BarRec {
+      LO curve;
+      double t;
+      GO a, b;
+    };
+    std::vector<BarRec> bars;
+    for (std::size_t e = 0; e < cedges_.size(); ++e) {
+      const CEdge& ce = cedges_[e];
+      if (ce.curve == kNoIndex) continue;
+      GO prev = renum[static_cast<std::size_t>(vnode[static_cast<std::size_t>(ce.a)])];
+      for (LO s = 1; s <= ce.n; ++s) {
+        const GO node = s == ce.n ? vnode[static_cast<std::size_t>(ce.b)] : ebase[e] + s - 1;
+        const GO cur = renum[static_cast<std::size_t>(node)];
+        const auto& ka = sm.vclass[static_cast<std::size_t>(prev)];
+        const auto& kb = sm.vclass[static_cast<std::size_t>(cur)];
+        const double t = ka.dim == 1 ? ka.param[0] : kb.dim == 1 ? kb.param[0] : 0.0;
+        bars.push_back({ce.curve, t, prev, cur});
+        prev = cur;
+      }
+    }
+    std::stable_sort(bars.begin(), bars.end(), [](const BarRec& a, const BarRec& b) {
+      return a.curve != b.curve ? a.curve < b.curve : a.t < b.t;
+    });
+    for (const BarRec& b : bars) {
+      sm.bars.push_back({b.a, b.b});
+      sm.bar_curve.push_back(b.curve);
+    }
+    sm.num_cad_faces = m_.num_cad_faces;
+    sm.num_cad_curves = m_.num_cad_curves;
+    sm.num_cad_corners = m_.num_cad_corners;
+    sm.curve_corners = m_.curve_corners;
+    sm.face2curves = m_.face2curves;
+    sm.length_unit = m_.length_unit;
+    // Validity: no quad folded against the face (normal at its corners) and SICN > 0.
+    double smin = 2, ssum = 0;
+    for (std::size_t i = 0; i < sm.quads.size(); ++i) {
+      std::array<Vec3, 4> p{};
+      for (int c = 0; c < 4; ++c)
+        p[static_cast<std::size_t>(c)] =
+            sm.points[static_cast<std::size_t>(sm.quads[i][static_cast<std::size_t>(c)])];
+      const double s = mesh::quad_sicn(p);
+      smin = std::min(smin, s);
+      ssum += s;
+    }
+    out.stats.sicn_min = sm.quads.empty() ? 0 : smin;
+    out.stats.sicn_avg = sm.quads.empty() ? 0 : ssum / static_cast<double>(sm.quads.size());
+    bad_cquads_.clear();
+    bad_quads_ = 0;
+    for (std::size_t i = 0; i < sm.quads.size(); ++i) {
+      std::array<Vec3, 4> p{};
+      for (int c = 0; c < 4; ++c)
+        p[static_cast<std::size_t>(c)] =
+            sm.points[static_cast<std::size_t>(sm.quads[i][static_cast<std::size_t>(c)])];
+      const std::size_t k = cq_of_fine[i];
+      if (mesh::quad_sicn(p) <= 0 || bad_fine_cquad_[k]) {
+        bad_cquads_.push_back(k);
+        ++bad_quads_;
+      }
+    }
+    std::sort(bad_cquads_.begin(), bad_cquads_.end());
+    bad_cquads_.erase(std::unique(bad_cquads_.begin(), bad_cquads_.end()), bad_cquads_.end());
+    if (!bad_cquads_.empty()) return;
+    blocks(block_grid, renum, cq_of_fine, out.layout);
+  }
+
+  // Blocks: the coarse quads joined across the chords that can go (closed loops of coarse edges
+  // off the CAD curves through vertices of four quads, away from CAD corners: removing one joins
+  // the quads on its two sides pairwise, and the layout stays conforming), each as one grid.
+  void blocks(const std::vector<std::vector<GO>>& block_grid, const std::vector<GO>& renum,
+              const std::vector<std::size_t>& cq_of_fine, QuadLayout& lay) {
+    const std::size_t nq = cquads_.size(), ne = cedges_.size();
+    std::vector<std::vector<std::pair<std::size_t, int>>> at(static_cast<std::size_t>(ng_));
+    for (std::size_t q = 0; q < nq; ++q)
+      for (int k = 0; k < 4; ++k)
+        at[static_cast<std::size_t>(cquads_[q].v[static_cast<std::size_t>(k)])].emplace_back(q, k);
+    // The edge across vertex g from edge e (-1: g is no regular crossing).
+    auto opposite = [&](GO g, GO e) -> GO {
+      const auto& list = at[static_cast<std::size_t>(g)];
+      if (list.size() != 4 || vc(center_[static_cast<std::size_t>(g)]).dim == 0) return -1;
+      std::vector<GO> edges;
+      std::vector<std::pair<GO, GO>> paired;
+      for (const auto& [q, k] : list) {
+        const GO a = cquads_[q].e[static_cast<std::size_t>(k)];
+        const GO b = cquads_[q].e[static_cast<std::size_t>((k + 3) % 4)];
+        edges.push_back(a);
+        edges.push_back(b);
+        paired.emplace_back(a, b);
+      }
+      std::sort(edges.begin(), edges.end());
+      edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
+      if (edges.size() != 4) return -1;
+      GO out = -1;
+      for (GO x : edges) {
+        if (x == e) continue;
+        bool with_e = false;
+        for (const auto& [a, b] : paired)
+          with_e = with_e || (a == e && b == x) || (a == x && b == e);
+        if (!with_e) {
+          if (out >= 0) return -1;
+          out = x;
+        }
+      }
+      return out;
+    };
+    std::vector<char> removed(ne, 0), seen(ne, 0);
+    for (std::size_t e0 = 0; e0 < ne; ++e0) {
+      if (seen[e0] || cedges_[e0].curve != kNoIndex) continue;
+      std::vector<GO> chain{static_cast<GO>(e0)};
+      std::vector<GO> verts{cedges_[e0].a};
+      seen[e0] = 1;
+      bool closed = false, ok = true;
+      GO e = static_cast<GO>(e0), g = cedges_[e0].b;
+      while (ok) {
+        const GO next = opposite(g, e);
+        if (next < 0 || cedges_[static_cast<std::size_t>(next)].curve != kNoIndex) {
+          ok = false;
+          break;
+        }
+        if (std::find(verts.begin(), verts.end(), g) != verts.end() && g != verts.front()) {
+          ok = false;
+          break;
+        }
+        verts.push_back(g);
+        if (next == static_cast<GO>(e0)) {
+          closed = g == verts.front();
+          break;
+        }
+        if (seen[static_cast<std::size_t>(next)]) {
+          ok = false;
+          break;
+        }
+        seen[static_cast<std::size_t>(next)] = 1;
+        chain.push_back(next);
+        const CEdge& ce = cedges_[static_cast<std::size_t>(next)];
+        g = ce.a == g ? ce.b : ce.a;
+        e = next;
+      }
+      if (ok && closed)
+        for (GO x : chain) removed[static_cast<std::size_t>(x)] = 1;
+    }
+    // Components across removed edges, each walked as a grid of (quad, orientation).
+    Dsu comp;
+    comp.resize(static_cast<GO>(nq));
+    for (std::size_t e = 0; e < ne; ++e)
+      if (removed[e] && cedges_[e].uses.size() == 2)
+        comp.unite(cedges_[e].uses[0].first, cedges_[e].uses[1].first);
+    std::map<GO, std::vector<std::size_t>> members;
+    for (std::size_t q = 0; q < nq; ++q) members[comp.find(static_cast<GO>(q))].push_back(q);
+    struct Ori {
+      std::size_t q;
+      int k;
+    };
+    auto edge_of = [&](Ori o, int side) {
+      return cquads_[o.q].e[static_cast<std::size_t>((o.k + side) % 4)];
+    };
+    auto across = [&](Ori o, int side, int new_side) -> std::optional<Ori> {
+      const GO e = edge_of(o, side);
+      if (!removed[static_cast<std::size_t>(e)]) return std::nullopt;
+      const CEdge& ce = cedges_[static_cast<std::size_t>(e)];
+      for (const auto& [q, m] : ce.uses)
+        if (q != static_cast<GO>(o.q)) {
+          const Ori n{static_cast<std::size_t>(q), ((m - new_side) % 4 + 4) % 4};
+          // The shared edge runs the other way in the neighbour (consistent orientation).
+          if (cquads_[n.q].v[static_cast<std::size_t>((n.k + new_side) % 4)] !=
+              cquads_[o.q].v[static_cast<std::size_t>((o.k + side + 1) % 4)])
+            return std::nullopt;
+          return n;
+        }
+      return std::nullopt;
+    };
+    auto own = [](int k, LO il, LO jl, LO n0, LO n1) -> std::pair<LO, LO> {
+      if (k == 0) return {il, jl};
+      if (k == 1) return {n0 - jl, il};
+      if (k == 2) return {n0 - il, n1 - jl};
+      return {jl, n1 - il};
+    };
+    std::vector<GO> block_of(nq, -1);
+    std::vector<std::pair<LO, std::size_t>> order;  // (face, first quad) of each component
+    for (const auto& [r, list] : members)
+      order.emplace_back(cquads_[list.front()].face, list.front());
+    std::sort(order.begin(), order.end());
+    for (const auto& [face, first] : order) {
+      const std::vector<std::size_t>& list = members[comp.find(static_cast<GO>(first))];
+      // Rows of the component's grid, or each quad alone when it is not one.
+      std::vector<std::vector<Ori>> rows;
+      bool grid = false;
+      for (std::size_t q : list) {
+        for (int k = 0; k < 4 && !grid; ++k) {
+          const Ori o{q, k};
+          if (removed[static_cast<std::size_t>(edge_of(o, 0))] ||
+              removed[static_cast<std::size_t>(edge_of(o, 3))])
+            continue;
+          rows.clear();
+          std::size_t count = 0;
+          bool bad = false;
+          for (std::optional<Ori> row = o; row && !bad; row = across(*row, 2, 0)) {
+            rows.emplace_back();
+            for (std::optional<Ori> c = row; c && !bad; c = across(*c, 1, 3)) {
+              rows.back().push_back(*c);
+              if (++count > list.size()) bad = true;
+            }
+            if (rows.back().size() != rows.front().size()) bad = true;
+          }
+          grid = !bad && count == list.size();
+        }
+        if (grid) break;
+      }
+      auto emit = [&](const std::vector<std::vector<Ori>>& g) {
+        const auto b = static_cast<GO>(lay.blocks.size());
+        std::vector<LO> widths_i, widths_j;
+        for (const Ori& o : g.front())
+          widths_i.push_back(cedges_[static_cast<std::size_t>(edge_of(o, 0))].n);
+        for (const auto& row : g)
+          widths_j.push_back(cedges_[static_cast<std::size_t>(edge_of(row.front(), 3))].n);
+        Block blk;
+        blk.face = face;
+        blk.ni = std::accumulate(widths_i.begin(), widths_i.end(), 0);
+        blk.nj = std::accumulate(widths_j.begin(), widths_j.end(), 0);
+        blk.first = static_cast<std::int64_t>(lay.vertices.size());
+        std::vector<GO> grid_v(static_cast<std::size_t>(blk.ni + 1) *
+                               static_cast<std::size_t>(blk.nj + 1));
+        LO j0 = 0;
+        for (std::size_t r = 0; r < g.size(); ++r) {
+          LO i0 = 0;
+          for (std::size_t c = 0; c < g[r].size(); ++c) {
+            const Ori o = g[r][c];
+            const CQuad& cq = cquads_[o.q];
+            const LO n0 = cedges_[static_cast<std::size_t>(cq.e[0])].n;
+            const LO n1 = cedges_[static_cast<std::size_t>(cq.e[1])].n;
+            for (LO jl = 0; jl <= widths_j[r]; ++jl)
+              for (LO il = 0; il <= widths_i[c]; ++il) {
+                const auto [i, j] = own(o.k, il, jl, n0, n1);
+                grid_v[static_cast<std::size_t>(j0 + jl) * static_cast<std::size_t>(blk.ni + 1) +
+                       static_cast<std::size_t>(i0 + il)] =
+                    renum[static_cast<std::size_t>(
+                        block_grid[o.q]
+                                  [static_cast<std::size_t>(j) * static_cast<std::size_t>(n0 + 1) +
+                                   static_cast<std::size_t>(i)])];
+              }
+            block_of[o.q] = b;
+            i0 += widths_i[c];
+          }
+          j0 += widths_j[r];
+        }
+        lay.vertices.insert(lay.vertices.end(), grid_v.begin(), grid_v.end());
+        lay.blocks.push_back(blk);
+      };
+      if (grid) {
+        emit(rows);
+      } else {
+        for (std::size_t q : list) emit({{Ori{q, 0}}});
+      }
+    }
+    lay.quad2block.resize(cq_of_fine.size());
+    for (std::size_t i = 0; i < cq_of_fine.size(); ++i) lay.quad2block[i] = block_of[cq_of_fine[i]];
+  }
+
+  // Winslow smoothing face by face (smooth::smooth_face: boundary locked, every move kept only
+  // when the local minimum SICN does not drop, nodes on the CAD surface), then a count of the
+  // quads folded against their face's normal.
+  template <typename FQ>
+  void smooth_nodes(std::vector<FineNode>& nodes, const std::vector<FQ>& fq) {
+    std::map<LO, std::vector<std::size_t>> by_face;
+    for (std::size_t i = 0; i < fq.size(); ++i) by_face[fq[i].face].push_back(i);
+    bad_fine_cquad_.assign(cquads_.size(), 0);
+    std::vector<LO> local(nodes.size(), -1);
+    for (const auto& [f, list] : by_face) {
+      mesh::FaceMesh fm;
+      fm.face = f;
+      std::vector<GO> global;
+      std::vector<Vec2> gs_uv;
+      for (std::size_t i : list) {
+        std::array<LO, 4> lq{};
+        for (int c = 0; c < 4; ++c) {
+          const GO g = fq[i].v[static_cast<std::size_t>(c)];
+          if (local[static_cast<std::size_t>(g)] < 0) {
+            local[static_cast<std::size_t>(g)] = static_cast<LO>(global.size());
+            global.push_back(g);
+          }
+          lq[static_cast<std::size_t>(c)] = local[static_cast<std::size_t>(g)];
+        }
+        fm.quads.push_back(lq);
+      }
+      // uv: a face node's own; a boundary node's is its projection from a face node of a quad of
+      // its.
+      fm.points.resize(global.size());
+      fm.uv.resize(global.size());
+      fm.vclass.resize(global.size());
+      std::vector<char> has(global.size(), 0);
+      for (std::size_t l = 0; l < global.size(); ++l) {
+        const FineNode& n = nodes[static_cast<std::size_t>(global[l])];
+        fm.points[l] = n.p;
+        fm.vclass[l] = n.c;
+        if (n.c.dim == 2) {
+          fm.uv[l] = {n.c.param[0], n.c.param[1]};
+          has[l] = 1;
+        }
+      }
+      for (int round = 0; round < 4; ++round)
+        for (std::size_t qi = 0; qi < fm.quads.size(); ++qi) {
+          const auto& lq = fm.quads[qi];
+          int src = -1;
+          for (int c = 0; c < 4; ++c)
+            if (has[static_cast<std::size_t>(lq[static_cast<std::size_t>(c)])]) src = c;
+          if (src < 0) continue;
+          for (int c = 0; c < 4; ++c) {
+            const auto l = static_cast<std::size_t>(lq[static_cast<std::size_t>(c)]);
+            if (has[l]) continue;
+            Vec3 foot{};
+            fm.uv[l] = face_geom(f).project(
+                fm.points[l], fm.uv[static_cast<std::size_t>(lq[static_cast<std::size_t>(src)])],
+                &foot);
+            has[l] = 2;
+          }
+        }
+      for (std::size_t l = 0; l < global.size(); ++l)
+        if (!has[l]) {
+          Vec3 foot{};
+          fm.uv[l] = face_geom(f).project(fm.points[l], Vec2{0, 0}, &foot);
+        }
+      smooth::SmoothOptions so;
+      so.iterations = opt_.smoothing_iterations;
+      so.laplacian_uv = false;
+      mesh::FaceMesh sm =
+          opt_.smoothing_iterations > 0 ? smooth::smooth_face(fm, face_geom(f), so) : fm;
+      // Concave corners may leave folded quads (paper 002 Sec. IV.E): local untangling there.
+      if (smooth::measure(sm).invalid > 0 || folded(sm, f) > 0)
+        sm = smooth::untangle_face(sm, face_geom(f), smooth::UntangleOptions{});
+      for (std::size_t l = 0; l < global.size(); ++l) {
+        FineNode& n = nodes[static_cast<std::size_t>(global[l])];
+        if (n.c.dim == 2) {
+          n.p = sm.points[l];
+          n.c.param = {sm.uv[l].u, sm.uv[l].v};
+        }
+        local[static_cast<std::size_t>(global[l])] = -1;
+      }
+      for (std::size_t qi = 0; qi < sm.quads.size(); ++qi)
+        if (folded_quad(sm, f, qi))
+          bad_fine_cquad_[static_cast<std::size_t>(fq[list[qi]].block)] = 1;
+    }
+  }
+
+  // Quads of face mesh fm turning against the normal of face f (at their corners).
+  bool folded_quad(const mesh::FaceMesh& fm, LO f, std::size_t qi) {
+    const auto& lq = fm.quads[qi];
+    Vec3 nsum{0, 0, 0};
+    for (LO c : lq) nsum += face_geom(f).normal(fm.uv[static_cast<std::size_t>(c)]);
+    const Vec3 d1 =
+        fm.points[static_cast<std::size_t>(lq[2])] - fm.points[static_cast<std::size_t>(lq[0])];
+    const Vec3 d2 =
+        fm.points[static_cast<std::size_t>(lq[3])] - fm.points[static_cast<std::size_t>(lq[1])];
+    return norm2(nsum) > 0 && dot(cross(d1, d2), nsum) <= 0;
+  }
+
+  std::int64_t folded(const mesh::FaceMesh& fm, LO f) {
+    std::int64_t n = 0;
+    for (const auto& lq : fm.quads) {
+      Vec3 nsum{0, 0, 0};
+      for (LO c : lq) nsum += face_geom(f).normal(fm.uv[static_cast<std::size_t>(c)]);
+      const Vec3 d1 =
+          fm.points[static_cast<std::size_t>(lq[2])] - fm.points[static_cast<std::size_t>(lq[0])];
+      const Vec3 d2 =
+          fm.points[static_cast<std::size_t>(lq[3])] - fm.points[static_cast<std::size_t>(lq[1])];
+      if (norm2(nsum) > 0 && dot(cross(d1, d2), nsum) <= 0) ++n;
+    }
+    return n;
+  }
+
+  struct CQuad {
+    std::array<GO, 4> v{};
+    std::array<GO, 4> e{};
+    LO face = kNoIndex;
+    LO cell = kNoIndex;
+  };
+  struct CEdge {
+    GO a, b;
+    std::vector<std::pair<GO, int>> uses{};
+    LO curve = kNoIndex;
+    double target = 0, target_count = 0;
+    LO n = 1;
+  };
+
+  const mesh::SurfaceMesh& m_;
+  const cad::CadModel& model_;
+  const CoarseOptions& opt_;
+  GO nv_;
+  std::vector<GO> v2q_off_, v2q_;
+  std::unordered_map<std::uint64_t, EdgeRec> edges_;
+  std::vector<Trace> traces_;
+  std::vector<Grid> grids_;
+  std::vector<char> node_;
+  std::vector<Arc> arcs_;
+  std::unordered_map<std::uint64_t, LO> edge_arc_;
+  std::vector<std::array<std::vector<SideArc>, 4>> sides_;
+  std::vector<long> q_;
+  std::unordered_map<GO, GO> node_point_;
+  std::vector<GO> arc_base_, rep_;
+  Dsu dsu_;
+  std::vector<std::vector<std::pair<GO, LO>>> links_;  // zero-length links of each point
+  std::vector<std::vector<LO>> labels_;                // the arcs whose lengths make each link
+  std::vector<Cell> cells_;
+  std::vector<GO> group_, center_;
+  GO ng_ = 0;
+  std::vector<CQuad> cquads_;
+  std::vector<CEdge> cedges_;
+  std::unordered_map<std::uint64_t, GO> edge_id_;
+  std::map<LO, std::unique_ptr<cad::FaceGeometry>> face_geom_;
+  std::map<LO, std::unique_ptr<cad::CurveGeometry>> curve_geom_;
+  std::vector<char> bad_fine_cquad_;
+  std::vector<int> repair_level_;
+  std::vector<std::size_t> bad_cquads_;
+  std::int64_t bad_quads_ = 0;
+  std::vector<std::vector<LO>> point_patches_;
+};
+
+}  // namespace
+
+CoarseResult build_coarse_layout(const mesh::SurfaceMesh& input, const cad::CadModel& model,
+                                 const CoarseOptions& options) {
+  QSMESH_CHECK(input.quad_face.size() == input.quads.size() &&
+                   input.vclass.size() == input.points.size() &&
+                   input.bar_curve.size() == input.bars.size(),
+               "coarse layout: inconsistent mesh arrays");
+  Builder b(input, model, options);
+  return b.run();
+}
+
+}  // namespace qsmesh::layout

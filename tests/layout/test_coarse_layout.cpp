@@ -1,0 +1,176 @@
+// The coarse block layout (paper 002 Sec. III-IV) on OpenCASCADE-built models meshed through the
+// library, and the integer program solver behind it on small programs with known answers.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <limits>
+#include <map>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cgns_blocks_check.hpp"
+#include "qsmesh/cad/model.hpp"
+#include "qsmesh/core/log.hpp"
+#include "qsmesh/core/tasks.hpp"
+#include "qsmesh/io/writer.hpp"
+#include "qsmesh/layout/coarse_layout.hpp"
+#include "qsmesh/layout/ilp.hpp"
+#include "qsmesh/mesh/quality.hpp"
+#include "qsmesh/mesh/validate.hpp"
+#include "qsmesh/parallel/comm.hpp"
+#include "qsmesh/parallel/pipeline.hpp"
+#include "shapes.hpp"
+#include "tmp_dir.hpp"
+
+namespace qsmesh::layout {
+namespace {
+
+constexpr double kInf = std::numeric_limits<double>::infinity();
+
+TEST(Ilp, SolvesASmallProgramExactly) {
+  // min x + y + 3z  s.t.  x + 2y >= 3,  x - y = 0,  y + z >= 2,  0 <= x, y, z <= 5.
+  // x = y >= 1; x = y = 1 needs z = 1 (cost 5), x = y = 2 needs no z (cost 4, the optimum).
+  IntegerProgram p;
+  p.objective = {1, 1, 3};
+  p.lower = {0, 0, 0};
+  p.upper = {5, 5, 5};
+  p.rows.push_back({{{0, 1.0}, {1, 2.0}}, 3, kInf});
+  p.rows.push_back({{{0, 1.0}, {1, -1.0}}, 0, 0});
+  p.rows.push_back({{{1, 1.0}, {2, 1.0}}, 2, kInf});
+  const IlpResult r = solve_integer_program(p);
+  ASSERT_TRUE(r.feasible) << r.status;
+  EXPECT_TRUE(r.optimal);
+  EXPECT_EQ(r.x, (std::vector<long>{2, 2, 0}));
+  EXPECT_DOUBLE_EQ(r.objective, 4.0);
+  // The same program gives the same solution.
+  EXPECT_EQ(solve_integer_program(p).x, r.x);
+}
+
+TEST(Ilp, IntegralityMatters) {
+  // 2x = 1 has the LP solution 1/2 and no integer one.
+  IntegerProgram p;
+  p.objective = {1};
+  p.lower = {0};
+  p.upper = {3};
+  p.rows.push_back({{{0, 2.0}}, 1, 1});
+  const IlpResult r = solve_integer_program(p);
+  EXPECT_FALSE(r.feasible);
+  EXPECT_TRUE(r.x.empty());
+  // 2x >= 1: the integer optimum is 1.
+  p.rows.front().hi = kInf;
+  EXPECT_EQ(solve_integer_program(p).x, (std::vector<long>{1}));
+}
+
+struct Meshed {
+  cad::CadModel model;
+  mesh::SurfaceMesh mesh;
+};
+
+Meshed mesh_model(const std::string& path, double size) {
+  Meshed m{cad::load_cad(path), {}};
+  parallel::PipelineOptions options;
+  options.background.sizes.size = size;
+  options.sizemap.size_max = size;
+  options.until = parallel::Stage::QuasiStructured;
+  std::ostringstream sink;
+  Logger log(sink, LogLevel::Quiet);
+  m.mesh = parallel::run_pipeline(parallel::Comm::self(), m.model, options, TaskArena(1), log).mesh;
+  return m;
+}
+
+// Side s of block b (vertex ids, counter-clockwise around the block as in quad_layout.cpp).
+std::vector<GO> block_side(const QuadLayout& lay, const Block& b, int s) {
+  std::vector<GO> out;
+  if (s == 0)
+    for (LO i = 0; i <= b.ni; ++i) out.push_back(b.vertex(i, 0, lay.vertices));
+  if (s == 1)
+    for (LO j = 0; j <= b.nj; ++j) out.push_back(b.vertex(b.ni, j, lay.vertices));
+  if (s == 2)
+    for (LO i = b.ni; i >= 0; --i) out.push_back(b.vertex(i, b.nj, lay.vertices));
+  if (s == 3)
+    for (LO j = b.nj; j >= 0; --j) out.push_back(b.vertex(0, j, lay.vertices));
+  return out;
+}
+
+// Checks the coarse result of a closed model: a valid all-quad mesh conforming to the CAD, whose
+// blocks cover it and each share every side whole with exactly one other block side.
+void expect_conforming_blocks(const CoarseResult& r, const cad::CadModel& model) {
+  ASSERT_TRUE(r.ok) << r.failure;
+  const mesh::SurfaceMesh& m = r.mesh;
+  EXPECT_TRUE(m.triangles.empty());
+  ASSERT_FALSE(m.quads.empty());
+  const auto conformity = mesh::check_conformity(m, model);
+  EXPECT_TRUE(conformity.ok()) << conformity.summary();
+  for (const auto& q : m.quads) {
+    std::array<Vec3, 4> p{};
+    for (int c = 0; c < 4; ++c)
+      p[static_cast<std::size_t>(c)] =
+          m.points[static_cast<std::size_t>(q[static_cast<std::size_t>(c)])];
+    EXPECT_GT(mesh::quad_sicn(p), 0.0);
+  }
+  std::int64_t covered = 0;
+  std::map<std::vector<GO>, int> sides;
+  for (const Block& b : r.layout.blocks) {
+    covered += static_cast<std::int64_t>(b.ni) * b.nj;
+    for (int s = 0; s < 4; ++s) ++sides[block_side(r.layout, b, s)];
+  }
+  EXPECT_EQ(covered, static_cast<std::int64_t>(m.quads.size()));
+  for (const auto& [side, n] : sides) {
+    std::vector<GO> back(side.rbegin(), side.rend());
+    const auto it = sides.find(back);
+    EXPECT_TRUE(it != sides.end() && it->second == 1 && n == 1)
+        << "a block side of " << side.size() - 1 << " edges from " << side.front() << " to "
+        << side.back() << " is not shared whole with exactly one other block";
+  }
+  for (GO b : r.layout.quad2block) EXPECT_GE(b, 0);
+}
+
+TEST(CoarseLayout, BoxWithHoleIsConformingValidAndDeterministic) {
+  const std::string path = test::write_box_with_hole(test::tmp("coarse_box_hole.brep"));
+  const Meshed in = mesh_model(path, 0.35);
+  ASSERT_TRUE(in.mesh.triangles.empty());
+  const CoarseResult r = build_coarse_layout(in.mesh, in.model);
+  expect_conforming_blocks(r, in.model);
+  // The quantization keeps the mesh density: subdivision by quad loops uses the input lengths.
+  EXPECT_GT(r.mesh.quads.size(), in.mesh.quads.size() / 2);
+  EXPECT_LT(r.mesh.quads.size(), in.mesh.quads.size() * 2);
+  EXPECT_GT(r.stats.ilp_variables, 0);
+  // The CGNS file of the blocks reads back with every interface matching.
+  const std::string out = test::tmp("coarse_box_hole.cgns");
+  io::write_cgns_blocks(r.mesh, r.layout, out);
+  const test::BlockFileSummary s = test::check_block_file(out, true);
+  EXPECT_TRUE(s.error.empty()) << s.error;
+  EXPECT_EQ(s.structured_zones, static_cast<int>(r.layout.blocks.size()));
+  // Deterministic.
+  const CoarseResult again = build_coarse_layout(in.mesh, in.model);
+  EXPECT_EQ(again.mesh.quads, r.mesh.quads);
+  EXPECT_EQ(again.mesh.points, r.mesh.points);
+}
+
+TEST(CoarseLayout, CylinderWithClosedCurves) {
+  const std::string path = test::write_cylinder(test::tmp("coarse_cylinder.brep"));
+  const Meshed in = mesh_model(path, 0.4);
+  const CoarseResult r = build_coarse_layout(in.mesh, in.model);
+  expect_conforming_blocks(r, in.model);
+  EXPECT_GT(r.stats.ilp_variables, 0);
+}
+
+TEST(CoarseLayout, AMeshWithTrianglesIsRefusedWithAReason) {
+  mesh::SurfaceMesh m;
+  m.points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  m.vclass.assign(3, {});
+  m.triangles = {{0, 1, 2}};
+  m.triangle_face = {0};
+  m.num_cad_faces = 1;
+  const std::string path = test::write_cylinder(test::tmp("coarse_refused.brep"));
+  const cad::CadModel model = cad::load_cad(path);
+  const CoarseResult r = build_coarse_layout(m, model);
+  EXPECT_FALSE(r.ok);
+  EXPECT_FALSE(r.failure.empty());
+  EXPECT_TRUE(r.layout.blocks.empty());
+}
+
+}  // namespace
+}  // namespace qsmesh::layout
