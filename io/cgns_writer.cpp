@@ -128,8 +128,10 @@ std::uint32_t lookup3(const unsigned char* k, std::size_t length) {
 // every version-2 object header, so two writes of the same mesh differ. This zeroes those times and
 // rewrites the header checksums. A candidate "OHDR" is only patched when its stored checksum
 // verifies, so bytes in raw data that happen to read "OHDR" are left alone. The file is scanned in
-// blocks and each header read alone: the whole file in memory was the largest allocation of a run
-// on the writing rank (50 MB of heap for a 17.5 MB file; docs/benchmarks.md).
+// 1 MiB blocks (the whole file in memory was the largest allocation of a run on the writing rank:
+// 50 MB of heap for a 17.5 MB file; docs/benchmarks.md); a header inside the block is patched
+// there and the block written back once, one across its end through the file. Seeking and writing
+// each header alone cost 1-2 s for the ~100,000 headers of a file of 3,000 zones.
 void strip_hdf5_times(const std::string& file) {
   std::FILE* f = std::fopen(file.c_str(), "r+b");
   if (f == nullptr) throw Error("cannot reopen " + file + ": " + std::strerror(errno));
@@ -154,20 +156,51 @@ void strip_hdf5_times(const std::string& file) {
   constexpr std::uint64_t kBlock = std::uint64_t{1} << 20;
   std::vector<unsigned char> block;
   std::vector<unsigned char> header;
+  std::uint64_t base = 0;
+  bool dirty = false;  // the block holds patches not yet in the file
+  // Bytes [at, at + n): from the block when it holds them all (with its patches), else the file
+  // (a header across the block's end; the bytes of other headers patched in the block are not
+  // among them, as headers do not overlap).
+  const auto get = [&](std::uint64_t at, unsigned char* to, std::size_t n) {
+    if (at >= base && at - base + n <= block.size())
+      std::memcpy(to, block.data() + (at - base), n);
+    else
+      read_at(at, to, n);
+  };
+  // Patches [at, at + n) in the block when it holds them all, else in the file and in the part of
+  // the block that holds some of them (so that writing the block back keeps the patch).
+  const auto put = [&](std::uint64_t at, const void* from, std::size_t n) {
+    if (at >= base && at - base + n <= block.size()) {
+      std::memcpy(block.data() + (at - base), from, n);
+      dirty = true;
+      return;
+    }
+    write_at(at, from, n);
+    const std::uint64_t lo = std::max(at, base), hi = std::min(at + n, base + block.size());
+    if (lo < hi) {
+      std::memcpy(block.data() + (lo - base), static_cast<const unsigned char*>(from) + (lo - at),
+                  static_cast<std::size_t>(hi - lo));
+      dirty = true;
+    }
+  };
   std::uint64_t next = 0;  // a header may start here or later (not inside one already patched)
-  for (std::uint64_t base = 0; base < size; base += kBlock) {
+  for (; base < size; base += kBlock) {
     // 3 bytes past the block, so that a tag across the border is seen from this block.
     block.resize(static_cast<std::size_t>(std::min(kBlock + 3, size - base)));
     read_at(base, block.data(), block.size());
-    const std::string_view view(reinterpret_cast<const char*>(block.data()), block.size());
-    for (std::size_t i = view.find("OHDR"); i != std::string_view::npos && i < kBlock;
-         i = view.find("OHDR", i + 1)) {
+    dirty = false;
+    for (std::size_t i = 0; i < std::min<std::size_t>(block.size(), kBlock); ++i) {
+      const auto* hit = static_cast<const unsigned char*>(
+          std::memchr(block.data() + i, 'O', std::min<std::size_t>(block.size(), kBlock) - i));
+      if (hit == nullptr) break;
+      i = static_cast<std::size_t>(hit - block.data());
+      if (i + 4 > block.size() || std::memcmp(hit, "OHDR", 4) != 0) continue;
       const std::uint64_t start = base + i;
       if (start < next || start + 6 > size) continue;
       unsigned char prefix[6 + 16 + 4 + 8];
       const std::size_t have =
           static_cast<std::size_t>(std::min<std::uint64_t>(sizeof prefix, size - start));
-      read_at(start, prefix, have);
+      get(start, prefix, have);
       if (prefix[4] != 2 || (prefix[5] & 0x20) == 0) continue;
       const unsigned flags = prefix[5];
       const std::size_t p = 6 + 16 + ((flags & 0x10) != 0 ? 4 : 0);
@@ -179,17 +212,18 @@ void strip_hdf5_times(const std::string& file) {
       if (chunk > size - body || body + chunk + 4 > size) continue;
       const std::uint64_t sum_at = body + chunk;
       header.resize(static_cast<std::size_t>(sum_at + 4 - start));
-      read_at(start, header.data(), header.size());
+      get(start, header.data(), header.size());
       const std::size_t covered = header.size() - 4;
       std::uint32_t stored = 0;
       std::memcpy(&stored, header.data() + covered, 4);  // little-endian file, little-endian host
       if (lookup3(header.data(), covered) != stored) continue;
       std::memset(header.data() + 6, 0, 16);
       const std::uint32_t sum = lookup3(header.data(), covered);
-      write_at(start + 6, header.data() + 6, 16);
-      write_at(sum_at, &sum, 4);
+      put(start + 6, header.data() + 6, 16);
+      put(sum_at, &sum, 4);
       next = sum_at + 4;
     }
+    if (dirty) write_at(base, block.data(), block.size());
   }
   if (std::fclose(f) != 0) throw Error("cannot rewrite " + file + ": " + std::strerror(errno));
 }
@@ -211,6 +245,7 @@ void fix_range_label(int cgio, double root, const std::string& node, const std::
   char label[CGIO_MAX_LABEL_LENGTH + 1] = {};
   std::strncpy(label, "IndexRange_t", CGIO_MAX_LABEL_LENGTH);
   QSMESH_CGIO(cgio_set_label(cgio, id, label));
+  QSMESH_CGIO(cgio_release_id(cgio, id));
 }
 
 // The base of every qsmesh CGNS file: CellDimension 2, PhysicalDimension 3, dimensional data in
@@ -437,6 +472,21 @@ void new_node(int cgio, double parent, const std::string& name, const char* labe
   QSMESH_CGIO(cgio_new_node(cgio, parent, n, l, t, ndims, dims, data, id));
 }
 
+// cgio (HDF5) keeps every node id it hands out open until it is released or the file closes; the
+// open objects slow every later HDF5 call (docs/benchmarks.md, "Block CGNS write speed"), so the
+// ids made or looked up here are released as soon as they are done with.
+void release_node(int cgio, double id, const std::string& path) {
+  QSMESH_CGIO(cgio_release_id(cgio, id));
+}
+
+// A new leaf node (no children added later): made and released.
+void new_leaf(int cgio, double parent, const std::string& name, const char* label, const char* type,
+              int ndims, const cgsize_t* dims, const void* data, const std::string& path) {
+  double id = 0;
+  new_node(cgio, parent, name, label, type, ndims, dims, data, &id, path);
+  release_node(cgio, id, path);
+}
+
 // The ZoneGridConnectivity node of zone `zone` (made through cgio, as the connectivities under it).
 double new_zone_grid_connectivity(int cgio, double root, const std::string& base,
                                   const std::string& zone, const std::string& path) {
@@ -444,6 +494,7 @@ double new_zone_grid_connectivity(int cgio, double root, const std::string& base
   QSMESH_CGIO(cgio_get_node_id(cgio, root, ("/" + base + "/" + zone).c_str(), &zone_id));
   new_node(cgio, zone_id, "ZoneGridConnectivity", "ZoneGridConnectivity_t", "MT", 0, nullptr,
            nullptr, &id, path);
+  release_node(cgio, zone_id, path);
   return id;
 }
 
@@ -456,20 +507,21 @@ void write_abutment(int cgio, double parent, const std::string& name, const std:
                     std::array<cgsize_t, 2> points_dims, const cgsize_t* points,
                     std::array<cgsize_t, 2> donor_dims, const cgsize_t* donor_points,
                     const std::string& path) {
-  double id = 0, child = 0;
+  double id = 0;
   const cgsize_t donor_size[1] = {static_cast<cgsize_t>(donor.size())};
   new_node(cgio, parent, name.c_str(), "GridConnectivity_t", "C1", 1, donor_size, donor.data(), &id,
            path);
   const std::string type = "Abutting1to1", location = "Vertex";
   const cgsize_t type_size[1] = {static_cast<cgsize_t>(type.size())};
   const cgsize_t location_size[1] = {static_cast<cgsize_t>(location.size())};
-  new_node(cgio, id, "GridConnectivityType", "GridConnectivityType_t", "C1", 1, type_size,
-           type.data(), &child, path);
-  new_node(cgio, id, "GridLocation", "GridLocation_t", "C1", 1, location_size, location.data(),
-           &child, path);
-  new_node(cgio, id, points_name, points_label, "I4", 2, points_dims.data(), points, &child, path);
-  new_node(cgio, id, "PointListDonor", "IndexArray_t", "I4", 2, donor_dims.data(), donor_points,
-           &child, path);
+  new_leaf(cgio, id, "GridConnectivityType", "GridConnectivityType_t", "C1", 1, type_size,
+           type.data(), path);
+  new_leaf(cgio, id, "GridLocation", "GridLocation_t", "C1", 1, location_size, location.data(),
+           path);
+  new_leaf(cgio, id, points_name, points_label, "I4", 2, points_dims.data(), points, path);
+  new_leaf(cgio, id, "PointListDonor", "IndexArray_t", "I4", 2, donor_dims.data(), donor_points,
+           path);
+  release_node(cgio, id, path);
 }
 
 // The name of connectivity node number n of a zone ("C1", "C2", ...).
@@ -597,16 +649,17 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
         const std::string cname = next_connection();
         const std::string donor_name = zone_name(r.donor);
         const cgsize_t name_size[1] = {static_cast<cgsize_t>(donor_name.size())};
-        double conn_id = 0, child = 0;
+        double conn_id = 0;
         new_node(cgio, zgc_id, cname.c_str(), "GridConnectivity1to1_t", "C1", 1, name_size,
                  donor_name.data(), &conn_id, path);
         const cgsize_t range_dims[2] = {2, 2}, transform_dims[1] = {2};
-        new_node(cgio, conn_id, "Transform", "\"int[IndexDimension]\"", "I4", 1, transform_dims,
-                 r.transform.data(), &child, path);
-        new_node(cgio, conn_id, "PointRange", "IndexRange_t", "I4", 2, range_dims, r.range.data(),
-                 &child, path);
-        new_node(cgio, conn_id, "PointRangeDonor", "IndexRange_t", "I4", 2, range_dims,
-                 r.donor_range.data(), &child, path);
+        new_leaf(cgio, conn_id, "Transform", "\"int[IndexDimension]\"", "I4", 1, transform_dims,
+                 r.transform.data(), path);
+        new_leaf(cgio, conn_id, "PointRange", "IndexRange_t", "I4", 2, range_dims, r.range.data(),
+                 path);
+        new_leaf(cgio, conn_id, "PointRangeDonor", "IndexRange_t", "I4", 2, range_dims,
+                 r.donor_range.data(), path);
+        release_node(cgio, conn_id, path);
       }
       // Runs of side edges on the unstructured zone: a GridConnectivity (Abutting1to1, vertex
       // ranges here, vertex lists there), written as cgio nodes beside the 1-to-1 ones.
@@ -640,6 +693,7 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
         QSMESH_CG(cg_famname_write(("Curve_" + std::to_string(r.curve)).c_str()));
       }
     }
+    if (zgc_id != 0) release_node(cgio, zgc_id, path);
   }
 
   // Faces the layout could not cut into blocks: one unstructured zone with a section per face, and
@@ -666,6 +720,7 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
                        "PointList", "IndexArray_t", {1, n}, a.local.data(), {2, n}, a.ij.data(),
                        path);
       }
+      release_node(cgio, zgc_id, path);
     }
   }
 
