@@ -725,6 +725,19 @@ class Builder {
     return out;
   }
 
+  // The arcs of side s of patch p after its last arc of nonzero length in the solution (all of
+  // them when the side has length 0).
+  [[nodiscard]] std::vector<LO> trailing_zero_arcs(std::size_t p, int s) const {
+    std::vector<LO> out;
+    for (const SideArc& x : sides_[p][static_cast<std::size_t>(s)]) {
+      if (q_[static_cast<std::size_t>(x.arc)] != 0)
+        out.clear();
+      else
+        out.push_back(x.arc);
+    }
+    return out;
+  }
+
   // Points x and y are one (zero distance); the distance between them is the sum of `arcs`.
   void link(GO x, GO y, std::vector<LO> arcs) {
     if (x == y) return;
@@ -942,10 +955,13 @@ class Builder {
       const auto a = static_cast<LO>(sp[0].size()) - 1, b = static_cast<LO>(sp[1].size()) - 1;
       if (a != static_cast<LO>(sp[2].size()) - 1 || b != static_cast<LO>(sp[3].size()) - 1)
         throw Reject{cat("patch ", p, " is not consistent in the solution")};
-      // Sides meet at the corners (a side of length 0 is a single point).
+      // Sides meet at the corners (a side of length 0 is a single point). The last point of side
+      // k is the end of its last arc of nonzero length, so the distance from it to the corner is
+      // the sum of the arcs after that one only: a label with the whole side would make a row that
+      // the solution already meets, which cuts nothing.
       for (int k = 0; k < 4; ++k)
         link(sp[static_cast<std::size_t>(k)].back(),
-             sp[static_cast<std::size_t>((k + 1) % 4)].front(), side_arcs(p, k));
+             sp[static_cast<std::size_t>((k + 1) % 4)].front(), trailing_zero_arcs(p, k));
       if (a == 0 || b == 0) {
         // A patch of zero area: its opposite sides' points merge (Sec. IV.A-B).
         for (LO k = 0; a == 0 && k <= b; ++k)
