@@ -1,6 +1,7 @@
 // Run by ctest at 1, 2 and 4 ranks: OpenCASCADE models with curves that three faces border (a T of
 // three plates; a box whose top face is given twice) mesh alike on any number of ranks, the
-// assembled mesh conforms, and its block-structured CGNS file passes the block reader.
+// assembled mesh conforms, and its block-structured CGNS file passes the block reader. The coarse
+// block layout (paper 002) of a box with a hole is the same on any number of ranks too.
 #include <gtest/gtest.h>
 #include <mpi.h>
 
@@ -11,6 +12,7 @@
 
 #include "cgns_blocks_check.hpp"
 #include "qsmesh/io/writer.hpp"
+#include "qsmesh/layout/coarse_layout.hpp"
 #include "qsmesh/layout/quad_layout.hpp"
 #include "qsmesh/mesh/validate.hpp"
 #include "qsmesh/parallel/comm.hpp"
@@ -89,6 +91,38 @@ TEST(NonManifold, TOfThreePlates) {
 TEST(NonManifold, BoxWithItsTopGivenTwice) {
   check_model([](const std::string& p) { test::write_box_with_duplicated_face(6.0, p); }, "nm_box",
               1.0, 4);
+}
+
+// The coarse layout runs on rank 0 on the gathered mesh: the same new mesh and blocks whatever the
+// number of ranks that meshed it.
+TEST(CoarseLayout, SameBlocksOnAnyRanks) {
+  const Comm comm = Comm::world();
+  const std::string path = tmp("coarse_np" + std::to_string(comm.size()) + ".brep");
+  if (comm.rank() == 0) test::write_box_with_hole(path);
+  comm.barrier();
+  const cad::CadModel model = cad::load_cad(path);
+  PipelineOptions options;
+  options.background.sizes.size = 0.35;
+  options.sizemap.size_max = 0.35;
+  options.until = Stage::QuasiStructured;
+  std::ostringstream sink;
+  Logger log(sink, LogLevel::Quiet);
+  const PipelineResult dist = run_pipeline(comm, model, options, TaskArena(2), log);
+  if (comm.rank() != 0) return;
+  const PipelineResult serial = run_pipeline(Comm::self(), model, options, TaskArena(1), log);
+  const layout::CoarseResult a = layout::build_coarse_layout(dist.mesh, model);
+  const layout::CoarseResult b = layout::build_coarse_layout(serial.mesh, model);
+  ASSERT_TRUE(a.ok) << a.failure;
+  ASSERT_TRUE(b.ok) << b.failure;
+  EXPECT_EQ(a.mesh.points, b.mesh.points);
+  EXPECT_EQ(a.mesh.quads, b.mesh.quads);
+  ASSERT_EQ(a.layout.blocks.size(), b.layout.blocks.size());
+  for (std::size_t k = 0; k < a.layout.blocks.size(); ++k) {
+    EXPECT_EQ(a.layout.blocks[k].ni, b.layout.blocks[k].ni) << k;
+    EXPECT_EQ(a.layout.blocks[k].nj, b.layout.blocks[k].nj) << k;
+  }
+  EXPECT_EQ(a.layout.vertices, b.layout.vertices);
+  EXPECT_GT(a.layout.blocks.size(), 0U);
 }
 
 }  // namespace
