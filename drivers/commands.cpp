@@ -268,11 +268,9 @@ struct Checks {
     LO unblocked_faces = 0, extended_faces = 0;
     /// PLOT3D output: what it could not hold (the unblocked faces with elements).
     std::optional<io::Plot3dReport> plot3d;
-    /// --layout coarse: asked for; fallback: it failed and the dense layout was written.
-    bool coarse = false, fallback = false;
-    std::int64_t ilp_variables = 0, ilp_constraints = 0, fine_quads = 0, tmesh_patches = 0;
-    int ilp_rounds = 0, repairs = 0;
-    double ilp_seconds = 0, layout_seconds = 0, sicn_min = 0, sicn_avg = 0;
+    /// --layout coarse: its statistics; fallback: it failed and the dense layout was written.
+    std::optional<layout::CoarseStats> coarse;
+    bool fallback = false;
     [[nodiscard]] double mean_quads() const {
       return blocks > 0 ? static_cast<double>(quads) / static_cast<double>(blocks) : 0.0;
     }
@@ -443,17 +441,19 @@ std::string stats_json(const Arguments& args, const Session& session,
             std::string(checks.blocks->coarse
                             ? (checks.blocks->fallback ? "dense (coarse failed)" : "coarse")
                             : "dense"));
-    if (checks.blocks->coarse) {
-      j.value("ilp_variables", checks.blocks->ilp_variables);
-      j.value("ilp_constraints", checks.blocks->ilp_constraints);
-      j.value("ilp_seconds", checks.blocks->ilp_seconds);
-      j.value("ilp_rounds", static_cast<std::int64_t>(checks.blocks->ilp_rounds));
-      j.value("tmesh_patches", checks.blocks->tmesh_patches);
-      j.value("coarse_layout_repairs", static_cast<std::int64_t>(checks.blocks->repairs));
-      j.value("coarse_layout_seconds", checks.blocks->layout_seconds);
-      j.value("block_mesh_quads", checks.blocks->fine_quads);
-      j.value("block_mesh_sicn_min", checks.blocks->sicn_min);
-      j.value("block_mesh_sicn_avg", checks.blocks->sicn_avg);
+    if (const auto& c = checks.blocks->coarse) {
+      // The new mesh's numbers only when it was written.
+      const bool kept = !checks.blocks->fallback;
+      j.value("ilp_variables", c->ilp_variables);
+      j.value("ilp_constraints", c->ilp_constraints);
+      j.value("ilp_seconds", c->ilp_seconds);
+      j.value("ilp_rounds", static_cast<std::int64_t>(c->ilp_rounds));
+      j.value("tmesh_patches", c->tmesh_patches);
+      j.value("coarse_layout_repairs", static_cast<std::int64_t>(c->repairs));
+      j.value("coarse_layout_seconds", c->seconds);
+      j.value("block_mesh_quads", kept ? c->fine_quads : std::int64_t{0});
+      j.value("block_mesh_sicn_min", kept ? c->sicn_min : 0.0);
+      j.value("block_mesh_sicn_avg", kept ? c->sicn_avg : 0.0);
     }
     if (checks.blocks->plot3d) {
       const io::Plot3dReport& p = *checks.blocks->plot3d;
@@ -610,9 +610,10 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
          << " faces, " << b.plot3d->skipped_triangles << " triangles, " << b.plot3d->skipped_quads
          << " quads\n";
     if (b.coarse && !b.fallback)
-      os << "  coarse layout: ILP " << b.ilp_variables << " variables, " << b.ilp_constraints
-         << " constraints, " << b.ilp_seconds << " s; layout " << b.layout_seconds << " s; "
-         << b.fine_quads << " quads, SICN min " << b.sicn_min << " avg " << b.sicn_avg << "\n";
+      os << "  coarse layout: ILP " << b.coarse->ilp_variables << " variables, "
+         << b.coarse->ilp_constraints << " constraints, " << b.coarse->ilp_seconds << " s; layout "
+         << b.coarse->seconds << " s; " << b.coarse->fine_quads << " quads, SICN min "
+         << b.coarse->sicn_min << " avg " << b.coarse->sicn_avg << "\n";
     if (b.fallback) os << "  coarse layout failed: the dense layout was written\n";
   }
   if (!checks.rank_peak_mb.empty()) {
@@ -890,20 +891,8 @@ int run_mesh(const Arguments& args) {
       std::optional<layout::CoarseResult> coarse;
       if (args.coarse_layout) {
         coarse = layout::build_coarse_layout(result.mesh, s.model);
-        const layout::CoarseStats& c = coarse->stats;
-        b.coarse = true;
-        b.ilp_variables = c.ilp_variables;
-        b.ilp_constraints = c.ilp_constraints;
-        b.ilp_seconds = c.ilp_seconds;
-        b.layout_seconds = c.seconds;
-        b.tmesh_patches = c.tmesh_patches;
-        b.ilp_rounds = c.ilp_rounds;
-        b.repairs = c.repairs;
-        if (coarse->ok) {
-          b.fine_quads = c.fine_quads;
-          b.sicn_min = c.sicn_min;
-          b.sicn_avg = c.sicn_avg;
-        } else {
+        b.coarse = coarse->stats;
+        if (!coarse->ok) {
           b.fallback = true;
           s.log.warn(cat("coarse layout failed (", coarse->failure,
                          "): writing the dense layout instead"));

@@ -117,6 +117,17 @@ Polyline trace(const Context& c, std::vector<Node>& nodes, LO origin, const Vec2
   Polyline out;
   out.from = origin;
   out.uv = {nodes[origin].uv, seed};
+  // The separatrix ends at x on loop `loop` (position pos along it): a new Hit node.
+  const auto end_on_boundary = [&](const Vec2& x, LO loop, double pos) {
+    Node hit;
+    hit.kind = Node::Hit;
+    hit.uv = x;
+    hit.xyz = at(c, x);
+    hit.loop = loop;
+    hit.pos = pos;
+    out.to = static_cast<LO>(nodes.size());
+    nodes.push_back(hit);
+  };
   Vec2 p = seed;
   Vec3 prev = w0;
   double length = c.rho;
@@ -149,14 +160,7 @@ Polyline trace(const Context& c, std::vector<Node>& nodes, LO origin, const Vec2
       }
       if (loop == kNoIndex || best > 2 * norm(out.uv.back() - out.uv[out.uv.size() - 2]) + 1e-12)
         fail("separatrices", "a separatrix left the triangulation");
-      Node hit;
-      hit.kind = Node::Hit;
-      hit.uv = x;
-      hit.xyz = at(c, x);
-      hit.loop = loop;
-      hit.pos = pos;
-      out.to = static_cast<LO>(nodes.size());
-      nodes.push_back(hit);
+      end_on_boundary(x, loop, pos);
       out.uv.back() = x;
       return out;
     }
@@ -170,14 +174,7 @@ Polyline trace(const Context& c, std::vector<Node>& nodes, LO origin, const Vec2
     double pos = 0;
     Vec2 x;
     if (boundary_crossing(c, p, q, loop, pos, x)) {
-      Node hit;
-      hit.kind = Node::Hit;
-      hit.uv = x;
-      hit.xyz = at(c, x);
-      hit.loop = loop;
-      hit.pos = pos;
-      out.to = static_cast<LO>(nodes.size());
-      nodes.push_back(hit);
+      end_on_boundary(x, loop, pos);
       out.uv.push_back(x);
       return out;
     }

@@ -14,6 +14,7 @@
 #include <utility>
 #include <vector>
 
+#include "grid.hpp"
 #include "qsmesh/cad/geometry.hpp"
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/core/timer.hpp"
@@ -93,28 +94,7 @@ struct Passage {
 };
 
 // A T-mesh patch: a grid of ni x nj input quads of one face.
-struct Grid {
-  LO face = kNoIndex;
-  LO ni = 0, nj = 0;
-  std::vector<GO> v;  // (ni + 1) x (nj + 1), i fastest
-  [[nodiscard]] GO at(LO i, LO j) const {
-    return v[static_cast<std::size_t>(j) * static_cast<std::size_t>(ni + 1) +
-             static_cast<std::size_t>(i)];
-  }
-  // Side s, counter-clockwise: 0 = j min (i up), 1 = i max (j up), 2 = j max (i down), 3 = i min.
-  [[nodiscard]] std::vector<GO> side(int s) const {
-    std::vector<GO> out;
-    if (s == 0)
-      for (LO i = 0; i <= ni; ++i) out.push_back(at(i, 0));
-    if (s == 1)
-      for (LO j = 0; j <= nj; ++j) out.push_back(at(ni, j));
-    if (s == 2)
-      for (LO i = ni; i >= 0; --i) out.push_back(at(i, nj));
-    if (s == 3)
-      for (LO j = nj; j >= 0; --j) out.push_back(at(0, j));
-    return out;
-  }
-};
+using detail::Grid;
 
 struct Arc {
   std::vector<GO> verts;  // input mesh vertices, node to node
@@ -559,7 +539,7 @@ class Builder {
     }
     std::sort(seen.begin(), seen.end());
     if (seen != members) return std::nullopt;
-    return Grid{face, ni, nj, std::move(gv)};
+    return Grid{face, ni, nj, std::move(gv), {}};
   }
 
   // Nodes (irregular and boundary-turning vertices, trace crossings and ends, patch corners) and
@@ -1716,15 +1696,7 @@ class Builder {
 
   std::int64_t folded(const mesh::FaceMesh& fm, LO f) {
     std::int64_t n = 0;
-    for (const auto& lq : fm.quads) {
-      Vec3 nsum{0, 0, 0};
-      for (LO c : lq) nsum += face_geom(f).normal(fm.uv[static_cast<std::size_t>(c)]);
-      const Vec3 d1 =
-          fm.points[static_cast<std::size_t>(lq[2])] - fm.points[static_cast<std::size_t>(lq[0])];
-      const Vec3 d2 =
-          fm.points[static_cast<std::size_t>(lq[3])] - fm.points[static_cast<std::size_t>(lq[1])];
-      if (norm2(nsum) > 0 && dot(cross(d1, d2), nsum) <= 0) ++n;
-    }
+    for (std::size_t qi = 0; qi < fm.quads.size(); ++qi) n += folded_quad(fm, f, qi) ? 1 : 0;
     return n;
   }
 
