@@ -167,12 +167,14 @@ Arguments parse(const std::vector<std::string>& args) {
       help_only.command = Command::Help;
       return help_only;
     }
-    if (opt == "-o" || opt == "--output") a.output = value();
+    if (opt == "-o" || opt == "--output")
+      a.output = value();
     else if (opt == "--size" && (meshing || a.command == Command::Info))
       a.size = parse_positive(opt, value());
     else if (opt == "--size-factor" && (meshing || a.command == Command::Info))
       a.size_factor = parse_positive(opt, value());
-    else if (opt == "--until" && a.command == Command::Mesh) a.until = value();
+    else if (opt == "--until" && a.command == Command::Mesh)
+      a.until = value();
     else if (opt == "--method" && a.command == Command::Mesh) {
       a.method = value();
       // separatrix: paper 003's partition (fieldmesh); the others: paper 004's dispatch.
@@ -185,7 +187,8 @@ Arguments parse(const std::vector<std::string>& args) {
       a.threads = parse_threads(value());
     else if (opt == "--face-time-budget" && a.command == Command::Mesh)
       a.face_time_budget = parse_positive(opt, value());
-    else if (opt == "--stats" && meshing) a.stats = value();
+    else if (opt == "--stats" && meshing)
+      a.stats = value();
     else if (opt == "--field-divisions" && meshing) {
       const std::string& v = value();
       const auto n = parse_double(v);
@@ -214,8 +217,8 @@ Arguments parse(const std::vector<std::string>& args) {
       if (v.size() != 1 || v[0] < '1' || v[0] > '5')
         throw InputError("--order: '" + v + "' is not 1, 2, 3, 4 or 5");
       a.order = v[0] - '0';
-    }
-    else if (opt == "--check" && a.command == Command::CrossField) a.check = true;
+    } else if (opt == "--check" && a.command == Command::CrossField)
+      a.check = true;
     else if (opt == "--curvature-edges" && sizing) {
       const std::string& v = value();
       const auto n = parse_double(v);
@@ -231,14 +234,16 @@ Arguments parse(const std::vector<std::string>& args) {
     } else if (opt == "--feature-ratio" && sizing) {
       const std::string& v = value();
       const auto r = parse_double(v);
-      if (!r || !(*r >= 0 && *r <= 1)) throw InputError(opt + ": '" + v + "' is not a number in [0, 1]");
+      if (!r || !(*r >= 0 && *r <= 1))
+        throw InputError(opt + ": '" + v + "' is not a number in [0, 1]");
       a.feature_ratio = *r;
     } else if (opt == "--size-min" && sizing) {
       a.size_min = parse_positive(opt, value());
     } else if (opt == "--size-min-ratio" && sizing) {
       const std::string& v = value();
       const auto r = parse_double(v);
-      if (!r || !(*r > 0 && *r <= 1)) throw InputError(opt + ": '" + v + "' is not a number in (0, 1]");
+      if (!r || !(*r > 0 && *r <= 1))
+        throw InputError(opt + ": '" + v + "' is not a number in (0, 1]");
       a.size_min_ratio = *r;
     } else if (opt == "--sizing" && sizing) {
       a.sizing = value();
@@ -299,8 +304,10 @@ Arguments parse(const std::vector<std::string>& args) {
       }
     } else if (opt == "--sew")
       a.sew = true;
-    else if (opt == "--quiet" || opt == "-q") a.quiet = true;
-    else if (opt == "--verbose" || opt == "-v") a.verbose = true;
+    else if (opt == "--quiet" || opt == "-q")
+      a.quiet = true;
+    else if (opt == "--verbose" || opt == "-v")
+      a.verbose = true;
     else if (!opt.empty() && opt[0] == '-' && opt.size() > 1)
       throw InputError("unknown option '" + opt + "' for '" + cmd + "' (see qsmesh " + cmd +
                        " --help)");
@@ -471,9 +478,11 @@ std::string help(const std::string& topic) {
           "                        orders as the linear quads of their corners)\n"
           "  --block-structured    write the .cgns file as structured zones, one per block,\n"
           "                        joined by 1-to-1 connectivity (see --layout)\n"
-          "  --layout dense|coarse the blocks of --block-structured (and of .xyz). dense (default):\n"
+          "  --layout dense|coarse the blocks of --block-structured (and of .xyz). dense "
+          "(default):\n"
           "                        the layout of the quad mesh as it is (traces from irregular\n"
-          "                        vertices and CAD corners, paper 002 Sec. III.A; blocks may meet\n"
+          "                        vertices and CAD corners, paper 002 Sec. III.A; blocks may "
+          "meet\n"
           "                        along part of a side); faces that do not split into blocks go\n"
           "                        to one unstructured zone. coarse: a new mesh on a conforming\n"
           "                        layout (paper 002 Sec. III-IV: T-mesh, ILP, subdivision,\n"

@@ -50,7 +50,7 @@ struct Arguments {
   /// --order N, 2..5: Lagrange quads ((N + 1)^2 nodes) and bars (N + 1 nodes) on the CAD
   /// (highorder::make_high_order); 1: linear.
   int order = 1;
-  bool json = false;                   ///< info --json
+  bool json = false;  ///< info --json
   /// info --partition P,...: the METIS partition of the faces that `mpirun -np P qsmesh mesh`
   /// with the same --size/--size-factor uses, for each P (scripts/simulate_scaling.py).
   std::vector<int> partition;

@@ -46,7 +46,8 @@ int run_mesh(const Arguments& args);
 /// `qsmesh crossfield`: background meshes and cross fields of every face (paper 000 Sec. 3),
 /// written as VTU with the fields, and the Euler check per face. Collective.
 int run_crossfield(const Arguments& args);
-/// `qsmesh sizemap`: size map and curve quantization (paper 000 Sec. 4), written as VTU. Collective.
+/// `qsmesh sizemap`: size map and curve quantization (paper 000 Sec. 4), written as VTU.
+/// Collective.
 int run_sizemap(const Arguments& args);
 
 /// The size-map options of the command line (--sizemap, --quads, --curvature-edges, --curve-edges,

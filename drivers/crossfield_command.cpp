@@ -70,12 +70,14 @@ int run_crossfield(const Arguments& args) {
   options.background.sizes.size = s.size;
   options.background.sizes.field_divisions = field_divisions(args);
   options.cross_fields = true;
-  const parallel::PipelineResult result = parallel::run_pipeline(s.comm, s.model, options, *s.tasks, s.log, &lane);
+  const parallel::PipelineResult result =
+      parallel::run_pipeline(s.comm, s.model, options, *s.tasks, s.log, &lane);
   for (const auto& [stage, sec] : result.times.entries()) s.times.add(stage, sec);
   if (s.rank != 0) return 0;
 
   const LO nfaces = s.model.num_faces();
-  int consistent = 0, with_field = 0, plus = 0, minus = 0, levels = 0, factorizations = 0, solves = 0;
+  int consistent = 0, with_field = 0, plus = 0, minus = 0, levels = 0, factorizations = 0,
+      solves = 0;
   for (const auto& cf : result.cross_fields) {
     if (!cf.ok) continue;
     ++with_field;
@@ -93,7 +95,8 @@ int run_crossfield(const Arguments& args) {
   }
 
   if (!args.quiet && !args.check) {
-    std::cout << "\nper face: singularities (+1 / -1), Euler relation (found / expected), levels, solves, seconds\n";
+    std::cout << "\nper face: singularities (+1 / -1), Euler relation (found / expected), levels, "
+                 "solves, seconds\n";
     for (LO f = 0; f < nfaces; ++f) {
       const auto& cf = result.cross_fields[f];
       if (!cf.ok) {
@@ -104,13 +107,14 @@ int run_crossfield(const Arguments& args) {
       for (const auto& sg : cf.singularities) (sg.index > 0 ? p : n) += 1;
       std::cout << "  face " << std::setw(4) << f << ": " << p << " / " << n << ", euler "
                 << (cf.euler.consistent ? "ok" : "NOT ok") << " (" << cf.euler.found << " / "
-                << cf.euler.expected << "), " << cf.levels << " levels, " << cf.solves << " solves, "
-                << std::setprecision(3) << cf.seconds << " s\n";
+                << cf.euler.expected << "), " << cf.levels << " levels, " << cf.solves
+                << " solves, " << std::setprecision(3) << cf.seconds << " s\n";
     }
-    std::cout << "\nsummary\n  faces: " << nfaces << " (" << nfaces - with_field << " without cross field)\n"
+    std::cout << "\nsummary\n  faces: " << nfaces << " (" << nfaces - with_field
+              << " without cross field)\n"
               << "  singularities: " << plus << " of index +1, " << minus << " of index -1\n"
-              << "  factorizations: " << factorizations << ", solves: " << solves << "\n  time (s):"
-              << times_line(s.times) << "\n";
+              << "  factorizations: " << factorizations << ", solves: " << solves
+              << "\n  time (s):" << times_line(s.times) << "\n";
   }
   if (args.check) {
     for (LO f = 0; f < nfaces; ++f) {
@@ -118,9 +122,9 @@ int run_crossfield(const Arguments& args) {
       if (!cf.ok)
         std::cout << "face " << f << ": no cross field: " << cf.error << "\n";
       else if (!cf.euler.consistent)
-        std::cout << "face " << f << ": singularities sum to " << cf.euler.found << ", Euler relation asks "
-                  << cf.euler.expected << " (chi " << cf.euler.chi << ", corner term " << cf.euler.corner_term
-                  << ")\n";
+        std::cout << "face " << f << ": singularities sum to " << cf.euler.found
+                  << ", Euler relation asks " << cf.euler.expected << " (chi " << cf.euler.chi
+                  << ", corner term " << cf.euler.corner_term << ")\n";
     }
   }
   std::cout << "euler-consistent: " << consistent << "/" << nfaces << "\n";
@@ -143,10 +147,18 @@ int run_crossfield(const Arguments& args) {
       const auto& cf = result.cross_fields[f];
       int p = 0, n = 0;
       for (const auto& sg : cf.singularities) (sg.index > 0 ? p : n) += 1;
-      j.begin_object().value("face", static_cast<std::int64_t>(f)).value("ok", cf.ok).value("plus", p)
-          .value("minus", n).value("euler_found", cf.euler.found).value("euler_expected", cf.euler.expected)
-          .value("euler_consistent", cf.euler.consistent).value("levels", cf.levels)
-          .value("factorizations", cf.factorizations).value("solves", cf.solves).value("seconds", cf.seconds)
+      j.begin_object()
+          .value("face", static_cast<std::int64_t>(f))
+          .value("ok", cf.ok)
+          .value("plus", p)
+          .value("minus", n)
+          .value("euler_found", cf.euler.found)
+          .value("euler_expected", cf.euler.expected)
+          .value("euler_consistent", cf.euler.consistent)
+          .value("levels", cf.levels)
+          .value("factorizations", cf.factorizations)
+          .value("solves", cf.solves)
+          .value("seconds", cf.seconds)
           .end_object();
     }
     j.end_array();

@@ -17,7 +17,9 @@ class JsonWriter {
   JsonWriter& value(const std::string& key, const char* v) { return value(key, std::string(v)); }
   JsonWriter& value(const std::string& key, double v);
   JsonWriter& value(const std::string& key, std::int64_t v);
-  JsonWriter& value(const std::string& key, int v) { return value(key, static_cast<std::int64_t>(v)); }
+  JsonWriter& value(const std::string& key, int v) {
+    return value(key, static_cast<std::int64_t>(v));
+  }
   JsonWriter& value(const std::string& key, bool v);
   [[nodiscard]] const std::string& str() const { return out_; }
 

@@ -37,7 +37,9 @@ io::WriteOptions size_fields(const cad::CadModel& model, const parallel::Pipelin
     const auto& fs = r.face_sizes[f];
     for (std::size_t v = 0; v < bg.vclass.size(); ++v) {
       const auto& vc = bg.vclass[v];
-      const GO g = vc.dim == 2 ? next++ : vc.dim == 0 ? vc.entity : curve_first[vc.entity] + vc.index - 1;
+      const GO g = vc.dim == 2   ? next++
+                   : vc.dim == 0 ? vc.entity
+                                 : curve_first[vc.entity] + vc.index - 1;
       if (fs.s.empty() || !std::isnan(s[g])) continue;
       s[g] = fs.s[v];
       s_min[g] = fs.s_min[v];
@@ -54,7 +56,8 @@ io::WriteOptions size_fields(const cad::CadModel& model, const parallel::Pipelin
   opt.vtu_include_bars = true;
   for (LO c = 0; c < static_cast<LO>(r.quantized_curves.size()); ++c) {
     const auto& cm = r.quantized_curves[c];
-    for (std::size_t i = 0; i < cm.points.size(); ++i) opt.vtu_markers.push_back({cm.points[i], kNoIndex});
+    for (std::size_t i = 0; i < cm.points.size(); ++i)
+      opt.vtu_markers.push_back({cm.points[i], kNoIndex});
   }
   const std::size_t nm = opt.vtu_markers.size();
   for (auto* f : {&s, &s_min, &s_cf}) f->resize(nv + nm, kUnset);
@@ -85,7 +88,8 @@ int run_sizemap(const Arguments& args) {
   check_request(args, s);
   apply_size_options(args, s, options);
   s.announce(args, "sizemap");
-  const parallel::PipelineResult result = parallel::run_pipeline(s.comm, s.model, options, *s.tasks, s.log, &lane);
+  const parallel::PipelineResult result =
+      parallel::run_pipeline(s.comm, s.model, options, *s.tasks, s.log, &lane);
   for (const auto& [stage, sec] : result.times.entries()) s.times.add(stage, sec);
   if (s.rank != 0) return 0;
 
@@ -102,9 +106,10 @@ int run_sizemap(const Arguments& args) {
       smax = std::max(smax, x);
     }
   if (!args.quiet) {
-    std::cout << "\nsummary\n  size map method: " << args.sizemap << "\n  curves: " << s.model.num_curves()
-              << ", chords: " << q.num_chords << ", edges: " << q.total_edges << "\n  size on curves: "
-              << smin << " to " << smax << "\n  time (s):" << times_line(s.times) << "\n";
+    std::cout << "\nsummary\n  size map method: " << args.sizemap
+              << "\n  curves: " << s.model.num_curves() << ", chords: " << q.num_chords
+              << ", edges: " << q.total_edges << "\n  size on curves: " << smin << " to " << smax
+              << "\n  time (s):" << times_line(s.times) << "\n";
   }
   if (!args.stats.empty()) {
     JsonWriter j;

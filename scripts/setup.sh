@@ -19,6 +19,8 @@ packages=(
   libgtest-dev
   # the libFuzzer targets of scripts/fuzz.sh (llvm-14: llvm-symbolizer for their reports)
   clang-14 libclang-rt-14-dev llvm-14
+  # scripts/check_style.sh (CI): formatting in check mode, clang-tidy on changed files
+  clang-format-14 clang-tidy-14
   python3
   time
   # Pictures (scripts/render_mesh.py, scripts/plot_table.py): Debian's VTK renders through X even

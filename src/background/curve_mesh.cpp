@@ -13,8 +13,8 @@
 
 namespace qsmesh::background {
 
-CurveCurvatureSize::CurveCurvatureSize(const cad::CadModel& model, LO curve, std::span<const CurveUseRef> uses,
-                                       const SizeOptions& sizes)
+CurveCurvatureSize::CurveCurvatureSize(const cad::CadModel& model, LO curve,
+                                       std::span<const CurveUseRef> uses, const SizeOptions& sizes)
     : geometry_(model.curve_geometry(curve)), refs_(uses.begin(), uses.end()), sizes_(sizes) {
   for (const CurveUseRef& u : uses) faces_.push_back(model.face_geometry(u.face));
 }
@@ -65,7 +65,8 @@ CurveSamples sample_curve(const CurveCurvatureSize& sizer, const cad::Curve& cur
     length += ds;
     prev = q;
   }
-  const int n = std::clamp(static_cast<int>(std::ceil(std::max(8 * estimate, 4 * length / cap))), 32, 16384);
+  const int n =
+      std::clamp(static_cast<int>(std::ceil(std::max(8 * estimate, 4 * length / cap))), 32, 16384);
   CurveSamples cs;
   cs.t.resize(static_cast<std::size_t>(n) + 1);
   cs.s.assign(cs.t.size(), 0.0);
@@ -86,8 +87,10 @@ void grade_along(CurveSamples& cs, double h_start, double h_end, double g) {
   const std::size_t n = cs.h.size();
   cs.h.front() = std::min(cs.h.front(), h_start);
   cs.h.back() = std::min(cs.h.back(), h_end);
-  for (std::size_t i = 1; i < n; ++i) cs.h[i] = std::min(cs.h[i], cs.h[i - 1] + g * (cs.s[i] - cs.s[i - 1]));
-  for (std::size_t i = n - 1; i-- > 0;) cs.h[i] = std::min(cs.h[i], cs.h[i + 1] + g * (cs.s[i + 1] - cs.s[i]));
+  for (std::size_t i = 1; i < n; ++i)
+    cs.h[i] = std::min(cs.h[i], cs.h[i - 1] + g * (cs.s[i] - cs.s[i - 1]));
+  for (std::size_t i = n - 1; i-- > 0;)
+    cs.h[i] = std::min(cs.h[i], cs.h[i + 1] + g * (cs.s[i + 1] - cs.s[i]));
 }
 
 /// Places round(integral of ds / h) edges (at least min_edges) at equal steps of that integral.
@@ -96,7 +99,8 @@ mesh::CurveMesh place_vertices(const CurveSamples& cs, const CurveCurvatureSize&
   const std::size_t n = cs.t.size();
   std::vector<double> cumulative(n, 0.0);
   for (std::size_t i = 1; i < n; ++i)
-    cumulative[i] = cumulative[i - 1] + 0.5 * (1 / cs.h[i - 1] + 1 / cs.h[i]) * (cs.s[i] - cs.s[i - 1]);
+    cumulative[i] =
+        cumulative[i - 1] + 0.5 * (1 / cs.h[i - 1] + 1 / cs.h[i]) * (cs.s[i] - cs.s[i - 1]);
   const double total = cumulative.back();
   QSMESH_CHECK(std::isfinite(total) && total > 0, "size integral is not finite (" << total << ")");
   const int edges = std::max(min_edges, static_cast<int>(std::lround(total)));
@@ -109,7 +113,8 @@ mesh::CurveMesh place_vertices(const CurveSamples& cs, const CurveCurvatureSize&
   for (int k = 1; k < edges; ++k) {
     const double target = total * k / edges;
     const auto it = std::lower_bound(cumulative.begin(), cumulative.end(), target);
-    const auto i = std::clamp<std::size_t>(static_cast<std::size_t>(it - cumulative.begin()), 1, n - 1);
+    const auto i =
+        std::clamp<std::size_t>(static_cast<std::size_t>(it - cumulative.begin()), 1, n - 1);
     const double c0 = cumulative[i - 1], c1 = cumulative[i];
     const double w = c1 > c0 ? std::clamp((target - c0) / (c1 - c0), 0.0, 1.0) : 0.0;
     out.t[k] = cs.t[i - 1] + w * (cs.t[i] - cs.t[i - 1]);
@@ -207,10 +212,13 @@ std::vector<mesh::CurveMesh> mesh_curves(const cad::CadModel& model, const SizeO
       return;
     }
     int min_edges = 1;
-    if (curve.corners[0] == curve.corners[1]) min_edges = 3;
-    else if (pair_count.at(std::minmax(curve.corners[0], curve.corners[1])) > 1) min_edges = 2;
+    if (curve.corners[0] == curve.corners[1])
+      min_edges = 3;
+    else if (pair_count.at(std::minmax(curve.corners[0], curve.corners[1])) > 1)
+      min_edges = 2;
     with_context(c, [&] {
-      grade_along(samples[c], corner_size[curve.corners[0]], corner_size[curve.corners[1]], sizes.gradation);
+      grade_along(samples[c], corner_size[curve.corners[0]], corner_size[curve.corners[1]],
+                  sizes.gradation);
       meshes[c] = place_vertices(samples[c], *sizers[c], c, p0, p1, min_edges);
     });
   });

@@ -31,7 +31,7 @@ class ModelBuilder {
 
 std::unique_ptr<CurveGeometry> make_curve_geometry(const CadModel::Impl& impl, const Curve& curve,
                                                    const Vec3& corner_point, LO c);
-std::unique_ptr<FaceGeometry> make_face_geometry(const CadModel::Impl& impl, const Face& face,
-                                                 LO f, bool with_classifier);
+std::unique_ptr<FaceGeometry> make_face_geometry(const CadModel::Impl& impl, const Face& face, LO f,
+                                                 bool with_classifier);
 
 }  // namespace qsmesh::cad

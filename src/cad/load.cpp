@@ -5,10 +5,10 @@
 #include <BRep_Builder.hxx>
 #include <Bnd_Box.hxx>
 #include <IFSelect_ReturnStatus.hxx>
+#include <IGESControl_Reader.hxx>
 #include <Message.hxx>
 #include <Message_Messenger.hxx>
 #include <Message_PrinterOStream.hxx>
-#include <IGESControl_Reader.hxx>
 #include <STEPControl_Reader.hxx>
 #include <Standard_Failure.hxx>
 #include <TopExp_Explorer.hxx>
@@ -119,7 +119,8 @@ void set_kernel_messages(bool quiet) {
   // Quiet: the program reports load failures itself, in one line; the kernel's own parser messages
   // would only repeat them. Verbose: the kernel's warnings go to stderr, never to stdout.
   if (quiet) return;
-  Handle(Message_PrinterOStream) printer = new Message_PrinterOStream("cerr", Standard_False, Message_Warning);
+  Handle(Message_PrinterOStream) printer =
+      new Message_PrinterOStream("cerr", Standard_False, Message_Warning);
   printer->SetToColorize(Standard_False);
   messenger->AddPrinter(printer);
 }

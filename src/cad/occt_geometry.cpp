@@ -140,7 +140,8 @@ class OcctFace final : public FaceGeometry {
       vmin_ = surface_.FirstVParameter();
       vmax_ = surface_.LastVParameter();
       geom_ = BRep_Tool::Surface(ff);
-      if (with_classifier) classifier_ = std::make_unique<BRepTopAdaptor_FClass2d>(ff, Precision::PConfusion());
+      if (with_classifier)
+        classifier_ = std::make_unique<BRepTopAdaptor_FClass2d>(ff, Precision::PConfusion());
       for (const auto& loop : impl.loop_edges[id]) {
         std::vector<Geom2dAdaptor_Curve> pl;
         for (const TopoDS_Edge& e : loop) {
@@ -257,7 +258,8 @@ class OcctFace final : public FaceGeometry {
   }
 
   bool contains(const Vec2& uv) const override {
-    QSMESH_CHECK(classifier_ != nullptr, "face " << id_ << ": contains() needs an evaluator made with a classifier");
+    QSMESH_CHECK(classifier_ != nullptr,
+                 "face " << id_ << ": contains() needs an evaluator made with a classifier");
     const TopAbs_State s = classifier_->Perform(gp_Pnt2d(uv.u, uv.v));
     return s == TopAbs_IN || s == TopAbs_ON;
   }
@@ -290,8 +292,8 @@ std::unique_ptr<CurveGeometry> make_curve_geometry(const CadModel::Impl& impl, c
   return std::make_unique<OcctCurve>(impl.edges[c], curve, corner_point, c);
 }
 
-std::unique_ptr<FaceGeometry> make_face_geometry(const CadModel::Impl& impl, const Face& face,
-                                                 LO f, bool with_classifier) {
+std::unique_ptr<FaceGeometry> make_face_geometry(const CadModel::Impl& impl, const Face& face, LO f,
+                                                 bool with_classifier) {
   return std::make_unique<OcctFace>(impl, face, f, with_classifier);
 }
 

@@ -3,7 +3,9 @@
 namespace qsmesh {
 
 Error::Error(const std::string& message, ErrorContext context)
-    : std::runtime_error(compose(message, context)), message_(message), context_(std::move(context)) {}
+    : std::runtime_error(compose(message, context)),
+      message_(message),
+      context_(std::move(context)) {}
 
 std::string Error::compose(const std::string& message, const ErrorContext& context) {
   std::ostringstream os;

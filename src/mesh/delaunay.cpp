@@ -1,6 +1,7 @@
 // triangulate_face: boundary Delaunay triangulation, boundary recovery by flips, removal of the
 // outside, then frontal Delaunay refinement (Rebay) measured with the surface metric, and a final
-// edge-flip pass on 3D angles. Paper 000 Sec. 3.1 (background mesh) and Sec. 5.1 (insertion kernel).
+// edge-flip pass on 3D angles. Paper 000 Sec. 3.1 (background mesh) and Sec. 5.1 (insertion
+// kernel).
 #include "qsmesh/mesh/delaunay.hpp"
 
 #include <algorithm>
@@ -18,15 +19,15 @@ namespace qsmesh::mesh {
 namespace {
 
 using detail::Cavity;
-using detail::LocKind;
 using detail::Location;
+using detail::LocKind;
 using detail::next3;
 using detail::prev3;
 using detail::Tri;
 using detail::Triangulation;
 
 constexpr double kMaxEdge = 1.4142135623730951;  // refine triangles with a longer 3D edge (x size)
-constexpr double kTooClose = 0.5;                 // reject points closer than this (x size)
+constexpr double kTooClose = 0.5;                // reject points closer than this (x size)
 constexpr double kPi = 3.14159265358979323846;
 constexpr std::uint8_t kWaiting = 0;
 constexpr std::uint8_t kAccepted = 1;
@@ -103,15 +104,15 @@ class FaceMesher {
   TriangulateStats& stats_;
 
   Triangulation tr_;
-  std::vector<Vec3> xyz_;       // per internal vertex
-  std::vector<double> h_;       // target size per internal vertex
-  std::vector<LO> out_;         // output index of boundary internal vertices (kNoIndex: interior)
-  std::vector<LO> in2v_;        // input point (flattened) -> internal vertex
-  std::vector<LO> in_out_;      // input point (flattened) -> output index
+  std::vector<Vec3> xyz_;   // per internal vertex
+  std::vector<double> h_;   // target size per internal vertex
+  std::vector<LO> out_;     // output index of boundary internal vertices (kNoIndex: interior)
+  std::vector<LO> in2v_;    // input point (flattened) -> internal vertex
+  std::vector<LO> in_out_;  // input point (flattened) -> output index
   std::vector<Segment> segs_;
   std::vector<double> loop_area_;
   LO num_out_boundary_ = 0;
-  LO first_real_ = 3;           // internal vertices 0..2 are the super triangle
+  LO first_real_ = 3;  // internal vertices 0..2 are the super triangle
   double cos_min_angle_ = 0;
   Cavity cav_;
   std::vector<LO> created_;
@@ -123,7 +124,8 @@ class FaceMesher {
     for (std::size_t l = 0; l < loops_.size(); ++l) {
       const BoundaryLoop& L = loops_[l];
       QSMESH_CHECK(L.points.size() >= 2, "triangulate_face: loop " << l << " has "
-                                            << L.points.size() << " points (need >= 2)");
+                                                                   << L.points.size()
+                                                                   << " points (need >= 2)");
       QSMESH_CHECK(L.degenerate.empty() || L.degenerate.size() == L.points.size(),
                    "triangulate_face: loop " << l << " degenerate flags size mismatch");
       std::vector<Vec2> poly;
@@ -175,7 +177,7 @@ class FaceMesher {
     const Location loc = tr_.locate(uv, hint, false);
     QSMESH_CHECK(loc.kind != LocKind::kFailed && loc.kind != LocKind::kBlocked,
                  "triangulate_face: point location failed for boundary point (" << uv.u << ", "
-                                                                               << uv.v << ")");
+                                                                                << uv.v << ")");
     if (loc.kind == LocKind::kOnVertex) {
       const LO w = tr_.tris[loc.tri].v[loc.index];
       QSMESH_CHECK(w >= first_real_ && out_[w] == out,
@@ -187,9 +189,9 @@ class FaceMesher {
       const Tri& T = tr_.tris[t];
       return incircle(tr_.pts[T.v[0]], tr_.pts[T.v[1]], tr_.pts[T.v[2]], uv) > 0;
     };
-    QSMESH_CHECK(tr_.build_cavity(uv, loc, crit, cav_),
-                 "triangulate_face: invalid cavity for boundary point (" << uv.u << ", " << uv.v
-                                                                         << ")");
+    QSMESH_CHECK(
+        tr_.build_cavity(uv, loc, crit, cav_),
+        "triangulate_face: invalid cavity for boundary point (" << uv.u << ", " << uv.v << ")");
     const LO v = tr_.add_vertex(uv);
     xyz_.push_back(xyz);
     h_.push_back(size_(uv, xyz));
@@ -301,7 +303,9 @@ class FaceMesher {
       return;
     }
     const Vec2 A = tr_.pts[a], B = tr_.pts[b];
-    auto on_segment = [&](LO w) { return dot(tr_.pts[w] - A, B - A) > 0 && dot(tr_.pts[w] - B, A - B) > 0; };
+    auto on_segment = [&](LO w) {
+      return dot(tr_.pts[w] - A, B - A) > 0 && dot(tr_.pts[w] - B, A - B) > 0;
+    };
     // Find the first crossed edge around a.
     std::vector<LO> star;
     tr_.star(a, star);
@@ -392,8 +396,10 @@ class FaceMesher {
         const int lv = level[t] + (T.is_locked(i) ? 1 : 0);
         if (level[u] < 0 || lv < level[u]) {
           level[u] = lv;
-          if (T.is_locked(i)) dq.push_back(u);
-          else dq.push_front(u);
+          if (T.is_locked(i))
+            dq.push_back(u);
+          else
+            dq.push_front(u);
         }
       }
     }
@@ -416,10 +422,11 @@ class FaceMesher {
     }
     double expected = std::fabs(loop_area_[0]);
     for (std::size_t l = 1; l < loop_area_.size(); ++l) expected -= std::fabs(loop_area_[l]);
-    QSMESH_CHECK(expected > 0 && std::fabs(area - expected) <= 1e-9 * std::fabs(loop_area_[0]) + 1e-300,
-                 "triangulate_face: inconsistent loops (holes outside the outer loop or "
-                 "overlapping): triangulated area "
-                     << area << " vs expected " << expected);
+    QSMESH_CHECK(
+        expected > 0 && std::fabs(area - expected) <= 1e-9 * std::fabs(loop_area_[0]) + 1e-300,
+        "triangulate_face: inconsistent loops (holes outside the outer loop or "
+        "overlapping): triangulated area "
+            << area << " vs expected " << expected);
     for (LO& t : tr_.v2t) t = kNoIndex;
     for (LO t = 0; t < static_cast<LO>(nt); ++t)
       if (tr_.tris[t].alive)
@@ -565,7 +572,8 @@ class FaceMesher {
   LO try_insert(const Vec2& x, const cad::SurfaceEval& ex, double hx, double spacing, LO hint) {
     return try_insert_at(tr_.locate(x, hint, true), x, ex, hx, spacing);
   }
-  LO try_insert_at(const Location& loc, const Vec2& x, const cad::SurfaceEval& ex, double hx, double spacing) {
+  LO try_insert_at(const Location& loc, const Vec2& x, const cad::SurfaceEval& ex, double hx,
+                   double spacing) {
     if (loc.kind != LocKind::kInside && loc.kind != LocKind::kOnEdge) return kNoIndex;
     const Frame f = frame_of(ex);
     const Vec2 origin{0, 0};

@@ -79,7 +79,8 @@ int sum_expansion(int elen, const double* e, int flen, const double* f, double* 
 }
 
 // h = e * f; h holds 2 * elen * flen, scratch needs 2 * elen + 2 * elen * flen.
-int mul_expansion(int elen, const double* e, int flen, const double* f, double* h, double* scratch) {
+int mul_expansion(int elen, const double* e, int flen, const double* f, double* h,
+                  double* scratch) {
   double* part = scratch;
   double* acc = scratch + 2 * elen;
   int n = scale_expansion(elen, e, f[0], h);

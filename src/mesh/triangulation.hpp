@@ -7,8 +7,8 @@
 
 #include <algorithm>
 #include <array>
-#include <utility>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "qsmesh/core/types.hpp"
@@ -93,14 +93,14 @@ class Triangulation {
   std::vector<LO> free_;
   std::uint32_t next_stamp_ = 1;
   mutable std::uint32_t rng_ = 12345U;
-  std::vector<std::uint32_t> in_cav_;   // == cav_id_: in the current cavity
-  std::vector<std::uint32_t> tested_;   // == cav_id_: criterion evaluated
+  std::vector<std::uint32_t> in_cav_;  // == cav_id_: in the current cavity
+  std::vector<std::uint32_t> tested_;  // == cav_id_: criterion evaluated
   std::uint32_t cav_id_ = 0;
-  std::vector<std::uint32_t> conn_;     // == conn_id_: reached while reconnecting
+  std::vector<std::uint32_t> conn_;  // == conn_id_: reached while reconnecting
   std::uint32_t conn_id_ = 0;
   std::vector<LO> next_;
   std::vector<LO> stack_;
-  std::vector<LO> vlink_;               // per vertex scratch for fill_cavity
+  std::vector<LO> vlink_;  // per vertex scratch for fill_cavity
   void grow_marks();
 };
 
@@ -184,8 +184,10 @@ bool Triangulation::build_cavity(const Vec2& p, const Location& loc, Criterion&&
     }
     next_.clear();
     for (LO tid : cav.tris) {
-      if (in_cav_[tid] == id && conn_[tid] == conn_id_) next_.push_back(tid);
-      else in_cav_[tid] = out_mark;
+      if (in_cav_[tid] == id && conn_[tid] == conn_id_)
+        next_.push_back(tid);
+      else
+        in_cav_[tid] = out_mark;
     }
     cav.tris.swap(next_);
   }

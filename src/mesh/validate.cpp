@@ -42,8 +42,10 @@ ConformityReport check_conformity(const SurfaceMesh& mesh, const cad::CadModel& 
       uses[edge_key(a, b)].push_back({face, a < b});
     }
   };
-  for (std::size_t i = 0; i < mesh.triangles.size(); ++i) add(mesh.triangles[i].data(), 3, mesh.triangle_face[i]);
-  for (std::size_t i = 0; i < mesh.quads.size(); ++i) add(mesh.quads[i].data(), 4, mesh.quad_face[i]);
+  for (std::size_t i = 0; i < mesh.triangles.size(); ++i)
+    add(mesh.triangles[i].data(), 3, mesh.triangle_face[i]);
+  for (std::size_t i = 0; i < mesh.quads.size(); ++i)
+    add(mesh.quads[i].data(), 4, mesh.quad_face[i]);
 
   // Expected uses of each curve edge: one per use of the curve in a face loop.
   std::vector<int> curve_uses(static_cast<std::size_t>(model.num_curves()), 0);

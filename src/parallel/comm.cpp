@@ -18,7 +18,8 @@ void check_mpi(int code, const char* what) {
   char text[MPI_MAX_ERROR_STRING];
   int len = 0;
   MPI_Error_string(code, text, &len);
-  throw Error(std::string("MPI error in ") + what + ": " + std::string(text, static_cast<std::size_t>(len)));
+  throw Error(std::string("MPI error in ") + what + ": " +
+              std::string(text, static_cast<std::size_t>(len)));
 }
 }  // namespace
 
@@ -86,21 +87,24 @@ int Comm::local_size() const {
 void Comm::barrier() const { check_mpi(MPI_Barrier(impl_->comm), "MPI_Barrier"); }
 
 void Comm::allreduce_sum(std::vector<double>& values) const {
-  QSMESH_CHECK(values.size() <= static_cast<std::size_t>(std::numeric_limits<int>::max()), "reduction too large");
+  QSMESH_CHECK(values.size() <= static_cast<std::size_t>(std::numeric_limits<int>::max()),
+               "reduction too large");
   check_mpi(MPI_Allreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()), MPI_DOUBLE,
                           MPI_SUM, impl_->comm),
             "MPI_Allreduce");
 }
 
 void Comm::allreduce_sum(std::vector<std::int64_t>& values) const {
-  QSMESH_CHECK(values.size() <= static_cast<std::size_t>(std::numeric_limits<int>::max()), "reduction too large");
+  QSMESH_CHECK(values.size() <= static_cast<std::size_t>(std::numeric_limits<int>::max()),
+               "reduction too large");
   check_mpi(MPI_Allreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()), MPI_INT64_T,
                           MPI_SUM, impl_->comm),
             "MPI_Allreduce");
 }
 
 void Comm::allreduce_min(std::vector<double>& values) const {
-  QSMESH_CHECK(values.size() <= static_cast<std::size_t>(std::numeric_limits<int>::max()), "reduction too large");
+  QSMESH_CHECK(values.size() <= static_cast<std::size_t>(std::numeric_limits<int>::max()),
+               "reduction too large");
   check_mpi(MPI_Allreduce(MPI_IN_PLACE, values.data(), static_cast<int>(values.size()), MPI_DOUBLE,
                           MPI_MIN, impl_->comm),
             "MPI_Allreduce");

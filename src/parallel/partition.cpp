@@ -35,9 +35,9 @@ std::vector<int> partition_faces(const Adjacency& face2faces, std::span<const do
   options[METIS_OPTION_SEED] = 12345;  // fixed: every rank must get the same partition
   options[METIS_OPTION_NUMBERING] = 0;
   options[METIS_OPTION_CONTIG] = 0;
-  const int status = METIS_PartGraphKway(&nvtxs, &ncon, xadj.data(), adjncy.data(), vwgt.data(),
-                                         nullptr, nullptr, &nparts, nullptr, nullptr, options,
-                                         &objval, result.data());
+  const int status =
+      METIS_PartGraphKway(&nvtxs, &ncon, xadj.data(), adjncy.data(), vwgt.data(), nullptr, nullptr,
+                          &nparts, nullptr, nullptr, options, &objval, result.data());
   QSMESH_CHECK(status == METIS_OK, "METIS_PartGraphKway failed with status " << status);
   for (LO i = 0; i < n; ++i) part[i] = static_cast<int>(result[i]);
   return part;

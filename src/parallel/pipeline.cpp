@@ -137,10 +137,8 @@ sizemap::CurveSizes size_map_stage(const Context& cx, std::span<const mesh::Curv
 // boundary crosses itself, computed identically on every rank: fills result.quantization,
 // balance, curves_refined_for_crossings and quantized_curves (the final curve meshes; each face
 // halves its own loops from them, background::halved_face_boundary).
-void quantize_stage(const Context& cx,
-                                            std::span<const mesh::CurveMesh> curves,
-                                            const std::vector<FaceTask>& faces,
-                                            PipelineResult& result) {
+void quantize_stage(const Context& cx, std::span<const mesh::CurveMesh> curves,
+                    const std::vector<FaceTask>& faces, PipelineResult& result) {
   const PipelineOptions& options = cx.options;
   const cad::CadModel& model = cx.model;
   std::vector<LO> fixed;  // user prescriptions: never changed
@@ -175,9 +173,9 @@ void quantize_stage(const Context& cx,
       cx.tasks.parallel_for(static_cast<std::int64_t>(faces.size()), [&](std::int64_t i) {
         const LO f = faces[static_cast<std::size_t>(i)].face;
         try {
-          const auto c =
-              halved ? quantize::crossing_curves_halved(model, f, result.quantized_curves)
-                     : quantize::crossing_curves(model, f, result.quantized_curves);
+          const auto c = halved
+                             ? quantize::crossing_curves_halved(model, f, result.quantized_curves)
+                             : quantize::crossing_curves(model, f, result.quantized_curves);
           found[i].insert(found[i].end(), c.begin(), c.end());
         } catch (const std::exception& e) {
           // The face's own stages report its geometry errors; this check only looks for

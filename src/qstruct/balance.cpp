@@ -68,7 +68,9 @@ std::vector<int> balance_curve_counts(const cad::CadModel& model,
   std::vector<std::vector<LO>> chord_members(static_cast<std::size_t>(q.num_chords));
   for (LO c = 0; c < nc; ++c)
     if (q.curve2chord[c] != kNoIndex) chord_members[q.curve2chord[c]].push_back(c);
-  const auto var_of = [&](LO c) { return q.curve2chord[c] == kNoIndex ? c : nc + q.curve2chord[c]; };
+  const auto var_of = [&](LO c) {
+    return q.curve2chord[c] == kNoIndex ? c : nc + q.curve2chord[c];
+  };
   const auto members = [&](LO v) -> std::vector<LO> {
     return v < nc ? std::vector<LO>{v} : chord_members[v - nc];
   };
@@ -84,7 +86,8 @@ std::vector<int> balance_curve_counts(const cad::CadModel& model,
     const cad::Face& face = model.faces()[f];
     if (face.loops.size() != 1 || !face.loops_closed) continue;
     const auto& uses = face.loops[0].uses;
-    if (std::any_of(uses.begin(), uses.end(), [&](const cad::CurveUse& u) { return cads[u.curve].degenerate; }))
+    if (std::any_of(uses.begin(), uses.end(),
+                    [&](const cad::CurveUse& u) { return cads[u.curve].degenerate; }))
       continue;
     FaceSides fs;
     try {
@@ -116,7 +119,9 @@ std::vector<int> balance_curve_counts(const cad::CadModel& model,
       // Faces come in increasing i: a repeat is always the last entry (a seam used twice).
       if (curve2targets[c].empty() || curve2targets[c].back() != i) curve2targets[c].push_back(i);
 
-  const auto fits = [&](const std::vector<LO>& n) { return !match_patterns(patterns, n, options.faces.match).empty(); };
+  const auto fits = [&](const std::vector<LO>& n) {
+    return !match_patterns(patterns, n, options.faces.match).empty();
+  };
   std::vector<char> fit(targets.size());
   for (std::size_t i = 0; i < targets.size(); ++i) fit[i] = fits(side_counts(targets[i], edges));
   rep.fitting_before = static_cast<LO>(std::count(fit.begin(), fit.end(), 1));
@@ -147,7 +152,8 @@ std::vector<int> balance_curve_counts(const cad::CadModel& model,
   // The targets a move of these curves touches, each once, in increasing order.
   const auto touched_by = [&](const std::vector<LO>& mem) {
     std::vector<LO> touched;
-    for (const LO c : mem) touched.insert(touched.end(), curve2targets[c].begin(), curve2targets[c].end());
+    for (const LO c : mem)
+      touched.insert(touched.end(), curve2targets[c].begin(), curve2targets[c].end());
     std::sort(touched.begin(), touched.end());
     touched.erase(std::unique(touched.begin(), touched.end()), touched.end());
     return touched;
@@ -171,9 +177,9 @@ std::vector<int> balance_curve_counts(const cad::CadModel& model,
 
   struct Eval {
     bool ok = false;
-    int gain = 0;        // fitting faces gained
-    int dmisfit = 0;     // change of the misfit of the touched faces
-    double rel = 0;      // relative size of the change
+    int gain = 0;     // fitting faces gained
+    int dmisfit = 0;  // change of the misfit of the touched faces
+    double rel = 0;   // relative size of the change
     std::vector<std::pair<LO, char>> fit_after;
   };
   const auto evaluate = [&](LO var, int delta) {

@@ -154,7 +154,7 @@ class Grower {
             continue;
           }
           res.stop = static_cast<LO>(quads_.size()) >= o_.max_quads ? GrowResult::Stop::MaxQuads
-                                                                     : GrowResult::Stop::Concave;
+                                                                    : GrowResult::Stop::Concave;
           break;
         }
         add(out);
@@ -433,7 +433,7 @@ class Grower {
   std::vector<char> in_, frontier_flag_, forbidden_;
   std::vector<LO> n_in_, next_, quads_, frontier_, interior_;
   std::vector<double> frontier_d_;  // distance from each frontier_ quad's centroid to the seed
-  LO corners_ = 0;                   // vertices in exactly one cavity quad
+  LO corners_ = 0;                  // vertices in exactly one cavity quad
   static constexpr LO kMaxSides = 16;
   std::array<char, kMaxSides + 1> has_sides_{};  // a pattern has that many sides (last: or more)
   std::set<LO> concave_;
@@ -854,11 +854,21 @@ mesh::FaceMesh remesh_cavities(const mesh::FaceMesh& input, const cad::FaceGeome
       const GrowResult g = grow_cavity(work, topo, seed, singular, go);
       auto& d = rep.diagnostics[step];
       switch (g.stop) {
-        case GrowResult::Stop::Concave: ++d.stop_concave; break;
-        case GrowResult::Stop::MaxQuads: ++d.stop_max_quads; break;
-        case GrowResult::Stop::NoFrontier: ++d.stop_no_frontier; break;
-        case GrowResult::Stop::Fan: ++d.stop_fan; break;
-        case GrowResult::Stop::Found: ++d.stop_found; break;
+        case GrowResult::Stop::Concave:
+          ++d.stop_concave;
+          break;
+        case GrowResult::Stop::MaxQuads:
+          ++d.stop_max_quads;
+          break;
+        case GrowResult::Stop::NoFrontier:
+          ++d.stop_no_frontier;
+          break;
+        case GrowResult::Stop::Fan:
+          ++d.stop_fan;
+          break;
+        case GrowResult::Stop::Found:
+          ++d.stop_found;
+          break;
       }
       d.checks += g.checks;
       d.no_pattern += g.no_pattern;
@@ -881,10 +891,18 @@ mesh::FaceMesh remesh_cavities(const mesh::FaceMesh& input, const cad::FaceGeome
           Remesher::Refusal why = Remesher::Refusal::None;
           if (!remesher.build(topo, c, match, pats, r, why)) {
             switch (why) {
-              case Remesher::Refusal::Layout: ++d.refused_layout; break;
-              case Remesher::Refusal::Invalid: ++d.refused_invalid; break;
-              case Remesher::Refusal::MinSicn: ++d.refused_min; break;
-              default: ++d.refused_avg; break;
+              case Remesher::Refusal::Layout:
+                ++d.refused_layout;
+                break;
+              case Remesher::Refusal::Invalid:
+                ++d.refused_invalid;
+                break;
+              case Remesher::Refusal::MinSicn:
+                ++d.refused_min;
+                break;
+              default:
+                ++d.refused_avg;
+                break;
             }
             continue;
           }

@@ -654,7 +654,8 @@ FaceSides face_sides(const cad::CadModel& model, LO f, const cad::FaceGeometry& 
                  "singular surface or curve at the corner of curve " << uses[u].curve);
     // With the normal du x dv flipped for a clockwise (u, v) loop, the interior lies on the left.
     normal = normalized(normal) * orient;
-    const Vec3 a = normalized(project_tangent(t_in, normal)), b = normalized(project_tangent(t_out, normal));
+    const Vec3 a = normalized(project_tangent(t_in, normal)),
+               b = normalized(project_tangent(t_out, normal));
     const double turn = std::atan2(dot(cross(a, b), normal), dot(a, b)) * kDeg;
     fs.angle_deg[pos] = 180.0 - turn;
     if (fs.angle_deg[pos] < options.corner_angle_deg) fs.corners.push_back(pos);

@@ -27,8 +27,9 @@ void reduce_row(std::vector<Int>& row) {
 // Depth-first search over the integer echelon form, bottom row first (paper 000 Sec. 6.1.1).
 class EchelonSearch {
  public:
-  EchelonSearch(std::vector<std::vector<Int>> rows, std::vector<LO> pivots, std::vector<double> ideal,
-                std::vector<Int> upper, std::span<const int> w, std::span<const LO> rhs, int max_attempts)
+  EchelonSearch(std::vector<std::vector<Int>> rows, std::vector<LO> pivots,
+                std::vector<double> ideal, std::vector<Int> upper, std::span<const int> w,
+                std::span<const LO> rhs, int max_attempts)
       : rows_(std::move(rows)),
         pivots_(std::move(pivots)),
         ideal_(std::move(ideal)),
@@ -51,7 +52,8 @@ class EchelonSearch {
     }
     // A variable in no row (a zero column) is not constrained: it keeps its ideal value.
     for (LO j = 0; j < c_; ++j)
-      if (!fixed[j]) s_[j] = std::clamp<Int>(std::llround(ideal_[j]), 1, std::max<Int>(1, upper_[j]));
+      if (!fixed[j])
+        s_[j] = std::clamp<Int>(std::llround(ideal_[j]), 1, std::max<Int>(1, upper_[j]));
   }
 
   void run() { descend(0); }
@@ -110,7 +112,8 @@ class EchelonSearch {
       if (sum != rhs_[i]) return;  // cannot happen with exact elimination; kept as a guard
     }
     double e = 0;
-    for (LO j = 0; j < c_; ++j) e += (static_cast<double>(s_[j]) - ideal_[j]) * (static_cast<double>(s_[j]) - ideal_[j]);
+    for (LO j = 0; j < c_; ++j)
+      e += (static_cast<double>(s_[j]) - ideal_[j]) * (static_cast<double>(s_[j]) - ideal_[j]);
     if (best_.empty() || e < best_energy_) {
       best_ = s_;
       best_energy_ = e;
@@ -134,13 +137,13 @@ class EchelonSearch {
 
 }  // namespace
 
-ChordSolution solve_chords(std::span<const int> w, int num_sides, LO num_chords, std::span<const LO> side_edges,
-                           const MatchOptions& options) {
+ChordSolution solve_chords(std::span<const int> w, int num_sides, LO num_chords,
+                           std::span<const LO> side_edges, const MatchOptions& options) {
   const int m = num_sides;
   const LO c = num_chords;
   QSMESH_CHECK(m >= 1 && c >= 1, "solve_chords: " << m << " sides, " << c << " chords");
-  QSMESH_CHECK(w.size() == static_cast<std::size_t>(m) * c, "solve_chords: w has " << w.size() << " entries, not "
-                                                                                  << m << " x " << c);
+  QSMESH_CHECK(w.size() == static_cast<std::size_t>(m) * c,
+               "solve_chords: w has " << w.size() << " entries, not " << m << " x " << c);
   QSMESH_CHECK(static_cast<int>(side_edges.size()) == m,
                "solve_chords: " << side_edges.size() << " side counts for " << m << " sides");
   ChordSolution out;
@@ -178,7 +181,8 @@ ChordSolution solve_chords(std::span<const int> w, int num_sides, LO num_chords,
   for (LO col = 0; col < c && r < m; ++col) {
     int best = -1;
     for (int i = r; i < m; ++i)
-      if (rows[i][col] != 0 && (best < 0 || std::llabs(rows[i][col]) < std::llabs(rows[best][col]))) best = i;
+      if (rows[i][col] != 0 && (best < 0 || std::llabs(rows[i][col]) < std::llabs(rows[best][col])))
+        best = i;
     if (best < 0) continue;
     std::swap(rows[r], rows[best]);
     if (rows[r][col] < 0)
@@ -197,8 +201,8 @@ ChordSolution solve_chords(std::span<const int> w, int num_sides, LO num_chords,
     if (rows[i][c] != 0) return out;  // 0 = nonzero: inconsistent counts
   rows.resize(r);
 
-  EchelonSearch search(std::move(rows), std::move(pivots), out.ideal, std::move(upper), w, side_edges,
-                       options.max_attempts);
+  EchelonSearch search(std::move(rows), std::move(pivots), out.ideal, std::move(upper), w,
+                       side_edges, options.max_attempts);
   search.run();
   out.attempts = search.attempts();
   if (!search.found()) return out;
@@ -223,7 +227,8 @@ std::vector<PatternMatch> match_patterns(std::span<const Pattern> patterns,
     for (const bool reversed : {false, true})
       for (int start = 0; start < m; ++start) {
         std::vector<LO> counts(m);
-        for (int i = 0; i < m; ++i) counts[i] = side_edges[(((reversed ? start - i : start + i) % m) + m) % m];
+        for (int i = 0; i < m; ++i)
+          counts[i] = side_edges[(((reversed ? start - i : start + i) % m) + m) % m];
         ChordSolution sol = solve_chords(pat.w, m, pat.num_chords, counts, options);
         if (!sol.found) continue;
         std::vector<std::vector<LO>> key(m);
@@ -231,7 +236,8 @@ std::vector<PatternMatch> match_patterns(std::span<const Pattern> patterns,
         for (int i = 0; i < m; ++i) {
           const int side = (((reversed ? start - i : start + i) % m) + m) % m;
           const LO end = i + 1 < m ? pat.side_start[i + 1] : nb;
-          for (LO k = pat.side_start[i]; k < end; ++k) key[side].push_back(sol.s[pat.edge_chord[pat.boundary_edge[k]]]);
+          for (LO k = pat.side_start[i]; k < end; ++k)
+            key[side].push_back(sol.s[pat.edge_chord[pat.boundary_edge[k]]]);
           if (reversed) std::reverse(key[side].begin(), key[side].end());
         }
         if (!seen.insert(std::move(key)).second) continue;
@@ -243,8 +249,9 @@ std::vector<PatternMatch> match_patterns(std::span<const Pattern> patterns,
         match.energy = sol.energy;
         found.push_back(std::move(match));
       }
-    std::stable_sort(found.begin(), found.end(),
-                     [](const PatternMatch& a, const PatternMatch& b) { return a.energy < b.energy; });
+    std::stable_sort(found.begin(), found.end(), [](const PatternMatch& a, const PatternMatch& b) {
+      return a.energy < b.energy;
+    });
     for (auto& f : found) out.push_back(std::move(f));
   }
   return out;

@@ -11,7 +11,7 @@ struct RawPattern {
   const char* name;
   const double* xy;  ///< 2 * num_vertices drawing coordinates
   LO num_vertices;
-  const LO* quads;   ///< 4 * num_quads vertex ids
+  const LO* quads;  ///< 4 * num_quads vertex ids
   LO num_quads;
 };
 

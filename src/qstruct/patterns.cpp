@@ -41,10 +41,12 @@ Pattern make_pattern(std::string name, std::vector<Vec2> xy, std::vector<std::ar
   for (LO q = 0; q < nq; ++q) {
     const auto& quad = p.quads[q];
     for (int k = 0; k < 4; ++k) {
-      QSMESH_CHECK(quad[k] >= 0 && quad[k] < nv, "pattern " << p.name << ": quad " << q << " has vertex " << quad[k]
-                                                             << " out of range [0, " << nv << ")");
+      QSMESH_CHECK(quad[k] >= 0 && quad[k] < nv, "pattern " << p.name << ": quad " << q
+                                                            << " has vertex " << quad[k]
+                                                            << " out of range [0, " << nv << ")");
       for (int l = 0; l < k; ++l)
-        QSMESH_CHECK(quad[k] != quad[l], "pattern " << p.name << ": quad " << q << " repeats vertex " << quad[k]);
+        QSMESH_CHECK(quad[k] != quad[l],
+                     "pattern " << p.name << ": quad " << q << " repeats vertex " << quad[k]);
       ++p.valence[quad[k]];
     }
     for (int k = 0; k < 4; ++k) {
@@ -56,11 +58,13 @@ Pattern make_pattern(std::string name, std::vector<Vec2> xy, std::vector<std::ar
         uses.push_back(0);
         first_dir.push_back({a, b});
       } else {
-        QSMESH_CHECK(first_dir[it->second] != (std::array<LO, 2>{a, b}),
-                     "pattern " << p.name << ": edge " << a << "-" << b
-                                << " used twice in one direction (quads not consistently oriented)");
+        QSMESH_CHECK(
+            first_dir[it->second] != (std::array<LO, 2>{a, b}),
+            "pattern " << p.name << ": edge " << a << "-" << b
+                       << " used twice in one direction (quads not consistently oriented)");
       }
-      QSMESH_CHECK(++uses[it->second] <= 2, "pattern " << p.name << ": edge " << a << "-" << b << " in more than two quads");
+      QSMESH_CHECK(++uses[it->second] <= 2,
+                   "pattern " << p.name << ": edge " << a << "-" << b << " in more than two quads");
       p.quad_edges[q][k] = it->second;
     }
   }
@@ -74,7 +78,8 @@ Pattern make_pattern(std::string name, std::vector<Vec2> xy, std::vector<std::ar
   for (LO e = 0; e < ne; ++e) {
     if (uses[e] != 1) continue;
     const auto [a, b] = first_dir[e];
-    QSMESH_CHECK(next[a] == kNoIndex, "pattern " << p.name << ": boundary vertex " << a << " is pinched");
+    QSMESH_CHECK(next[a] == kNoIndex,
+                 "pattern " << p.name << ": boundary vertex " << a << " is pinched");
     next[a] = b;
     next_edge[a] = e;
     ++boundary_edges;
@@ -130,7 +135,8 @@ Pattern make_pattern(std::string name, std::vector<Vec2> xy, std::vector<std::ar
   const int m = p.num_sides();
   p.w.assign(static_cast<std::size_t>(m) * p.num_chords, 0);
   for (int i = 0; i < m; ++i) {
-    const LO end = i + 1 < m ? p.side_start[i + 1] : static_cast<LO>(p.boundary.size()) + p.side_start[0];
+    const LO end =
+        i + 1 < m ? p.side_start[i + 1] : static_cast<LO>(p.boundary.size()) + p.side_start[0];
     for (LO k = p.side_start[i]; k < end; ++k) {
       const LO e = p.boundary_edge[k % static_cast<LO>(p.boundary.size())];
       ++p.w[static_cast<std::size_t>(i) * p.num_chords + p.edge_chord[e]];
@@ -139,7 +145,8 @@ Pattern make_pattern(std::string name, std::vector<Vec2> xy, std::vector<std::ar
   std::vector<char> on_boundary(nv, 0);
   for (const LO v : p.boundary) on_boundary[v] = 1;
   for (LO v = 0; v < nv; ++v)
-    if (on_boundary[v] ? (p.valence[v] != 1 && p.valence[v] != 2) : p.valence[v] != 4) ++p.irregular;
+    if (on_boundary[v] ? (p.valence[v] != 1 && p.valence[v] != 2) : p.valence[v] != 4)
+      ++p.irregular;
   return p;
 }
 
@@ -150,7 +157,8 @@ std::vector<Pattern> builtin_patterns() {
     for (LO v = 0; v < raw.num_vertices; ++v) xy[v] = {raw.xy[2 * v], raw.xy[2 * v + 1]};
     std::vector<std::array<LO, 4>> quads(raw.num_quads);
     for (LO q = 0; q < raw.num_quads; ++q)
-      quads[q] = {raw.quads[4 * q], raw.quads[4 * q + 1], raw.quads[4 * q + 2], raw.quads[4 * q + 3]};
+      quads[q] = {raw.quads[4 * q], raw.quads[4 * q + 1], raw.quads[4 * q + 2],
+                  raw.quads[4 * q + 3]};
     out.push_back(make_pattern(raw.name, std::move(xy), std::move(quads)));
   }
   return out;
@@ -160,7 +168,8 @@ RefinedPattern refine_pattern(const Pattern& pattern, std::span<const LO> chords
   QSMESH_CHECK(static_cast<LO>(chords.size()) == pattern.num_chords,
                "pattern " << pattern.name << ": " << chords.size() << " chord subdivisions for "
                           << pattern.num_chords << " chords");
-  for (const LO s : chords) QSMESH_CHECK(s >= 1, "pattern " << pattern.name << ": chord subdivision " << s);
+  for (const LO s : chords)
+    QSMESH_CHECK(s >= 1, "pattern " << pattern.name << ": chord subdivision " << s);
   RefinedPattern r;
   r.num_vertices = pattern.num_vertices();
   r.coarse_vertex.resize(pattern.num_vertices());
@@ -188,7 +197,9 @@ RefinedPattern refine_pattern(const Pattern& pattern, std::span<const LO> chords
     const LO m = chords[pattern.edge_chord[qe[1]]];  // along v1 -> v2 (and v0 -> v3)
     // Grid (i, k): (0,0) = v0, (n,0) = v1, (n,m) = v2, (0,m) = v3.
     std::vector<LO> grid(static_cast<std::size_t>(n + 1) * (m + 1));
-    const auto id = [&](LO i, LO k) -> LO& { return grid[static_cast<std::size_t>(k) * (n + 1) + i]; };
+    const auto id = [&](LO i, LO k) -> LO& {
+      return grid[static_cast<std::size_t>(k) * (n + 1) + i];
+    };
     for (LO i = 0; i <= n; ++i) {
       id(i, 0) = at(qe[0], v[0], i);
       id(i, m) = at(qe[2], v[3], i);  // edge 2 joins v2 and v3
@@ -200,7 +211,8 @@ RefinedPattern refine_pattern(const Pattern& pattern, std::span<const LO> chords
     for (LO k = 1; k < m; ++k)
       for (LO i = 1; i < n; ++i) id(i, k) = r.num_vertices++;
     for (LO k = 0; k < m; ++k)
-      for (LO i = 0; i < n; ++i) r.quads.push_back({id(i, k), id(i + 1, k), id(i + 1, k + 1), id(i, k + 1)});
+      for (LO i = 0; i < n; ++i)
+        r.quads.push_back({id(i, k), id(i + 1, k), id(i + 1, k + 1), id(i, k + 1)});
   }
 
   const LO nb = static_cast<LO>(pattern.boundary.size());

@@ -13,16 +13,19 @@ namespace qsmesh::quad {
 
 // ------------------------------------------------------------------------------------ FaceGuide
 
-FaceGuide::FaceGuide(const mesh::FaceMesh& background, const crossfield::FaceCrossField& cross_field,
-                     std::span<const double> sizes)
+FaceGuide::FaceGuide(const mesh::FaceMesh& background,
+                     const crossfield::FaceCrossField& cross_field, std::span<const double> sizes)
     : bg_(background), cf_(cross_field), sizes_(sizes) {
   const LO nv = bg_.num_vertices();
   QSMESH_CHECK(static_cast<LO>(sizes_.size()) == nv,
                "frontal guide: " << sizes_.size() << " sizes for " << nv << " background vertices");
-  QSMESH_CHECK(static_cast<LO>(cf_.input2glued.size()) == nv && static_cast<LO>(bg_.uv.size()) == nv,
-               "frontal guide: cross field and background mesh do not match");
-  QSMESH_CHECK(cf_.directions.size() == cf_.triangles.size(), "frontal guide: cross field has no directions");
-  for (double s : sizes_) QSMESH_CHECK(s > 0 && std::isfinite(s), "frontal guide: non-positive size " << s);
+  QSMESH_CHECK(
+      static_cast<LO>(cf_.input2glued.size()) == nv && static_cast<LO>(bg_.uv.size()) == nv,
+      "frontal guide: cross field and background mesh do not match");
+  QSMESH_CHECK(cf_.directions.size() == cf_.triangles.size(),
+               "frontal guide: cross field has no directions");
+  for (double s : sizes_)
+    QSMESH_CHECK(s > 0 && std::isfinite(s), "frontal guide: non-positive size " << s);
   // The glued triangulation drops the triangles that gluing collapses, in order; replay that to
   // find each background triangle's cross.
   const auto nt = static_cast<LO>(bg_.triangles.size());
@@ -32,18 +35,21 @@ FaceGuide::FaceGuide(const mesh::FaceMesh& background, const crossfield::FaceCro
     const auto& T = bg_.triangles[t];
     const LO a = cf_.input2glued[T[0]], b = cf_.input2glued[T[1]], c = cf_.input2glued[T[2]];
     if (a == b || b == c || c == a) continue;
-    const bool same = g < static_cast<LO>(cf_.triangles.size()) && cf_.triangles[g] == std::array<LO, 3>{a, b, c};
-    QSMESH_CHECK(same,
-                 "frontal guide: glued triangle " << g << " does not match background triangle " << t);
+    const bool same =
+        g < static_cast<LO>(cf_.triangles.size()) && cf_.triangles[g] == std::array<LO, 3>{a, b, c};
+    QSMESH_CHECK(
+        same, "frontal guide: glued triangle " << g << " does not match background triangle " << t);
     tri2glued_[t] = g++;
   }
-  QSMESH_CHECK(g == static_cast<LO>(cf_.triangles.size()), "frontal guide: triangle count mismatch");
+  QSMESH_CHECK(g == static_cast<LO>(cf_.triangles.size()),
+               "frontal guide: triangle count mismatch");
   QSMESH_CHECK(g > 0, "frontal guide: no triangle");
 
   for (LO t = 0; t < nt; ++t)
     if (tri2glued_[t] != kNoIndex)
       for (LO v : bg_.triangles[t]) box_.add(bg_.uv[v]);
-  const double wu = std::max(box_.hi.u - box_.lo.u, 1e-300), wv = std::max(box_.hi.v - box_.lo.v, 1e-300);
+  const double wu = std::max(box_.hi.u - box_.lo.u, 1e-300),
+               wv = std::max(box_.hi.v - box_.lo.v, 1e-300);
   // About one triangle per cell, cells as square as the box allows.
   const double cells = std::max(1.0, static_cast<double>(g));
   nu_ = std::clamp(static_cast<int>(std::ceil(std::sqrt(cells * wu / wv))), 1, 2048);
@@ -62,7 +68,8 @@ FaceGuide::FaceGuide(const mesh::FaceMesh& background, const crossfield::FaceCro
     range[t] = {cell(b.lo.u, box_.lo.u, cu_, nu_), cell(b.hi.u, box_.lo.u, cu_, nu_),
                 cell(b.lo.v, box_.lo.v, cv_, nv_), cell(b.hi.v, box_.lo.v, cv_, nv_)};
     for (int j = range[t][2]; j <= range[t][3]; ++j)
-      for (int i = range[t][0]; i <= range[t][1]; ++i) ++count[static_cast<std::size_t>(j) * nu_ + i + 1];
+      for (int i = range[t][0]; i <= range[t][1]; ++i)
+        ++count[static_cast<std::size_t>(j) * nu_ + i + 1];
   }
   for (std::size_t k = 1; k < count.size(); ++k) count[k] += count[k - 1];
   cell_start_ = count;
@@ -123,7 +130,8 @@ FaceGuide::Sample FaceGuide::at(const Vec2& uv) const {
     if (best != kNoIndex && r >= 1) break;  // the least-outside triangle of the neighbourhood
   }
   Sample s;
-  QSMESH_CHECK(best != kNoIndex, "frontal guide: no background triangle near (" << uv.u << ", " << uv.v << ")");
+  QSMESH_CHECK(best != kNoIndex,
+               "frontal guide: no background triangle near (" << uv.u << ", " << uv.v << ")");
   s.found = found;
   s.cross = cf_.directions[tri2glued_[best]];
   const auto& T = bg_.triangles[best];
@@ -175,7 +183,8 @@ class LoopTest {
   }
 
   [[nodiscard]] bool inside(const Vec2& p) const {
-    if (segs_.empty() || p.v < box_.lo.v || p.v > box_.hi.v || p.u < box_.lo.u || p.u > box_.hi.u) return false;
+    if (segs_.empty() || p.v < box_.lo.v || p.v > box_.hi.v || p.u < box_.lo.u || p.u > box_.hi.u)
+      return false;
     const int r = row(p.v);
     bool in = false;
     for (LO k = start_[r]; k < start_[r + 1]; ++k) {
@@ -257,7 +266,9 @@ class PointIndex {
   std::vector<double> weight_;
   std::vector<std::unordered_map<std::uint64_t, std::vector<LO>>> grids_;
   [[nodiscard]] double cell(int l) const { return std::ldexp(base_, l); }
-  static std::int64_t coord(double x, double c) { return static_cast<std::int64_t>(std::floor(x / c)); }
+  static std::int64_t coord(double x, double c) {
+    return static_cast<std::int64_t>(std::floor(x / c));
+  }
   static std::uint64_t key(std::int64_t i, std::int64_t j, std::int64_t k) {
     auto mix = [](std::uint64_t h, std::uint64_t v) {
       h ^= v + 0x9e3779b97f4a7c15ULL + (h << 6) + (h >> 2);
@@ -300,8 +311,9 @@ struct Node {
 
 }  // namespace
 
-std::vector<Vec2> frontal_points(const cad::FaceGeometry& surface, std::span<const mesh::BoundaryLoop> loops,
-                                 const FaceGuide& guide, const FrontalOptions& options, FrontalStats* stats) {
+std::vector<Vec2> frontal_points(const cad::FaceGeometry& surface,
+                                 std::span<const mesh::BoundaryLoop> loops, const FaceGuide& guide,
+                                 const FrontalOptions& options, FrontalStats* stats) {
   QSMESH_CHECK(options.spacing_factor > 0 && options.min_distance > 0 && options.min_distance < 1,
                "frontal: spacing_factor must be > 0 and min_distance in (0, 1)");
   FrontalStats local;

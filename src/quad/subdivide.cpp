@@ -4,8 +4,8 @@
 #include <cmath>
 #include <limits>
 #include <map>
-#include <utility>
 #include <tuple>
+#include <utility>
 #include <vector>
 
 #include "qsmesh/core/error.hpp"
@@ -350,7 +350,8 @@ mesh::FaceMesh subdivide(const mesh::FaceMesh& mesh, const cad::FaceGeometry& su
       p = out.points[a];
     } else {
       if (pole[a] != 0 || pole[b] != 0)
-        uv = surface.project(0.5 * (mesh.points[a] + mesh.points[b]), pole[a] != 0 ? mesh.uv[b] : mesh.uv[a], nullptr);
+        uv = surface.project(0.5 * (mesh.points[a] + mesh.points[b]),
+                             pole[a] != 0 ? mesh.uv[b] : mesh.uv[a], nullptr);
       vc.dim = 2;
       vc.entity = mesh.face;
       vc.param = {uv.u, uv.v};

@@ -194,7 +194,8 @@ CurveSizes initial_curve_sizes(const cad::CadModel& model, std::span<const mesh:
           uses.empty() ? std::span<const background::CurveUseRef>()
                        : std::span<const background::CurveUseRef>(uses[c]),
           curvature);
-      for (std::size_t k = 0; k < curves[c].t.size(); ++k) out.at[c][k] = std::min(out.at[c][k], size(curves[c].t[k]));
+      for (std::size_t k = 0; k < curves[c].t.size(); ++k)
+        out.at[c][k] = std::min(out.at[c][k], size(curves[c].t[k]));
     });
   }
   for (const auto& [f, v] : options.face_sizes)

@@ -37,7 +37,8 @@ namespace {
 
 std::uint64_t edge_key(LO a, LO b) {
   const auto [lo, hi] = std::minmax(a, b);
-  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(lo)) << 32) | static_cast<std::uint32_t>(hi);
+  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(lo)) << 32) |
+         static_cast<std::uint32_t>(hi);
 }
 
 // Unique edges of `quads` and, per quad, its four edge ids (edge k joins corners k and k+1).
@@ -166,7 +167,8 @@ bool chord_laplace_uv(const std::vector<std::array<LO, 4>>& quads, LO num_fixed,
   const double mean = count > 0 ? sum / count : 1.0;
   std::vector<double> weight(static_cast<std::size_t>(ne));
   // A floor keeps the system well conditioned where a chord ends on a pole (zero width).
-  for (LO i = 0; i < ne; ++i) weight[i] = 1.0 / std::max(target[i] > 0 ? target[i] : mean, 1e-3 * mean);
+  for (LO i = 0; i < ne; ++i)
+    weight[i] = 1.0 / std::max(target[i] > 0 ? target[i] : mean, 1e-3 * mean);
   return weighted_laplace(e, weight, num_fixed, uv);
 }
 

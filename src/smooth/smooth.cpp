@@ -11,12 +11,12 @@
 #include <vector>
 
 #include "internal.hpp"
-#include "qsmesh/smooth/quad_tools.hpp"
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/core/timer.hpp"
 #include "qsmesh/linalg/solver.hpp"
 #include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/smooth/approx_surface.hpp"
+#include "qsmesh/smooth/quad_tools.hpp"
 
 namespace qsmesh::smooth {
 
@@ -388,8 +388,9 @@ mesh::FaceMesh smooth_face(const mesh::FaceMesh& input, const cad::FaceGeometry&
     // The approximate surface is the input mesh itself, triangulated: it lies on the CAD surface
     // at its vertices and is as fine as the mesh being smoothed.
     const std::optional<ApproxSurface> approx =
-        options.approximate_projection ? std::optional<ApproxSurface>(ApproxSurface::from_mesh(input))
-                                       : std::nullopt;
+        options.approximate_projection
+            ? std::optional<ApproxSurface>(ApproxSurface::from_mesh(input))
+            : std::nullopt;
     Smoother sm(m, surface, topo, quad_orientation(m, surface), approx ? &*approx : nullptr);
     const LO nq = static_cast<LO>(m.quads.size());
 
@@ -443,7 +444,8 @@ mesh::FaceMesh smooth_face(const mesh::FaceMesh& input, const cad::FaceGeometry&
     }
     detail::sync_interior_params(m);
   }
-  st.rolled_back = detail::keep_or_roll_back(m, input, st.before, detail::Accept::kNoDrop, st.after);
+  st.rolled_back =
+      detail::keep_or_roll_back(m, input, st.before, detail::Accept::kNoDrop, st.after);
   if (stats) *stats = st;
   return m;
 }

@@ -8,9 +8,9 @@
 #include <vector>
 
 #include "internal.hpp"
-#include "qsmesh/smooth/quad_tools.hpp"
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/core/timer.hpp"
+#include "qsmesh/smooth/quad_tools.hpp"
 
 namespace qsmesh::smooth {
 namespace {
@@ -42,8 +42,8 @@ class Untangler {
     const auto& qd = m_.quads[q];
     Vec3 n{};
     for (const LO w : qd) n += normal_[w];
-    return oriented_sicn(
-        {m_.points[qd[0]], m_.points[qd[1]], m_.points[qd[2]], m_.points[qd[3]]}, n, 1.0);
+    return oriented_sicn({m_.points[qd[0]], m_.points[qd[1]], m_.points[qd[2]], m_.points[qd[3]]},
+                         n, 1.0);
   }
 
   // Corner values of Eq. 12 (what mesh::quad_sicn takes the minimum of: against the quad's own

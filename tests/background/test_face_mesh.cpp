@@ -46,7 +46,9 @@ void expect_valid(const Meshed& m, const cad::CadModel& model, double tolerance)
   const auto stats = mesh::compute_stats(m.mesh);
   EXPECT_GT(stats.triangles, 0);
   // Slivers: every triangle has all angles above 10 degrees away from sharp corners.
-  EXPECT_EQ(stats.min_angle_histogram[0] + stats.min_angle_histogram[1] - stats.small_angle_at_sharp_corner, 0)
+  EXPECT_EQ(stats.min_angle_histogram[0] + stats.min_angle_histogram[1] -
+                stats.small_angle_at_sharp_corner,
+            0)
       << "min angle " << stats.min_angle_deg;
 }
 
@@ -54,11 +56,13 @@ TEST(FaceMesh, BoxWithHoleIsConformingAndWellShaped) {
   const cad::CadModel model = cad::load_cad(test::write_box_with_hole(tmp("fm_box.brep")));
   const Meshed m = mesh_model(model, 0.6, 2);
   expect_valid(m, model, 1e-9 * model.diagonal());
-  // Total area of the triangulation close to the CAD area (flat faces and a cylinder of 16+ edges/turn).
+  // Total area of the triangulation close to the CAD area (flat faces and a cylinder of 16+
+  // edges/turn).
   double cad_area = 0, mesh_area = 0;
   for (const auto& f : model.faces()) cad_area += f.area;
   for (const auto& t : m.mesh.triangles)
-    mesh_area += 0.5 * norm(cross(m.mesh.points[t[1]] - m.mesh.points[t[0]], m.mesh.points[t[2]] - m.mesh.points[t[0]]));
+    mesh_area += 0.5 * norm(cross(m.mesh.points[t[1]] - m.mesh.points[t[0]],
+                                  m.mesh.points[t[2]] - m.mesh.points[t[0]]));
   EXPECT_NEAR(mesh_area, cad_area, 0.01 * cad_area);
 }
 
@@ -92,7 +96,8 @@ TEST(FaceMesh, SameMeshWhateverTheThreads) {
   const Meshed a = mesh_model(model, 0.7, 1);
   const Meshed b = mesh_model(model, 0.7, 2);
   ASSERT_EQ(a.mesh.points.size(), b.mesh.points.size());
-  for (std::size_t i = 0; i < a.mesh.points.size(); ++i) ASSERT_EQ(a.mesh.points[i], b.mesh.points[i]);
+  for (std::size_t i = 0; i < a.mesh.points.size(); ++i)
+    ASSERT_EQ(a.mesh.points[i], b.mesh.points[i]);
   EXPECT_EQ(a.mesh.triangles, b.mesh.triangles);
 }
 

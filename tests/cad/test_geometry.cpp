@@ -1,8 +1,6 @@
 // Evaluation and projection on curves and faces.
 #include <gtest/gtest.h>
 
-#include "qsmesh/core/error.hpp"
-
 #include <BRepBuilderAPI_MakeEdge.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepPrimAPI_MakeBox.hxx>
@@ -19,6 +17,7 @@
 
 #include "helpers.hpp"
 #include "qsmesh/cad/model.hpp"
+#include "qsmesh/core/error.hpp"
 
 namespace qsmesh::cad {
 namespace {

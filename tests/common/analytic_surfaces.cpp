@@ -32,7 +32,9 @@ Vec2 AnalyticSurface::project(const Vec3& p, const Vec2& uv_guess, Vec3* foot) c
   return uv;
 }
 
-cad::SurfaceEval Plane::eval(const Vec2& uv) const { return {{uv.u, uv.v, 0}, {1, 0, 0}, {0, 1, 0}}; }
+cad::SurfaceEval Plane::eval(const Vec2& uv) const {
+  return {{uv.u, uv.v, 0}, {1, 0, 0}, {0, 1, 0}};
+}
 
 cad::SurfaceEval Cylinder::eval(const Vec2& uv) const {
   const double c = std::cos(uv.u), s = std::sin(uv.u);

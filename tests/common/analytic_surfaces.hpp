@@ -9,7 +9,7 @@ namespace qsmesh::test {
 /// How AnalyticSurface::project finds (u, v).
 enum class Projection {
   kNewton,  ///< Newton steps on the normal equations from the guess (smooth surfaces)
-  kGuess,   ///< returns the guess unchanged and leaves foot untouched (for code that never projects)
+  kGuess,  ///< returns the guess unchanged and leaves foot untouched (for code that never projects)
 };
 
 /// Base of the analytic surfaces: subclasses give eval(); eval2 has zero second derivatives, the

@@ -1,4 +1,5 @@
-// Test models built with OpenCASCADE inside a test, written to the test's scratch folder and loaded.
+// Test models built with OpenCASCADE inside a test, written to the test's scratch folder and
+// loaded.
 #pragma once
 
 #include <BRepTools.hxx>

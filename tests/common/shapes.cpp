@@ -94,7 +94,8 @@ std::string write_sphere_lune(const std::string& path) {
   return write(BRepPrimAPI_MakeSphere(3.0, -quarter, quarter, quarter).Shape(), path);
 }
 
-std::string write_polygon_face(const std::vector<std::pair<double, double>>& xy, const std::string& path) {
+std::string write_polygon_face(const std::vector<std::pair<double, double>>& xy,
+                               const std::string& path) {
   BRepBuilderAPI_MakePolygon poly;
   for (const auto& [x, y] : xy) poly.Add(gp_Pnt(x, y, 0));
   poly.Close();
@@ -174,7 +175,8 @@ std::string write_l_prism(const std::string& path) {
 std::string write_filleted_box(const std::string& path) {
   const TopoDS_Shape box = BRepPrimAPI_MakeBox(8.0, 6.0, 4.0).Shape();
   BRepFilletAPI_MakeFillet fillet(box);
-  for (TopExp_Explorer e(box, TopAbs_EDGE); e.More(); e.Next()) fillet.Add(1.0, TopoDS::Edge(e.Current()));
+  for (TopExp_Explorer e(box, TopAbs_EDGE); e.More(); e.Next())
+    fillet.Add(1.0, TopoDS::Edge(e.Current()));
   fillet.Build();
   if (!fillet.IsDone()) throw std::runtime_error("fillet failed");
   STEPControl_Writer w;

@@ -27,7 +27,8 @@ std::string write_sphere_octant(const std::string& path);
 /// loop holds both poles, between two half meridians, and two half disks.
 std::string write_sphere_lune(const std::string& path);
 /// Writes the planar face (z = 0) bounded by the polygon through `xy`, as BREP; returns path.
-std::string write_polygon_face(const std::vector<std::pair<double, double>>& xy, const std::string& path);
+std::string write_polygon_face(const std::vector<std::pair<double, double>>& xy,
+                               const std::string& path);
 /// Writes the planar teardrop made of a circle of this radius about the origin and the two
 /// tangents to it from the point (0, -radius sqrt 2): one corner (90 degrees), smooth elsewhere.
 std::string write_teardrop(double radius, const std::string& path);

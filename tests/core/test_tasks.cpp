@@ -15,7 +15,8 @@ TEST(TaskArena, EveryIndexRunsOnce) {
     const TaskArena arena(threads);
     EXPECT_EQ(arena.threads(), std::min(threads, TaskArena::max_threads()));
     std::vector<int> hits(1000, 0);
-    arena.parallel_for(static_cast<std::int64_t>(hits.size()), [&](std::int64_t i) { hits[i] += 1; });
+    arena.parallel_for(static_cast<std::int64_t>(hits.size()),
+                       [&](std::int64_t i) { hits[i] += 1; });
     for (int h : hits) ASSERT_EQ(h, 1);
   }
 }

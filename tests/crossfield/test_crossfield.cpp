@@ -17,11 +17,11 @@
 #include <numbers>
 #include <stdexcept>
 
+#include "load_shape.hpp"
 #include "qsmesh/background/curve_mesh.hpp"
 #include "qsmesh/background/face_mesh.hpp"
 #include "qsmesh/crossfield/cross_field.hpp"
 #include "shapes.hpp"
-#include "load_shape.hpp"
 #include "tmp_dir.hpp"
 
 namespace qsmesh::crossfield {
@@ -216,7 +216,8 @@ TEST(CrossField, LShapeWithReflexCorner) {
                         gp_Pnt(1, 2, 0), gp_Pnt(0, 2, 0)})
     poly.Add(p);
   poly.Close();
-  const auto model = test::load_shape(BRepBuilderAPI_MakeFace(poly.Wire()).Face(), "cf_lshape.brep");
+  const auto model =
+      test::load_shape(BRepBuilderAPI_MakeFace(poly.Wire()).Face(), "cf_lshape.brep");
   const auto r = run(model, 0, 0.06, "L-shape");
   const auto& cf = r.cf;
   expect_stats(cf);
@@ -326,7 +327,8 @@ TEST(CrossField, AcuteCornerGetsAnArtificialSingularity) {
   // Right triangle with angles 90, 60 and 30 degrees.
   BRepBuilderAPI_MakePolygon poly(gp_Pnt(0, 0, 0), gp_Pnt(2, 0, 0),
                                   gp_Pnt(2, 2 * std::tan(kPi / 6), 0), true);
-  const auto model = test::load_shape(BRepBuilderAPI_MakeFace(poly.Wire()).Face(), "cf_triangle.brep");
+  const auto model =
+      test::load_shape(BRepBuilderAPI_MakeFace(poly.Wire()).Face(), "cf_triangle.brep");
   const auto r = run(model, 0, 0.04, "triangle");
   const auto& cf = r.cf;
   expect_stats(cf);

@@ -495,7 +495,8 @@ TEST_F(Qsmesh, SizeMapWritesFieldsAndHonoursPrescriptions) {
   const std::string json = slurp(stats);
   const auto list = json.find("\"curve_edges\": [");
   ASSERT_NE(list, std::string::npos) << json;
-  EXPECT_EQ(json.substr(json.find_first_not_of(" \n", list + 16), 2), "14") << json.substr(list, 60);
+  EXPECT_EQ(json.substr(json.find_first_not_of(" \n", list + 16), 2), "14")
+      << json.substr(list, 60);
   for (const std::string method : {"features", "crossfield"})
     EXPECT_EQ(run("sizemap " + model_ + " -o " + out + " --size 0.8 -q --sizemap " + method).code,
               0)

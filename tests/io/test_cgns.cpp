@@ -117,11 +117,27 @@ TEST(Cgns, ReadBack) {
   EXPECT_EQ(sections[1].type, CGNS_ENUMV(MIXED));
   EXPECT_EQ(sections[1].end - sections[1].start + 1, 5);
   // face 1: its triangles in mesh order, then its quad, each after its type code
-  EXPECT_EQ(sections[1].conn, (std::vector<cgsize_t>{CGNS_ENUMV(TRI_3), 10, 5, 12,
-                                                     CGNS_ENUMV(TRI_3), 5, 6, 12,
-                                                     CGNS_ENUMV(TRI_3), 6, 11, 12,
-                                                     CGNS_ENUMV(TRI_3), 11, 10, 12,
-                                                     CGNS_ENUMV(QUAD_4), 2, 10, 11, 3}));
+  EXPECT_EQ(sections[1].conn, (std::vector<cgsize_t>{CGNS_ENUMV(TRI_3),
+                                                     10,
+                                                     5,
+                                                     12,
+                                                     CGNS_ENUMV(TRI_3),
+                                                     5,
+                                                     6,
+                                                     12,
+                                                     CGNS_ENUMV(TRI_3),
+                                                     6,
+                                                     11,
+                                                     12,
+                                                     CGNS_ENUMV(TRI_3),
+                                                     11,
+                                                     10,
+                                                     12,
+                                                     CGNS_ENUMV(QUAD_4),
+                                                     2,
+                                                     10,
+                                                     11,
+                                                     3}));
   EXPECT_EQ(sections[1].offsets, (std::vector<cgsize_t>{0, 4, 8, 12, 16, 21}));
   EXPECT_EQ(sections[2].type, CGNS_ENUMV(TRI_3));
   EXPECT_EQ(sections[2].conn, (std::vector<cgsize_t>{3, 7, 9, 9, 7, 4}));

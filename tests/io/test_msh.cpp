@@ -60,7 +60,11 @@ TEST(Msh, ReadBack) {
     ent >> nphys >> nb;
     EXPECT_EQ(tag, c + 1);
     EXPECT_EQ(nphys, 0);
-    for (int i = 0; i < nb; ++i) { int t; ent >> t; curve_bounds[tag].push_back(t); }
+    for (int i = 0; i < nb; ++i) {
+      int t;
+      ent >> t;
+      curve_bounds[tag].push_back(t);
+    }
   }
   for (int f = 0; f < ns; ++f) {
     int tag = 0, nphys = -1, nb = 0;
@@ -70,7 +74,11 @@ TEST(Msh, ReadBack) {
     ent >> nphys >> nb;
     EXPECT_EQ(tag, f + 1);
     face_box[tag] = box;
-    for (int i = 0; i < nb; ++i) { int t; ent >> t; face_bounds[tag].push_back(t); }
+    for (int i = 0; i < nb; ++i) {
+      int t;
+      ent >> t;
+      face_bounds[tag].push_back(t);
+    }
   }
   EXPECT_TRUE(static_cast<bool>(ent));
   EXPECT_EQ(curve_bounds[1], (std::vector<int>{1, -2}));
@@ -116,7 +124,8 @@ TEST(Msh, ReadBack) {
   EXPECT_EQ(nelem, 7u + 13u + 9u);
   EXPECT_EQ(minE, 1u);
   EXPECT_EQ(maxE, nelem);
-  EXPECT_EQ(neb, 7u + 9u + 4u);  // corners, 9 meshed curves, face 0 quads, face 1 tris+quads, face 3
+  EXPECT_EQ(neb,
+            7u + 9u + 4u);  // corners, 9 meshed curves, face 0 quads, face 1 tris+quads, face 3
   std::size_t expect_tag = 1;
   std::map<std::pair<int, int>, int> count;  // (dim, type) -> elements
   std::map<int, int> face_elems;
@@ -130,7 +139,11 @@ TEST(Msh, ReadBack) {
       std::size_t t;
       elems >> t;
       EXPECT_EQ(t, expect_tag++);
-      for (int i = 0; i < nn; ++i) { int v; elems >> v; EXPECT_TRUE(v >= 1 && v <= 12); }
+      for (int i = 0; i < nn; ++i) {
+        int v;
+        elems >> v;
+        EXPECT_TRUE(v >= 1 && v <= 12);
+      }
     }
     count[{dim, type}] += static_cast<int>(n);
     if (dim == 2) face_elems[tag] += static_cast<int>(n);

@@ -26,12 +26,18 @@ std::vector<unsigned char> base64_decode(const std::string& s) {
   int bits = 0;
   for (char c : s) {
     int v = -1;
-    if (c >= 'A' && c <= 'Z') v = c - 'A';
-    else if (c >= 'a' && c <= 'z') v = c - 'a' + 26;
-    else if (c >= '0' && c <= '9') v = c - '0' + 52;
-    else if (c == '+') v = 62;
-    else if (c == '/') v = 63;
-    else continue;  // padding, blanks
+    if (c >= 'A' && c <= 'Z')
+      v = c - 'A';
+    else if (c >= 'a' && c <= 'z')
+      v = c - 'a' + 26;
+    else if (c >= '0' && c <= '9')
+      v = c - '0' + 52;
+    else if (c == '+')
+      v = 62;
+    else if (c == '/')
+      v = 63;
+    else
+      continue;  // padding, blanks
     acc = (acc << 6) | static_cast<std::uint32_t>(v);
     bits += 6;
     if (bits >= 8) {
@@ -76,20 +82,27 @@ std::map<std::string, Array> parse_arrays(const std::string& xml) {
     const std::string body = xml.substr(tag_end + 1, body_end - tag_end - 1);
     Array a;
     a.type = attribute(tag, "type");
-    if (!attribute(tag, "NumberOfComponents").empty()) a.components = std::stoi(attribute(tag, "NumberOfComponents"));
+    if (!attribute(tag, "NumberOfComponents").empty())
+      a.components = std::stoi(attribute(tag, "NumberOfComponents"));
     if (attribute(tag, "format") == "binary") {
       std::string text;
-      for (char c : body) if (!std::isspace(static_cast<unsigned char>(c))) text += c;
+      for (char c : body)
+        if (!std::isspace(static_cast<unsigned char>(c))) text += c;
       const auto header = base64_decode(text.substr(0, 12));
       std::uint64_t nbytes = 0;
       std::memcpy(&nbytes, header.data(), 8);
       const auto data = base64_decode(text.substr(12));
       EXPECT_EQ(data.size(), nbytes) << tag;
-      if (a.type == "Float64") append_values<double>(data, a.values);
-      else if (a.type == "Int32") append_values<std::int32_t>(data, a.values);
-      else if (a.type == "Int64") append_values<std::int64_t>(data, a.values);
-      else if (a.type == "UInt8") append_values<std::uint8_t>(data, a.values);
-      else ADD_FAILURE() << "type " << a.type;
+      if (a.type == "Float64")
+        append_values<double>(data, a.values);
+      else if (a.type == "Int32")
+        append_values<std::int32_t>(data, a.values);
+      else if (a.type == "Int64")
+        append_values<std::int64_t>(data, a.values);
+      else if (a.type == "UInt8")
+        append_values<std::uint8_t>(data, a.values);
+      else
+        ADD_FAILURE() << "type " << a.type;
     } else {
       std::istringstream in(body);
       for (double v; in >> v;) a.values.push_back(v);
@@ -116,7 +129,10 @@ void check_basic(const std::string& xml, const mesh::SurfaceMesh& m, std::size_t
   for (std::size_t e = 0; e < 3; ++e) face[6 + e] = m.quad_face[e];
   EXPECT_EQ(arrays["cad_face"].values, face);
   std::vector<double> dim, entity;
-  for (const auto& vc : m.vclass) { dim.push_back(vc.dim); entity.push_back(vc.entity); }
+  for (const auto& vc : m.vclass) {
+    dim.push_back(vc.dim);
+    entity.push_back(vc.entity);
+  }
   EXPECT_EQ(arrays["cad_dim"].values, dim);
   EXPECT_EQ(arrays["cad_entity"].values, entity);
   EXPECT_EQ(arrays["cad_entity"].type, "Int32");
@@ -126,7 +142,7 @@ void check_basic(const std::string& xml, const mesh::SurfaceMesh& m, std::size_t
   EXPECT_EQ(arrays["offsets"].values[5], 18);
   EXPECT_EQ(arrays["offsets"].values[8], 30);
   ASSERT_GE(arrays["connectivity"].values.size(), 30u);
-  EXPECT_EQ(arrays["connectivity"].values[0], 2);  // first triangle {2, 6, 8}
+  EXPECT_EQ(arrays["connectivity"].values[0], 2);   // first triangle {2, 6, 8}
   EXPECT_EQ(arrays["connectivity"].values[18], 0);  // first quad {0, 7, 8, 3}
   EXPECT_EQ(arrays["connectivity"].values[21], 3);
 }
@@ -146,7 +162,8 @@ TEST(Vtu, BinaryAndAsciiReadBack) {
   check_basic(b, m, 9);
   check_basic(a, m, 9);
   EXPECT_EQ(parse_arrays(a).size(), parse_arrays(b).size());
-  for (const auto& [name, arr] : parse_arrays(a)) EXPECT_EQ(arr.values, parse_arrays(b)[name].values) << name;
+  for (const auto& [name, arr] : parse_arrays(a))
+    EXPECT_EQ(arr.values, parse_arrays(b)[name].values) << name;
 }
 
 TEST(Vtu, ExtraFieldsAndBars) {
@@ -155,7 +172,9 @@ TEST(Vtu, ExtraFieldsAndBars) {
   WriteOptions opt;
   opt.vtu_include_bars = true;
   Field cross{"cross<1>", 3, {}};
-  for (int v = 0; v < 12; ++v) { cross.values.insert(cross.values.end(), {1.0 * v, 0.5, -0.125}); }
+  for (int v = 0; v < 12; ++v) {
+    cross.values.insert(cross.values.end(), {1.0 * v, 0.5, -0.125});
+  }
   opt.point_fields.push_back(cross);
   Field quality{"quality", 1, {}};
   for (int e = 0; e < 9 + 13; ++e) quality.values.push_back(0.1 * e);

@@ -1,6 +1,5 @@
 // write_mesh dispatch, path checks, atomic output, determinism.
 #include <gtest/gtest.h>
-
 #include <unistd.h>
 
 #include <filesystem>

@@ -9,10 +9,10 @@
 #include <map>
 #include <set>
 
+#include "analytic_surfaces.hpp"
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/mesh/delaunay.hpp"
 #include "qsmesh/mesh/predicates.hpp"
-#include "analytic_surfaces.hpp"
 
 namespace {
 
@@ -28,8 +28,8 @@ using test::Sphere;
 
 // ------------------------------------------------------------------ loops
 // Appends the side uv0 -> uv1 (uv-linear, n segments; the end point is left to the next side).
-void add_side(BoundaryLoop& loop, const cad::FaceGeometry& s, Vec2 uv0, Vec2 uv1, int n,
-              LO curve, bool degenerate = false, Vec3 pole = {}) {
+void add_side(BoundaryLoop& loop, const cad::FaceGeometry& s, Vec2 uv0, Vec2 uv1, int n, LO curve,
+              bool degenerate = false, Vec3 pole = {}) {
   for (int k = 0; k < n; ++k) {
     const double t = static_cast<double>(k) / n;
     BoundaryPoint p;
@@ -87,11 +87,14 @@ Report check_mesh(const std::string& name, const FaceMesh& fm, std::span<const B
     const double o = orient2d(fm.uv[t[0]], fm.uv[t[1]], fm.uv[t[2]]);
     const bool at_pole = std::any_of(t.begin(), t.end(), [&](LO v) { return poles.count(v) > 0; });
     if (!at_pole) {
-      if (reversed) EXPECT_LT(o, 0) << name;
-      else EXPECT_GT(o, 0) << name;
+      if (reversed)
+        EXPECT_LT(o, 0) << name;
+      else
+        EXPECT_GT(o, 0) << name;
     }
     r.uv_area += std::fabs(0.5 * o);
-    r.area3d += 0.5 * norm(cross(fm.points[t[1]] - fm.points[t[0]], fm.points[t[2]] - fm.points[t[0]]));
+    r.area3d +=
+        0.5 * norm(cross(fm.points[t[1]] - fm.points[t[0]], fm.points[t[2]] - fm.points[t[0]]));
     EXPECT_GT(norm(cross(fm.points[t[1]] - fm.points[t[0]], fm.points[t[2]] - fm.points[t[0]])), 0)
         << name << ": zero-area triangle";
   }
@@ -139,10 +142,11 @@ Report check_mesh(const std::string& name, const FaceMesh& fm, std::span<const B
   }
   r.mean_min_angle = sum / fm.triangles.size();
   r.frac_angle_ok = static_cast<double>(aok) / fm.triangles.size();
-  std::printf("[%s] %zu triangles, %d vertices; min angle %.1f deg, mean min angle %.1f; "
-              "edges in [0.3,2]h: %.2f%%; min angle >= 20: %.2f%%\n",
-              name.c_str(), fm.triangles.size(), nv, r.min_angle, r.mean_min_angle,
-              100 * r.frac_len_ok, 100 * r.frac_angle_ok);
+  std::printf(
+      "[%s] %zu triangles, %d vertices; min angle %.1f deg, mean min angle %.1f; "
+      "edges in [0.3,2]h: %.2f%%; min angle >= 20: %.2f%%\n",
+      name.c_str(), fm.triangles.size(), nv, r.min_angle, r.mean_min_angle, 100 * r.frac_len_ok,
+      100 * r.frac_angle_ok);
   std::printf("   min-angle histogram (10 deg bins): ");
   for (int k = 0; k < 7; ++k) std::printf("[%d,%d):%d ", 10 * k, 10 * k + 10, ahist[k]);
   std::printf("\n   edge/h histogram (0.25 bins): ");
@@ -251,10 +255,10 @@ TEST(Delaunay, FullCylinderWithSeam) {
   const double h = 1.0, H = 12;
   BoundaryLoop loop;
   const int nc = segs(2 * kPi * 10, h), ns = segs(H, h);
-  add_side(loop, cyl, {0, 0}, {2 * kPi, 0}, nc, 0);          // bottom circle
-  add_side(loop, cyl, {2 * kPi, 0}, {2 * kPi, H}, ns, 1);    // seam up at u = 2 pi
-  add_side(loop, cyl, {2 * kPi, H}, {0, H}, nc, 2);          // top circle, reversed
-  add_side(loop, cyl, {0, H}, {0, 0}, ns, 1);                // seam down at u = 0
+  add_side(loop, cyl, {0, 0}, {2 * kPi, 0}, nc, 0);        // bottom circle
+  add_side(loop, cyl, {2 * kPi, 0}, {2 * kPi, H}, ns, 1);  // seam up at u = 2 pi
+  add_side(loop, cyl, {2 * kPi, H}, {0, H}, nc, 2);        // top circle, reversed
+  add_side(loop, cyl, {0, H}, {0, 0}, ns, 1);              // seam down at u = 0
   std::vector<BoundaryLoop> loops{loop};
   SizeFunction size = [&](const Vec2&, const Vec3&) { return h; };
   const FaceMesh fm = triangulate_face(cyl, false, loops, size);
@@ -271,9 +275,9 @@ TEST(Delaunay, SphereWithPoles) {
   BoundaryLoop loop;
   const int nm = segs(kPi * R, h);
   add_side(loop, sph, {0, -kPi / 2}, {2 * kPi, -kPi / 2}, 1, 0, true, south);  // south pole
-  add_side(loop, sph, {2 * kPi, -kPi / 2}, {2 * kPi, kPi / 2}, nm, 1);          // seam up
-  add_side(loop, sph, {2 * kPi, kPi / 2}, {0, kPi / 2}, 1, 2, true, north);     // north pole
-  add_side(loop, sph, {0, kPi / 2}, {0, -kPi / 2}, nm, 1);                      // seam down
+  add_side(loop, sph, {2 * kPi, -kPi / 2}, {2 * kPi, kPi / 2}, nm, 1);         // seam up
+  add_side(loop, sph, {2 * kPi, kPi / 2}, {0, kPi / 2}, 1, 2, true, north);    // north pole
+  add_side(loop, sph, {0, kPi / 2}, {0, -kPi / 2}, nm, 1);                     // seam down
   loop.points[nm + 2].xyz = north;  // the degenerate segments' ends are the poles exactly
   loop.points[1].xyz = south;
   std::vector<BoundaryLoop> loops{loop};
@@ -284,7 +288,8 @@ TEST(Delaunay, SphereWithPoles) {
   // checked in 3D below.
   std::set<LO> poles;
   for (LO v = 0; v < fm.num_vertices(); ++v)
-    if (distance(fm.points[v], south) < 1e-12 || distance(fm.points[v], north) < 1e-12) poles.insert(v);
+    if (distance(fm.points[v], south) < 1e-12 || distance(fm.points[v], north) < 1e-12)
+      poles.insert(v);
   const Report r = check_mesh("sphere", fm, loops, false, size, poles);
   EXPECT_NEAR(r.area3d, 4 * kPi * R * R, 4 * kPi * R * R * 0.02);
   expect_quality(r, 0.97, 0.95);
@@ -353,8 +358,14 @@ TEST(Delaunay, GradedSize) {
   for (const auto& t : fm.triangles) {
     const Vec2 c = (fm.uv[t[0]] + fm.uv[t[1]] + fm.uv[t[2]]) / 3.0;
     const double a = 0.5 * std::fabs(orient2d(fm.uv[t[0]], fm.uv[t[1]], fm.uv[t[2]]));
-    if (c.u < 1) { small += a; ++ns; }
-    if (c.u > 9) { large += a; ++nl; }
+    if (c.u < 1) {
+      small += a;
+      ++ns;
+    }
+    if (c.u > 9) {
+      large += a;
+      ++nl;
+    }
   }
   ASSERT_GT(ns, 0);
   ASSERT_GT(nl, 0);
@@ -442,8 +453,8 @@ TEST(Delaunay, AnisotropicAndMismatchedBoundary) {
     SizeFunction size = [&](const Vec2&, const Vec3&) { return h; };
     TriangulateStats stats;
     const FaceMesh fm = triangulate_face(cyl, false, loops, size, {}, &stats);
-    const Report r = check_mesh(bh < 1 ? "aniso-fine-boundary" : "aniso-coarse-boundary", fm,
-                                loops, false, size);
+    const Report r = check_mesh(bh < 1 ? "aniso-fine-boundary" : "aniso-coarse-boundary", fm, loops,
+                                false, size);
     EXPECT_NEAR(r.uv_area, 0.2, 1e-12);
     EXPECT_NEAR(r.area3d, 200, 2);
     EXPECT_LT(stats.inserted, 2000);

@@ -94,7 +94,8 @@ TEST(Predicates, IncircleNearCocircularMatchesExact) {
   std::vector<std::pair<std::int64_t, std::int64_t>> circle;
   const std::int64_t r2 = 390625;  // 5^8
   for (std::int64_t x = -625; x <= 625; ++x) {
-    const auto y = static_cast<std::int64_t>(std::llround(std::sqrt(static_cast<double>(r2 - x * x))));
+    const auto y =
+        static_cast<std::int64_t>(std::llround(std::sqrt(static_cast<double>(r2 - x * x))));
     if (x * x + y * y == r2) {
       circle.emplace_back(x, y);
       if (y != 0) circle.emplace_back(x, -y);
@@ -122,8 +123,9 @@ TEST(Predicates, IncircleNearCocircularMatchesExact) {
   }
   EXPECT_EQ(robust_wrong, 0);
   EXPECT_GT(zeros, 0);
-  std::printf("incircle near-cocircular: naive wrong on %d / 20000, robust wrong on %d (%d exact zeros)\n",
-              naive_wrong, robust_wrong, zeros);
+  std::printf(
+      "incircle near-cocircular: naive wrong on %d / 20000, robust wrong on %d (%d exact zeros)\n",
+      naive_wrong, robust_wrong, zeros);
 }
 
 // Non-integer inputs with tiny perturbations: exact reference by scaling dyadic coordinates.

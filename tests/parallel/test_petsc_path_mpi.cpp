@@ -21,8 +21,8 @@ namespace {
 
 TEST(PetscPath, FaceAboveTheThresholdIsSolvedByPetscAlikeOnEveryRankCount) {
   const Comm comm = Comm::world();
-  const std::string path = std::string(QSMESH_TEST_TMP_DIR) + "/petsc_path_np" +
-                           std::to_string(comm.size()) + ".brep";
+  const std::string path =
+      std::string(QSMESH_TEST_TMP_DIR) + "/petsc_path_np" + std::to_string(comm.size()) + ".brep";
   if (comm.rank() == 0) test::write_teardrop(3.0, path);
   comm.barrier();
   const cad::CadModel model = cad::load_cad(path);

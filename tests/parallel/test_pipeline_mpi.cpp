@@ -44,11 +44,13 @@ TEST(Comm, ReductionsAndGather) {
   comm.allreduce_min(m);
   EXPECT_EQ(m, (std::vector<double>{0.0, 5.0 - (comm.size() - 1)}));
   EXPECT_FALSE(comm.allreduce_and(comm.rank() != 0));
-  const std::vector<char> mine(static_cast<std::size_t>(comm.rank()) + 1, static_cast<char>('a' + comm.rank()));
+  const std::vector<char> mine(static_cast<std::size_t>(comm.rank()) + 1,
+                               static_cast<char>('a' + comm.rank()));
   const auto all = comm.gather_bytes(mine, 0);
   if (comm.rank() == 0) {
     ASSERT_EQ(static_cast<int>(all.size()), comm.size());
-    for (int r = 0; r < comm.size(); ++r) EXPECT_EQ(all[r], std::vector<char>(r + 1, static_cast<char>('a' + r)));
+    for (int r = 0; r < comm.size(); ++r)
+      EXPECT_EQ(all[r], std::vector<char>(r + 1, static_cast<char>('a' + r)));
   } else {
     EXPECT_TRUE(all.empty());
   }
@@ -201,7 +203,8 @@ TEST(Pipeline, DistributedEqualsSerial) {
 
   const mesh::SurfaceMesh& dist = result.mesh;
   ASSERT_EQ(dist.points.size(), serial.points.size());
-  for (std::size_t i = 0; i < serial.points.size(); ++i) ASSERT_EQ(dist.points[i], serial.points[i]) << i;
+  for (std::size_t i = 0; i < serial.points.size(); ++i)
+    ASSERT_EQ(dist.points[i], serial.points[i]) << i;
   EXPECT_EQ(dist.triangles, serial.triangles);
   EXPECT_EQ(dist.triangle_face, serial.triangle_face);
   EXPECT_EQ(dist.bars, serial.bars);
@@ -225,8 +228,10 @@ TEST(Pipeline, CrossFieldsDoNotDependOnRanks) {
   const auto curves = background::mesh_curves(model, options.background.sizes, TaskArena(1));
   int consistent = 0;
   for (LO f = 0; f < model.num_faces(); ++f) {
-    const auto face = background::mesh_face_background(model, f, curves, options.background, nullptr);
-    const CrossFieldOutput serial = summarize(crossfield::compute_face_cross_field(face, options.crossfield, nullptr));
+    const auto face =
+        background::mesh_face_background(model, f, curves, options.background, nullptr);
+    const CrossFieldOutput serial =
+        summarize(crossfield::compute_face_cross_field(face, options.crossfield, nullptr));
     const CrossFieldOutput& dist = result.cross_fields[f];
     ASSERT_TRUE(dist.ok) << dist.error;
     ASSERT_EQ(dist.directions.size(), serial.directions.size());
@@ -282,8 +287,10 @@ void check_size_map(const Comm& comm, const cad::CadModel& model, double size,
   }
   sizemap::grade_curves(model, curves, options.sizemap.gradation, united);
   EXPECT_EQ(result.curve_sizes.pack(), united.pack());
-  auto q = quantize::quantize_curves(model, quantize::ideal_edge_counts(curves, united.at), options.quantize);
-  q.edges = qstruct::balance_curve_counts(model, curves, q, qstruct::builtin_patterns(), {}, options.balance);
+  auto q = quantize::quantize_curves(model, quantize::ideal_edge_counts(curves, united.at),
+                                     options.quantize);
+  q.edges = qstruct::balance_curve_counts(model, curves, q, qstruct::builtin_patterns(), {},
+                                          options.balance);
   EXPECT_EQ(result.quantization.edges, q.edges);
   const auto placed = quantize::place_vertices(model, curves, united.at, q, false, one);
   ASSERT_EQ(result.quantized_curves.size(), placed.size());
@@ -383,7 +390,9 @@ TEST(Pipeline, CrossingBoundaryIsRepairedAlikeOnEveryRank) {
     ASSERT_EQ(dist.mesh.points[i], serial.mesh.points[i]);
 }
 
-TEST(Pipeline, QuadMeshDoesNotDependOnRanks) { check_quads_do_not_depend_on_ranks(Stage::Unstructured, "pipe_quads"); }
+TEST(Pipeline, QuadMeshDoesNotDependOnRanks) {
+  check_quads_do_not_depend_on_ranks(Stage::Unstructured, "pipe_quads");
+}
 
 // With the background at the geometry's resolution (the program's default): on an L-shaped
 // plate 30 wide the caps (diagonal / 8, about 5) bind against the size 1, and the background is
@@ -439,7 +448,8 @@ int check_refused_patterns_compared(const Comm& comm, const cad::CadModel& model
   EXPECT_EQ(compared.quasi_reports.size(), nf);
   EXPECT_EQ(never.face_stats.size(), nf);
   int taken = 0;
-  const std::size_t checked = std::min({nf, compared.quasi_reports.size(), never.face_stats.size()});
+  const std::size_t checked =
+      std::min({nf, compared.quasi_reports.size(), never.face_stats.size()});
   for (std::size_t f = 0; f < checked; ++f) {
     const QuasiReport& q = compared.quasi_reports[f];
     EXPECT_EQ(q.by_comparison, serial.quasi_reports[f].by_comparison) << "face " << f;

@@ -36,7 +36,8 @@ int main(int argc, char** argv) {
   const bool ok = test::parse_survey_args(
       argc, argv,
       "usage: cavity_survey MODEL [--size-factor F] [--threads T] [--first N] [--faces] "
-      "[--quad-change F] [--avg-ratio R] [--candidates N] [--rings N] [--backtracks N] [--minimal-tries N] "
+      "[--quad-change F] [--avg-ratio R] [--candidates N] [--rings N] [--backtracks N] "
+      "[--minimal-tries N] "
       "[--smooth-iterations N] [--no-step3-transitions]",
       args, [&](const std::string& a, int& i) {
         if (a == "--no-step3-transitions") {
@@ -73,7 +74,8 @@ int main(int argc, char** argv) {
   return test::run_reporting_errors("cavity_survey", [&] {
     const cad::CadModel model = test::load_survey_model(path);
     const TaskArena tasks(args.threads);
-    const test::SurveyRun run = test::run_survey_pipeline(model, size_factor, /*cross_fields=*/true, tasks);
+    const test::SurveyRun run =
+        test::run_survey_pipeline(model, size_factor, /*cross_fields=*/true, tasks);
     const parallel::PipelineResult& result = run.result;
     const double size = run.size;
     quad::UnstructuredOptions qo;
@@ -186,11 +188,11 @@ int main(int argc, char** argv) {
       const auto& b = diag[k];
       std::cout << "  step " << k + 1 << ": growth stops concave/max_quads/no_frontier/fan/found "
                 << b.stop_concave << "/" << b.stop_max_quads << "/" << b.stop_no_frontier << "/"
-                << b.stop_fan << "/" << b.stop_found << "; checks " << b.checks
-                << " (no pattern " << b.no_pattern << ", no match " << b.no_match
-                << ", not better " << b.not_better << "); refused layout/invalid/min/avg "
-                << b.refused_layout << "/" << b.refused_invalid << "/" << b.refused_min << "/"
-                << b.refused_avg << "; skipped (nothing changed) " << b.skipped_futile << "\n";
+                << b.stop_fan << "/" << b.stop_found << "; checks " << b.checks << " (no pattern "
+                << b.no_pattern << ", no match " << b.no_match << ", not better " << b.not_better
+                << "); refused layout/invalid/min/avg " << b.refused_layout << "/"
+                << b.refused_invalid << "/" << b.refused_min << "/" << b.refused_avg
+                << "; skipped (nothing changed) " << b.skipped_futile << "\n";
     }
     std::cout << "  remesh_cavities time " << seconds << " s\n";
   });

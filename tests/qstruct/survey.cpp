@@ -62,7 +62,8 @@ int main(int argc, char** argv) {
   return test::run_reporting_errors("qstruct_survey", [&] {
     const cad::CadModel model = test::load_survey_model(path);
     const TaskArena tasks(args.threads);
-    const test::SurveyRun run = test::run_survey_pipeline(model, size_factor, /*cross_fields=*/false, tasks);
+    const test::SurveyRun run =
+        test::run_survey_pipeline(model, size_factor, /*cross_fields=*/false, tasks);
     const parallel::PipelineResult& result = run.result;
     const double pipeline_s = run.pipeline_seconds;
 
@@ -75,7 +76,8 @@ int main(int argc, char** argv) {
     for (LO f = 0; f < model.num_faces(); ++f) {
       qstruct::PatternFaceReport rep;
       const Stopwatch face_clock;
-      const auto m = qstruct::mesh_face_pattern(model, f, result.quantized_curves, patterns, fo, &rep);
+      const auto m =
+          qstruct::mesh_face_pattern(model, f, result.quantized_curves, patterns, fo, &rep);
       const double face_seconds = face_clock.seconds();
       if (f == detail && !dump.empty()) {
         const mesh::FaceMesh& out = rep.ok ? m : rep.refused_mesh;
@@ -102,7 +104,8 @@ int main(int argc, char** argv) {
       }
       if (per_face) {
         std::cout << "face " << f << " " << cad::to_string(model.faces()[f].type) << " sides [";
-        for (std::size_t i = 0; i < rep.side_edges.size(); ++i) std::cout << (i ? "," : "") << rep.side_edges[i];
+        for (std::size_t i = 0; i < rep.side_edges.size(); ++i)
+          std::cout << (i ? "," : "") << rep.side_edges[i];
         std::cout << "] (" << face_seconds << " s) ";
         if (model.faces()[f].loops.size() == 1) {
           try {
@@ -120,8 +123,8 @@ int main(int argc, char** argv) {
           }
         }
         if (rep.ok)
-          std::cout << "ok " << rep.pattern_name << " quads " << rep.quads << " sicn " << rep.sicn_min << "/"
-                    << rep.sicn_avg;
+          std::cout << "ok " << rep.pattern_name << " quads " << rep.quads << " sicn "
+                    << rep.sicn_min << "/" << rep.sicn_avg;
         else
           std::cout << qstruct::to_string(rep.refusal) << ": " << rep.reason;
         // How far the geometric stage went: untangler calls, moves kept, and for a refused valid
@@ -132,8 +135,8 @@ int main(int argc, char** argv) {
             int poor = 0;
             const auto& rm = rep.refused_mesh;
             for (const auto& q : rm.quads)
-              if (mesh::quad_sicn({rm.points[q[0]], rm.points[q[1]], rm.points[q[2]], rm.points[q[3]]}) <=
-                  rep.min_sicn)
+              if (mesh::quad_sicn({rm.points[q[0]], rm.points[q[1]], rm.points[q[2]],
+                                   rm.points[q[3]]}) <= rep.min_sicn)
                 ++poor;
             std::cout << ", poor " << poor << " of " << rm.quads.size();
           }
@@ -147,26 +150,32 @@ int main(int argc, char** argv) {
       // One face in detail: the corners, their angles and sides, for looking into a refusal.
       const auto surface = model.face_geometry(detail);
       const auto fs = qstruct::face_sides(model, detail, *surface, result.quantized_curves, fo);
-      std::cout << "face " << detail << ": " << fs.points.size() << " boundary points, uv area " << fs.uv_area << "\n";
+      std::cout << "face " << detail << ": " << fs.points.size() << " boundary points, uv area "
+                << fs.uv_area << "\n";
       for (std::size_t i = 0; i < fs.points.size(); ++i)
         if (fs.points[i].vclass.dim == 0)
-          std::cout << "  point " << i << " corner " << fs.points[i].vclass.entity << " angle " << fs.angle_deg[i]
-                    << " uv (" << fs.points[i].uv.u << ", " << fs.points[i].uv.v << ") xyz (" << fs.points[i].xyz.x
-                    << ", " << fs.points[i].xyz.y << ", " << fs.points[i].xyz.z << ")\n";
+          std::cout << "  point " << i << " corner " << fs.points[i].vclass.entity << " angle "
+                    << fs.angle_deg[i] << " uv (" << fs.points[i].uv.u << ", " << fs.points[i].uv.v
+                    << ") xyz (" << fs.points[i].xyz.x << ", " << fs.points[i].xyz.y << ", "
+                    << fs.points[i].xyz.z << ")\n";
       for (const auto& use : model.faces()[detail].loops[0].uses)
-        std::cout << "  curve " << use.curve << (use.reversed ? " (rev) " : " ") << cad::to_string(model.curves()[use.curve].type)
-                  << " edges " << result.quantized_curves[use.curve].num_edges() << " length "
+        std::cout << "  curve " << use.curve << (use.reversed ? " (rev) " : " ")
+                  << cad::to_string(model.curves()[use.curve].type) << " edges "
+                  << result.quantized_curves[use.curve].num_edges() << " length "
                   << model.curves()[use.curve].length << "\n";
       if (args.per_face)
         for (const auto& use : model.faces()[detail].loops[0].uses) {
           std::cout << "  curve " << use.curve << " vertices:";
-          for (const auto& p : result.quantized_curves[use.curve].points) std::cout << " (" << p.x << "," << p.y << "," << p.z << ")";
+          for (const auto& p : result.quantized_curves[use.curve].points)
+            std::cout << " (" << p.x << "," << p.y << "," << p.z << ")";
           std::cout << "\n";
         }
     }
-    std::cout << path << ": " << meshed << "/" << model.num_faces() << " faces meshed by patterns (size factor "
-              << size_factor << ", " << quads << " quads";
-    if (meshed > 0) std::cout << ", SICN min " << worst << ", mean of face averages " << sum_avg / meshed;
+    std::cout << path << ": " << meshed << "/" << model.num_faces()
+              << " faces meshed by patterns (size factor " << size_factor << ", " << quads
+              << " quads";
+    if (meshed > 0)
+      std::cout << ", SICN min " << worst << ", mean of face averages " << sum_avg / meshed;
     std::cout << ")\n  patterns:";
     for (const auto& [k, n] : used) std::cout << " " << k << " " << n << ";";
     std::cout << "\n  refused:";
@@ -175,6 +184,7 @@ int main(int argc, char** argv) {
     for (const auto& [k, n] : no_pattern_sides) std::cout << " " << k << ": " << n << ";";
     std::cout << "\n  quality refusals by best pattern:";
     for (const auto& [k, n] : quality_patterns) std::cout << " " << k << " " << n << ";";
-    std::cout << "\n  time (s): pipeline to quantization " << pipeline_s << ", pattern meshing " << faces_s << "\n";
+    std::cout << "\n  time (s): pipeline to quantization " << pipeline_s << ", pattern meshing "
+              << faces_s << "\n";
   });
 }

@@ -50,8 +50,10 @@ SurveyRun run_survey_pipeline(const cad::CadModel& model, double size_factor, bo
   run.options.size_map = true;
   run.options.cross_fields = cross_fields;
   run.options.until = parallel::Stage::Background;
-  // QSMESH_SURVEY_NO_BALANCE=1: the plain quantization of Sec. 4.3, to compare with the balanced one.
-  if (const char* nb = std::getenv("QSMESH_SURVEY_NO_BALANCE"); nb != nullptr && std::string(nb) == "1")
+  // QSMESH_SURVEY_NO_BALANCE=1: the plain quantization of Sec. 4.3, to compare with the balanced
+  // one.
+  if (const char* nb = std::getenv("QSMESH_SURVEY_NO_BALANCE");
+      nb != nullptr && std::string(nb) == "1")
     run.options.balance_counts = false;
   const Stopwatch clock;
   run.result = parallel::run_pipeline(parallel::Comm::self(), model, run.options, tasks, log);

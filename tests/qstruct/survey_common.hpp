@@ -13,10 +13,10 @@ namespace qsmesh::test {
 
 /// Options every survey takes.
 struct SurveyArgs {
-  std::string path;          ///< the model (first argument that is not an option)
-  double size_factor = 0.02; ///< --size-factor: target size as a fraction of the model diagonal
-  int threads = 1;           ///< --threads
-  bool per_face = false;     ///< --faces: one line per face
+  std::string path;           ///< the model (first argument that is not an option)
+  double size_factor = 0.02;  ///< --size-factor: target size as a fraction of the model diagonal
+  int threads = 1;            ///< --threads
+  bool per_face = false;      ///< --faces: one line per face
 };
 
 /// Reads MODEL, --size-factor F, --threads T and --faces into `args`; any other argument argv[i]
@@ -31,8 +31,8 @@ struct SurveyArgs {
 struct SurveyRun {
   parallel::PipelineOptions options;  ///< what it ran with
   parallel::PipelineResult result;
-  double size = 0;               ///< target size, model diagonal * size factor (model units)
-  double pipeline_seconds = 0;   ///< wall time of run_pipeline
+  double size = 0;              ///< target size, model diagonal * size factor (model units)
+  double pipeline_seconds = 0;  ///< wall time of run_pipeline
 };
 
 /// Runs the pipeline on MPI_COMM_SELF up to parallel::Stage::Background with the size map on

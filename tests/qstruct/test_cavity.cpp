@@ -9,11 +9,11 @@
 #include <string>
 #include <vector>
 
+#include "analytic_surfaces.hpp"
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/qstruct/cavity.hpp"
 #include "qsmesh/smooth/quad_tools.hpp"
-#include "analytic_surfaces.hpp"
 
 namespace qsmesh::qstruct {
 namespace {

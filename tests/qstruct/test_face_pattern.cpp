@@ -453,7 +453,8 @@ TEST(FacePattern, LShapeKeepsItsConcaveCornerOnTheBoundary) {
   EXPECT_EQ(rep.side_edges.size(), 5u);  // the concave corner does not split a side
   EXPECT_EQ(v.interior, (std::map<int, int>{{4, static_cast<int>(v.interior.at(4))}}));
   for (LO i = 0; i < m.num_vertices(); ++i)
-    if (m.vclass[i].dim == 0 && std::abs(m.points[i].x - 3) < 1e-12 && std::abs(m.points[i].y - 3) < 1e-12) {
+    if (m.vclass[i].dim == 0 && std::abs(m.points[i].x - 3) < 1e-12 &&
+        std::abs(m.points[i].y - 3) < 1e-12) {
       EXPECT_EQ(v.of[i], 3);
     }
 }
@@ -466,7 +467,8 @@ TEST(FacePattern, CylinderSideIsAFourSidedDiskAcrossItsSeam) {
   ASSERT_NE(side, kNoIndex);
   std::vector<mesh::CurveMesh> curves;
   for (LO c = 0; c < model.num_curves(); ++c)
-    curves.push_back(test::uniform_curve_mesh(model, c, model.curves()[c].type == cad::CurveType::Circle ? 12 : 5));
+    curves.push_back(test::uniform_curve_mesh(
+        model, c, model.curves()[c].type == cad::CurveType::Circle ? 12 : 5));
   const auto patterns = builtin_patterns();
   PatternFaceReport rep;
   const auto m = mesh_face_pattern(model, side, curves, patterns, {}, &rep);
@@ -663,7 +665,8 @@ TEST(FacePattern, PolesInsideAndHolesAreRefused) {
   {
     const auto model = cad::load_cad(test::write_box_with_hole(tmp("qs_holed.brep")));
     std::vector<mesh::CurveMesh> curves;
-    for (LO c = 0; c < model.num_curves(); ++c) curves.push_back(test::uniform_curve_mesh(model, c, 4));
+    for (LO c = 0; c < model.num_curves(); ++c)
+      curves.push_back(test::uniform_curve_mesh(model, c, 4));
     int holes = 0, meshed = 0;
     // Quality bounds that accept the stretched 4 x 4 grids of the box's long sides: this test is
     // about the refusal of holes, not about the quality policy.
@@ -714,7 +717,8 @@ TEST(Balance, SidesOfSeveralCurvesAreMadeToFit) {
   ASSERT_EQ(fs.use_start.size(), uses.size());
   const auto sides = [&](const std::vector<int>& e) {
     std::vector<LO> n(fs.corners.size(), 0);
-    for (std::size_t u = 0; u < uses.size(); ++u) n[side_of(fs, fs.use_start[u])] += e[uses[u].curve];
+    for (std::size_t u = 0; u < uses.size(); ++u)
+      n[side_of(fs, fs.use_start[u])] += e[uses[u].curve];
     return n;
   };
   const std::vector<LO> before = sides(q.edges);

@@ -154,11 +154,14 @@ TEST(Match, OneSidedPatternsFitByCorners) {
 
 TEST(Patterns, InvalidPatternsAreRejected) {
   // Two quads with inconsistent orientation.
-  EXPECT_THROW((void)make_pattern("bad", {{0, 0}, {1, 0}, {1, 1}, {0, 1}, {2, 0}, {2, 1}}, {{0, 1, 2, 3}, {1, 2, 5, 4}}),
+  EXPECT_THROW((void)make_pattern("bad", {{0, 0}, {1, 0}, {1, 1}, {0, 1}, {2, 0}, {2, 1}},
+                                  {{0, 1, 2, 3}, {1, 2, 5, 4}}),
                Error);
   // An annulus (not a disk).
   std::vector<Vec2> xy(8);
-  EXPECT_THROW((void)make_pattern("ring", xy, {{0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}}), Error);
+  EXPECT_THROW(
+      (void)make_pattern("ring", xy, {{0, 1, 5, 4}, {1, 2, 6, 5}, {2, 3, 7, 6}, {3, 0, 4, 7}}),
+      Error);
   // Index out of range.
   EXPECT_THROW((void)make_pattern("range", {{0, 0}, {1, 0}, {1, 1}}, {{0, 1, 2, 3}}), Error);
 }

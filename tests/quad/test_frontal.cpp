@@ -45,7 +45,6 @@
 namespace qsmesh::quad {
 namespace {
 
-
 cad::CadModel rectangle(double w, double h) {
   BRepBuilderAPI_MakePolygon poly;
   for (const auto& [x, y] : std::vector<std::pair<double, double>>{{0, 0}, {w, 0}, {w, h}, {0, h}})
@@ -93,7 +92,8 @@ cad::CadModel thin_torus_fillet() {
 }
 
 // What the pipeline hands the quad stage for face 0 with a uniform size map `size`: the curve
-// meshes at the final size (full) and at twice it (halved), the background mesh and its cross field.
+// meshes at the final size (full) and at twice it (halved), the background mesh and its cross
+// field.
 struct Prepared {
   std::vector<mesh::CurveMesh> full, halved;
   mesh::FaceMesh background;
@@ -130,7 +130,8 @@ std::vector<LO> irregular_interior(const mesh::FaceMesh& m) {
 double sicn_min(const mesh::FaceMesh& m) {
   double worst = 1;
   for (const auto& q : m.quads)
-    worst = std::min(worst, mesh::quad_sicn({m.points[q[0]], m.points[q[1]], m.points[q[2]], m.points[q[3]]}));
+    worst = std::min(
+        worst, mesh::quad_sicn({m.points[q[0]], m.points[q[1]], m.points[q[2]], m.points[q[3]]}));
   return worst;
 }
 
@@ -175,12 +176,14 @@ TEST(FaceGuide, InterpolatesTheSizeAndFindsTheCross) {
   const auto model = rectangle(4, 3);
   Prepared p = prepare(model, 0.5);
   // A size growing with x: the guide must return the linear interpolant exactly on a plane.
-  for (LO v = 0; v < p.background.num_vertices(); ++v) p.sizes[v] = 0.2 + 0.1 * p.background.points[v].x;
+  for (LO v = 0; v < p.background.num_vertices(); ++v)
+    p.sizes[v] = 0.2 + 0.1 * p.background.points[v].x;
   const FaceGuide guide(p.background, p.cf, p.sizes);
   const auto surface = model.face_geometry(0);
   for (std::size_t t = 0; t < p.background.triangles.size(); t += 7) {
     const auto& T = p.background.triangles[t];
-    const Vec2 uv = (p.background.uv[T[0]] * 0.2 + p.background.uv[T[1]] * 0.3 + p.background.uv[T[2]] * 0.5);
+    const Vec2 uv =
+        (p.background.uv[T[0]] * 0.2 + p.background.uv[T[1]] * 0.3 + p.background.uv[T[2]] * 0.5);
     const Vec3 x = surface->eval(uv).p;
     const FaceGuide::Sample s = guide.at(uv);
     EXPECT_TRUE(s.found);
@@ -296,8 +299,11 @@ TEST(Unstructured, DiskHasIrregularVerticesAtTheSingularitiesAndFewerThanWithout
     for (const auto& s : p.cf.singularities) d = std::min(d, distance(s.position, m.points[v]));
     near += d < 4 * 2 * size ? 1 : 0;
   }
-  std::printf("[frontal] disk: %zu quads, %zu irregular interior vertices (%zu near the %zu singularities), "
-              "SICN min %.3f\n", m.quads.size(), irr.size(), near, p.cf.singularities.size(), sicn_min(m));
+  std::printf(
+      "[frontal] disk: %zu quads, %zu irregular interior vertices (%zu near the %zu "
+      "singularities), "
+      "SICN min %.3f\n",
+      m.quads.size(), irr.size(), near, p.cf.singularities.size(), sicn_min(m));
   EXPECT_EQ(p.cf.singularities.size(), 4U);
   // Every singularity of the field shows up as an irregular vertex nearby (the others come from
   // fronts meeting).
@@ -315,8 +321,8 @@ TEST(Unstructured, DiskHasIrregularVerticesAtTheSingularitiesAndFewerThanWithout
   const mesh::FaceMesh plain =
       mesh_face_unstructured(model, 0, p.full, FaceFields{}, options, &plain_rep);
   const auto plain_irr = irregular_interior(plain);
-  std::printf("[frontal] disk without cross field: %zu quads, %zu irregular interior vertices\n", plain.quads.size(),
-              plain_irr.size());
+  std::printf("[frontal] disk without cross field: %zu quads, %zu irregular interior vertices\n",
+              plain.quads.size(), plain_irr.size());
   EXPECT_LT(static_cast<double>(irr.size()), 0.8 * static_cast<double>(plain_irr.size()));
 }
 

@@ -35,7 +35,8 @@ cad::CadModel load(const TopoDS_Shape& shape, const std::string& name) {
 }
 
 // A planar polygonal face through the given (x, y) points.
-cad::CadModel polygon_face(const std::vector<std::pair<double, double>>& xy, const std::string& name) {
+cad::CadModel polygon_face(const std::vector<std::pair<double, double>>& xy,
+                           const std::string& name) {
   return cad::load_cad(test::write_polygon_face(xy, tmp(name)));
 }
 

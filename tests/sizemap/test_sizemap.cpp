@@ -1,8 +1,6 @@
 // Size map (paper 000 Sec. 4.1, 4.2) on OpenCASCADE-built models.
 #include <gtest/gtest.h>
 
-#include <numbers>
-
 #include <BRepBuilderAPI_MakeEdge.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepBuilderAPI_MakePolygon.hxx>
@@ -17,6 +15,7 @@
 #include <gp_Circ.hxx>
 #include <limits>
 #include <map>
+#include <numbers>
 #include <numeric>
 #include <stdexcept>
 #include <utility>
@@ -42,7 +41,8 @@ cad::CadModel load_shape(const TopoDS_Shape& s, const std::string& name) {
 }
 
 /// A planar face bounded by the polygon through `xy` (z = 0).
-cad::CadModel polygon_face(const std::vector<std::pair<double, double>>& xy, const std::string& name) {
+cad::CadModel polygon_face(const std::vector<std::pair<double, double>>& xy,
+                           const std::string& name) {
   return cad::load_cad(test::write_polygon_face(xy, tmp(name)));
 }
 

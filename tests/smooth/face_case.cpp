@@ -1,10 +1,11 @@
 #include "face_case.hpp"
-#include "tmp_dir.hpp"
 
 #include <gtest/gtest.h>
 
 #include <BRepTools.hxx>
 #include <stdexcept>
+
+#include "tmp_dir.hpp"
 
 namespace qsmesh::test {
 

@@ -16,10 +16,10 @@
 #include <stdexcept>
 #include <string>
 
+#include "face_case.hpp"
 #include "qsmesh/cad/model.hpp"
 #include "qsmesh/smooth/approx_surface.hpp"
 #include "qsmesh/smooth/smooth.hpp"
-#include "face_case.hpp"
 
 namespace qsmesh::smooth {
 namespace {

@@ -30,7 +30,8 @@ Grid make_grid(LO nx, LO ny, X x, Y y) {
   for (int pass = 0; pass < 2; ++pass)
     for (LO j = 0; j <= ny; ++j)
       for (LO i = 0; i <= nx; ++i)
-        if (boundary(i, j) == (pass == 0)) g.id[static_cast<std::size_t>(j * (nx + 1) + i)] = next++;
+        if (boundary(i, j) == (pass == 0))
+          g.id[static_cast<std::size_t>(j * (nx + 1) + i)] = next++;
   g.uv.resize(static_cast<std::size_t>(next));
   for (LO j = 0; j <= ny; ++j)
     for (LO i = 0; i <= nx; ++i) {
@@ -40,7 +41,8 @@ Grid make_grid(LO nx, LO ny, X x, Y y) {
       if (boundary(i, j)) ++g.num_fixed;
     }
   for (LO j = 0; j < ny; ++j)
-    for (LO i = 0; i < nx; ++i) g.quads.push_back({g.at(i, j), g.at(i + 1, j), g.at(i + 1, j + 1), g.at(i, j + 1)});
+    for (LO i = 0; i < nx; ++i)
+      g.quads.push_back({g.at(i, j), g.at(i + 1, j), g.at(i + 1, j + 1), g.at(i, j + 1)});
   return g;
 }
 

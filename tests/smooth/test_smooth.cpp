@@ -11,9 +11,9 @@
 #include <numbers>
 #include <string>
 
+#include "face_case.hpp"
 #include "qsmesh/cad/model.hpp"
 #include "qsmesh/smooth/smooth.hpp"
-#include "face_case.hpp"
 #include "shapes.hpp"
 
 namespace qsmesh::smooth {

@@ -12,10 +12,10 @@
 #include <stdexcept>
 #include <string>
 
+#include "face_case.hpp"
 #include "qsmesh/cad/model.hpp"
 #include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/smooth/untangle.hpp"
-#include "face_case.hpp"
 
 namespace qsmesh::smooth {
 namespace {

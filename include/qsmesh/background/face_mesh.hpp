@@ -23,9 +23,9 @@ struct BackgroundOptions {
 /// What happened on one face.
 struct FaceReport {
   LO face = kNoIndex;
-  bool ok = false;            ///< false: the face could not be meshed and is absent from the output
-  bool fell_back = false;     ///< true: refinement failed and the boundary-only triangulation was kept
-  std::string error;          ///< the error met, if any (with stage and face id)
+  bool ok = false;         ///< false: the face could not be meshed and is absent from the output
+  bool fell_back = false;  ///< true: refinement failed and the boundary-only triangulation was kept
+  std::string error;       ///< the error met, if any (with stage and face id)
   double seconds = 0;
   /// Every field, once (visit(name, member)): what the ranks exchange (parallel/record.hpp).
   template <class S, class V>
@@ -41,9 +41,9 @@ struct FaceReport {
 /// The boundary loops of face f in its parameter plane, built from the curve meshes: each curve
 /// use contributes its vertices in traversal order (the last one is the first of the next use),
 /// with uv from the face's pcurve of that use, xyz and classification from the curve mesh.
-[[nodiscard]] std::vector<mesh::BoundaryLoop> face_boundary(const cad::CadModel& model, LO f,
-                                                            const cad::FaceGeometry& surface,
-                                                            std::span<const mesh::CurveMesh> curves);
+[[nodiscard]] std::vector<mesh::BoundaryLoop> face_boundary(
+    const cad::CadModel& model, LO f, const cad::FaceGeometry& surface,
+    std::span<const mesh::CurveMesh> curves);
 
 /// One segment of a halved boundary loop (see halved_face_boundary): the full boundary vertex
 /// that midpoint subdivision puts at its middle.

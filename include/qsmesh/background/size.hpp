@@ -44,8 +44,8 @@ struct SizeOptions {
   [[nodiscard]] SizeOptions capped(double cap) const;
 };
 
-/// Size field of one face: the curvature size of the face, graded from the boundary: at a point x it
-/// is at most h_b + gradation * |x - b| for every boundary vertex b with local edge length h_b.
+/// Size field of one face: the curvature size of the face, graded from the boundary: at a point x
+/// it is at most h_b + gradation * |x - b| for every boundary vertex b with local edge length h_b.
 /// Without the grading, a curve meshed finely (for the curvature of a neighbouring face, say) next
 /// to a face of large size forces long thin triangles along it.
 class FaceSizeField {

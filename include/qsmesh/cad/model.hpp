@@ -16,10 +16,29 @@
 namespace qsmesh::cad {
 
 enum class SurfaceType : std::uint8_t {
-  Plane, Cylinder, Cone, Sphere, Torus, Bezier, BSpline, Revolution, Extrusion, Offset, Other
+  Plane,
+  Cylinder,
+  Cone,
+  Sphere,
+  Torus,
+  Bezier,
+  BSpline,
+  Revolution,
+  Extrusion,
+  Offset,
+  Other
 };
 enum class CurveType : std::uint8_t {
-  Line, Circle, Ellipse, Hyperbola, Parabola, Bezier, BSpline, Offset, Other, Degenerate
+  Line,
+  Circle,
+  Ellipse,
+  Hyperbola,
+  Parabola,
+  Bezier,
+  BSpline,
+  Offset,
+  Other,
+  Degenerate
 };
 [[nodiscard]] const char* to_string(SurfaceType t);
 [[nodiscard]] const char* to_string(CurveType t);
@@ -32,7 +51,8 @@ struct Corner {
 
 /// A CAD edge.
 struct Curve {
-  std::array<LO, 2> corners{kNoIndex, kNoIndex};  ///< corner at t0, corner at t1 (equal when closed)
+  std::array<LO, 2> corners{kNoIndex,
+                            kNoIndex};  ///< corner at t0, corner at t1 (equal when closed)
   /// Parameter range, t0 < t1: the edge's range, trimmed at an end where the curve runs past its
   /// corner (sloppy CAD: the curve passes within the corner's tolerance of it, goes on and comes
   /// back no closer) to the parameter of the curve's point nearest the corner. Without the trim,
@@ -60,13 +80,13 @@ struct Loop {
 
 /// A CAD face.
 struct Face {
-  std::vector<Loop> loops;   ///< loops[0] is the outer loop; the others bound holes
-  std::vector<LO> seams;     ///< curves used twice in this face's loops (seams of periodic surfaces)
+  std::vector<Loop> loops;  ///< loops[0] is the outer loop; the others bound holes
+  std::vector<LO> seams;    ///< curves used twice in this face's loops (seams of periodic surfaces)
   SurfaceType type = SurfaceType::Other;
-  bool reversed = false;     ///< face normal opposite to the surface's natural normal du x dv
-  double area = 0;           ///< model units squared
-  Box3 box;                  ///< 3D bounding box
-  Box2 uv_box;               ///< parameter-plane bounds of the trimmed face
+  bool reversed = false;  ///< face normal opposite to the surface's natural normal du x dv
+  double area = 0;        ///< model units squared
+  Box3 box;               ///< 3D bounding box
+  Box2 uv_box;            ///< parameter-plane bounds of the trimmed face
   bool u_periodic = false, v_periodic = false;
   double u_period = 0, v_period = 0;
   /// True when every loop is a closed chain (consecutive uses share a corner, last meets first).
@@ -108,10 +128,11 @@ class CadModel {
 
   /// New evaluator of curve c (the caller owns it and uses it from one thread).
   [[nodiscard]] std::unique_ptr<CurveGeometry> curve_geometry(LO c) const;
-  /// New evaluator of face f (the caller owns it and uses it from one thread). FaceGeometry::contains
-  /// needs `with_classifier`: building the point classifier costs more than the evaluator itself,
-  /// so only the stages that classify points ask for it.
-  [[nodiscard]] std::unique_ptr<FaceGeometry> face_geometry(LO f, bool with_classifier = false) const;
+  /// New evaluator of face f (the caller owns it and uses it from one thread).
+  /// FaceGeometry::contains needs `with_classifier`: building the point classifier costs more than
+  /// the evaluator itself, so only the stages that classify points ask for it.
+  [[nodiscard]] std::unique_ptr<FaceGeometry> face_geometry(LO f,
+                                                            bool with_classifier = false) const;
 
   /// Implementation data (OpenCASCADE shapes), opaque outside src/cad.
   struct Impl;

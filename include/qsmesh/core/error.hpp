@@ -13,8 +13,8 @@ namespace qsmesh {
 
 /// Where an error happened in the pipeline: stage name and CAD entity (dimension, id).
 struct ErrorContext {
-  std::string stage;   ///< e.g. "background", "load"; empty when unknown
-  int entity_dim = -1; ///< 0 corner, 1 curve, 2 face, -1 none
+  std::string stage;    ///< e.g. "background", "load"; empty when unknown
+  int entity_dim = -1;  ///< 0 corner, 1 curve, 2 face, -1 none
   long entity_id = -1;
 };
 
@@ -55,13 +55,13 @@ namespace detail {
 }  // namespace qsmesh
 
 /// Always-on check. Usage: QSMESH_CHECK(n > 0, "face " << f << " has no vertex");
-#define QSMESH_CHECK(cond, msg)                                                        \
-  do {                                                                                 \
-    if (!(cond)) [[unlikely]] {                                                        \
-      std::ostringstream qsmesh_check_os_;                                             \
-      qsmesh_check_os_ << msg; /* NOLINT(bugprone-macro-parentheses) */                \
+#define QSMESH_CHECK(cond, msg)                                                          \
+  do {                                                                                   \
+    if (!(cond)) [[unlikely]] {                                                          \
+      std::ostringstream qsmesh_check_os_;                                               \
+      qsmesh_check_os_ << msg; /* NOLINT(bugprone-macro-parentheses) */                  \
       ::qsmesh::detail::check_failed(#cond, __FILE__, __LINE__, qsmesh_check_os_.str()); \
-    }                                                                                  \
+    }                                                                                    \
   } while (false)
 
 #ifdef QSMESH_DEBUG

@@ -13,7 +13,8 @@ enum class LogLevel { Quiet = 0, Warning = 1, Info = 2, Debug = 3 };
 
 class Logger {
  public:
-  /// Writes to `out` the messages at or below `level`; `prefix` (e.g. "[rank 1] ") starts each line.
+  /// Writes to `out` the messages at or below `level`; `prefix` (e.g. "[rank 1] ") starts each
+  /// line.
   explicit Logger(std::ostream& out, LogLevel level = LogLevel::Info, std::string prefix = {});
 
   void log(LogLevel level, const std::string& line);

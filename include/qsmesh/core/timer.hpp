@@ -30,7 +30,9 @@ class StageTimes {
  public:
   void add(const std::string& stage, double seconds);
   [[nodiscard]] double get(const std::string& stage) const;
-  [[nodiscard]] const std::vector<std::pair<std::string, double>>& entries() const { return entries_; }
+  [[nodiscard]] const std::vector<std::pair<std::string, double>>& entries() const {
+    return entries_;
+  }
   [[nodiscard]] double total() const;
 
  private:

@@ -23,9 +23,24 @@ struct Vec3 {
   constexpr Vec3 operator-(const Vec3& o) const { return {x - o.x, y - o.y, z - o.z}; }
   constexpr Vec3 operator*(double s) const { return {x * s, y * s, z * s}; }
   constexpr Vec3 operator/(double s) const { return {x / s, y / s, z / s}; }
-  constexpr Vec3& operator+=(const Vec3& o) { x += o.x; y += o.y; z += o.z; return *this; }
-  constexpr Vec3& operator-=(const Vec3& o) { x -= o.x; y -= o.y; z -= o.z; return *this; }
-  constexpr Vec3& operator*=(double s) { x *= s; y *= s; z *= s; return *this; }
+  constexpr Vec3& operator+=(const Vec3& o) {
+    x += o.x;
+    y += o.y;
+    z += o.z;
+    return *this;
+  }
+  constexpr Vec3& operator-=(const Vec3& o) {
+    x -= o.x;
+    y -= o.y;
+    z -= o.z;
+    return *this;
+  }
+  constexpr Vec3& operator*=(double s) {
+    x *= s;
+    y *= s;
+    z *= s;
+    return *this;
+  }
   constexpr double operator[](int i) const { return i == 0 ? x : (i == 1 ? y : z); }
   constexpr bool operator==(const Vec3&) const = default;
 };
@@ -52,7 +67,11 @@ struct Vec2 {
   constexpr Vec2 operator-(const Vec2& o) const { return {u - o.u, v - o.v}; }
   constexpr Vec2 operator*(double s) const { return {u * s, v * s}; }
   constexpr Vec2 operator/(double s) const { return {u / s, v / s}; }
-  constexpr Vec2& operator+=(const Vec2& o) { u += o.u; v += o.v; return *this; }
+  constexpr Vec2& operator+=(const Vec2& o) {
+    u += o.u;
+    v += o.v;
+    return *this;
+  }
   constexpr double operator[](int i) const { return i == 0 ? u : v; }
   constexpr bool operator==(const Vec2&) const = default;
 };
@@ -73,7 +92,10 @@ struct Box3 {
     hi = {std::fmax(hi.x, p.x), std::fmax(hi.y, p.y), std::fmax(hi.z, p.z)};
   }
   void add(const Box3& b) {
-    if (b.valid()) { add(b.lo); add(b.hi); }
+    if (b.valid()) {
+      add(b.lo);
+      add(b.hi);
+    }
   }
   [[nodiscard]] bool valid() const { return lo.x <= hi.x; }
   [[nodiscard]] double diagonal() const { return valid() ? distance(lo, hi) : 0.0; }

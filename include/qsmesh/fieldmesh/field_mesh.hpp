@@ -90,8 +90,8 @@ struct FieldMeshOptions {
 struct FieldMeshReport {
   LO face = kNoIndex;
   bool ok = false;
-  std::string stage;  ///< the stage that failed (compatibility, separatrices, regions,
-                      ///< quantization, filling), empty when ok
+  std::string stage;   ///< the stage that failed (compatibility, separatrices, regions,
+                       ///< quantization, filling), empty when ok
   std::string reason;  ///< why, one line
   Compatibility compatibility;
   int singularities = 0;  ///< interior singular points of the aligned field

@@ -47,16 +47,16 @@ struct Marker {
 
 struct WriteOptions {
   // CGNS
-  std::string cgns_base_name = "qsmesh";   ///< CGNS names are at most 32 characters
+  std::string cgns_base_name = "qsmesh";  ///< CGNS names are at most 32 characters
   std::string cgns_zone_name = "Surface";
   // VTU
-  bool vtu_binary = true;                  ///< inline base64 (true) or ASCII (false) data arrays
-  bool vtu_include_bars = false;           ///< also write the curve bars as VTK_LINE cells
-  std::vector<Marker> vtu_markers;         ///< extra points with a vertex cell each
-  std::vector<Field> point_fields;         ///< one value (or 3) per mesh vertex, then per marker
-  std::vector<Field> cell_fields;          ///< one value (or 3) per VTU cell (see above), markers last
+  bool vtu_binary = true;           ///< inline base64 (true) or ASCII (false) data arrays
+  bool vtu_include_bars = false;    ///< also write the curve bars as VTK_LINE cells
+  std::vector<Marker> vtu_markers;  ///< extra points with a vertex cell each
+  std::vector<Field> point_fields;  ///< one value (or 3) per mesh vertex, then per marker
+  std::vector<Field> cell_fields;   ///< one value (or 3) per VTU cell (see above), markers last
   // MSH
-  bool msh_corner_elements = true;         ///< write one point element (type 15) per meshed corner
+  bool msh_corner_elements = true;  ///< write one point element (type 15) per meshed corner
   // PLOT3D
   /// Fortran unformatted sequential records (a 4-byte length before and after each record: what
   /// CFL3D and most PLOT3D tools read), or false: the same bytes without them (C stream).
@@ -69,7 +69,8 @@ struct WriteOptions {
 /// Throws InputError (one line naming the path) when the extension is not supported or the folder
 /// does not exist or is not writable, before any work; qsmesh::Error when the mesh is inconsistent
 /// (check_mesh_for_output) or writing fails.
-void write_mesh(const mesh::SurfaceMesh& mesh, const std::string& path, const WriteOptions& options = {});
+void write_mesh(const mesh::SurfaceMesh& mesh, const std::string& path,
+                const WriteOptions& options = {});
 
 /// Output formats, from the extension of the path (case-insensitive): .cgns, .vtu, .msh, .h5,
 /// .xyz or .p3d (PLOT3D).
@@ -113,7 +114,8 @@ void check_mesh_for_output(const mesh::SurfaceMesh& mesh);
 /// sections instead (CGNS's node order, mesh::quad_grid_positions_recursive); CGNS defines no
 /// elements of order 5: that throws InputError. Limit: Debian's cgnslib uses 32-bit ids; larger
 /// meshes throw Error.
-void write_cgns(const mesh::SurfaceMesh& mesh, const std::string& path, const WriteOptions& options = {});
+void write_cgns(const mesh::SurfaceMesh& mesh, const std::string& path,
+                const WriteOptions& options = {});
 
 /// Block-structured CGNS/HDF5 (paper 002's block-structured output, from the layout as it is): one
 /// base (CellDimension 2, PhysicalDimension 3, units as write_cgns), one structured zone
@@ -175,7 +177,8 @@ Plot3dReport write_plot3d(const mesh::SurfaceMesh& mesh, const layout::QuadLayou
 /// A mesh of order 2 has biquadratic quads (28) and quadratic edges (21), of order 3 to 5 Lagrange
 /// quadrilaterals (70) and Lagrange curves (68) in VTK's node order
 /// (mesh::quad_grid_positions_vtk).
-void write_vtu(const mesh::SurfaceMesh& mesh, const std::string& path, const WriteOptions& options = {});
+void write_vtu(const mesh::SurfaceMesh& mesh, const std::string& path,
+               const WriteOptions& options = {});
 
 /// HDF5 (format_version 2) for solvers, plus the XDMF 3 file xdmf_path_for(path) describing it
 /// (open that one in ParaView: one block each for the quads, the triangles and the curve bars, with
@@ -223,6 +226,7 @@ void write_hdf5(const mesh::SurfaceMesh& mesh, const std::string& path,
 /// Gmsh MSH 4.1 ASCII: $Entities (corners, curves with their end corners, faces with their bounding
 /// curves), $Nodes and $Elements grouped by CAD entity (parametric 0). A mesh of order N has
 /// Gmsh's quads and lines of order N (types 10, 36, 37, 38 and 8, 26, 27, 28; Gmsh's node order).
-void write_msh(const mesh::SurfaceMesh& mesh, const std::string& path, const WriteOptions& options = {});
+void write_msh(const mesh::SurfaceMesh& mesh, const std::string& path,
+               const WriteOptions& options = {});
 
 }  // namespace qsmesh::io

@@ -15,9 +15,9 @@ namespace qsmesh::mesh {
 
 /// A vertex of a face boundary loop, as given by the curve meshes.
 struct BoundaryPoint {
-  Vec2 uv;            ///< image on the face's parameter plane (pcurve of the curve use)
-  Vec3 xyz;           ///< position on the curve (the curve mesh's point, shared by all faces)
-  VertexClass vclass; ///< corner or curve classification
+  Vec2 uv;             ///< image on the face's parameter plane (pcurve of the curve use)
+  Vec3 xyz;            ///< position on the curve (the curve mesh's point, shared by all faces)
+  VertexClass vclass;  ///< corner or curve classification
 };
 
 /// A closed boundary loop: segment i joins points[i] and points[(i + 1) % n].
@@ -59,9 +59,9 @@ struct TriangulateOptions {
 
 /// Statistics of a triangulation run.
 struct TriangulateStats {
-  std::int64_t inserted = 0;          ///< interior points inserted
-  std::int64_t rejected = 0;          ///< candidate points rejected (outside, too close, ...)
-  std::int64_t boundary_flips = 0;    ///< flips used to recover the locked boundary
+  std::int64_t inserted = 0;        ///< interior points inserted
+  std::int64_t rejected = 0;        ///< candidate points rejected (outside, too close, ...)
+  std::int64_t boundary_flips = 0;  ///< flips used to recover the locked boundary
 };
 
 /// Triangulates the face bounded by `loops` (loops[0] outer, others holes; either orientation)
@@ -70,12 +70,13 @@ struct TriangulateStats {
 /// and appear first in the output, loop by loop, in input order, except that extra points of
 /// degenerate segments are merged with their corner. Interior vertices are classified on the face
 /// (dim 2) with their (u, v). Triangles are counterclockwise in (u, v) when face_reversed is false
-/// and clockwise when it is true, so that in 3D they are oriented along the face normal. Deterministic: same input, same output, whatever the thread count.
-/// Degenerate segments: every point of a chain of degenerate segments (both ends and the extra
-/// points) becomes one output vertex, the chain's first input point (the other end is omitted
-/// from the output); triangles with two vertices there are dropped. Triangles of the pole fan use
-/// that vertex's (u, v), so they are valid in 3D but may be inverted in (u, v).
-/// Throws qsmesh::Error when the boundary cannot be recovered or a loop is invalid.
+/// and clockwise when it is true, so that in 3D they are oriented along the face normal.
+/// Deterministic: same input, same output, whatever the thread count. Degenerate segments: every
+/// point of a chain of degenerate segments (both ends and the extra points) becomes one output
+/// vertex, the chain's first input point (the other end is omitted from the output); triangles with
+/// two vertices there are dropped. Triangles of the pole fan use that vertex's (u, v), so they are
+/// valid in 3D but may be inverted in (u, v). Throws qsmesh::Error when the boundary cannot be
+/// recovered or a loop is invalid.
 [[nodiscard]] FaceMesh triangulate_face(const cad::FaceGeometry& surface, bool face_reversed,
                                         std::span<const BoundaryLoop> loops,
                                         const SizeFunction& size,

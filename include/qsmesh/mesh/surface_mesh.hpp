@@ -24,11 +24,12 @@ struct VertexClass {
 };
 
 /// Mesh of one CAD curve: vertices ordered from t0 to t1, both ends included (they are the curve's
-/// corners; a closed curve repeats its corner). A degenerate curve has exactly its two end vertices.
+/// corners; a closed curve repeats its corner). A degenerate curve has exactly its two end
+/// vertices.
 struct CurveMesh {
   LO curve = kNoIndex;
-  std::vector<double> t;      ///< curve parameters, increasing
-  std::vector<Vec3> points;   ///< C(t) (corner points at both ends)
+  std::vector<double> t;     ///< curve parameters, increasing
+  std::vector<Vec3> points;  ///< C(t) (corner points at both ends)
   [[nodiscard]] LO num_edges() const { return static_cast<LO>(t.size()) - 1; }
 };
 
@@ -36,7 +37,7 @@ struct CurveMesh {
 struct FaceMesh {
   LO face = kNoIndex;
   std::vector<Vec3> points;
-  std::vector<Vec2> uv;                      ///< parameter-plane position (boundary: the pcurve image)
+  std::vector<Vec2> uv;  ///< parameter-plane position (boundary: the pcurve image)
   std::vector<VertexClass> vclass;
   std::vector<std::array<LO, 3>> triangles;
   std::vector<std::array<LO, 4>> quads;
@@ -44,17 +45,17 @@ struct FaceMesh {
 };
 
 /// The assembled surface mesh of a model, global numbering: corners first (vertex id = corner id),
-/// then interior vertices of the curves by curve id, then interior vertices of the faces by face id.
-/// Elements are grouped by face, faces in increasing id; bars are grouped by curve.
+/// then interior vertices of the curves by curve id, then interior vertices of the faces by face
+/// id. Elements are grouped by face, faces in increasing id; bars are grouped by curve.
 struct SurfaceMesh {
   std::vector<Vec3> points;
   std::vector<VertexClass> vclass;
   std::vector<std::array<GO, 3>> triangles;
   std::vector<std::array<GO, 4>> quads;
-  std::vector<LO> triangle_face;              ///< CAD face of each triangle
-  std::vector<LO> quad_face;                  ///< CAD face of each quad
-  std::vector<std::array<GO, 2>> bars;        ///< curve edges
-  std::vector<LO> bar_curve;                  ///< CAD curve of each bar
+  std::vector<LO> triangle_face;        ///< CAD face of each triangle
+  std::vector<LO> quad_face;            ///< CAD face of each quad
+  std::vector<std::array<GO, 2>> bars;  ///< curve edges
+  std::vector<LO> bar_curve;            ///< CAD curve of each bar
   /// Order of the elements: 1 linear; 2..5 with the nodes below (highorder::make_high_order).
   int order = 1;
   /// High-order nodes, flat (empty when order is 1). Per quad, quad_nodes_per_quad() =

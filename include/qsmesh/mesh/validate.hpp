@@ -12,13 +12,13 @@
 namespace qsmesh::mesh {
 
 struct ConformityReport {
-  std::int64_t edges = 0;                 ///< distinct element edges
+  std::int64_t edges = 0;  ///< distinct element edges
   /// Edges off the curves that some face using them does not have in exactly 2 of its elements
   /// (two faces may each have one inside: a face given twice, faces sharing two curves).
   std::int64_t interior_edges_bad = 0;
-  std::int64_t curve_edges_bad = 0;       ///< curve edges not used once per use of the curve by a face
-  std::int64_t orientation_bad = 0;       ///< interior edges traversed the same way by both elements
-  std::int64_t degenerate_elements = 0;   ///< elements repeating a vertex
+  std::int64_t curve_edges_bad = 0;  ///< curve edges not used once per use of the curve by a face
+  std::int64_t orientation_bad = 0;  ///< interior edges traversed the same way by both elements
+  std::int64_t degenerate_elements = 0;  ///< elements repeating a vertex
   std::int64_t faces_without_elements = 0;
   [[nodiscard]] bool ok() const {
     return interior_edges_bad == 0 && curve_edges_bad == 0 && orientation_bad == 0 &&
@@ -29,7 +29,8 @@ struct ConformityReport {
 
 /// Checks that elements of a face meet edge to edge, that faces meet along the curve meshes and
 /// nowhere else, and that each face is consistently oriented.
-[[nodiscard]] ConformityReport check_conformity(const SurfaceMesh& mesh, const cad::CadModel& model);
+[[nodiscard]] ConformityReport check_conformity(const SurfaceMesh& mesh,
+                                                const cad::CadModel& model);
 
 /// Largest distance (model units) between a vertex and its CAD entity evaluated at the vertex's
 /// parameters (corner point, C(t), S(u, v)).

@@ -13,8 +13,8 @@
 #include "qsmesh/core/tasks.hpp"
 #include "qsmesh/core/timer.hpp"
 #include "qsmesh/crossfield/cross_field.hpp"
-#include "qsmesh/holomorphic/holomorphic.hpp"
 #include "qsmesh/fieldmesh/field_file.hpp"
+#include "qsmesh/holomorphic/holomorphic.hpp"
 #include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/mesh/surface_mesh.hpp"
 #include "qsmesh/parallel/comm.hpp"
@@ -127,23 +127,23 @@ struct PipelineResult {
   mesh::SurfaceMesh mesh;                       ///< assembled mesh (rank 0 only)
   std::vector<background::FaceReport> reports;  ///< one per face, by face id (rank 0 only)
   std::vector<CrossFieldOutput> cross_fields;   ///< one per face when requested (rank 0 only)
-  std::vector<mesh::FaceMesh> background;       ///< background meshes by face (rank 0, size map only)
-  std::vector<sizemap::FaceSizes> face_sizes;   ///< size fields by face (rank 0, size map only)
-  sizemap::CurveSizes curve_sizes;              ///< size map on the background curve meshes (every rank)
-  quantize::Quantization quantization;          ///< curve edge counts (every rank)
-  qstruct::BalanceReport balance;               ///< pattern-aware balancing of those counts (every rank)
+  std::vector<mesh::FaceMesh> background;  ///< background meshes by face (rank 0, size map only)
+  std::vector<sizemap::FaceSizes> face_sizes;  ///< size fields by face (rank 0, size map only)
+  sizemap::CurveSizes curve_sizes;      ///< size map on the background curve meshes (every rank)
+  quantize::Quantization quantization;  ///< curve edge counts (every rank)
+  qstruct::BalanceReport balance;       ///< pattern-aware balancing of those counts (every rank)
   /// Curves refined because a face boundary crossed itself (boundary_repair_rounds), by round.
   std::vector<LO> curves_refined_for_crossings;
-  std::vector<mesh::CurveMesh> quantized_curves;  ///< final curve meshes (every rank)
+  std::vector<mesh::CurveMesh> quantized_curves;       ///< final curve meshes (every rank)
   std::vector<quad::UnstructuredReport> quad_reports;  ///< by face, Stage::Unstructured (rank 0)
-  std::vector<QuasiReport> quasi_reports;  ///< by face, Stage::QuasiStructured (rank 0)
+  std::vector<QuasiReport> quasi_reports;              ///< by face, Stage::QuasiStructured (rank 0)
   /// By face, quad stages (rank 0): statistics of the face's final mesh, and the wall time spent
   /// on the face in the quad stages (patterns, unstructured, disk remeshing), seconds.
   std::vector<mesh::FaceQuadStats> face_stats;
   std::vector<double> face_seconds;
   /// By face, quad stages (rank 0): the face's time per stage and the dealt stages' keys.
   std::vector<FaceTimes> face_times;
-  std::vector<int> face_rank;                   ///< rank that meshed each face (every rank)
+  std::vector<int> face_rank;  ///< rank that meshed each face (every rank)
   /// Wall time (s) each rank spent in the stages split by faces (background to the comparison of
   /// refused pattern fills), its own work without its waits for the others (every rank). Their
   /// spread is the load imbalance of the METIS partition (max / mean, 1 on one rank).
@@ -152,7 +152,7 @@ struct PipelineResult {
   /// over the faces of all ranks, seconds (every rank). The stage itself is timed as one
   /// ("improvement"): its faces are dealt out dynamically, each face running the three in turn.
   std::array<double, 3> improvement_seconds{};
-  StageTimes times;                             ///< wall time per stage (max over ranks)
+  StageTimes times;  ///< wall time per stage (max over ranks)
 };
 
 /// Runs the pipeline up to options.until on all ranks of `comm` (collective). Stage::Unstructured

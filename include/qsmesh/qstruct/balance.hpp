@@ -37,12 +37,12 @@ struct BalanceOptions {
 };
 
 struct BalanceReport {
-  LO faces_considered = 0;   ///< faces with one loop, no pole and 2 to 6 sides
-  LO fitting_before = 0;     ///< of those, faces some pattern fits before balancing
-  LO fitting_after = 0;      ///< and after
-  LO grids_before = 0;       ///< four-sided faces with equal opposite counts, before balancing
-  LO grids_after = 0;        ///< and after
-  LO curves_changed = 0;     ///< curves whose count changed
+  LO faces_considered = 0;  ///< faces with one loop, no pole and 2 to 6 sides
+  LO fitting_before = 0;    ///< of those, faces some pattern fits before balancing
+  LO fitting_after = 0;     ///< and after
+  LO grids_before = 0;      ///< four-sided faces with equal opposite counts, before balancing
+  LO grids_after = 0;       ///< and after
+  LO curves_changed = 0;    ///< curves whose count changed
   int passes = 0;
 };
 
@@ -64,12 +64,9 @@ struct BalanceReport {
 ///    faces gained, misfit, relative change) is taken.
 /// Deterministic: the result depends only on the model, the curve meshes, q and the options.
 /// Fills `report` when not null.
-[[nodiscard]] std::vector<int> balance_curve_counts(const cad::CadModel& model,
-                                                    std::span<const mesh::CurveMesh> curves,
-                                                    const quantize::Quantization& q,
-                                                    std::span<const Pattern> patterns,
-                                                    std::span<const LO> fixed,
-                                                    const BalanceOptions& options,
-                                                    BalanceReport* report = nullptr);
+[[nodiscard]] std::vector<int> balance_curve_counts(
+    const cad::CadModel& model, std::span<const mesh::CurveMesh> curves,
+    const quantize::Quantization& q, std::span<const Pattern> patterns, std::span<const LO> fixed,
+    const BalanceOptions& options, BalanceReport* report = nullptr);
 
 }  // namespace qsmesh::qstruct

@@ -35,19 +35,19 @@ namespace qsmesh::qstruct {
 /// leaves its subdivision free.
 struct Pattern {
   std::string name;
-  std::vector<Vec2> xy;                   ///< drawing coordinates from the data file
-  std::vector<std::array<LO, 4>> quads;   ///< counter-clockwise
-  std::vector<LO> valence;                ///< quads per vertex
-  std::vector<std::array<LO, 2>> edges;   ///< unique edges (lower id first)
+  std::vector<Vec2> xy;                       ///< drawing coordinates from the data file
+  std::vector<std::array<LO, 4>> quads;       ///< counter-clockwise
+  std::vector<LO> valence;                    ///< quads per vertex
+  std::vector<std::array<LO, 2>> edges;       ///< unique edges (lower id first)
   std::vector<std::array<LO, 4>> quad_edges;  ///< edge k of a quad joins its vertices k and k+1
-  std::vector<LO> edge_chord;             ///< chord of each edge
+  std::vector<LO> edge_chord;                 ///< chord of each edge
   LO num_chords = 0;
   /// Boundary vertices counter-clockwise (interior on the left), starting at the corner with the
   /// smallest id (without corner: the boundary vertex with the smallest id); boundary edge k
   /// joins boundary[k] and boundary[k + 1] (cyclic).
   std::vector<LO> boundary;
-  std::vector<LO> boundary_edge;          ///< edge id of boundary edge k
-  std::vector<LO> side_start;             ///< position in `boundary` where each side starts
+  std::vector<LO> boundary_edge;  ///< edge id of boundary edge k
+  std::vector<LO> side_start;     ///< position in `boundary` where each side starts
   /// Eq. 14 matrix, num_sides() x num_chords, row-major: w[i * num_chords + j].
   std::vector<int> w;
   /// Interior vertices whose valence is not 4 plus boundary non-corners whose valence is not 2.
@@ -108,8 +108,8 @@ struct ChordSolution {
 /// (reversed ? (start - i) : (start + i)) mod m; `reversed` means the pattern is used mirrored
 /// (its boundary runs against the cavity's).
 struct PatternMatch {
-  LO pattern = kNoIndex;   ///< index in the pattern list
-  int start = 0;           ///< cavity side holding pattern side 0
+  LO pattern = kNoIndex;  ///< index in the pattern list
+  int start = 0;          ///< cavity side holding pattern side 0
   bool reversed = false;
   std::vector<LO> chords;  ///< subdivision of each chord of the pattern
   double energy = 0;       ///< E of the solution

@@ -50,7 +50,7 @@ class FaceGuide {
   std::vector<LO> tri2glued_;  // background triangle -> cross-field triangle (kNoIndex: collapsed)
   Box2 box_;
   int nu_ = 1, nv_ = 1;
-  double cu_ = 1, cv_ = 1;                 // cell sizes
+  double cu_ = 1, cv_ = 1;                  // cell sizes
   std::vector<LO> cell_start_, cell_tris_;  // CSR: cell -> background triangles (increasing)
   [[nodiscard]] bool barycentric(LO t, const Vec2& uv, std::array<double, 3>& w) const;
 };
@@ -97,7 +97,8 @@ struct FrontalStats {
 /// test sees across them. Poles: the 3D test sees the pole; the Gauss-Newton step is damped there.
 [[nodiscard]] std::vector<Vec2> frontal_points(const cad::FaceGeometry& surface,
                                                std::span<const mesh::BoundaryLoop> loops,
-                                               const FaceGuide& guide, const FrontalOptions& options,
+                                               const FaceGuide& guide,
+                                               const FrontalOptions& options,
                                                FrontalStats* stats = nullptr);
 
 }  // namespace qsmesh::quad

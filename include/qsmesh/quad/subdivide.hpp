@@ -13,8 +13,8 @@
 namespace qsmesh::quad {
 
 struct SubdivideStats {
-  std::int64_t quads = 0;           ///< quads of the result
-  std::int64_t snaps_reverted = 0;  ///< new face vertices moved back off their uv placement
+  std::int64_t quads = 0;                 ///< quads of the result
+  std::int64_t snaps_reverted = 0;        ///< new face vertices moved back off their uv placement
   std::int64_t flat_boundary_splits = 0;  ///< strips re-triangulated at flat boundary vertices
 };
 

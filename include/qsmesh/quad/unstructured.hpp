@@ -12,9 +12,9 @@
 #include "qsmesh/background/face_mesh.hpp"
 #include "qsmesh/cad/model.hpp"
 #include "qsmesh/crossfield/cross_field.hpp"
+#include "qsmesh/mesh/improve.hpp"
 #include "qsmesh/mesh/surface_mesh.hpp"
 #include "qsmesh/quad/frontal.hpp"
-#include "qsmesh/mesh/improve.hpp"
 #include "qsmesh/quad/recombine.hpp"
 
 namespace qsmesh::quad {
@@ -52,8 +52,8 @@ struct UnstructuredOptions {
   /// 3D clean-up of the frontal triangulation before recombination: interior vertices of triangles
   /// with an angle below 40 degrees moved to their centroids when that helps (no tangent-plane
   /// search: measured slower and no better here).
-  mesh::ImproveOptions improve_triangles{.target_angle_deg = 40, .rounds = 4, .move_vertices = true,
-                                         .compass_search = false};
+  mesh::ImproveOptions improve_triangles{
+      .target_angle_deg = 40, .rounds = 4, .move_vertices = true, .compass_search = false};
 };
 
 /// What the frontal path reads for one face, from the earlier stages (all from the same face).
@@ -65,15 +65,15 @@ struct FaceFields {
 
 /// What happened on one face.
 struct UnstructuredReport {
-  bool ok = false;          ///< an all-quad mesh with every quad valid (SICN > 0)
+  bool ok = false;  ///< an all-quad mesh with every quad valid (SICN > 0)
   /// The face did not get the intended method: the frontal path was wanted (options.use_frontal)
   /// but the face has no fields or the path failed, or recombination failed or folded a quad and
   /// every triangle was subdivided instead.
   bool fell_back = false;
-  bool frontal = false;     ///< the mesh comes from the frontal triangulation (else the fallback path)
+  bool frontal = false;  ///< the mesh comes from the frontal triangulation (else the fallback path)
   std::int64_t frontal_points = 0;  ///< interior points the frontal insertion placed
-  std::string error;        ///< the error met, with stage and face id
-  double sicn_min = 0;      ///< of the face's quads
+  std::string error;                ///< the error met, with stage and face id
+  double sicn_min = 0;              ///< of the face's quads
   std::int64_t quads = 0;
   /// Every field, once (visit(name, member)): what the ranks exchange (parallel/record.hpp).
   template <class S, class V>

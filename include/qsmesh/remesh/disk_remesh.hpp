@@ -25,8 +25,8 @@ enum class VertexKind : std::uint8_t { corner = 0, curve = 1, interior = 2 };
 /// (counter-clockwise seen from the face normal). All vectors have b entries.
 struct Cavity {
   std::vector<VertexKind> kind;
-  std::vector<int> out_valence;      ///< n_out: quads at x_j outside the cavity
-  std::vector<int> ideal_valence;    ///< n-bar: 4 inside a face, 2 on a curve, the corner's own
+  std::vector<int> out_valence;    ///< n_out: quads at x_j outside the cavity
+  std::vector<int> ideal_valence;  ///< n-bar: 4 inside a face, 2 on a curve, the corner's own
   /// Total valence today (n_out + today's n_in): keeping it is always allowed. Negative: the
   /// vertex must end in its allowed range (the defect being fixed).
   std::vector<int> current_valence;

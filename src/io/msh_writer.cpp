@@ -17,12 +17,14 @@ namespace {
 
 void write_box(OutputFile& out, const Box3& box) {
   const Box3 b = box.valid() ? box : Box3{Vec3{0, 0, 0}, Vec3{0, 0, 0}};
-  out << b.lo.x << ' ' << b.lo.y << ' ' << b.lo.z << ' ' << b.hi.x << ' ' << b.hi.y << ' ' << b.hi.z;
+  out << b.lo.x << ' ' << b.lo.y << ' ' << b.lo.z << ' ' << b.hi.x << ' ' << b.hi.y << ' '
+      << b.hi.z;
 }
 
 }  // namespace
 
-void write_msh(const mesh::SurfaceMesh& mesh, const std::string& path, const WriteOptions& options) {
+void write_msh(const mesh::SurfaceMesh& mesh, const std::string& path,
+               const WriteOptions& options) {
   detail::check_output_folder(path);
   check_mesh_for_output(mesh);
   const GO nv = mesh.num_vertices();
@@ -142,20 +144,30 @@ void write_msh(const mesh::SurfaceMesh& mesh, const std::string& path, const Wri
   GO num_elems = 0;
   if (options.msh_corner_elements) {
     for (const auto& nodes : entity2nodes[0]) {
-      if (!nodes.empty()) { ++elem_blocks; ++num_elems; }
+      if (!nodes.empty()) {
+        ++elem_blocks;
+        ++num_elems;
+      }
     }
   }
   for (const auto& bars : groups.curve2bars) {
-    if (!bars.empty()) { ++elem_blocks; num_elems += static_cast<GO>(bars.size()); }
+    if (!bars.empty()) {
+      ++elem_blocks;
+      num_elems += static_cast<GO>(bars.size());
+    }
   }
   for (LO f = 0; f < mesh.num_cad_faces; ++f) {
     for (const auto* list : {&groups.face2tris[static_cast<std::size_t>(f)],
                              &groups.face2quads[static_cast<std::size_t>(f)]}) {
-      if (!list->empty()) { ++elem_blocks; num_elems += static_cast<GO>(list->size()); }
+      if (!list->empty()) {
+        ++elem_blocks;
+        num_elems += static_cast<GO>(list->size());
+      }
     }
   }
   out << "$Elements\n"
-      << elem_blocks << ' ' << num_elems << ' ' << (num_elems > 0 ? 1 : 0) << ' ' << num_elems << '\n';
+      << elem_blocks << ' ' << num_elems << ' ' << (num_elems > 0 ? 1 : 0) << ' ' << num_elems
+      << '\n';
   GO tag = 1;
   // Gmsh's element types of quads and lines of order 1..5, and its node order of quads (the
   // recursive one of CGNS).

@@ -95,21 +95,21 @@ void check_mesh_for_output(const mesh::SurfaceMesh& m) {
   QSMESH_CHECK(m.triangle_face.size() == m.triangles.size(),
                "output: triangle_face has " << m.triangle_face.size() << " entries for "
                                             << m.triangles.size() << " triangles");
-  QSMESH_CHECK(m.quad_face.size() == m.quads.size(),
-               "output: quad_face has " << m.quad_face.size() << " entries for " << m.quads.size()
-                                        << " quads");
-  QSMESH_CHECK(m.bar_curve.size() == m.bars.size(),
-               "output: bar_curve has " << m.bar_curve.size() << " entries for " << m.bars.size()
-                                        << " bars");
+  QSMESH_CHECK(m.quad_face.size() == m.quads.size(), "output: quad_face has "
+                                                         << m.quad_face.size() << " entries for "
+                                                         << m.quads.size() << " quads");
+  QSMESH_CHECK(m.bar_curve.size() == m.bars.size(), "output: bar_curve has "
+                                                        << m.bar_curve.size() << " entries for "
+                                                        << m.bars.size() << " bars");
   QSMESH_CHECK(m.num_cad_faces >= 0 && m.num_cad_curves >= 0 && m.num_cad_corners >= 0,
                "output: negative CAD entity count");
-  QSMESH_CHECK(m.curve_corners.empty() ||
-                   static_cast<LO>(m.curve_corners.size()) == m.num_cad_curves,
-               "output: curve_corners has " << m.curve_corners.size() << " entries for "
-                                            << m.num_cad_curves << " curves");
-  QSMESH_CHECK(m.face2curves.size() == 0 || m.face2curves.size() == m.num_cad_faces,
-               "output: face2curves has " << m.face2curves.size() << " faces, mesh has "
-                                          << m.num_cad_faces);
+  QSMESH_CHECK(
+      m.curve_corners.empty() || static_cast<LO>(m.curve_corners.size()) == m.num_cad_curves,
+      "output: curve_corners has " << m.curve_corners.size() << " entries for " << m.num_cad_curves
+                                   << " curves");
+  QSMESH_CHECK(
+      m.face2curves.size() == 0 || m.face2curves.size() == m.num_cad_faces,
+      "output: face2curves has " << m.face2curves.size() << " faces, mesh has " << m.num_cad_faces);
   for (const auto& cc : m.curve_corners) {
     for (LO k : cc) {
       QSMESH_CHECK(k == kNoIndex || (k >= 0 && k < m.num_cad_corners),
@@ -117,7 +117,8 @@ void check_mesh_for_output(const mesh::SurfaceMesh& m) {
     }
   }
   for (LO c : m.face2curves.targets) {
-    QSMESH_CHECK(c >= 0 && c < m.num_cad_curves, "output: face2curves curve " << c << " out of range");
+    QSMESH_CHECK(c >= 0 && c < m.num_cad_curves,
+                 "output: face2curves curve " << c << " out of range");
   }
   auto check_vertices = [&](const auto& elements, const char* what) {
     for (std::size_t e = 0; e < elements.size(); ++e) {
@@ -150,9 +151,8 @@ void check_mesh_for_output(const mesh::SurfaceMesh& m) {
   check_vertices(m.bars, "bar");
   auto check_ids = [](const std::vector<LO>& ids, LO n, const char* what) {
     for (std::size_t e = 0; e < ids.size(); ++e) {
-      QSMESH_CHECK(ids[e] >= 0 && ids[e] < n,
-                   "output: " << what << ' ' << e << " on CAD entity " << ids[e] << " out of [0, "
-                              << n << ")");
+      QSMESH_CHECK(ids[e] >= 0 && ids[e] < n, "output: " << what << ' ' << e << " on CAD entity "
+                                                         << ids[e] << " out of [0, " << n << ")");
     }
   };
   check_ids(m.triangle_face, m.num_cad_faces, "triangle");
@@ -160,19 +160,27 @@ void check_mesh_for_output(const mesh::SurfaceMesh& m) {
   check_ids(m.bar_curve, m.num_cad_curves, "bar");
 }
 
-void write_mesh(const mesh::SurfaceMesh& mesh, const std::string& path, const WriteOptions& options) {
+void write_mesh(const mesh::SurfaceMesh& mesh, const std::string& path,
+                const WriteOptions& options) {
   check_output_path(path);
   switch (output_format(path)) {
-    case Format::kCgns: write_cgns(mesh, path, options); return;
-    case Format::kVtu: write_vtu(mesh, path, options); return;
-    case Format::kMsh: write_msh(mesh, path, options); return;
+    case Format::kCgns:
+      write_cgns(mesh, path, options);
+      return;
+    case Format::kVtu:
+      write_vtu(mesh, path, options);
+      return;
+    case Format::kMsh:
+      write_msh(mesh, path, options);
+      return;
     case Format::kHdf5:
       write_hdf5(mesh, path, options);
       return;
     case Format::kPlot3d:
       (void)write_plot3d(mesh, layout::extract_quad_layout(mesh), path, options);
       return;
-    case Format::kNone: break;
+    case Format::kNone:
+      break;
   }
   QSMESH_CHECK(false, "unreachable: unsupported output " << path);
 }

@@ -1,5 +1,6 @@
-// VTK XML UnstructuredGrid (version 1.0, UInt64 headers). Binary arrays are inline base64: the 8-byte
-// header (the byte count) and the data are encoded as two separate base64 blocks, as VTK writes them.
+// VTK XML UnstructuredGrid (version 1.0, UInt64 headers). Binary arrays are inline base64: the
+// 8-byte header (the byte count) and the data are encoded as two separate base64 blocks, as VTK
+// writes them.
 #include <bit>
 #include <cstdint>
 #include <string>
@@ -16,7 +17,8 @@ namespace qsmesh::io {
 
 namespace {
 
-static_assert(std::endian::native == std::endian::little, "the VTU writer assumes a little-endian host");
+static_assert(std::endian::native == std::endian::little,
+              "the VTU writer assumes a little-endian host");
 
 constexpr char kBase64[] = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789+/";
 
@@ -44,11 +46,20 @@ std::string xml_escape(const std::string& s) {
   std::string r;
   for (char c : s) {
     switch (c) {
-      case '&': r += "&amp;"; break;
-      case '<': r += "&lt;"; break;
-      case '>': r += "&gt;"; break;
-      case '"': r += "&quot;"; break;
-      default: r += c;
+      case '&':
+        r += "&amp;";
+        break;
+      case '<':
+        r += "&lt;";
+        break;
+      case '>':
+        r += "&gt;";
+        break;
+      case '"':
+        r += "&quot;";
+        break;
+      default:
+        r += c;
     }
   }
   return r;
@@ -56,10 +67,22 @@ std::string xml_escape(const std::string& s) {
 
 template <class T>
 const char* vtk_type();
-template <> const char* vtk_type<double>() { return "Float64"; }
-template <> const char* vtk_type<std::int32_t>() { return "Int32"; }
-template <> const char* vtk_type<std::int64_t>() { return "Int64"; }
-template <> const char* vtk_type<std::uint8_t>() { return "UInt8"; }
+template <>
+const char* vtk_type<double>() {
+  return "Float64";
+}
+template <>
+const char* vtk_type<std::int32_t>() {
+  return "Int32";
+}
+template <>
+const char* vtk_type<std::int64_t>() {
+  return "Int64";
+}
+template <>
+const char* vtk_type<std::uint8_t>() {
+  return "UInt8";
+}
 
 template <class T>
 void write_array(OutputFile& out, const std::string& name, int components, const std::vector<T>& v,
@@ -105,7 +128,8 @@ void check_fields(const std::vector<Field>& fields, std::size_t n, const char* w
 
 }  // namespace
 
-void write_vtu(const mesh::SurfaceMesh& mesh, const std::string& path, const WriteOptions& options) {
+void write_vtu(const mesh::SurfaceMesh& mesh, const std::string& path,
+               const WriteOptions& options) {
   detail::check_output_folder(path);
   check_mesh_for_output(mesh);
   const std::size_t nm = options.vtu_markers.size();

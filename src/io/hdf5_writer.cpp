@@ -95,8 +95,7 @@ class H5Writer {
   }
 
   // Grows the image 4 MiB at a time.
-  static hid_t create_in_memory(const std::string& core_name, const std::string& path,
-                                hid_t fapl) {
+  static hid_t create_in_memory(const std::string& core_name, const std::string& path, hid_t fapl) {
     QSMESH_H5(fapl);
     QSMESH_H5(H5Pset_fapl_core(fapl, std::size_t{1} << 22, 0));
     return H5Fcreate(core_name.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, fapl);

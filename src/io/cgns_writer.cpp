@@ -81,7 +81,6 @@ cgsize_t to_cg(GO value, const std::string& path) {
   return static_cast<cgsize_t>(value);
 }
 
-
 // Bob Jenkins' lookup3 hashlittle with initval 0: the checksum HDF5 stores in its metadata.
 std::uint32_t lookup3(const unsigned char* k, std::size_t length) {
   auto rot = [](std::uint32_t x, int r) { return (x << r) | (x >> (32 - r)); };
@@ -96,12 +95,24 @@ std::uint32_t lookup3(const unsigned char* k, std::size_t length) {
     a += word(0);
     b += word(4);
     c += word(8);
-    a -= c; a ^= rot(c, 4);  c += b;
-    b -= a; b ^= rot(a, 6);  a += c;
-    c -= b; c ^= rot(b, 8);  b += a;
-    a -= c; a ^= rot(c, 16); c += b;
-    b -= a; b ^= rot(a, 19); a += c;
-    c -= b; c ^= rot(b, 4);  b += a;
+    a -= c;
+    a ^= rot(c, 4);
+    c += b;
+    b -= a;
+    b ^= rot(a, 6);
+    a += c;
+    c -= b;
+    c ^= rot(b, 8);
+    b += a;
+    a -= c;
+    a ^= rot(c, 16);
+    c += b;
+    b -= a;
+    b ^= rot(a, 19);
+    a += c;
+    c -= b;
+    c ^= rot(b, 4);
+    b += a;
     length -= 12;
     k += 12;
   }
@@ -114,13 +125,20 @@ std::uint32_t lookup3(const unsigned char* k, std::size_t length) {
        (std::uint32_t{tail[7]} << 24);
   c += std::uint32_t{tail[8]} | (std::uint32_t{tail[9]} << 8) | (std::uint32_t{tail[10]} << 16) |
        (std::uint32_t{tail[11]} << 24);
-  c ^= b; c -= rot(b, 14);
-  a ^= c; a -= rot(c, 11);
-  b ^= a; b -= rot(a, 25);
-  c ^= b; c -= rot(b, 16);
-  a ^= c; a -= rot(c, 4);
-  b ^= a; b -= rot(a, 14);
-  c ^= b; c -= rot(b, 24);
+  c ^= b;
+  c -= rot(b, 14);
+  a ^= c;
+  a -= rot(c, 11);
+  b ^= a;
+  b -= rot(a, 25);
+  c ^= b;
+  c -= rot(b, 16);
+  a ^= c;
+  a -= rot(c, 4);
+  b ^= a;
+  b -= rot(a, 14);
+  c ^= b;
+  c -= rot(b, 24);
   return c;
 }
 
