@@ -22,6 +22,7 @@
 #include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/smooth/smooth.hpp"
 #include "qsmesh/smooth/untangle.hpp"
+#include "quad_topology.hpp"
 
 namespace qsmesh::layout {
 
@@ -117,7 +118,7 @@ struct Cell {
 class Builder {
  public:
   Builder(const mesh::SurfaceMesh& m, const cad::CadModel& model, const CoarseOptions& o)
-      : m_(m), model_(model), opt_(o), nv_(m.num_vertices()) {}
+      : m_(m), model_(model), opt_(o), nv_(m.num_vertices()), v2q_(m) {}
 
   CoarseResult run() {
     CoarseResult out;
@@ -210,15 +211,6 @@ class Builder {
   // ---------------------------------------------------------------- adjacency
   void adjacency() {
     const auto nq = static_cast<GO>(m_.quads.size());
-    v2q_off_.assign(static_cast<std::size_t>(nv_) + 1, 0);
-    for (const auto& q : m_.quads)
-      for (GO v : q) ++v2q_off_[static_cast<std::size_t>(v) + 1];
-    std::partial_sum(v2q_off_.begin(), v2q_off_.end(), v2q_off_.begin());
-    v2q_.resize(static_cast<std::size_t>(v2q_off_.back()));
-    std::vector<GO> fill(v2q_off_.begin(), v2q_off_.end() - 1);
-    for (GO q = 0; q < nq; ++q)
-      for (GO v : m_.quads[static_cast<std::size_t>(q)])
-        v2q_[static_cast<std::size_t>(fill[static_cast<std::size_t>(v)]++)] = q;
     edges_.reserve(static_cast<std::size_t>(2 * nq + static_cast<GO>(m_.bars.size())));
     for (GO q = 0; q < nq; ++q) {
       const auto& quad = m_.quads[static_cast<std::size_t>(q)];
@@ -234,10 +226,7 @@ class Builder {
     }
   }
 
-  [[nodiscard]] LO valence(GO v) const {
-    return static_cast<LO>(v2q_off_[static_cast<std::size_t>(v) + 1] -
-                           v2q_off_[static_cast<std::size_t>(v)]);
-  }
+  [[nodiscard]] LO valence(GO v) const { return v2q_.valence(v); }
   [[nodiscard]] const mesh::VertexClass& vc(GO v) const {
     return m_.vclass[static_cast<std::size_t>(v)];
   }
@@ -254,10 +243,10 @@ class Builder {
   [[nodiscard]] bool crossable(const EdgeRec& e) const { return interior(e) && !e.traced; }
 
   [[nodiscard]] std::array<GO, 2> neighbours_in_quad(GO q, GO v) const {
-    const auto& quad = m_.quads[static_cast<std::size_t>(q)];
-    for (int k = 0; k < 4; ++k)
-      if (quad[k] == v) return {quad[(k + 1) % 4], quad[(k + 3) % 4]};
-    throw Reject{cat("vertex ", v, " not in quad ", q)};
+    std::array<GO, 2> nb{};
+    if (!detail::neighbours_in_quad(m_.quads[static_cast<std::size_t>(q)], v, nb))
+      throw Reject{cat("vertex ", v, " not in quad ", q)};
+    return nb;
   }
 
   // At a regular vertex c reached from prev: the vertex across c on the same grid line, and the
@@ -267,9 +256,8 @@ class Builder {
   };
   [[nodiscard]] Cross cross_at(GO c, GO prev) const {
     std::vector<GO> nb;
-    for (auto i = v2q_off_[static_cast<std::size_t>(c)];
-         i < v2q_off_[static_cast<std::size_t>(c) + 1]; ++i)
-      for (GO w : neighbours_in_quad(v2q_[static_cast<std::size_t>(i)], c))
+    for (GO q : v2q_[c])
+      for (GO w : neighbours_in_quad(q, c))
         if (std::find(nb.begin(), nb.end(), w) == nb.end()) nb.push_back(w);
     if (nb.size() != 4) throw Reject{cat("vertex ", c, " has ", nb.size(), " neighbours")};
     const EdgeRec& e = edge(c, prev);
@@ -284,9 +272,8 @@ class Builder {
     if (next < 0) throw Reject{cat("no straight continuation at vertex ", c)};
     // The quad with c followed by next: its vertex before c is on the left.
     GO left = side[0];
-    for (auto i = v2q_off_[static_cast<std::size_t>(c)];
-         i < v2q_off_[static_cast<std::size_t>(c) + 1]; ++i) {
-      const auto& quad = m_.quads[static_cast<std::size_t>(v2q_[static_cast<std::size_t>(i)])];
+    for (GO q : v2q_[c]) {
+      const auto& quad = m_.quads[static_cast<std::size_t>(q)];
       for (int k = 0; k < 4; ++k)
         if (quad[k] == c && quad[(k + 1) % 4] == next) left = quad[(k + 3) % 4];
     }
@@ -304,35 +291,16 @@ class Builder {
   // every interior edge at a CAD corner too.
   [[nodiscard]] std::vector<Start> starts(const std::vector<char>& extra) const {
     std::vector<Start> out;
-    std::vector<GO> quads, parent;
     for (GO v = 0; v < nv_; ++v) {
       const auto& c = vc(v);
-      quads.assign(v2q_.begin() + v2q_off_[static_cast<std::size_t>(v)],
-                   v2q_.begin() + v2q_off_[static_cast<std::size_t>(v) + 1]);
+      const auto quads = v2q_[v];
       if (quads.empty() || (c.dim == 2 && quads.size() == 4)) continue;
-      parent.resize(quads.size());
-      std::iota(parent.begin(), parent.end(), 0);
-      auto find = [&](GO i) {
-        while (parent[static_cast<std::size_t>(i)] != i) i = parent[static_cast<std::size_t>(i)];
-        return i;
+      auto across = [&](GO w, GO q) -> GO {
+        const EdgeRec& e = edge(v, w);
+        if (!interior(e)) return -1;
+        return e.q[0] == q ? e.q[1] : e.q[0];
       };
-      std::vector<std::pair<GO, std::size_t>> inner;
-      for (std::size_t a = 0; a < quads.size(); ++a)
-        for (GO w : neighbours_in_quad(quads[a], v)) {
-          const EdgeRec& e = edge(v, w);
-          if (!interior(e)) continue;
-          inner.emplace_back(w, a);
-          const GO other = e.q[0] == quads[a] ? e.q[1] : e.q[0];
-          const auto b = static_cast<std::size_t>(std::find(quads.begin(), quads.end(), other) -
-                                                  quads.begin());
-          parent[static_cast<std::size_t>(find(static_cast<GO>(a)))] = find(static_cast<GO>(b));
-        }
-      std::vector<int> side_size(quads.size(), 0);
-      for (std::size_t a = 0; a < quads.size(); ++a)
-        ++side_size[static_cast<std::size_t>(find(static_cast<GO>(a)))];
-      for (const auto& [w, a] : inner) {
-        const bool irregular_side =
-            side_size[static_cast<std::size_t>(find(static_cast<GO>(a)))] != 2;
+      for (const auto& [w, a, irregular_side] : detail::side_edges(m_, v, quads, across)) {
         const LO f = m_.quad_face[static_cast<std::size_t>(quads[a])];
         if (c.dim == 2 || irregular_side || (c.dim == 0 && extra[static_cast<std::size_t>(f)]))
           out.push_back({v, w});
@@ -1718,7 +1686,7 @@ class Builder {
   const cad::CadModel& model_;
   const CoarseOptions& opt_;
   GO nv_;
-  std::vector<GO> v2q_off_, v2q_;
+  detail::VertexQuads v2q_;
   std::unordered_map<std::uint64_t, EdgeRec> edges_;
   std::vector<Trace> traces_;
   std::vector<Grid> grids_;

@@ -13,6 +13,7 @@
 #include "grid.hpp"
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/mesh/edges.hpp"
+#include "quad_topology.hpp"
 
 namespace qsmesh::layout {
 
@@ -51,20 +52,10 @@ using detail::Grid;
 
 class Layouter {
  public:
-  explicit Layouter(const mesh::SurfaceMesh& m) : m_(m), nv_(m.num_vertices()) {
+  explicit Layouter(const mesh::SurfaceMesh& m) : m_(m), nv_(m.num_vertices()), v2q_(m) {
     const auto nq = static_cast<GO>(m.quads.size());
     face_unblocked_.assign(static_cast<std::size_t>(std::max<LO>(m.num_cad_faces, 0)), 0);
     for (LO f : m.triangle_face) face_unblocked_[static_cast<std::size_t>(f)] = 1;
-    // vertex -> quads (CSR)
-    v2q_offsets_.assign(static_cast<std::size_t>(nv_) + 1, 0);
-    for (const auto& q : m.quads)
-      for (GO v : q) ++v2q_offsets_[static_cast<std::size_t>(v) + 1];
-    std::partial_sum(v2q_offsets_.begin(), v2q_offsets_.end(), v2q_offsets_.begin());
-    v2q_.resize(static_cast<std::size_t>(v2q_offsets_.back()));
-    std::vector<GO> fill(v2q_offsets_.begin(), v2q_offsets_.end() - 1);
-    for (GO q = 0; q < nq; ++q)
-      for (GO v : m.quads[static_cast<std::size_t>(q)])
-        v2q_[static_cast<std::size_t>(fill[v]++)] = q;
     edges_.reserve(static_cast<std::size_t>(2 * nq + m.bars.size()));
     for (GO q = 0; q < nq; ++q) {
       const auto& quad = m.quads[static_cast<std::size_t>(q)];
@@ -92,10 +83,7 @@ class Layouter {
   }
 
   [[nodiscard]] bool regular_interior(GO v) const {
-    return m_.vclass[static_cast<std::size_t>(v)].dim == 2 &&
-           v2q_offsets_[static_cast<std::size_t>(v) + 1] -
-                   v2q_offsets_[static_cast<std::size_t>(v)] ==
-               4;
+    return m_.vclass[static_cast<std::size_t>(v)].dim == 2 && v2q_.valence(v) == 4;
   }
 
   // Trace starts (v, w) in their face: the edges leaving irregular interior vertices, and the
@@ -103,37 +91,16 @@ class Layouter {
   // included: their fan is one side). Restricted to the faces in `faces` when given.
   [[nodiscard]] std::vector<Start> starts(const std::vector<char>* faces) const {
     std::vector<Start> out;
-    std::vector<GO> quads, parent;
     for (GO v = 0; v < nv_; ++v) {
       const auto& c = m_.vclass[static_cast<std::size_t>(v)];
-      quads.assign(v2q_.begin() + v2q_offsets_[static_cast<std::size_t>(v)],
-                   v2q_.begin() + v2q_offsets_[static_cast<std::size_t>(v) + 1]);
+      const auto quads = v2q_[v];
       if (quads.empty() || (c.dim == 2 && quads.size() == 4)) continue;
-      // Sides of a boundary vertex: its quads joined through interior edges at v.
-      parent.resize(quads.size());
-      std::iota(parent.begin(), parent.end(), 0);
-      auto find = [&](GO i) {
-        while (parent[static_cast<std::size_t>(i)] != i) i = parent[static_cast<std::size_t>(i)];
-        return i;
+      auto across = [&](GO w, GO q) -> GO {
+        const EdgeInfo& e = edges_.at(edge(v, w, q));
+        if (!interior(e)) return -1;
+        return e.quads[0] == q ? e.quads[1] : e.quads[0];
       };
-      std::vector<std::pair<GO, std::size_t>> interior_edges;  // (w, quad index)
-      for (std::size_t a = 0; a < quads.size(); ++a) {
-        for (GO w : neighbours_in_quad(quads[a], v)) {
-          const EdgeInfo& e = edges_.at(edge(v, w, quads[a]));
-          if (!interior(e)) continue;
-          interior_edges.emplace_back(w, a);
-          const GO other = e.quads[0] == quads[a] ? e.quads[1] : e.quads[0];
-          const auto b = static_cast<std::size_t>(std::find(quads.begin(), quads.end(), other) -
-                                                  quads.begin());
-          parent[static_cast<std::size_t>(find(static_cast<GO>(a)))] = find(static_cast<GO>(b));
-        }
-      }
-      std::vector<int> side_size(quads.size(), 0);
-      for (std::size_t a = 0; a < quads.size(); ++a)
-        ++side_size[static_cast<std::size_t>(find(static_cast<GO>(a)))];
-      for (const auto& [w, a] : interior_edges) {
-        const bool irregular_side =
-            side_size[static_cast<std::size_t>(find(static_cast<GO>(a)))] != 2;
+      for (const auto& [w, a, irregular_side] : detail::side_edges(m_, v, quads, across)) {
         if (c.dim == 2 || irregular_side) {
           const LO f = m_.quad_face[static_cast<std::size_t>(quads[a])];
           if (faces != nullptr && (*faces)[static_cast<std::size_t>(f)] == 0) continue;
@@ -232,11 +199,10 @@ class Layouter {
   [[nodiscard]] bool crossable(const EdgeInfo& e) const { return interior(e) && !e.traced; }
 
   [[nodiscard]] std::array<GO, 2> neighbours_in_quad(GO q, GO v) const {
-    const auto& quad = m_.quads[static_cast<std::size_t>(q)];
-    for (int k = 0; k < 4; ++k)
-      if (quad[k] == v) return {quad[(k + 1) % 4], quad[(k + 3) % 4]};
-    QSMESH_CHECK(false, "layout: vertex " << v << " not in quad " << q);
-    return {};
+    std::array<GO, 2> nb{};
+    QSMESH_CHECK(detail::neighbours_in_quad(m_.quads[static_cast<std::size_t>(q)], v, nb),
+                 "layout: vertex " << v << " not in quad " << q);
+    return nb;
   }
 
   // At a valence-4 vertex c of face `face` reached from prev: the vertex across c on the same grid
@@ -248,9 +214,8 @@ class Layouter {
       const auto n = neighbours_in_quad(e.quads[static_cast<std::size_t>(s)], c);
       side[static_cast<std::size_t>(s) + 1] = n[0] == prev ? n[1] : n[0];
     }
-    for (std::size_t i = v2q_offsets_[static_cast<std::size_t>(c)];
-         i < static_cast<std::size_t>(v2q_offsets_[static_cast<std::size_t>(c) + 1]); ++i)
-      for (GO w : neighbours_in_quad(v2q_[i], c))
+    for (GO q : v2q_[c])
+      for (GO w : neighbours_in_quad(q, c))
         if (std::find(side.begin(), side.end(), w) == side.end()) return w;
     QSMESH_CHECK(false, "layout: no straight continuation at vertex " << c);
     return -1;
@@ -338,7 +303,7 @@ class Layouter {
   const mesh::SurfaceMesh& m_;
   GO nv_;
   std::vector<char> face_unblocked_;
-  std::vector<GO> v2q_offsets_, v2q_;
+  detail::VertexQuads v2q_;
   std::unordered_map<FaceEdge, EdgeInfo, FaceEdgeHash> edges_;
 };
 
