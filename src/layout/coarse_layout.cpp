@@ -1489,7 +1489,8 @@ class Builder {
     for (const auto& [r, list] : members)
       order.emplace_back(cquads_[list.front()].face, list.front());
     std::sort(order.begin(), order.end());
-    for (const auto& [face, first] : order) {
+    for (const auto& [face_of, first] : order) {
+      const LO face = face_of;  // a lambda below names it (clang 14 cannot capture bindings)
       const std::vector<std::size_t>& list = members[comp.find(static_cast<GO>(first))];
       // Rows of the component's grid, or each quad alone when it is not one.
       std::vector<std::vector<Ori>> rows;
