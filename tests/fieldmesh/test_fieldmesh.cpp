@@ -30,6 +30,7 @@
 #include "qsmesh/background/face_mesh.hpp"
 #include "qsmesh/cad/model.hpp"
 #include "qsmesh/core/tasks.hpp"
+#include "qsmesh/fieldmesh/field_file.hpp"
 #include "qsmesh/fieldmesh/field_mesh.hpp"
 #include "qsmesh/quantize/quantize.hpp"
 #include "tmp_dir.hpp"
@@ -365,6 +366,18 @@ TEST(FieldMesh, DiskWithTwoSingularPointsAndTwoBoundarySingularPoints) {
     EXPECT_NEAR(x.y, 0.0, 1e-9);
   }
 
+  // The same points as a FIELD file gives them (mesh_face_by_method: its own triangulation).
+  fieldmesh::GivenFaceField given;
+  given.face = 0;
+  given.points = pts;
+  fieldmesh::FieldMeshReport rep;
+  const auto m = fieldmesh::mesh_face_by_method(
+      c.model, 0, c.curves, fieldmesh::FaceMethod::GivenField, &given, nullptr, {}, nullptr, &rep);
+  ASSERT_TRUE(rep.ok) << rep.stage << ": " << rep.reason;
+  EXPECT_EQ(rep.stats.irregular_interior, 2);
+  EXPECT_EQ(rep.stats.irregular_boundary, 2);
+  EXPECT_GT(rep.stats.sicn_min, 0.3);
+
   // Index -1/4 at the two boundary points: Eq. 11 asks for deg(u) = 3/2.
   pts[2].d = pts[3].d = -1;
   r = run_points(c, 0, 0.1, pts);
@@ -390,6 +403,18 @@ TEST(FieldMesh, TrapezoidWithoutSingularPointIsRefusedByItsCurveCounts) {
       << r.report.reason;
   EXPECT_NE(r.report.reason.find("hold 10 and 6 curve edges"), std::string::npos)
       << r.report.reason;
+}
+
+TEST(FieldMesh, PlateWithHoleAndTwoSingularPointsIsRefusedByEq16) {
+  // Four right corners (index 1/4 each) and a hole: chi = 0, so the singular points' indices must
+  // sum to -1 (Eq. 16); two valence-5 points give -1/2.
+  const Case c = make_case(write_plate_with_hole(2.0, 0.8), 0.2);
+  const std::vector<fieldmesh::SingularPoint> pts{{{1.15, 1.15, 0}, -1}, {{-1.15, -1.15, 0}, -1}};
+  const FaceRun r = run_points(c, 0, 0.1, pts);
+  EXPECT_FALSE(r.report.ok);
+  EXPECT_TRUE(r.quads.quads.empty());
+  EXPECT_EQ(r.report.stage, "compatibility");
+  EXPECT_NE(r.report.reason.find("Eq. 16"), std::string::npos) << r.report.reason;
 }
 
 TEST(FieldMesh, PlateWithHoleUnalignedFieldIsCorrected) {
