@@ -88,15 +88,24 @@ Frame face_frame(const mesh::FaceMesh& tri, const cad::FaceGeometry& surface,
       trip.push_back({2 * i + 1, 2 * j + 1, a});
     };
     for (LO v = 0; v < n; ++v) block(v, v, mass[v], 0);
-    for_cotangent_weights(tri, [&](LO i, LO j, double w) {
-      const Vec3 e = tri.points[j] - tri.points[i];
-      const double rho = detail::frame_angle(e, e1[j], frame.normal[j]) -
-                         detail::frame_angle(e, e1[i], frame.normal[i]);
+    // Edge weights summed over the edge's triangles and clamped at 0: an edge whose opposite
+    // angles sum past 180 degrees (the triangulation is Delaunay in the parameter plane, not in
+    // 3D) has a negative weight, and with t this large one such edge makes M + t H indefinite
+    // (A319 faces 1, 3 and 50: 'not positive definite'). Nonnegative weights keep H a sum of
+    // positive semidefinite edge terms w |z_i - r_ij z_j|^2.
+    std::map<std::pair<LO, LO>, double> weight;
+    for_cotangent_weights(tri, [&](LO i, LO j, double w) { weight[std::minmax(i, j)] += w; });
+    for (const auto& [e, w] : weight) {
+      if (w <= 0) continue;
+      const auto [i, j] = e;
+      const Vec3 d = tri.points[j] - tri.points[i];
+      const double rho = detail::frame_angle(d, e1[j], frame.normal[j]) -
+                         detail::frame_angle(d, e1[i], frame.normal[i]);
       block(i, i, t * w, 0);
       block(j, j, t * w, 0);
       block(i, j, -t * w * std::cos(rho), t * w * std::sin(rho));
       block(j, i, -t * w * std::cos(rho), -t * w * std::sin(rho));
-    });
+    }
     const linalg::SparseMatrix A(2 * n, trip);
     auto solver = factorized(A, linalg::SolverOptions{}, lane);
     std::vector<double> b(2 * n, 0.0), x(2 * n);

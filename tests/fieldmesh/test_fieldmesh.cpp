@@ -498,6 +498,33 @@ TEST(FieldMesh, CylinderPatchWithTheHeatMethodFrame) {
   EXPECT_GT(r.report.stats.sicn_min, 0.9);
 }
 
+TEST(FieldMesh, HeatMethodFrameOnASliverTriangle) {
+  // Two triangles of the cylinder patch, ABC and ACD, with B 5e-5 radians off the straight
+  // segment AC (along the axis): the sliver ABC has cotangents of about +-1e4, clamped at +-1e3
+  // each, and gives the edge AC a weight of -500 that ACD (a right angle at D) does not offset.
+  // With t = diagonal^2 the heat system was then indefinite ('not positive definite', A319's
+  // faces 1, 3 and 50). Summed per edge and clamped at 0, the weights keep it definite.
+  const Case c = make_case(write_cylinder_patch(1.0, 1.5), 0.1);
+  const auto surface = c.model.face_geometry(0);
+  mesh::FaceMesh tri;
+  tri.face = 0;
+  for (const Vec2 uv : {Vec2{0.7, 0.2}, Vec2{0.70005, 0.7}, Vec2{0.7, 1.2}, Vec2{0.2, 0.7}}) {
+    tri.uv.push_back(uv);
+    tri.points.push_back(surface->eval(uv).p);
+    mesh::VertexClass vc;
+    vc.dim = 2;
+    vc.entity = 0;
+    tri.vclass.push_back(vc);
+  }
+  // A = 0, B = 1, C = 2, D = 3; counter-clockwise in the parameter plane.
+  tri.triangles = {{0, 1, 2}, {0, 2, 3}};
+  const fieldmesh::Frame frame = fieldmesh::face_frame(tri, *surface, nullptr);
+  for (std::size_t v = 0; v < frame.ref.size(); ++v) {
+    EXPECT_NEAR(norm(frame.ref[v]), 1.0, 1e-9);
+    EXPECT_NEAR(dot(frame.ref[v], frame.normal[v]), 0.0, 1e-9);
+  }
+}
+
 TEST(FieldMesh, CylinderPatchWithAValence3And5PairOfEq2) {
   // A valence-3 / valence-5 pair along the circumference: as on the plane, the straight side near
   // the valence-3 point must hold more edges than the other one; with the top cut aslant the two
