@@ -71,8 +71,8 @@ Frame face_frame(const mesh::FaceMesh& tri, const cad::FaceGeometry& surface,
     for (LO v = 0; v < n; ++v) {
       const Vec3 du = surface.eval(tri.uv[v]).du;
       e1[v] = normalized(du - frame.normal[v] * dot(du, frame.normal[v]));
-      QSMESH_CHECK(norm(e1[v]) > 0,
-                   "face " << tri.face << ": no tangent basis at vertex " << v << " (pole)");
+      if (!(norm(e1[v]) > 0))
+        detail::refuse("face ", tri.face, ": no tangent basis at vertex ", v, " (pole)");
     }
     std::vector<double> mass(n, 0.0);
     for (const auto& tr : tri.triangles) {
@@ -113,8 +113,8 @@ Frame face_frame(const mesh::FaceMesh& tri, const cad::FaceGeometry& surface,
     solver->solve(b, x);
     for (LO v = 0; v < n; ++v) {
       const Vec3 wv = e1[v] * x[2 * v] + cross(frame.normal[v], e1[v]) * x[2 * v + 1];
-      QSMESH_CHECK(norm(wv) > 0,
-                   "face " << tri.face << ": the heat-method frame vanishes at vertex " << v);
+      if (!(norm(wv) > 0))
+        detail::refuse("face ", tri.face, ": the heat-method frame vanishes at vertex ", v);
       frame.ref[v] = normalized(wv);
     }
   } else {
@@ -221,10 +221,9 @@ SplitPoints split_points(const mesh::FaceMesh& tri, const cad::FaceGeometry& sur
       out.interior.push_back(p);
       continue;
     }
-    QSMESH_CHECK(!taken[vertex], "face " << tri.face << ": two boundary singular points on the "
-                                         << "curve vertex at (" << tri.points[vertex].x << ", "
-                                         << tri.points[vertex].y << ", " << tri.points[vertex].z
-                                         << ")");
+    if (taken[vertex])
+      refuse("face ", tri.face, ": two boundary singular points on the curve vertex at (",
+             tri.points[vertex].x, ", ", tri.points[vertex].y, ", ", tri.points[vertex].z, ")");
     taken[vertex] = 1;
     out.boundary.push_back({vertex, p.d});
   }
@@ -242,8 +241,8 @@ Loops face_loops(const cad::CadModel& model, LO f, std::span<const mesh::CurveMe
     const auto& c = tri.vclass[v];
     if (c.dim == 2) continue;
     const auto key = std::make_tuple(int{c.dim}, c.entity, c.dim == 0 ? LO{0} : c.index);
-    QSMESH_CHECK(key2tri.emplace(key, v).second,
-                 "face " << f << ": a boundary vertex appears twice (seam or pole), not handled");
+    if (!key2tri.emplace(key, v).second)
+      refuse("face ", f, ": a boundary vertex appears twice (seam or pole), not handled");
   }
   auto area = [](const mesh::BoundaryLoop& loop) {
     double a = 0;
@@ -259,7 +258,7 @@ Loops face_loops(const cad::CadModel& model, LO f, std::span<const mesh::CurveMe
       std::reverse(loop.degenerate.begin(), loop.degenerate.end());
     }
     for (std::uint8_t dg : loop.degenerate)
-      QSMESH_CHECK(dg == 0, "face " << f << ": degenerate curve (pole), not handled");
+      if (dg != 0) refuse("face ", f, ": degenerate curve (pole), not handled");
   }
   const std::size_t nl = L.loops.size();
   L.tri.resize(nl);
@@ -302,8 +301,9 @@ Loops face_loops(const cad::CadModel& model, LO f, std::span<const mesh::CurveMe
         L.quads[l][i] = std::max(1, static_cast<int>(std::lround(L.angle[l][i] / (kPi / 2))));
       if (const auto it = given_d.find(v); it != given_d.end()) {
         // Eq. 15 read backwards: index I leaves 2 - 4 I quads at the point, whatever its angle.
-        QSMESH_CHECK(it->second <= 1, "face " << f << ": a boundary singular point of index "
-                                              << it->second << "/4: at most 1/4 (one quad)");
+        if (it->second > 1)
+          refuse("face ", f, ": a boundary singular point of index ", it->second,
+                 "/4: at most 1/4 (one quad)");
         L.quads[l][i] = 2 - it->second;
         L.given[l][i] = 1;
         ++num_given;

@@ -5,15 +5,27 @@
 #include <cmath>
 #include <numbers>
 #include <span>
+#include <sstream>
 #include <vector>
 
 #include "qsmesh/cad/geometry.hpp"
+#include "qsmesh/core/error.hpp"
 #include "qsmesh/fieldmesh/field_mesh.hpp"
 #include "qsmesh/mesh/delaunay.hpp"
 
 namespace qsmesh::fieldmesh::detail {
 
 inline constexpr double kPi = std::numbers::pi;
+
+/// A face this module does not handle or a given field it refuses (poles, seams, two boundary
+/// points on one vertex): qsmesh::Error with the parts as one line, the reason `--stats` reports
+/// in face_stats[].field_refusal, without the source location a failed QSMESH_CHECK adds.
+template <class... Parts>
+[[noreturn]] void refuse(const Parts&... parts) {
+  std::ostringstream os;
+  (os << ... << parts);
+  throw Error(os.str());
+}
 
 /// x wrapped into (-period / 2, period / 2].
 inline double wrap(double x, double period) { return x - period * std::round(x / period); }
