@@ -71,8 +71,8 @@ Frame face_frame(const mesh::FaceMesh& tri, const cad::FaceGeometry& surface,
     for (LO v = 0; v < n; ++v) {
       const Vec3 du = surface.eval(tri.uv[v]).du;
       e1[v] = normalized(du - frame.normal[v] * dot(du, frame.normal[v]));
-      QSMESH_CHECK(norm(e1[v]) > 0,
-                   "face " << tri.face << ": no tangent basis at vertex " << v << " (pole)");
+      if (!(norm(e1[v]) > 0))
+        detail::refuse("face ", tri.face, ": no tangent basis at vertex ", v, " (pole)");
     }
     std::vector<double> mass(n, 0.0);
     for (const auto& tr : tri.triangles) {
@@ -88,15 +88,24 @@ Frame face_frame(const mesh::FaceMesh& tri, const cad::FaceGeometry& surface,
       trip.push_back({2 * i + 1, 2 * j + 1, a});
     };
     for (LO v = 0; v < n; ++v) block(v, v, mass[v], 0);
-    for_cotangent_weights(tri, [&](LO i, LO j, double w) {
-      const Vec3 e = tri.points[j] - tri.points[i];
-      const double rho = detail::frame_angle(e, e1[j], frame.normal[j]) -
-                         detail::frame_angle(e, e1[i], frame.normal[i]);
+    // Edge weights summed over the edge's triangles and clamped at 0: an edge whose opposite
+    // angles sum past 180 degrees (the triangulation is Delaunay in the parameter plane, not in
+    // 3D) has a negative weight, and with t this large one such edge makes M + t H indefinite
+    // (A319 faces 1, 3 and 50: 'not positive definite'). Nonnegative weights keep H a sum of
+    // positive semidefinite edge terms w |z_i - r_ij z_j|^2.
+    std::map<std::pair<LO, LO>, double> weight;
+    for_cotangent_weights(tri, [&](LO i, LO j, double w) { weight[std::minmax(i, j)] += w; });
+    for (const auto& [e, w] : weight) {
+      if (w <= 0) continue;
+      const auto [i, j] = e;
+      const Vec3 d = tri.points[j] - tri.points[i];
+      const double rho = detail::frame_angle(d, e1[j], frame.normal[j]) -
+                         detail::frame_angle(d, e1[i], frame.normal[i]);
       block(i, i, t * w, 0);
       block(j, j, t * w, 0);
       block(i, j, -t * w * std::cos(rho), t * w * std::sin(rho));
       block(j, i, -t * w * std::cos(rho), -t * w * std::sin(rho));
-    });
+    }
     const linalg::SparseMatrix A(2 * n, trip);
     auto solver = factorized(A, linalg::SolverOptions{}, lane);
     std::vector<double> b(2 * n, 0.0), x(2 * n);
@@ -104,8 +113,8 @@ Frame face_frame(const mesh::FaceMesh& tri, const cad::FaceGeometry& surface,
     solver->solve(b, x);
     for (LO v = 0; v < n; ++v) {
       const Vec3 wv = e1[v] * x[2 * v] + cross(frame.normal[v], e1[v]) * x[2 * v + 1];
-      QSMESH_CHECK(norm(wv) > 0,
-                   "face " << tri.face << ": the heat-method frame vanishes at vertex " << v);
+      if (!(norm(wv) > 0))
+        detail::refuse("face ", tri.face, ": the heat-method frame vanishes at vertex ", v);
       frame.ref[v] = normalized(wv);
     }
   } else {
@@ -117,13 +126,16 @@ Frame face_frame(const mesh::FaceMesh& tri, const cad::FaceGeometry& surface,
 
 std::vector<double> field_from_points(const mesh::FaceMesh& tri, const cad::FaceGeometry& surface,
                                       std::span<const SingularPoint> points) {
+  // Boundary singular points do not enter Eq. 2: the field turns there by the alignment (Eq. 14
+  // with the jump of Eq. 15), not by a factor of the product.
+  const std::vector<SingularPoint> interior = detail::split_points(tri, surface, points).interior;
   std::vector<Vec2> a;
-  for (const auto& p : points) a.push_back(surface.project(p.position, tri.uv[0], nullptr));
+  for (const auto& p : interior) a.push_back(surface.project(p.position, tri.uv[0], nullptr));
   std::vector<double> theta(tri.uv.size(), 0.0);
   for (std::size_t v = 0; v < tri.uv.size(); ++v)
     for (std::size_t i = 0; i < a.size(); ++i) {
       const Vec2 d = tri.uv[v] - a[i];
-      if (norm(d) > 0) theta[v] += points[i].d / 4.0 * std::atan2(d.v, d.u);
+      if (norm(d) > 0) theta[v] += interior[i].d / 4.0 * std::atan2(d.v, d.u);
     }
   return theta;
 }
@@ -178,8 +190,49 @@ std::vector<SingularPoint> detect_singularities(const mesh::FaceMesh& tri,
 
 namespace detail {
 
+SplitPoints split_points(const mesh::FaceMesh& tri, const cad::FaceGeometry& surface,
+                         std::span<const SingularPoint> points) {
+  SplitPoints out;
+  if (points.empty()) return out;
+  // Boundary edges: the edges of one triangle.
+  std::map<std::pair<LO, LO>, int> uses;
+  for (const auto& t : tri.triangles)
+    for (int k = 0; k < 3; ++k) ++uses[std::minmax(t[k], t[(k + 1) % 3])];
+  std::vector<std::pair<LO, LO>> edges;
+  for (const auto& [e, n] : uses)
+    if (n == 1) edges.push_back(e);
+  std::vector<char> taken(tri.points.size(), 0);
+  for (const auto& p : points) {
+    const Vec3 x = surface.eval(surface.project(p.position, tri.uv[0], nullptr)).p;
+    double best = 1e300;
+    LO vertex = kNoIndex;
+    for (const auto& [a, b] : edges) {
+      const Vec3 pa = tri.points[a], e = tri.points[b] - pa;
+      const double len2 = dot(e, e);
+      if (len2 <= 0) continue;
+      const double t = std::clamp(dot(x - pa, e) / len2, 0.0, 1.0);
+      const double rel = distance(pa + e * t, x) / std::sqrt(len2);
+      if (rel < best) {
+        best = rel;
+        vertex = t < 0.5 ? a : b;
+      }
+    }
+    if (best >= 0.25) {
+      out.interior.push_back(p);
+      continue;
+    }
+    if (taken[vertex])
+      refuse("face ", tri.face, ": two boundary singular points on the curve vertex at (",
+             tri.points[vertex].x, ", ", tri.points[vertex].y, ", ", tri.points[vertex].z, ")");
+    taken[vertex] = 1;
+    out.boundary.push_back({vertex, p.d});
+  }
+  return out;
+}
+
 Loops face_loops(const cad::CadModel& model, LO f, std::span<const mesh::CurveMesh> curves,
-                 const mesh::FaceMesh& tri, const Frame& frame) {
+                 const mesh::FaceMesh& tri, const Frame& frame,
+                 std::span<const BoundaryPoint> boundary) {
   const auto surface = model.face_geometry(f);
   Loops L;
   L.loops = background::face_boundary(model, f, *surface, curves);
@@ -188,8 +241,8 @@ Loops face_loops(const cad::CadModel& model, LO f, std::span<const mesh::CurveMe
     const auto& c = tri.vclass[v];
     if (c.dim == 2) continue;
     const auto key = std::make_tuple(int{c.dim}, c.entity, c.dim == 0 ? LO{0} : c.index);
-    QSMESH_CHECK(key2tri.emplace(key, v).second,
-                 "face " << f << ": a boundary vertex appears twice (seam or pole), not handled");
+    if (!key2tri.emplace(key, v).second)
+      refuse("face ", f, ": a boundary vertex appears twice (seam or pole), not handled");
   }
   auto area = [](const mesh::BoundaryLoop& loop) {
     double a = 0;
@@ -205,7 +258,7 @@ Loops face_loops(const cad::CadModel& model, LO f, std::span<const mesh::CurveMe
       std::reverse(loop.degenerate.begin(), loop.degenerate.end());
     }
     for (std::uint8_t dg : loop.degenerate)
-      QSMESH_CHECK(dg == 0, "face " << f << ": degenerate curve (pole), not handled");
+      if (dg != 0) refuse("face ", f, ": degenerate curve (pole), not handled");
   }
   const std::size_t nl = L.loops.size();
   L.tri.resize(nl);
@@ -214,6 +267,10 @@ Loops face_loops(const cad::CadModel& model, LO f, std::span<const mesh::CurveMe
   L.turn.resize(nl);
   L.transport.resize(nl);
   L.tangent.resize(nl);
+  L.given.resize(nl);
+  std::map<LO, int> given_d;
+  for (const auto& b : boundary) given_d[b.vertex] = b.d;
+  std::size_t num_given = 0;
   for (std::size_t l = 0; l < nl; ++l) {
     const auto& pts = L.loops[l].points;
     const std::size_t n = pts.size();
@@ -231,6 +288,7 @@ Loops face_loops(const cad::CadModel& model, LO f, std::span<const mesh::CurveMe
     L.turn[l].resize(n);
     L.transport[l].resize(n);
     L.tangent[l].resize(n);
+    L.given[l].assign(n, 0);
     for (std::size_t i = 0; i < n; ++i) {
       const LO v = L.tri[l][i];
       const Vec3 ein = pts[i].xyz - pts[(i + n - 1) % n].xyz,
@@ -241,6 +299,15 @@ Loops face_loops(const cad::CadModel& model, LO f, std::span<const mesh::CurveMe
       L.angle[l][i] = kPi - L.turn[l][i];
       if (pts[i].vclass.dim == 0)
         L.quads[l][i] = std::max(1, static_cast<int>(std::lround(L.angle[l][i] / (kPi / 2))));
+      if (const auto it = given_d.find(v); it != given_d.end()) {
+        // Eq. 15 read backwards: index I leaves 2 - 4 I quads at the point, whatever its angle.
+        if (it->second > 1)
+          refuse("face ", f, ": a boundary singular point of index ", it->second,
+                 "/4: at most 1/4 (one quad)");
+        L.quads[l][i] = 2 - it->second;
+        L.given[l][i] = 1;
+        ++num_given;
+      }
       // theta_N: the boundary cross at the point, halfway through the rotation that Eq. 15 leaves
       // to the corner (turn - 2 pi I(b); the whole turn on smooth points).
       L.tangent[l][i] = ain + 0.5 * (L.turn[l][i] - 2 * kPi * corner_index(L.quads[l][i]));
@@ -248,6 +315,8 @@ Loops face_loops(const cad::CadModel& model, LO f, std::span<const mesh::CurveMe
       L.transport[l][i] = wrap(frame_angle(eout, frame.ref[w], frame.normal[w]) - aout, 2 * kPi);
     }
   }
+  QSMESH_CHECK(num_given == given_d.size(),
+               "face " << f << ": a boundary singular point is not on a boundary loop");
   return L;
 }
 
@@ -263,6 +332,9 @@ double tangent_step(const Loops& L, std::size_t l, std::size_t i) {
 Compatibility compatibility(const Loops& L, std::span<const double> theta) {
   Compatibility c;
   double total_field = 0, total_aligned = 0, total_corners = 0;
+  std::size_t num_given = 0;
+  for (const auto& g : L.given)
+    num_given += static_cast<std::size_t>(std::count(g.begin(), g.end(), 1));
   for (std::size_t l = 0; l < L.loops.size(); ++l) {
     const std::size_t n = L.loops[l].points.size();
     LoopDegree d;
@@ -287,7 +359,10 @@ Compatibility compatibility(const Loops& L, std::span<const double> theta) {
     if (!c.ok)
       why << "Eq. 11 violated: deg(u, boundary) = " << total_field
           << " but chi - sum of boundary indices = " << total_aligned
-          << " (boundary indices from the corner angles, Table 1: " << total_corners << ")";
+          << " (boundary indices from the corner angles, Table 1"
+          << (num_given > 0 ? ", and the " + std::to_string(num_given) + " given boundary points"
+                            : std::string())
+          << ": " << total_corners << ")";
     c.needs_hole_correction = false;
   } else {
     c.ok = total_field == total_aligned;
@@ -389,8 +464,12 @@ std::vector<double> align_field(const mesh::FaceMesh& tri, const Loops& L,
 Compatibility check_compatibility(const cad::CadModel& model, LO f,
                                   std::span<const mesh::CurveMesh> curves,
                                   const mesh::FaceMesh& tri, const Frame& frame,
-                                  std::span<const double> theta) {
-  return detail::compatibility(detail::face_loops(model, f, curves, tri, frame), theta);
+                                  std::span<const double> theta,
+                                  std::span<const SingularPoint> given) {
+  const auto surface = model.face_geometry(f);
+  const auto split = detail::split_points(tri, *surface, given);
+  return detail::compatibility(detail::face_loops(model, f, curves, tri, frame, split.boundary),
+                               theta);
 }
 
 namespace detail {

@@ -5,15 +5,27 @@
 #include <cmath>
 #include <numbers>
 #include <span>
+#include <sstream>
 #include <vector>
 
 #include "qsmesh/cad/geometry.hpp"
+#include "qsmesh/core/error.hpp"
 #include "qsmesh/fieldmesh/field_mesh.hpp"
 #include "qsmesh/mesh/delaunay.hpp"
 
 namespace qsmesh::fieldmesh::detail {
 
 inline constexpr double kPi = std::numbers::pi;
+
+/// A face this module does not handle or a given field it refuses (poles, seams, two boundary
+/// points on one vertex): qsmesh::Error with the parts as one line, the reason `--stats` reports
+/// in face_stats[].field_refusal, without the source location a failed QSMESH_CHECK adds.
+template <class... Parts>
+[[noreturn]] void refuse(const Parts&... parts) {
+  std::ostringstream os;
+  (os << ... << parts);
+  throw Error(os.str());
+}
 
 /// x wrapped into (-period / 2, period / 2].
 inline double wrap(double x, double period) { return x - period * std::round(x / period); }
@@ -34,13 +46,35 @@ struct Loops {
   std::vector<std::vector<double>> turn;       ///< turn of the boundary at each point (radians)
   std::vector<std::vector<double>> transport;  ///< frame change along edge i -> i + 1
   std::vector<std::vector<double>> tangent;    ///< theta_N at each point (Sec. 2.4, see .cpp)
+  /// given[l][i]: a boundary singular point of the user (Sec. 2.5); quads then come from its index
+  std::vector<std::vector<char>> given;
   bool uv_reversed = false;  ///< the CAD loops ran clockwise in the parameter plane
 };
 
-/// Throws qsmesh::Error when a loop point has no vertex of `tri` (seams, poles).
+/// A boundary singular point of the user: vertex of the face's triangulation, index d / 4.
+struct BoundaryPoint {
+  LO vertex = kNoIndex;
+  int d = 0;
+};
+
+/// Throws qsmesh::Error when a loop point has no vertex of `tri` (seams, poles), or when a
+/// boundary point is not a loop point. Loop points are corners with round(angle / 90 deg) quads
+/// (at least 1) at CAD vertices, and with 2 - d quads (I = d / 4 by Eq. 15, replacing Table 1) at
+/// the `boundary` points.
 [[nodiscard]] Loops face_loops(const cad::CadModel& model, LO f,
                                std::span<const mesh::CurveMesh> curves, const mesh::FaceMesh& tri,
-                               const Frame& frame);
+                               const Frame& frame, std::span<const BoundaryPoint> boundary = {});
+
+/// The given singular points split into interior ones and boundary ones (paper 003 Sec. 2.5): a
+/// point (projected on the surface) nearer to a boundary edge of `tri` than a quarter of the
+/// edge's length is on the boundary, at the nearer end of that edge (a curve vertex: the curve
+/// meshes are fixed). Throws qsmesh::Error when two points land on one vertex.
+struct SplitPoints {
+  std::vector<SingularPoint> interior;
+  std::vector<BoundaryPoint> boundary;
+};
+[[nodiscard]] SplitPoints split_points(const mesh::FaceMesh& tri, const cad::FaceGeometry& surface,
+                                       std::span<const SingularPoint> points);
 
 /// Table 1 of paper 003: index of a boundary point from the number of quads its angle asks for.
 inline double corner_index(int quads) { return quads == 0 ? 0.0 : (2 - quads) / 4.0; }

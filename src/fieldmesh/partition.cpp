@@ -367,7 +367,7 @@ mesh::FaceMesh partition_and_fill(Context& c, std::span<const SingularPoint> sin
   const LO num_singular = static_cast<LO>(nodes.size());
   for (LO l = 0; l < static_cast<LO>(L.loops.size()); ++l)
     for (std::size_t i = 0; i < L.loops[l].points.size(); ++i)
-      if (L.loops[l].points[i].vclass.dim == 0) {
+      if (L.quads[l][i] > 0) {  // CAD vertices and the given boundary singular points
         Node n;
         n.kind = Node::Corner;
         n.uv = L.loops[l].points[i].uv;
@@ -549,15 +549,16 @@ mesh::FaceMesh partition_and_fill(Context& c, std::span<const SingularPoint> sin
   struct Equation {
     const Side* a;
     const Side* b;
+    std::size_t region;
   };
   std::vector<Equation> eqs;
-  for (const auto& s : sides)
+  for (std::size_t r = 0; r < sides.size(); ++r)
     for (int k = 0; k < 2; ++k) {
-      const Side &a = s[k], &b = s[k + 2];
+      const Side &a = sides[r][k], &b = sides[r][k + 2];
       if (!a.boundary && !b.boundary)
         uf[find(a.half_edges[0] / 2)] = find(b.half_edges[0] / 2);
       else
-        eqs.push_back({&a, &b});
+        eqs.push_back({&a, &b, r});
     }
   std::vector<LO> hits;
   for (LO k = 0; k < static_cast<LO>(nodes.size()); ++k)
@@ -575,26 +576,53 @@ mesh::FaceMesh partition_and_fill(Context& c, std::span<const SingularPoint> sin
     return d == 0 ? m : d;
   };
   std::vector<LO> value(num_sep_edges);
-  auto consistent = [&]() {
+  std::vector<std::size_t> value_region(num_sep_edges);
+  // Whether the placed ends give equal counts on opposite sides; `why`, when given, says where
+  // they do not (only asked once the search failed: the search calls this many times).
+  auto consistent = [&](std::string* why = nullptr) {
     std::fill(value.begin(), value.end(), -1);
     for (const auto& e : eqs) {
       LO va = -1, vb = -1;
       if (e.a->boundary) va = boundary_count(*e.a);
       if (e.b->boundary) vb = boundary_count(*e.b);
-      if ((e.a->boundary && va == 0) || (e.b->boundary && vb == 0)) return false;
+      if ((e.a->boundary && va == 0) || (e.b->boundary && vb == 0)) {
+        if (why != nullptr)
+          *why = "a side of region " + std::to_string(e.region) + " holds no curve edge";
+        return false;
+      }
       if (e.a->boundary && e.b->boundary) {
-        if (va >= 0 && vb >= 0 && va != vb) return false;
+        if (va >= 0 && vb >= 0 && va != vb) {
+          if (why != nullptr)
+            *why = "the opposite boundary sides of region " + std::to_string(e.region) + " hold " +
+                   std::to_string(va) + " and " + std::to_string(vb) + " curve edges";
+          return false;
+        }
         continue;
       }
       const Side& sep = e.a->boundary ? *e.b : *e.a;
       const LO known = e.a->boundary ? va : vb;
       if (known < 0) continue;
-      LO& v = value[find(sep.half_edges[0] / 2)];
-      if (v >= 0 && v != known) return false;
+      const LO cls = find(sep.half_edges[0] / 2);
+      LO& v = value[cls];
+      if (v >= 0 && v != known) {
+        if (why != nullptr)
+          *why = "regions " + std::to_string(value_region[cls]) + " and " +
+                 std::to_string(e.region) +
+                 ", joined by a chain of separatrix arcs of equal counts, ask for " +
+                 std::to_string(v) + " and " + std::to_string(known) + " curve edges";
+        return false;
+      }
       v = known;
+      value_region[cls] = e.region;
     }
     return true;
   };
+  // Structural: with no separatrix end placed, the sides between CAD corners (and given boundary
+  // points) already disagree; no move of the ends can help, only other curve counts.
+  if (std::string why; !consistent(&why))
+    fail("quantization", "the face's curve counts cannot fit the partition (" +
+                             std::to_string(hits.size()) +
+                             " separatrix ends, none can change this): " + why);
   auto order_ok = [&]() {
     for (LO l = 0; l < static_cast<LO>(L.loops.size()); ++l) {
       const auto& ids = on_loop[l];
@@ -784,13 +812,18 @@ mesh::FaceMesh mesh_face_from_field(const cad::CadModel& model, LO f,
   try {
     QSMESH_CHECK(theta.size() == tri.points.size(), "one angle per vertex expected");
     const auto surface = model.face_geometry(f);
-    const detail::Loops loops = detail::face_loops(model, f, curves, tri, frame);
+    const detail::SplitPoints split = detail::split_points(tri, *surface, given);
+    for (const auto& b : split.boundary)
+      if (b.d > 1)
+        fail("compatibility", "a boundary singular point of index " + std::to_string(b.d) +
+                                  "/4: Eq. 15 leaves 2 - 4 I quads there, at least one (I <= 1/4)");
+    const detail::Loops loops = detail::face_loops(model, f, curves, tri, frame, split.boundary);
     rep.compatibility = detail::compatibility(loops, theta);
     if (!rep.compatibility.ok) fail("compatibility", rep.compatibility.reason);
     const std::vector<double> aligned =
         detail::align_field(tri, loops, theta, rep.compatibility, options.solver, lane);
-    std::vector<SingularPoint> singular(given.begin(), given.end());
-    if (singular.empty()) singular = detect_singularities(tri, aligned);
+    std::vector<SingularPoint> singular = split.interior;
+    if (given.empty()) singular = detect_singularities(tri, aligned);
     // Points of index 0 are regular; they emit four separatrices that only cut regions further.
     std::erase_if(singular, [](const SingularPoint& s) { return s.d == 0; });
     rep.singularities = static_cast<int>(singular.size());

@@ -1,6 +1,6 @@
 // `qsmesh mesh --cross-field` and `--method separatrix` (paper 003) on a plate with a hole: the
 // round trip of `qsmesh crossfield`'s VTU, a list of singular points, the separatrix method, and
-// bad files refused up front.
+// bad files refused up front; on a disk, boundary singular points.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
@@ -48,6 +48,18 @@ std::string plate_with_hole() {
   return path;
 }
 
+// The disk of radius 1 about the origin (one circle, its CAD vertex at (1, 0, 0)).
+std::string disk() {
+  const TopoDS_Wire w =
+      BRepBuilderAPI_MakeWire(
+          BRepBuilderAPI_MakeEdge(gp_Circ(gp_Ax2(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), 1.0)).Edge())
+          .Wire();
+  const std::string path = tmp("disk.brep");
+  const TopoDS_Face f = BRepBuilderAPI_MakeFace(w, true).Face();
+  if (!BRepTools::Write(f, path.c_str())) throw std::runtime_error("cannot write " + path);
+  return path;
+}
+
 bool has(const std::string& json, const std::string& what) {
   return json.find(what) != std::string::npos;
 }
@@ -81,6 +93,38 @@ TEST(FieldMeshCli, CrossfieldOutputFedBackAndSingularPoints) {
   EXPECT_TRUE(has(json, "\"faces_meshed_by_field\": 1")) << json;
   EXPECT_TRUE(has(json, "\"irregular_interior\": 4"));
   EXPECT_TRUE(has(json, "\"field_refusal\": \"\""));
+}
+
+TEST(FieldMeshCli, BoundarySingularPointsOnADisk) {
+  // Two valence-3 points and, as Eq. 11 asks, two boundary points of index 1/4 on the circle
+  // (paper 003 Fig. 9, top). At size 0.4 the circle has 16 edges: the quad at a boundary point
+  // has the polygon's angle, SICN about sin(22.5 deg). At 0.2 (32 edges) that corner would give
+  // 0.195, below the floor of 0.2: the face keeps its default mesh and says why.
+  const std::string model = disk(), log = tmp("disk.log"), stats = tmp("disk.json");
+  const std::string points = tmp("disk_pts.txt");
+  std::ofstream(points) << "qsmesh-cross-field singular-points 1\nface 0\n"
+                           "point 0.3 0 0 1\npoint -0.3 0 0 1\n"
+                           "point 1 0 0 1   # on the circle: boundary singular points\n"
+                           "point -1 0 0 1\n";
+  ASSERT_EQ(qsmesh("mesh " + model + " --size 0.4 --cross-field " + points + " -o " +
+                       tmp("disk.msh") + " --stats " + stats,
+                   log),
+            0)
+      << slurp(log);
+  std::string json = slurp(stats);
+  EXPECT_TRUE(has(json, "\"faces_meshed_by_field\": 1")) << json;
+  EXPECT_TRUE(has(json, "\"irregular_interior\": 2")) << json;
+  EXPECT_TRUE(has(json, "\"irregular_boundary\": 2")) << json;
+  EXPECT_TRUE(has(json, "\"triangles\": 0"));
+
+  ASSERT_EQ(qsmesh("mesh " + model + " --size 0.2 --cross-field " + points + " -o " +
+                       tmp("disk2.msh") + " --stats " + stats,
+                   log),
+            0)
+      << slurp(log);
+  json = slurp(stats);
+  EXPECT_TRUE(has(json, "\"faces_meshed_by_field\": 0")) << json;
+  EXPECT_TRUE(has(json, "filling: SICN min 0.19")) << json;
 }
 
 TEST(FieldMeshCli, SeparatrixMethodAndRefusals) {

@@ -30,6 +30,7 @@
 #include "qsmesh/background/face_mesh.hpp"
 #include "qsmesh/cad/model.hpp"
 #include "qsmesh/core/tasks.hpp"
+#include "qsmesh/fieldmesh/field_file.hpp"
 #include "qsmesh/fieldmesh/field_mesh.hpp"
 #include "qsmesh/quantize/quantize.hpp"
 #include "tmp_dir.hpp"
@@ -300,6 +301,122 @@ TEST(FieldMesh, DiskWithTwoSingularPointsIsRefusedByEq11) {
   EXPECT_NE(r.report.reason.find("Eq. 11"), std::string::npos) << r.report.reason;
 }
 
+// Boundary vertices of m away from their ideal valence (as mesh::face_quad_stats counts them),
+// with their valence.
+std::vector<std::pair<Vec3, int>> irregular_on_boundary(const mesh::FaceMesh& m) {
+  std::vector<int> val(m.points.size(), 0);
+  std::vector<double> angle(m.points.size(), 0.0);
+  for (const auto& q : m.quads)
+    for (int k = 0; k < 4; ++k) {
+      ++val[q[k]];
+      const Vec3 a = m.points[q[(k + 3) % 4]] - m.points[q[k]],
+                 b = m.points[q[(k + 1) % 4]] - m.points[q[k]];
+      angle[q[k]] += std::atan2(norm(cross(a, b)), dot(a, b));
+    }
+  std::vector<std::pair<Vec3, int>> out;
+  for (std::size_t v = 0; v < m.points.size(); ++v) {
+    if (m.vclass[v].dim == 2 || val[v] == 0) continue;
+    const int ideal =
+        m.vclass[v].dim == 1 ? 2 : std::max(1, static_cast<int>(std::lround(angle[v] / (kPi / 2))));
+    if (val[v] != ideal) out.emplace_back(m.points[v], val[v]);
+  }
+  return out;
+}
+
+// The circle of radius 1 in 16 edges, a vertex at (1, 0, 0) (the circle's CAD vertex).
+Case disk_of_16_edges() {
+  return make_case(write_disk(1.0), 0.4, 2.0, [](const cad::CadModel&) {
+    return std::vector<std::pair<LO, int>>{{0, 16}};
+  });
+}
+
+TEST(FieldMesh, DiskWithTwoSingularPointsAndTwoBoundarySingularPoints) {
+  // Fig. 4 with two singular points, as Fig. 9 (top): two valence-3 points of Eq. 2 give
+  // deg(u) = 1/2 on the circle, so Eq. 11 asks for boundary singular points whose indices sum to
+  // 1/2: two of index 1/4, at (1, 0) (the circle's CAD vertex, Table 1 index 0 replaced) and
+  // (-1, 0) (a curve vertex). Each is the corner of one quad, whose angle there is the circle
+  // polygon's, 180 - 360/16 degrees: SICN sin(2 pi / 16) = 0.383 bounds the face's. With the
+  // points at +-0.3 (0.2 to 0.35 alike) their separatrices end at the circle's 45-degree vertices:
+  // four regions of 2 x 2 and 4 x 2 quads. From +-0.4 on they end at 22.5 degrees and the two
+  // middle regions are one row of wedges (SICN 0.23 to 0.29).
+  const Case c = disk_of_16_edges();
+  ASSERT_EQ(c.curves.at(0).points.size(), 17u);
+  const std::vector<fieldmesh::SingularPoint> interior{{{0.3, 0, 0}, 1}, {{-0.3, 0, 0}, 1}};
+  std::vector<fieldmesh::SingularPoint> pts = interior;
+  pts.push_back({{1, 0, 0}, 1});
+  pts.push_back({{-1, 0, 0}, 1});
+  FaceRun r = run_points(c, 0, 0.1, pts);
+  ASSERT_TRUE(r.report.ok) << r.report.stage << ": " << r.report.reason;
+  EXPECT_EQ(r.report.compatibility.loops.at(0).field, 0.5);
+  EXPECT_EQ(r.report.compatibility.loops.at(0).corner_indices, 0.5);
+  EXPECT_EQ(r.report.singularities, 2);
+  EXPECT_TRUE(r.quads.triangles.empty());
+  EXPECT_GT(r.report.stats.sicn_min, 0.3);
+  EXPECT_NEAR(r.report.stats.sicn_min, std::sin(2 * kPi / 16), 1e-3);
+  EXPECT_EQ(r.report.regions, 4);
+  EXPECT_EQ(r.quads.quads.size(), 24u);
+  expect_irregular_at(r, interior, 1e-9);
+  // The boundary irregular vertices are the two given ones, one quad each.
+  const auto on_boundary = irregular_on_boundary(r.quads);
+  EXPECT_EQ(r.report.stats.irregular_boundary, 2);
+  ASSERT_EQ(on_boundary.size(), 2u);
+  for (const auto& [x, val] : on_boundary) {
+    EXPECT_EQ(val, 1);
+    EXPECT_NEAR(std::abs(x.x), 1.0, 1e-9);
+    EXPECT_NEAR(x.y, 0.0, 1e-9);
+  }
+
+  // The same points as a FIELD file gives them (mesh_face_by_method: its own triangulation).
+  fieldmesh::GivenFaceField given;
+  given.face = 0;
+  given.points = pts;
+  fieldmesh::FieldMeshReport rep;
+  const auto m = fieldmesh::mesh_face_by_method(
+      c.model, 0, c.curves, fieldmesh::FaceMethod::GivenField, &given, nullptr, {}, nullptr, &rep);
+  ASSERT_TRUE(rep.ok) << rep.stage << ": " << rep.reason;
+  EXPECT_EQ(rep.stats.irregular_interior, 2);
+  EXPECT_EQ(rep.stats.irregular_boundary, 2);
+  EXPECT_GT(rep.stats.sicn_min, 0.3);
+
+  // Index -1/4 at the two boundary points: Eq. 11 asks for deg(u) = 3/2.
+  pts[2].d = pts[3].d = -1;
+  r = run_points(c, 0, 0.1, pts);
+  EXPECT_FALSE(r.report.ok);
+  EXPECT_EQ(r.report.stage, "compatibility");
+  EXPECT_NE(r.report.reason.find("Eq. 11"), std::string::npos) << r.report.reason;
+  EXPECT_NE(r.report.reason.find("2 given boundary points"), std::string::npos) << r.report.reason;
+}
+
+TEST(FieldMesh, TrapezoidWithoutSingularPointIsRefusedByItsCurveCounts) {
+  // Four corners of about 72 and 108 degrees (index 1/4 each by Table 1) and no singular point:
+  // the partition is the face itself, one region whose opposite sides the curve quantization gave
+  // 10 and 6 edges. No separatrix end can change that: the refusal says so, with the counts.
+  // chord_ratio_limit 1: the quantization keeps the opposite curves' own counts (10 and 6).
+  const Case c = make_case(write_polygon({{0, 0}, {1, 0}, {0.8, 0.6}, {0.2, 0.6}}), 0.1, 1.0);
+  const FaceRun r = run_points(c, 0, 0.05, {});
+  EXPECT_FALSE(r.report.ok);
+  EXPECT_TRUE(r.quads.quads.empty());
+  EXPECT_TRUE(r.report.compatibility.ok);
+  EXPECT_EQ(r.report.regions, 1);
+  EXPECT_EQ(r.report.stage, "quantization");
+  EXPECT_NE(r.report.reason.find("curve counts cannot fit the partition"), std::string::npos)
+      << r.report.reason;
+  EXPECT_NE(r.report.reason.find("hold 10 and 6 curve edges"), std::string::npos)
+      << r.report.reason;
+}
+
+TEST(FieldMesh, PlateWithHoleAndTwoSingularPointsIsRefusedByEq16) {
+  // Four right corners (index 1/4 each) and a hole: chi = 0, so the singular points' indices must
+  // sum to -1 (Eq. 16); two valence-5 points give -1/2.
+  const Case c = make_case(write_plate_with_hole(2.0, 0.8), 0.2);
+  const std::vector<fieldmesh::SingularPoint> pts{{{1.15, 1.15, 0}, -1}, {{-1.15, -1.15, 0}, -1}};
+  const FaceRun r = run_points(c, 0, 0.1, pts);
+  EXPECT_FALSE(r.report.ok);
+  EXPECT_TRUE(r.quads.quads.empty());
+  EXPECT_EQ(r.report.stage, "compatibility");
+  EXPECT_NE(r.report.reason.find("Eq. 16"), std::string::npos) << r.report.reason;
+}
+
 TEST(FieldMesh, PlateWithHoleUnalignedFieldIsCorrected) {
   // Figs. 10-11: four valence-5 points of Eq. 2 satisfy Eq. 16 but not Eq. 17 (the field does not
   // turn around the hole); the hole correction of Eqs. 18-20 makes it alignable.
@@ -379,6 +496,33 @@ TEST(FieldMesh, CylinderPatchWithTheHeatMethodFrame) {
   EXPECT_EQ(r.report.regions, 1);
   EXPECT_TRUE(irregular(r.quads).empty());
   EXPECT_GT(r.report.stats.sicn_min, 0.9);
+}
+
+TEST(FieldMesh, HeatMethodFrameOnASliverTriangle) {
+  // Two triangles of the cylinder patch, ABC and ACD, with B 5e-5 radians off the straight
+  // segment AC (along the axis): the sliver ABC has cotangents of about +-1e4, clamped at +-1e3
+  // each, and gives the edge AC a weight of -500 that ACD (a right angle at D) does not offset.
+  // With t = diagonal^2 the heat system was then indefinite ('not positive definite', A319's
+  // faces 1, 3 and 50). Summed per edge and clamped at 0, the weights keep it definite.
+  const Case c = make_case(write_cylinder_patch(1.0, 1.5), 0.1);
+  const auto surface = c.model.face_geometry(0);
+  mesh::FaceMesh tri;
+  tri.face = 0;
+  for (const Vec2 uv : {Vec2{0.7, 0.2}, Vec2{0.70005, 0.7}, Vec2{0.7, 1.2}, Vec2{0.2, 0.7}}) {
+    tri.uv.push_back(uv);
+    tri.points.push_back(surface->eval(uv).p);
+    mesh::VertexClass vc;
+    vc.dim = 2;
+    vc.entity = 0;
+    tri.vclass.push_back(vc);
+  }
+  // A = 0, B = 1, C = 2, D = 3; counter-clockwise in the parameter plane.
+  tri.triangles = {{0, 1, 2}, {0, 2, 3}};
+  const fieldmesh::Frame frame = fieldmesh::face_frame(tri, *surface, nullptr);
+  for (std::size_t v = 0; v < frame.ref.size(); ++v) {
+    EXPECT_NEAR(norm(frame.ref[v]), 1.0, 1e-9);
+    EXPECT_NEAR(dot(frame.ref[v], frame.normal[v]), 0.0, 1e-9);
+  }
 }
 
 TEST(FieldMesh, CylinderPatchWithAValence3And5PairOfEq2) {

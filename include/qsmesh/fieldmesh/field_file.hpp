@@ -12,7 +12,10 @@
 namespace qsmesh::fieldmesh {
 
 /// Crosses sampled at points of a face: one branch per sample (3D, any length > 0), and the
-/// field's interior singular points when known (otherwise they are detected on the sampled field).
+/// field's interior singular points as the file or the mesher gives them. mesh_face_by_method does
+/// not use `singular`: it detects the singular points on the field interpolated from the samples,
+/// where that field has them (a point given near the boundary would otherwise be taken for a
+/// boundary singular point, see SingularPoint).
 struct FieldSamples {
   std::vector<Vec3> positions, directions;
   std::vector<SingularPoint> singular;
@@ -36,7 +39,7 @@ struct GivenFields {
 /// Reads FIELD: a text file starting with the line `qsmesh-cross-field singular-points 1`, or the
 /// VTU file `qsmesh crossfield -o` writes (ASCII or binary data arrays; the cell arrays cad_face
 /// and cross_u of its triangles are read, each triangle one sample at its centroid, and its
-/// singularity markers, vertex cells with singularity_index +1 / -1, as the singular points).
+/// singularity markers, vertex cells with singularity_index +1 / -1, into samples.singular).
 /// Throws qsmesh::InputError, one line naming the file and, for text files, the line, when the file
 /// cannot be read, is of neither form, or names a face outside [0, num_faces).
 [[nodiscard]] GivenFields read_cross_field_file(const std::string& path, LO num_faces);

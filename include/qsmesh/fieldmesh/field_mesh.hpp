@@ -19,8 +19,12 @@
 
 namespace qsmesh::fieldmesh {
 
-/// An interior singular point of a user field (paper 003 Eq. 2): position (model units, on or near
-/// the face) and d, the index being d / 4 (d = 1: valence 3, d = -1: valence 5).
+/// A singular point of a user field (paper 003 Eq. 2): position (model units, on or near the face)
+/// and d, the index being d / 4 (d = 1: valence 3, d = -1: valence 5). A point on the face's
+/// boundary (nearer to a boundary edge of the face's triangulation than a quarter of its length)
+/// is a boundary singular point (Sec. 2.5) at the nearer curve vertex: it replaces the Table 1
+/// index of that point (0 on a smooth curve), so the point gets 2 - d quads (d <= 1); it is a
+/// corner of the partition when d = 1 and sends 1 - d separatrices when d < 0.
 struct SingularPoint {
   Vec3 position;
   int d = 0;
@@ -45,7 +49,8 @@ struct Frame {
 /// Angle (radians, modulo pi/2) of the cross of Eq. 2 at every vertex of `tri`, measured from
 /// frame.ref: sum_i d_i / 4 arg(z - a_i), z and a_i the parameter-plane images (a_i projected on
 /// the surface). On a planar face with an isometric parametrization this is Eq. 2 itself; on a
-/// curved one it is a smooth field with the same singular points and indices.
+/// curved one it is a smooth field with the same singular points and indices. Boundary singular
+/// points (see SingularPoint) are left out of the product: the alignment turns the field there.
 [[nodiscard]] std::vector<double> field_from_points(const mesh::FaceMesh& tri,
                                                     const cad::FaceGeometry& surface,
                                                     std::span<const SingularPoint> points);
@@ -110,7 +115,9 @@ struct FieldMeshReport {
 /// conforms to the faces around) and a field given on a triangulation `tri` of the face whose
 /// boundary vertices are those curve meshes' (mesh_face_background on `curves`): `theta` per
 /// vertex of `tri` (field_from_points / field_from_directions, measured from frame.ref), `given`
-/// the interior singular points the field was built from (empty: taken from the discrete field).
+/// the singular points the field was built from (empty: taken from the discrete field); those on
+/// the boundary are boundary singular points (see SingularPoint), whose indices enter Eq. 11 and
+/// the alignment's corner jumps (Eq. 15).
 /// Returns the all-quad FaceMesh (boundary vertices classified as the curve meshes, interior ones
 /// dim 2 on f); on failure an empty mesh and report->ok false with the stage and the reason. An
 /// incompatible field (Eq. 11 or 16) fails at stage "compatibility"; never throws for a face-level
@@ -124,10 +131,12 @@ struct FieldMeshReport {
                                                   linalg::PetscLane* lane, FieldMeshReport* report);
 
 /// Compatibility of `theta` with face f (the loops of `tri`'s boundary, corner indices from the
-/// corner angles by Table 1: I = (2 - round(angle / 90 deg)) / 4).
+/// corner angles by Table 1: I = (2 - round(angle / 90 deg)) / 4, or d / 4 at the boundary points
+/// of `given`).
 [[nodiscard]] Compatibility check_compatibility(const cad::CadModel& model, LO f,
                                                 std::span<const mesh::CurveMesh> curves,
                                                 const mesh::FaceMesh& tri, const Frame& frame,
-                                                std::span<const double> theta);
+                                                std::span<const double> theta,
+                                                std::span<const SingularPoint> given = {});
 
 }  // namespace qsmesh::fieldmesh
