@@ -201,7 +201,8 @@ struct HolomorphicReport {
   std::string reason;  ///< why not (the default path then meshes the face)
   LO boundaries = 0;   ///< boundary loops of the background triangulation
   LO zeros = 0;        ///< interior zeros of the optimised form
-  int rows = 0, columns = 0;
+  int rows = 0, columns = 0;   ///< b >= 3: rows summed over the patches, most columns of one
+  int patches = 0;             ///< b >= 3: flat cylinders between critical levels (0 for b = 2)
   std::vector<double> energy;  ///< per iteration
   double basis_seconds = 0, energy_seconds = 0, seconds = 0;
 };
@@ -226,6 +227,29 @@ struct HolomorphicReport {
                                           const cad::FaceGeometry& surface,
                                           const HolomorphicOptions& options,
                                           HolomorphicReport* report);
+
+/// The quad mesh of a poly-annulus (paper 004 Sec. 4, "Quad-mesh generation"); b = 2 is
+/// mesh_annulus. For b >= 3: v = Im of the integral of the optimised form is single valued
+/// (the conjugates are exact), harmonic, constant on each loop; its saddles are the zeros of the
+/// form. The levels of the saddles and of the loops cut the surface into flat cylinders (the
+/// critical horizontal trajectories bound them), each meshed as a grid: its side on a loop takes
+/// that loop's final points; a side on a cut takes points at equal steps of u, shared with the
+/// cylinders across the cut, a saddle being a point of all three; rows at equal steps of v
+/// (round(height * columns / period) of them), u harmonic over the grid (GridOptions), each
+/// point placed on its row's level curve and projected on `surface`. A simple zero becomes a
+/// valence-8 vertex (two quads in each of the two lobes' grids, four in the grid that passes it
+/// twice), so the mesh has exactly b - 2 of them and no other irregular vertex.
+/// Conformity across a cut needs the counts on each side to sum to the same: the loops' counts
+/// must add up as the form's periods do (for a plate with holes on which v is lowest on the outer
+/// loop: outer count = the holes' counts summed). Returns an empty mesh with report->reason when
+/// they do not, when a loop has a sharp corner or a zero of the form (v crossing its level next to
+/// it), when a zero is not simple, two zeros share a critical curve, the face has a seam, or a
+/// level curve is not one closed curve. Never throws for a face-level failure.
+[[nodiscard]] mesh::FaceMesh mesh_poly_annulus(const mesh::FaceMesh& background,
+                                               std::span<const mesh::BoundaryLoop> loops,
+                                               const cad::FaceGeometry& surface,
+                                               const HolomorphicOptions& options,
+                                               HolomorphicReport* report);
 
 /// The per-face method of the quad stage.
 enum class Method { Default, Holomorphic, Auto };
