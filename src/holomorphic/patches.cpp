@@ -342,7 +342,8 @@ mesh::FaceMesh mesh_poly_annulus(const mesh::FaceMesh& background,
       return fail("the final boundary has " + std::to_string(F.cycles.size()) + " cycles, not " +
                   std::to_string(b));
     // A loop is a level of v, straight in the form's flat metric; a grid with two quads at every
-    // boundary vertex folds at a sharp CAD corner (see mesh_annulus).
+    // boundary vertex folds at a sharp CAD corner (see mesh_annulus); a right angle is split in
+    // two by the column from it.
     for (const auto& cycle : F.cycles)
       for (std::size_t i = 0; i < cycle.size(); ++i) {
         const auto& p = F.points[static_cast<std::size_t>(cycle[i])];
@@ -352,7 +353,7 @@ mesh::FaceMesh mesh_poly_annulus(const mesh::FaceMesh& background,
         const Vec3& c = F.points[static_cast<std::size_t>(cycle[(i + 1) % cycle.size()])].xyz;
         const double turn =
             std::acos(std::clamp(dot(normalized(p.xyz - a), normalized(c - p.xyz)), -1.0, 1.0));
-        if (turn > options.max_corner_turn_deg * std::numbers::pi / 180)
+        if (turn > options.max_patch_corner_turn_deg * std::numbers::pi / 180)
           return fail("a loop turns by " +
                       std::to_string(std::lround(turn * 180 / std::numbers::pi)) +
                       " degrees at corner " + std::to_string(p.vclass.entity) +

@@ -219,16 +219,34 @@ TEST(HolomorphicPatches, CountsThatDoNotAddUpFallBack) {
   EXPECT_NE(report.reason.find("do not add up"), std::string::npos) << report.reason;
 }
 
-// A plate with square corners: its outer loop turns by 90 degrees, where a grid folds.
-TEST(HolomorphicPatches, SquareCornersFallBack) {
+// A plate with square corners: each corner is a boundary vertex of two quads of the outer
+// patch's grid (the right angle split by the column from it), the interior as on the rounded
+// plate. Above max_patch_corner_turn_deg the face falls back.
+TEST(HolomorphicPatches, SquarePlateWithTwoHolesSplitsItsCorners) {
   const MeshedFace m =
       mesh_face(test::write_plate_with_holes(8, 4, {{{2.5, 2.0, 0.8}}, {{5.5, 2.0, 0.8}}},
                                              tmp("splate2.brep")),
                 0.2, 6.0, 28, 56);
   HolomorphicReport report;
   const mesh::FaceMesh q = mesh_poly_annulus(m.background, m.loops, *m.surface, {}, &report);
+  ASSERT_TRUE(report.ok) << report.reason;
+  const Valences v = valences(q);
+  EXPECT_EQ(v.eight, 1);
+  EXPECT_EQ(v.other_irregular, 0);
+  EXPECT_EQ(v.boundary_irregular, 0);  // two quads at every boundary vertex, corners included
+  const auto stats = mesh::face_quad_stats(q);
+  EXPECT_EQ(stats.irregular_interior, 1);
+  EXPECT_EQ(stats.irregular_boundary, 4);  // the corners, where the default mesh puts one quad
+  EXPECT_GT(stats.sicn_min, 0.3);
+  std::cout << "square plate: " << stats.quads << " quads, SICN min " << stats.sicn_min << " avg "
+            << stats.sicn_avg << "\n";
+  expect_conforming(q, m.loops);
+  expect_oriented(q);
+  HolomorphicOptions strict;
+  strict.max_patch_corner_turn_deg = 60;
+  const mesh::FaceMesh none = mesh_poly_annulus(m.background, m.loops, *m.surface, strict, &report);
   EXPECT_FALSE(report.ok);
-  EXPECT_TRUE(q.quads.empty());
+  EXPECT_TRUE(none.quads.empty());
   EXPECT_NE(report.reason.find("turns by 90 degrees"), std::string::npos) << report.reason;
 }
 

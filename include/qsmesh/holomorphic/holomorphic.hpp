@@ -194,6 +194,11 @@ struct HolomorphicOptions {
   /// mesh_annulus refuses a loop that turns by more than this at a CAD corner (3D angle between
   /// its edges there, degrees).
   double max_corner_turn_deg = 30;
+  /// mesh_poly_annulus (b >= 3) refuses a loop that turns by more than this at a CAD corner. A
+  /// 90-degree corner of a plate becomes a boundary vertex with two quads of the patch's grid
+  /// (about 45 degrees each, SICN about 0.7 there; a rounded plate's tangent corners are not
+  /// corners); the face's SICN check (keep_holomorphic) still rejects a folded result.
+  double max_patch_corner_turn_deg = 100;
   /// mesh_poly_annulus (b >= 3) smooths its patches' grids (smooth::smooth_face, boundary locked;
   /// rolled back when the minimum SICN would drop): next to a zero the form's grid has quads that
   /// are thin in 3D (a critical curve close to a loop on one side), which the smoothing widens.
@@ -248,9 +253,10 @@ struct HolomorphicReport {
 /// Conformity across a cut needs the counts on each side to sum to the same: the loops' counts
 /// must add up as the form's periods do (for a plate with holes on which v is lowest on the outer
 /// loop: outer count = the holes' counts summed). Returns an empty mesh with report->reason when
-/// they do not, when a loop has a sharp corner or a zero of the form (v crossing its level next to
-/// it), when a zero is not simple, two zeros share a critical curve, the face has a seam, or a
-/// level curve is not one closed curve. Never throws for a face-level failure.
+/// they do not, when a loop turns by more than max_patch_corner_turn_deg at a corner, has a zero of
+/// the form (v crossing its level next to it), when a zero is not simple, two zeros share a
+/// critical curve, the face has a seam, or a level curve is not one closed curve. Never throws for
+/// a face-level failure.
 [[nodiscard]] mesh::FaceMesh mesh_poly_annulus(const mesh::FaceMesh& background,
                                                std::span<const mesh::BoundaryLoop> loops,
                                                const cad::FaceGeometry& surface,
