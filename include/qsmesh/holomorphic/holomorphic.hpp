@@ -208,10 +208,10 @@ struct HolomorphicOptions {
 
 /// What the holomorphic path did on one face.
 struct HolomorphicReport {
-  bool ok = false;     ///< a mesh was made
-  std::string reason;  ///< why not (the default path then meshes the face)
-  LO boundaries = 0;   ///< boundary loops of the background triangulation
-  LO zeros = 0;        ///< interior zeros of the optimised form
+  bool ok = false;             ///< a mesh was made
+  std::string reason;          ///< why not (the default path then meshes the face)
+  LO boundaries = 0;           ///< boundary loops of the background triangulation
+  LO zeros = 0;                ///< interior zeros of the optimised form
   int rows = 0, columns = 0;   ///< b >= 3: rows summed over the patches, most columns of one
   int patches = 0;             ///< b >= 3: flat cylinders between critical levels (0 for b = 2)
   std::vector<double> energy;  ///< per iteration
