@@ -600,10 +600,12 @@ mesh::FaceMesh mesh_poly_annulus(const mesh::FaceMesh& background,
           bedge_tri[static_cast<std::size_t>(e)] = static_cast<LO>(t);
       }
     // (loop, u in its cylinder) of a final boundary point.
+    std::vector<std::size_t> boundary_edges;
+    for (std::size_t e = 0; e < s.edges.size(); ++e)
+      if (bedge_tri[e] != kNoIndex) boundary_edges.push_back(e);
     auto on_boundary = [&](const Vec3& x, LO* loop, double* u) {
       double best = 1e300;
-      for (std::size_t e = 0; e < s.edges.size(); ++e) {
-        if (bedge_tri[e] == kNoIndex) continue;
+      for (const std::size_t e : boundary_edges) {
         const Vec3& a = s.points[static_cast<std::size_t>(s.edges[e][0])];
         const Vec3 ab = s.points[static_cast<std::size_t>(s.edges[e][1])] - a;
         const double l2 = dot(ab, ab);
