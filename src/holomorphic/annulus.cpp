@@ -40,9 +40,8 @@ mesh::FaceMesh mesh_annulus(const mesh::FaceMesh& background,
     R.boundaries = static_cast<LO>(s.loops.size());
     if (!s.ok) return fail("not a poly-annulus: " + s.reason);
     if (s.loops.size() != 2)
-      return fail(
-          "b = " + std::to_string(s.loops.size()) +
-          " boundary loops: patch meshing along critical trajectories is only done for b = 2");
+      return fail("b = " + std::to_string(s.loops.size()) +
+                  " boundary loops: not an annulus (mesh_poly_annulus meshes b >= 3)");
     const HolomorphicBasis B = holomorphic_basis(s, options.basis, nullptr);
     R.basis_seconds = B.seconds;
     const EnergyResult E = minimize_area_distortion(s, B, options.energy);
