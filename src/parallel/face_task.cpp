@@ -188,8 +188,8 @@ void make_holomorphic_candidate(FaceTask& task, const cad::CadModel& model,
   try {
     const auto surface = model.face_geometry(task.face);
     const auto loops = background::face_boundary(model, task.face, *surface, full);
-    task.holomorphic_mesh =
-        holomorphic::mesh_annulus(task.background, loops, *surface, options, &task.holomorphic);
+    task.holomorphic_mesh = holomorphic::mesh_poly_annulus(task.background, loops, *surface,
+                                                           options, &task.holomorphic);
   } catch (const std::exception& e) {
     task.holomorphic.ok = false;
     task.holomorphic.reason = std::string("boundary: ") + e.what();

@@ -17,4 +17,15 @@ std::string write_plate_with_holes(double length, double width,
                                    const std::vector<std::array<double, 3>>& holes,
                                    const std::string& path);
 
+/// Writes the disk of radius `radius` about the origin (z = 0) with circular holes {x, y, radius}
+/// (inside it, disjoint), as BREP; returns path.
+std::string write_disk_with_holes(double radius, const std::vector<std::array<double, 3>>& holes,
+                                  const std::string& path);
+
+/// Writes write_plate_with_holes' plate with its four corners rounded (radius `corner`, tangent
+/// arcs: the outer loop has no sharp corner), as BREP; returns path.
+std::string write_rounded_plate_with_holes(double length, double width, double corner,
+                                           const std::vector<std::array<double, 3>>& holes,
+                                           const std::string& path);
+
 }  // namespace qsmesh::test

@@ -210,7 +210,8 @@ void check_plate(const std::vector<std::array<double, 3>>& holes, const std::str
                                      t.end_loop == l;
                             }))
         << "loop " << l;
-  // b >= 3: the patch meshing is not done; the face falls back with a reason.
+  // b >= 3 is not an annulus: mesh_annulus refuses it (mesh_poly_annulus meshes it,
+  // test_patches.cpp).
   HolomorphicReport report;
   const mesh::FaceMesh q = mesh_annulus(m.background, m.loops, *m.surface, {}, &report);
   EXPECT_FALSE(report.ok);

@@ -5,6 +5,7 @@
 
 #include <sstream>
 
+#include "holo_shapes.hpp"
 #include "qsmesh/mesh/validate.hpp"
 #include "qsmesh/parallel/comm.hpp"
 #include "qsmesh/parallel/pipeline.hpp"
@@ -51,6 +52,43 @@ TEST(HolomorphicPipeline, CylinderSideIsAGridOnEveryRankCount) {
     kept += q.by_holomorphic ? 1 : 0;
   }
   EXPECT_EQ(kept, 1);
+}
+
+// A disk with two holes (b = 3) whose circles are prescribed 48, 24 and 24 edges (the outer
+// count the sum of the holes', as the form's periods add up): its mesh is the patches' (one
+// valence-8 vertex), the same at every rank count.
+TEST(HolomorphicPipeline, DiskWithTwoHolesIsPatchMeshedOnEveryRankCount) {
+  const Comm comm = Comm::world();
+  const std::string path =
+      std::string(QSMESH_TEST_TMP_DIR) + "/holo_disk2_np" + std::to_string(comm.size()) + ".brep";
+  if (comm.rank() == 0)
+    test::write_disk_with_holes(3.0, {{{-1.3, 0.0, 0.8}}, {{1.3, 0.0, 0.8}}}, path);
+  comm.barrier();
+  const cad::CadModel model = cad::load_cad(path);
+  ASSERT_EQ(model.num_faces(), 1);
+  PipelineOptions options;
+  options.background.sizes.size = 0.2;
+  options.sizemap.size_max = 0.2;
+  options.until = Stage::QuasiStructured;
+  options.face_method = holomorphic::Method::Holomorphic;
+  for (LO c = 0; c < model.num_curves(); ++c)
+    options.quantize.prescribed.emplace_back(
+        c, model.curves()[static_cast<std::size_t>(c)].length > 10 ? 48 : 24);
+  std::ostringstream sink;
+  Logger log(sink, LogLevel::Quiet);
+  const PipelineResult dist = run_pipeline(comm, model, options, TaskArena(2), log);
+  if (comm.rank() != 0) return;
+  const PipelineResult serial = run_pipeline(Comm::self(), model, options, TaskArena(1), log);
+  EXPECT_EQ(dist.mesh.points, serial.mesh.points);
+  EXPECT_EQ(dist.mesh.quads, serial.mesh.quads);
+  EXPECT_TRUE(dist.mesh.triangles.empty());
+  const auto conformity = mesh::check_conformity(dist.mesh, model);
+  EXPECT_TRUE(conformity.ok()) << conformity.summary();
+  const auto& q = dist.quasi_reports[0];
+  EXPECT_TRUE(q.by_holomorphic) << q.holomorphic;
+  EXPECT_EQ(dist.face_stats[0].irregular_interior, 1);
+  EXPECT_EQ(dist.face_stats[0].irregular_boundary, 0);
+  EXPECT_GT(dist.face_stats[0].sicn_min, 0.3);
 }
 
 }  // namespace

@@ -21,6 +21,7 @@
 #include "qsmesh/mesh/delaunay.hpp"
 #include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/mesh/surface_mesh.hpp"
+#include "qsmesh/smooth/smooth.hpp"
 
 namespace qsmesh::holomorphic {
 
@@ -193,15 +194,26 @@ struct HolomorphicOptions {
   /// mesh_annulus refuses a loop that turns by more than this at a CAD corner (3D angle between
   /// its edges there, degrees).
   double max_corner_turn_deg = 30;
+  /// mesh_poly_annulus (b >= 3) refuses a loop that turns by more than this at a CAD corner. A
+  /// 90-degree corner of a plate becomes a boundary vertex with two quads of the patch's grid
+  /// (about 45 degrees each, SICN about 0.7 there; a rounded plate's tangent corners are not
+  /// corners); the face's SICN check (keep_holomorphic) still rejects a folded result.
+  double max_patch_corner_turn_deg = 100;
+  /// mesh_poly_annulus (b >= 3) smooths its patches' grids (smooth::smooth_face, boundary locked;
+  /// rolled back when the minimum SICN would drop): next to a zero the form's grid has quads that
+  /// are thin in 3D (a critical curve close to a loop on one side), which the smoothing widens.
+  bool smooth_patches = true;
+  smooth::SmoothOptions smoothing;
 };
 
 /// What the holomorphic path did on one face.
 struct HolomorphicReport {
-  bool ok = false;     ///< a mesh was made
-  std::string reason;  ///< why not (the default path then meshes the face)
-  LO boundaries = 0;   ///< boundary loops of the background triangulation
-  LO zeros = 0;        ///< interior zeros of the optimised form
-  int rows = 0, columns = 0;
+  bool ok = false;             ///< a mesh was made
+  std::string reason;          ///< why not (the default path then meshes the face)
+  LO boundaries = 0;           ///< boundary loops of the background triangulation
+  LO zeros = 0;                ///< interior zeros of the optimised form
+  int rows = 0, columns = 0;   ///< b >= 3: rows summed over the patches, most columns of one
+  int patches = 0;             ///< b >= 3: flat cylinders between critical levels (0 for b = 2)
   std::vector<double> energy;  ///< per iteration
   double basis_seconds = 0, energy_seconds = 0, seconds = 0;
 };
@@ -226,6 +238,30 @@ struct HolomorphicReport {
                                           const cad::FaceGeometry& surface,
                                           const HolomorphicOptions& options,
                                           HolomorphicReport* report);
+
+/// The quad mesh of a poly-annulus (paper 004 Sec. 4, "Quad-mesh generation"); b = 2 is
+/// mesh_annulus. For b >= 3: v = Im of the integral of the optimised form is single valued
+/// (the conjugates are exact), harmonic, constant on each loop; its saddles are the zeros of the
+/// form. The levels of the saddles and of the loops cut the surface into flat cylinders (the
+/// critical horizontal trajectories bound them), each meshed as a grid: its side on a loop takes
+/// that loop's final points; a side on a cut takes points at equal steps of u, shared with the
+/// cylinders across the cut, a saddle being a point of all three; rows at equal steps of v
+/// (round(height * columns / period) of them), u harmonic over the grid (GridOptions), each
+/// point placed on its row's level curve and projected on `surface`. A simple zero becomes a
+/// valence-8 vertex (two quads in each of the two lobes' grids, four in the grid that passes it
+/// twice), so the mesh has exactly b - 2 of them and no other irregular vertex.
+/// Conformity across a cut needs the counts on each side to sum to the same: the loops' counts
+/// must add up as the form's periods do (for a plate with holes on which v is lowest on the outer
+/// loop: outer count = the holes' counts summed). Returns an empty mesh with report->reason when
+/// they do not, when a loop turns by more than max_patch_corner_turn_deg at a corner, has a zero of
+/// the form (v crossing its level next to it), when a zero is not simple, two zeros share a
+/// critical curve, the face has a seam, or a level curve is not one closed curve. Never throws for
+/// a face-level failure.
+[[nodiscard]] mesh::FaceMesh mesh_poly_annulus(const mesh::FaceMesh& background,
+                                               std::span<const mesh::BoundaryLoop> loops,
+                                               const cad::FaceGeometry& surface,
+                                               const HolomorphicOptions& options,
+                                               HolomorphicReport* report);
 
 /// The per-face method of the quad stage.
 enum class Method { Default, Holomorphic, Auto };
