@@ -27,10 +27,10 @@ double quad_orientation(const mesh::FaceMesh& m, const cad::FaceGeometry& surfac
 }
 
 double oriented_sicn(const std::array<Vec3, 4>& x, const Vec3& normal, double sign) {
-  Vec3 sum{};
-  for (int k = 0; k < 4; ++k) sum += cross(x[k] - x[(k + 3) % 4], x[(k + 1) % 4] - x[k]);
-  if (norm2(normal) > 0 && sign * dot(sum, normal) <= 0) return -1.0;
-  return mesh::quad_sicn(x);
+  // The corner cross products give the area vector and the SICN both (mesh::quad_corners).
+  const mesh::QuadCorners c = mesh::quad_corners(x);
+  if (norm2(normal) > 0 && sign * dot(c.sum, normal) <= 0) return -1.0;
+  return mesh::quad_sicn_from(c);
 }
 
 namespace {

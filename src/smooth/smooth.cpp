@@ -162,12 +162,12 @@ class Smoother {
     const auto& qd = m_.quads[q];
     const std::array<Vec3, 4> p{m_.points[qd[0]], m_.points[qd[1]], m_.points[qd[2]],
                                 m_.points[qd[3]]};
-    Vec3 sum{};
-    for (int k = 0; k < 4; ++k) sum += cross(p[k] - p[(k + 3) % 4], p[(k + 1) % 4] - p[k]);
+    // The corner cross products give the area vector and the SICN both.
+    const mesh::QuadCorners c = mesh::quad_corners(p);
     Vec3 n{};
     for (int k = 0; k < 4 && norm2(n) == 0; ++k) n = vertex_normal(qd[k]);  // skip a pole corner
-    if (sign_ * dot(sum, n) <= 0) return -1.0;
-    return mesh::quad_sicn(p);
+    if (sign_ * dot(c.sum, n) <= 0) return -1.0;
+    return mesh::quad_sicn_from(c);
   }
   // (minimum, sum) of the quality of the quads around v.
   std::pair<double, double> local_quality(LO v) const {
