@@ -211,11 +211,22 @@ class Smoother {
       m_.uv[v] = uv;
       m_.points[v] = s_.eval(uv).p;
       normal_ok_[v] = 0;
-      const auto after = local_quality(v);
       // The minimum must not drop; on a tie (a folded quad stuck at -1) the sum decides, so that
-      // a move cannot spoil the other quads for free.
-      const bool keep = after.first > before.first ||
-                        (after.first == before.first && after.second >= before.second);
+      // a move cannot spoil the other quads for free. A quad below the old minimum refuses the
+      // move at once: the quads after it need not be measured.
+      double after_min = std::numeric_limits<double>::max(), after_sum = 0;
+      bool keep = true;
+      for (const LO q : t_.v2q[v]) {
+        const double s = quality(q);
+        if (s < before.first) {
+          keep = false;
+          break;
+        }
+        after_min = std::min(after_min, s);
+        after_sum += s;
+      }
+      keep = keep && (after_min > before.first ||
+                      (after_min == before.first && after_sum >= before.second));
       if (!keep) {
         m_.uv[v] = uv0;
         m_.points[v] = x0;

@@ -51,7 +51,10 @@ class Untangler {
   // mean normal), soft minimum over the quads of v, and the hard minimum. A quad turned against the
   // surface is measured against the surface normal instead, so that all its corners score negative
   // and unfolding it raises the score.
-  [[nodiscard]] Score score(LO v) const {
+  // With `floor`: a score whose soft minimum cannot exceed it (its lowest corner value is at or
+  // below it, and the soft minimum is never above the lowest value) comes back as soft = -inf
+  // without the exponentials: the search only asks whether a trial beats its best so far.
+  [[nodiscard]] Score score(LO v, double floor = -std::numeric_limits<double>::infinity()) const {
     corner_.clear();
     Score sc;
     sc.hard = std::numeric_limits<double>::infinity();
@@ -75,6 +78,10 @@ class Untangler {
       sc.hard = std::min(sc.hard, flipped ? -1.0 : worst);
     }
     const double lo = *std::min_element(corner_.begin(), corner_.end());
+    if (lo <= floor) {
+      sc.soft = -std::numeric_limits<double>::infinity();
+      return sc;
+    }
     double sum = 0;
     for (const double c : corner_) sum += std::exp(-(c - lo) / kTau);
     sc.soft = lo - kTau * std::log(sum);
@@ -117,7 +124,7 @@ class Untangler {
         m_.uv[v] = uv;
         m_.points[v] = s_.eval(uv).p;
         normal_[v] = s_.normal(uv) * sign_;
-        const Score sc = score(v);
+        const Score sc = score(v, best.soft);
         const bool valid_kept = sc.hard > 0 || sc.hard >= cur.hard;
         if (valid_kept && sc.soft > best.soft) {
           best = sc;
