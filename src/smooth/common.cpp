@@ -1,7 +1,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <unordered_map>
+#include <utility>
+#include <vector>
 
 #include "internal.hpp"
 #include "qsmesh/linalg/solver.hpp"
@@ -50,22 +51,35 @@ struct QuadEdges {
 };
 
 QuadEdges quad_edges(const std::vector<std::array<LO, 4>>& quads) {
+  // Edges numbered in order of first appearance (quad by quad, corner by corner), found by
+  // sorting the (edge, position) pairs: a hash map allocated a node per edge, and this runs
+  // for every layout of every pattern and cavity.
   QuadEdges e;
-  std::unordered_map<std::uint64_t, LO> ids;
-  ids.reserve(quads.size() * 2);
+  const auto nq = static_cast<LO>(quads.size());
+  std::vector<std::pair<std::uint64_t, LO>> keyed(static_cast<std::size_t>(nq) * 4);
+  for (LO q = 0; q < nq; ++q)
+    for (int k = 0; k < 4; ++k)
+      keyed[4 * q + k] = {edge_key(quads[q][k], quads[q][(k + 1) % 4]), 4 * q + k};
+  std::sort(keyed.begin(), keyed.end());
+  std::vector<LO> group_of(keyed.size());
+  LO groups = 0;
+  for (std::size_t i = 0; i < keyed.size(); ++i) {
+    if (i > 0 && keyed[i].first != keyed[i - 1].first) ++groups;
+    group_of[keyed[i].second] = groups;
+  }
+  std::vector<LO> id_of(keyed.empty() ? 0 : static_cast<std::size_t>(groups) + 1, kNoIndex);
   e.quad2edges.resize(quads.size());
-  for (std::size_t q = 0; q < quads.size(); ++q)
+  for (LO q = 0; q < nq; ++q)
     for (int k = 0; k < 4; ++k) {
-      const LO a = quads[q][k], b = quads[q][(k + 1) % 4];
-      const auto [it, inserted] = ids.emplace(edge_key(a, b), static_cast<LO>(e.ends.size()));
-      if (inserted) {
-        e.ends.push_back({a, b});
+      LO& id = id_of[group_of[4 * q + k]];
+      if (id == kNoIndex) {
+        id = static_cast<LO>(e.ends.size());
+        e.ends.push_back({quads[q][k], quads[q][(k + 1) % 4]});
         e.edge2quads.push_back({kNoIndex, kNoIndex});
         e.num_quads.push_back(0);
       }
-      const LO id = it->second;
       e.quad2edges[q][k] = id;
-      if (e.num_quads[id] < 2) e.edge2quads[id][e.num_quads[id]] = static_cast<LO>(q);
+      if (e.num_quads[id] < 2) e.edge2quads[id][e.num_quads[id]] = q;
       ++e.num_quads[id];
     }
   return e;
