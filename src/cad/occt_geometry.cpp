@@ -12,7 +12,9 @@
 #include <ShapeAnalysis_Surface.hxx>
 #include <Standard_Failure.hxx>
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <vector>
 
@@ -158,10 +160,20 @@ class OcctFace final : public FaceGeometry {
   }
 
   SurfaceEval eval(const Vec2& uv) const override {
+    // The smoother and the untangler evaluate a moved vertex, then its normal at the same (u, v):
+    // the last evaluation is kept and returned for the same parameters, bit for bit (D1 is
+    // deterministic, so this is what evaluating again would give).
+    if (last_ok_ &&
+        std::bit_cast<std::uint64_t>(uv.u) == std::bit_cast<std::uint64_t>(last_uv_.u) &&
+        std::bit_cast<std::uint64_t>(uv.v) == std::bit_cast<std::uint64_t>(last_uv_.v))
+      return last_;
     gp_Pnt p;
     gp_Vec du, dv;
     surface_.D1(uv.u, uv.v, p, du, dv);
-    return {to_vec(p), to_vec(du), to_vec(dv)};
+    last_ = {to_vec(p), to_vec(du), to_vec(dv)};
+    last_uv_ = uv;
+    last_ok_ = true;
+    return last_;
   }
   SurfaceEval2 eval2(const Vec2& uv) const override {
     gp_Pnt p;
@@ -281,6 +293,9 @@ class OcctFace final : public FaceGeometry {
   BRepAdaptor_Surface surface_;
   Handle(Geom_Surface) geom_;
   mutable Handle(ShapeAnalysis_Surface) analysis_;
+  mutable Vec2 last_uv_;  // parameters of the last eval, and its result (eval)
+  mutable SurfaceEval last_;
+  mutable bool last_ok_ = false;
   std::unique_ptr<BRepTopAdaptor_FClass2d> classifier_;
   std::vector<std::vector<Geom2dAdaptor_Curve>> pcurves_;
 };

@@ -243,9 +243,10 @@ std::vector<std::int64_t> pattern_stage(const Context& cx, std::vector<FaceTask>
   DealProgress progress("patterns", nfaces, cx.comm, cx.log);
   deal_out(cx.comm, nfaces, cx.tasks, [&](std::int64_t k) {
     const auto f = static_cast<std::size_t>(order[static_cast<std::size_t>(k)]);
-    fills[f] =
-        mesh_face_fill(cx.model, static_cast<LO>(f), result.quantized_curves, patterns,
-                       options.patterns, fill_bound[f], options.pattern_compare_tolerance >= 0);
+    qstruct::PatternFaceOptions po = options.patterns;
+    po.size_map_quads = expected[f];
+    fills[f] = mesh_face_fill(cx.model, static_cast<LO>(f), result.quantized_curves, patterns, po,
+                              fill_bound[f], options.pattern_compare_tolerance >= 0);
     filled[f] = 1;
     progress.done();
   });

@@ -90,6 +90,7 @@ struct Candidate {
   RefinedPattern refined;
   std::vector<LO> seq;  // face loop point of each refined boundary position
   int score = 0;        // boundary valence mismatch at the corners that do not split sides
+  double held = 1;      // lowest boundary_held_sicn at the loop points holding a single quad
 };
 
 mesh::FaceMesh build_mesh(LO f, const cad::Face& face, const cad::FaceGeometry& surface,
@@ -203,6 +204,14 @@ mesh::FaceMesh move_irregular_vertices(LO f, const cad::Face& face,
   Candidate best = start;
   const int moves_before = rep.moves;
   int evaluations = 0;
+  // PatternFaceOptions::move_work_ratio: the search's layouts in proportion to the quads the
+  // face asks for.
+  int max_evaluations = options.move_evaluations;
+  const auto start_quads = static_cast<double>(start.refined.quads.size());
+  if (options.size_map_quads > 0 && options.move_work_ratio > 0 && start_quads > 0)
+    max_evaluations = static_cast<int>(std::min<double>(
+        max_evaluations, std::floor(options.move_work_ratio * options.size_map_quads *
+                                    options.move_evaluations / start_quads)));
   // The layouts are compared after a few smoothing passes, the winner smoothed fully at the end;
   // the start is compared as the others are (the caller's mesh of it had every pass).
   smooth::SmoothOptions search = options.smooth;
@@ -229,7 +238,7 @@ mesh::FaceMesh move_irregular_vertices(LO f, const cad::Face& face,
   };
   // Lays out the best candidate moved by t along v; true (and best, mesh, q updated) when better.
   const auto try_move = [&](const std::vector<LO>& v, LO t) {
-    if (t == 0 || evaluations >= options.move_evaluations) return false;
+    if (t == 0 || evaluations >= max_evaluations) return false;
     Candidate c = best;
     if (v.empty()) {
       for (LO& p : c.seq) p = (((p + t) % nb) + nb) % nb;
@@ -422,6 +431,13 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
                               : 2;
         c.score += std::abs(valence[refined.boundary[p]] - ideal);
       }
+      for (LO p = 0; p < nb; ++p) {
+        if (valence[refined.boundary[p]] != 1) continue;
+        const LO i = c.seq[p];
+        const Vec3& at = fs.points[i].xyz;
+        c.held = std::min(c.held, boundary_held_sicn(fs.points[(i + nb - 1) % nb].xyz - at,
+                                                     fs.points[(i + 1) % nb].xyz - at));
+      }
       (options.max_quads > 0 && nq > options.max_quads ? oversize : cands).push_back(std::move(c));
     }
   }
@@ -448,7 +464,8 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
     std::ostringstream os;
     os << "every fitting pattern needs at least " << fewest_quads << " quads, more than the "
        << options.max_quads << " the size map allows";
-    if (options.move_evaluations > 0) {
+    if (options.move_evaluations > 0 &&
+        !(oversize.front().held < options.held_sicn_ratio * min_sicn)) {
       // The balanced subdivisions put a transition where it costs the most quads; moved, the
       // same pattern may fit the bound (Block's half-disks [60, 78] at size factor 0.0037). The
       // search starts from a worst-possible score and lays out only the moves within the bound.
@@ -483,15 +500,20 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
   smooth::QualityReport best_q;
   const int tries = std::min<int>(m == 0 ? kCornerlessStarts : std::max(1, options.max_candidates),
                                   static_cast<int>(cands.size()));
+  bool best_held = false;  // the best candidate is held below the threshold (held_sicn_ratio)
   for (int k = 0; k < tries; ++k) {
     const Candidate& c = cands[k];
+    // A candidate held below the threshold fails it whatever is done to it: only the first is
+    // laid out, for the caller's comparison.
+    const bool held = c.held < options.held_sicn_ratio * min_sicn;
+    if (held && k > 0) continue;
     mesh::FaceMesh mesh =
         smooth::smooth_face(build_mesh(f, face, surface, fs, c), surface, options.smooth);
     smooth::QualityReport q = smooth::measure(mesh);
     // A layout good on average but with a few poor quads (usually next to an irregular vertex of
     // the pattern, or a folded corner of a size transition) is worth lifting locally; the
     // smoothing kernels never lower the minimum, so they cannot get out of a fold.
-    if (options.lift_poor_quads && (q.invalid > 0 || q.sicn_min <= min_sicn) &&
+    if (!held && options.lift_poor_quads && (q.invalid > 0 || q.sicn_min <= min_sicn) &&
         q.sicn_avg > options.min_sicn_avg && few_poor_quads(mesh, options, min_sicn)) {
       ++rep.lifts;
       smooth::UntangleOptions uo;
@@ -504,7 +526,7 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
     // best start balanced is often not the best moved (an ellipse 2:1 with 64 edges: SICN avg
     // 0.78 against 0.97).
     std::vector<LO> chords = c.match.chords;
-    if (m == 0 && options.move_evaluations > 0 && q.invalid == 0 && q.sicn_min > 0 &&
+    if (!held && m == 0 && options.move_evaluations > 0 && q.invalid == 0 && q.sicn_min > 0 &&
         q.sicn_avg < options.move_below_avg) {
       PatternFaceReport trial;
       mesh = move_irregular_vertices(f, face, surface, fs, patterns[c.match.pattern], c,
@@ -519,6 +541,7 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
     const bool better =
         best_good ? good && q.sicn_avg > rep.sicn_avg : good || k == 0 || q.sicn_min > rep.sicn_min;
     if (better) {
+      best_held = held;
       best_good = good;
       best_valid = q.invalid == 0 && q.sicn_min > 0;
       best_k = k;
@@ -540,7 +563,7 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
       return keep(std::move(best));
     }
   }
-  if (best_valid && m != 0 && options.move_evaluations > 0) {
+  if (best_valid && !best_held && m != 0 && options.move_evaluations > 0) {
     // The best valid candidate below the thresholds may pass them with its irregular vertices
     // elsewhere (Block's half-disks [60, 78]: SICN avg 0.53 balanced, 0.84 moved). Without
     // corner every start was moved already.
@@ -564,6 +587,11 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
 }
 
 }  // namespace
+
+double boundary_held_sicn(const Vec3& a, const Vec3& b) {
+  const double denom = norm2(a) + norm2(b);
+  return denom > 0 ? 2.0 * norm(cross(a, b)) / denom : 0.0;
+}
 
 FaceSides face_sides(const cad::CadModel& model, LO f, const cad::FaceGeometry& surface,
                      std::span<const mesh::CurveMesh> curves, const PatternFaceOptions& options) {

@@ -175,28 +175,36 @@ RefinedPattern refine_pattern(const Pattern& pattern, std::span<const LO> chords
   r.coarse_vertex.resize(pattern.num_vertices());
   std::iota(r.coarse_vertex.begin(), r.coarse_vertex.end(), 0);
 
-  // Vertices along each coarse edge, from its lower id to its higher id.
-  std::vector<std::vector<LO>> along(pattern.edges.size());
+  // Vertices along each coarse edge, from its lower id to its higher id, edge e's at
+  // along[first[e]] .. along[first[e + 1] - 1] (flat: this runs for every layout a search tries).
+  std::vector<LO> first(pattern.edges.size() + 1, 0), along;
+  for (std::size_t e = 0; e < pattern.edges.size(); ++e)
+    first[e + 1] = first[e] + chords[pattern.edge_chord[e]] + 1;
+  along.reserve(static_cast<std::size_t>(first.back()));
   for (std::size_t e = 0; e < pattern.edges.size(); ++e) {
     const LO s = chords[pattern.edge_chord[e]];
-    auto& ids = along[e];
-    ids.push_back(pattern.edges[e][0]);
-    for (LO t = 1; t < s; ++t) ids.push_back(r.num_vertices++);
-    ids.push_back(pattern.edges[e][1]);
+    along.push_back(pattern.edges[e][0]);
+    for (LO t = 1; t < s; ++t) along.push_back(r.num_vertices++);
+    along.push_back(pattern.edges[e][1]);
   }
   // Vertex t of the edge walked from a (t = 0) to b.
   const auto at = [&](LO e, LO a, LO t) {
-    const auto& ids = along[e];
-    return a == pattern.edges[e][0] ? ids[t] : ids[ids.size() - 1 - t];
+    return a == pattern.edges[e][0] ? along[first[e] + t] : along[first[e + 1] - 1 - t];
   };
 
+  std::size_t num_quads = 0;
+  for (const auto& qe : pattern.quad_edges)
+    num_quads += static_cast<std::size_t>(chords[pattern.edge_chord[qe[0]]]) *
+                 static_cast<std::size_t>(chords[pattern.edge_chord[qe[1]]]);
+  r.quads.reserve(num_quads);
+  std::vector<LO> grid;
   for (std::size_t q = 0; q < pattern.quads.size(); ++q) {
     const auto& v = pattern.quads[q];
     const auto& qe = pattern.quad_edges[q];
     const LO n = chords[pattern.edge_chord[qe[0]]];  // along v0 -> v1 (and v3 -> v2)
     const LO m = chords[pattern.edge_chord[qe[1]]];  // along v1 -> v2 (and v0 -> v3)
     // Grid (i, k): (0,0) = v0, (n,0) = v1, (n,m) = v2, (0,m) = v3.
-    std::vector<LO> grid(static_cast<std::size_t>(n + 1) * (m + 1));
+    grid.assign(static_cast<std::size_t>(n + 1) * (m + 1), 0);
     const auto id = [&](LO i, LO k) -> LO& {
       return grid[static_cast<std::size_t>(k) * (n + 1) + i];
     };

@@ -1,7 +1,8 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
-#include <unordered_map>
+#include <utility>
+#include <vector>
 
 #include "internal.hpp"
 #include "qsmesh/linalg/solver.hpp"
@@ -27,10 +28,10 @@ double quad_orientation(const mesh::FaceMesh& m, const cad::FaceGeometry& surfac
 }
 
 double oriented_sicn(const std::array<Vec3, 4>& x, const Vec3& normal, double sign) {
-  Vec3 sum{};
-  for (int k = 0; k < 4; ++k) sum += cross(x[k] - x[(k + 3) % 4], x[(k + 1) % 4] - x[k]);
-  if (norm2(normal) > 0 && sign * dot(sum, normal) <= 0) return -1.0;
-  return mesh::quad_sicn(x);
+  // The corner cross products give the area vector and the SICN both (mesh::quad_corners).
+  const mesh::QuadCorners c = mesh::quad_corners(x);
+  if (norm2(normal) > 0 && sign * dot(c.sum, normal) <= 0) return -1.0;
+  return mesh::quad_sicn_from(c);
 }
 
 namespace {
@@ -50,22 +51,35 @@ struct QuadEdges {
 };
 
 QuadEdges quad_edges(const std::vector<std::array<LO, 4>>& quads) {
+  // Edges numbered in order of first appearance (quad by quad, corner by corner), found by
+  // sorting the (edge, position) pairs: a hash map allocated a node per edge, and this runs
+  // for every layout of every pattern and cavity.
   QuadEdges e;
-  std::unordered_map<std::uint64_t, LO> ids;
-  ids.reserve(quads.size() * 2);
+  const auto nq = static_cast<LO>(quads.size());
+  std::vector<std::pair<std::uint64_t, LO>> keyed(static_cast<std::size_t>(nq) * 4);
+  for (LO q = 0; q < nq; ++q)
+    for (int k = 0; k < 4; ++k)
+      keyed[4 * q + k] = {edge_key(quads[q][k], quads[q][(k + 1) % 4]), 4 * q + k};
+  std::sort(keyed.begin(), keyed.end());
+  std::vector<LO> group_of(keyed.size());
+  LO groups = 0;
+  for (std::size_t i = 0; i < keyed.size(); ++i) {
+    if (i > 0 && keyed[i].first != keyed[i - 1].first) ++groups;
+    group_of[keyed[i].second] = groups;
+  }
+  std::vector<LO> id_of(keyed.empty() ? 0 : static_cast<std::size_t>(groups) + 1, kNoIndex);
   e.quad2edges.resize(quads.size());
-  for (std::size_t q = 0; q < quads.size(); ++q)
+  for (LO q = 0; q < nq; ++q)
     for (int k = 0; k < 4; ++k) {
-      const LO a = quads[q][k], b = quads[q][(k + 1) % 4];
-      const auto [it, inserted] = ids.emplace(edge_key(a, b), static_cast<LO>(e.ends.size()));
-      if (inserted) {
-        e.ends.push_back({a, b});
+      LO& id = id_of[group_of[4 * q + k]];
+      if (id == kNoIndex) {
+        id = static_cast<LO>(e.ends.size());
+        e.ends.push_back({quads[q][k], quads[q][(k + 1) % 4]});
         e.edge2quads.push_back({kNoIndex, kNoIndex});
         e.num_quads.push_back(0);
       }
-      const LO id = it->second;
       e.quad2edges[q][k] = id;
-      if (e.num_quads[id] < 2) e.edge2quads[id][e.num_quads[id]] = static_cast<LO>(q);
+      if (e.num_quads[id] < 2) e.edge2quads[id][e.num_quads[id]] = q;
       ++e.num_quads[id];
     }
   return e;

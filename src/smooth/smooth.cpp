@@ -6,11 +6,13 @@
 #include <map>
 #include <numbers>
 #include <optional>
+#include <span>
 #include <tuple>
 #include <utility>
 #include <vector>
 
 #include "internal.hpp"
+#include "qsmesh/core/adjacency.hpp"
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/core/timer.hpp"
 #include "qsmesh/linalg/solver.hpp"
@@ -39,50 +41,73 @@ QualityReport measure(const mesh::FaceMesh& mesh) {
 
 namespace {
 
+// Flat (CSR) per-vertex lists: smooth_face runs on every cavity of the improvement stage, most of
+// them a few dozen quads, where one vector per vertex was a good part of the time (allocation).
 struct Topology {
-  std::vector<char> free;            // vertex may move
-  std::vector<std::vector<LO>> v2q;  // incident quads, increasing
-  std::vector<std::vector<LO>> v2v;  // edge neighbours, increasing
-  std::vector<std::vector<LO>>
-      ring;  // ordered one-ring (edge, diagonal, edge, ...); empty: not a closed fan
+  std::vector<char> free;  // vertex may move
+  Adjacency v2q;           // incident quads, increasing
+  Adjacency v2v;           // edge neighbours, increasing
+  Adjacency ring;          // ordered one-ring (edge, diagonal, edge, ...); empty: not a closed fan
 };
 
 Topology build_topology(const mesh::FaceMesh& m) {
   const LO n = m.num_vertices();
+  const LO nq = static_cast<LO>(m.quads.size());
   Topology t;
   t.free.assign(static_cast<std::size_t>(n), 0);
-  t.v2q.resize(n);
-  t.v2v.resize(n);
-  t.ring.resize(n);
   for (LO v = 0; v < n; ++v) t.free[v] = m.vclass[v].dim == 2 ? 1 : 0;
   // Triangles are not measured here, so their vertices stay where they are.
   for (const auto& tri : m.triangles)
     for (LO v : tri) t.free[v] = 0;
-  for (LO q = 0; q < static_cast<LO>(m.quads.size()); ++q) {
-    const auto& qd = m.quads[q];
-    for (int k = 0; k < 4; ++k) {
-      t.v2q[qd[k]].push_back(q);
-      t.v2v[qd[k]].push_back(qd[(k + 1) % 4]);
-      t.v2v[qd[k]].push_back(qd[(k + 3) % 4]);
+  // v2q in quad order (increasing), by counting.
+  t.v2q.offsets.assign(static_cast<std::size_t>(n) + 1, 0);
+  for (const auto& qd : m.quads)
+    for (const LO v : qd) ++t.v2q.offsets[v + 1];
+  for (LO v = 0; v < n; ++v) t.v2q.offsets[v + 1] += t.v2q.offsets[v];
+  t.v2q.targets.resize(static_cast<std::size_t>(t.v2q.offsets[n]));
+  {
+    std::vector<LO> fill(t.v2q.offsets.begin(), t.v2q.offsets.end() - 1);
+    for (LO q = 0; q < nq; ++q)
+      for (const LO v : m.quads[q]) t.v2q.targets[fill[v]++] = q;
+  }
+  // v2v: the two edge neighbours in each incident quad, sorted and made unique per vertex.
+  t.v2v.offsets.assign(static_cast<std::size_t>(n) + 1, 0);
+  t.v2v.targets.clear();
+  t.v2v.targets.reserve(t.v2q.targets.size() * 2);
+  for (LO v = 0; v < n; ++v) {
+    const auto begin = static_cast<std::ptrdiff_t>(t.v2v.targets.size());
+    for (const LO q : t.v2q[v]) {
+      const auto& qd = m.quads[q];
+      for (int k = 0; k < 4; ++k)
+        if (qd[k] == v) {
+          t.v2v.targets.push_back(qd[(k + 1) % 4]);
+          t.v2v.targets.push_back(qd[(k + 3) % 4]);
+        }
     }
+    const auto first = t.v2v.targets.begin() + begin;
+    std::sort(first, t.v2v.targets.end());
+    t.v2v.targets.erase(std::unique(first, t.v2v.targets.end()), t.v2v.targets.end());
+    t.v2v.offsets[v + 1] = static_cast<LO>(t.v2v.targets.size());
   }
+  t.ring.offsets.assign(static_cast<std::size_t>(n) + 1, 0);
+  t.ring.targets.clear();
+  t.ring.targets.reserve(t.v2q.targets.size() * 2);
+  std::vector<std::array<LO, 3>> seg;
+  std::vector<LO> ring;
+  std::vector<char> used;
   for (LO v = 0; v < n; ++v) {
-    auto& nb = t.v2v[v];
-    std::sort(nb.begin(), nb.end());
-    nb.erase(std::unique(nb.begin(), nb.end()), nb.end());
-  }
-  for (LO v = 0; v < n; ++v) {
+    t.ring.offsets[v + 1] = t.ring.offsets[v];
     if (!t.free[v] || t.v2q[v].size() < 3) continue;
     // Fan segments (a, d, b) of quads (v, a, d, b); chained by b_i == a_{i+1}.
-    std::vector<std::array<LO, 3>> seg;
+    seg.clear();
     for (LO q : t.v2q[v]) {
       const auto& qd = m.quads[q];
       int k = 0;
       while (qd[k] != v) ++k;
       seg.push_back({qd[(k + 1) % 4], qd[(k + 2) % 4], qd[(k + 3) % 4]});
     }
-    std::vector<LO> ring;
-    std::vector<char> used(seg.size(), 0);
+    ring.clear();
+    used.assign(seg.size(), 0);
     std::size_t cur = 0;
     bool ok = true;
     for (std::size_t step = 0; step < seg.size(); ++step) {
@@ -105,7 +130,9 @@ Topology build_topology(const mesh::FaceMesh& m) {
       }
       cur = next;
     }
-    if (ok) t.ring[v] = std::move(ring);
+    if (!ok) continue;
+    t.ring.targets.insert(t.ring.targets.end(), ring.begin(), ring.end());
+    t.ring.offsets[v + 1] = static_cast<LO>(t.ring.targets.size());
   }
   return t;
 }
@@ -139,6 +166,7 @@ class Smoother {
   // normals alone a quarter of the cavity remeshing). Call after moving vertices behind the
   // smoother's back.
   void forget_geometry() {
+    settled_.assign(m_.points.size(), 0);
     normal_ok_.assign(m_.points.size(), 0);
     normal_.resize(m_.points.size());
     quality_ok_.assign(m_.quads.size(), 0);
@@ -147,7 +175,10 @@ class Smoother {
 
   // Kernel targets go to the surface through the approximate surface when there is one, unless
   // `exact` (then by Gauss-Newton on the CAD surface from the current uv).
-  void set_exact(bool exact) { exact_ = exact; }
+  void set_exact(bool exact) {
+    if (exact != exact_) settled_.assign(m_.points.size(), 0);
+    exact_ = exact;
+  }
 
   // SICN of a quad, -1 when it turns against the face normal (quad_sicn alone cannot see a quad
   // flipped as a whole, its normal being the average of its own corners).
@@ -162,12 +193,12 @@ class Smoother {
     const auto& qd = m_.quads[q];
     const std::array<Vec3, 4> p{m_.points[qd[0]], m_.points[qd[1]], m_.points[qd[2]],
                                 m_.points[qd[3]]};
-    Vec3 sum{};
-    for (int k = 0; k < 4; ++k) sum += cross(p[k] - p[(k + 3) % 4], p[(k + 1) % 4] - p[k]);
+    // The corner cross products give the area vector and the SICN both.
+    const mesh::QuadCorners c = mesh::quad_corners(p);
     Vec3 n{};
     for (int k = 0; k < 4 && norm2(n) == 0; ++k) n = vertex_normal(qd[k]);  // skip a pole corner
-    if (sign_ * dot(sum, n) <= 0) return -1.0;
-    return mesh::quad_sicn(p);
+    if (sign_ * dot(c.sum, n) <= 0) return -1.0;
+    return mesh::quad_sicn_from(c);
   }
   // (minimum, sum) of the quality of the quads around v.
   std::pair<double, double> local_quality(LO v) const {
@@ -184,7 +215,12 @@ class Smoother {
   double pass() {
     double moved = 0;
     for (LO v = 0; v < m_.num_vertices(); ++v) {
-      if (!t_.free[v] || t_.ring[v].empty()) continue;
+      if (!t_.free[v] || t_.ring[v].empty() || settled_[v]) continue;
+      // Until a vertex of its one-ring moves, a vertex whose move was refused (or had no target)
+      // would get the same target and the same refusal: everything the pass reads for it (its
+      // ring's points and normals, the quality of its quads) is unchanged. It is marked settled
+      // here and cleared by the moves around it.
+      settled_[v] = 1;
       const Vec2 uv0 = m_.uv[v];
       const Vec3 x0 = m_.points[v];
       const Vec3 n0 = vertex_normal(v);
@@ -211,11 +247,22 @@ class Smoother {
       m_.uv[v] = uv;
       m_.points[v] = s_.eval(uv).p;
       normal_ok_[v] = 0;
-      const auto after = local_quality(v);
       // The minimum must not drop; on a tie (a folded quad stuck at -1) the sum decides, so that
-      // a move cannot spoil the other quads for free.
-      const bool keep = after.first > before.first ||
-                        (after.first == before.first && after.second >= before.second);
+      // a move cannot spoil the other quads for free. A quad below the old minimum refuses the
+      // move at once: the quads after it need not be measured.
+      double after_min = std::numeric_limits<double>::max(), after_sum = 0;
+      bool keep = true;
+      for (const LO q : t_.v2q[v]) {
+        const double s = quality(q);
+        if (s < before.first) {
+          keep = false;
+          break;
+        }
+        after_min = std::min(after_min, s);
+        after_sum += s;
+      }
+      keep = keep && (after_min > before.first ||
+                      (after_min == before.first && after_sum >= before.second));
       if (!keep) {
         m_.uv[v] = uv0;
         m_.points[v] = x0;
@@ -227,6 +274,8 @@ class Smoother {
         }
         continue;
       }
+      settled_[v] = 0;
+      for (const LO w : t_.ring[v]) settled_[w] = 0;
       moved = std::max(moved, distance(x0, m_.points[v]));
     }
     return moved;
@@ -235,7 +284,7 @@ class Smoother {
  private:
   // New position in the tangent plane at x (normal n, unit).
   bool kernel(LO v, const Vec3& x, const Vec3& n, Vec3* out) const {
-    const auto& ring = t_.ring[v];
+    const std::span<const LO> ring = t_.ring[v];
     std::vector<Vec3>& p = ring_;
     p.resize(ring.size());
     for (std::size_t i = 0; i < ring.size(); ++i) {
@@ -315,6 +364,7 @@ class Smoother {
   mutable std::vector<double> quality_;
   mutable std::vector<char> quality_ok_;
   std::vector<double> saved_;       // qualities of the quads around the vertex being moved
+  std::vector<char> settled_;       // refused since the last move in its one-ring (pass)
   mutable std::vector<Vec3> ring_;  // the kernel's one-ring in the tangent plane
   double sign_;
   const ApproxSurface* approx_;

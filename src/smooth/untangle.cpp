@@ -10,6 +10,7 @@
 #include "internal.hpp"
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/core/timer.hpp"
+#include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/smooth/quad_tools.hpp"
 
 namespace qsmesh::smooth {
@@ -50,30 +51,37 @@ class Untangler {
   // mean normal), soft minimum over the quads of v, and the hard minimum. A quad turned against the
   // surface is measured against the surface normal instead, so that all its corners score negative
   // and unfolding it raises the score.
-  [[nodiscard]] Score score(LO v) const {
+  // With `floor`: a score whose soft minimum cannot exceed it (its lowest corner value is at or
+  // below it, and the soft minimum is never above the lowest value) comes back as soft = -inf
+  // without the exponentials: the search only asks whether a trial beats its best so far.
+  [[nodiscard]] Score score(LO v, double floor = -std::numeric_limits<double>::infinity()) const {
     corner_.clear();
     Score sc;
     sc.hard = std::numeric_limits<double>::infinity();
     for (const LO q : v2q_[v]) {
       const auto& qd = m_.quads[q];
-      Vec3 ref{}, sum{};
-      std::array<Vec3, 4> cr;
+      const mesh::QuadCorners c = mesh::quad_corners(
+          {m_.points[qd[0]], m_.points[qd[1]], m_.points[qd[2]], m_.points[qd[3]]});
+      Vec3 ref{};
+      for (int k = 0; k < 4; ++k) ref += normal_[qd[k]];
+      const bool flipped = norm2(ref) > 0 && dot(c.sum, ref) <= 0;
+      const Vec3 nq = flipped ? normalized(ref) : normalized(c.sum);
+      // Unflipped, the corner values are those quad_sicn takes the minimum of, so the quad's
+      // oriented SICN (quad_quality) is their minimum, -1 flipped: one evaluation, not two.
+      double worst = std::numeric_limits<double>::max();
       for (int k = 0; k < 4; ++k) {
-        const Vec3& x = m_.points[qd[k]];
-        cr[k] = cross(m_.points[qd[(k + 1) % 4]] - x, m_.points[qd[(k + 3) % 4]] - x);
-        sum += cr[k];
-        ref += normal_[qd[k]];
+        const double value =
+            c.denom[k] > 0 && norm2(nq) > 0 ? 2.0 * dot(c.n[k], nq) / c.denom[k] : -1.0;
+        corner_.push_back(value);
+        worst = std::min(worst, value);
       }
-      const Vec3 nq = norm2(ref) > 0 && dot(sum, ref) <= 0 ? normalized(ref) : normalized(sum);
-      for (int k = 0; k < 4; ++k) {
-        const Vec3& x = m_.points[qd[k]];
-        const double den =
-            norm2(m_.points[qd[(k + 1) % 4]] - x) + norm2(m_.points[qd[(k + 3) % 4]] - x);
-        corner_.push_back(den > 0 && norm2(nq) > 0 ? 2.0 * dot(cr[k], nq) / den : -1.0);
-      }
-      sc.hard = std::min(sc.hard, quad_quality(q));
+      sc.hard = std::min(sc.hard, flipped ? -1.0 : worst);
     }
     const double lo = *std::min_element(corner_.begin(), corner_.end());
+    if (lo <= floor) {
+      sc.soft = -std::numeric_limits<double>::infinity();
+      return sc;
+    }
     double sum = 0;
     for (const double c : corner_) sum += std::exp(-(c - lo) / kTau);
     sc.soft = lo - kTau * std::log(sum);
@@ -116,7 +124,7 @@ class Untangler {
         m_.uv[v] = uv;
         m_.points[v] = s_.eval(uv).p;
         normal_[v] = s_.normal(uv) * sign_;
-        const Score sc = score(v);
+        const Score sc = score(v, best.soft);
         const bool valid_kept = sc.hard > 0 || sc.hard >= cur.hard;
         if (valid_kept && sc.soft > best.soft) {
           best = sc;

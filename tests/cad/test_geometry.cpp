@@ -9,7 +9,9 @@
 #include <GeomAPI_PointsToBSplineSurface.hxx>
 #include <Geom_BSplineSurface.hxx>
 #include <TColgp_Array2OfPnt.hxx>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <gp_Pln.hxx>
 #include <numbers>
 #include <thread>
@@ -104,6 +106,53 @@ TEST(CadGeometry, BSplineEvalAndProjection) {
     const Vec2 end = g->boundary_uv(0, k, a.reversed ? ca.t0 : ca.t1);
     const Vec2 start = g->boundary_uv(0, (k + 1) % 4, b.reversed ? cb.t1 : cb.t0);
     EXPECT_LT(norm(end - start), 1e-9);
+  }
+}
+
+// The face evaluator keeps its last evaluation (the smoother evaluates a moved vertex, then the
+// normal there): any sequence of eval, eval2, normal and project on one evaluator gives, bit for
+// bit, what a fresh evaluator gives at the same parameters, +0 and -0 told apart.
+TEST(CadGeometry, RepeatedEvaluationIsBitIdentical) {
+  TColgp_Array2OfPnt pts(1, 7, 1, 7);
+  for (int i = 1; i <= 7; ++i)
+    for (int j = 1; j <= 7; ++j) {
+      const double x = (i - 1) * 1.5, y = (j - 1) * 1.0;
+      pts(i, j) = gp_Pnt(x, y, std::cos(0.7 * x) * std::sin(0.4 * y));
+    }
+  GeomAPI_PointsToBSplineSurface fit(pts);
+  ASSERT_TRUE(fit.IsDone());
+  BRepBuilderAPI_MakeFace mf(fit.Surface(), 1e-7);
+  ASSERT_TRUE(mf.IsDone());
+  const CadModel m = test::round_trip(mf.Face(), "bspline_cache");
+  const Box2& b = m.faces()[0].uv_box;
+  const auto same = [](const Vec3& x, const Vec3& y) {
+    return std::bit_cast<std::uint64_t>(x.x) == std::bit_cast<std::uint64_t>(y.x) &&
+           std::bit_cast<std::uint64_t>(x.y) == std::bit_cast<std::uint64_t>(y.y) &&
+           std::bit_cast<std::uint64_t>(x.z) == std::bit_cast<std::uint64_t>(y.z);
+  };
+  const auto g = m.face_geometry(0);
+  std::vector<Vec2> uvs;
+  for (int k = 0; k < 40; ++k)
+    uvs.push_back({b.lo.u + (b.hi.u - b.lo.u) * ((k * 7) % 11) / 10.0,
+                   b.lo.v + (b.hi.v - b.lo.v) * ((k * 3) % 5) / 4.0});
+  uvs.push_back({0.0, b.lo.v});
+  uvs.push_back({-0.0, b.lo.v});
+  for (std::size_t k = 0; k < uvs.size(); ++k) {
+    const Vec2 uv = uvs[k];
+    const auto fresh = m.face_geometry(0);
+    const SurfaceEval e0 = fresh->eval(uv);
+    const Vec3 n0 = m.face_geometry(0)->normal(uv);
+    // eval twice, then normal, eval2 and eval again at the same uv; then a different uv.
+    for (int rep = 0; rep < 2; ++rep) {
+      const SurfaceEval e = g->eval(uv);
+      EXPECT_TRUE(same(e.p, e0.p) && same(e.du, e0.du) && same(e.dv, e0.dv)) << k;
+    }
+    EXPECT_TRUE(same(g->normal(uv), n0)) << k;
+    const SurfaceEval2 e2 = g->eval2(uv);
+    EXPECT_TRUE(same(e2.p, m.face_geometry(0)->eval2(uv).p)) << k;
+    EXPECT_TRUE(same(g->eval(uv).du, e0.du)) << k;
+    (void)g->project(e0.p + Vec3{0.01, 0.02, 0.03}, uv, nullptr);
+    EXPECT_TRUE(same(g->eval(uv).p, e0.p)) << k;
   }
 }
 

@@ -390,6 +390,89 @@ TEST(FacePattern, MovedFillsMayFitTheQuadBound) {
   EXPECT_EQ(rep.quads, static_cast<std::int64_t>(m.quads.size()));
 }
 
+// PatternFaceOptions::size_map_quads and move_work_ratio: the move search lays out at most
+// move_work_ratio x size_map_quads x move_evaluations quads. On the flared strip, a size map
+// asking for a quarter of the balanced fill's quads leaves the search fewer layouts than it makes
+// improving moves unbounded; one asking for nothing near that leaves it none (the balanced fill).
+TEST(FacePattern, SearchWorkIsBoundedByTheFacesQuads) {
+  const auto pc = flared_strip("qs_flare_work.brep");
+  const auto patterns = builtin_patterns();
+  PatternFaceReport fixed, free, some, none;
+  const auto m0 = mesh_face_pattern(pc.model, 0, pc.curves, patterns, without_moves(), &fixed);
+  ASSERT_TRUE(fixed.ok) << fixed.reason;
+  PatternFaceOptions o;
+  o.move_work_ratio = 1;
+  (void)mesh_face_pattern(pc.model, 0, pc.curves, patterns, o, &free);  // size map unknown
+  ASSERT_TRUE(free.ok) << free.reason;
+  const auto quads = static_cast<double>(fixed.quads);
+  ASSERT_GT(free.moves, 2);
+  // Two layouts of the balanced fill's size, at most two improving moves.
+  o.size_map_quads = 2.0 * quads / o.move_evaluations;
+  (void)mesh_face_pattern(pc.model, 0, pc.curves, patterns, o, &some);
+  ASSERT_TRUE(some.ok) << some.reason;
+  EXPECT_GT(some.moves, 0);
+  EXPECT_LE(some.moves, 2);
+  EXPECT_LT(some.moves, free.moves);
+  // Less than one layout.
+  o.size_map_quads = 0.5 * quads / o.move_evaluations;
+  const auto m1 = mesh_face_pattern(pc.model, 0, pc.curves, patterns, o, &none);
+  ASSERT_TRUE(none.ok) << none.reason;
+  EXPECT_EQ(none.moves, 0);
+  EXPECT_EQ(none.chords, fixed.chords);
+  EXPECT_EQ(m1.quads, m0.quads);
+  // A size map asking for as many quads as the fill has: the bound is move_work_ratio x
+  // move_evaluations layouts, more than the search uses.
+  o.size_map_quads = quads;
+  PatternFaceReport loose;
+  (void)mesh_face_pattern(pc.model, 0, pc.curves, patterns, o, &loose);
+  EXPECT_EQ(loose.moves, free.moves);
+  EXPECT_EQ(loose.chords, free.chords);
+}
+
+// qstruct::boundary_held_sicn is the SICN of the rectangle on the two edges, and no quad on them
+// does better, whatever its fourth vertex.
+TEST(FacePattern, BoundaryHeldSicnBoundsEveryQuadOnTheTwoEdges) {
+  const Vec3 corner{1, 2, 0}, a{0.03, 0, 0}, b{0, 1, 0};
+  const double held = boundary_held_sicn(a, b);
+  EXPECT_NEAR(held, 2 * 0.03 / (1 + 0.03 * 0.03), 1e-15);
+  EXPECT_NEAR(held, mesh::quad_sicn({corner, corner + a, corner + a + b, corner + b}), 1e-12);
+  for (int i = 0; i <= 20; ++i)
+    for (int j = 0; j <= 20; ++j) {
+      const Vec3 fourth = corner + Vec3{-1 + 0.15 * i, -1 + 0.15 * j, 0.05 * (i - j)};
+      EXPECT_LE(mesh::quad_sicn({corner, corner + a, fourth, corner + b}), held + 1e-12);
+    }
+  EXPECT_EQ(boundary_held_sicn(Vec3{0, 0, 0}, Vec3{0, 0, 0}), 0.0);
+}
+
+// PatternFaceOptions::held_sicn_ratio: a 10 x 5 rectangle whose left side ends in a curve 0.03
+// long at the top-left corner. Every fill puts one quad at that corner, on that short edge and
+// the top side's first edge (length 1): held at about 0.06, below half the threshold 0.3. Only
+// the first candidate is laid out, neither lifted nor moved; without the rule the others are,
+// and none gets above the bound either.
+TEST(FacePattern, QuadHeldByAShortBoundaryEdgeEndsTheTrials) {
+  const XY xy = {{0, 0}, {10, 0}, {10, 5}, {0, 5}, {0, 4.97}};
+  const auto pc = polygon(xy, {10, 6, 10, 1, 5}, "qs_held.brep");
+  const auto patterns = builtin_patterns();
+  const double held = boundary_held_sicn(Vec3{1, 0, 0}, Vec3{0, -0.03, 0});
+  PatternFaceReport rep;
+  (void)mesh_face_pattern(pc.model, 0, pc.curves, patterns, {}, &rep);
+  EXPECT_FALSE(rep.ok);
+  EXPECT_EQ(rep.refusal, Refusal::Quality);
+  EXPECT_EQ(rep.candidates, 1);
+  EXPECT_EQ(rep.lifts, 0);
+  EXPECT_EQ(rep.moves, 0);
+  EXPECT_FALSE(rep.refused_mesh.quads.empty());  // still offered to the comparison
+  EXPECT_LE(rep.sicn_min, held + 1e-9);
+  PatternFaceOptions off;
+  off.held_sicn_ratio = 0;
+  PatternFaceReport all;
+  (void)mesh_face_pattern(pc.model, 0, pc.curves, patterns, off, &all);
+  EXPECT_FALSE(all.ok);
+  EXPECT_EQ(all.refusal, Refusal::Quality);
+  EXPECT_GT(all.candidates + all.lifts + all.moves, 1);
+  EXPECT_LE(all.sicn_min, held + 1e-9);
+}
+
 // PatternFaceOptions::lift_max_poor_fraction: the untangler only gets fills with few poor quads.
 // With min_sicn 0.95 most quads of the transition fill are "poor" (and the average bound is off),
 // so the default bound skips the untangler; without the bound it runs.

@@ -3,16 +3,23 @@
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepTools.hxx>
 #include <TopoDS_Face.hxx>
+#include <algorithm>
+#include <array>
+#include <bit>
 #include <cstdint>
 #include <gp_Ax3.hxx>
 #include <gp_Cylinder.hxx>
 #include <gp_Pln.hxx>
+#include <limits>
 #include <map>
 #include <numbers>
+#include <random>
 #include <string>
 
 #include "face_case.hpp"
 #include "qsmesh/cad/model.hpp"
+#include "qsmesh/mesh/quality.hpp"
+#include "qsmesh/smooth/quad_tools.hpp"
 #include "qsmesh/smooth/smooth.hpp"
 #include "shapes.hpp"
 
@@ -23,6 +30,67 @@ using test::load_face;
 using test::tmp_path;
 using test::write_face;
 using Case = test::FaceCase;
+
+// mesh::quad_corners computes each corner's terms once for the SICN and the area vector; the
+// smoother, the untangler and oriented_sicn take both from it. The values must be those of the
+// formula evaluated term by term as before (Eq. 12 per corner, the area vector from the edge
+// cross products), bit for bit, or the meshes would change: quads of every shape, folded and
+// degenerate ones included.
+double reference_sicn(const std::array<Vec3, 4>& q) {
+  std::array<Vec3, 4> n{};
+  Vec3 sum{};
+  for (int i = 0; i < 4; ++i) {
+    n[i] = cross(q[(i + 1) % 4] - q[i], q[(i + 3) % 4] - q[i]);
+    sum += n[i];
+  }
+  const double ns = norm(sum);
+  if (!(ns > 0)) return -1.0;
+  const Vec3 normal = sum / ns;
+  double worst = std::numeric_limits<double>::max();
+  for (int i = 0; i < 4; ++i) {
+    const Vec3 prev = q[(i + 3) % 4] - q[i];
+    const Vec3 next = q[(i + 1) % 4] - q[i];
+    const double denom = norm2(prev) + norm2(next);
+    worst = std::min(worst, denom > 0 ? 2.0 * dot(n[i], normal) / denom : -1.0);
+  }
+  return worst;
+}
+double reference_oriented_sicn(const std::array<Vec3, 4>& x, const Vec3& normal, double sign) {
+  Vec3 sum{};
+  for (int k = 0; k < 4; ++k) sum += cross(x[k] - x[(k + 3) % 4], x[(k + 1) % 4] - x[k]);
+  if (norm2(normal) > 0 && sign * dot(sum, normal) <= 0) return -1.0;
+  return reference_sicn(x);
+}
+std::uint64_t bits(double d) { return std::bit_cast<std::uint64_t>(d); }
+
+TEST(Smooth, OrientedSicnIsQuadSicnBitForBit) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> coord(-1.0, 1.0);
+  const Vec3 up{0, 0, 1}, tilted = normalized(Vec3{0.3, -0.2, 1});
+  int flipped = 0, valid = 0;
+  for (int t = 0; t < 20000; ++t) {
+    std::array<Vec3, 4> q;
+    // A unit square jittered by up to `jitter`: near-squares, skewed, folded and twisted quads.
+    const double jitter = t % 4 == 0 ? 1e-3 : (t % 4 == 1 ? 0.3 : 1.5);
+    const std::array<Vec3, 4> square{Vec3{0, 0, 0}, Vec3{1, 0, 0}, Vec3{1, 1, 0}, Vec3{0, 1, 0}};
+    for (int k = 0; k < 4; ++k)
+      q[k] = square[k] * 1e3 + Vec3{coord(rng), coord(rng), 0.2 * coord(rng)} * (1e3 * jitter);
+    if (t % 97 == 0) q[2] = q[1];  // a degenerate edge
+    if (t % 89 == 0) q = {q[0], q[0], q[0], q[0]};
+    const double s = mesh::quad_sicn(q);
+    ASSERT_EQ(bits(s), bits(reference_sicn(q))) << t;
+    ASSERT_EQ(bits(mesh::quad_sicn_from(mesh::quad_corners(q))), bits(s)) << t;
+    for (const Vec3& n : {up, tilted, Vec3{0, 0, 0}})
+      for (const double sign : {1.0, -1.0}) {
+        const double o = oriented_sicn(q, n, sign);
+        ASSERT_EQ(bits(o), bits(reference_oriented_sicn(q, n, sign))) << t;
+        flipped += o == -1.0 && s != -1.0 ? 1 : 0;
+      }
+    valid += s > 0 ? 1 : 0;
+  }
+  EXPECT_GT(flipped, 1000);
+  EXPECT_GT(valid, 5000);
+}
 
 // 10 x 6 plate in the z = 0 plane, u = x, v = y.
 std::string write_plate() {

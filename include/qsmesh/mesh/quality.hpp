@@ -14,6 +14,19 @@ namespace qsmesh::mesh {
 /// cross products. 1 for a square, <= 0 for a folded or non-convex quad.
 [[nodiscard]] double quad_sicn(const std::array<Vec3, 4>& q);
 
+/// The terms of quad_sicn at each corner i of q, computed once for callers that need them as well
+/// as the SICN (the smoother's orientation test, the untangler's corner values):
+/// n[i] = (q[i+1] - q[i]) x (q[i-1] - q[i]), denom[i] = |q[i+1] - q[i]|^2 + |q[i-1] - q[i]|^2, and
+/// sum = n[0] + n[1] + n[2] + n[3] (the quad's area vector, twice its area for a planar quad).
+struct QuadCorners {
+  std::array<Vec3, 4> n;
+  std::array<double, 4> denom;
+  Vec3 sum;
+};
+[[nodiscard]] QuadCorners quad_corners(const std::array<Vec3, 4>& q);
+/// quad_sicn from the terms of quad_corners(q): the same value, bit for bit.
+[[nodiscard]] double quad_sicn_from(const QuadCorners& c);
+
 /// Shape quality of a triangle, 4 sqrt(3) area / (sum of squared edge lengths): 1 equilateral,
 /// 0 degenerate.
 [[nodiscard]] double triangle_quality(const Vec3& a, const Vec3& b, const Vec3& c);

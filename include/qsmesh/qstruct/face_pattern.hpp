@@ -105,8 +105,28 @@ struct PatternFaceOptions {
   /// smoothings; ranked after 3 passes of 10 it is about a third (docs/benchmarks.md, "Fields at
   /// the geometry's resolution"). 0, or at least smooth.iterations: every layout fully smoothed.
   int move_search_iterations = 3;
+  /// Quads the size map asks of the face (sizemap::expected_quads; the pipeline sets it per face;
+  /// 0: unknown, no bound below) and the bound it puts on the move search: the search lays out
+  /// at most move_work_ratio x size_map_quads x move_evaluations quads, so a fill far finer
+  /// than the size map gets proportionally fewer layouts (fewer than move_evaluations when its
+  /// start has more than move_work_ratio x size_map_quads quads). wing_fuselage at its reference
+  /// count: faces 7 and 15, one-corner fills of 8893 quads where the size map asks for 713 (the
+  /// unstructured mesh has 792), laid out 18 times each and refused (docs/benchmarks.md).
+  double size_map_quads = 0;
+  double move_work_ratio = 2;
   /// Matches tried geometrically (laid out, smoothed, measured) before giving up, best first.
   int max_candidates = 4;
+  /// A loop point where a candidate puts a single quad holds that quad's two boundary edges there,
+  /// so no smoothing or untangling lifts it above boundary_held_sicn of those edges (a short CAD
+  /// curve beside a long edge: wing_fuselage's faces 1 and 8, a 0.018-long edge beside a 3.8-long
+  /// one, held at 0.028). A candidate held below held_sicn_ratio x the face's min threshold cannot
+  /// pass the thresholds: it is laid out only when it is the first (still offered to the caller's
+  /// comparison with the unstructured mesh), and never lifted or moved. At 1, on the six shared
+  /// models at their reference counts, every mesh is unchanged, byte for byte; the pattern stage
+  /// loses wing_fuselage's faces 1 and 8 (2.5 s each: four candidates, each lifted, then 28 moved
+  /// layouts) and Block's faces 445-455 (held at 0.204 against 0.229, four lifts and 22 moved
+  /// layouts each), docs/benchmarks.md. 0: off.
+  double held_sicn_ratio = 1;
   MatchOptions match;
   smooth::SmoothOptions smooth;
 };
@@ -207,6 +227,13 @@ struct FaceSides {
 /// corner at or before it, the last side before the first corner. Precondition: fs.corners not
 /// empty, 0 <= pos < fs.points.size().
 [[nodiscard]] int side_of(const FaceSides& fs, LO pos);
+
+/// The highest SICN (Eq. 12, mesh::quad_sicn) a quad can have when two of its edges meeting at a
+/// corner are `a` and `b` (vectors from that corner): the corner's term 2 |a x b| / (|a|^2 +
+/// |b|^2), whatever the quad's other two vertices. A single quad at a boundary loop point has its
+/// two boundary edges there fixed, so this bounds every fill that puts one quad there. 0 for a
+/// zero edge.
+[[nodiscard]] double boundary_held_sicn(const Vec3& a, const Vec3& b);
 
 /// Paper 000 Sec. 6.1.2 on face f.
 ///  - Input: the model, the final curve meshes of all curves (`full_curves`, by curve id, as
