@@ -266,6 +266,8 @@ struct Checks {
   struct Blocks {
     std::int64_t blocks = 0, quads = 0, largest = 0;
     LO unblocked_faces = 0, extended_faces = 0;
+    /// Faces whose blocks are the regions of their cross-field partition (paper 003), as given.
+    LO partition_faces = 0;
     /// PLOT3D output: what it could not hold (the unblocked faces with elements).
     std::optional<io::Plot3dReport> plot3d;
     /// --layout coarse: its statistics; fallback: it failed and the dense layout was written.
@@ -437,6 +439,8 @@ std::string stats_json(const Arguments& args, const Session& session,
     j.value("block_quads_largest", checks.blocks->largest);
     j.value("faces_not_in_blocks", static_cast<std::int64_t>(checks.blocks->unblocked_faces));
     j.value("faces_with_extended_traces", static_cast<std::int64_t>(checks.blocks->extended_faces));
+    j.value("faces_with_partition_blocks",
+            static_cast<std::int64_t>(checks.blocks->partition_faces));
     j.value("block_layout",
             std::string(checks.blocks->coarse
                             ? (checks.blocks->fallback ? "dense (coarse failed)" : "coarse")
@@ -604,7 +608,7 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
     os << "  blocks (structured zones): " << b.blocks << ", " << b.mean_quads()
        << " quads each on average, largest " << b.largest << "; faces not in blocks "
        << b.unblocked_faces << "; faces traced again with extended traces " << b.extended_faces
-       << "\n";
+       << "; faces whose blocks are their cross-field partition " << b.partition_faces << "\n";
     if (b.plot3d && !b.plot3d->skipped_faces.empty())
       os << "  left out of the PLOT3D file (not blocks): " << b.plot3d->skipped_faces.size()
          << " faces, " << b.plot3d->skipped_triangles << " triangles, " << b.plot3d->skipped_quads
@@ -900,8 +904,14 @@ int run_mesh(const Arguments& args) {
         }
       }
       const mesh::SurfaceMesh& written = coarse ? coarse->mesh : result.mesh;
+      // The faces meshed from a cross field bring their blocks: the partition's regions.
+      std::vector<layout::GivenBlock> given;
+      for (std::size_t f = 0; f < result.field_grids.size(); ++f)
+        for (fieldmesh::RegionGrid& g : result.field_grids[f])
+          given.push_back({static_cast<LO>(f), g.ni, g.nj, std::move(g.vertices)});
       const layout::QuadLayout lay =
-          coarse ? std::move(coarse->layout) : layout::extract_quad_layout(result.mesh);
+          coarse ? std::move(coarse->layout)
+                 : layout::extract_quad_layout(result.mesh, layout::LayoutOptions{}, given);
       b.blocks = static_cast<std::int64_t>(lay.blocks.size());
       for (const layout::Block& k : lay.blocks) {
         const std::int64_t n = static_cast<std::int64_t>(k.ni) * k.nj;
@@ -910,6 +920,7 @@ int run_mesh(const Arguments& args) {
       }
       b.unblocked_faces = static_cast<LO>(lay.unblocked_faces.size());
       b.extended_faces = lay.faces_with_extended_traces;
+      b.partition_faces = lay.faces_with_given_blocks;
       s.times.add("layout", clock.seconds());
       clock.reset();
       if (io::output_format(args.output) == io::Format::kPlot3d) {

@@ -792,6 +792,17 @@ mesh::FaceMesh partition_and_fill(Context& c, std::span<const SingularPoint> sin
         if (flip) std::swap(q[1], q[3]);
         out_mesh.quads.push_back(q);
       }
+    // The region as a block: (i, j) runs counter-clockwise in uv, which is along the face normal
+    // unless the face is reversed; then the quads were flipped and the block is the transposed
+    // grid (j, i).
+    RegionGrid g;
+    g.ni = static_cast<LO>(flip ? m : n);
+    g.nj = static_cast<LO>(flip ? n : m);
+    g.vertices.resize(grid.size());
+    for (std::size_t j = 0; j <= m; ++j)
+      for (std::size_t i = 0; i <= n; ++i)
+        g.vertices[flip ? i * (m + 1) + j : j * (n + 1) + i] = id(i, j);
+    rep.grids.push_back(std::move(g));
   }
   return out_mesh;
 }
@@ -911,6 +922,7 @@ mesh::FaceMesh mesh_face_from_field(const cad::CadModel& model, LO f,
     rep.reason = e.what();
   }
   rep.ok = false;
+  rep.grids.clear();
   return {};
 }
 

@@ -361,20 +361,85 @@ void merge_blocks(std::vector<Grid>& grids, const mesh::SurfaceMesh& mesh) {
   grids.resize(kept);
 }
 
+// The given blocks as grids with their quads, by face (faces with none: empty); a face keeps none
+// unless its blocks cover its quads exactly once, each cell a quad of the face in its orientation
+// (its vertices in the order of the quad, up to the starting one).
+std::vector<std::vector<Grid>> given_grids(const mesh::SurfaceMesh& mesh,
+                                           std::span<const GivenBlock> given) {
+  const auto nf = static_cast<std::size_t>(std::max<LO>(mesh.num_cad_faces, 0));
+  std::vector<std::vector<Grid>> out(nf);
+  if (given.empty()) return out;
+  std::vector<char> has(nf, 0);
+  for (const GivenBlock& b : given) {
+    QSMESH_CHECK(b.face >= 0 && static_cast<std::size_t>(b.face) < nf,
+                 "layout: given block of unknown face " << b.face);
+    has[static_cast<std::size_t>(b.face)] = 1;
+  }
+  // An oriented quad as its vertex cycle from the smallest id.
+  auto key = [](std::array<GO, 4> c) {
+    std::rotate(c.begin(), std::min_element(c.begin(), c.end()), c.end());
+    return c;
+  };
+  std::map<std::array<GO, 4>, GO> quad_of;
+  std::vector<GO> face_quads(nf, 0);
+  for (std::size_t q = 0; q < mesh.quads.size(); ++q) {
+    const auto f = static_cast<std::size_t>(mesh.quad_face[q]);
+    if (!has[f]) continue;
+    ++face_quads[f];
+    quad_of.emplace(key(mesh.quads[q]), static_cast<GO>(q));
+  }
+  std::vector<char> covered(mesh.quads.size(), 0), bad(nf, 0);
+  for (LO t : mesh.triangle_face) bad[static_cast<std::size_t>(t)] = 1;  // no blocks there
+  std::vector<GO> cells(nf, 0);
+  for (const GivenBlock& b : given) {
+    const auto f = static_cast<std::size_t>(b.face);
+    if (b.ni < 1 || b.nj < 1 ||
+        b.vertices.size() !=
+            static_cast<std::size_t>(b.ni + 1) * static_cast<std::size_t>(b.nj + 1))
+      bad[f] = 1;
+    if (bad[f]) continue;
+    Grid g{b.face, b.ni, b.nj, b.vertices, {}};
+    for (LO j = 0; j < b.nj && !bad[f]; ++j)
+      for (LO i = 0; i < b.ni && !bad[f]; ++i) {
+        const auto it =
+            quad_of.find(key({g.at(i, j), g.at(i + 1, j), g.at(i + 1, j + 1), g.at(i, j + 1)}));
+        if (it == quad_of.end() || mesh.quad_face[static_cast<std::size_t>(it->second)] != b.face ||
+            covered[static_cast<std::size_t>(it->second)]) {
+          bad[f] = 1;
+          break;
+        }
+        covered[static_cast<std::size_t>(it->second)] = 1;
+        g.quads.push_back(it->second);
+      }
+    cells[f] += static_cast<GO>(g.quads.size());
+    std::sort(g.quads.begin(), g.quads.end());
+    out[f].push_back(std::move(g));
+  }
+  for (std::size_t f = 0; f < nf; ++f) {
+    if (bad[f] || cells[f] != face_quads[f]) out[f].clear();
+    // In the order of the traced ones: by their smallest quad.
+    std::sort(out[f].begin(), out[f].end(),
+              [](const Grid& a, const Grid& b) { return a.quads.front() < b.quads.front(); });
+  }
+  return out;
+}
+
 }  // namespace
 
-QuadLayout extract_quad_layout(const mesh::SurfaceMesh& mesh, const LayoutOptions& options) {
+QuadLayout extract_quad_layout(const mesh::SurfaceMesh& mesh, const LayoutOptions& options,
+                               std::span<const GivenBlock> given) {
   QSMESH_CHECK(
       mesh.quad_face.size() == mesh.quads.size() && mesh.vclass.size() == mesh.points.size(),
       "layout: inconsistent mesh arrays");
   const auto nf = static_cast<std::size_t>(std::max<LO>(mesh.num_cad_faces, 0));
   Layouter layouter(mesh);
   std::vector<char> bad = layouter.face_unblocked();  // faces that get no block
-  std::vector<char> faces(nf, 0);
-  for (std::size_t f = 0; f < nf; ++f) faces[f] = bad[f] ? 0 : 1;
+  const std::vector<std::vector<Grid>> kept = given_grids(mesh, given);
+  std::vector<char> faces(nf, 0);  // the faces traced
+  for (std::size_t f = 0; f < nf; ++f) faces[f] = bad[f] || !kept[f].empty() ? 0 : 1;
 
   QuadLayout out;
-  layouter.trace(layouter.starts(nullptr), options.motorcycle);
+  layouter.trace(layouter.starts(&faces), options.motorcycle);
   std::vector<Grid> grids;
   const std::vector<LO> failed = layouter.patches(faces, grids);
   std::vector<char> again(nf, 0);
@@ -395,6 +460,15 @@ QuadLayout extract_quad_layout(const mesh::SurfaceMesh& mesh, const LayoutOption
   std::stable_sort(grids.begin(), grids.end(),
                    [](const Grid& a, const Grid& b) { return a.face < b.face; });
   if (options.merge) merge_blocks(grids, mesh);
+  // The given blocks join the traced ones, by face (a stable merge keeps each face's order).
+  const auto traced = static_cast<std::ptrdiff_t>(grids.size());
+  for (std::size_t f = 0; f < nf; ++f) {
+    if (kept[f].empty()) continue;
+    ++out.faces_with_given_blocks;
+    grids.insert(grids.end(), kept[f].begin(), kept[f].end());
+  }
+  std::inplace_merge(grids.begin(), grids.begin() + traced, grids.end(),
+                     [](const Grid& a, const Grid& b) { return a.face < b.face; });
 
   out.quad2block.assign(mesh.quads.size(), -1);
   for (Grid& g : grids) {

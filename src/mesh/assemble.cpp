@@ -102,7 +102,7 @@ MeshAssembler::MeshAssembler(const cad::CadModel& model, std::span<const CurveMe
   }
 }
 
-void MeshAssembler::add_face(LO f, const FaceMesh& fm) {
+std::vector<GO> MeshAssembler::add_face(LO f, const FaceMesh& fm) {
   const LO nc = model_.num_corners();
   const LO ncurves = model_.num_curves();
   QSMESH_CHECK(f >= 0 && f < model_.num_faces(), "assembly: no face " << f);
@@ -158,6 +158,7 @@ void MeshAssembler::add_face(LO f, const FaceMesh& fm) {
                          local2global[q[3]]};
     out_.quad_face[q_out++] = f;
   }
+  return local2global;
 }
 
 SurfaceMesh MeshAssembler::finish() {

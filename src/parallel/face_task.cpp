@@ -71,6 +71,7 @@ FaceOutput take_output(FaceTask&& task, bool quads) {
   out.quasi = std::move(task.quasi);
   out.seconds = task.seconds;
   out.times = task.times;
+  if (quads) out.field_grids = std::move(task.field_grids);
   task = FaceTask{};
   return out;
 }

@@ -43,6 +43,7 @@ void take_field_mesh(FaceTask& task, FieldFace&& face) {
   task.quasi.field_regions = face.report.regions;
   task.quasi.by_pattern = false;
   task.quad_mesh = std::move(face.mesh);
+  task.field_grids = std::move(face.report.grids);
   task.unstructured.ok = true;
   task.unstructured.quads = static_cast<std::int64_t>(task.quad_mesh.quads.size());
   task.unstructured.sicn_min = face.report.stats.sicn_min;

@@ -423,6 +423,7 @@ void gather_stage(const Context& cx, std::vector<FaceTask>& faces,
       result.face_stats.resize(n);
       result.face_seconds.resize(n);
       result.face_times.resize(n);
+      result.field_grids.resize(n);
     }
     if (keep_background) result.background.resize(n);
   }
@@ -437,7 +438,12 @@ void gather_stage(const Context& cx, std::vector<FaceTask>& faces,
       QSMESH_CHECK(f >= 0 && f < nfaces, "gathered report for unknown face " << f);
       result.reports[f] = std::move(out.report);
       out.mesh.face = f;
-      assembler->add_face(f, out.mesh);
+      const std::vector<GO> global = assembler->add_face(f, out.mesh);
+      if (quads) {
+        for (fieldmesh::RegionGrid& g : out.field_grids)
+          for (GO& v : g.vertices) v = global[static_cast<std::size_t>(v)];
+        result.field_grids[f] = std::move(out.field_grids);
+      }
       if (keep_background) result.background[f] = std::move(out.mesh);
       if (options.cross_fields) result.cross_fields[f] = std::move(out.cross_field);
       if (options.size_map) result.face_sizes[f] = std::move(out.sizes);

@@ -42,6 +42,8 @@ struct BlockFileSummary {
   std::int64_t interface_points = 0;
   std::int64_t boundary_conditions = 0;  ///< BCs (free block edges), each checked to lie on a side
   std::int64_t abutments = 0;  ///< general connectivities between a block and the unstructured zone
+  /// Cells along i and along j of each structured zone, in the file's order.
+  std::vector<std::array<std::int64_t, 2>> block_cells;
 };
 
 /// whole_sides: also every 1-to-1 interface spans a whole side of its zone and of its donor (a
@@ -91,6 +93,8 @@ inline BlockFileSummary check_block_file(const std::string& path, bool whole_sid
       zone.nj = size[1];
       n = static_cast<std::size_t>(zone.ni * zone.nj);
       out.block_quads += static_cast<std::int64_t>(size[2]) * size[3];
+      out.block_cells.push_back(
+          {static_cast<std::int64_t>(size[2]), static_cast<std::int64_t>(size[3])});
       if (size[2] != size[0] - 1 || size[3] != size[1] - 1) err << name << ": cell sizes; ";
       for (int s = 0; s < 4; ++s) {
         zone.covered[static_cast<std::size_t>(s)].assign(

@@ -1,6 +1,7 @@
 // `qsmesh mesh --cross-field` and `--method separatrix` (paper 003) on a plate with a hole: the
 // round trip of `qsmesh crossfield`'s VTU, a list of singular points, the separatrix method, and
-// bad files refused up front; on a disk, boundary singular points.
+// bad files refused up front; on a disk, boundary singular points; the partition's regions as the
+// blocks of --block-structured.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
@@ -8,14 +9,21 @@
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepBuilderAPI_MakePolygon.hxx>
 #include <BRepBuilderAPI_MakeWire.hxx>
+#include <BRepPrimAPI_MakeBox.hxx>
 #include <BRepTools.hxx>
 #include <TopoDS_Face.hxx>
+#include <TopoDS_Shape.hxx>
 #include <TopoDS_Wire.hxx>
+#include <algorithm>
+#include <cstdint>
 #include <cstdlib>
 #include <fstream>
 #include <gp_Circ.hxx>
 #include <string>
+#include <utility>
+#include <vector>
 
+#include "cgns_blocks_check.hpp"
 #include "tmp_dir.hpp"
 
 namespace {
@@ -156,6 +164,60 @@ TEST(FieldMeshCli, SeparatrixMethodAndRefusals) {
       qsmesh("mesh " + model + " --cross-field " + tmp("none.txt") + " -o " + tmp("b.vtu"), log),
       2);
   EXPECT_EQ(qsmesh("mesh " + model + " --method other -o " + tmp("b.vtu"), log), 2);
+}
+
+// Each structured zone's cells as (smaller, larger), sorted: block dimensions up to the axes.
+std::vector<std::pair<std::int64_t, std::int64_t>> block_sizes(
+    const qsmesh::test::BlockFileSummary& s) {
+  std::vector<std::pair<std::int64_t, std::int64_t>> out;
+  for (const auto& c : s.block_cells) out.emplace_back(std::min(c[0], c[1]), std::max(c[0], c[1]));
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+TEST(FieldMeshCli, PartitionRegionsAreTheBlocks) {
+  // The disk of BoundarySingularPointsOnADisk at size 0.4: four regions, of 2 x 2 and 4 x 2 quads
+  // (tests/fieldmesh). --block-structured writes them as they are: no layout is traced there.
+  const std::string model = disk(), log = tmp("pb.log"), stats = tmp("pb.json");
+  const std::string points = tmp("pb_pts.txt"), out = tmp("pb.cgns");
+  std::ofstream(points) << "qsmesh-cross-field singular-points 1\nface 0\n"
+                           "point 0.3 0 0 1\npoint -0.3 0 0 1\npoint 1 0 0 1\npoint -1 0 0 1\n";
+  ASSERT_EQ(qsmesh("mesh " + model + " --size 0.4 --cross-field " + points + " -o " + out +
+                       " --block-structured --stats " + stats,
+                   log),
+            0)
+      << slurp(log);
+  std::string json = slurp(stats);
+  EXPECT_TRUE(has(json, "\"faces_meshed_by_field\": 1")) << json;
+  EXPECT_TRUE(has(json, "\"field_regions\": 4")) << json;
+  EXPECT_TRUE(has(json, "\"blocks\": 4")) << json;
+  EXPECT_TRUE(has(json, "\"faces_with_partition_blocks\": 1")) << json;
+  qsmesh::test::BlockFileSummary s = qsmesh::test::check_block_file(out);
+  EXPECT_TRUE(s.error.empty()) << s.error;
+  EXPECT_EQ(s.unstructured_zones, 0);
+  using Sizes = std::vector<std::pair<std::int64_t, std::int64_t>>;
+  EXPECT_EQ(block_sizes(s), (Sizes{{2, 2}, {2, 2}, {2, 4}, {2, 4}}));
+
+  // A box whose face 0 alone has a field (no singular point: one region, the whole face); its
+  // neighbours keep the default pipeline and their traced blocks meet its block along the shared
+  // curves. Each face takes the field in turn (faces of both orientations).
+  const TopoDS_Shape box = BRepPrimAPI_MakeBox(2.0, 1.0, 0.6).Shape();
+  const std::string box_path = tmp("pb_box.brep");
+  ASSERT_TRUE(BRepTools::Write(box, box_path.c_str()));
+  for (int f = 0; f < 6; ++f) {
+    std::ofstream(points) << "qsmesh-cross-field singular-points 1\nface " << f << "\n";
+    ASSERT_EQ(qsmesh("mesh " + box_path + " --size 0.2 --cross-field " + points + " -o " + out +
+                         " --block-structured --stats " + stats,
+                     log),
+              0)
+        << slurp(log);
+    json = slurp(stats);
+    EXPECT_TRUE(has(json, "\"faces_meshed_by_field\": 1")) << "face " << f << ": " << json;
+    EXPECT_TRUE(has(json, "\"faces_with_partition_blocks\": 1")) << "face " << f << ": " << json;
+    s = qsmesh::test::check_block_file(out);
+    EXPECT_TRUE(s.error.empty()) << "face " << f << ": " << s.error;
+    EXPECT_EQ(s.unstructured_zones, 0);
+  }
 }
 
 }  // namespace

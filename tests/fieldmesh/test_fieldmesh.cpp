@@ -18,6 +18,8 @@
 #include <TopoDS_Face.hxx>
 #include <TopoDS_Solid.hxx>
 #include <TopoDS_Wire.hxx>
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <functional>
 #include <gp_Ax3.hxx>
@@ -201,8 +203,36 @@ void expect_irregular_at(const FaceRun& r, const std::vector<fieldmesh::Singular
   }
 }
 
+// The report's grids are the partition's regions, one each, and they cover the quads once: the
+// cell (i, j) of a grid is a quad of the mesh with the vertices (i, j), (i + 1, j), (i + 1, j + 1),
+// (i, j + 1) in its order (up to the first), i.e. oriented as the face.
+void expect_region_grids(const mesh::FaceMesh& quads, const fieldmesh::FieldMeshReport& report) {
+  ASSERT_EQ(static_cast<int>(report.grids.size()), report.regions);
+  auto key = [](std::array<GO, 4> c) {
+    std::rotate(c.begin(), std::min_element(c.begin(), c.end()), c.end());
+    return c;
+  };
+  std::map<std::array<GO, 4>, int> uses;
+  for (const auto& q : quads.quads) uses[key({q[0], q[1], q[2], q[3]})] = 0;
+  std::size_t cells = 0;
+  for (const auto& g : report.grids) {
+    ASSERT_GE(g.ni, 1);
+    ASSERT_GE(g.nj, 1);
+    ASSERT_EQ(g.vertices.size(), static_cast<std::size_t>((g.ni + 1) * (g.nj + 1)));
+    auto at = [&](LO i, LO j) { return g.vertices[static_cast<std::size_t>(j * (g.ni + 1) + i)]; };
+    for (LO j = 0; j < g.nj; ++j)
+      for (LO i = 0; i < g.ni; ++i, ++cells) {
+        const auto it = uses.find(key({at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)}));
+        ASSERT_NE(it, uses.end()) << "cell (" << i << ", " << j << ") is no quad of the face";
+        EXPECT_EQ(++it->second, 1);
+      }
+  }
+  EXPECT_EQ(cells, quads.quads.size());
+}
+
 void expect_valid(const FaceRun& r) {
   ASSERT_TRUE(r.report.ok) << r.report.stage << ": " << r.report.reason;
+  expect_region_grids(r.quads, r.report);
   EXPECT_GT(r.quads.quads.size(), 0u);
   EXPECT_TRUE(r.quads.triangles.empty());
   EXPECT_GT(r.report.stats.sicn_min, 0.3);
@@ -297,6 +327,7 @@ TEST(FieldMesh, DiskWithTwoSingularPointsIsRefusedByEq11) {
   const std::vector<fieldmesh::SingularPoint> pts{{{0.4, 0, 0}, 1}, {{-0.4, 0, 0}, 1}};
   const FaceRun r = run_points(c, 0, 0.05, pts);
   EXPECT_FALSE(r.report.ok);
+  EXPECT_TRUE(r.report.grids.empty());
   EXPECT_EQ(r.report.stage, "compatibility");
   EXPECT_NE(r.report.reason.find("Eq. 11"), std::string::npos) << r.report.reason;
 }
@@ -355,6 +386,12 @@ TEST(FieldMesh, DiskWithTwoSingularPointsAndTwoBoundarySingularPoints) {
   EXPECT_NEAR(r.report.stats.sicn_min, std::sin(2 * kPi / 16), 1e-3);
   EXPECT_EQ(r.report.regions, 4);
   EXPECT_EQ(r.quads.quads.size(), 24u);
+  expect_region_grids(r.quads, r.report);
+  std::vector<std::pair<LO, LO>> sizes;
+  for (const auto& g : r.report.grids)
+    sizes.emplace_back(std::min(g.ni, g.nj), std::max(g.ni, g.nj));
+  std::sort(sizes.begin(), sizes.end());
+  EXPECT_EQ(sizes, (std::vector<std::pair<LO, LO>>{{2, 2}, {2, 2}, {2, 4}, {2, 4}}));
   expect_irregular_at(r, interior, 1e-9);
   // The boundary irregular vertices are the two given ones, one quad each.
   const auto on_boundary = irregular_on_boundary(r.quads);
@@ -374,6 +411,7 @@ TEST(FieldMesh, DiskWithTwoSingularPointsAndTwoBoundarySingularPoints) {
   const auto m = fieldmesh::mesh_face_by_method(
       c.model, 0, c.curves, fieldmesh::FaceMethod::GivenField, &given, nullptr, {}, nullptr, &rep);
   ASSERT_TRUE(rep.ok) << rep.stage << ": " << rep.reason;
+  expect_region_grids(m, rep);
   EXPECT_EQ(rep.stats.irregular_interior, 2);
   EXPECT_EQ(rep.stats.irregular_boundary, 2);
   EXPECT_GT(rep.stats.sicn_min, 0.3);
@@ -382,6 +420,7 @@ TEST(FieldMesh, DiskWithTwoSingularPointsAndTwoBoundarySingularPoints) {
   pts[2].d = pts[3].d = -1;
   r = run_points(c, 0, 0.1, pts);
   EXPECT_FALSE(r.report.ok);
+  EXPECT_TRUE(r.report.grids.empty());
   EXPECT_EQ(r.report.stage, "compatibility");
   EXPECT_NE(r.report.reason.find("Eq. 11"), std::string::npos) << r.report.reason;
   EXPECT_NE(r.report.reason.find("2 given boundary points"), std::string::npos) << r.report.reason;

@@ -702,6 +702,23 @@ TEST(Pipeline, SeparatrixMethodDoesNotDependOnRanks) {
     EXPECT_EQ(dist.quasi_reports[f].by_field, serial.quasi_reports[f].by_field);
     EXPECT_EQ(dist.quasi_reports[f].field_refusal, serial.quasi_reports[f].field_refusal);
     by_field += dist.quasi_reports[f].by_field ? 1 : 0;
+    // The partition's regions reach rank 0 in the assembled numbering, as on one rank: one grid
+    // per region, the face's quads once.
+    const auto& grids = dist.field_grids[f];
+    const auto& one = serial.field_grids[f];
+    ASSERT_EQ(grids.size(), one.size()) << "face " << f;
+    EXPECT_EQ(static_cast<std::int64_t>(grids.size()),
+              dist.quasi_reports[f].by_field ? dist.quasi_reports[f].field_regions : 0);
+    std::int64_t cells = 0;
+    for (std::size_t k = 0; k < grids.size(); ++k) {
+      EXPECT_EQ(grids[k].ni, one[k].ni);
+      EXPECT_EQ(grids[k].nj, one[k].nj);
+      EXPECT_EQ(grids[k].vertices, one[k].vertices);
+      cells += static_cast<std::int64_t>(grids[k].ni) * grids[k].nj;
+    }
+    if (dist.quasi_reports[f].by_field) {
+      EXPECT_EQ(cells, dist.face_stats[f].quads) << "face " << f;
+    }
   }
   EXPECT_GT(by_field, 0);
 }

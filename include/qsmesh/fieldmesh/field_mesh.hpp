@@ -91,6 +91,23 @@ struct FieldMeshOptions {
   linalg::SolverOptions solver;
 };
 
+/// One four-sided region of the partition as the structured grid of its quads: ni x nj quads whose
+/// (ni + 1) x (nj + 1) vertices are vertices[j * (ni + 1) + i] (ids of the face mesh's vertices, i
+/// fastest), oriented as layout::Block: the quad at (i, j) is (i, j), (i + 1, j), (i + 1, j + 1),
+/// (i, j + 1), counter-clockwise about the face normal. These are the blocks of the face for
+/// block-structured output, so that no layout has to be extracted from its mesh.
+struct RegionGrid {
+  LO ni = 0, nj = 0;
+  std::vector<GO> vertices;
+  /// Every field, once (visit(name, member)): what the ranks exchange (parallel/record.hpp).
+  template <class S, class V>
+  static void fields(S& self, V&& visit) {
+    visit("ni", self.ni);
+    visit("nj", self.nj);
+    visit("vertices", self.vertices);
+  }
+};
+
 /// What happened on one face.
 struct FieldMeshReport {
   LO face = kNoIndex;
@@ -103,6 +120,9 @@ struct FieldMeshReport {
   int separatrices = 0;   ///< traced (after merging)
   int regions = 0;        ///< four-sided regions
   mesh::FaceQuadStats stats;
+  /// When ok: the regions as grids of the returned mesh's vertices, which they cover once (in the
+  /// order of the mesh's quads, which are emitted region by region).
+  std::vector<RegionGrid> grids;
 };
 
 /// The singular points of a discrete field (angles per vertex of `tri`): triangles around which the

@@ -19,6 +19,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include "qsmesh/core/types.hpp"
@@ -48,6 +49,15 @@ struct LayoutOptions {
   bool merge = true;
 };
 
+/// A block given for a face instead of traced from its mesh: paper 003's partition into
+/// four-sided regions (fieldmesh::RegionGrid, in the assembled mesh's vertex ids). ni x nj quads
+/// of CAD face `face` with (ni + 1) x (nj + 1) vertices, i fastest, oriented as Block.
+struct GivenBlock {
+  LO face = kNoIndex;
+  LO ni = 0, nj = 0;
+  std::vector<GO> vertices;
+};
+
 struct QuadLayout {
   std::vector<Block> blocks;   ///< by face, then by the smallest quad id of the block
   std::vector<GO> vertices;    ///< the blocks' vertex grids (Block::first)
@@ -56,11 +66,17 @@ struct QuadLayout {
   /// elements are in no block (block-structured output writes them as an unstructured zone).
   std::vector<LO> unblocked_faces;
   LO faces_with_extended_traces = 0;  ///< faces traced again with extended traces
+  LO faces_with_given_blocks = 0;     ///< faces whose blocks are the given ones
 };
 
 /// Partitions the quads of `mesh` (an assembled SurfaceMesh: bars on every CAD curve, each CAD
 /// face's elements oriented along its normal) into blocks. Deterministic: depends on the mesh only.
+/// The faces of `given` take those blocks as they are (neither traced nor merged) when they cover
+/// the face's quads exactly once, each cell a quad of the face with its orientation; a face whose
+/// given blocks do not is traced as the others. Their blocks end on the CAD curves like the traced
+/// ones, so those of a neighbouring face may meet them in T-junctions there, as traced faces do.
 [[nodiscard]] QuadLayout extract_quad_layout(const mesh::SurfaceMesh& mesh,
-                                             const LayoutOptions& options = {});
+                                             const LayoutOptions& options = {},
+                                             std::span<const GivenBlock> given = {});
 
 }  // namespace qsmesh::layout

@@ -42,7 +42,8 @@ class MeshAssembler {
                 std::span<const FaceContribution> contributions);
   /// Adds the mesh of face f (once per face; faces never added stay empty). Throws Error when
   /// its counts differ from the contribution given for f or its classification is out of range.
-  void add_face(LO f, const FaceMesh& face);
+  /// Returns the assembled mesh's id of each vertex of `face` (its numbering in the result).
+  std::vector<GO> add_face(LO f, const FaceMesh& face);
   /// The mesh; throws Error unless every face with a non-zero contribution was added.
   [[nodiscard]] SurfaceMesh finish();
 

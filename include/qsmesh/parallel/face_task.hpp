@@ -18,6 +18,7 @@
 #include "qsmesh/background/face_mesh.hpp"
 #include "qsmesh/cad/model.hpp"
 #include "qsmesh/crossfield/cross_field.hpp"
+#include "qsmesh/fieldmesh/field_mesh.hpp"
 #include "qsmesh/holomorphic/holomorphic.hpp"
 #include "qsmesh/linalg/solver.hpp"
 #include "qsmesh/mesh/quality.hpp"
@@ -224,6 +225,9 @@ struct FaceTask {
   /// The face's holomorphic mesh until choose_face_method weighs it (empty: none).
   mesh::FaceMesh holomorphic_mesh;
   holomorphic::HolomorphicReport holomorphic;
+  /// Meshed from a cross field (quasi.by_field): the partition's regions as grids of quad_mesh's
+  /// vertices (fieldmesh::FieldMeshReport::grids), the face's blocks in block-structured output.
+  std::vector<fieldmesh::RegionGrid> field_grids;
 };
 
 /// Background triangulation of task.face (background::mesh_face_background) into task.background
@@ -251,6 +255,7 @@ struct FaceOutput {
   mesh::FaceQuadStats stats;  ///< of the quad mesh (quad stages)
   double seconds = 0;
   FaceTimes times;
+  std::vector<fieldmesh::RegionGrid> field_grids;  ///< FaceTask::field_grids, of `mesh`
   template <class S, class V>
   static void fields(S& self, V&& visit) {
     visit("mesh", self.mesh);
@@ -262,6 +267,7 @@ struct FaceOutput {
     visit("stats", self.stats);
     visit("seconds", self.seconds);
     visit("times", self.times);
+    visit("field_grids", self.field_grids);
   }
 };
 

@@ -143,6 +143,10 @@ struct PipelineResult {
   std::vector<double> face_seconds;
   /// By face, quad stages (rank 0): the face's time per stage and the dealt stages' keys.
   std::vector<FaceTimes> face_times;
+  /// By face, quad stages (rank 0): the regions of the faces meshed from a cross field
+  /// (QuasiReport::by_field) as grids of the assembled mesh's vertex ids (fieldmesh::RegionGrid);
+  /// empty for the other faces. Their blocks in block-structured output.
+  std::vector<std::vector<fieldmesh::RegionGrid>> field_grids;
   std::vector<int> face_rank;  ///< rank that meshed each face (every rank)
   /// Wall time (s) each rank spent in the stages split by faces (background to the comparison of
   /// refused pattern fills), its own work without its waits for the others (every rank). Their
