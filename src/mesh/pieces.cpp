@@ -1,6 +1,7 @@
 #include "qsmesh/mesh/pieces.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -16,21 +17,40 @@ namespace {
 double coord(const Vec3& p, int axis) { return axis == 0 ? p.x : axis == 1 ? p.y : p.z; }
 
 // Leaves [leaf, leaf + share.size()) for the quads `ids` (any order; reordered in place).
-void bisect(const std::vector<Vec3>& centroid, std::span<LO> ids, std::span<const double> share,
-            LO leaf, std::vector<LO>& out) {
-  if (share.size() == 1 || ids.empty()) {
-    for (const LO q : ids) out[static_cast<std::size_t>(q)] = leaf;
-    return;
-  }
+// The pieces of a strip (every cut across one axis) may be this many times longer across than
+// along it. Cuts across one axis never cross, so the second cut's pieces hold each first cut
+// whole; where cuts of two axes cross, a few first-cut vertices lie on a second cut too and keep
+// what the first pass left there (a 100 x 20 plate of 217k quads: interior irregular vertices 1.00
+// times the whole face's with 6 strips, 1.14 with 12 pieces cut across both axes, 1.62 with 23).
+constexpr double kMaxStripAspect = 4.0;
+
+// Bounding box extents of the centroids of `ids` along x, y, z.
+std::array<double, 3> extents(const std::vector<Vec3>& centroid, std::span<const LO> ids) {
   Vec3 lo = centroid[static_cast<std::size_t>(ids[0])], hi = lo;
   for (const LO q : ids) {
     const Vec3& c = centroid[static_cast<std::size_t>(q)];
     lo = {std::min(lo.x, c.x), std::min(lo.y, c.y), std::min(lo.z, c.z)};
     hi = {std::max(hi.x, c.x), std::max(hi.y, c.y), std::max(hi.z, c.z)};
   }
+  return {hi.x - lo.x, hi.y - lo.y, hi.z - lo.z};
+}
+
+int longest(const std::array<double, 3>& e) {
   int axis = 0;
   for (int a = 1; a < 3; ++a)
-    if (coord(hi, a) - coord(lo, a) > coord(hi, axis) - coord(lo, axis)) axis = a;
+    if (e[static_cast<std::size_t>(a)] > e[static_cast<std::size_t>(axis)]) axis = a;
+  return axis;
+}
+
+// Leaves [leaf, leaf + share.size()) for the quads `ids` (any order; reordered in place), cut
+// across `strip_axis`, or across each set's longest extent when it is -1.
+void bisect(const std::vector<Vec3>& centroid, std::span<LO> ids, std::span<const double> share,
+            LO leaf, int strip_axis, std::vector<LO>& out) {
+  if (share.size() == 1 || ids.empty()) {
+    for (const LO q : ids) out[static_cast<std::size_t>(q)] = leaf;
+    return;
+  }
+  const int axis = strip_axis >= 0 ? strip_axis : longest(extents(centroid, ids));
   const std::size_t m1 = share.size() / 2;
   const double left = std::accumulate(share.begin(), share.begin() + static_cast<long>(m1), 0.0);
   const double all = std::accumulate(share.begin(), share.end(), 0.0);
@@ -45,8 +65,8 @@ void bisect(const std::vector<Vec3>& centroid, std::span<LO> ids, std::span<cons
   };
   if (n1 > 0 && n1 < ids.size())
     std::nth_element(ids.begin(), ids.begin() + static_cast<long>(n1), ids.end(), before);
-  bisect(centroid, ids.first(n1), share.first(m1), leaf, out);
-  bisect(centroid, ids.subspan(n1), share.subspan(m1), leaf + static_cast<LO>(m1), out);
+  bisect(centroid, ids.first(n1), share.first(m1), leaf, strip_axis, out);
+  bisect(centroid, ids.subspan(n1), share.subspan(m1), leaf + static_cast<LO>(m1), strip_axis, out);
 }
 
 }  // namespace
@@ -68,7 +88,19 @@ std::vector<LO> bisect_quads(const FaceMesh& m, LO k, bool shifted) {
   std::vector<LO> ids(nq);
   std::iota(ids.begin(), ids.end(), LO{0});
   std::vector<LO> leaf(nq, 0);
-  bisect(centroid, ids, share, 0, leaf);
+  // Strips across the face's longest extent when k of them are no more than kMaxStripAspect
+  // times longer across than along (k, not k + 1: both cuts of a face take the same rule).
+  int strip_axis = -1;
+  if (nq > 0) {
+    const std::array<double, 3> e = extents(centroid, ids);
+    const int a = longest(e);
+    double across = 0;
+    for (int b = 0; b < 3; ++b)
+      if (b != a) across = std::max(across, e[static_cast<std::size_t>(b)]);
+    if (across * static_cast<double>(k) <= kMaxStripAspect * e[static_cast<std::size_t>(a)])
+      strip_axis = a;
+  }
+  bisect(centroid, ids, share, 0, strip_axis, leaf);
   // Drop empty leaves.
   std::vector<LO> renumber(share.size(), kNoIndex);
   for (const LO l : leaf) renumber[static_cast<std::size_t>(l)] = 0;

@@ -81,6 +81,29 @@ TEST(Pieces, BisectionGivesBalancedDeterministicPieces) {
   }
 }
 
+// A square in 8 pieces is cut across both axes (strips would be 8 times longer than wide); a
+// long grid in as many pieces is cut into strips.
+TEST(Pieces, StripsWhereThinEnoughElseBothAxes) {
+  const auto spans_across = [](const FaceMesh& m, const std::vector<LO>& part, LO p) {
+    double lo = 1e300, hi = -1e300;
+    for (std::size_t q = 0; q < m.quads.size(); ++q)
+      if (part[q] == p)
+        for (const LO v : m.quads[q]) {
+          lo = std::min(lo, m.points[static_cast<std::size_t>(v)].y);
+          hi = std::max(hi, m.points[static_cast<std::size_t>(v)].y);
+        }
+    return hi - lo;
+  };
+  const FaceMesh square = grid(24, 24);
+  const std::vector<LO> sq = bisect_quads(square, 8, false);
+  int full = 0;
+  for (LO p = 0; p < 8; ++p) full += spans_across(square, sq, p) == 24 ? 1 : 0;
+  EXPECT_LT(full, 8);
+  const FaceMesh strip = grid(96, 24);
+  const std::vector<LO> st = bisect_quads(strip, 8, false);
+  for (LO p = 0; p < 8; ++p) EXPECT_EQ(spans_across(strip, st, p), 24) << p;
+}
+
 // On a strip the shifted cuts fall halfway between the unshifted ones: 4 pieces of 10 columns
 // cut at x = 10, 20, 30; shifted, 5 pieces cut at x = 5, 15, 25, 35.
 TEST(Pieces, ShiftedBisectionCutsHalfwayOnAStrip) {
