@@ -54,8 +54,8 @@ void bisect(const std::vector<Vec3>& centroid, std::span<LO> ids, std::span<cons
   const std::size_t m1 = share.size() / 2;
   const double left = std::accumulate(share.begin(), share.begin() + static_cast<long>(m1), 0.0);
   const double all = std::accumulate(share.begin(), share.end(), 0.0);
-  const auto n1 = static_cast<std::size_t>(
-      std::llround(static_cast<double>(ids.size()) * left / all));
+  const auto n1 =
+      static_cast<std::size_t>(std::llround(static_cast<double>(ids.size()) * left / all));
   // A strict total order (coordinate, then id), so the first n1 quads are one set whatever the
   // algorithm leaves in the order of the others.
   const auto before = [&](LO a, LO b) {
@@ -77,11 +77,10 @@ std::vector<LO> bisect_quads(const FaceMesh& m, LO k, bool shifted) {
   std::vector<Vec3> centroid(nq);
   for (std::size_t q = 0; q < nq; ++q) {
     const auto& qd = m.quads[q];
-    centroid[q] = (m.points[static_cast<std::size_t>(qd[0])] +
-                   m.points[static_cast<std::size_t>(qd[1])] +
-                   m.points[static_cast<std::size_t>(qd[2])] +
-                   m.points[static_cast<std::size_t>(qd[3])]) *
-                  0.25;
+    centroid[q] =
+        (m.points[static_cast<std::size_t>(qd[0])] + m.points[static_cast<std::size_t>(qd[1])] +
+         m.points[static_cast<std::size_t>(qd[2])] + m.points[static_cast<std::size_t>(qd[3])]) *
+        0.25;
   }
   std::vector<double> share(static_cast<std::size_t>(k) + (shifted ? 1 : 0), 1.0);
   if (shifted) share.front() = share.back() = 0.5;
@@ -117,9 +116,9 @@ std::vector<FacePiece> split_face_mesh(const FaceMesh& m, std::span<const LO> qu
   QSMESH_CHECK(m.triangles.empty(), "face " << m.face << ": only an all-quad mesh is split");
   QSMESH_CHECK(m.uv.size() == m.points.size() && m.vclass.size() == m.points.size(),
                "face " << m.face << ": points, uv and vclass sizes differ");
-  QSMESH_CHECK(quad_piece.size() == m.quads.size(),
-               "face " << m.face << ": " << quad_piece.size() << " pieces for " << m.quads.size()
-                       << " quads");
+  QSMESH_CHECK(quad_piece.size() == m.quads.size(), "face " << m.face << ": " << quad_piece.size()
+                                                            << " pieces for " << m.quads.size()
+                                                            << " quads");
   QSMESH_CHECK(nv < (LO{1} << 30), "face " << m.face << ": too many vertices to cut");
   // The piece of each vertex's quads: kNoIndex none yet, -2 two or more (a cut vertex).
   constexpr LO kShared = -2;
@@ -181,9 +180,10 @@ std::vector<FacePiece> split_face_mesh(const FaceMesh& m, std::span<const LO> qu
       const auto v = static_cast<std::size_t>(order[i]);
       pm.points.push_back(m.points[v]);
       pm.uv.push_back(m.uv[v]);
-      pm.vclass.push_back(vpiece[v] == kShared
-                              ? VertexClass{0, kCutEntity - order[i], kNoIndex, {m.uv[v].u, m.uv[v].v}}
-                              : m.vclass[v]);
+      pm.vclass.push_back(
+          vpiece[v] == kShared
+              ? VertexClass{0, kCutEntity - order[i], kNoIndex, {m.uv[v].u, m.uv[v].v}}
+              : m.vclass[v]);
     }
     p.boundary = static_cast<LO>(nb + c.size());
     // Face vertex -> piece vertex, through `local` for the piece's own vertices and a lookup in
@@ -211,9 +211,9 @@ std::vector<FacePiece> split_face_mesh(const FaceMesh& m, std::span<const LO> qu
 
 FaceMesh merge_face_pieces(const FaceMesh& m, std::span<const FacePiece> pieces,
                            std::span<const FaceMesh> improved) {
-  QSMESH_CHECK(pieces.size() == improved.size(),
-               "face " << m.face << ": " << improved.size() << " results for " << pieces.size()
-                       << " pieces");
+  QSMESH_CHECK(pieces.size() == improved.size(), "face " << m.face << ": " << improved.size()
+                                                         << " results for " << pieces.size()
+                                                         << " pieces");
   const LO nv = m.num_vertices();
   // The face's vertices that come back: dim < 2 ones and those of the pieces' boundaries.
   std::vector<LO> merged(static_cast<std::size_t>(nv), kNoIndex);
@@ -260,10 +260,9 @@ FaceMesh merge_face_pieces(const FaceMesh& m, std::span<const FacePiece> pieces,
       out.vclass.push_back(r.vclass[i]);
     }
     for (const auto& q : r.quads)
-      out.quads.push_back({to_out[static_cast<std::size_t>(q[0])],
-                           to_out[static_cast<std::size_t>(q[1])],
-                           to_out[static_cast<std::size_t>(q[2])],
-                           to_out[static_cast<std::size_t>(q[3])]});
+      out.quads.push_back(
+          {to_out[static_cast<std::size_t>(q[0])], to_out[static_cast<std::size_t>(q[1])],
+           to_out[static_cast<std::size_t>(q[2])], to_out[static_cast<std::size_t>(q[3])]});
   }
   return out;
 }

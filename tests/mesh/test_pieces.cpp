@@ -163,8 +163,8 @@ TEST(Pieces, SplitThenMergeGivesTheSameMesh) {
     cls[{m.uv[static_cast<std::size_t>(v)].u, m.uv[static_cast<std::size_t>(v)].v}] =
         m.vclass[static_cast<std::size_t>(v)];
   for (LO v = 0; v < merged.num_vertices(); ++v) {
-    const VertexClass& want =
-        cls.at({merged.uv[static_cast<std::size_t>(v)].u, merged.uv[static_cast<std::size_t>(v)].v});
+    const VertexClass& want = cls.at(
+        {merged.uv[static_cast<std::size_t>(v)].u, merged.uv[static_cast<std::size_t>(v)].v});
     EXPECT_EQ(merged.vclass[static_cast<std::size_t>(v)].dim, want.dim);
     EXPECT_EQ(merged.vclass[static_cast<std::size_t>(v)].entity, want.entity);
   }
@@ -173,7 +173,8 @@ TEST(Pieces, SplitThenMergeGivesTheSameMesh) {
     double a = 0;
     for (int k2 = 0; k2 < 4; ++k2) {
       const Vec2& p = merged.uv[static_cast<std::size_t>(q[static_cast<std::size_t>(k2)])];
-      const Vec2& r = merged.uv[static_cast<std::size_t>(q[static_cast<std::size_t>((k2 + 1) % 4)])];
+      const Vec2& r =
+          merged.uv[static_cast<std::size_t>(q[static_cast<std::size_t>((k2 + 1) % 4)])];
       a += p.u * r.v - r.u * p.v;
     }
     EXPECT_GT(a, 0);

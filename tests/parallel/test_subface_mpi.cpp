@@ -36,11 +36,13 @@ TEST(SubFace, PiecesGiveTheSameMeshAtEveryRankCountAndKeepTheQuality) {
   std::ostringstream sink;
   Logger log(sink, LogLevel::Quiet);
   constexpr std::int64_t kTaskQuads = 800;
-  const PipelineResult dist = run_pipeline(comm, model, plate_options(kTaskQuads), TaskArena(2), log);
+  const PipelineResult dist =
+      run_pipeline(comm, model, plate_options(kTaskQuads), TaskArena(2), log);
   if (comm.rank() != 0) return;
   const PipelineResult serial =
       run_pipeline(Comm::self(), model, plate_options(kTaskQuads), TaskArena(1), log);
-  const PipelineResult whole = run_pipeline(Comm::self(), model, plate_options(0), TaskArena(1), log);
+  const PipelineResult whole =
+      run_pipeline(Comm::self(), model, plate_options(0), TaskArena(1), log);
 
   // Improved, in at least 8 pieces at the first cut (and one more at the second).
   ASSERT_EQ(dist.face_times.size(), 1U);
@@ -69,8 +71,8 @@ TEST(SubFace, PiecesGiveTheSameMeshAtEveryRankCountAndKeepTheQuality) {
   EXPECT_GT(cut.sicn_min, 0);
   std::cout << "plate: " << quads << " quads, " << k << " pieces; interior irregular "
             << cut.irregular_interior << " (whole " << one.irregular_interior << "), SICN avg "
-            << cut.sicn_avg << " (whole " << one.sicn_avg << "), min " << cut.sicn_min
-            << " (whole " << one.sicn_min << ")\n";
+            << cut.sicn_avg << " (whole " << one.sicn_avg << "), min " << cut.sicn_min << " (whole "
+            << one.sicn_min << ")\n";
 }
 
 }  // namespace
