@@ -6,7 +6,9 @@
 #include <cstdint>
 #include <cstring>
 #include <iterator>
+#include <map>
 #include <numeric>
+#include <tuple>
 
 #include "qsmesh/core/error.hpp"
 
@@ -131,6 +133,21 @@ std::vector<FacePiece> split_face_mesh(const FaceMesh& m, std::span<const LO> qu
       s = s == kNoIndex || s == p ? p : kShared;
     }
   }
+  // The id in a cut vertex's entity: its own, or for the images of one seam vertex (same
+  // (dim, entity, index) on the curve, two uv) the first image's, so that smoothing still sees
+  // the seam (one key, two uv) inside a piece.
+  std::vector<LO> cut_id(static_cast<std::size_t>(nv));
+  std::map<std::tuple<int, LO, LO>, LO> first_image;
+  for (LO v = 0; v < nv; ++v) {
+    const VertexClass& c = m.vclass[static_cast<std::size_t>(v)];
+    cut_id[static_cast<std::size_t>(v)] =
+        c.dim == 2
+            ? v
+            : first_image
+                  .emplace(std::make_tuple(int(c.dim), c.entity, c.dim == 1 ? c.index : kNoIndex),
+                           v)
+                  .first->second;
+  }
   std::vector<FacePiece> out(static_cast<std::size_t>(pieces));
   std::vector<LO> local(static_cast<std::size_t>(nv), kNoIndex);  // in the vertex's piece
   // Boundary first in every piece (each piece's vertices in face order), then the interior.
@@ -182,7 +199,7 @@ std::vector<FacePiece> split_face_mesh(const FaceMesh& m, std::span<const LO> qu
       pm.uv.push_back(m.uv[v]);
       pm.vclass.push_back(
           vpiece[v] == kShared
-              ? VertexClass{0, kCutEntity - order[i], kNoIndex, {m.uv[v].u, m.uv[v].v}}
+              ? VertexClass{0, kCutEntity - cut_id[v], kNoIndex, {m.uv[v].u, m.uv[v].v}}
               : m.vclass[v]);
     }
     p.boundary = static_cast<LO>(nb + c.size());

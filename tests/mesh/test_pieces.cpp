@@ -141,6 +141,7 @@ TEST(Pieces, SplitThenMergeGivesTheSameMesh) {
       const VertexClass& c = p.mesh.vclass[static_cast<std::size_t>(i)];
       // Fixed ones first, and only those: the face's boundary and the cut vertices.
       EXPECT_EQ(i < p.boundary, c.dim < 2) << "piece vertex " << i;
+      // (no seam here: each cut vertex's own id)
       if (is_cut_vertex(c)) EXPECT_EQ(c.entity, kCutEntity - static_cast<LO>(v));
     }
   }

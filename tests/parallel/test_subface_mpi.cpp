@@ -75,5 +75,32 @@ TEST(SubFace, PiecesGiveTheSameMeshAtEveryRankCountAndKeepTheQuality) {
             << one.sicn_min << ")\n";
 }
 
+// A sphere: one face with a seam and two poles, cut into pieces that hold both images of seam
+// vertices (the cut follows the centroids in 3D, not the parameter plane). Valid, conforming, and
+// the same at every rank count.
+TEST(SubFace, SeamAndPolesInPieces) {
+  const Comm comm = Comm::world();
+  const std::string path = tmp("subface_sphere_np" + std::to_string(comm.size()) + ".brep");
+  if (comm.rank() == 0) test::write_sphere(path);
+  comm.barrier();
+  const cad::CadModel model = cad::load_cad(path);
+  std::ostringstream sink;
+  Logger log(sink, LogLevel::Quiet);
+  PipelineOptions options = plate_options(150);
+  options.background.sizes.size = 0.3;
+  options.sizemap.size_max = 0.3;
+  const PipelineResult dist = run_pipeline(comm, model, options, TaskArena(2), log);
+  if (comm.rank() != 0) return;
+  const PipelineResult serial = run_pipeline(Comm::self(), model, options, TaskArena(1), log);
+  ASSERT_EQ(dist.face_times.size(), 1U);
+  EXPECT_GT(dist.face_times[0].improvement_tasks.size(), 8U)
+      << dist.face_times[0].improvement_quads << " quads";
+  EXPECT_EQ(dist.mesh.points, serial.mesh.points);
+  EXPECT_EQ(dist.mesh.quads, serial.mesh.quads);
+  const auto conformity = mesh::check_conformity(dist.mesh, model);
+  EXPECT_TRUE(conformity.ok()) << conformity.summary();
+  EXPECT_GT(dist.face_stats[0].sicn_min, 0);
+}
+
 }  // namespace
 }  // namespace qsmesh::parallel

@@ -14,8 +14,9 @@ namespace qsmesh::mesh {
 
 /// Entities at or below kCutEntity mark cut vertices in a piece: VertexClass{0, kCutEntity - v}
 /// for face vertex v (a corner of its own, so every improvement step keeps it fixed and keeps its
-/// valence, and no two vertices share a key, which smoothing would read as a seam). The steps'
-/// own locked classes (entities -2 - k, k small) stay far above.
+/// valence, and no two vertices share a key, which smoothing would read as a seam; the two images
+/// of a seam vertex share v, the first image's id, so that it still does). The steps' own locked
+/// classes (entities -2 - k, k small) stay far above.
 inline constexpr LO kCutEntity = -(LO{1} << 30);
 
 /// Whether `c` marks a cut vertex (split_face_mesh).
