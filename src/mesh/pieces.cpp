@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
 #include <iterator>
 #include <map>
 #include <numeric>
@@ -15,6 +15,11 @@
 namespace qsmesh::mesh {
 
 namespace {
+
+// Equal bit for bit (-0 and 0 differ; no tolerance).
+bool same_bits(double a, double b) {
+  return std::bit_cast<std::uint64_t>(a) == std::bit_cast<std::uint64_t>(b);
+}
 
 double coord(const Vec3& p, int axis) { return axis == 0 ? p.x : axis == 1 ? p.y : p.z; }
 
@@ -260,12 +265,13 @@ FaceMesh merge_face_pieces(const FaceMesh& m, std::span<const FacePiece> pieces,
       const auto v = static_cast<std::size_t>(p.vertex[i]);
       const auto ri = static_cast<std::size_t>(i);
       // Bit for bit: the neighbouring piece holds the same vertex and must meet it exactly.
-      QSMESH_CHECK(std::memcmp(&r.points[ri], &m.points[v], sizeof(Vec3)) == 0 &&
-                       std::memcmp(&r.uv[ri], &m.uv[v], sizeof(Vec2)) == 0 &&
-                       r.vclass[ri].dim == p.mesh.vclass[ri].dim &&
-                       r.vclass[ri].entity == p.mesh.vclass[ri].entity,
-                   "face " << m.face << ": piece " << pi << " moved its fixed vertex " << i
-                           << " (face vertex " << v << ")");
+      QSMESH_CHECK(
+          same_bits(r.points[ri].x, m.points[v].x) && same_bits(r.points[ri].y, m.points[v].y) &&
+              same_bits(r.points[ri].z, m.points[v].z) && same_bits(r.uv[ri].u, m.uv[v].u) &&
+              same_bits(r.uv[ri].v, m.uv[v].v) && r.vclass[ri].dim == p.mesh.vclass[ri].dim &&
+              r.vclass[ri].entity == p.mesh.vclass[ri].entity,
+          "face " << m.face << ": piece " << pi << " moved its fixed vertex " << i
+                  << " (face vertex " << v << ")");
       to_out[ri] = merged[v];
     }
     for (std::size_t i = static_cast<std::size_t>(p.boundary); i < r.points.size(); ++i) {

@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdint>
 #include <map>
 #include <set>
 #include <vector>
@@ -19,7 +20,8 @@ namespace {
 FaceMesh grid(int nx, int ny) {
   const int nv = (nx + 1) * (ny + 1);
   std::vector<LO> id(static_cast<std::size_t>(nv));
-  for (int k = 0; k < nv; ++k) id[static_cast<std::size_t>(k)] = (k * 7919) % nv;
+  for (int k = 0; k < nv; ++k)
+    id[static_cast<std::size_t>(k)] = static_cast<LO>((std::int64_t{k} * 7919) % nv);
   FaceMesh m;
   m.face = 3;
   m.points.resize(static_cast<std::size_t>(nv));
@@ -153,6 +155,7 @@ TEST(Pieces, SplitThenMergeGivesTheSameMesh) {
                 uses[p.vertex[static_cast<std::size_t>(i)]] > 1);
 
   std::vector<FaceMesh> same;
+  same.reserve(pieces.size());
   for (const FacePiece& p : pieces) same.push_back(p.mesh);
   const FaceMesh merged = merge_face_pieces(m, pieces, same);
   EXPECT_EQ(merged.face, m.face);
