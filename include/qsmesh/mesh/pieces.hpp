@@ -28,7 +28,7 @@ inline constexpr LO kCutEntity = -(LO{1} << 30);
 /// centroids in 3D: each set is cut across the longest extent of its centroids' bounding box (x
 /// before y before z on ties), at the quantile that its two halves' shares of the leaves ask
 /// for, centroids ordered by coordinate then quad id. Where k strips across the face's longest
-/// extent would be at most 4 times longer across than along, every cut is across that extent
+/// extent would be at most 8 times longer across than along, every cut is across that extent
 /// (strips: cuts that never cross, which a second, shifted cut then holds whole). Without
 /// `shifted`, k leaves of equal share; with it, k + 1 leaves of shares 1/2, 1, ..., 1, 1/2, so that
 /// on a strip the cuts fall halfway between those of the unshifted partition. Returns the piece of
