@@ -335,7 +335,12 @@ mesh::FaceMesh merge_pieces(const Split& split, std::vector<Result>& results, Im
       improved[p] = split.cut[p].mesh;
     }
   }
-  return mesh::merge_face_pieces(split.input, split.cut, improved);
+  try {
+    return mesh::merge_face_pieces(split.input, split.cut, improved);
+  } catch (const std::exception& e) {
+    log.warn(Error(e.what(), ErrorContext{"merging the pieces", 2, split.input.face}).what());
+    return split.input;  // the face as this pass found it
+  }
 }
 
 void apply(Result&& r, ImproveFace& f) {
