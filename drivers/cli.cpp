@@ -9,6 +9,7 @@
 
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/io/writer.hpp"
+#include "qsmesh/parallel/pipeline.hpp"
 
 namespace qsmesh::cli {
 
@@ -275,7 +276,13 @@ Arguments parse(const std::vector<std::string>& args) {
       append(a.curve_sizes, parse_id_values(opt, value()));
     else if (opt == "--face-size" && sizing)
       append(a.face_sizes, parse_id_values(opt, value()));
-    else if (opt == "--max-quads" && meshing) {
+    else if (opt == "--task-quads" && a.command == Command::Mesh) {
+      const std::string& v = value();
+      const auto n = parse_double(v);
+      if (!n || !std::isfinite(*n) || *n < 0 || *n > 1e15 || *n != std::floor(*n))
+        throw InputError(opt + ": '" + v + "' is not a whole number of quads (0: never cut)");
+      a.task_quads = static_cast<std::int64_t>(*n);
+    } else if (opt == "--max-quads" && meshing) {
       const std::string& v = value();
       const auto n = parse_double(v);
       if (!n || !std::isfinite(*n) || *n < 0)
@@ -520,6 +527,12 @@ std::string help(const std::string& topic) {
           "is\n"
           "                        counted in the summary. Without it the work is bounded by\n"
           "                        iteration counts only and the mesh does not depend on timing\n"
+          "  --task-quads N        improve a face of more than N quads (default "
+       << parallel::kDefaultTaskQuads
+       << ") in pieces, each\n"
+          "                        a task of its own for the ranks and threads, in two passes\n"
+          "                        whose cuts alternate; 0: never. The mesh depends on N, not on\n"
+          "                        the rank or thread count\n"
           "  --max-quads N         refuse, before any work, a run whose estimated quad count is\n"
           "                        above N (default "
        << kDefaultMaxQuads

@@ -87,6 +87,9 @@ struct Arguments {
   /// --max-quads N: refuse, before any work, a run whose estimated quad count is above N
   /// (0: no bound; the machine's memory still bounds it). See kDefaultMaxQuads.
   double max_quads = -1;  ///< -1: kDefaultMaxQuads
+  /// --task-quads N: faces of more quads than N are improved in pieces, each a task
+  /// (parallel::PipelineOptions::task_quads; 0: never); -1: parallel::kDefaultTaskQuads.
+  std::int64_t task_quads = -1;
   /// --field-divisions N: the background (where the fields are computed) at the geometry's
   /// resolution, each face's edges at most its bounding-box diagonal / N (and at most the target
   /// size's resolution); 0: the background follows the target size. See kDefaultFieldDivisions.

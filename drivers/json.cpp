@@ -80,6 +80,23 @@ JsonWriter& JsonWriter::end_array() {
   return *this;
 }
 
+JsonWriter& JsonWriter::value(const std::string& key, const std::vector<double>& v) {
+  key_prefix(key);
+  out_ += "[";
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    if (i > 0) out_ += ", ";
+    if (!std::isfinite(v[i])) {
+      out_ += "null";
+    } else {
+      char buf[32];
+      std::snprintf(buf, sizeof buf, "%.10g", v[i]);
+      out_ += buf;
+    }
+  }
+  out_ += "]";
+  return *this;
+}
+
 JsonWriter& JsonWriter::value(const std::string& key, const std::string& v) {
   key_prefix(key);
   out_ += escape(v);

@@ -21,6 +21,8 @@ class JsonWriter {
     return value(key, static_cast<std::int64_t>(v));
   }
   JsonWriter& value(const std::string& key, bool v);
+  /// An array of numbers, on one line.
+  JsonWriter& value(const std::string& key, const std::vector<double>& v);
   [[nodiscard]] const std::string& str() const { return out_; }
 
  private:

@@ -10,7 +10,11 @@ rank, by replaying its measured per-face, per-stage times through the pipeline's
 - dealt stages (patterns, improvement): all P x T threads take the next face from one shared
   counter, largest first by the pipeline's own keys (expected quads; the unstructured mesh's
   quads), i.e. list scheduling in that order over P x T workers; a face taken away from its owner
-  is read from it first (MPI_Get), and each result goes back to its owner.
+  is read from it first (MPI_Get), and each result goes back to its owner. A face improved in
+  pieces (--task-quads; face_stats' stage_seconds.improvement_tasks: 2k + 1 piece times) is k
+  tasks in the first round, dealt with the whole faces, and k + 1 in a second round after it
+  (each piece keyed by the face's quads / pieces); its cutting and merging (its improvement time
+  less its pieces') runs on its owner between and after the rounds.
 - assemble: rank 0 unpacks and assembles every face (as measured) after receiving the other ranks'
   faces (bytes / bandwidth); the driver's later stages (statistics, write, ...) on rank 0 as
   measured.
@@ -105,6 +109,7 @@ class Run:
                   for s in PARTITIONED + DEALT}
         self.expected = [f["stage_seconds"].get("expected_quads", 0.0) for f in self.faces]
         self.improve_quads = [f["stage_seconds"].get("improvement_quads", 0) for f in self.faces]
+        self.improve_tasks = [f["stage_seconds"].get("improvement_tasks", []) for f in self.faces]
         self.bytes = [f["stage_seconds"].get("bytes", 0) for f in self.faces]
         self.by_pattern = [f.get("method", "").startswith("pattern") for f in self.faces]
         self.face_rank = [f.get("rank", 0) for f in self.faces]
@@ -172,45 +177,80 @@ class Simulator:
         bw = self.comm["bandwidth_bytes_per_s"]
         fetch = self.comm["fetch_and_add_s"] if (messages and p > 1) else 0.0
         times, extra = {}, {}
-        for s, key, items in (
-                ("patterns", run.expected, range(run.n)),
-                ("improvement", run.improve_quads,
-                 [f for f in range(run.n) if run.improve_quads[f] > 0])):
-            order = sorted(items, key=lambda f: (-key[f], f))
+        patterns = [[(f, run.expected[f], 0, run.t["patterns"][f], run.bytes[f])
+                     for f in range(run.n)]]
+        improvement, owner_work = self.improvement_rounds()
+        for s, rounds in (("patterns", patterns), ("improvement", improvement)):
+            times[s] = 0.0
+            extra[s] = 0.0
+            ends = [0.0] * (p * t)
+            for items in rounds:
+                if not items:
+                    continue
+                order = sorted(items, key=lambda i: (-i[1], i[0], i[2]))
 
-            def cost(f):
-                def c(w):
-                    d = run.t[s][f] + fetch
-                    if messages and p > 1 and s == "improvement" and w // t != part[f]:
-                        d += self.get_cost(run.bytes[f])
-                    return d
-                return c
-            span, assigned, end = list_schedule([cost(f) for f in order], p * t)
-            times[s] = span
+                def cost(item):
+                    f, _, _, sec, nbytes = item
+
+                    def c(w):
+                        d = sec + fetch
+                        if messages and p > 1 and s == "improvement" and w // t != part[f]:
+                            d += self.get_cost(nbytes)
+                        return d
+                    return c
+                span, assigned, end = list_schedule([cost(i) for i in order], p * t)
+                times[s] += span
+                ends = [a + b for a, b in zip(ends, end)]
+                if not messages or p == 1:
+                    continue
+                # Results (fills, improved meshes) back to their owners: each rank's traffic in
+                # and out at the bandwidth, pairwise (latency per peer it talks to).
+                out_b = [0.0] * p
+                in_b = [0.0] * p
+                for (f, _, _, _, nbytes), w in zip(order, assigned):
+                    r = w // t
+                    if r != part[f] and (s == "improvement" or run.by_pattern[f]):
+                        out_b[r] += nbytes
+                        in_b[part[f]] += nbytes
+                move = max(a + b for a, b in zip(out_b, in_b)) / bw + self.comm["allreduce_s"] * levels(p)
+                if s == "patterns":  # the expected quads summed over ranks first
+                    move += self.allreduce(p) + 8 * run.n / bw
+                else:  # the task records gathered, the tasks packed, two window collectives
+                    mine = max(sum(i[4] for i in items if part[i[0]] == r) for r in range(p))
+                    move += self.allreduce(p) + RECORD_BYTES * len(items) / bw + mine / bw + 2 * self.allreduce(p)
+                extra[s] += move
+            if s == "improvement" and len(improvement) > 1 and improvement[1]:
+                # Cutting and merging on the owners, between and after the rounds.
+                per_rank = [0.0] * p
+                for f, sec in owner_work.items():
+                    per_rank[part[f]] += sec
+                times[s] += max(per_rank)
+                if messages and p > 1:
+                    extra[s] += self.allreduce(p)  # whether any face was cut
             if not messages:
                 for r in range(p):
-                    self.busy[r] += max(end[r * t:(r + 1) * t])
-            if not messages or p == 1:
-                extra[s] = 0.0
-                continue
-            # Results (fills, improved meshes) back to their owners: each rank's traffic in and
-            # out at the bandwidth, pairwise (latency per peer it talks to).
-            out_b = [0.0] * p
-            in_b = [0.0] * p
-            for f, w in zip(order, assigned):
-                r = w // t
-                if r != part[f] and (s == "improvement" or run.by_pattern[f]):
-                    out_b[r] += run.bytes[f]
-                    in_b[part[f]] += run.bytes[f]
-            move = max(a + b for a, b in zip(out_b, in_b)) / bw + self.comm["allreduce_s"] * levels(p)
-            if s == "patterns":  # the expected quads summed over ranks first
-                move += self.allreduce(p) + 8 * run.n / bw
-            else:  # the face records gathered, the faces packed, two window collectives
-                mine = max(sum(run.bytes[f] for f in range(run.n) if part[f] == r and run.improve_quads[f] > 0)
-                           for r in range(p))
-                move += self.allreduce(p) + RECORD_BYTES * run.n / bw + mine / bw + 2 * self.allreduce(p)
-            extra[s] = move
+                    self.busy[r] += max(ends[r * t:(r + 1) * t])
         return times, extra
+
+    def improvement_rounds(self):
+        """The improvement's tasks, [first round, second round], each task (face, order key,
+        piece, seconds, bytes), and the seconds of each cut face's cutting and merging."""
+        run = self.run
+        first, second, owner_work = [], [], {}
+        for f in range(run.n):
+            q = run.improve_quads[f]
+            if q <= 0:
+                continue
+            tasks = run.improve_tasks[f]
+            if not tasks:
+                first.append((f, q, -1, run.t["improvement"][f], run.bytes[f]))
+                continue
+            k = (len(tasks) - 1) // 2
+            for i, sec in enumerate(tasks):
+                n = k if i < k else len(tasks) - k
+                (first if i < k else second).append((f, q / n, i, sec, run.bytes[f] / n))
+            owner_work[f] = max(0.0, run.t["improvement"][f] - sum(tasks))
+        return [first, second], owner_work
 
     def predict(self, p, t):
         """{stage: predicted seconds} on p ranks x t threads, in the measured run's stage order."""
@@ -251,6 +291,12 @@ class Simulator:
             if tot > 0:
                 f = max(range(run.n), key=lambda i: run.t[s][i])
                 res[s] = (run.faces[f]["face"], run.t[s][f], run.t[s][f] / tot)
+        rounds, _ = self.improvement_rounds()
+        tasks = rounds[0] + rounds[1]
+        tot = sum(i[3] for i in tasks)
+        if tot > 0:
+            big = max(tasks, key=lambda i: i[3])
+            res["improvement task"] = (run.faces[big[0]]["face"], big[3], big[3] / tot)
         per_face = [sum(run.t[s][f] for s in PARTITIONED + DEALT) for f in range(run.n)]
         tot = sum(per_face)
         f = max(range(run.n), key=lambda i: per_face[i])
@@ -261,8 +307,13 @@ class Simulator:
         """Time with unlimited ranks: what is not split, plus each split stage's largest face."""
         run = self.run
         v = 0.0
+        rounds, owner_work = self.improvement_rounds()
         for s, measured in run.seconds.items():
-            if s in PARTITIONED or s in DEALT:
+            if s == "improvement" and rounds[1]:
+                # Faces cut into pieces: each round's largest task, and the cutting and merging.
+                v += (max(i[3] for i in rounds[0]) + max(i[3] for i in rounds[1])
+                      + max(owner_work.values()) + self.residual[s])
+            elif s in PARTITIONED or s in DEALT:
                 v += max(run.t[s]) + self.residual[s]
             else:
                 v += measured

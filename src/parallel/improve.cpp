@@ -4,6 +4,7 @@
 #include <atomic>
 #include <cstdint>
 #include <exception>
+#include <limits>
 #include <numeric>
 #include <optional>
 #include <string>
@@ -11,6 +12,7 @@
 #include "exchange.hpp"
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/core/timer.hpp"
+#include "qsmesh/mesh/pieces.hpp"
 #include "qsmesh/parallel/record.hpp"
 #include "qsmesh/qstruct/cavity.hpp"
 #include "qsmesh/remesh/disk_remesh.hpp"
@@ -20,25 +22,27 @@ namespace qsmesh::parallel {
 
 namespace {
 
-// A face of any rank, as this rank sees it.
+// A task of any rank, as this rank sees it: a whole face, or a piece of one (issue 28).
 struct Work {
   LO face = kNoIndex;
+  LO piece = kNoIndex;      // kNoIndex: the whole face
   int owner = 0;            // not exchanged: the sender
-  std::size_t local = 0;    // index in the owner's `mine`; not exchanged: the order received
-  std::int64_t offset = 0;  // the face's bytes in the owner's SharedBytes (several ranks)
+  std::size_t local = 0;    // index in the owner's tasks; not exchanged: the order received
+  std::int64_t offset = 0;  // the task's bytes in the owner's SharedBytes (several ranks)
   std::int64_t length = 0;
   std::int64_t quads = 0;
-  // What every rank learns of every face.
+  // What every rank learns of every task.
   template <class S, class V>
   static void fields(S& self, V&& visit) {
     visit("face", self.face);
+    visit("piece", self.piece);
     visit("quads", self.quads);
     visit("offset", self.offset);
     visit("length", self.length);
   }
 };
 
-// What a face taken away from its owner holds: its mesh and singularities.
+// What a task holds: a mesh (a face's or a piece's) and the singularities within it.
 struct Input {
   mesh::FaceMesh mesh;
   std::vector<crossfield::Singularity> singularities;
@@ -49,13 +53,20 @@ struct Input {
   }
 };
 
-// What improving one face gives, wherever it ran.
+// A task of this rank.
+struct Task {
+  LO face = kNoIndex;
+  LO piece = kNoIndex;
+  Input input;
+};
+
+// What improving one task gives, wherever it ran.
 struct Result {
   bool done = false;  // not exchanged: a received result is done
   mesh::FaceMesh mesh;
   ImprovementReport report;
   double seconds = 0;
-  std::array<double, 3> steps{};  // not exchanged: summed over all faces by a reduction
+  std::array<double, 3> steps{};  // not exchanged: summed over all tasks by a reduction
   template <class S, class V>
   static void fields(S& self, V&& visit) {
     visit("mesh", self.mesh);
@@ -102,7 +113,24 @@ Result improve_one(const cad::CadModel& model, LO face, mesh::FaceMesh mesh,
   // replacement a transaction.
   step(1, "disk remeshing", [&](const cad::FaceGeometry& s) {
     remesh::DiskRemeshStats ds;
-    mesh::FaceMesh out = remesh::remesh_disk_defects(mesh, s, *settings.table, settings.disk, &ds);
+    // In a piece, a cut vertex is a corner whose valence is what the piece has: it is no defect
+    // and keeps it (the angle estimate would call a staircase of the cut a row of defects).
+    const bool piece =
+        std::any_of(mesh.vclass.begin(), mesh.vclass.end(),
+                    [](const mesh::VertexClass& c) { return mesh::is_cut_vertex(c); });
+    mesh::FaceMesh out;
+    if (piece) {
+      remesh::DiskRemeshOptions disk = settings.disk;
+      disk.corner_valence = remesh::estimate_corner_valences(mesh);
+      std::vector<int> valence(mesh.points.size(), 0);
+      for (const auto& q : mesh.quads)
+        for (const LO v : q) ++valence[static_cast<std::size_t>(v)];
+      for (std::size_t v = 0; v < mesh.vclass.size(); ++v)
+        if (mesh::is_cut_vertex(mesh.vclass[v])) disk.corner_valence[v] = valence[v];
+      out = remesh::remesh_disk_defects(mesh, s, *settings.table, disk, &ds);
+    } else {
+      out = remesh::remesh_disk_defects(mesh, s, *settings.table, settings.disk, &ds);
+    }
     r.report.record(ds);
     return out;
   });
@@ -113,6 +141,206 @@ Result improve_one(const cad::CadModel& model, LO face, mesh::FaceMesh mesh,
   r.mesh = std::move(mesh);
   r.seconds = total.seconds();
   return r;
+}
+
+// Deals `mine` (this rank's tasks; their inputs are consumed) over the threads of all ranks,
+// largest first (quads, then face, then piece), and returns the results of this rank's tasks in
+// their order; adds the time of each step of the tasks it ran to `steps`. Collective.
+std::vector<Result> deal_round(const Comm& comm, const cad::CadModel& model,
+                               std::vector<Task>& mine, const ImproveSettings& settings,
+                               const TaskArena& tasks, Logger& log, const char* stage,
+                               std::vector<double>& steps) {
+  const int rank = comm.rank();
+  const int nranks = comm.size();
+
+  // Every rank's tasks as records (owner, where its bytes lie); this rank's are read in place,
+  // another rank's are fetched by whichever rank takes the task, when it takes it.
+  std::vector<Work> work;
+  std::vector<char> buffer;  // this rank's tasks, packed (several ranks)
+  for (std::size_t i = 0; i < mine.size(); ++i) {
+    Work w{mine[i].face,
+           mine[i].piece,
+           rank,
+           i,
+           0,
+           0,
+           static_cast<std::int64_t>(mine[i].input.mesh.quads.size())};
+    if (nranks > 1) {
+      w.offset = static_cast<std::int64_t>(buffer.size());
+      write_record(buffer, mine[i].input);
+      w.length = static_cast<std::int64_t>(buffer.size()) - w.offset;
+    }
+    work.push_back(w);
+  }
+  std::optional<SharedBytes> shared;
+  if (nranks > 1) {
+    std::vector<char> records;
+    for (const Work& w : work) write_record(records, w);
+    const auto all = comm.allgather_bytes(records);
+    work.clear();
+    for (int r = 0; r < nranks; ++r) {
+      const std::vector<char>& bytes = all[static_cast<std::size_t>(r)];
+      std::size_t pos = 0;
+      for (std::size_t i = 0; pos < bytes.size(); ++i) {
+        Work w;
+        w.owner = r;
+        w.local = i;
+        read_record(bytes, pos, w);
+        QSMESH_CHECK(
+            r != rank || (i < mine.size() && mine[i].face == w.face && mine[i].piece == w.piece),
+            "improvement: task record " << w.face << "/" << w.piece << " out of order");
+        work.push_back(w);
+      }
+    }
+    shared.emplace(comm, buffer);
+    std::vector<char>().swap(buffer);  // the window holds the copy now
+  }
+
+  // Largest first, so that the last tasks dealt out are short.
+  std::vector<std::size_t> order(work.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    const Work& x = work[a];
+    const Work& y = work[b];
+    if (x.quads != y.quads) return x.quads > y.quads;
+    return x.face != y.face ? x.face < y.face : x.piece < y.piece;
+  });
+  const auto n = static_cast<std::int64_t>(work.size());
+  std::vector<Result> results(work.size());
+  DealProgress progress(stage, n, comm, log);
+  deal_out(comm, n, tasks, [&](std::int64_t k) {
+    const std::size_t w_at = order[static_cast<std::size_t>(k)];
+    const Work& w = work[w_at];
+    if (w.owner == rank) {
+      Task& t = mine[w.local];
+      results[w_at] =
+          improve_one(model, w.face, std::move(t.input.mesh), t.input.singularities, settings, log);
+    } else {
+      const std::vector<char> bytes = shared->read(w.owner, w.offset, w.length);
+      std::size_t pos = 0;
+      Input in;
+      read_record(bytes, pos, in);
+      QSMESH_CHECK(in.mesh.face == w.face, "improvement: rank " << w.owner << " sent face "
+                                                                << in.mesh.face << " for face "
+                                                                << w.face);
+      results[w_at] =
+          improve_one(model, w.face, std::move(in.mesh), in.singularities, settings, log);
+    }
+    progress.done();
+  });
+  shared.reset();  // collective: every rank is past its last read
+
+  // Results to their owners only, keyed by their index in the owner's tasks.
+  std::vector<Result> out(mine.size());
+  ToOwners<Result> to_owners(nranks);
+  for (std::size_t i = 0; i < work.size(); ++i) {
+    Result& r = results[i];
+    if (!r.done) continue;
+    for (std::size_t k = 0; k < 3; ++k) steps[k] += r.steps[k];
+    if (work[i].owner == rank) {
+      out[work[i].local] = std::move(r);
+    } else {
+      to_owners.add(work[i].owner, static_cast<LO>(work[i].local), r);
+      r = Result{};
+    }
+  }
+  to_owners.deliver(comm, [&](LO local, Result&& r) {
+    QSMESH_CHECK(local >= 0 && static_cast<std::size_t>(local) < out.size(),
+                 "improvement: result of task " << local << " of " << out.size());
+    r.done = true;
+    out[static_cast<std::size_t>(local)] = std::move(r);
+  });
+  for (const Result& r : out) QSMESH_CHECK(r.done, "improvement: a task's result is missing");
+  return out;
+}
+
+// The singularities within each piece: those whose nearest quad centroid lies in it (ties: the
+// lower quad id), so that a piece flags no vertex for a singularity of its neighbour.
+std::vector<std::vector<crossfield::Singularity>> singularities_of_pieces(
+    const mesh::FaceMesh& m, std::span<const LO> quad_piece, LO pieces,
+    std::span<const crossfield::Singularity> singularities) {
+  std::vector<std::vector<crossfield::Singularity>> out(static_cast<std::size_t>(pieces));
+  for (const auto& s : singularities) {
+    double best = std::numeric_limits<double>::max();
+    LO at = 0;
+    for (std::size_t q = 0; q < m.quads.size(); ++q) {
+      const auto& qd = m.quads[q];
+      const Vec3 c =
+          (m.points[static_cast<std::size_t>(qd[0])] + m.points[static_cast<std::size_t>(qd[1])] +
+           m.points[static_cast<std::size_t>(qd[2])] + m.points[static_cast<std::size_t>(qd[3])]) *
+          0.25;
+      const double d = norm2(c - s.position);
+      if (d < best) {
+        best = d;
+        at = quad_piece[q];
+      }
+    }
+    out[static_cast<std::size_t>(at)].push_back(s);
+  }
+  return out;
+}
+
+// A face of this rank cut into pieces, between the rounds.
+struct Split {
+  std::size_t face = 0;  // index in `mine`
+  LO pieces = 0;         // k, the pieces of the first pass
+  mesh::FaceMesh input;  // the mesh the pass started from
+  std::vector<mesh::FacePiece> cut;
+  std::size_t first_task = 0;  // its first piece among the round's tasks
+  std::int64_t irregular_before = 0;
+};
+
+// Cuts split.input into pieces by `quad_piece` and appends them to `round` as tasks.
+void add_pieces(Split& split, std::span<const LO> quad_piece, LO pieces,
+                std::span<const crossfield::Singularity> singularities, std::vector<Task>& round) {
+  split.cut = mesh::split_face_mesh(split.input, quad_piece, pieces);
+  auto sing = singularities_of_pieces(split.input, quad_piece, pieces, singularities);
+  split.first_task = round.size();
+  for (LO p = 0; p < pieces; ++p) {
+    Task t;
+    t.face = split.input.face;
+    t.piece = p;
+    t.input.mesh = split.cut[static_cast<std::size_t>(p)].mesh;
+    t.input.singularities = std::move(sing[static_cast<std::size_t>(p)]);
+    round.push_back(std::move(t));
+  }
+}
+
+// Merges the improved pieces of `split` (results[first_task...]); the counts and times go to
+// `f`. A piece whose result cannot be merged gives way to its input (logged).
+mesh::FaceMesh merge_pieces(const Split& split, std::vector<Result>& results, ImproveFace& f,
+                            Logger& log) {
+  std::vector<mesh::FaceMesh> improved;
+  for (std::size_t p = 0; p < split.cut.size(); ++p) {
+    Result& r = results[split.first_task + p];
+    improved.push_back(std::move(r.mesh));
+    const auto& a = r.report;
+    for (std::size_t k = 0; k < 4; ++k) f.report->cavities[k] += a.cavities[k];
+    f.report->disk_replaced += a.disk_replaced;
+    f.report->time_budget_hit = f.report->time_budget_hit || a.time_budget_hit;
+    *f.seconds += r.seconds;
+    if (f.task_seconds != nullptr) f.task_seconds->push_back(r.seconds);
+  }
+  try {
+    return mesh::merge_face_pieces(split.input, split.cut, improved);
+  } catch (const std::exception& e) {
+    log.warn(Error(e.what(), ErrorContext{"merging the pieces", 2, split.input.face}).what());
+  }
+  // Piece by piece: a piece that does not fit keeps its input.
+  for (std::size_t p = 0; p < split.cut.size(); ++p) {
+    const std::array<mesh::FaceMesh, 1> one{improved[p]};
+    try {
+      (void)mesh::merge_face_pieces(split.input, std::span(&split.cut[p], 1), one);
+    } catch (const std::exception&) {
+      improved[p] = split.cut[p].mesh;
+    }
+  }
+  try {
+    return mesh::merge_face_pieces(split.input, split.cut, improved);
+  } catch (const std::exception& e) {
+    log.warn(Error(e.what(), ErrorContext{"merging the pieces", 2, split.input.face}).what());
+    return split.input;  // the face as this pass found it
+  }
 }
 
 void apply(Result&& r, ImproveFace& f) {
@@ -143,109 +371,77 @@ std::array<double, 3> improve_faces(const Comm& comm, const cad::CadModel& model
                                     std::span<ImproveFace> mine, const ImproveSettings& settings,
                                     const TaskArena& tasks, Logger& log) {
   QSMESH_CHECK(settings.table != nullptr, "improvement: no disk quadrangulation table");
-  const int rank = comm.rank();
-  const int nranks = comm.size();
-
-  // Every rank's faces as records (owner, where its bytes lie); this rank's are read in place,
-  // another rank's are fetched by whichever rank takes the face, when it takes it.
-  std::vector<Work> work;
-  std::vector<char> buffer;  // this rank's faces, packed (several ranks)
-  for (std::size_t i = 0; i < mine.size(); ++i) {
-    Work w{mine[i].face, rank, i, 0, 0, static_cast<std::int64_t>(mine[i].mesh->quads.size())};
-    if (nranks > 1) {
-      w.offset = static_cast<std::int64_t>(buffer.size());
-      // Input's fields in order, without copying the mesh into one.
-      write_record(buffer, *mine[i].mesh);
-      write_record(buffer, std::vector<crossfield::Singularity>(mine[i].singularities.begin(),
-                                                                mine[i].singularities.end()));
-      w.length = static_cast<std::int64_t>(buffer.size()) - w.offset;
-    }
-    work.push_back(w);
-  }
-  std::optional<SharedBytes> shared;
-  if (nranks > 1) {
-    std::vector<char> records;
-    for (const Work& w : work) write_record(records, w);
-    const auto all = comm.allgather_bytes(records);
-    work.clear();
-    for (int r = 0; r < nranks; ++r) {
-      const std::vector<char>& bytes = all[static_cast<std::size_t>(r)];
-      std::size_t pos = 0;
-      for (std::size_t i = 0; pos < bytes.size(); ++i) {
-        Work w;
-        w.owner = r;
-        w.local = i;
-        read_record(bytes, pos, w);
-        QSMESH_CHECK(r != rank || (i < mine.size() && mine[i].face == w.face),
-                     "improvement: face record " << w.face << " out of order");
-        work.push_back(w);
-      }
-    }
-    shared.emplace(comm, buffer);
-    std::vector<char>().swap(buffer);  // the window holds the copy now
-  }
-
-  // Largest first, so that the last faces dealt out are short.
-  std::vector<std::size_t> order(work.size());
-  std::iota(order.begin(), order.end(), std::size_t{0});
-  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
-    return work[a].quads != work[b].quads ? work[a].quads > work[b].quads
-                                          : work[a].face < work[b].face;
-  });
-  const auto n = static_cast<std::int64_t>(work.size());
-  std::vector<Result> results(work.size());
-  DealProgress progress("improvement", n, comm, log);
-  deal_out(comm, n, tasks, [&](std::int64_t k) {
-    const std::size_t w_at = order[static_cast<std::size_t>(k)];
-    const Work& w = work[w_at];
-    if (w.owner == rank) {
-      ImproveFace& f = mine[w.local];
-      results[w_at] =
-          improve_one(model, w.face, std::move(*f.mesh), f.singularities, settings, log);
-    } else {
-      const std::vector<char> bytes = shared->read(w.owner, w.offset, w.length);
-      std::size_t pos = 0;
-      Input in;
-      read_record(bytes, pos, in);
-      QSMESH_CHECK(in.mesh.face == w.face, "improvement: rank " << w.owner << " sent face "
-                                                                << in.mesh.face << " for face "
-                                                                << w.face);
-      results[w_at] =
-          improve_one(model, w.face, std::move(in.mesh), in.singularities, settings, log);
-    }
-    progress.done();
-  });
-  shared.reset();  // collective: every rank is past its last read
-
-  // Results to their owners only; the time of each step summed over the faces of all ranks.
   std::vector<double> steps(3, 0.0);
-  ToOwners<Result> to_owners(nranks);
-  for (std::size_t i = 0; i < work.size(); ++i) {
-    Result& r = results[i];
-    if (!r.done) continue;
-    for (std::size_t k = 0; k < 3; ++k) steps[k] += r.steps[k];
-    if (work[i].owner == rank) {
-      apply(std::move(r), mine[work[i].local]);
+
+  // Round 1: the whole faces, and the pieces of the first cut of the faces above
+  // settings.task_quads.
+  std::vector<Task> round;
+  std::vector<std::array<std::size_t, 2>> whole;  // each whole face: index in `mine`, task
+  std::vector<Split> splits;
+  for (std::size_t i = 0; i < mine.size(); ++i) {
+    const ImproveFace& f = mine[i];
+    const auto quads = static_cast<std::int64_t>(f.mesh->quads.size());
+    if (settings.task_quads > 0 && quads > settings.task_quads && f.mesh->triangles.empty()) {
+      const Stopwatch clock;  // cutting is part of the face's time
+      *f.report = ImprovementReport{};
+      Split s;
+      s.face = i;
+      s.pieces = static_cast<LO>((quads + settings.task_quads - 1) / settings.task_quads);
+      s.input = std::move(*f.mesh);
+      s.irregular_before = qstruct::count_irregular(s.input);
+      const std::vector<LO> part = mesh::bisect_quads(s.input, s.pieces, false);
+      const LO n = part.empty() ? 0 : *std::max_element(part.begin(), part.end()) + 1;
+      add_pieces(s, part, n, f.singularities, round);
+      splits.push_back(std::move(s));
+      *f.seconds += clock.seconds();
     } else {
-      to_owners.add(work[i].owner, work[i].face, r);
-      r = Result{};
+      Task t;
+      t.face = f.face;
+      t.input.mesh = std::move(*f.mesh);
+      t.input.singularities.assign(f.singularities.begin(), f.singularities.end());
+      whole.push_back({i, round.size()});
+      round.push_back(std::move(t));
     }
   }
-  if (nranks > 1) {
-    std::vector<std::size_t> local_of_face;  // face -> index in mine + 1 (0: not this rank's)
-    for (std::size_t i = 0; i < mine.size(); ++i) {
-      const auto f = static_cast<std::size_t>(mine[i].face);
-      if (local_of_face.size() <= f) local_of_face.resize(f + 1, 0);
-      local_of_face[f] = i + 1;
+  std::vector<Result> results =
+      deal_round(comm, model, round, settings, tasks, log, "improvement", steps);
+  for (const auto& [i, k] : whole) apply(std::move(results[k]), mine[i]);
+
+  // Round 2, where any face was cut: the merged faces cut again halfway between the first cuts
+  // (bisect_quads shifted), so that the cavity and disk passes run across the first cuts and
+  // remove the irregular vertices they alone left.
+  const bool any_split = comm.size() > 1 ? !comm.allreduce_and(splits.empty()) : !splits.empty();
+  if (any_split) {
+    round.clear();
+    for (Split& s : splits) {
+      ImproveFace& f = mine[s.face];
+      const Stopwatch clock;
+      // Defects before the disk step: the first pass's pieces' (a cut vertex is none).
+      f.report->defects_before = 0;
+      for (std::size_t p = 0; p < s.cut.size(); ++p)
+        f.report->defects_before += results[s.first_task + p].report.defects_before;
+      mesh::FaceMesh merged = merge_pieces(s, results, f, log);
+      s.input = std::move(merged);
+      const std::vector<LO> part = mesh::bisect_quads(s.input, s.pieces, true);
+      const LO n = part.empty() ? 0 : *std::max_element(part.begin(), part.end()) + 1;
+      add_pieces(s, part, n, f.singularities, round);
+      *f.seconds += clock.seconds();
     }
-    to_owners.deliver(comm, [&](LO face, Result&& r) {
-      const auto f = static_cast<std::size_t>(face);
-      QSMESH_CHECK(face >= 0 && f < local_of_face.size() && local_of_face[f] != 0,
-                   "improvement: the result of face " << f << " came to a rank not owning it");
-      apply(std::move(r), mine[local_of_face[f] - 1]);
-    });
-    comm.allreduce_sum(steps);
+    results =
+        deal_round(comm, model, round, settings, tasks, log, "improvement (second cut)", steps);
+    for (Split& s : splits) {
+      ImproveFace& f = mine[s.face];
+      const Stopwatch clock;
+      *f.mesh = merge_pieces(s, results, f, log);
+      f.mesh->face = f.face;
+      // The counts of the whole face (a piece's count leaves its cut vertices out).
+      f.report->irregular_before = s.irregular_before;
+      f.report->irregular_after = qstruct::count_irregular(*f.mesh);
+      f.report->defects_after = remesh::count_defects(*f.mesh, settings.disk);
+      *f.seconds += clock.seconds();
+    }
   }
+  if (comm.size() > 1) comm.allreduce_sum(steps);
   return {steps[0], steps[1], steps[2]};
 }
 

@@ -51,6 +51,9 @@ struct ImproveFace {
   std::span<const crossfield::Singularity> singularities;  ///< of the face's cross field
   ImprovementReport* report = nullptr;                     ///< out: what the steps did
   double* seconds = nullptr;                               ///< out: += wall time spent on the face
+  /// out (optional): the seconds of each piece task of a face cut into pieces (the first cut's
+  /// pieces, then the second's; ImproveSettings::task_quads), appended.
+  std::vector<double>* task_seconds = nullptr;
 };
 
 /// What the steps take.
@@ -61,6 +64,12 @@ struct ImproveSettings {
   remesh::DiskRemeshOptions disk;
   bool final_smoothing = true;
   smooth::SmoothOptions final_smooth;
+  /// A face of more quads than this is improved in pieces (0: never; issue 28): cut into k =
+  /// ceil(quads / task_quads) pieces by mesh::bisect_quads, each piece a task with its cut
+  /// vertices fixed, merged, then cut again halfway between the first cuts (k + 1 pieces, the
+  /// end ones half size) and improved again, so that the first cuts end inside pieces. The
+  /// result depends on the face and task_quads only, not on ranks or threads.
+  std::int64_t task_quads = 0;
 };
 
 /// Per face, in order: cavity remeshing (Sec. 6.2), disk remeshing of the defects (Sec. 6.3), the
@@ -75,6 +84,10 @@ struct ImproveSettings {
 /// alone), and each result goes back to the owner alone (Comm::alltoall_bytes). A rank thus holds
 /// its own faces plus those it works on, not the model. A face's result depends only on the face,
 /// so the mesh is the same whatever the numbers of ranks and threads. One rank: no copies.
+/// Faces above settings.task_quads are dealt as pieces instead, in two rounds (the pieces of
+/// the first cut with the whole faces, then those of the second cut); their counts in the report
+/// are of the whole face (irregular vertices and defects before the first cut and after the
+/// second, cavities and disk replacements summed over the pieces).
 /// Returns the wall time of the three steps summed over the faces of all ranks (every rank).
 std::array<double, 3> improve_faces(const Comm& comm, const cad::CadModel& model,
                                     std::span<ImproveFace> mine, const ImproveSettings& settings,

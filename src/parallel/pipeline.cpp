@@ -329,6 +329,7 @@ std::array<double, 3> improvement_stage(const Context& cx, std::vector<FaceTask>
     f.singularities = t.singularities;
     f.report = &t.quasi.improvement;
     f.seconds = &t.seconds;
+    f.task_seconds = &t.times.improvement_tasks;
     to_improve.push_back(f);
   }
   const remesh::DiskQuadTable table = remesh::DiskQuadTable::builtin();
@@ -339,6 +340,7 @@ std::array<double, 3> improvement_stage(const Context& cx, std::vector<FaceTask>
   settings.disk = cx.options.disk;
   settings.final_smoothing = cx.options.final_smoothing;
   settings.final_smooth = cx.options.final_smooth;
+  settings.task_quads = cx.options.task_quads;
   const std::array<double, 3> steps =
       improve_faces(cx.comm, cx.model, to_improve, settings, cx.tasks, cx.log);
   for (std::size_t i = 0; i < faces.size(); ++i)

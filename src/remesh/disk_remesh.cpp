@@ -109,30 +109,14 @@ std::vector<std::array<LO, 4>> place_replacement(const DiskQuadTable& table, con
 
 namespace {
 
-// Ideal valence of a corner from its angle in the face: the sum of its quads' 3D angles.
 std::vector<int> corner_ideal_valences(const mesh::FaceMesh& m, const DiskRemeshOptions& options) {
-  const LO nv = m.num_vertices();
   if (!options.corner_valence.empty()) {
-    QSMESH_CHECK(static_cast<LO>(options.corner_valence.size()) == nv,
+    QSMESH_CHECK(static_cast<LO>(options.corner_valence.size()) == m.num_vertices(),
                  "face " << m.face << ": corner_valence has " << options.corner_valence.size()
-                         << " entries for " << nv << " vertices");
+                         << " entries for " << m.num_vertices() << " vertices");
     return options.corner_valence;
   }
-  std::vector<double> angle(nv, 0.0);
-  for (const auto& q : m.quads)
-    for (int k = 0; k < 4; ++k) {
-      const LO v = q[k];
-      if (m.vclass[v].dim != 0) continue;
-      const Vec3 a = m.points[q[(k + 1) % 4]] - m.points[v];
-      const Vec3 c = m.points[q[(k + 3) % 4]] - m.points[v];
-      const double na = norm(a), nc = norm(c);
-      if (na > 0 && nc > 0) angle[v] += std::acos(std::clamp(dot(a, c) / (na * nc), -1.0, 1.0));
-    }
-  std::vector<int> ideal(nv, 0);
-  for (LO v = 0; v < nv; ++v)
-    if (m.vclass[v].dim == 0)
-      ideal[v] = std::max(1, static_cast<int>(std::lround(angle[v] / (std::numbers::pi / 2))));
-  return ideal;
+  return estimate_corner_valences(m);
 }
 
 // Vertices where the surface normal vanishes (poles): their quads fan out of a collapsed curve, so
@@ -429,6 +413,25 @@ bool Work::try_cavity(LO x, std::vector<LO> cav, bool force) {  // cav by value:
 }
 
 }  // namespace
+
+std::vector<int> estimate_corner_valences(const mesh::FaceMesh& m) {
+  const LO nv = m.num_vertices();
+  std::vector<double> angle(nv, 0.0);
+  for (const auto& q : m.quads)
+    for (int k = 0; k < 4; ++k) {
+      const LO v = q[k];
+      if (m.vclass[v].dim != 0) continue;
+      const Vec3 a = m.points[q[(k + 1) % 4]] - m.points[v];
+      const Vec3 c = m.points[q[(k + 3) % 4]] - m.points[v];
+      const double na = norm(a), nc = norm(c);
+      if (na > 0 && nc > 0) angle[v] += std::acos(std::clamp(dot(a, c) / (na * nc), -1.0, 1.0));
+    }
+  std::vector<int> ideal(nv, 0);
+  for (LO v = 0; v < nv; ++v)
+    if (m.vclass[v].dim == 0)
+      ideal[v] = std::max(1, static_cast<int>(std::lround(angle[v] / (std::numbers::pi / 2))));
+  return ideal;
+}
 
 LO count_defects(const mesh::FaceMesh& m, const DiskRemeshOptions& options) {
   const std::vector<int> ideal = corner_ideal_valences(m, options);

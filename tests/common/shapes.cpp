@@ -25,6 +25,7 @@
 #include <TopoDS_Wire.hxx>
 #include <cmath>
 #include <gp_Ax2.hxx>
+#include <gp_Circ.hxx>
 #include <gp_Vec.hxx>
 #include <stdexcept>
 #include <string_view>
@@ -100,6 +101,26 @@ std::string write_polygon_face(const std::vector<std::pair<double, double>>& xy,
   for (const auto& [x, y] : xy) poly.Add(gp_Pnt(x, y, 0));
   poly.Close();
   return write_planar_face(poly.Wire(), "polygon", path);
+}
+
+std::string write_long_plate(double length, double width, const std::string& path) {
+  const double l = length, w = width;
+  BRepBuilderAPI_MakePolygon outline;
+  for (const auto& [x, y] : std::vector<std::pair<double, double>>{
+           {0, 0}, {0.6 * l, 0}, {l, 0.2 * w}, {l, w}, {0.55 * l, w}, {0.45 * l, 0.8 * w}, {0, w}})
+    outline.Add(gp_Pnt(x, y, 0));
+  outline.Close();
+  BRepBuilderAPI_MakeFace face(outline.Wire(), /*OnlyPlane=*/true);
+  if (!face.IsDone()) throw std::runtime_error("long plate face construction failed");
+  // Three holes: the face is not a disk, so no pattern fits it.
+  for (const auto& [x, y] : std::vector<std::pair<double, double>>{
+           {0.2 * l, 0.5 * w}, {0.5 * l, 0.4 * w}, {0.8 * l, 0.55 * w}}) {
+    const gp_Circ circle(gp_Ax2(gp_Pnt(x, y, 0), gp_Dir(0, 0, 1)), 0.15 * w);
+    const TopoDS_Wire hole = BRepBuilderAPI_MakeWire(BRepBuilderAPI_MakeEdge(circle).Edge()).Wire();
+    face.Add(TopoDS::Wire(hole.Reversed()));
+  }
+  if (!face.IsDone()) throw std::runtime_error("long plate holes failed");
+  return write(face.Face(), path);
 }
 
 std::string write_teardrop(double radius, const std::string& path) {

@@ -29,6 +29,10 @@ std::string write_sphere_lune(const std::string& path);
 /// Writes the planar face (z = 0) bounded by the polygon through `xy`, as BREP; returns path.
 std::string write_polygon_face(const std::vector<std::pair<double, double>>& xy,
                                const std::string& path);
+/// Writes a planar seven-sided plate, length x width (x along the length), with a slanted end,
+/// a notch in one long side and three round holes: no pattern fits it (issue 28's long face).
+/// BREP; returns path.
+std::string write_long_plate(double length, double width, const std::string& path);
 /// Writes the planar teardrop made of a circle of this radius about the origin and the two
 /// tangents to it from the point (0, -radius sqrt 2): one corner (90 degrees), smooth elsewhere.
 std::string write_teardrop(double radius, const std::string& path);

@@ -121,6 +121,25 @@ class Stages(unittest.TestCase):
         self.assertAlmostEqual(s.bound(), 11.1, places=6)
 
 
+class Pieces(unittest.TestCase):
+    def test_pieces_are_tasks_in_two_rounds(self):
+        # Face 0 (3000 quads) improved in pieces: 3 of 2 s in the first round, 4 of 1 s in the
+        # second, 1 s of cutting and merging on its owner (11 - 10); face 1 (500 quads) whole, 1 s.
+        st = stats([(1, 0, 0, 11, 1, 3000), (1, 0, 0, 1, 1, 500)],
+                   {"background": 2.0, "improvement": 12.0})
+        st["face_stats"][0]["stage_seconds"]["improvement_tasks"] = [2, 2, 2, 1, 1, 1, 1]
+        s = sim.Simulator(sim.Run(st), comm=NO_COMM)
+        # Three workers: round 1 2 | 2 | 2+1 -> 3, round 2 1+1 | 1 | 1 -> 2, then 1 on the owner.
+        self.assertAlmostEqual(s.predict(3, 1)["improvement"], 6.0, places=6)
+        # One worker: everything in turn.
+        self.assertAlmostEqual(s.predict(1, 1)["improvement"], 12.0, places=6)
+        big = s.largest_faces()
+        self.assertEqual(big["improvement task"][0], 0)
+        self.assertAlmostEqual(big["improvement task"][1], 2.0)
+        # Unlimited ranks: background 1 + improvement 2 + 1 + 1.
+        self.assertAlmostEqual(s.bound(), 5.0, places=6)
+
+
 class CommandLine(unittest.TestCase):
     def test_refusals_and_output(self):
         script = os.path.join(SCRIPTS, "simulate_scaling.py")

@@ -176,6 +176,10 @@ struct FaceTimes {
   /// Bytes of the face's gathered record (its mesh and reports): the size of what crosses ranks
   /// for the face at the gather, and about that of its improvement's input and result.
   std::int64_t bytes = 0;
+  /// A face improved in pieces (PipelineOptions::task_quads): the seconds of each piece, the
+  /// first cut's pieces (dealt with the whole faces) then the second cut's (dealt after them).
+  /// Their sum and the cutting and merging make `improvement`. Empty: one task.
+  std::vector<double> improvement_tasks;
   template <class S, class V>
   static void fields(S& self, V&& visit) {
     visit("background", self.background);
@@ -188,6 +192,7 @@ struct FaceTimes {
     visit("expected_quads", self.expected_quads);
     visit("improvement_quads", self.improvement_quads);
     visit("bytes", self.bytes);
+    visit("improvement_tasks", self.improvement_tasks);
   }
 };
 

@@ -38,6 +38,12 @@ enum class Stage { Background, Unstructured, QuasiStructured };
 /// Parses a stage name; throws InputError listing the valid names.
 [[nodiscard]] Stage parse_stage(const std::string& name);
 
+/// Default PipelineOptions::task_quads: above the largest improved face of the six shared models
+/// at their reference sizes (their meshes do not change), and small enough that the one face
+/// that dominates A319 at 16 times its reference vertex count is dealt as several tasks
+/// (docs/benchmarks.md, issue 28).
+inline constexpr std::int64_t kDefaultTaskQuads = 20000;
+
 struct PipelineOptions {
   background::BackgroundOptions background;
   Stage until = Stage::Background;
@@ -105,6 +111,10 @@ struct PipelineOptions {
   /// 0.884 -> 0.885 (min 0.093 -> 0.099) for 0.06-0.5 s; 30 iterations instead of 10 add nothing.
   bool final_smoothing = true;
   smooth::SmoothOptions final_smooth;
+  /// Stage::QuasiStructured: a face whose unstructured mesh has more quads than this is improved
+  /// in pieces, each a task of its own (ImproveSettings::task_quads; 0: never). A fixed count,
+  /// not a share of the ranks' work, so that the mesh does not depend on the rank count.
+  std::int64_t task_quads = kDefaultTaskQuads;
   /// Quad stages: the per-face method (`--method`). Holomorphic and Auto also mesh each face whose
   /// background triangulation is a topological annulus from its holomorphic 1-form (paper 004,
   /// holomorphic::mesh_annulus) and choose between that and the default mesh with

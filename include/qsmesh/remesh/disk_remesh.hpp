@@ -127,6 +127,11 @@ struct DiskRemeshStats {
   // no_candidate, rejected_geometry and skipped count tries: a defect may try up to four cavities.
 };
 
+/// The ideal valence of each dim-0 vertex estimated from its angle in the face: max(1, round(angle
+/// / 90 deg)), the angle summed over its quads' corners in 3D (0 for other vertices). What
+/// DiskRemeshOptions::corner_valence defaults to.
+[[nodiscard]] std::vector<int> estimate_corner_valences(const mesh::FaceMesh& mesh);
+
 /// Defects of a quad face mesh (Sec. 6.3): dim-2 vertices of valence >= 6, dim-1 vertices of
 /// valence != 2, dim-0 vertices of valence != ideal (options.corner_valence or the estimate).
 /// Each image of a seam vertex (its (dim, entity, index) twice in the mesh, one per side) counts as
