@@ -547,5 +547,100 @@ TEST(SizeMap, FaceCurvatureBoundsStraightCurvesOnlyWhenAskedFor) {
   EXPECT_EQ(seams, 1);
 }
 
+TEST(SizeMap, ThinAspectCapsTheSizeAlongAStripOnly) {
+  // Three 10-long rectangles, 4, 0.05 and 4 wide, sharing their long curves, at size 1 and the
+  // default rules' floor 0.17. The strip's long curves are 0.05 apart and sides of one face:
+  // without the cap they keep max(floor, 0.75 x 1) (the feature ratio), with K = 4 they get
+  // 4 x 0.05 = 0.2 (below the floor too, with K = 2). The plate's outer long curves are 4 from
+  // anything: untouched but for the gradation from the corners.
+  const Model m = prepare(
+      cad::load_cad(test::write_plate_with_strip(10, 4, 0.05, tmp("sm_strip.brep"))), 1.0, false);
+  SizeMapOptions o;
+  o.method = Method::Features;
+  o.size_max = 1.0;
+  o.size_min = 0.17;
+  auto along = [&](const CurveSizes& cs, double y) {  // sizes on the curve y, 3.5 from its ends
+    std::vector<double> out;
+    for (LO c = 0; c < m.cad.num_curves(); ++c)
+      for (std::size_t i = 0; i < cs.at[c].size(); ++i) {
+        const Vec3& p = m.curves[c].points[i];
+        const auto& a = m.curves[c].points.front();
+        const auto& b = m.curves[c].points.back();
+        if (std::abs(a.y - y) < 1e-9 && std::abs(b.y - y) < 1e-9 && p.x > 3.5 && p.x < 6.5)
+          out.push_back(cs.at[c][i]);
+      }
+    return out;
+  };
+  const CurveSizes off = initial_curve_sizes(m.cad, m.curves, o, TaskArena(1));
+  for (const double y : {4.0, 4.05}) {
+    const auto s = along(off, y);
+    ASSERT_GT(s.size(), 2u);
+    for (const double x : s)
+      EXPECT_NEAR(x, 0.75, 1e-6) << "y " << y;  // graded from 0.17 up to x = 3
+  }
+  for (const double k : {4.0, 2.0}) {
+    o.thin_aspect = k;
+    const CurveSizes on = initial_curve_sizes(m.cad, m.curves, o, TaskArena(2));
+    for (const double y : {4.0, 4.05})
+      for (const double x : along(on, y)) EXPECT_NEAR(x, k * 0.05, 1e-6) << "K " << k;
+    for (const double y : {0.0, 8.05}) {
+      const auto s = along(on, y);
+      ASSERT_GT(s.size(), 2u);
+      EXPECT_NEAR(*std::max_element(s.begin(), s.end()), 1.0, 1e-9);  // far from the strip
+    }
+    EXPECT_LE(curve_gradation_excess(m, on, o.gradation), 1e-9);
+  }
+  o.thin_aspect = -1;
+  EXPECT_THROW((void)initial_curve_sizes(m.cad, m.curves, o, TaskArena(1)), InputError);
+}
+
+TEST(SizeMap, ThinAspectLeavesWideFacesAndOrdinaryCornersAlone) {
+  // A 10 x 0.6 rectangle at size 1: 0.6 apart is more than half the size, not thin. A triangle
+  // with a 20-degree corner: its two long sides are close near the corner, but no closer than
+  // sin 10 degrees times the distance to it (an ordinary corner, not a cusp's tail).
+  SizeMapOptions o;
+  o.method = Method::Features;
+  o.size_max = 1.0;
+  o.size_min = 0.17;
+  const double tip = 8 * std::tan(20 * std::numbers::pi / 180);
+  for (const auto& xy :
+       {std::vector<std::pair<double, double>>{{0, 0}, {10, 0}, {10, 0.6}, {0, 0.6}},
+        std::vector<std::pair<double, double>>{{0, 0}, {8, 0}, {8, tip}}}) {
+    const Model m = prepare(polygon_face(xy, "sm_thin_alone.brep"), 1.0, false);
+    o.thin_aspect = 0;
+    const CurveSizes off = initial_curve_sizes(m.cad, m.curves, o, TaskArena(1));
+    o.thin_aspect = 4;
+    const CurveSizes on = initial_curve_sizes(m.cad, m.curves, o, TaskArena(1));
+    EXPECT_EQ(off.pack(), on.pack());
+  }
+}
+
+TEST(SizeMap, ThinAspectGradesTheSizeIntoASharpWedge) {
+  // A triangle with a 3-degree corner at the origin: at x along the bottom, the other side is
+  // x sin 3 degrees away, so the size there is at most 4 times that (graded toward the cusp),
+  // where without the cap the feature ratio keeps 0.75 x the size from about x = 3 on.
+  const double deg = 3 * std::numbers::pi / 180;
+  const Model m =
+      prepare(polygon_face({{0, 0}, {8, 0}, {8, 8 * std::tan(deg)}}, "sm_wedge.brep"), 1.0, false);
+  SizeMapOptions o;
+  o.method = Method::Features;
+  o.size_max = 1.0;
+  o.size_min = 0.17;
+  o.thin_aspect = 4;
+  const CurveSizes on = initial_curve_sizes(m.cad, m.curves, o, TaskArena(1));
+  int seen = 0;
+  for (LO c = 0; c < m.cad.num_curves(); ++c) {
+    const auto& pts = m.curves[c].points;
+    if (std::abs(pts.front().y) > 1e-9 || std::abs(pts.back().y) > 1e-9) continue;  // the bottom
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      if (pts[i].x < 1 || pts[i].x > 6) continue;
+      ++seen;
+      EXPECT_LE(on.at[c][i], 4 * pts[i].x * std::sin(deg) + 1e-9) << "x " << pts[i].x;
+    }
+  }
+  EXPECT_GT(seen, 3);
+  EXPECT_LE(curve_gradation_excess(m, on, o.gradation), 1e-9);
+}
+
 }  // namespace
 }  // namespace qsmesh::sizemap
