@@ -25,15 +25,9 @@ void limit_by_feature_distance(const cad::CadModel& model,
                                std::vector<std::vector<double>>& sizes, double touching,
                                double floor, const TaskArena& tasks);
 
-/// Two curves meeting at a corner are two sides of a thin region where they are closer than
-/// sin(kSharpWedgeDeg) times the distance to that corner (limit_by_face_width).
-inline constexpr double kSharpWedgeDeg = 10;
-
 /// The width of thin faces along their sides: lowers sizes[c][k] to the distance d from polyline
-/// vertex k of curve c to the nearest other curve that bounds a face with c (the other side of a
-/// strip, a neck or a cusp's tail), searching only within the current sizes[c][k]; no floor. A
-/// curve sharing a corner with c counts only where d < sin(kSharpWedgeDeg) x the distance from the
-/// vertex to that corner (inside a wedge sharper than that, not along an ordinary corner's sides).
+/// vertex k of curve c to the nearest curve that bounds a face with c but shares no corner with it
+/// (the other side of a strip or a neck), searching only within the current sizes[c][k]; no floor.
 /// Distances up to `touching` are ignored. Curves near each other across a gap between two faces
 /// (a slot) do not count: neither face is thin there. The distance is taken in space, so it is at
 /// most the width inside the face. Same inputs and determinism as limit_by_feature_distance.
