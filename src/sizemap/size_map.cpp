@@ -254,7 +254,7 @@ CurveSizes initial_curve_sizes(const cad::CadModel& model, std::span<const mesh:
         width = h;
         for (auto& w : width)
           for (double& x : w) x *= 0.5;
-        background::limit_by_face_width(model, dense, width, touching, tasks);
+        background::limit_by_face_width(model, dense, width, touching, floor, tasks);
       }
       background::limit_by_feature_distance(model, dense, h, touching, floor, tasks);
       // h only ever lowers the sizes it started from, and the ratio is at most 1.

@@ -615,5 +615,33 @@ TEST(SizeMap, ThinAspectLeavesWideFacesAndSidesMeetingAtACornerAlone) {
   }
 }
 
+TEST(SizeMap, ThinAspectLeavesTheBluntedTipOfAWedgeAlone) {
+  // A 20-degree wedge whose tip a curve 0.05 long cuts off (shorter than the floor 0.17): its two
+  // long sides share no corner and are 0.05-0.5 apart near the tip, but they are a wedge, not a
+  // strip (farther apart than twice the sliver, and than sin 10 degrees x the distance to it).
+  const double slope = std::tan(20 * std::numbers::pi / 180);
+  const Model m =
+      prepare(polygon_face({{0, 0}, {8, 0}, {8, 0.05 + 8 * slope}, {0, 0.05}}, "sm_blunt.brep"),
+              1.0, false);
+  SizeMapOptions o;
+  o.method = Method::Features;
+  o.size_max = 1.0;
+  o.size_min = 0.17;
+  const CurveSizes off = initial_curve_sizes(m.cad, m.curves, o, TaskArena(1));
+  o.thin_aspect = 4;
+  const CurveSizes on = initial_curve_sizes(m.cad, m.curves, o, TaskArena(1));
+  int seen = 0;
+  for (LO c = 0; c < m.cad.num_curves(); ++c) {
+    const auto& pts = m.curves[c].points;
+    if (std::abs(pts.front().y) > 1e-9 || std::abs(pts.back().y) > 1e-9) continue;  // the bottom
+    for (std::size_t i = 0; i < pts.size(); ++i)
+      if (pts[i].x > 0.5 && pts[i].x < 1.3) {
+        ++seen;
+        EXPECT_DOUBLE_EQ(on.at[c][i], off.at[c][i]) << "x " << pts[i].x;
+      }
+  }
+  EXPECT_GT(seen, 0);
+}
+
 }  // namespace
 }  // namespace qsmesh::sizemap
