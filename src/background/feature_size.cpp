@@ -200,10 +200,6 @@ void limit_by_face_width(const cad::CadModel& model, std::span<const std::vector
     }
     return false;
   };
-  // Sides meeting at a corner are not counted: inside a sharp wedge (a cusp's tail) that was
-  // tried, and the sizes it grades toward the cusp reach the faces along its sides (t20_data's
-  // chamfer slivers at their reference size: the grids beside them went from SICN min 0.91 to 0.33,
-  // +14% vertices, SICN avg 0.984 -> 0.947).
   // Corners joined by a curve shorter than `sliver`: (corner, corner, its length), both orders.
   struct Joint {
     LO a, b;
@@ -221,13 +217,18 @@ void limit_by_face_width(const cad::CadModel& model, std::span<const std::vector
     }
   std::sort(joints.begin(), joints.end());
   // Two sides joined by a sliver curve are a strip whose end it is (as far apart as it is long),
-  // or a wedge whose tip it cuts off (wing_fuselage's wing root trailing edge, a 0.04-long curve
+  // or a wedge whose tip it cuts off (wing_fuselage's wing-root trailing edges, a 0.04-long curve
   // between sides 0.1-1 apart around it). The wedge's sides count only where they are closer than
-  // sin(10 degrees) x the distance to the sliver, as a strip: the sizes graded toward a blunted tip
-  // of an ordinary wedge gave its small faces irregular vertices (+6% vertices, SICN avg -0.003 to
-  // -0.006 across wing_fuselage's window), and the quads at the sliver stayed flat.
+  // sin(10 degrees) x the distance to the sliver, as a strip's do: the sizes graded toward the
+  // blunted tip of an ordinary wedge gave its small faces irregular vertices (across
+  // wing_fuselage's window up to 19 more, SICN avg 0.004-0.008 lower; docs/benchmarks.md), and
+  // the quads at the sliver stayed flat.
   const double sharp = std::sin(10 * std::numbers::pi / 180);
   const auto corners = model.corners();
+  // Sides meeting at a corner are not counted: inside a sharp wedge (a cusp's tail) that was
+  // tried, and the sizes it grades toward the cusp reach the faces along its sides (t20_data's
+  // chamfer slivers at their reference size: the grids beside them went from SICN min 0.91 to 0.33,
+  // +14% vertices, SICN avg 0.984 -> 0.947).
   limit_by_distance(
       polylines, sizes, touching, 0.0, tasks,
       [&](LO c, LO other) { return !share_corner(model, c, other) && share_face(c, other); },

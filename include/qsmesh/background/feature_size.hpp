@@ -31,7 +31,8 @@ void limit_by_feature_distance(const cad::CadModel& model,
 /// Distances up to `touching` are ignored. Curves near each other across a gap between two faces
 /// (a slot) do not count: neither face is thin there. Two curves whose ends are joined by a curve
 /// shorter than `sliver` (the end of a strip, or the blunted tip of a wedge) count only where d is
-/// less than sin(10 degrees) x the distance from the vertex to that joint. The distance is taken in
+/// at most twice that curve's length (a strip as wide as its end) or less than sin(10 degrees) x
+/// the distance from the vertex to the joint (a wedge sharper than that). The distance is taken in
 /// space, so it is at most the width inside the face. Same inputs and determinism as
 /// limit_by_feature_distance.
 void limit_by_face_width(const cad::CadModel& model, std::span<const std::vector<Vec3>> polylines,

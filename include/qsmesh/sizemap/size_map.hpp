@@ -66,13 +66,14 @@ struct SizeMapOptions {
   /// 0.96%, wing_fuselage 2.60% -> 0.82%, A319 1.54% -> 1.50%.
   double feature_ratio = 0.75;
   /// Largest length-to-width ratio K of the edges along a thin face (>= 0; 0: off). Where a curve
-  /// and another side of one of its faces (sharing no corner with it, see
-  /// background::limit_by_face_width) are closer than half the curve's size before rule (ii), the
-  /// size along the curve is capped at K x that width. The feature ratio keeps the size along a
-  /// strip at nearly the full size, and a quad w/2 wide (2 across) and L long has SICN about w / L:
-  /// K = 4 keeps it near 0.25. Only along the strip (local anisotropy; the count across stays that
-  /// of the quantization), and below the floor, which would otherwise make flat quads in strips
-  /// narrower than floor / K; gaps under a tenth of the floor (curves touching) do not count.
+  /// and another side of one of its faces (sharing no corner with it; joined through a curve
+  /// shorter than the floor only as a strip's end, see background::limit_by_face_width) are closer
+  /// than half the curve's size before rule (ii), the size along the curve is capped at K x that
+  /// width. The feature ratio keeps the size along a strip at nearly the full size, and a quad w/2
+  /// wide (2 across) and L long has SICN about w / L: K = 4 keeps it near 0.25. Only along the
+  /// strip (local anisotropy; the count across stays that of the quantization), and below the
+  /// floor, which would otherwise make flat quads in strips narrower than floor / K; gaps under a
+  /// tenth of the floor (curves touching) do not count.
   double thin_aspect = 0;
   /// N, the target number of quads of the whole model; 0: total area / size_max^2.
   double target_quads = 0;
