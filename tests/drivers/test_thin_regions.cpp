@@ -157,7 +157,7 @@ ThinCheck mesh_and_check(const std::string& model, const std::string& options,
 std::string write_face(const TopoDS_Wire& wire, const std::string& path) {
   BRepBuilderAPI_MakeFace face(wire, /*OnlyPlane=*/true);
   if (!face.IsDone()) throw std::runtime_error("face construction failed");
-  const TopoDS_Shape shape = face.Face();
+  const TopoDS_Shape& shape = face.Face();
   if (!BRepTools::Write(shape, path.c_str())) throw std::runtime_error("cannot write " + path);
   return path;
 }

@@ -589,6 +589,7 @@ TEST(SizeMap, ThinAspectCapsTheSizeAlongAStripOnly) {
       EXPECT_NEAR(*std::max_element(s.begin(), s.end()), 1.0, 1e-9);  // far from the strip
     }
     EXPECT_LE(curve_gradation_excess(m, on, o.gradation), 1e-9);
+    EXPECT_EQ(on.pack(), initial_curve_sizes(m.cad, m.curves, o, TaskArena(1)).pack());
   }
   o.thin_aspect = -1;
   EXPECT_THROW((void)initial_curve_sizes(m.cad, m.curves, o, TaskArena(1)), InputError);
