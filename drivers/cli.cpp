@@ -238,6 +238,12 @@ Arguments parse(const std::vector<std::string>& args) {
       if (!r || !(*r >= 0 && *r <= 1))
         throw InputError(opt + ": '" + v + "' is not a number in [0, 1]");
       a.feature_ratio = *r;
+    } else if (opt == "--thin-aspect" && sizing) {
+      const std::string& v = value();
+      const auto k = parse_double(v);
+      if (!k || !std::isfinite(*k) || *k < 0)
+        throw InputError(opt + ": '" + v + "' is not 0 (off) or a positive aspect ratio");
+      a.thin_aspect = *k;
     } else if (opt == "--size-min" && sizing) {
       a.size_min = parse_positive(opt, value());
     } else if (opt == "--size-min-ratio" && sizing) {
@@ -330,11 +336,11 @@ Arguments parse(const std::vector<std::string>& args) {
   if (a.size_min && a.size_min_ratio)
     throw InputError("--size-min and --size-min-ratio: give one, not both");
   // The size-map options asked for on the line; the default rules' own options (below) are not.
-  const bool sizing_given = sizing_rules_given || a.sizemap != "crossfield" || a.quads > 0 ||
-                            a.curvature_edges || a.face_curvature || a.feature_ratio ||
-                            a.size_min || a.size_min_ratio || !a.curve_edges.empty() ||
-                            !a.face_quads.empty() || !a.corner_sizes.empty() ||
-                            !a.curve_sizes.empty() || !a.face_sizes.empty() || a.odd_slivers;
+  const bool sizing_given =
+      sizing_rules_given || a.sizemap != "crossfield" || a.quads > 0 || a.curvature_edges ||
+      a.face_curvature || a.feature_ratio || a.thin_aspect || a.size_min || a.size_min_ratio ||
+      !a.curve_edges.empty() || !a.face_quads.empty() || !a.corner_sizes.empty() ||
+      !a.curve_sizes.empty() || !a.face_sizes.empty() || a.odd_slivers;
   if (a.command == Command::Mesh && sizing_given && a.until == "background")
     throw InputError(
         "size-map options act on the quad mesh: with --until background only --size or "
@@ -505,8 +511,10 @@ std::string help(const std::string& topic) {
           "                        regions, transfinite filling); FIELD is a list of singular\n"
           "                        points per face or a `qsmesh crossfield` VTU (docs/usage.md).\n"
           "                        A face whose field is refused keeps the default mesh\n"
-          "  --quads N, --curvature-edges N, --face-curvature, --feature-ratio R, --size-min H,\n"
-          "  --size-min-ratio R, --sizing RULES, --curve-edges C:N,.., --odd-slivers,\n"
+          "  --quads N, --curvature-edges N, --face-curvature, --feature-ratio R, --thin-aspect "
+          "K,\n"
+          "  --size-min H, --size-min-ratio R, --sizing RULES, --curve-edges C:N,.., "
+          "--odd-slivers,\n"
           "  --face-quads F:N,.., --corner-size K:H,.., --curve-size C:H,.., --face-size F:H,..,\n"
           "  --sizemap METHOD\n"
           "                        size-map controls, as for sizemap (see qsmesh sizemap --help);\n"
@@ -593,6 +601,9 @@ std::string help(const std::string& topic) {
           "                        0.75); 0 resolves every feature, at the price of more "
           "irregular\n"
           "                        vertices along thin strips and slots\n"
+          "  --thin-aspect K       along a face narrower than half the size (a strip, a neck),\n"
+          "                        edges are at most K times its width long, so that its quads\n"
+          "                        keep SICN about 1 / K (default 4; 0: off)\n"
           "  --size-min H          smallest size the size map may ask for (model units; default\n"
           "                        0.17 x the size cap with the default sizing rules, the size\n"
           "                        cap / 100 with --sizing paper); given, it also stops curves\n"

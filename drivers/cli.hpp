@@ -74,6 +74,9 @@ struct Arguments {
   /// --feature-ratio R: how far small features refine (sizemap::SizeMapOptions::feature_ratio;
   /// unset: its default).
   std::optional<double> feature_ratio;
+  /// --thin-aspect K: largest length-to-width ratio of the edges along thin faces
+  /// (sizemap::SizeMapOptions::thin_aspect; unset: kDefaultThinAspect, 0: off).
+  std::optional<double> thin_aspect;
   /// --size-min H: floor of the automatic sizes, model units (sizemap::SizeMapOptions::size_min;
   /// unset: the size cap / 100, which curves shorter than it still go below).
   std::optional<double> size_min;
@@ -110,6 +113,9 @@ inline constexpr double kDefaultSizeFactor = 0.02;
 /// of the size cap: the value at which all six shared models meet the Gmsh reference runs'
 /// criteria (docs/benchmarks.md, fifteenth session; 0.10 and 0.25 miss wing_fuselage's).
 inline constexpr double kClampedSizeMinRatio = 0.17;
+/// Default --thin-aspect (sizemap::SizeMapOptions::thin_aspect, off in the library): quads along
+/// a strip 2 across keep SICN about 1 / K (docs/benchmarks.md, issue 29, has the measurements).
+inline constexpr double kDefaultThinAspect = 4;
 
 /// Default --max-quads: far above any mesh the project has been run on (1.2M vertices) and far
 /// below what a mistyped size asks for (--size-factor 1e-6: about 1e12 quads), so that a runaway

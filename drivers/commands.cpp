@@ -373,6 +373,7 @@ std::string stats_json(const Arguments& args, const Session& session,
   j.value("curvature_edges", curvature_edges(args));  // edges per full turn (0: none)
   j.value("face_curvature", args.face_curvature);
   j.value("feature_ratio", feature_ratio(args));
+  j.value("thin_aspect", thin_aspect(args));
   j.value("size_min", given_size_min(args, session.size));  // model units (0: the size cap / 100)
   j.value("corners", static_cast<std::int64_t>(model.num_corners()));
   j.value("curves", static_cast<std::int64_t>(model.num_curves()));
@@ -751,6 +752,8 @@ double feature_ratio(const Arguments& args) {
   return args.feature_ratio.value_or(sizemap::SizeMapOptions{}.feature_ratio);
 }
 
+double thin_aspect(const Arguments& args) { return args.thin_aspect.value_or(kDefaultThinAspect); }
+
 double given_size_min(const Arguments& args, double size) {
   if (args.size_min_ratio) return *args.size_min_ratio * size;
   return args.size_min.value_or(0.0);
@@ -770,6 +773,7 @@ void apply_size_options(const Arguments& args, const Session& s,
   so.edges_per_turn = curvature_edges(args);
   so.face_curvature = args.face_curvature;
   so.feature_ratio = feature_ratio(args);
+  so.thin_aspect = thin_aspect(args);
   if (args.size_min && *args.size_min > s.size) {
     std::ostringstream os;
     os << "--size-min " << *args.size_min << " is larger than the size cap " << s.size

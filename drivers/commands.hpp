@@ -62,6 +62,8 @@ double field_divisions(const Arguments& args);
 double curvature_edges(const Arguments& args);
 /// The feature ratio a run uses: --feature-ratio, or the size map's default.
 double feature_ratio(const Arguments& args);
+/// The thin-face aspect ratio a run uses: --thin-aspect, or kDefaultThinAspect.
+double thin_aspect(const Arguments& args);
 /// The floor of the automatic sizes the user gave, in model units: --size-min, or --size-min-ratio
 /// times `size` (the size cap); 0 when neither is given (the size map's default floor).
 double given_size_min(const Arguments& args, double size);

@@ -119,6 +119,7 @@ int run_sizemap(const Arguments& args) {
     j.value("curvature_edges", curvature_edges(args));
     j.value("face_curvature", args.face_curvature);
     j.value("feature_ratio", feature_ratio(args));
+    j.value("thin_aspect", thin_aspect(args));
     j.value("size_min", given_size_min(args, s.size));
     j.value("curves", static_cast<std::int64_t>(s.model.num_curves()));
     j.value("chords", static_cast<std::int64_t>(q.num_chords));

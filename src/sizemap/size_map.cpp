@@ -44,6 +44,8 @@ void validate(const cad::CadModel& model, const SizeMapOptions& options) {
     input_error("gradation must be >= 0");
   if (!(options.feature_ratio >= 0 && options.feature_ratio <= 1))
     input_error("the feature ratio must be in [0, 1]");
+  if (!(options.thin_aspect >= 0) || !std::isfinite(options.thin_aspect))
+    input_error("the thin-face aspect ratio must be >= 0");
   check_entities(options.corner_sizes, model.num_corners(), "corner");
   check_entities(options.curve_sizes, model.num_curves(), "curve");
   check_entities(options.face_sizes, model.num_faces(), "face");
@@ -244,12 +246,31 @@ CurveSizes initial_curve_sizes(const cad::CadModel& model, std::span<const mesh:
     if (cell > 0) {
       // Gaps narrower than a tenth of the floor are curves touching or lying on top of each other
       // (unsewn or sloppy models), not features a mesh could resolve.
-      background::limit_by_feature_distance(model, dense, h, 0.1 * floor, floor, tasks);
+      const double touching = 0.1 * floor;
+      // The thin-face widths are searched within half the size before (ii): wider faces are not
+      // thin. Taken from the same densified polylines, before h is lowered by (ii).
+      std::vector<std::vector<double>> width;
+      if (options.thin_aspect > 0) {
+        width = h;
+        for (auto& w : width)
+          for (double& x : w) x *= 0.5;
+        background::limit_by_face_width(model, dense, width, touching, floor, tasks);
+      }
+      background::limit_by_feature_distance(model, dense, h, touching, floor, tasks);
       // h only ever lowers the sizes it started from, and the ratio is at most 1.
       for (LO c = 0; c < nc; ++c)
         for (std::size_t i = 0; i < original[c].size(); ++i) {
           double& s = out.at[c][i];
+          const double before = s;
           s = std::max(h[c][original[c][i]], options.feature_ratio * s);
+          // The feature ratio and the floor keep the size along a thin face near the full size:
+          // its quads would be about width / size flat. Capped by the aspect ratio instead, below
+          // the floor too (the floor is about the sizes the faces around may ask for, not the
+          // shape of the quads inside a strip).
+          if (!width.empty()) {
+            const double w = width[c][original[c][i]];
+            if (w < 0.5 * before) s = std::min(s, options.thin_aspect * w);
+          }
         }
     }
   }

@@ -253,7 +253,20 @@ TEST(Cli, SizeMapOptions) {
         error_of({"mesh", "m.step", "-o", "o.vtu", "--feature-ratio", bad}).find("--feature-ratio"),
         std::string::npos)
         << bad;
-  EXPECT_FALSE(p({"mesh", "m.step", "-o", "o.vtu"}).size_min.has_value());
+  EXPECT_FALSE(p({"mesh", "m.step", "-o", "o.vtu"}).thin_aspect.has_value());
+  EXPECT_DOUBLE_EQ(*p({"mesh", "m.step", "-o", "o.vtu", "--thin-aspect", "0"}).thin_aspect, 0.0);
+  EXPECT_DOUBLE_EQ(*p({"sizemap", "m.step", "-o", "s.vtu", "--thin-aspect", "5"}).thin_aspect, 5.0);
+  for (const char* bad : {"-1", "x", "inf", "nan"})
+    EXPECT_NE(
+        error_of({"mesh", "m.step", "-o", "o.vtu", "--thin-aspect", bad}).find("--thin-aspect"),
+        std::string::npos)
+        << bad;
+  // A size-map option: refused with --until background, as the others.
+  EXPECT_NE(
+      error_of({"mesh", "m.step", "-o", "o.vtu", "--until", "background", "--thin-aspect", "4"})
+          .find("size-map options"),
+      std::string::npos);
+
   EXPECT_DOUBLE_EQ(*p({"sizemap", "m.step", "-o", "s.vtu", "--size-min", "0.25"}).size_min, 0.25);
   for (const char* bad : {"0", "-1", "x"})
     EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--size-min", bad}).find("--size-min"),

@@ -547,5 +547,102 @@ TEST(SizeMap, FaceCurvatureBoundsStraightCurvesOnlyWhenAskedFor) {
   EXPECT_EQ(seams, 1);
 }
 
+TEST(SizeMap, ThinAspectCapsTheSizeAlongAStripOnly) {
+  // Three 10-long rectangles, 4, 0.05 and 4 wide, sharing their long curves, at size 1 and the
+  // default rules' floor 0.17. The strip's long curves are 0.05 apart and sides of one face:
+  // without the cap they keep max(floor, 0.75 x 1) (the feature ratio), with K = 4 they get
+  // 4 x 0.05 = 0.2 (below the floor too, with K = 2). The plate's outer long curves are 4 from
+  // anything: untouched but for the gradation from the corners.
+  const Model m = prepare(
+      cad::load_cad(test::write_plate_with_strip(10, 4, 0.05, tmp("sm_strip.brep"))), 1.0, false);
+  SizeMapOptions o;
+  o.method = Method::Features;
+  o.size_max = 1.0;
+  o.size_min = 0.17;
+  auto along = [&](const CurveSizes& cs, double y) {  // sizes on the curve y, 3.5 from its ends
+    std::vector<double> out;
+    for (LO c = 0; c < m.cad.num_curves(); ++c)
+      for (std::size_t i = 0; i < cs.at[c].size(); ++i) {
+        const Vec3& p = m.curves[c].points[i];
+        const auto& a = m.curves[c].points.front();
+        const auto& b = m.curves[c].points.back();
+        if (std::abs(a.y - y) < 1e-9 && std::abs(b.y - y) < 1e-9 && p.x > 3.5 && p.x < 6.5)
+          out.push_back(cs.at[c][i]);
+      }
+    return out;
+  };
+  const CurveSizes off = initial_curve_sizes(m.cad, m.curves, o, TaskArena(1));
+  for (const double y : {4.0, 4.05}) {
+    const auto s = along(off, y);
+    ASSERT_GT(s.size(), 2u);
+    for (const double x : s)
+      EXPECT_NEAR(x, 0.75, 1e-6) << "y " << y;  // graded from 0.17 up to x = 3
+  }
+  for (const double k : {4.0, 2.0}) {
+    o.thin_aspect = k;
+    const CurveSizes on = initial_curve_sizes(m.cad, m.curves, o, TaskArena(2));
+    for (const double y : {4.0, 4.05})
+      for (const double x : along(on, y)) EXPECT_NEAR(x, k * 0.05, 1e-6) << "K " << k;
+    for (const double y : {0.0, 8.05}) {
+      const auto s = along(on, y);
+      ASSERT_GT(s.size(), 2u);
+      EXPECT_NEAR(*std::max_element(s.begin(), s.end()), 1.0, 1e-9);  // far from the strip
+    }
+    EXPECT_LE(curve_gradation_excess(m, on, o.gradation), 1e-9);
+    EXPECT_EQ(on.pack(), initial_curve_sizes(m.cad, m.curves, o, TaskArena(1)).pack());
+  }
+  o.thin_aspect = -1;
+  EXPECT_THROW((void)initial_curve_sizes(m.cad, m.curves, o, TaskArena(1)), InputError);
+}
+
+TEST(SizeMap, ThinAspectLeavesWideFacesAndSidesMeetingAtACornerAlone) {
+  // A 10 x 0.6 rectangle at size 1: 0.6 apart is more than half the size, not thin. A triangle
+  // with a 3-degree corner: its two long sides are close near the corner, but they share it (a
+  // cusp's tail; grading toward it reached the faces beside it, see limit_by_face_width).
+  SizeMapOptions o;
+  o.method = Method::Features;
+  o.size_max = 1.0;
+  o.size_min = 0.17;
+  const double tip = 8 * std::tan(3 * std::numbers::pi / 180);
+  for (const auto& xy :
+       {std::vector<std::pair<double, double>>{{0, 0}, {10, 0}, {10, 0.6}, {0, 0.6}},
+        std::vector<std::pair<double, double>>{{0, 0}, {8, 0}, {8, tip}}}) {
+    const Model m = prepare(polygon_face(xy, "sm_thin_alone.brep"), 1.0, false);
+    o.thin_aspect = 0;
+    const CurveSizes off = initial_curve_sizes(m.cad, m.curves, o, TaskArena(1));
+    o.thin_aspect = 4;
+    const CurveSizes on = initial_curve_sizes(m.cad, m.curves, o, TaskArena(1));
+    EXPECT_EQ(off.pack(), on.pack());
+  }
+}
+
+TEST(SizeMap, ThinAspectLeavesTheBluntedTipOfAWedgeAlone) {
+  // A 20-degree wedge whose tip a curve 0.05 long cuts off (shorter than the floor 0.17): its two
+  // long sides share no corner and are 0.05-0.5 apart near the tip, but they are a wedge, not a
+  // strip (farther apart than twice the sliver, and than sin 10 degrees x the distance to it).
+  const double slope = std::tan(20 * std::numbers::pi / 180);
+  const Model m =
+      prepare(polygon_face({{0, 0}, {8, 0}, {8, 0.05 + 8 * slope}, {0, 0.05}}, "sm_blunt.brep"),
+              1.0, false);
+  SizeMapOptions o;
+  o.method = Method::Features;
+  o.size_max = 1.0;
+  o.size_min = 0.17;
+  const CurveSizes off = initial_curve_sizes(m.cad, m.curves, o, TaskArena(1));
+  o.thin_aspect = 4;
+  const CurveSizes on = initial_curve_sizes(m.cad, m.curves, o, TaskArena(1));
+  int seen = 0;
+  for (LO c = 0; c < m.cad.num_curves(); ++c) {
+    const auto& pts = m.curves[c].points;
+    if (std::abs(pts.front().y) > 1e-9 || std::abs(pts.back().y) > 1e-9) continue;  // the bottom
+    for (std::size_t i = 0; i < pts.size(); ++i)
+      if (pts[i].x > 0.5 && pts[i].x < 1.3) {
+        ++seen;
+        EXPECT_DOUBLE_EQ(on.at[c][i], off.at[c][i]) << "x " << pts[i].x;
+      }
+  }
+  EXPECT_GT(seen, 0);
+}
+
 }  // namespace
 }  // namespace qsmesh::sizemap

@@ -65,6 +65,16 @@ struct SizeMapOptions {
   /// counts (docs/benchmarks.md, eleventh session), 0 -> 0.75: interior irregular Block 1.28% ->
   /// 0.96%, wing_fuselage 2.60% -> 0.82%, A319 1.54% -> 1.50%.
   double feature_ratio = 0.75;
+  /// Largest length-to-width ratio K of the edges along a thin face (>= 0; 0: off). Where a curve
+  /// and another side of one of its faces (sharing no corner with it; joined through a curve
+  /// shorter than the floor only as a strip's end, see background::limit_by_face_width) are closer
+  /// than half the curve's size before rule (ii), the size along the curve is capped at K x that
+  /// width. The feature ratio keeps the size along a strip at nearly the full size, and a quad w/2
+  /// wide (2 across) and L long has SICN about w / L: K = 4 keeps it near 0.25. Only along the
+  /// strip (local anisotropy; the count across stays that of the quantization), and below the
+  /// floor, which would otherwise make flat quads in strips narrower than floor / K; gaps under a
+  /// tenth of the floor (curves touching) do not count.
+  double thin_aspect = 0;
   /// N, the target number of quads of the whole model; 0: total area / size_max^2.
   double target_quads = 0;
   /// (face id, quad count) fixed by the user: that face gets this N_i instead of its area share.
@@ -104,10 +114,10 @@ struct CurveSizes {
 /// is no longer than half the local size), (ii) lowering a size to no less than feature_ratio x
 /// its value before (ii); floored by effective_size_min (so (i) and (ii) hold for
 /// features larger than the floor; (i) also below the floor unless size_min was given); then user
-/// corner sizes, and grade_curves (corners = min over their curves, Eq. 10 along the curve edges
-/// and through corners). `curves` indexed by curve id, as background::mesh_curves returns them.
-/// Deterministic whatever the thread count of `tasks`. Throws InputError for bad options (sizes <=
-/// 0, ids out of range).
+/// corner sizes, the thin-face cap (thin_aspect), and grade_curves (corners = min over their
+/// curves, Eq. 10 along the curve edges and through corners). `curves` indexed by curve id, as
+/// background::mesh_curves returns them. Deterministic whatever the thread count of `tasks`. Throws
+/// InputError for bad options (sizes <= 0, ids out of range).
 [[nodiscard]] CurveSizes initial_curve_sizes(const cad::CadModel& model,
                                              std::span<const mesh::CurveMesh> curves,
                                              const SizeMapOptions& options, const TaskArena& tasks);
