@@ -8,31 +8,6 @@
 
 namespace qsmesh::mesh {
 
-QuadCorners quad_corners(const std::array<Vec3, 4>& q) {
-  QuadCorners c;
-  c.sum = Vec3{};
-  for (int i = 0; i < 4; ++i) {
-    const Vec3 prev = q[(i + 3) % 4] - q[i];
-    const Vec3 next = q[(i + 1) % 4] - q[i];
-    c.n[i] = cross(next, prev);
-    c.denom[i] = norm2(prev) + norm2(next);
-    c.sum += c.n[i];
-  }
-  return c;
-}
-
-double quad_sicn_from(const QuadCorners& c) {
-  const double ns = norm(c.sum);
-  if (!(ns > 0)) return -1.0;
-  const Vec3 normal = c.sum / ns;
-  double worst = std::numeric_limits<double>::max();
-  for (int i = 0; i < 4; ++i) {
-    const double v = c.denom[i] > 0 ? 2.0 * dot(c.n[i], normal) / c.denom[i] : -1.0;
-    worst = std::min(worst, v);
-  }
-  return worst;
-}
-
 double quad_sicn(const std::array<Vec3, 4>& q) { return quad_sicn_from(quad_corners(q)); }
 
 double triangle_quality(const Vec3& a, const Vec3& b, const Vec3& c) {

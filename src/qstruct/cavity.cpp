@@ -512,29 +512,44 @@ class Remesher {
     // Free vertices: the new ones, then rings of old ones around the cavity (never CAD vertices).
     std::vector<char> in_cavity(static_cast<std::size_t>(t.num_quads()), 0);
     for (const LO q : c.quads) in_cavity[q] = 1;
-    std::set<LO> free_old;
+    // Sorted vectors rather than std::set: this runs for every candidate layout of every cavity,
+    // and the node allocations of the sets were a visible share of the remeshing.
+    std::vector<LO> free_old;
     std::vector<LO> ring(c.boundary.begin(), c.boundary.end());
-    std::set<LO> seen(ring.begin(), ring.end());
-    for (const LO v : c.interior) seen.insert(v);
+    std::vector<LO> seen(ring.begin(), ring.end());
+    seen.insert(seen.end(), c.interior.begin(), c.interior.end());
+    std::sort(seen.begin(), seen.end());
+    seen.erase(std::unique(seen.begin(), seen.end()), seen.end());
+    const auto insert_sorted = [](std::vector<LO>& set, LO x) {
+      const auto it = std::lower_bound(set.begin(), set.end(), x);
+      if (it != set.end() && *it == x) return false;
+      set.insert(it, x);
+      return true;
+    };
     for (int k = 1; k <= o_.smooth_rings; ++k) {
       for (const LO v : ring)
-        if (w_.vclass[v].dim == 2 && !t.on_boundary(v)) free_old.insert(v);
+        if (w_.vclass[v].dim == 2 && !t.on_boundary(v)) insert_sorted(free_old, v);
       if (k == o_.smooth_rings) break;
       std::vector<LO> next_ring;
       for (const LO v : ring)
         for (const LO q : t.quads_of(v)) {
           if (in_cavity[q]) continue;
           for (const LO x : w_.quads[q])
-            if (seen.insert(x).second) next_ring.push_back(x);
+            if (insert_sorted(seen, x)) next_ring.push_back(x);
         }
       std::sort(next_ring.begin(), next_ring.end());
       ring = std::move(next_ring);
     }
+    const auto is_free_old = [&](LO v) {
+      return std::binary_search(free_old.begin(), free_old.end(), v);
+    };
     // Region: the new quads and the old ones around a free old vertex.
-    std::set<LO> old_quads;
+    std::vector<LO> old_quads;
     for (const LO v : free_old)
       for (const LO q : t.quads_of(v))
-        if (!in_cavity[q]) old_quads.insert(q);
+        if (!in_cavity[q]) old_quads.push_back(q);
+    std::sort(old_quads.begin(), old_quads.end());
+    old_quads.erase(std::unique(old_quads.begin(), old_quads.end()), old_quads.end());
 
     double before = std::numeric_limits<double>::max(), before_sum = 0;
     for (const LO q : c.quads) {
@@ -570,7 +585,7 @@ class Remesher {
       lm.points[i] = w_.points[v];
       lm.uv[i] = w_.uv[v];
       lm.vclass[i] = w_.vclass[v];
-      if (lm.vclass[i].dim == 2 && !free_old.count(v))
+      if (lm.vclass[i].dim == 2 && !is_free_old(v))
         lm.vclass[i] = mesh::VertexClass{1, -2, i, {0, 0}};
     }
     for (const auto& q : out.quads)
@@ -613,7 +628,7 @@ class Remesher {
     }
     for (LO i = 0; i < nold; ++i) {
       const LO v = verts[i];
-      if (!free_old.count(v)) continue;
+      if (!is_free_old(v)) continue;
       if (lm.uv[i] == w_.uv[v] && lm.points[i] == w_.points[v]) continue;
       out.moved.push_back(v);
       out.moved_uv.push_back(lm.uv[i]);
