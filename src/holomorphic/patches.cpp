@@ -810,13 +810,13 @@ mesh::FaceMesh mesh_poly_annulus(const mesh::FaceMesh& background,
         const bool from_loop = static_cast<LO>(fu.size()) == n;
         std::size_t k0 = 0;
         if (from_loop)
-          for (std::size_t k = 1; k < fu.size(); ++k)
-            if (std::abs(wrap(fu[k] - u0, lc.period)) < std::abs(wrap(fu[k0] - u0, lc.period)))
-              k0 = k;
+          for (std::size_t q = 1; q < fu.size(); ++q)
+            if (std::abs(wrap(fu[q] - u0, lc.period)) < std::abs(wrap(fu[k0] - u0, lc.period)))
+              k0 = q;
         auto offset = [&](LO j) {
           if (!from_loop) return lc.period * double(j) / double(n);
-          const std::size_t k = k0 + static_cast<std::size_t>(j);
-          return k < fu.size() ? fu[k] - fu[k0] : fu[k - fu.size()] + lc.period - fu[k0];
+          const std::size_t q = k0 + static_cast<std::size_t>(j);
+          return q < fu.size() ? fu[q] - fu[k0] : fu[q - fu.size()] + lc.period - fu[k0];
         };
         for (LO j = 1; j < n; ++j) {
           const double du = offset(j);
@@ -884,15 +884,15 @@ mesh::FaceMesh mesh_poly_annulus(const mesh::FaceMesh& background,
         // points identified (a zero's point replaces the one it meets); a row there would be a
         // sliver.
         for (std::size_t i = 0; i < N; ++i) {
-          const LO a = find_same(lo_ids[i]), h = find_same(hi_ids[i]);
-          if (a == h) continue;
-          const bool za = std::find(saddle_ids.begin(), saddle_ids.end(), a) != saddle_ids.end();
+          const LO l = find_same(lo_ids[i]), h = find_same(hi_ids[i]);
+          if (l == h) continue;
+          const bool za = std::find(saddle_ids.begin(), saddle_ids.end(), l) != saddle_ids.end();
           const bool zh = std::find(saddle_ids.begin(), saddle_ids.end(), h) != saddle_ids.end();
           if (za && zh) return fail("two zeros meet across a thin patch");
           if (zh)
-            same[a] = h;
+            same[l] = h;
           else
-            same[h] = a;
+            same[h] = l;
         }
         ++collapsed;
         continue;

@@ -144,7 +144,9 @@ TEST(Pieces, SplitThenMergeGivesTheSameMesh) {
       // Fixed ones first, and only those: the face's boundary and the cut vertices.
       EXPECT_EQ(i < p.boundary, c.dim < 2) << "piece vertex " << i;
       // (no seam here: each cut vertex's own id)
-      if (is_cut_vertex(c)) EXPECT_EQ(c.entity, kCutEntity - static_cast<LO>(v));
+      if (is_cut_vertex(c)) {
+        EXPECT_EQ(c.entity, kCutEntity - static_cast<LO>(v));
+      }
     }
   }
   EXPECT_EQ(quads, m.quads.size());
