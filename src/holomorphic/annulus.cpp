@@ -77,24 +77,9 @@ mesh::FaceMesh mesh_annulus(const mesh::FaceMesh& background,
     if (!why.empty()) return fail(why);
     if (F.cycles.size() != 2)
       return fail("the final boundary has " + std::to_string(F.cycles.size()) + " cycles, not 2");
-    // Each loop is a horizontal trajectory, straight in the form's flat metric: a CAD corner on
-    // it is flattened, and a grid with two quads at every boundary vertex folds next to it (a
-    // sharp corner needs one or three quads, a boundary singularity the grid does not have).
-    for (const auto& cycle : F.cycles)
-      for (std::size_t i = 0; i < cycle.size(); ++i) {
-        const auto& p = F.points[static_cast<std::size_t>(cycle[i])];
-        if (p.vclass.dim != 0) continue;
-        const Vec3& a =
-            F.points[static_cast<std::size_t>(cycle[(i + cycle.size() - 1) % cycle.size()])].xyz;
-        const Vec3& b = F.points[static_cast<std::size_t>(cycle[(i + 1) % cycle.size()])].xyz;
-        const double turn =
-            std::acos(std::clamp(dot(normalized(p.xyz - a), normalized(b - p.xyz)), -1.0, 1.0));
-        if (turn > options.max_corner_turn_deg * std::numbers::pi / 180)
-          return fail("a loop turns by " +
-                      std::to_string(std::lround(turn * 180 / std::numbers::pi)) +
-                      " degrees at corner " + std::to_string(p.vclass.entity) +
-                      ": the grid would fold there");
-      }
+    // Each loop is a horizontal trajectory, straight in the form's flat metric.
+    if (std::string sharp = sharp_corner_on_a_loop(F, options.max_corner_turn_deg); !sharp.empty())
+      return fail(sharp);
 
     // (u, v) of every final boundary point: on the nearest background boundary edge.
     std::vector<C> uv_of(F.points.size());

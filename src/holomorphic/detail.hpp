@@ -7,6 +7,7 @@
 #include <cmath>
 #include <complex>
 #include <map>
+#include <numbers>
 #include <span>
 #include <string>
 #include <tuple>
@@ -198,6 +199,27 @@ inline FinalBoundary merge_final(std::span<const mesh::BoundaryLoop> loops, std:
     F.cycles.push_back(std::move(cycle));
   }
   return F;
+}
+
+// Why a grid with two quads at every boundary vertex would fold on F (a loop turning by more than
+// max_turn_deg at a CAD corner: a level of the form is straight in its flat metric, so the corner
+// is flattened and a sharp one needs one or three quads); empty when no corner does.
+inline std::string sharp_corner_on_a_loop(const FinalBoundary& F, double max_turn_deg) {
+  for (const auto& cycle : F.cycles)
+    for (std::size_t i = 0; i < cycle.size(); ++i) {
+      const auto& p = F.points[static_cast<std::size_t>(cycle[i])];
+      if (p.vclass.dim != 0) continue;
+      const Vec3& a =
+          F.points[static_cast<std::size_t>(cycle[(i + cycle.size() - 1) % cycle.size()])].xyz;
+      const Vec3& c = F.points[static_cast<std::size_t>(cycle[(i + 1) % cycle.size()])].xyz;
+      const double turn =
+          std::acos(std::clamp(dot(normalized(p.xyz - a), normalized(c - p.xyz)), -1.0, 1.0));
+      if (turn > max_turn_deg * std::numbers::pi / 180)
+        return "a loop turns by " + std::to_string(std::lround(turn * 180 / std::numbers::pi)) +
+               " degrees at corner " + std::to_string(p.vclass.entity) +
+               ": the grid would fold there";
+    }
+  return {};
 }
 
 // u at grid point (i, j), i in [0, N], j in [0, M], row-major by j: the rows' ends on the two

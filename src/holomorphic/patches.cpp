@@ -341,24 +341,11 @@ mesh::FaceMesh mesh_poly_annulus(const mesh::FaceMesh& background,
     if (F.cycles.size() != b)
       return fail("the final boundary has " + std::to_string(F.cycles.size()) + " cycles, not " +
                   std::to_string(b));
-    // A loop is a level of v, straight in the form's flat metric; a grid with two quads at every
-    // boundary vertex folds at a sharp CAD corner (see mesh_annulus); a right angle is split in
-    // two by the column from it.
-    for (const auto& cycle : F.cycles)
-      for (std::size_t i = 0; i < cycle.size(); ++i) {
-        const auto& p = F.points[static_cast<std::size_t>(cycle[i])];
-        if (p.vclass.dim != 0) continue;
-        const Vec3& a =
-            F.points[static_cast<std::size_t>(cycle[(i + cycle.size() - 1) % cycle.size()])].xyz;
-        const Vec3& c = F.points[static_cast<std::size_t>(cycle[(i + 1) % cycle.size()])].xyz;
-        const double turn =
-            std::acos(std::clamp(dot(normalized(p.xyz - a), normalized(c - p.xyz)), -1.0, 1.0));
-        if (turn > options.max_patch_corner_turn_deg * std::numbers::pi / 180)
-          return fail("a loop turns by " +
-                      std::to_string(std::lround(turn * 180 / std::numbers::pi)) +
-                      " degrees at corner " + std::to_string(p.vclass.entity) +
-                      ": the grid would fold there");
-      }
+    // A loop is a level of v, straight in the form's flat metric (see mesh_annulus); a right
+    // angle is split in two by the column from it.
+    if (std::string sharp = sharp_corner_on_a_loop(F, options.max_patch_corner_turn_deg);
+        !sharp.empty())
+      return fail(sharp);
 
     const HolomorphicBasis B = holomorphic_basis(s, options.basis, nullptr);
     R.basis_seconds = B.seconds;
