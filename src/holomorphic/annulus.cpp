@@ -21,10 +21,11 @@ using detail::Locator;
 using detail::merge_final;
 using detail::wrap;
 
-mesh::FaceMesh mesh_annulus(const mesh::FaceMesh& background,
-                            std::span<const mesh::BoundaryLoop> loops,
-                            const cad::FaceGeometry& surface, const HolomorphicOptions& options,
-                            HolomorphicReport* report) {
+mesh::FaceMesh detail::mesh_annulus_of(const PolyAnnulus& s, const mesh::FaceMesh& background,
+                                       std::span<const mesh::BoundaryLoop> loops,
+                                       const cad::FaceGeometry& surface,
+                                       const HolomorphicOptions& options,
+                                       HolomorphicReport* report) {
   const Stopwatch clock;
   HolomorphicReport local;
   HolomorphicReport& R = report != nullptr ? *report : local;
@@ -36,7 +37,6 @@ mesh::FaceMesh mesh_annulus(const mesh::FaceMesh& background,
     return mesh::FaceMesh{};
   };
   try {
-    const PolyAnnulus s = poly_annulus(background);
     R.boundaries = static_cast<LO>(s.loops.size());
     if (!s.ok) return fail("not a poly-annulus: " + s.reason);
     if (s.loops.size() != 2)
@@ -338,6 +338,14 @@ mesh::FaceMesh mesh_annulus(const mesh::FaceMesh& background,
   } catch (const std::exception& e) {
     return fail(std::string("holomorphic: ") + e.what());
   }
+}
+
+mesh::FaceMesh mesh_annulus(const mesh::FaceMesh& background,
+                            std::span<const mesh::BoundaryLoop> loops,
+                            const cad::FaceGeometry& surface, const HolomorphicOptions& options,
+                            HolomorphicReport* report) {
+  return detail::mesh_annulus_of(poly_annulus(background), background, loops, surface, options,
+                                 report);
 }
 
 Method parse_method(const std::string& text) {

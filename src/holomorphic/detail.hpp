@@ -270,4 +270,11 @@ inline std::vector<double> grid_u(const std::vector<double>& a, const std::vecto
   return u;
 }
 
+// mesh_annulus on the poly-annulus `s` of `background` already found (mesh_poly_annulus finds
+// it to count the loops).
+mesh::FaceMesh mesh_annulus_of(const PolyAnnulus& s, const mesh::FaceMesh& background,
+                               std::span<const mesh::BoundaryLoop> loops,
+                               const cad::FaceGeometry& surface, const HolomorphicOptions& options,
+                               HolomorphicReport* report);
+
 }  // namespace qsmesh::holomorphic::detail

@@ -331,7 +331,8 @@ mesh::FaceMesh mesh_poly_annulus(const mesh::FaceMesh& background,
       R.boundaries = static_cast<LO>(s.loops.size());
       return fail("not a poly-annulus: " + s.reason);
     }
-    if (s.loops.size() == 2) return mesh_annulus(background, loops, surface, options, report);
+    if (s.loops.size() == 2)
+      return detail::mesh_annulus_of(s, background, loops, surface, options, report);
     R.boundaries = static_cast<LO>(s.loops.size());
     const std::size_t b = s.loops.size();
     std::string why;

@@ -375,19 +375,23 @@ std::vector<std::vector<Grid>> given_grids(const mesh::SurfaceMesh& mesh,
                  "layout: given block of unknown face " << b.face);
     has[static_cast<std::size_t>(b.face)] = 1;
   }
-  // An oriented quad as its vertex cycle from the smallest id.
-  auto key = [](std::array<GO, 4> c) {
-    std::rotate(c.begin(), std::min_element(c.begin(), c.end()), c.end());
-    return c;
+  // The quad of `face` whose vertex cycle is c, up to its starting vertex (its orientation
+  // too); -1: none.
+  const detail::VertexQuads v2q(mesh);
+  const auto quad_of = [&](LO face, const std::array<GO, 4>& c) -> GO {
+    for (const GO q : v2q[c[0]]) {
+      if (mesh.quad_face[static_cast<std::size_t>(q)] != face) continue;
+      const auto& qd = mesh.quads[static_cast<std::size_t>(q)];
+      int k = 0;
+      while (k < 4 && qd[k] != c[0]) ++k;
+      if (k < 4 && qd[(k + 1) % 4] == c[1] && qd[(k + 2) % 4] == c[2] && qd[(k + 3) % 4] == c[3])
+        return q;
+    }
+    return -1;
   };
-  std::map<std::array<GO, 4>, GO> quad_of;
   std::vector<GO> face_quads(nf, 0);
-  for (std::size_t q = 0; q < mesh.quads.size(); ++q) {
-    const auto f = static_cast<std::size_t>(mesh.quad_face[q]);
-    if (!has[f]) continue;
-    ++face_quads[f];
-    quad_of.emplace(key(mesh.quads[q]), static_cast<GO>(q));
-  }
+  for (const LO f : mesh.quad_face)
+    if (has[static_cast<std::size_t>(f)]) ++face_quads[static_cast<std::size_t>(f)];
   std::vector<char> covered(mesh.quads.size(), 0), bad(nf, 0);
   for (LO t : mesh.triangle_face) bad[static_cast<std::size_t>(t)] = 1;  // no blocks there
   std::vector<GO> cells(nf, 0);
@@ -401,15 +405,14 @@ std::vector<std::vector<Grid>> given_grids(const mesh::SurfaceMesh& mesh,
     Grid g{b.face, b.ni, b.nj, b.vertices, {}};
     for (LO j = 0; j < b.nj && !bad[f]; ++j)
       for (LO i = 0; i < b.ni && !bad[f]; ++i) {
-        const auto it =
-            quad_of.find(key({g.at(i, j), g.at(i + 1, j), g.at(i + 1, j + 1), g.at(i, j + 1)}));
-        if (it == quad_of.end() || mesh.quad_face[static_cast<std::size_t>(it->second)] != b.face ||
-            covered[static_cast<std::size_t>(it->second)]) {
+        const GO q =
+            quad_of(b.face, {g.at(i, j), g.at(i + 1, j), g.at(i + 1, j + 1), g.at(i, j + 1)});
+        if (q < 0 || covered[static_cast<std::size_t>(q)]) {
           bad[f] = 1;
           break;
         }
-        covered[static_cast<std::size_t>(it->second)] = 1;
-        g.quads.push_back(it->second);
+        covered[static_cast<std::size_t>(q)] = 1;
+        g.quads.push_back(q);
       }
     cells[f] += static_cast<GO>(g.quads.size());
     std::sort(g.quads.begin(), g.quads.end());

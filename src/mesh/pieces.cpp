@@ -79,17 +79,22 @@ void bisect(const std::vector<Vec3>& centroid, std::span<LO> ids, std::span<cons
 
 }  // namespace
 
-std::vector<LO> bisect_quads(const FaceMesh& m, LO k, bool shifted) {
-  QSMESH_CHECK(k >= 1, "bisect_quads: " << k << " pieces");
-  const std::size_t nq = m.quads.size();
-  std::vector<Vec3> centroid(nq);
-  for (std::size_t q = 0; q < nq; ++q) {
+std::vector<Vec3> quad_centroids(const FaceMesh& m) {
+  std::vector<Vec3> centroid(m.quads.size());
+  for (std::size_t q = 0; q < m.quads.size(); ++q) {
     const auto& qd = m.quads[q];
     centroid[q] =
         (m.points[static_cast<std::size_t>(qd[0])] + m.points[static_cast<std::size_t>(qd[1])] +
          m.points[static_cast<std::size_t>(qd[2])] + m.points[static_cast<std::size_t>(qd[3])]) *
         0.25;
   }
+  return centroid;
+}
+
+std::vector<LO> bisect_quads(const FaceMesh& m, LO k, bool shifted) {
+  QSMESH_CHECK(k >= 1, "bisect_quads: " << k << " pieces");
+  const std::size_t nq = m.quads.size();
+  const std::vector<Vec3> centroid = quad_centroids(m);
   std::vector<double> share(static_cast<std::size_t>(k) + (shifted ? 1 : 0), 1.0);
   if (shifted) share.front() = share.back() = 0.5;
   std::vector<LO> ids(nq);
@@ -155,22 +160,17 @@ std::vector<FacePiece> split_face_mesh(const FaceMesh& m, std::span<const LO> qu
                   .first->second;
   }
   std::vector<FacePiece> out(static_cast<std::size_t>(pieces));
-  std::vector<LO> local(static_cast<std::size_t>(nv), kNoIndex);  // in the vertex's piece
-  // Boundary first in every piece (each piece's vertices in face order), then the interior.
+  // Each piece's own vertices (not cut ones): its dim < 2 ones first, then its interior, each in
+  // face order.
   for (int pass = 0; pass < 2; ++pass)
     for (LO v = 0; v < nv; ++v) {
       const LO s = vpiece[static_cast<std::size_t>(v)];
-      if (s == kNoIndex) continue;  // used by no quad: left to the merge (dim < 2) or dropped
-      const bool cut = s == kShared;
-      const bool fixed = cut || m.vclass[static_cast<std::size_t>(v)].dim < 2;
-      if (fixed != (pass == 0) || cut) continue;
-      FacePiece& p = out[static_cast<std::size_t>(s)];
-      local[static_cast<std::size_t>(v)] = p.mesh.num_vertices();
-      p.mesh.points.push_back(m.points[static_cast<std::size_t>(v)]);
-      p.mesh.uv.push_back(m.uv[static_cast<std::size_t>(v)]);
-      p.mesh.vclass.push_back(m.vclass[static_cast<std::size_t>(v)]);
-      p.vertex.push_back(v);
+      // Used by no quad (left to the merge, dim < 2, or dropped), or a cut vertex (below).
+      if (s == kNoIndex || s == kShared) continue;
+      if ((m.vclass[static_cast<std::size_t>(v)].dim < 2) != (pass == 0)) continue;
+      out[static_cast<std::size_t>(s)].vertex.push_back(v);
     }
+  std::vector<LO> local(static_cast<std::size_t>(nv), kNoIndex);  // in the vertex's piece
   // Cut vertices belong to several pieces: give each piece its copy as it meets them, in face
   // order (a quad sweep would order them by quads), among the boundary vertices. So the pieces'
   // boundary is collected per piece: a second sweep over the vertices per piece would cost

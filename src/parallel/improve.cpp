@@ -260,16 +260,13 @@ std::vector<std::vector<crossfield::Singularity>> singularities_of_pieces(
     const mesh::FaceMesh& m, std::span<const LO> quad_piece, LO pieces,
     std::span<const crossfield::Singularity> singularities) {
   std::vector<std::vector<crossfield::Singularity>> out(static_cast<std::size_t>(pieces));
+  if (singularities.empty()) return out;
+  const std::vector<Vec3> centroid = mesh::quad_centroids(m);
   for (const auto& s : singularities) {
     double best = std::numeric_limits<double>::max();
     LO at = 0;
-    for (std::size_t q = 0; q < m.quads.size(); ++q) {
-      const auto& qd = m.quads[q];
-      const Vec3 c =
-          (m.points[static_cast<std::size_t>(qd[0])] + m.points[static_cast<std::size_t>(qd[1])] +
-           m.points[static_cast<std::size_t>(qd[2])] + m.points[static_cast<std::size_t>(qd[3])]) *
-          0.25;
-      const double d = norm2(c - s.position);
+    for (std::size_t q = 0; q < centroid.size(); ++q) {
+      const double d = norm2(centroid[q] - s.position);
       if (d < best) {
         best = d;
         at = quad_piece[q];
@@ -306,18 +303,16 @@ void add_pieces(Split& split, std::span<const LO> quad_piece, LO pieces,
   }
 }
 
-// Merges the improved pieces of `split` (results[first_task...]); the counts and times go to
-// `f`. A piece whose result cannot be merged gives way to its input (logged).
+// Merges the improved pieces of `split` (results[first_task...]); the counts (ImprovementReport::
+// add_piece) and times go to `f`. A piece whose result cannot be merged gives way to its input
+// (logged).
 mesh::FaceMesh merge_pieces(const Split& split, std::vector<Result>& results, ImproveFace& f,
-                            Logger& log) {
+                            bool first_cut, Logger& log) {
   std::vector<mesh::FaceMesh> improved;
   for (std::size_t p = 0; p < split.cut.size(); ++p) {
     Result& r = results[split.first_task + p];
     improved.push_back(std::move(r.mesh));
-    const auto& a = r.report;
-    for (std::size_t k = 0; k < 4; ++k) f.report->cavities[k] += a.cavities[k];
-    f.report->disk_replaced += a.disk_replaced;
-    f.report->time_budget_hit = f.report->time_budget_hit || a.time_budget_hit;
+    f.report->add_piece(r.report, first_cut);
     *f.seconds += r.seconds;
     if (f.task_seconds != nullptr) f.task_seconds->push_back(r.seconds);
   }
@@ -416,11 +411,7 @@ std::array<double, 3> improve_faces(const Comm& comm, const cad::CadModel& model
     for (Split& s : splits) {
       ImproveFace& f = mine[s.face];
       const Stopwatch clock;
-      // Defects before the disk step: the first pass's pieces' (a cut vertex is none).
-      f.report->defects_before = 0;
-      for (std::size_t p = 0; p < s.cut.size(); ++p)
-        f.report->defects_before += results[s.first_task + p].report.defects_before;
-      mesh::FaceMesh merged = merge_pieces(s, results, f, log);
+      mesh::FaceMesh merged = merge_pieces(s, results, f, /*first_cut=*/true, log);
       s.input = std::move(merged);
       const std::vector<LO> part = mesh::bisect_quads(s.input, s.pieces, true);
       const LO n = part.empty() ? 0 : *std::max_element(part.begin(), part.end()) + 1;
@@ -432,12 +423,10 @@ std::array<double, 3> improve_faces(const Comm& comm, const cad::CadModel& model
     for (Split& s : splits) {
       ImproveFace& f = mine[s.face];
       const Stopwatch clock;
-      *f.mesh = merge_pieces(s, results, f, log);
+      *f.mesh = merge_pieces(s, results, f, /*first_cut=*/false, log);
       f.mesh->face = f.face;
-      // The counts of the whole face (a piece's count leaves its cut vertices out).
-      f.report->irregular_before = s.irregular_before;
-      f.report->irregular_after = qstruct::count_irregular(*f.mesh);
-      f.report->defects_after = remesh::count_defects(*f.mesh, settings.disk);
+      f.report->whole_face(s.irregular_before, qstruct::count_irregular(*f.mesh),
+                           remesh::count_defects(*f.mesh, settings.disk));
       *f.seconds += clock.seconds();
     }
   }

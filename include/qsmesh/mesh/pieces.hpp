@@ -24,6 +24,9 @@ inline constexpr LO kCutEntity = -(LO{1} << 30);
   return c.dim == 0 && c.entity <= kCutEntity;
 }
 
+/// The centroid of each quad of `m` (the mean of its four points), by quad.
+[[nodiscard]] std::vector<Vec3> quad_centroids(const FaceMesh& m);
+
 /// Partition of the quads of `m` into pieces by recursive coordinate bisection of the quad
 /// centroids in 3D: each set is cut across the longest extent of its centroids' bounding box (x
 /// before y before z on ties), at the quantile that its two halves' shares of the leaves ask

@@ -26,13 +26,9 @@ struct QuadCorners {
   std::array<double, 4> denom;
   Vec3 sum;
 };
-[[nodiscard]] QuadCorners quad_corners(const std::array<Vec3, 4>& q);
-/// quad_sicn from the terms of quad_corners(q): the same value, bit for bit.
-[[nodiscard]] double quad_sicn_from(const QuadCorners& c);
-
 // Defined here so that the smoother's and the untangler's inner loops inline them (they were a
 // tenth of the run on Block.stp as calls returning the 136-byte QuadCorners through memory).
-inline QuadCorners quad_corners(const std::array<Vec3, 4>& q) {
+[[nodiscard]] inline QuadCorners quad_corners(const std::array<Vec3, 4>& q) {
   QuadCorners c;
   c.sum = Vec3{};
   for (int i = 0; i < 4; ++i) {
@@ -45,7 +41,8 @@ inline QuadCorners quad_corners(const std::array<Vec3, 4>& q) {
   return c;
 }
 
-inline double quad_sicn_from(const QuadCorners& c) {
+/// quad_sicn from the terms of quad_corners(q): the same value, bit for bit.
+[[nodiscard]] inline double quad_sicn_from(const QuadCorners& c) {
   const double ns = norm(c.sum);
   if (!(ns > 0)) return -1.0;
   const Vec3 normal = c.sum / ns;

@@ -62,6 +62,23 @@ struct ImprovementReport {
     defects_after = s.defects_after;
     disk_replaced = s.replaced;
   }
+  /// Adds the counts of one piece of a face improved in pieces (issue 28): its remeshings, and
+  /// with `first_cut` its defects before the disk step (a cut vertex is none; the second cut's
+  /// pieces start from the first's result). The face's own counts come from whole_face().
+  void add_piece(const ImprovementReport& piece, bool first_cut) {
+    for (std::size_t k = 0; k < cavities.size(); ++k) cavities[k] += piece.cavities[k];
+    disk_replaced += piece.disk_replaced;
+    time_budget_hit = time_budget_hit || piece.time_budget_hit;
+    if (first_cut) defects_before += piece.defects_before;
+  }
+  /// The counts of a face improved in pieces that only the merged face gives (a piece's counts
+  /// leave its cut vertices out).
+  void whole_face(std::int64_t irregular_start, std::int64_t irregular_end,
+                  std::int64_t defects_end) {
+    irregular_before = irregular_start;
+    irregular_after = irregular_end;
+    defects_after = defects_end;
+  }
   template <class S, class V>
   static void fields(S& self, V&& visit) {
     visit("irregular_unstructured_before", self.irregular_before);
