@@ -101,7 +101,8 @@ std::vector<int> balance_annulus_counts(const cad::CadModel& model,
     if (total[0] == total[1]) {
       ++R.equal_before;
       ++R.equal_after;
-    } else {
+    } else if (double(std::abs(total[1] - total[0])) <=
+               options.max_loop_difference * double(std::max(total[0], total[1]))) {
       const std::size_t lo = total[0] < total[1] ? 0 : 1;
       long need = std::abs(total[1] - total[0]);
       std::vector<int> trial = out;
@@ -140,7 +141,9 @@ std::vector<int> balance_annulus_counts(const cad::CadModel& model,
             ratio += double(trial[i]) / id * sign / double(var.size());
           }
           if (!ok || delta == 0 || delta > need) continue;
-          if (best.empty() || ratio < best_ratio) {
+          // The fewest curves first: each curve moved off the loop changes another face.
+          if (best.empty() || var.size() < best.size() ||
+              (var.size() == best.size() && ratio < best_ratio)) {
             best = var;
             best_ratio = ratio;
             best_delta = delta;

@@ -286,24 +286,37 @@ TEST(Holomorphic, AnnulusCountsAreMadeEqualWithinTheirRoom) {
   const LO outer = model.curves()[0].length > model.curves()[1].length ? 0 : 1;
   std::vector<int> edges(2);
   edges[static_cast<std::size_t>(outer)] = 40;
-  edges[static_cast<std::size_t>(1 - outer)] = 24;
+  edges[static_cast<std::size_t>(1 - outer)] = 32;
   const std::vector<double> ideal(edges.begin(), edges.end());
   const std::vector<LO> no_chord(2, kNoIndex);
   AnnulusCountReport report;
   const auto out = balance_annulus_counts(model, curves, edges, ideal, no_chord, {}, {}, &report);
-  // The inner circle up by its room (35% of 24: 8), the outer down by the rest.
-  EXPECT_EQ(out[static_cast<std::size_t>(1 - outer)], 32);
-  EXPECT_EQ(out[static_cast<std::size_t>(outer)], 32);
+  // The short loop raised (room: 35% of 32 = 11.2 edges).
+  EXPECT_EQ(out[static_cast<std::size_t>(1 - outer)], 40);
+  EXPECT_EQ(out[static_cast<std::size_t>(outer)], 40);
   EXPECT_EQ(report.annuli, 1);
   EXPECT_EQ(report.equal_before, 0);
   EXPECT_EQ(report.equal_after, 1);
-  EXPECT_EQ(report.curves_changed, 2);
-  // The inner circle prescribed: the outer alone cannot come down by 16 (room 14): unchanged.
+  EXPECT_EQ(report.curves_changed, 1);
+  // The inner circle prescribed: the outer comes down instead.
   const std::vector<LO> fixed{1 - outer};
-  const auto kept =
+  const auto down =
       balance_annulus_counts(model, curves, edges, ideal, no_chord, fixed, {}, &report);
-  EXPECT_EQ(kept, edges);
+  EXPECT_EQ(down[static_cast<std::size_t>(outer)], 32);
+  EXPECT_EQ(down[static_cast<std::size_t>(1 - outer)], 32);
+  // Loops further apart than 20% (40 against 24) are left alone, as is a face whose room does
+  // not reach (the inner prescribed, the outer's room 14 < 16, with the limit lifted).
+  edges[static_cast<std::size_t>(1 - outer)] = 24;
+  EXPECT_EQ(balance_annulus_counts(model, curves, edges, ideal, no_chord, {}, {}, &report), edges);
   EXPECT_EQ(report.equal_after, 0);
+  AnnulusCountOptions wide;
+  wide.max_loop_difference = 1;
+  const std::vector<double> ideal2(edges.begin(), edges.end());
+  EXPECT_EQ(balance_annulus_counts(model, curves, edges, ideal2, no_chord, fixed, wide, &report),
+            edges);
+  const auto both = balance_annulus_counts(model, curves, edges, ideal2, no_chord, {}, wide);
+  EXPECT_EQ(both[0], 32);  // inner up by 8, outer down by 8
+  EXPECT_EQ(both[1], 32);
 }
 
 TEST(Holomorphic, AnnulusCountsOnACylinderSideAndNotOnASquarePlate) {

@@ -270,6 +270,10 @@ struct AnnulusCountOptions {
   /// Faces whose loops turn by more than this at a corner are left alone: mesh_annulus refuses
   /// them (HolomorphicOptions::max_corner_turn_deg).
   double max_corner_turn_deg = 30;
+  /// Loops whose counts differ by more than this fraction of the larger are left apart: the
+  /// moves reach other faces through the chords (t20_data's annulus, 224 against 312 edges, made
+  /// equal cost its chamfer faces 4 to 10 irregular vertices each, docs/benchmarks.md).
+  double max_loop_difference = 0.2;
 };
 
 struct AnnulusCountReport {
@@ -293,8 +297,9 @@ struct AnnulusCountReport {
 /// by even steps, then, where their room (options.max_change) does not suffice, the long loop's
 /// lowered. A step moves one variable by 2 edges on each of its curves: a chord (curve2chord:
 /// the curves of a chord move together, so that the four-sided faces across it keep their equal
-/// opposite counts) or a curve in no chord, the one of least count / ideal (up; most, down), then
-/// first found; never past what the loops still differ by. A variable moves only when none of its
+/// opposite counts) or a curve in no chord, the one of fewest curves, then least count / ideal
+/// (up; most, down), then first found; never past what the loops still differ by. Loops further
+/// apart than options.max_loop_difference are left alone. A variable moves only when none of its
 /// curves is in `fixed` (user prescriptions), degenerate, on the other loop, or on a loop of an
 /// annulus done before (so that it stays balanced). A face that cannot be balanced keeps its
 /// counts. Parities and loop parities are kept (even steps). Deterministic; returns the new
