@@ -141,4 +141,24 @@ std::string write_t_duct(double main_radius, double half_length, double branch_r
   return write(shell, path);
 }
 
+std::string write_two_piece_pipe(double radius, double half_length, const std::string& path) {
+  const TopoDS_Shape lower =
+      BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), radius, half_length)
+          .Shape();
+  const TopoDS_Shape upper =
+      BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(0, 0, half_length), gp_Dir(0, 0, 1)), radius,
+                               half_length)
+          .Shape();
+  BRepAlgoAPI_Fuse fuse(lower, upper);
+  fuse.Build();
+  if (!fuse.IsDone()) throw std::runtime_error("boolean fuse failed");
+  BRep_Builder builder;
+  TopoDS_Shell shell;
+  builder.MakeShell(shell);
+  for (TopExp_Explorer f(fuse.Shape(), TopAbs_FACE); f.More(); f.Next())
+    if (BRepAdaptor_Surface(TopoDS::Face(f.Current())).GetType() != GeomAbs_Plane)
+      builder.Add(shell, f.Current());
+  return write(shell, path);
+}
+
 }  // namespace qsmesh::test

@@ -37,4 +37,9 @@ std::string write_rounded_plate_with_holes(double length, double width, double c
 std::string write_t_duct(double main_radius, double half_length, double branch_radius,
                          double branch_height, double fillet, const std::string& path);
 
+/// Writes a straight pipe (radius `radius` about the z axis, z in [0, 2 * half_length]) made of
+/// two cylindrical faces joined along the circle at z = half_length (two cylinders fused), end caps
+/// removed, as BREP; returns path.
+std::string write_two_piece_pipe(double radius, double half_length, const std::string& path);
+
 }  // namespace qsmesh::test

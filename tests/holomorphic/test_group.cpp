@@ -8,6 +8,7 @@
 #include <cmath>
 #include <iostream>
 #include <map>
+#include <numbers>
 #include <numeric>
 #include <set>
 
@@ -34,13 +35,16 @@ cad::CadModel t_duct(double fillet, const std::string& name) {
 
 TEST(HolomorphicGroup, FilletedTDuctIsOneSmoothGroup) {
   const cad::CadModel model = t_duct(0.25, "tduct.brep");
-  for (LO f = 0; f < model.num_faces(); ++f)
-    std::cout << "face " << f << ": " << cad::to_string(model.faces()[f].type) << ", "
-              << model.faces()[f].loops.size() << " loops, " << model.faces()[f].seams.size()
-              << " seams\n";
-  for (LO c = 0; c < model.num_curves(); ++c)
-    std::cout << "curve " << c << ": faces " << model.curve2faces()[c].size() << " smooth "
-              << smooth_across(model, c, {}) << "\n";
+  // Two cylinders and the fillet; the fillet's two curves are the smooth ones, the ends and the
+  // seams are not (one face each).
+  ASSERT_EQ(model.num_faces(), 3);
+  int smooth = 0;
+  for (LO c = 0; c < model.num_curves(); ++c) {
+    const bool two = model.curve2faces()[c].size() == 2;
+    EXPECT_EQ(smooth_across(model, c, {}), two) << "curve " << c;
+    smooth += two ? 1 : 0;
+  }
+  EXPECT_EQ(smooth, 2);
   const auto groups = smooth_face_groups(model, {});
   ASSERT_EQ(groups.size(), 1u);
   EXPECT_EQ(static_cast<LO>(groups[0].size()), model.num_faces());
@@ -214,6 +218,64 @@ TEST(HolomorphicGroup, FilletedTDuctMeshedAsOnePairOfPants) {
     const auto at = surfaces[static_cast<std::size_t>(it - faces.begin())]->eval(q.mesh.uv[x]);
     EXPECT_LT(norm(at.p - q.mesh.points[x]), 1e-6);
   }
+}
+
+// A straight pipe in two faces (b = 2 once glued): the annulus grid of the group, the two seams
+// and the circle between the faces inside it, no singularity.
+TEST(HolomorphicGroup, TwoPiecePipeIsOneAnnulusGrid) {
+  const cad::CadModel model =
+      cad::load_cad(test::write_two_piece_pipe(1.0, 1.5, tmp("pipe2.brep")));
+  ASSERT_EQ(model.num_faces(), 2);
+  const auto groups = smooth_face_groups(model, {});
+  ASSERT_EQ(groups.size(), 1u);
+  background::BackgroundOptions options;
+  options.sizes.size = 0.2;
+  std::vector<mesh::CurveMesh> curves = background::mesh_curves(model, options.sizes, TaskArena(1));
+  // The two end circles (one face each) get 30 edges.
+  for (LO c = 0; c < model.num_curves(); ++c) {
+    const auto& curve = model.curves()[static_cast<std::size_t>(c)];
+    if (model.curve2faces()[c].size() == 1 && curve.corners[0] == curve.corners[1] &&
+        std::abs(curve.length - 2 * std::numbers::pi) < 1e-6)
+      curves[static_cast<std::size_t>(c)] = test::uniform_curve_mesh(model, c, 30);
+  }
+  std::vector<mesh::FaceMesh> backgrounds;
+  std::vector<std::vector<mesh::BoundaryLoop>> loops;
+  std::vector<std::unique_ptr<cad::FaceGeometry>> owned;
+  std::vector<const cad::FaceGeometry*> surfaces;
+  for (const LO f : groups[0]) {
+    background::FaceReport report;
+    backgrounds.push_back(background::mesh_face_background(model, f, curves, options, &report));
+    ASSERT_TRUE(report.ok) << report.error;
+    owned.push_back(model.face_geometry(f));
+    surfaces.push_back(owned.back().get());
+    loops.push_back(background::face_boundary(model, f, *surfaces.back(), curves));
+  }
+  const GluedGroup group = glue_group(groups[0], backgrounds, loops);
+  ASSERT_TRUE(group.ok) << group.reason;
+  HolomorphicReport report;
+  const GroupMesh q = mesh_group(group, surfaces, {}, &report);
+  ASSERT_TRUE(report.ok) << report.reason;
+  EXPECT_EQ(report.boundaries, 2);
+  EXPECT_EQ(report.zeros, 0);
+  EXPECT_EQ(report.columns, 30);
+  // Rows from the modulus: height 3 over the period 2 pi, 30 columns: 14.3 -> 14.
+  EXPECT_EQ(report.rows, 14);
+  const auto stats = mesh::face_quad_stats(q.mesh);
+  EXPECT_EQ(stats.quads, 30 * 14);
+  EXPECT_EQ(stats.irregular_interior, 0);
+  EXPECT_GT(stats.sicn_min, 0.95);
+  for (const auto& p : q.mesh.points) EXPECT_NEAR(std::hypot(p.x, p.y), 1.0, 1e-6);
+  // Half the quads on each face, split at the middle circle.
+  std::map<LO, int> per_face;
+  for (std::size_t k = 0; k < q.quad_face.size(); ++k) {
+    ++per_face[q.quad_face[k]];
+    Vec3 c{0, 0, 0};
+    for (const LO x : q.mesh.quads[k]) c = c + q.mesh.points[static_cast<std::size_t>(x)] * 0.25;
+    const LO lower = c.z < 1.5 ? 0 : 1;
+    const auto& f = model.faces()[static_cast<std::size_t>(q.quad_face[k])];
+    EXPECT_EQ(f.box.lo.z < 0.75 ? 0 : 1, lower) << "quad " << k;
+  }
+  EXPECT_EQ(per_face.size(), 2u);
 }
 
 }  // namespace
