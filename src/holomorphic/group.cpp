@@ -10,6 +10,7 @@
 
 #include "detail.hpp"
 #include "qsmesh/core/error.hpp"
+#include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/smooth/approx_surface.hpp"
 
 namespace qsmesh::holomorphic {
@@ -243,6 +244,73 @@ std::vector<LO> balanced_loop_counts(std::span<const double> periods, double siz
   return counts;
 }
 
+namespace {
+
+// The minimum SICN of the quads `around` (3D).
+double min_sicn(const mesh::FaceMesh& m, std::span<const LO> around) {
+  double worst = 1;
+  for (const LO q : around) {
+    const auto& quad = m.quads[static_cast<std::size_t>(q)];
+    std::array<Vec3, 4> x{};
+    for (std::size_t k = 0; k < 4; ++k) x[k] = m.points[static_cast<std::size_t>(quad[k])];
+    worst = std::min(worst, mesh::quad_sicn(x));
+  }
+  return worst;
+}
+
+// Laplacian smoothing of a group mesh's interior vertices, each moved to the mean of its edge
+// neighbours and projected on the face of the background triangle nearest that point (so a
+// vertex may move across an inner curve onto the next face); a move is kept only when the
+// minimum SICN of its quads does not drop. Gauss-Seidel in vertex order: deterministic.
+void smooth_group(GroupMesh& g, const GluedGroup& group,
+                  std::span<const cad::FaceGeometry* const> surfaces,
+                  const smooth::ApproxSurface& locator, int sweeps) {
+  mesh::FaceMesh& m = g.mesh;
+  const std::size_t nv = m.points.size();
+  std::vector<std::vector<LO>> quads_of(nv), nbrs(nv);
+  for (std::size_t q = 0; q < m.quads.size(); ++q)
+    for (std::size_t k = 0; k < 4; ++k) {
+      const auto v = static_cast<std::size_t>(m.quads[q][k]);
+      quads_of[v].push_back(static_cast<LO>(q));
+      for (const std::size_t d : {std::size_t{1}, std::size_t{3}}) {
+        const LO w = m.quads[q][(k + d) % 4];
+        if (std::find(nbrs[v].begin(), nbrs[v].end(), w) == nbrs[v].end()) nbrs[v].push_back(w);
+      }
+    }
+  std::vector<LO> hint(nv, kNoIndex);
+  for (int sweep = 0; sweep < sweeps; ++sweep) {
+    int moved = 0;
+    for (std::size_t v = 0; v < nv; ++v) {
+      if (m.vclass[v].dim != 2 || nbrs[v].empty()) continue;
+      Vec3 target{0, 0, 0};
+      for (const LO w : nbrs[v]) target = target + m.points[static_cast<std::size_t>(w)];
+      target = target * (1.0 / double(nbrs[v].size()));
+      const auto hit = locator.closest(target, hint[v]);
+      if (hit.triangle == kNoIndex) continue;
+      const auto part =
+          static_cast<std::size_t>(group.triangle_part[static_cast<std::size_t>(hit.triangle)]);
+      Vec3 foot;
+      const Vec2 uv = surfaces[part]->project(target, hit.uv, &foot);
+      const double before = min_sicn(m, quads_of[v]);
+      const Vec3 old = m.points[v];
+      m.points[v] = foot;
+      if (min_sicn(m, quads_of[v]) < before) {
+        m.points[v] = old;
+        continue;
+      }
+      hint[v] = hit.triangle;
+      m.uv[v] = uv;
+      m.vclass[v].entity = group.faces[part];
+      m.vclass[v].param = {uv.u, uv.v};
+      g.vertex_face[v] = group.faces[part];
+      ++moved;
+    }
+    if (moved == 0) break;
+  }
+}
+
+}  // namespace
+
 GroupMesh mesh_group(const GluedGroup& group, std::span<const cad::FaceGeometry* const> surfaces,
                      const HolomorphicOptions& options, HolomorphicReport* report) {
   HolomorphicReport local;
@@ -267,9 +335,10 @@ GroupMesh mesh_group(const GluedGroup& group, std::span<const cad::FaceGeometry*
     const auto& vc = out.mesh.vclass[v];
     out.vertex_face[v] = vc.dim == 2 ? vc.entity : first_face.at(detail::point_key(vc));
   }
-  // Each quad to the face of the background triangle nearest its centre.
   const auto locator = smooth::ApproxSurface(group.background.points, group.background.uv,
                                              group.background.triangles);
+  if (options.smooth_patches) smooth_group(out, group, surfaces, locator, options.group_sweeps);
+  // Each quad to the face of the background triangle nearest its centre.
   out.quad_face.reserve(out.mesh.quads.size());
   LO hint = kNoIndex;
   for (const auto& q : out.mesh.quads) {

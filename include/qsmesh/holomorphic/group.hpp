@@ -100,7 +100,10 @@ struct GroupMesh {
 
 /// mesh_poly_annulus (b >= 3) or mesh_annulus (b = 2) on a glued group: the points the grids put
 /// inside a background triangle are projected on that triangle's face (surfaces[i] for faces[i]).
-/// The patches are not smoothed (smooth::smooth_face works in one face's parameter plane).
+/// With options.smooth_patches, the interior vertices are then smoothed in 3D (group_sweeps
+/// Laplacian sweeps, each move projected on the face of the background triangle nearest it and
+/// kept only when the minimum SICN of the vertex's quads does not drop; smooth::smooth_face works
+/// in one face's parameter plane).
 /// Returns an empty mesh with report->reason on failure, as mesh_poly_annulus; never throws for
 /// a group-level failure.
 [[nodiscard]] GroupMesh mesh_group(const GluedGroup& group,

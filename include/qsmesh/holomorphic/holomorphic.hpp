@@ -204,6 +204,9 @@ struct HolomorphicOptions {
   /// are thin in 3D (a critical curve close to a loop on one side), which the smoothing widens.
   bool smooth_patches = true;
   smooth::SmoothOptions smoothing;
+  /// mesh_group (group.hpp): Laplacian sweeps over the group mesh's interior vertices when
+  /// smooth_patches (smooth_face works in one parameter plane, a group spans several).
+  int group_sweeps = 10;
 };
 
 /// What the holomorphic path did on one face.
