@@ -364,14 +364,9 @@ bool keep_holomorphic(Method method, const HolomorphicReport& report,
       holomorphic.triangles != 0 || !(holomorphic.sicn_min > 0))
     return false;
   if (method == Method::Holomorphic) return true;
-  if (holomorphic.irregular_interior < by_default.irregular_interior)
-    return holomorphic.sicn_min >= by_default.sicn_min - sicn_tolerance &&
-           holomorphic.sicn_avg >= by_default.sicn_avg - sicn_tolerance;
-  // As regular: only a clear gain in shape (a sheared grid against the form's square one), never
-  // a loss, so that two meshes alike keep the default one.
-  return holomorphic.irregular_interior == by_default.irregular_interior &&
-         holomorphic.sicn_min >= by_default.sicn_min &&
-         holomorphic.sicn_avg >= by_default.sicn_avg + sicn_tolerance;
+  return holomorphic.irregular_interior < by_default.irregular_interior &&
+         holomorphic.sicn_min >= by_default.sicn_min - sicn_tolerance &&
+         holomorphic.sicn_avg >= by_default.sicn_avg - sicn_tolerance;
 }
 
 }  // namespace qsmesh::holomorphic

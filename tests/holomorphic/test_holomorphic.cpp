@@ -370,17 +370,6 @@ TEST(Holomorphic, PolicyKeepsTheHolomorphicMeshOnlyWhenItWins) {
   EXPECT_FALSE(keep_holomorphic(Method::Auto, ok, h, d, 0.01));  // SICN min 0.02 lower
   d.irregular_interior = 0;
   EXPECT_FALSE(keep_holomorphic(Method::Auto, ok, h, d, 0.05));  // no fewer irregular vertices
-  // As many irregular vertices, but the default grid sheared: a clear gain in SICN wins.
-  h.sicn_min = 0.98;
-  h.sicn_avg = 0.99;
-  d.sicn_min = 0.82;
-  d.sicn_avg = 0.86;
-  EXPECT_TRUE(keep_holomorphic(Method::Auto, ok, h, d, 0.02));
-  d.sicn_avg = 0.98;  // within the tolerance: alike, the default kept
-  EXPECT_FALSE(keep_holomorphic(Method::Auto, ok, h, d, 0.02));
-  d.sicn_avg = 0.86;
-  d.sicn_min = 0.99;  // a lower minimum is never traded
-  EXPECT_FALSE(keep_holomorphic(Method::Auto, ok, h, d, 0.02));
   HolomorphicReport failed;
   EXPECT_FALSE(keep_holomorphic(Method::Holomorphic, failed, h, d, 0.05));
   EXPECT_EQ(parse_method("auto"), Method::Auto);

@@ -319,10 +319,9 @@ enum class Method { Default, Holomorphic, Auto };
 [[nodiscard]] Method parse_method(const std::string& text);
 
 /// Whether a face keeps its holomorphic mesh: Holomorphic keeps any valid one (report ok, all
-/// quads, SICN min > 0); Auto keeps it with fewer interior irregular vertices than the default
-/// mesh and SICN min and avg each no lower than the default's minus `sicn_tolerance`, or with as
-/// many, SICN min no lower and SICN avg higher by at least `sicn_tolerance` (a sheared default
-/// grid); Default never.
+/// quads, SICN min > 0); Auto keeps it only with fewer interior irregular vertices than the default
+/// mesh and SICN min and avg each no lower than the default's minus `sicn_tolerance`; Default
+/// never.
 [[nodiscard]] bool keep_holomorphic(Method method, const HolomorphicReport& report,
                                     const mesh::FaceQuadStats& holomorphic,
                                     const mesh::FaceQuadStats& by_default, double sicn_tolerance);
