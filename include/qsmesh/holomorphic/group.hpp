@@ -1,7 +1,9 @@
-// Paper 004 on a group of CAD faces: faces joined across curves where the surface is smooth form
-// one surface (a T-shaped duct made of two pipes and the fillet between them is one pair of
-// pants), their background triangulations are glued along the shared curves, and the basis,
-// energy and patches of holomorphic.hpp run on the glued triangulation as on one face's.
+// Paper 004 (Sec. 4, Alg. 1: basis, Eqs. 4.3-4.8; energy, Eqs. 4.9-4.11; patches) on a group of
+// CAD faces: faces joined across curves where the surface is smooth form one surface (a T-shaped
+// duct made of two pipes and the fillet between them is one pair of pants), their background
+// triangulations are glued along the shared curves, and the basis, energy and patches of
+// holomorphic.hpp run on the glued triangulation as on one face's (the paper's input is one
+// triangulated surface; its vessels are such unions).
 //
 // The quads of a group cross its inner curves: the form's critical trajectories are where the
 // patches end, and a fillet's tangent curves are not among them, so forcing quad edges onto them
