@@ -158,6 +158,20 @@ void quantize_stage(const Context& cx, std::span<const mesh::CurveMesh> curves,
                     ", grids ", result.balance.grids_before, " -> ", result.balance.grids_after,
                     " (", result.balance.curves_changed, " curves changed)"));
   }
+  if (options.face_method != holomorphic::Method::Default) {
+    // The holomorphic grid of an annulus needs equal counts on its two loops (after the pattern
+    // balancing, which does not look at faces with two loops).
+    holomorphic::AnnulusCountReport annuli;
+    std::vector<int> edges = holomorphic::balance_annulus_counts(
+        model, curves, result.quantization.edges, result.quantization.ideal,
+        result.quantization.curve2chord, fixed, {}, &annuli);
+    result.quantization.total_edges = 0;
+    for (const int e : edges) result.quantization.total_edges += e;
+    result.quantization.edges = std::move(edges);
+    cx.log.info(cat("quantize: annuli with equal loop counts ", annuli.equal_before, " -> ",
+                    annuli.equal_after, " of ", annuli.annuli, " (", annuli.curves_changed,
+                    " curves changed)"));
+  }
   // Boundary repair: a face whose boundary crosses itself in its parameter plane cannot be
   // triangulated. Each rank checks its own faces; the flags are summed, so every rank refines
   // the same curves and keeps the same quantization.
