@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <vector>
 
@@ -231,8 +232,13 @@ void limit_by_face_width(const cad::CadModel& model, std::span<const std::vector
   // +14% vertices, SICN avg 0.984 -> 0.947).
   limit_by_distance(
       polylines, sizes, touching, 0.0, tasks,
-      [&](LO c, LO other) { return !share_corner(model, c, other) && share_face(c, other); },
+      [&](LO c, LO other) { return other != c && share_face(c, other); },
       [&](LO c, LO other, const Vec3& p, double d) {
+        for (const LO k : model.curves()[c].corners)
+          if (k >= 0 &&
+              (k == model.curves()[other].corners[0] || k == model.curves()[other].corners[1]) &&
+              !(d < sharp * distance(p, corners[k].point)))
+            return false;
         for (const LO a : model.curves()[c].corners)
           for (const LO b : model.curves()[other].corners) {
             if (a < 0) continue;
@@ -242,6 +248,103 @@ void limit_by_face_width(const cad::CadModel& model, std::span<const std::vector
           }
         return true;
       });
+}
+
+void limit_in_sharp_wedges(const cad::CadModel& model, std::span<const std::vector<Vec3>> polylines,
+                           std::vector<std::vector<double>>& sizes, double touching,
+                           double sharp_deg, const TaskArena& tasks) {
+  std::vector<std::vector<LO>> faces(polylines.size());
+  for (LO f = 0; f < model.num_faces(); ++f)
+    for (const auto& loop : model.faces()[f].loops)
+      for (const auto& use : loop.uses)
+        if (use.curve >= 0 && use.curve < static_cast<LO>(faces.size()))
+          faces[use.curve].push_back(f);
+  for (auto& list : faces) std::sort(list.begin(), list.end());
+  const auto share_face = [&](LO a, LO b) {
+    for (const LO f : faces[a])
+      if (std::binary_search(faces[b].begin(), faces[b].end(), f)) return true;
+    return false;
+  };
+  const double sharp = std::sin(sharp_deg * std::numbers::pi / 180);
+  const auto corners = model.corners();
+  const auto shared_corner = [&](LO a, LO b) {
+    for (const LO k : model.curves()[a].corners)
+      if (k >= 0 && (k == model.curves()[b].corners[0] || k == model.curves()[b].corners[1]))
+        return k;
+    return kNoIndex;
+  };
+  // Searched within half the size, lowered to the width, then doubled: at most twice the width.
+  for (auto& h : sizes)
+    for (double& x : h) x *= 0.5;
+  limit_by_distance(
+      polylines, sizes, touching, 0.0, tasks,
+      [&](LO c, LO other) {
+        return other != c && shared_corner(c, other) != kNoIndex && share_face(c, other);
+      },
+      [&](LO c, LO other, const Vec3& p, double d) {
+        const LO k = shared_corner(c, other);
+        return d < sharp * distance(p, corners[k].point);
+      });
+  for (auto& h : sizes)
+    for (double& x : h) x *= 2;
+}
+
+std::vector<SharpTip> sharp_wedge_tips(const cad::CadModel& model,
+                                       std::span<const std::vector<Vec3>> polylines,
+                                       double touching, double sharp_deg) {
+  std::vector<std::vector<LO>> faces(polylines.size());
+  for (LO f = 0; f < model.num_faces(); ++f)
+    for (const auto& loop : model.faces()[f].loops)
+      for (const auto& use : loop.uses)
+        if (use.curve >= 0 && use.curve < static_cast<LO>(faces.size()))
+          faces[use.curve].push_back(f);
+  for (auto& list : faces) std::sort(list.begin(), list.end());
+  const auto share_face = [&](LO a, LO b) {
+    for (const LO f : faces[a])
+      if (std::binary_search(faces[b].begin(), faces[b].end(), f)) return true;
+    return false;
+  };
+  const auto distance_to = [&](const std::vector<Vec3>& line, const Vec3& p) {
+    double d = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i + 1 < line.size(); ++i) {
+      const Vec3 ab = line[i + 1] - line[i];
+      const double l2 = norm2(ab);
+      const double s = l2 > 0 ? std::clamp(dot(p - line[i], ab) / l2, 0.0, 1.0) : 0.0;
+      d = std::min(d, distance(p, line[i] + ab * s));
+    }
+    return d;
+  };
+  const double sharp = std::sin(sharp_deg * std::numbers::pi / 180);
+  const auto corners = model.corners();
+  std::vector<SharpTip> tips;
+  const auto nc = static_cast<LO>(polylines.size());
+  for (LO c = 0; c < nc; ++c) {
+    const auto& line = polylines[c];
+    const auto& curve = model.curves()[c];
+    if (curve.degenerate || line.size() < 2 || curve.corners[0] == curve.corners[1]) continue;
+    for (int end = 0; end < 2; ++end) {
+      const LO k = curve.corners[end];
+      if (k < 0) continue;
+      double tip = 0;
+      for (LO o = 0; o < nc; ++o) {
+        const auto& other = model.curves()[o];
+        if (o == c || other.degenerate || polylines[o].size() < 2 ||
+            (other.corners[0] != k && other.corners[1] != k) || !share_face(c, o))
+          continue;
+        // Walk away from the corner while the two sides stay inside a sharp wedge and closer
+        // than `touching`: that stretch is the tip, which one quad holds.
+        for (std::size_t i = 1; i < line.size(); ++i) {
+          const Vec3& p = line[end == 0 ? i : line.size() - 1 - i];
+          const double r = distance(p, corners[k].point);
+          const double d = distance_to(polylines[o], p);
+          if (!(d < sharp * r) || d > touching) break;
+          tip = std::max(tip, r);
+        }
+      }
+      if (tip > 0) tips.push_back({c, end, tip});
+    }
+  }
+  return tips;
 }
 
 }  // namespace qsmesh::background

@@ -18,6 +18,9 @@ namespace qsmesh::sizemap {
 
 namespace {
 
+/// Wedges sharper than this (degrees) have tips held by one quad (SizeMapOptions::thin_aspect).
+constexpr double kSharpWedgeDeg = 10;
+
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 [[noreturn]] void input_error(const std::string& what) { throw InputError("sizemap: " + what); }
@@ -255,6 +258,14 @@ CurveSizes initial_curve_sizes(const cad::CadModel& model, std::span<const mesh:
         for (auto& w : width)
           for (double& x : w) x *= 0.5;
         background::limit_by_face_width(model, dense, width, touching, floor, tasks);
+        // The tip of a sharp wedge, where its sides are closer than `touching`, is one edge:
+        // graded with the width down to the corner, its quads would be as flat as ever and
+        // endless in number. Never longer than the size there.
+        out.tips = background::sharp_wedge_tips(model, dense, touching, kSharpWedgeDeg);
+        for (auto& tip : out.tips) {
+          const auto& at = out.at[tip.curve];
+          tip.length = std::min(tip.length, tip.end == 0 ? at.front() : at.back());
+        }
       }
       background::limit_by_feature_distance(model, dense, h, touching, floor, tasks);
       // h only ever lowers the sizes it started from, and the ratio is at most 1.
@@ -474,6 +485,15 @@ void grade_curves(const cad::CadModel& model, std::span<const mesh::CurveMesh> c
   for (LO k = 0; k < nk; ++k) sizes.corner[k] = s[k];
   for (LO c = 0; c < nc; ++c)
     for (std::size_t i = 0; i < sizes.at[c].size(); ++i) sizes.at[c][i] = s[node(c, i)];
+  // The tip of a sharp wedge is held by one quad: one edge of its own length, however fine the
+  // sizes graded along the tail behind it (SizeMapOptions::thin_aspect).
+  for (const auto& tip : sizes.tips) {
+    const auto& p = curves[tip.curve].points;
+    auto& at = sizes.at[tip.curve];
+    const Vec3 corner = tip.end == 0 ? p.front() : p.back();
+    for (std::size_t i = 0; i < at.size(); ++i)
+      if (distance(p[i], corner) < tip.length) at[i] = tip.length;
+  }
 }
 
 }  // namespace qsmesh::sizemap

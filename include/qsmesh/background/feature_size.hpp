@@ -39,4 +39,34 @@ void limit_by_face_width(const cad::CadModel& model, std::span<const std::vector
                          std::vector<std::vector<double>>& sizes, double touching, double sliver,
                          const TaskArena& tasks);
 
+/// Resolution inside sharp wedges (a cusp's tail): lowers sizes[c][k] to twice the distance d from
+/// polyline vertex k of curve c to another side of one of its faces that shares a corner with c,
+/// where d is below sin(sharp_deg) x the distance to that corner, searching within half the
+/// current size; distances up to `touching` are ignored. The background curve meshes need it so
+/// that the sizes graded along such a tail (sizemap::SizeMapOptions::thin_aspect) have vertices
+/// to live on. Deterministic, whatever the thread count of `tasks`.
+void limit_in_sharp_wedges(const cad::CadModel& model, std::span<const std::vector<Vec3>> polylines,
+                           std::vector<std::vector<double>>& sizes, double touching,
+                           double sharp_deg, const TaskArena& tasks);
+
+/// The tip of a sharp wedge: where curve `curve` leaves its corner at end `end` (0: its first
+/// corner, 1: its last) inside a wedge sharper than the given angle with another side of one of its
+/// faces sharing that corner (a cusp, a sliver's end), the stretch of it, `length` (model units,
+/// straight from the corner), along which the two sides are closer than `touching`.
+struct SharpTip {
+  LO curve = kNoIndex;
+  int end = 0;
+  double length = 0;
+};
+
+/// Every sharp wedge tip of the model: for each curve end at a corner shared with another side of
+/// one of its faces, the polyline vertices of the curve (polylines[c], dense enough to stand for
+/// the curve) walked away from the corner while the distance d to the other side's polyline is at
+/// most `touching` and below sin(sharp_deg) x the distance r to the corner (the wedge sharper than
+/// sharp_deg there); the tip's length is the largest such r. Ends with no such vertex give no tip.
+/// Ordered by curve, then end. Deterministic (no threads).
+[[nodiscard]] std::vector<SharpTip> sharp_wedge_tips(const cad::CadModel& model,
+                                                     std::span<const std::vector<Vec3>> polylines,
+                                                     double touching, double sharp_deg);
+
 }  // namespace qsmesh::background

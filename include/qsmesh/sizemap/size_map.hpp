@@ -19,6 +19,7 @@
 #include <utility>
 #include <vector>
 
+#include "qsmesh/background/feature_size.hpp"
 #include "qsmesh/cad/model.hpp"
 #include "qsmesh/core/tasks.hpp"
 #include "qsmesh/core/types.hpp"
@@ -95,6 +96,10 @@ struct CurveSizes {
   std::vector<std::vector<double>> at;
   /// corner[k]: the value at corner k (what faces read at their dim-0 vertices).
   std::vector<double> corner;
+  /// The tips of sharp wedges (thin_aspect, initial_curve_sizes): one quad holds each, so
+  /// grade_curves sets the curve's sizes within `length` of the corner to `length` (one edge),
+  /// whatever the gradation gave them. The same on every rank; not part of pack().
+  std::vector<background::SharpTip> tips;
 
   /// Every value in one flat array: at[0], at[1], ..., then corner (for an MPI min-reduction).
   [[nodiscard]] std::vector<double> pack() const;
