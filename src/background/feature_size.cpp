@@ -147,7 +147,9 @@ void limit_by_distance(std::span<const std::vector<Vec3>> polylines,
         // exact enough for dense polylines, and far cheaper than a CAD projection.
         const double d = distance_to_polyline(polylines[o], j, line[k]);
         // The floor bounds what a feature may ask for, never a size already smaller.
-        if (d > touching && accept(c, o, line[k], d)) h[k] = std::min(h[k], std::max(floor, d));
+        // accept gives the factor the distance counts with (false / 0: not at all).
+        const double scale = d > touching ? static_cast<double>(accept(c, o, line[k], d)) : 0.0;
+        if (scale > 0) h[k] = std::min(h[k], std::max(floor, scale * d));
       }
     }
   });
@@ -226,27 +228,32 @@ void limit_by_face_width(const cad::CadModel& model, std::span<const std::vector
   // the quads at the sliver stayed flat.
   const double sharp = std::sin(10 * std::numbers::pi / 180);
   const auto corners = model.corners();
-  // Sides meeting at a corner are not counted: inside a sharp wedge (a cusp's tail) that was
-  // tried, and the sizes it grades toward the cusp reach the faces along its sides (t20_data's
-  // chamfer slivers at their reference size: the grids beside them went from SICN min 0.91 to 0.33,
-  // +14% vertices, SICN avg 0.984 -> 0.947).
+  // Sides meeting at a corner count only inside a wedge sharper than 10 degrees (a cusp's tail),
+  // and not at its tip (sharp_wedge_tips: one edge there, so the grading toward the cusp stops).
   limit_by_distance(
       polylines, sizes, touching, 0.0, tasks,
       [&](LO c, LO other) { return other != c && share_face(c, other); },
-      [&](LO c, LO other, const Vec3& p, double d) {
+      [&](LO c, LO other, const Vec3& p, double d) -> double {
+        // Sides meeting at a corner count inside a wedge sharper than 10 degrees (a cusp's tail),
+        // at 3/4 of their distance: the tail's quads are trapezoids whose inner row the smoothing
+        // places, and came out at about 0.8 of the SICN of the rectangles the cap aims at (the
+        // crescent and 5-degree corner of tests/drivers/test_thin_regions.cpp: 0.174 and 0.196
+        // at the full distance, 0.211 and 0.246 at 3/4).
+        double scale = 1;
         for (const LO k : model.curves()[c].corners)
           if (k >= 0 &&
-              (k == model.curves()[other].corners[0] || k == model.curves()[other].corners[1]) &&
-              !(d < sharp * distance(p, corners[k].point)))
-            return false;
+              (k == model.curves()[other].corners[0] || k == model.curves()[other].corners[1])) {
+            if (!(d < sharp * distance(p, corners[k].point))) return 0;
+            scale = 0.75;
+          }
         for (const LO a : model.curves()[c].corners)
           for (const LO b : model.curves()[other].corners) {
             if (a < 0) continue;
             auto it = std::lower_bound(joints.begin(), joints.end(), Joint{a, b, 0.0});
             for (; it != joints.end() && it->a == a && it->b == b; ++it)
-              if (!(d <= 2 * it->length || d < sharp * distance(p, corners[a].point))) return false;
+              if (!(d <= 2 * it->length || d < sharp * distance(p, corners[a].point))) return 0;
           }
-        return true;
+        return scale;
       });
 }
 
