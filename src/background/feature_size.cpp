@@ -162,6 +162,40 @@ bool share_corner(const cad::CadModel& model, LO a, LO b) {
          cb.corners[1] == ca.corners[0] || cb.corners[1] == ca.corners[1];
 }
 
+/// The faces using each curve (sorted, each once).
+std::vector<std::vector<LO>> faces_of_curves(const cad::CadModel& model, std::size_t num_curves) {
+  std::vector<std::vector<LO>> faces(num_curves);
+  for (LO f = 0; f < model.num_faces(); ++f)
+    for (const auto& loop : model.faces()[f].loops)
+      for (const auto& use : loop.uses)
+        if (use.curve >= 0 && use.curve < static_cast<LO>(faces.size()))
+          faces[use.curve].push_back(f);
+  for (auto& list : faces) {
+    std::sort(list.begin(), list.end());
+    list.erase(std::unique(list.begin(), list.end()), list.end());
+  }
+  return faces;
+}
+
+/// The distance from p to the nearer corner curves a and b share (a crescent's sides share both);
+/// infinite when they share none.
+double shared_corner_distance(const cad::CadModel& model, LO a, LO b, const Vec3& p) {
+  double r = std::numeric_limits<double>::infinity();
+  for (const LO k : model.curves()[a].corners)
+    if (k >= 0 && (k == model.curves()[b].corners[0] || k == model.curves()[b].corners[1]))
+      r = std::min(r, distance(p, model.corners()[k].point));
+  return r;
+}
+
+/// Two sides of a wedge whose tail is graded (thin_aspect): both bound one face and no other.
+/// A side another face also uses carries the tail's counts into that face, which pays for them
+/// with transitions across it: t20_data's chamfer slivers (0-degree cusps between faces filled
+/// by grids) at their reference size went from 60 quads below SICN 0.1 to 2, but from 87 to 212
+/// interior irregular vertices and SICN avg 0.984 to 0.925 (docs/benchmarks.md, issue 29).
+bool own_wedge_sides(const std::vector<std::vector<LO>>& faces, LO a, LO b) {
+  return faces[a].size() == 1 && faces[b].size() == 1 && faces[a][0] == faces[b][0];
+}
+
 }  // namespace
 
 void limit_by_feature_distance(const cad::CadModel& model,
@@ -240,12 +274,11 @@ void limit_by_face_width(const cad::CadModel& model, std::span<const std::vector
         // crescent and 5-degree corner of tests/drivers/test_thin_regions.cpp: 0.174 and 0.196
         // at the full distance, 0.211 and 0.246 at 3/4).
         double scale = 1;
-        for (const LO k : model.curves()[c].corners)
-          if (k >= 0 &&
-              (k == model.curves()[other].corners[0] || k == model.curves()[other].corners[1])) {
-            if (!(d < sharp * distance(p, corners[k].point))) return 0;
-            scale = 0.75;
-          }
+        const double r = shared_corner_distance(model, c, other, p);
+        if (std::isfinite(r)) {
+          if (!(d < sharp * r) || !own_wedge_sides(faces, c, other)) return 0;
+          scale = 0.75;
+        }
         for (const LO a : model.curves()[c].corners)
           for (const LO b : model.curves()[other].corners) {
             if (a < 0) continue;
@@ -260,37 +293,17 @@ void limit_by_face_width(const cad::CadModel& model, std::span<const std::vector
 void limit_in_sharp_wedges(const cad::CadModel& model, std::span<const std::vector<Vec3>> polylines,
                            std::vector<std::vector<double>>& sizes, double touching,
                            double sharp_deg, const TaskArena& tasks) {
-  std::vector<std::vector<LO>> faces(polylines.size());
-  for (LO f = 0; f < model.num_faces(); ++f)
-    for (const auto& loop : model.faces()[f].loops)
-      for (const auto& use : loop.uses)
-        if (use.curve >= 0 && use.curve < static_cast<LO>(faces.size()))
-          faces[use.curve].push_back(f);
-  for (auto& list : faces) std::sort(list.begin(), list.end());
-  const auto share_face = [&](LO a, LO b) {
-    for (const LO f : faces[a])
-      if (std::binary_search(faces[b].begin(), faces[b].end(), f)) return true;
-    return false;
-  };
+  const auto faces = faces_of_curves(model, polylines.size());
   const double sharp = std::sin(sharp_deg * std::numbers::pi / 180);
-  const auto corners = model.corners();
-  const auto shared_corner = [&](LO a, LO b) {
-    for (const LO k : model.curves()[a].corners)
-      if (k >= 0 && (k == model.curves()[b].corners[0] || k == model.curves()[b].corners[1]))
-        return k;
-    return kNoIndex;
-  };
   // Searched within half the size, lowered to the width, then doubled: at most twice the width.
   for (auto& h : sizes)
     for (double& x : h) x *= 0.5;
   limit_by_distance(
       polylines, sizes, touching, 0.0, tasks,
-      [&](LO c, LO other) {
-        return other != c && shared_corner(c, other) != kNoIndex && share_face(c, other);
-      },
+      [&](LO c, LO other) { return other != c && own_wedge_sides(faces, c, other); },
       [&](LO c, LO other, const Vec3& p, double d) {
-        const LO k = shared_corner(c, other);
-        return d < sharp * distance(p, corners[k].point);
+        const double r = shared_corner_distance(model, c, other, p);
+        return std::isfinite(r) && d < sharp * r;
       });
   for (auto& h : sizes)
     for (double& x : h) x *= 2;
@@ -299,18 +312,7 @@ void limit_in_sharp_wedges(const cad::CadModel& model, std::span<const std::vect
 std::vector<SharpTip> sharp_wedge_tips(const cad::CadModel& model,
                                        std::span<const std::vector<Vec3>> polylines,
                                        double touching, double sharp_deg) {
-  std::vector<std::vector<LO>> faces(polylines.size());
-  for (LO f = 0; f < model.num_faces(); ++f)
-    for (const auto& loop : model.faces()[f].loops)
-      for (const auto& use : loop.uses)
-        if (use.curve >= 0 && use.curve < static_cast<LO>(faces.size()))
-          faces[use.curve].push_back(f);
-  for (auto& list : faces) std::sort(list.begin(), list.end());
-  const auto share_face = [&](LO a, LO b) {
-    for (const LO f : faces[a])
-      if (std::binary_search(faces[b].begin(), faces[b].end(), f)) return true;
-    return false;
-  };
+  const auto faces = faces_of_curves(model, polylines.size());
   const auto distance_to = [&](const std::vector<Vec3>& line, const Vec3& p) {
     double d = std::numeric_limits<double>::infinity();
     for (std::size_t i = 0; i + 1 < line.size(); ++i) {
@@ -336,7 +338,7 @@ std::vector<SharpTip> sharp_wedge_tips(const cad::CadModel& model,
       for (LO o = 0; o < nc; ++o) {
         const auto& other = model.curves()[o];
         if (o == c || other.degenerate || polylines[o].size() < 2 ||
-            (other.corners[0] != k && other.corners[1] != k) || !share_face(c, o))
+            (other.corners[0] != k && other.corners[1] != k) || !own_wedge_sides(faces, c, o))
           continue;
         // Walk away from the corner while the two sides stay inside a sharp wedge and closer
         // than `touching`: that stretch is the tip, which one quad holds.
