@@ -68,7 +68,8 @@ struct SmoothStats {
 ///     That vertex is put on the line in (u, v) from the corner through the middle of the other
 ///     two vertices (the rung), 0.05 to 0.5 rung lengths past it, where the minimum SICN of its
 ///     other quads is highest, if higher than where it is; the cusp quad stays valid (oriented as
-///     before) and no worse. Without it the quads behind the rung got a sharp or a flat angle there.
+///     before) and no worse. Without it the quads behind the rung got a sharp or a flat angle
+///     there.
 /// Measures before and after; when the minimum SICN dropped or more quads are invalid, returns the
 /// input (stats->rolled_back). Deterministic: no randomness, fixed order, no threads.
 /// Returns the smoothed mesh (same topology and classification; dim-2 vclass.param = new uv).
