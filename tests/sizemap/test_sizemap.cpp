@@ -132,6 +132,7 @@ std::pair<CurveSizes, std::vector<FaceSizes>> full_flow(const Model& m, const Si
   sizes.unpack(reduced);
   grade_curves(m.cad, m.curves, o.gradation, sizes);
   std::vector<FaceSizes> final_fields;
+  final_fields.reserve(static_cast<std::size_t>(m.cad.num_faces()));
   for (LO f = 0; f < m.cad.num_faces(); ++f)
     final_fields.push_back(face_sizes(m.faces[f], cf_of(m, f), m.curves, sizes, n[f], o));
   return {std::move(sizes), std::move(final_fields)};
