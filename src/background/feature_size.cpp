@@ -311,8 +311,14 @@ void limit_in_sharp_wedges(const cad::CadModel& model, std::span<const std::vect
 
 std::vector<SharpTip> sharp_wedge_tips(const cad::CadModel& model,
                                        std::span<const std::vector<Vec3>> polylines,
-                                       double touching, double sharp_deg) {
+                                       std::span<const std::vector<double>> sizes, double touching,
+                                       double shared_ratio, double sharp_deg) {
   const auto faces = faces_of_curves(model, polylines.size());
+  const auto share_face = [&](LO a, LO b) {
+    for (const LO f : faces[a])
+      if (std::binary_search(faces[b].begin(), faces[b].end(), f)) return true;
+    return false;
+  };
   const auto distance_to = [&](const std::vector<Vec3>& line, const Vec3& p) {
     double d = std::numeric_limits<double>::infinity();
     for (std::size_t i = 0; i + 1 < line.size(); ++i) {
@@ -335,22 +341,30 @@ std::vector<SharpTip> sharp_wedge_tips(const cad::CadModel& model,
       const LO k = curve.corners[end];
       if (k < 0) continue;
       double tip = 0;
+      bool shared = false;
       for (LO o = 0; o < nc; ++o) {
         const auto& other = model.curves()[o];
         if (o == c || other.degenerate || polylines[o].size() < 2 ||
-            (other.corners[0] != k && other.corners[1] != k) || !own_wedge_sides(faces, c, o))
+            (other.corners[0] != k && other.corners[1] != k) || !share_face(c, o))
           continue;
+        const bool own = own_wedge_sides(faces, c, o);
         // Walk away from the corner while the two sides stay inside a sharp wedge and closer
-        // than `touching`: that stretch is the tip, which one quad holds.
-        for (std::size_t i = 1; i < line.size(); ++i) {
-          const Vec3& p = line[end == 0 ? i : line.size() - 1 - i];
+        // than the tip's width: that stretch is the tip, which one quad holds.
+        for (std::size_t j = 1; j < line.size(); ++j) {
+          const std::size_t i = end == 0 ? j : line.size() - 1 - j;
+          const Vec3& p = line[i];
           const double r = distance(p, corners[k].point);
           const double d = distance_to(polylines[o], p);
-          if (!(d < sharp * r) || d > touching) break;
-          tip = std::max(tip, r);
+          if (!(d < sharp * r) || !(d <= (own ? touching : shared_ratio * sizes[c][i]))) break;
+          if (r > tip) {
+            tip = r;
+            shared = !own;
+          }
         }
       }
-      if (tip > 0) tips.push_back({c, end, tip});
+      // Two tips of one curve never overlap.
+      tip = std::min(tip, 0.5 * distance(line.front(), line.back()));
+      if (tip > 0) tips.push_back({c, end, tip, shared});
     }
   }
   return tips;

@@ -606,7 +606,8 @@ TEST(SizeMap, ThinAspectLeavesWideFacesAndSidesMeetingAtACornerAlone) {
   // A 10 x 0.6 rectangle at size 1: 0.6 apart is more than half the size, not thin. A prism on a
   // triangle with a 3-degree corner: the long sides of its end faces are close near the corner and
   // share it (a cusp's tail), but each also bounds a side face of the prism, which would take the
-  // tail's graded counts (see background::limit_by_face_width).
+  // tail's graded counts (see background::limit_by_face_width): the tail keeps its sizes, and the
+  // tip is where it is thinner than a sixth of the size, x < (1 / 6) / sin(3 degrees) = 3.18.
   SizeMapOptions o;
   o.method = Method::Features;
   o.size_max = 1.0;
@@ -617,17 +618,36 @@ TEST(SizeMap, ThinAspectLeavesWideFacesAndSidesMeetingAtACornerAlone) {
   const TopoDS_Shape prism =
       BRepPrimAPI_MakePrism(BRepBuilderAPI_MakeFace(polygon.Wire(), true).Face(), gp_Vec(0, 0, 2))
           .Shape();
-  std::vector<cad::CadModel> models;
-  models.push_back(polygon_face({{0, 0}, {10, 0}, {10, 0.6}, {0, 0.6}}, "sm_thin_alone.brep"));
-  models.push_back(load_shape(prism, "sm_wedge_prism.brep"));
-  for (auto& cad : models) {
-    const Model m = prepare(std::move(cad), 1.0, false);
+  const Model wide = prepare(
+      polygon_face({{0, 0}, {10, 0}, {10, 0.6}, {0, 0.6}}, "sm_thin_alone.brep"), 1.0, false);
+  const Model m = prepare(load_shape(prism, "sm_wedge_prism.brep"), 1.0, false);
+  for (const Model* model : {&wide, &m}) {
     o.thin_aspect = 0;
-    const CurveSizes off = initial_curve_sizes(m.cad, m.curves, o, TaskArena(1));
+    const CurveSizes off = initial_curve_sizes(model->cad, model->curves, o, TaskArena(1));
     o.thin_aspect = 4;
-    const CurveSizes on = initial_curve_sizes(m.cad, m.curves, o, TaskArena(1));
-    EXPECT_EQ(off.pack(), on.pack());
-    EXPECT_TRUE(on.tips.empty());
+    const CurveSizes on = initial_curve_sizes(model->cad, model->curves, o, TaskArena(1));
+    if (model == &wide) {
+      EXPECT_EQ(off.pack(), on.pack());
+      EXPECT_TRUE(on.tips.empty());
+      continue;
+    }
+    // Two long sides at each of the prism's two sharp corners.
+    ASSERT_EQ(on.tips.size(), 4u);
+    const double limit = (1.0 / 6) / std::sin(3 * std::numbers::pi / 180);
+    for (const auto& tip : on.tips) {
+      EXPECT_TRUE(tip.shared);
+      EXPECT_GT(tip.length, 0.8 * limit);
+      EXPECT_LE(tip.length, limit * (1 + 1e-9));
+      const auto& pts = m.curves[tip.curve].points;
+      const Vec3 corner = tip.end == 0 ? pts.front() : pts.back();
+      for (std::size_t i = 0; i < pts.size(); ++i) {
+        if (distance(pts[i], corner) < tip.length) {
+          EXPECT_DOUBLE_EQ(on.at[tip.curve][i], tip.length);
+        } else {
+          EXPECT_DOUBLE_EQ(on.at[tip.curve][i], off.at[tip.curve][i]);  // no graded tail
+        }
+      }
+    }
   }
 }
 
