@@ -7,7 +7,9 @@
 
 #include <BRepBuilderAPI_MakeEdge.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
+#include <BRepBuilderAPI_MakePolygon.hxx>
 #include <BRepBuilderAPI_MakeWire.hxx>
+#include <BRepPrimAPI_MakePrism.hxx>
 #include <BRepTools.hxx>
 #include <GC_MakeArcOfCircle.hxx>
 #include <TopoDS_Face.hxx>
@@ -15,6 +17,7 @@
 #include <TopoDS_Wire.hxx>
 #include <array>
 #include <cmath>
+#include <cstdio>
 #include <cstdlib>
 #include <fstream>
 #include <map>
@@ -22,6 +25,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "qsmesh/core/types.hpp"
@@ -238,6 +242,34 @@ TEST(ThinRegions, FiveDegreeCornerQuadsAwayFromItStayAboveSicnPointTwo) {
   EXPECT_LT(off.sicn_min_away, 0.2);
   EXPECT_EQ(on.quads_at_sharp_corner, (std::vector<int>{1}));
   EXPECT_GE(on.sicn_min_away, 0.2) << on.quads << " quads";
+}
+
+// The 5-degree wedge's polygon extruded by 2: the sides of each end face at the sharp corner also
+// bound the prism's side faces, so the tail keeps their sizes (graded, its counts would reach
+// them) and the tip quad takes the part of the tail thinner than a sixth of the size: a quad
+// past it, half the width across and the size along, has SICN about 1/6. The bar for such
+// models is 0.1 away from the sharp corners; without the tips 0.102, with them 0.155.
+TEST(ThinRegions, PrismOfTheFiveDegreeCornerQuadsAwayFromItStayAbovePointOneFive) {
+  const double y = 6 * std::tan(5 * std::numbers::pi / 180);
+  BRepBuilderAPI_MakePolygon polygon;
+  for (const auto& [px, py] :
+       std::vector<std::pair<double, double>>{{0, 0}, {10, 0}, {10, 4}, {6, 4}, {6, y}})
+    polygon.Add(gp_Pnt(px, py, 0));
+  polygon.Close();
+  const TopoDS_Shape prism =
+      BRepPrimAPI_MakePrism(BRepBuilderAPI_MakeFace(polygon.Wire(), true).Face(), gp_Vec(0, 0, 2))
+          .Shape();
+  const std::string model = tmp("thin_wedge_prism.brep");
+  ASSERT_TRUE(BRepTools::Write(prism, model.c_str()));
+  const ThinCheck off = mesh_and_check(model, "--size 1 --thin-aspect 0", "thin_prism_off");
+  const ThinCheck on = mesh_and_check(model, "--size 1", "thin_prism");
+  std::printf(
+      "5-degree prism: SICN min away from the sharp corners %.3f (%zu quads), %.3f without "
+      "the tips (%zu quads)\n",
+      on.sicn_min_away, on.quads, off.sicn_min_away, off.quads);
+  EXPECT_EQ(on.quads_at_sharp_corner, (std::vector<int>{1, 1}));  // one per end face
+  EXPECT_LT(off.sicn_min_away, 0.15);
+  EXPECT_GE(on.sicn_min_away, 0.15) << on.quads << " quads";
 }
 
 }  // namespace
