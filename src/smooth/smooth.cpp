@@ -434,6 +434,18 @@ bool laplacian_uv(mesh::FaceMesh& m, const Topology& t) {
 constexpr double kCuspDeg = 10;
 
 void place_cusp_apices(mesh::FaceMesh& m, const cad::FaceGeometry& surface) {
+  // Most faces have no such corner: look before building the vertex-to-quad map.
+  const auto sharp_at = [&](const std::array<LO, 4>& q, int k) {
+    const LO c = q[k];
+    if (m.vclass[c].dim != 0 || m.vclass[q[(k + 2) % 4]].dim != 2) return false;
+    const Vec3 ea = m.points[q[(k + 1) % 4]] - m.points[c];
+    const Vec3 eb = m.points[q[(k + 3) % 4]] - m.points[c];
+    return std::atan2(norm(cross(ea, eb)), dot(ea, eb)) * 180 / std::numbers::pi < kCuspDeg;
+  };
+  bool any = false;
+  for (const auto& q : m.quads)
+    for (int k = 0; k < 4 && !any; ++k) any = sharp_at(q, k);
+  if (!any) return;
   const auto v2q = detail::vertex_quads(m);
   std::vector<char> in_triangle(static_cast<std::size_t>(m.num_vertices()), 0);
   for (const auto& t : m.triangles)
@@ -450,11 +462,7 @@ void place_cusp_apices(mesh::FaceMesh& m, const cad::FaceGeometry& surface) {
     for (int k = 0; k < 4; ++k) {
       const auto& q = m.quads[tip];
       const LO c = q[k], a = q[(k + 1) % 4], x = q[(k + 2) % 4], b = q[(k + 3) % 4];
-      if (m.vclass[c].dim != 0 || v2q[c].size() != 1 || m.vclass[x].dim != 2 || in_triangle[x] != 0)
-        continue;
-      const Vec3 ea = m.points[a] - m.points[c], eb = m.points[b] - m.points[c];
-      const double angle = std::atan2(norm(cross(ea, eb)), dot(ea, eb)) * 180 / std::numbers::pi;
-      if (!(angle < kCuspDeg)) continue;
+      if (!sharp_at(q, k) || v2q[c].size() != 1 || in_triangle[x] != 0) continue;
       const Vec2 mid = (m.uv[a] + m.uv[b]) * 0.5;
       const Vec2 axis = mid - m.uv[c];
       const double length = norm(axis), rung = norm(m.uv[a] - m.uv[b]);
