@@ -174,13 +174,17 @@ FillComparison compare_refused_fill(FaceTask& task, double tolerance,
 }
 
 bool second_pass_wins(const mesh::FaceQuadStats& first, const mesh::FaceQuadStats& second,
-                      double sicn_per_irregular, double good_sicn, double keep_ratio) {
-  if (sicn_per_irregular <= 0 || second.triangles > first.triangles) return false;
+                      double avg_per_irregular, double sum_per_irregular, double good_sicn,
+                      double keep_ratio) {
+  if (avg_per_irregular <= 0 || second.triangles > first.triangles) return false;
   const std::int64_t removed = first.irregular_interior - second.irregular_interior;
   if (removed <= 0) return false;
   // The second pass trades mean quality for irregular vertices; it must not make a poor quad.
   if (second.sicn_min < std::min(good_sicn, keep_ratio * first.sicn_min)) return false;
-  return first.sicn_avg - second.sicn_avg <= sicn_per_irregular * static_cast<double>(removed);
+  const double loss = first.sicn_avg - second.sicn_avg;
+  return loss <= avg_per_irregular * static_cast<double>(removed) &&
+         loss * static_cast<double>(first.quads) <=
+             sum_per_irregular * static_cast<double>(removed);
 }
 
 bool wants_unstructured(const FaceTask& task) { return !task.quasi.by_pattern; }

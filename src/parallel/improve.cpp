@@ -169,7 +169,8 @@ Result improve_one(const cad::CadModel& model, LO face, mesh::FaceMesh mesh,
       if (!again.report.time_budget_hit &&
           second_pass_wins(
               first, mesh::face_quad_stats(again.mesh), settings.second_pass_sicn_per_irregular,
-              settings.second_pass_cavities.good_sicn, settings.second_pass_cavities.keep_ratio)) {
+              settings.second_pass_sicn_sum_per_irregular, settings.second_pass_cavities.good_sicn,
+              settings.second_pass_cavities.keep_ratio)) {
         again.report.second_pass_kept = true;
         r = std::move(again);
       } else {

@@ -74,6 +74,7 @@ struct ImproveSettings {
   /// count depends on its cuts), never after a face reached its time budget. cost <= 0: off.
   qstruct::CavityOptions second_pass_cavities;
   double second_pass_sicn_per_irregular = 0;
+  double second_pass_sicn_sum_per_irregular = 0;
   std::int64_t second_pass_min_unnecessary = 2;
 };
 

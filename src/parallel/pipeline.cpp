@@ -343,6 +343,7 @@ std::array<double, 3> improvement_stage(const Context& cx, std::vector<FaceTask>
   settings.task_quads = cx.options.task_quads;
   settings.second_pass_cavities = cx.options.second_pass_cavities;
   settings.second_pass_sicn_per_irregular = cx.options.second_pass_sicn_per_irregular;
+  settings.second_pass_sicn_sum_per_irregular = cx.options.second_pass_sicn_sum_per_irregular;
   settings.second_pass_min_unnecessary = cx.options.second_pass_min_unnecessary;
   const std::array<double, 3> steps =
       improve_faces(cx.comm, cx.model, to_improve, settings, cx.tasks, cx.log);

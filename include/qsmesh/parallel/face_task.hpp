@@ -97,12 +97,14 @@ struct ImprovementReport {
 /// Whether a face keeps the result of the second pass of the topological improvement
 /// (PipelineOptions::second_pass_cavities) over the first pass's: it has fewer interior
 /// irregular vertices, no more triangles, its SICN minimum is at least min(good_sicn, keep_ratio
-/// x the first's) (the acceptance of a cavity replacement, qstruct::CavityOptions), and its mean
-/// SICN is lower by at most sicn_per_irregular per irregular vertex it removes. False when
-/// sicn_per_irregular <= 0 (off). Serial, pure.
+/// x the first's) (the acceptance of a cavity replacement, qstruct::CavityOptions), and for
+/// each irregular vertex it removes, its mean SICN is lower by at most avg_per_irregular and
+/// the SICN summed over the first pass's quads by at most sum_per_irregular (a large face may
+/// not spread a small mean loss over thousands of quads). False when avg_per_irregular <= 0
+/// (off). Serial, pure.
 [[nodiscard]] bool second_pass_wins(const mesh::FaceQuadStats& first,
-                                    const mesh::FaceQuadStats& second, double sicn_per_irregular,
-                                    double good_sicn, double keep_ratio);
+                                    const mesh::FaceQuadStats& second, double avg_per_irregular,
+                                    double sum_per_irregular, double good_sicn, double keep_ratio);
 
 /// How the quasi-structured stage treated one face. Its fields are declared once, in fields(), the
 /// countable ones named by their total over the faces in the drivers' --stats (as
