@@ -161,7 +161,8 @@ Result improve_one(const cad::CadModel& model, LO face, mesh::FaceMesh mesh,
                           settings.cavities, log, flagged);
   if (second_pass && !r.report.time_budget_hit) {
     const mesh::FaceQuadStats first = mesh::face_quad_stats(r.mesh);
-    if (first.irregular_interior - flagged >= settings.second_pass_min_unnecessary) {
+    if (first.irregular_interior - flagged >= settings.second_pass_min_unnecessary &&
+        (settings.second_pass_max_quads <= 0 || first.quads <= settings.second_pass_max_quads)) {
       std::int64_t flagged2 = 0;
       Result again = improve_pass(face, std::move(*input), surface.get(), singularities, settings,
                                   settings.second_pass_cavities, log, flagged2);

@@ -76,6 +76,7 @@ struct ImproveSettings {
   double second_pass_sicn_per_irregular = 0;
   double second_pass_sicn_sum_per_irregular = 0;
   std::int64_t second_pass_min_unnecessary = 2;
+  std::int64_t second_pass_max_quads = 0;  ///< 0: no bound
 };
 
 /// Per face, in order: cavity remeshing (Sec. 6.2), disk remeshing of the defects (Sec. 6.3), the
