@@ -45,16 +45,16 @@ enum class Stage { Background, Unstructured, QuasiStructured };
 inline constexpr std::int64_t kDefaultTaskQuads = 20000;
 
 /// The cavity options of the second pass (PipelineOptions::second_pass_cavities): the defaults
-/// with keep_avg_ratio 0.94 (0.97), max_candidates 4 (2), max_backtracks 16 (8) and
-/// max_quads_maximal = max_quads_sparse (3000). Each alone on wing_fuselage's window (eight
-/// factors 0.0058-0.0063) left 3 of 8 factors at most 84 interior irregular vertices or fewer;
-/// together, as a second pass, all 8 (docs/benchmarks.md, issue 29).
+/// with keep_avg_ratio 0.94 (0.97), max_candidates 4 (2) and max_backtracks 16 (8). Each alone,
+/// for every face, on wing_fuselage's window (eight factors 0.0058-0.0063) left 3, 7 and 3 of the
+/// 8 factors at both criteria of the Gmsh reference; together, as a second pass, all 8
+/// (max_quads_maximal 3000 from the start as well: the same meshes there and on Block, at more
+/// cost; docs/benchmarks.md, issue 29).
 [[nodiscard]] inline qstruct::CavityOptions loose_cavity_options() {
   qstruct::CavityOptions o;
   o.keep_avg_ratio = 0.94;
   o.max_candidates = 4;
   o.max_backtracks = 16;
-  o.max_quads_maximal = o.max_quads_sparse;
   return o;
 }
 
@@ -132,9 +132,10 @@ struct PipelineOptions {
   /// say) keeps mambo_s34's 5.9k-quad face 38 (4 fewer for 0.97 -> 0.93) and t20_data's face 0
   /// (2 fewer for 0.951 -> 0.941) on their first pass. Faces of more than
   /// second_pass_max_quads quads (after the first pass; 0: no bound) are not tried: the sum bound
-  /// lets a second pass through there only for a mean loss of a few thousandths, and with
-  /// maximal cavities of 3000 quads it is what costs (mambo_s34: the improvement stage 12.7 s
-  /// against 3.2 s with the bound 4000, for 250 against 254 interior irregular vertices).
+  /// lets a second pass through there only for a mean loss of a few thousandths, and there it
+  /// costs most (mambo_s34, with maximal cavities of 3000 quads in the second pass: the
+  /// improvement stage 12.7 s against 3.2 s with the bound 4000, for 250 against 254 interior
+  /// irregular vertices).
   /// second_pass_sicn_per_irregular <= 0: off.
   qstruct::CavityOptions second_pass_cavities = loose_cavity_options();
   double second_pass_sicn_per_irregular = 0.02;
