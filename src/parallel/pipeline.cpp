@@ -355,6 +355,11 @@ std::array<double, 3> improvement_stage(const Context& cx, std::vector<FaceTask>
   settings.final_smoothing = cx.options.final_smoothing;
   settings.final_smooth = cx.options.final_smooth;
   settings.task_quads = cx.options.task_quads;
+  settings.second_pass_cavities = cx.options.second_pass_cavities;
+  settings.second_pass_sicn_per_irregular = cx.options.second_pass_sicn_per_irregular;
+  settings.second_pass_sicn_sum_per_irregular = cx.options.second_pass_sicn_sum_per_irregular;
+  settings.second_pass_min_unnecessary = cx.options.second_pass_min_unnecessary;
+  settings.second_pass_max_quads = cx.options.second_pass_max_quads;
   const std::array<double, 3> steps =
       improve_faces(cx.comm, cx.model, to_improve, settings, cx.tasks, cx.log);
   for (std::size_t i = 0; i < faces.size(); ++i)
