@@ -288,6 +288,12 @@ Arguments parse(const std::vector<std::string>& args) {
       if (!n || !std::isfinite(*n) || *n < 0 || *n > 1e15 || *n != std::floor(*n))
         throw InputError(opt + ": '" + v + "' is not a whole number of quads (0: never cut)");
       a.task_quads = static_cast<std::int64_t>(*n);
+    } else if (opt == "--second-pass-quads" && a.command == Command::Mesh) {
+      const std::string& v = value();
+      const auto n = parse_double(v);
+      if (!n || !std::isfinite(*n) || *n < 0 || *n > 1e15 || *n != std::floor(*n))
+        throw InputError(opt + ": '" + v + "' is not a whole number of quads (0: no second pass)");
+      a.second_pass_quads = static_cast<std::int64_t>(*n);
     } else if (opt == "--max-quads" && meshing) {
       const std::string& v = value();
       const auto n = parse_double(v);
@@ -542,6 +548,13 @@ std::string help(const std::string& topic) {
           "                        a task of its own for the ranks and threads, in two passes\n"
           "                        whose cuts alternate; 0: never. The mesh depends on N, not on\n"
           "                        the rank or thread count\n"
+          "  --second-pass-quads N faces of at most N quads (default "
+       << parallel::PipelineOptions{}.second_pass_max_quads
+       << ") left with irregular\n"
+          "                        vertices their cross field does not ask for are improved a\n"
+          "                        second time with looser cavity bounds, and keep that mesh\n"
+          "                        when it has fewer irregular vertices at a small SICN cost\n"
+          "                        (docs/architecture.md); 0: no second pass (faster)\n"
           "  --max-quads N         refuse, before any work, a run whose estimated quad count is\n"
           "                        above N (default "
        << kDefaultMaxQuads

@@ -93,6 +93,9 @@ struct Arguments {
   /// --task-quads N: faces of more quads than N are improved in pieces, each a task
   /// (parallel::PipelineOptions::task_quads; 0: never); -1: parallel::kDefaultTaskQuads.
   std::int64_t task_quads = -1;
+  /// --second-pass-quads N: the largest face given a second improvement pass
+  /// (parallel::PipelineOptions::second_pass_max_quads; 0: no second pass); -1: the default.
+  std::int64_t second_pass_quads = -1;
   /// --field-divisions N: the background (where the fields are computed) at the geometry's
   /// resolution, each face's edges at most its bounding-box diagonal / N (and at most the target
   /// size's resolution); 0: the background follows the target size. See kDefaultFieldDivisions.

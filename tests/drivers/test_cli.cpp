@@ -365,6 +365,20 @@ TEST(Cli, MaxQuads) {
             std::string::npos);
 }
 
+TEST(Cli, SecondPassQuads) {
+  EXPECT_EQ(p({"mesh", "m.step", "-o", "o.msh"}).second_pass_quads, -1);  // the default applies
+  EXPECT_EQ(p({"mesh", "m.step", "-o", "o.msh", "--second-pass-quads", "0"}).second_pass_quads, 0);
+  EXPECT_EQ(p({"mesh", "m.step", "-o", "o.msh", "--second-pass-quads", "800"}).second_pass_quads,
+            800);
+  for (const std::string bad : {"-1", "2.5", "many"})
+    EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.msh", "--second-pass-quads", bad})
+                  .find("--second-pass-quads"),
+              std::string::npos)
+        << bad;
+  EXPECT_NE(error_of({"sizemap", "m.step", "-o", "o.vtu", "--second-pass-quads", "10"}), "");
+  EXPECT_NE(help("mesh").find("--second-pass-quads N"), std::string::npos);
+}
+
 // The example is written in the format its extension names; other names are refused up front.
 TEST(Cli, ExampleFormatByExtension) {
   EXPECT_EQ(p({"example", "wing-body", "-o", "w.step"}).output, "w.step");
