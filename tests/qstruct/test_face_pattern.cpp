@@ -402,6 +402,7 @@ TEST(FacePattern, SearchWorkIsBoundedByTheFacesQuads) {
   ASSERT_TRUE(fixed.ok) << fixed.reason;
   PatternFaceOptions o;
   o.move_work_ratio = 1;
+  o.move_min_layouts_per_vector = 0;  // searches of a layout or two too (tested below)
   (void)mesh_face_pattern(pc.model, 0, pc.curves, patterns, o, &free);  // size map unknown
   ASSERT_TRUE(free.ok) << free.reason;
   const auto quads = static_cast<double>(fixed.quads);
@@ -427,6 +428,42 @@ TEST(FacePattern, SearchWorkIsBoundedByTheFacesQuads) {
   (void)mesh_face_pattern(pc.model, 0, pc.curves, patterns, o, &loose);
   EXPECT_EQ(loose.moves, free.moves);
   EXPECT_EQ(loose.chords, free.chords);
+}
+
+// PatternFaceOptions::move_min_layouts_per_vector: a search the work bound would cut inside the
+// coarse sweeps of its vectors is not started, and the fill is the balanced one; with layouts
+// enough for them it runs.
+TEST(FacePattern, SearchTooShortForItsCoarseSweepsIsNotStarted) {
+  const auto pc = flared_strip("qs_flare_sweep.brep");
+  const auto patterns = builtin_patterns();
+  PatternFaceReport fixed, unbounded;
+  const auto m0 = mesh_face_pattern(pc.model, 0, pc.curves, patterns, without_moves(), &fixed);
+  ASSERT_TRUE(fixed.ok) << fixed.reason;
+  PatternFaceOptions o;
+  o.move_work_ratio = 1;
+  (void)mesh_face_pattern(pc.model, 0, pc.curves, patterns, o, &unbounded);
+  ASSERT_GT(unbounded.moves, 0);
+  const auto quads = static_cast<double>(fixed.quads);
+  // Three layouts of the balanced fill's size: fewer than 4 per vector.
+  o.size_map_quads = 3.0 * quads / o.move_evaluations;
+  PatternFaceReport cut, allowed;
+  const auto m1 = mesh_face_pattern(pc.model, 0, pc.curves, patterns, o, &cut);
+  ASSERT_TRUE(cut.ok) << cut.reason;
+  EXPECT_EQ(cut.moves, 0);
+  EXPECT_EQ(cut.chords, fixed.chords);
+  EXPECT_EQ(m1.quads, m0.quads);
+  EXPECT_EQ(m1.points, m0.points);
+  // The same bound, with the rule off: the search runs and moves.
+  o.move_min_layouts_per_vector = 0;
+  (void)mesh_face_pattern(pc.model, 0, pc.curves, patterns, o, &allowed);
+  EXPECT_GT(allowed.moves, 0);
+  // Layouts enough for every coarse sweep: the search runs with the rule on.
+  PatternFaceOptions enough;
+  enough.move_work_ratio = 1;
+  enough.size_map_quads = quads;
+  PatternFaceReport full;
+  (void)mesh_face_pattern(pc.model, 0, pc.curves, patterns, enough, &full);
+  EXPECT_EQ(full.moves, unbounded.moves);
 }
 
 // qstruct::boundary_held_sicn is the SICN of the rectangle on the two edges, and no quad on them

@@ -114,6 +114,15 @@ struct PatternFaceOptions {
   /// unstructured mesh has 792), laid out 18 times each and refused (docs/benchmarks.md).
   double size_map_quads = 0;
   double move_work_ratio = 2;
+  /// The search is not started when that bound leaves it fewer layouts than this per move
+  /// vector: it lays out 4 points of each vector's range before refining around the best, so it
+  /// would stop inside the first vectors' coarse sweeps. Measured on the six shared models at
+  /// their reference counts (docs/benchmarks.md, issue 27, branch `speed`): every search so
+  /// short (A319's faces 6, 10, 21, 24, 25 with 5-7 layouts for 2 vectors, t20's face 13,
+  /// wing_fuselage's faces 7 and 15 with 6) ended at a mean SICN of 0.36 at most, against the
+  /// 0.7 asked, and its face took the unstructured mesh; the meshes are byte-identical without
+  /// those searches, and wing_fuselage's patterns stage loses 0.5 s of its 1.5 s. 0: always.
+  int move_min_layouts_per_vector = 4;
   /// Matches tried geometrically (laid out, smoothed, measured) before giving up, best first.
   int max_candidates = 4;
   /// A loop point where a candidate puts a single quad holds that quad's two boundary edges there,
