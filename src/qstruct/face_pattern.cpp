@@ -528,6 +528,7 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
       ++rep.lifts;
       smooth::UntangleOptions uo;
       uo.target = min_sicn + 0.05;
+      uo.max_rings = std::max(uo.rings, options.lift_max_rings);
       mesh = smooth::untangle_face(mesh, surface, uo);
       q = smooth::measure(mesh);
     }

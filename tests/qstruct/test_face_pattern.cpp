@@ -533,6 +533,62 @@ TEST(FacePattern, UntanglerOnlyForFewPoorQuads) {
   EXPECT_EQ(rep.lifts, 0);
 }
 
+// PatternFaceOptions::lift_max_rings: the untangler moves only vertices within that many quad
+// rings of the quads it lifts. A transition fill with a few quads under a high min_sicn (0.85),
+// lifted, against the same fill not lifted.
+TEST(FacePattern, LiftStaysWithinItsRings) {
+  const XY xy = {{0, 0}, {30, 0}, {30, 15}, {0, 15}};
+  const auto pc = polygon(xy, {33, 12, 27, 18}, "qs_lift_rings.brep");
+  const auto patterns = builtin_patterns();
+  PatternFaceOptions o;
+  o.min_sicn = 0.85;
+  o.min_sicn_avg = 0;
+  o.max_candidates = 1;
+  o.lift_max_poor_fraction = 1;
+  o.move_evaluations = 0;
+  const auto fill = [&](bool lift, int rings) {
+    PatternFaceOptions p = o;
+    p.lift_poor_quads = lift;
+    p.lift_max_rings = rings;
+    PatternFaceReport rep;
+    mesh::FaceMesh m = mesh_face_pattern(pc.model, 0, pc.curves, patterns, p, &rep);
+    EXPECT_EQ(rep.lifts, lift ? 1 : 0);
+    return rep.ok ? m : rep.refused_mesh;
+  };
+  const mesh::FaceMesh plain = fill(false, 2);
+  ASSERT_FALSE(plain.quads.empty());
+  // Vertices within r quad rings of the quads the untangler starts from (SICN <= its target).
+  const double target = o.min_sicn + 0.05;
+  const auto within = [&](int r) {
+    std::vector<char> near(plain.points.size(), 0), seen(plain.quads.size(), 0);
+    for (std::size_t q = 0; q < plain.quads.size(); ++q) {
+      const auto& qd = plain.quads[q];
+      if (mesh::quad_sicn({plain.points[qd[0]], plain.points[qd[1]], plain.points[qd[2]],
+                           plain.points[qd[3]]}) <= target)
+        for (const LO v : qd) near[v] = 1;
+    }
+    for (int k = 0; k < r; ++k) {
+      std::vector<char> next = near;
+      for (const auto& qd : plain.quads)
+        if (near[qd[0]] || near[qd[1]] || near[qd[2]] || near[qd[3]])
+          for (const LO v : qd) next[v] = 1;
+      near = std::move(next);
+    }
+    return near;
+  };
+  const auto moved_outside = [&](const mesh::FaceMesh& m, int r) {
+    EXPECT_EQ(m.quads, plain.quads);
+    const std::vector<char> near = within(r);
+    int n = 0;
+    for (std::size_t v = 0; v < plain.points.size(); ++v)
+      n += !near[v] && !(m.points[v] == plain.points[v]) ? 1 : 0;
+    return n;
+  };
+  EXPECT_EQ(moved_outside(fill(true, 2), 2), 0);
+  // The untangler's own bound (8 rings) reaches farther on this fill.
+  EXPECT_GT(moved_outside(fill(true, 8), 2), 0);
+}
+
 TEST(FacePattern, TriangleAndPentagonGetTheirIrregularVertex) {
   const auto patterns = builtin_patterns();
   {
