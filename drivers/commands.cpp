@@ -570,6 +570,9 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
        << t(steps, 2) << ", " << t(steps, 3) << "\n"
        << "  disk remeshing: defects " << t("disk_defects_before") << " -> "
        << t("disk_defects_after") << " (" << t("disk_cavities_replaced") << " cavities replaced)\n";
+    if (const std::int64_t n = t("faces_second_pass_kept"); n > 0)
+      os << "  second improvement pass (looser cavity acceptance) kept on " << n
+         << " face(s): fewer irregular vertices at a bounded cost in SICN\n";
     if (const std::int64_t n = t("faces_time_budget_hit"); n > 0)
       os << "  faces stopped by --face-time-budget: " << n
          << " (kept the valid mesh reached; list with -v)\n";

@@ -177,6 +177,9 @@ std::vector<mesh::CurveMesh> mesh_curves(const cad::CadModel& model, const SizeO
     // other (unsewn volumes, sloppy models), not features the mesh could resolve.
     limit_by_feature_distance(model, polylines, h, 0.1 * sizes.effective_min_size(),
                               sizes.effective_min_size(), tasks);
+    // Inside sharp wedges the sides share a corner, so (ii) does not see them; the thin-face cap
+    // of the size map grades the sizes along such a tail with its width, and needs vertices there.
+    limit_in_sharp_wedges(model, polylines, h, 0.1 * sizes.effective_min_size(), 10, tasks);
     for (std::size_t c = 0; c < samples.size(); ++c) samples[c].h = std::move(h[c]);
   }
 

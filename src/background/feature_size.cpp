@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <numbers>
 #include <vector>
 
@@ -146,7 +147,9 @@ void limit_by_distance(std::span<const std::vector<Vec3>> polylines,
         // exact enough for dense polylines, and far cheaper than a CAD projection.
         const double d = distance_to_polyline(polylines[o], j, line[k]);
         // The floor bounds what a feature may ask for, never a size already smaller.
-        if (d > touching && accept(c, o, line[k], d)) h[k] = std::min(h[k], std::max(floor, d));
+        // accept gives the factor the distance counts with (false / 0: not at all).
+        const double scale = d > touching ? static_cast<double>(accept(c, o, line[k], d)) : 0.0;
+        if (scale > 0) h[k] = std::min(h[k], std::max(floor, scale * d));
       }
     }
   });
@@ -157,6 +160,40 @@ bool share_corner(const cad::CadModel& model, LO a, LO b) {
   const auto& cb = model.curves()[b];
   return a == b || cb.corners[0] == ca.corners[0] || cb.corners[0] == ca.corners[1] ||
          cb.corners[1] == ca.corners[0] || cb.corners[1] == ca.corners[1];
+}
+
+/// The faces using each curve (sorted, each once).
+std::vector<std::vector<LO>> faces_of_curves(const cad::CadModel& model, std::size_t num_curves) {
+  std::vector<std::vector<LO>> faces(num_curves);
+  for (LO f = 0; f < model.num_faces(); ++f)
+    for (const auto& loop : model.faces()[f].loops)
+      for (const auto& use : loop.uses)
+        if (use.curve >= 0 && use.curve < static_cast<LO>(faces.size()))
+          faces[use.curve].push_back(f);
+  for (auto& list : faces) {
+    std::sort(list.begin(), list.end());
+    list.erase(std::unique(list.begin(), list.end()), list.end());
+  }
+  return faces;
+}
+
+/// The distance from p to the nearer corner curves a and b share (a crescent's sides share both);
+/// infinite when they share none.
+double shared_corner_distance(const cad::CadModel& model, LO a, LO b, const Vec3& p) {
+  double r = std::numeric_limits<double>::infinity();
+  for (const LO k : model.curves()[a].corners)
+    if (k >= 0 && (k == model.curves()[b].corners[0] || k == model.curves()[b].corners[1]))
+      r = std::min(r, distance(p, model.corners()[k].point));
+  return r;
+}
+
+/// Two sides of a wedge whose tail is graded (thin_aspect): both bound one face and no other.
+/// A side another face also uses carries the tail's counts into that face, which pays for them
+/// with transitions across it: t20_data's chamfer slivers (0-degree cusps between faces filled
+/// by grids) at their reference size went from 60 quads below SICN 0.1 to 2, but from 87 to 212
+/// interior irregular vertices and SICN avg 0.984 to 0.925 (docs/benchmarks.md, issue 29).
+bool own_wedge_sides(const std::vector<std::vector<LO>>& faces, LO a, LO b) {
+  return faces[a].size() == 1 && faces[b].size() == 1 && faces[a][0] == faces[b][0];
 }
 
 }  // namespace
@@ -225,23 +262,112 @@ void limit_by_face_width(const cad::CadModel& model, std::span<const std::vector
   // the quads at the sliver stayed flat.
   const double sharp = std::sin(10 * std::numbers::pi / 180);
   const auto corners = model.corners();
-  // Sides meeting at a corner are not counted: inside a sharp wedge (a cusp's tail) that was
-  // tried, and the sizes it grades toward the cusp reach the faces along its sides (t20_data's
-  // chamfer slivers at their reference size: the grids beside them went from SICN min 0.91 to 0.33,
-  // +14% vertices, SICN avg 0.984 -> 0.947).
+  // Sides meeting at a corner count only inside a wedge sharper than 10 degrees (a cusp's tail),
+  // and not at its tip (sharp_wedge_tips: one edge there, so the grading toward the cusp stops).
   limit_by_distance(
       polylines, sizes, touching, 0.0, tasks,
-      [&](LO c, LO other) { return !share_corner(model, c, other) && share_face(c, other); },
-      [&](LO c, LO other, const Vec3& p, double d) {
+      [&](LO c, LO other) { return other != c && share_face(c, other); },
+      [&](LO c, LO other, const Vec3& p, double d) -> double {
+        // Sides meeting at a corner count inside a wedge sharper than 10 degrees (a cusp's tail),
+        // at 3/4 of their distance: the tail's quads are trapezoids whose inner row the smoothing
+        // places, and came out at about 0.8 of the SICN of the rectangles the cap aims at (the
+        // crescent and 5-degree corner of tests/drivers/test_thin_regions.cpp: 0.174 and 0.196
+        // at the full distance, 0.211 and 0.246 at 3/4).
+        double scale = 1;
+        const double r = shared_corner_distance(model, c, other, p);
+        if (std::isfinite(r)) {
+          if (!(d < sharp * r) || !own_wedge_sides(faces, c, other)) return 0;
+          scale = 0.75;
+        }
         for (const LO a : model.curves()[c].corners)
           for (const LO b : model.curves()[other].corners) {
             if (a < 0) continue;
             auto it = std::lower_bound(joints.begin(), joints.end(), Joint{a, b, 0.0});
             for (; it != joints.end() && it->a == a && it->b == b; ++it)
-              if (!(d <= 2 * it->length || d < sharp * distance(p, corners[a].point))) return false;
+              if (!(d <= 2 * it->length || d < sharp * distance(p, corners[a].point))) return 0;
           }
-        return true;
+        return scale;
       });
+}
+
+void limit_in_sharp_wedges(const cad::CadModel& model, std::span<const std::vector<Vec3>> polylines,
+                           std::vector<std::vector<double>>& sizes, double touching,
+                           double sharp_deg, const TaskArena& tasks) {
+  const auto faces = faces_of_curves(model, polylines.size());
+  const double sharp = std::sin(sharp_deg * std::numbers::pi / 180);
+  // Searched within half the size, lowered to the width, then doubled: at most twice the width.
+  for (auto& h : sizes)
+    for (double& x : h) x *= 0.5;
+  limit_by_distance(
+      polylines, sizes, touching, 0.0, tasks,
+      [&](LO c, LO other) { return other != c && own_wedge_sides(faces, c, other); },
+      [&](LO c, LO other, const Vec3& p, double d) {
+        const double r = shared_corner_distance(model, c, other, p);
+        return std::isfinite(r) && d < sharp * r;
+      });
+  for (auto& h : sizes)
+    for (double& x : h) x *= 2;
+}
+
+std::vector<SharpTip> sharp_wedge_tips(const cad::CadModel& model,
+                                       std::span<const std::vector<Vec3>> polylines,
+                                       std::span<const std::vector<double>> sizes, double touching,
+                                       double shared_ratio, double sharp_deg) {
+  const auto faces = faces_of_curves(model, polylines.size());
+  const auto share_face = [&](LO a, LO b) {
+    for (const LO f : faces[a])
+      if (std::binary_search(faces[b].begin(), faces[b].end(), f)) return true;
+    return false;
+  };
+  const auto distance_to = [&](const std::vector<Vec3>& line, const Vec3& p) {
+    double d = std::numeric_limits<double>::infinity();
+    for (std::size_t i = 0; i + 1 < line.size(); ++i) {
+      const Vec3 ab = line[i + 1] - line[i];
+      const double l2 = norm2(ab);
+      const double s = l2 > 0 ? std::clamp(dot(p - line[i], ab) / l2, 0.0, 1.0) : 0.0;
+      d = std::min(d, distance(p, line[i] + ab * s));
+    }
+    return d;
+  };
+  const double sharp = std::sin(sharp_deg * std::numbers::pi / 180);
+  const auto corners = model.corners();
+  std::vector<SharpTip> tips;
+  const auto nc = static_cast<LO>(polylines.size());
+  for (LO c = 0; c < nc; ++c) {
+    const auto& line = polylines[c];
+    const auto& curve = model.curves()[c];
+    if (curve.degenerate || line.size() < 2 || curve.corners[0] == curve.corners[1]) continue;
+    for (int end = 0; end < 2; ++end) {
+      const LO k = curve.corners[end];
+      if (k < 0) continue;
+      double tip = 0;
+      bool shared = false;
+      for (LO o = 0; o < nc; ++o) {
+        const auto& other = model.curves()[o];
+        if (o == c || other.degenerate || polylines[o].size() < 2 ||
+            (other.corners[0] != k && other.corners[1] != k) || !share_face(c, o))
+          continue;
+        const bool own = own_wedge_sides(faces, c, o);
+        // Walk away from the corner while the two sides stay inside a sharp wedge and closer
+        // than the tip's width: that stretch is the tip, which one quad holds.
+        for (std::size_t j = 1; j < line.size(); ++j) {
+          const std::size_t i = end == 0 ? j : line.size() - 1 - j;
+          const Vec3& p = line[i];
+          const double r = distance(p, corners[k].point);
+          const double d = distance_to(polylines[o], p);
+          if (!(d < sharp * r) || !(d <= (own ? touching : shared_ratio * sizes[c][i]))) break;
+          if (r > tip) {
+            tip = r;
+            shared = !own;
+          }
+        }
+      }
+      // Two tips of one curve never overlap.
+      tip = std::min(tip, 0.5 * distance(line.front(), line.back()));
+      if (tip > 0) tips.push_back({c, end, tip, shared});
+    }
+  }
+  return tips;
 }
 
 }  // namespace qsmesh::background

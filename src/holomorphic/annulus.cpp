@@ -23,7 +23,7 @@ using detail::wrap;
 
 mesh::FaceMesh detail::mesh_annulus_of(const PolyAnnulus& s, const mesh::FaceMesh& background,
                                        std::span<const mesh::BoundaryLoop> loops,
-                                       const cad::FaceGeometry& surface,
+                                       const Placement& placement,
                                        const HolomorphicOptions& options,
                                        HolomorphicReport* report) {
   const Stopwatch clock;
@@ -73,8 +73,10 @@ mesh::FaceMesh detail::mesh_annulus_of(const PolyAnnulus& s, const mesh::FaceMes
     if (!(period > 0)) return fail("the form has no period around the annulus");
 
     std::string why;
-    const FinalBoundary F = merge_final(loops, &why);
+    FinalBoundary F = merge_final(loops, &why);
     if (!why.empty()) return fail(why);
+    // A group's inner curves are traversed both ways like a seam, but cross no column.
+    if (placement.group()) F.seam_edges.clear();
     if (F.cycles.size() != 2)
       return fail("the final boundary has " + std::to_string(F.cycles.size()) + " cycles, not 2");
     // Each loop is a horizontal trajectory, straight in the form's flat metric.
@@ -287,11 +289,9 @@ mesh::FaceMesh detail::mesh_annulus_of(const PolyAnnulus& s, const mesh::FaceMes
           guess = guess + background.uv[static_cast<std::size_t>(ft[k])] * b[k];
         }
         Vec3 foot;
-        const Vec2 uv = surface.project(x, guess, &foot);
+        Vec2 uv;
         mesh::VertexClass vc;
-        vc.dim = 2;
-        vc.entity = background.face;
-        vc.param = {uv.u, uv.v};
+        placement.place(t, x, guess, &foot, &uv, &vc);
         at(i, j) = add_point(foot, uv, vc);
       }
     }
@@ -344,8 +344,10 @@ mesh::FaceMesh mesh_annulus(const mesh::FaceMesh& background,
                             std::span<const mesh::BoundaryLoop> loops,
                             const cad::FaceGeometry& surface, const HolomorphicOptions& options,
                             HolomorphicReport* report) {
-  return detail::mesh_annulus_of(poly_annulus(background), background, loops, surface, options,
-                                 report);
+  const cad::FaceGeometry* const one[] = {&surface};
+  const LO face[] = {background.face};
+  return detail::mesh_annulus_of(poly_annulus(background), background, loops,
+                                 detail::Placement{one, face, {}}, options, report);
 }
 
 Method parse_method(const std::string& text) {

@@ -270,11 +270,46 @@ inline std::vector<double> grid_u(const std::vector<double>& a, const std::vecto
   return u;
 }
 
+// Where the meshers put a point they found inside background triangle t: projected on the CAD
+// face of that triangle. One face (one surface, triangle_part empty), or a glued group of faces
+// (group.hpp), whose triangles come from several faces.
+struct Placement {
+  std::span<const cad::FaceGeometry* const> surfaces;  // per part
+  std::span<const LO> faces;                           // CAD face of each part
+  std::span<const LO> triangle_part;                   // per triangle; empty: all on part 0
+  [[nodiscard]] bool group() const { return !triangle_part.empty(); }
+  [[nodiscard]] LO part(LO t) const {
+    return triangle_part.empty() ? 0 : triangle_part[static_cast<std::size_t>(t)];
+  }
+  // x projected on the face of triangle t, searched from guess (a parameter point of that face).
+  void place(LO t, const Vec3& x, const Vec2& guess, Vec3* foot, Vec2* uv,
+             mesh::VertexClass* vc) const {
+    const auto p = static_cast<std::size_t>(part(t));
+    *uv = surfaces[p]->project(x, guess, foot);
+    *vc = interior(p, *uv);
+  }
+  [[nodiscard]] mesh::VertexClass interior(std::size_t p, const Vec2& uv) const {
+    mesh::VertexClass vc;
+    vc.dim = 2;
+    vc.entity = faces[p];
+    vc.param = {uv.u, uv.v};
+    return vc;
+  }
+};
+
 // mesh_annulus on the poly-annulus `s` of `background` already found (mesh_poly_annulus finds
-// it to count the loops).
+// it to count the loops). With a group placement, curves traversed both ways by the final loops
+// are the group's inner curves (and seams), not a seam joining the two loops: no seam column.
 mesh::FaceMesh mesh_annulus_of(const PolyAnnulus& s, const mesh::FaceMesh& background,
-                               std::span<const mesh::BoundaryLoop> loops,
-                               const cad::FaceGeometry& surface, const HolomorphicOptions& options,
-                               HolomorphicReport* report);
+                               std::span<const mesh::BoundaryLoop> loops, const Placement& place,
+                               const HolomorphicOptions& options, HolomorphicReport* report);
+
+// mesh_poly_annulus with its points placed by `place`; a group's patches are not smoothed (the
+// smoother works in one face's parameter plane), and its inner curves are allowed where a single
+// face's seam is refused.
+mesh::FaceMesh mesh_poly_annulus_of(const mesh::FaceMesh& background,
+                                    std::span<const mesh::BoundaryLoop> loops,
+                                    const Placement& place, const HolomorphicOptions& options,
+                                    HolomorphicReport* report);
 
 }  // namespace qsmesh::holomorphic::detail

@@ -50,8 +50,8 @@ struct LevelPoint {
 class PatchMesher {
  public:
   PatchMesher(const PolyAnnulus& s, const mesh::FaceMesh& background,
-              const cad::FaceGeometry& surface, std::span<const C> phi, std::vector<double> V)
-      : s_(s), bg_(background), surface_(surface), phi_(phi), V_(std::move(V)) {}
+              const detail::Placement& place, std::span<const C> phi, std::vector<double> V)
+      : s_(s), bg_(background), place_(place), phi_(phi), V_(std::move(V)) {}
 
   // The triangles with some part strictly between lo and hi, split into components across the
   // edges with some part there.
@@ -154,22 +154,29 @@ class PatchMesher {
   }
 
   // The point of a closed level curve at u (modulo its period), as a 3D point on the surface.
-  void point_at(const std::vector<LevelPoint>& curve, double u, Vec3* xyz, Vec2* uv) const {
+  // Both ends of the segment are evaluated in the one background triangle that holds it, so
+  // that the parameter guess is interpolated between copies on one side of a seam, on one face
+  // of a group.
+  void point_at(const std::vector<LevelPoint>& curve, double u, Vec3* xyz, Vec2* uv,
+                mesh::VertexClass* vc = nullptr) const {
     const double u0 = curve.front().u, period = curve.back().u - u0;
     const double q = u0 + (u - u0) - period * std::floor((u - u0) / period);
     std::size_t k = 0;
     while (k + 2 < curve.size() && curve[k + 1].u <= q) ++k;
     const double du = curve[k + 1].u - curve[k].u;
     const double w = du > 0 ? std::clamp((q - curve[k].u) / du, 0.0, 1.0) : 0.0;
+    const LO t = holds(curve[k].t, curve[k + 1]) ? curve[k].t : curve[k + 1].t;
     Vec3 x0, x1;
     Vec2 g0, g1;
-    position(curve[k], &x0, &g0);
-    position(curve[k + 1], &x1, &g1);
+    position(curve[k], t, &x0, &g0);
+    position(curve[k + 1], t, &x1, &g1);
     const Vec3 x = x0 * (1 - w) + x1 * w;
     const Vec2 guess = g0 * (1 - w) + g1 * w;
     Vec3 foot;
-    *uv = surface_.project(x, guess, &foot);
+    mesh::VertexClass klass;
+    place_.place(t, x, guess, &foot, uv, &klass);
     *xyz = foot;
+    if (vc != nullptr) *vc = klass;
   }
 
   // u of the curve at its point nearest to x (3D).
@@ -245,9 +252,17 @@ class PatchMesher {
   }
   // 3D point and a parameter guess (from the background triangle's FaceMesh corners, so a
   // seam's copies are told apart by the triangle).
-  void position(const LevelPoint& p, Vec3* x, Vec2* uv) const {
-    const auto& tri = s_.triangles[static_cast<std::size_t>(p.t)];
-    const auto& ft = bg_.triangles[static_cast<std::size_t>(p.t)];
+  void position(const LevelPoint& p, Vec3* x, Vec2* uv) const { position(p, p.t, x, uv); }
+  // Whether triangle t has p's edge.
+  bool holds(LO t, const LevelPoint& p) const {
+    const auto& tri = s_.triangles[static_cast<std::size_t>(t)];
+    return std::find(tri.begin(), tri.end(), p.a) != tri.end() &&
+           std::find(tri.begin(), tri.end(), p.b) != tri.end();
+  }
+  // The same in triangle t, which has p's edge.
+  void position(const LevelPoint& p, LO t, Vec3* x, Vec2* uv) const {
+    const auto& tri = s_.triangles[static_cast<std::size_t>(t)];
+    const auto& ft = bg_.triangles[static_cast<std::size_t>(t)];
     const auto ka = static_cast<std::size_t>(std::find(tri.begin(), tri.end(), p.a) - tri.begin());
     const auto kb = static_cast<std::size_t>(std::find(tri.begin(), tri.end(), p.b) - tri.begin());
     *x = bg_.points[static_cast<std::size_t>(ft[ka])] * (1 - p.w) +
@@ -304,7 +319,7 @@ class PatchMesher {
  private:
   const PolyAnnulus& s_;
   const mesh::FaceMesh& bg_;
-  const cad::FaceGeometry& surface_;
+  const detail::Placement& place_;
   std::span<const C> phi_;
   std::vector<double> V_;
 };
@@ -315,6 +330,17 @@ mesh::FaceMesh mesh_poly_annulus(const mesh::FaceMesh& background,
                                  std::span<const mesh::BoundaryLoop> loops,
                                  const cad::FaceGeometry& surface,
                                  const HolomorphicOptions& options, HolomorphicReport* report) {
+  const cad::FaceGeometry* const one[] = {&surface};
+  const LO face[] = {background.face};
+  return detail::mesh_poly_annulus_of(background, loops, detail::Placement{one, face, {}}, options,
+                                      report);
+}
+
+mesh::FaceMesh detail::mesh_poly_annulus_of(const mesh::FaceMesh& background,
+                                            std::span<const mesh::BoundaryLoop> loops,
+                                            const Placement& placement,
+                                            const HolomorphicOptions& options,
+                                            HolomorphicReport* report) {
   const Stopwatch clock;
   HolomorphicReport local;
   HolomorphicReport& R = report != nullptr ? *report : local;
@@ -332,13 +358,15 @@ mesh::FaceMesh mesh_poly_annulus(const mesh::FaceMesh& background,
       return fail("not a poly-annulus: " + s.reason);
     }
     if (s.loops.size() == 2)
-      return detail::mesh_annulus_of(s, background, loops, surface, options, report);
+      return detail::mesh_annulus_of(s, background, loops, placement, options, report);
     R.boundaries = static_cast<LO>(s.loops.size());
     const std::size_t b = s.loops.size();
     std::string why;
     const FinalBoundary F = merge_final(loops, &why);
     if (!why.empty()) return fail(why);
-    if (!F.seam_edges.empty()) return fail("b >= 3 with a seam: not handled");
+    // A group's inner curves (and its faces' seams) are traversed both ways like a seam; its
+    // points are placed per background triangle, so they cross them.
+    if (!F.seam_edges.empty() && !placement.group()) return fail("b >= 3 with a seam: not handled");
     if (F.cycles.size() != b)
       return fail("the final boundary has " + std::to_string(F.cycles.size()) + " cycles, not " +
                   std::to_string(b));
@@ -442,7 +470,7 @@ mesh::FaceMesh mesh_poly_annulus(const mesh::FaceMesh& background,
     }
     std::sort(levels.begin(), levels.end());
 
-    PatchMesher P(s, background, surface, phi, V);
+    PatchMesher P(s, background, placement, phi, V);
     std::vector<Cylinder> cyl;
     for (std::size_t k = 0; k + 1 < levels.size(); ++k)
       for (auto& c : P.cylinders(levels[k], levels[k + 1])) cyl.push_back(std::move(c));
@@ -622,13 +650,6 @@ mesh::FaceMesh mesh_poly_annulus(const mesh::FaceMesh& background,
       out.vclass.push_back(vc);
       return static_cast<LO>(out.points.size() - 1);
     };
-    auto interior_class = [&](const Vec2& uv) {
-      mesh::VertexClass vc;
-      vc.dim = 2;
-      vc.entity = background.face;
-      vc.param = {uv.u, uv.v};
-      return vc;
-    };
     for (std::size_t k = 0; k < F.cycles.size(); ++k) {
       const auto& cycle = F.cycles[k];
       std::vector<double> u(cycle.size());
@@ -740,12 +761,14 @@ mesh::FaceMesh mesh_poly_annulus(const mesh::FaceMesh& background,
       const double pair_level = two_below ? g.level - eps : g.level + eps;
       const double single_level = two_below ? g.level + eps : g.level - eps;
       const Vec3 xs = s.points[static_cast<std::size_t>(g.saddle)];
-      const Vec2 xs_uv = [&] {
-        for (std::size_t w = 0; w < background.vclass.size(); ++w)
-          if (s.face2merged[w] == g.saddle) return background.uv[w];
-        return Vec2{0, 0};
-      }();
-      const LO saddle_id = add_point(xs, xs_uv, interior_class(xs_uv));
+      // The saddle's parameters: its copy in a triangle around it (the face of that triangle).
+      const LO xs_t = vertex_tris[static_cast<std::size_t>(g.saddle)].front();
+      const auto& xs_c = s.triangles[static_cast<std::size_t>(xs_t)];
+      const Vec2 xs_uv = background.uv[static_cast<std::size_t>(
+          background.triangles[static_cast<std::size_t>(xs_t)][static_cast<std::size_t>(
+              std::find(xs_c.begin(), xs_c.end(), g.saddle) - xs_c.begin())])];
+      const LO saddle_id = add_point(
+          xs, xs_uv, placement.interior(static_cast<std::size_t>(placement.part(xs_t)), xs_uv));
       saddle_ids.push_back(saddle_id);
       const auto cs = P.level_curve(single, single_level);
       if (cs.empty()) return fail("a cut through a zero is not one closed curve");
@@ -810,8 +833,9 @@ mesh::FaceMesh mesh_poly_annulus(const mesh::FaceMesh& background,
           const double du = offset(j);
           Vec3 x;
           Vec2 uv;
-          P.point_at(curve, u0 + du, &x, &uv);
-          ids.push_back(add_point(x, uv, interior_class(uv)));
+          mesh::VertexClass vc;
+          P.point_at(curve, u0 + du, &x, &uv, &vc);
+          ids.push_back(add_point(x, uv, vc));
           ul.push_back(u0 + du);
           single_ids.push_back(ids.back());
           single_u.push_back(us + du);
@@ -900,8 +924,9 @@ mesh::FaceMesh mesh_poly_annulus(const mesh::FaceMesh& background,
         for (std::size_t i = 0; i < N; ++i) {
           Vec3 x;
           Vec2 uv;
-          P.point_at(curve, ug[j * (N + 1) + i], &x, &uv);
-          grid[j * N + i] = add_point(x, uv, interior_class(uv));
+          mesh::VertexClass vc;
+          P.point_at(curve, ug[j * (N + 1) + i], &x, &uv, &vc);
+          grid[j * N + i] = add_point(x, uv, vc);
         }
       }
       // Counter-clockwise in (u, v): the background's orientation (phi preserves it).
@@ -937,7 +962,8 @@ mesh::FaceMesh mesh_poly_annulus(const mesh::FaceMesh& background,
       }
       out = std::move(kept);
     }
-    if (options.smooth_patches) out = smooth::smooth_face(out, surface, options.smoothing);
+    if (options.smooth_patches && !placement.group())
+      out = smooth::smooth_face(out, *placement.surfaces[0], options.smoothing);
     R.patches = static_cast<int>(cyl.size()) - collapsed;
     R.ok = true;
     R.seconds = clock.seconds();

@@ -2,11 +2,16 @@
 // dense layout (quad_layout.cpp) and the coarse one (coarse_layout.cpp).
 #pragma once
 
+#include <algorithm>
+#include <array>
 #include <cstddef>
+#include <optional>
+#include <span>
 #include <utility>
 #include <vector>
 
 #include "qsmesh/core/types.hpp"
+#include "qsmesh/mesh/surface_mesh.hpp"
 
 namespace qsmesh::layout::detail {
 
@@ -50,5 +55,79 @@ struct Grid {
     *this = std::move(r);
   }
 };
+
+// The patch `members` (sorted quad ids of face `face` of m) as an ni x nj grid of its vertices, its
+// quads left empty; none when the patch is not a grid. `across(q, a, b)` gives the patch quad
+// across edge (a, b) of quad q, or -1 where that edge bounds the patch. Both layouts keep their
+// own edge tables, hence the callable.
+template <class Across>
+[[nodiscard]] std::optional<Grid> patch_grid(const mesh::SurfaceMesh& m,
+                                             std::span<const GO> members, LO face, Across across) {
+  // An oriented quad: local corners (0,0), (1,0), (1,1), (0,1) are quad[k], [k+1], [k+2], [k+3].
+  struct Oriented {
+    GO q;
+    int k;
+  };
+  auto corner = [&](Oriented o, int c) {
+    return m.quads[static_cast<std::size_t>(o.q)][static_cast<std::size_t>((o.k + c) % 4)];
+  };
+  auto position = [&](GO q, GO v) {
+    const auto& quad = m.quads[static_cast<std::size_t>(q)];
+    for (int k = 0; k < 4; ++k)
+      if (quad[static_cast<std::size_t>(k)] == v) return k;
+    return -1;
+  };
+  // The first quad with a patch corner: both its edges at that vertex bound the patch.
+  Oriented start{-1, 0};
+  for (GO q : members) {
+    const auto& quad = m.quads[static_cast<std::size_t>(q)];
+    for (int k = 0; k < 4 && start.q < 0; ++k)
+      if (across(q, quad[k], quad[(k + 1) % 4]) < 0 && across(q, quad[(k + 3) % 4], quad[k]) < 0)
+        start = {q, k};
+    if (start.q >= 0) break;
+  }
+  if (start.q < 0) return std::nullopt;
+  auto step_i = [&](Oriented o) -> Oriented {
+    const GO b = corner(o, 1), c = corner(o, 2);
+    const GO n = across(o.q, b, c);
+    return n < 0 ? Oriented{-1, 0} : Oriented{n, position(n, b)};
+  };
+  auto step_j = [&](Oriented o) -> Oriented {
+    const GO d = corner(o, 3), c = corner(o, 2);
+    const GO n = across(o.q, d, c);
+    return n < 0 ? Oriented{-1, 0} : Oriented{n, position(n, d)};
+  };
+  const auto count = static_cast<GO>(members.size());
+  LO ni = 0;
+  for (Oriented o = start; o.q >= 0; o = step_i(o))
+    if (++ni > count) return std::nullopt;
+  std::vector<GO> gv;
+  std::vector<GO> seen;
+  LO nj = 0;
+  for (Oriented row = start; row.q >= 0; row = step_j(row)) {
+    if (static_cast<GO>(nj + 1) * ni > count) return std::nullopt;
+    gv.resize(static_cast<std::size_t>(ni + 1) * static_cast<std::size_t>(nj + 2), -1);
+    Oriented o = row;
+    for (LO i = 0; i < ni; ++i) {
+      if (o.q < 0) return std::nullopt;
+      seen.push_back(o.q);
+      const std::array<std::pair<LO, LO>, 4> at{
+          {{i, nj}, {i + 1, nj}, {i + 1, nj + 1}, {i, nj + 1}}};
+      for (int c = 0; c < 4; ++c) {
+        GO& slot = gv[static_cast<std::size_t>(at[static_cast<std::size_t>(c)].second) *
+                          static_cast<std::size_t>(ni + 1) +
+                      static_cast<std::size_t>(at[static_cast<std::size_t>(c)].first)];
+        if (slot >= 0 && slot != corner(o, c)) return std::nullopt;
+        slot = corner(o, c);
+      }
+      o = step_i(o);
+    }
+    if (o.q >= 0) return std::nullopt;  // a longer row: not a grid
+    ++nj;
+  }
+  std::sort(seen.begin(), seen.end());
+  if (!std::equal(seen.begin(), seen.end(), members.begin(), members.end())) return std::nullopt;
+  return Grid{face, ni, nj, std::move(gv), {}};
+}
 
 }  // namespace qsmesh::layout::detail

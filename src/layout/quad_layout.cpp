@@ -221,14 +221,6 @@ class Layouter {
     return -1;
   }
 
-  // Position of v in quad q.
-  [[nodiscard]] int position(GO q, GO v) const {
-    const auto& quad = m_.quads[static_cast<std::size_t>(q)];
-    for (int k = 0; k < 4; ++k)
-      if (quad[k] == v) return k;
-    return -1;
-  }
-
   // The patch `members` (sorted quad ids) as an ni x nj grid; none when it is not one.
   [[nodiscard]] std::optional<Grid> grid(const std::vector<GO>& members, LO face) const {
     auto in_patch = [&](GO q) { return std::binary_search(members.begin(), members.end(), q); };
@@ -238,66 +230,9 @@ class Layouter {
       const GO other = e.quads[0] == q ? e.quads[1] : e.quads[0];
       return in_patch(other) ? other : -1;
     };
-    // An oriented quad: local corners (0,0), (1,0), (1,1), (0,1) are quad[k], [k+1], [k+2], [k+3].
-    struct Oriented {
-      GO q;
-      int k;
-    };
-    auto corner = [&](Oriented o, int c) {
-      return m_.quads[static_cast<std::size_t>(o.q)][(o.k + c) % 4];
-    };
-    // The first quad with a patch corner: both its edges at that vertex bound the patch.
-    Oriented start{-1, 0};
-    for (GO q : members) {
-      for (int k = 0; k < 4 && start.q < 0; ++k) {
-        const auto& quad = m_.quads[static_cast<std::size_t>(q)];
-        if (across(q, quad[k], quad[(k + 1) % 4]) < 0 && across(q, quad[(k + 3) % 4], quad[k]) < 0)
-          start = {q, k};
-      }
-      if (start.q >= 0) break;
-    }
-    if (start.q < 0) return std::nullopt;
-    auto step_i = [&](Oriented o) -> Oriented {
-      const GO b = corner(o, 1), c = corner(o, 2);
-      const GO n = across(o.q, b, c);
-      return n < 0 ? Oriented{-1, 0} : Oriented{n, position(n, b)};
-    };
-    auto step_j = [&](Oriented o) -> Oriented {
-      const GO d = corner(o, 3), c = corner(o, 2);
-      const GO n = across(o.q, d, c);
-      return n < 0 ? Oriented{-1, 0} : Oriented{n, position(n, d)};
-    };
-    LO ni = 0;
-    for (Oriented o = start; o.q >= 0; o = step_i(o)) {
-      if (++ni > static_cast<LO>(members.size())) return std::nullopt;
-    }
-    std::vector<GO> grid_vertices;
-    std::vector<GO> seen;
-    LO nj = 0;
-    for (Oriented row = start; row.q >= 0; row = step_j(row)) {
-      if (static_cast<GO>(nj + 1) * ni > static_cast<GO>(members.size())) return std::nullopt;
-      grid_vertices.resize(static_cast<std::size_t>(ni + 1) * static_cast<std::size_t>(nj + 2), -1);
-      Oriented o = row;
-      for (LO i = 0; i < ni; ++i) {
-        if (o.q < 0) return std::nullopt;
-        seen.push_back(o.q);
-        const std::array<std::pair<LO, LO>, 4> at{
-            {{i, nj}, {i + 1, nj}, {i + 1, nj + 1}, {i, nj + 1}}};
-        for (int c = 0; c < 4; ++c) {
-          GO& slot = grid_vertices[static_cast<std::size_t>(at[c].second) *
-                                       static_cast<std::size_t>(ni + 1) +
-                                   static_cast<std::size_t>(at[c].first)];
-          if (slot >= 0 && slot != corner(o, c)) return std::nullopt;
-          slot = corner(o, c);
-        }
-        o = step_i(o);
-      }
-      if (o.q >= 0) return std::nullopt;  // a longer row: not a grid
-      ++nj;
-    }
-    std::sort(seen.begin(), seen.end());
-    if (seen != members) return std::nullopt;
-    return Grid{face, ni, nj, std::move(grid_vertices), members};
+    auto g = detail::patch_grid(m_, members, face, across);
+    if (g) g->quads = members;
+    return g;
   }
 
   const mesh::SurfaceMesh& m_;

@@ -1,5 +1,6 @@
 #include "qsmesh/parallel/face_task.hpp"
 
+#include <algorithm>
 #include <exception>
 #include <string>
 #include <utility>
@@ -170,6 +171,20 @@ FillComparison compare_refused_fill(FaceTask& task, double tolerance,
   }
   r = RefusedFill{};
   return c;
+}
+
+bool second_pass_wins(const mesh::FaceQuadStats& first, const mesh::FaceQuadStats& second,
+                      double avg_per_irregular, double sum_per_irregular, double good_sicn,
+                      double keep_ratio) {
+  if (avg_per_irregular <= 0 || second.triangles > first.triangles) return false;
+  const std::int64_t removed = first.irregular_interior - second.irregular_interior;
+  if (removed <= 0) return false;
+  // The second pass trades mean quality for irregular vertices; it must not make a poor quad.
+  if (second.sicn_min < std::min(good_sicn, keep_ratio * first.sicn_min)) return false;
+  const double loss = first.sicn_avg - second.sicn_avg;
+  return loss <= avg_per_irregular * static_cast<double>(removed) &&
+         loss * static_cast<double>(first.quads) <=
+             sum_per_irregular * static_cast<double>(removed);
 }
 
 bool wants_unstructured(const FaceTask& task) { return !task.quasi.by_pattern; }

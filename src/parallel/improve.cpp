@@ -75,18 +75,15 @@ struct Result {
   }
 };
 
-Result improve_one(const cad::CadModel& model, LO face, mesh::FaceMesh mesh,
-                   std::span<const crossfield::Singularity> singularities,
-                   const ImproveSettings& settings, Logger& log) {
+// One pass of the steps (cavity, disk, final smoothing) on `mesh` with these cavity options;
+// `flagged_kept` gets the flagged vertices the cavity step kept (0 when it did not run).
+Result improve_pass(LO face, mesh::FaceMesh mesh, const cad::FaceGeometry* surface,
+                    std::span<const crossfield::Singularity> singularities,
+                    const ImproveSettings& settings, const qstruct::CavityOptions& cavities,
+                    Logger& log, std::int64_t& flagged_kept) {
   Result r;
   r.done = true;
-  const Stopwatch total;
-  std::unique_ptr<cad::FaceGeometry> surface;
-  try {
-    surface = model.face_geometry(face);
-  } catch (const std::exception& e) {
-    log.warn(Error(e.what(), ErrorContext{"topological improvement", 2, face}).what());
-  }
+  flagged_kept = 0;
   // A step that throws leaves the face's valid mesh as it was.
   const auto step = [&](int k, const char* what, const auto& run) {
     if (surface == nullptr) return;
@@ -98,15 +95,16 @@ Result improve_one(const cad::CadModel& model, LO face, mesh::FaceMesh mesh,
     } catch (const std::exception& e) {
       log.warn(Error(e.what(), ErrorContext{what, 2, face}).what());
     }
-    r.steps[static_cast<std::size_t>(k)] = clock.seconds();
+    r.steps[static_cast<std::size_t>(k)] += clock.seconds();
   };
   // Cavity remeshing (Sec. 6.2): irregular vertices that the cross field does not ask for are
   // removed by remeshing convex cavities with patterns.
   step(0, "cavity remeshing", [&](const cad::FaceGeometry& s) {
     qstruct::CavityReport cr;
     mesh::FaceMesh out =
-        qstruct::remesh_cavities(mesh, s, singularities, settings.patterns, settings.cavities, &cr);
+        qstruct::remesh_cavities(mesh, s, singularities, settings.patterns, cavities, &cr);
     r.report.record(cr);
+    flagged_kept = cr.flagged_kept;
     return out;
   });
   // Local clean-up (Sec. 6.3): defects remeshed with the best disk quadrangulation, each
@@ -139,6 +137,48 @@ Result improve_one(const cad::CadModel& model, LO face, mesh::FaceMesh mesh,
       return smooth::smooth_face(mesh, s, settings.final_smooth);
     });
   r.mesh = std::move(mesh);
+  return r;
+}
+
+Result improve_one(const cad::CadModel& model, LO face, mesh::FaceMesh mesh,
+                   std::span<const crossfield::Singularity> singularities,
+                   const ImproveSettings& settings, Logger& log) {
+  const Stopwatch total;
+  std::unique_ptr<cad::FaceGeometry> surface;
+  try {
+    surface = model.face_geometry(face);
+  } catch (const std::exception& e) {
+    log.warn(Error(e.what(), ErrorContext{"topological improvement", 2, face}).what());
+  }
+  const bool piece = std::any_of(mesh.vclass.begin(), mesh.vclass.end(),
+                                 [](const mesh::VertexClass& c) { return mesh::is_cut_vertex(c); });
+  const bool second_pass = settings.second_pass_sicn_per_irregular > 0 && !piece &&
+                           surface != nullptr && !mesh.quads.empty() && mesh.triangles.empty();
+  std::optional<mesh::FaceMesh> input;
+  if (second_pass) input = mesh;
+  std::int64_t flagged = 0;
+  Result r = improve_pass(face, std::move(mesh), surface.get(), singularities, settings,
+                          settings.cavities, log, flagged);
+  if (second_pass && !r.report.time_budget_hit) {
+    const mesh::FaceQuadStats first = mesh::face_quad_stats(r.mesh);
+    if (first.irregular_interior - flagged >= settings.second_pass_min_unnecessary &&
+        (settings.second_pass_max_quads <= 0 || first.quads <= settings.second_pass_max_quads)) {
+      std::int64_t flagged2 = 0;
+      Result again = improve_pass(face, std::move(*input), surface.get(), singularities, settings,
+                                  settings.second_pass_cavities, log, flagged2);
+      for (std::size_t k = 0; k < r.steps.size(); ++k) again.steps[k] += r.steps[k];
+      if (!again.report.time_budget_hit &&
+          second_pass_wins(
+              first, mesh::face_quad_stats(again.mesh), settings.second_pass_sicn_per_irregular,
+              settings.second_pass_sicn_sum_per_irregular, settings.second_pass_cavities.good_sicn,
+              settings.second_pass_cavities.keep_ratio)) {
+        again.report.second_pass_kept = true;
+        r = std::move(again);
+      } else {
+        r.steps = again.steps;
+      }
+    }
+  }
   r.seconds = total.seconds();
   return r;
 }

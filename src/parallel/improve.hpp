@@ -70,6 +70,13 @@ struct ImproveSettings {
   /// end ones half size) and improved again, so that the first cuts end inside pieces. The
   /// result depends on the face and task_quads only, not on ranks or threads.
   std::int64_t task_quads = 0;
+  /// The second pass of PipelineOptions (second_pass_cavities, ...): whole faces only (a piece's
+  /// count depends on its cuts), never after a face reached its time budget. cost <= 0: off.
+  qstruct::CavityOptions second_pass_cavities;
+  double second_pass_sicn_per_irregular = 0;
+  double second_pass_sicn_sum_per_irregular = 0;
+  std::int64_t second_pass_min_unnecessary = 2;
+  std::int64_t second_pass_max_quads = 0;  ///< 0: no bound
 };
 
 /// Per face, in order: cavity remeshing (Sec. 6.2), disk remeshing of the defects (Sec. 6.3), the

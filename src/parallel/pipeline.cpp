@@ -158,6 +158,20 @@ void quantize_stage(const Context& cx, std::span<const mesh::CurveMesh> curves,
                     ", grids ", result.balance.grids_before, " -> ", result.balance.grids_after,
                     " (", result.balance.curves_changed, " curves changed)"));
   }
+  if (options.face_method != holomorphic::Method::Default) {
+    // The holomorphic grid of an annulus needs equal counts on its two loops (after the pattern
+    // balancing, which does not look at faces with two loops).
+    holomorphic::AnnulusCountReport annuli;
+    std::vector<int> edges = holomorphic::balance_annulus_counts(
+        model, curves, result.quantization.edges, result.quantization.ideal,
+        result.quantization.curve2chord, fixed, {}, &annuli);
+    result.quantization.total_edges = 0;
+    for (const int e : edges) result.quantization.total_edges += e;
+    result.quantization.edges = std::move(edges);
+    cx.log.info(cat("quantize: annuli with equal loop counts ", annuli.equal_before, " -> ",
+                    annuli.equal_after, " of ", annuli.annuli, " (", annuli.curves_changed,
+                    " curves changed)"));
+  }
   // Boundary repair: a face whose boundary crosses itself in its parameter plane cannot be
   // triangulated. Each rank checks its own faces; the flags are summed, so every rank refines
   // the same curves and keeps the same quantization.
@@ -341,6 +355,11 @@ std::array<double, 3> improvement_stage(const Context& cx, std::vector<FaceTask>
   settings.final_smoothing = cx.options.final_smoothing;
   settings.final_smooth = cx.options.final_smooth;
   settings.task_quads = cx.options.task_quads;
+  settings.second_pass_cavities = cx.options.second_pass_cavities;
+  settings.second_pass_sicn_per_irregular = cx.options.second_pass_sicn_per_irregular;
+  settings.second_pass_sicn_sum_per_irregular = cx.options.second_pass_sicn_sum_per_irregular;
+  settings.second_pass_min_unnecessary = cx.options.second_pass_min_unnecessary;
+  settings.second_pass_max_quads = cx.options.second_pass_max_quads;
   const std::array<double, 3> steps =
       improve_faces(cx.comm, cx.model, to_improve, settings, cx.tasks, cx.log);
   for (std::size_t i = 0; i < faces.size(); ++i)

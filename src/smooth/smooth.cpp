@@ -423,6 +423,90 @@ bool laplacian_uv(mesh::FaceMesh& m, const Topology& t) {
   return true;
 }
 
+// The quad holding a CAD corner sharper than kCuspDeg alone (a cusp) has its minimum fixed by
+// that corner, so the kernels, which only keep a move that does not lower the minimum of the
+// quads around a vertex, let its inner vertex wander: ahead of the rung between the corner's two
+// curve neighbours it leaves the quads behind the rung a sharp angle, behind it a flat one (the
+// 5-degree corner of tests/drivers/test_thin_regions.cpp: 0.196 next to the corner's quad). The
+// inner vertex goes where the other quads around it are best: on the line from the corner through
+// the rung's middle, a little past the rung (a convex kite), the cusp quad kept valid and no
+// worse.
+constexpr double kCuspDeg = 10;
+
+void place_cusp_apices(mesh::FaceMesh& m, const cad::FaceGeometry& surface) {
+  // Most faces have no such corner: look before building the vertex-to-quad map.
+  const auto sharp_at = [&](const std::array<LO, 4>& q, int k) {
+    const LO c = q[k];
+    if (m.vclass[c].dim != 0 || m.vclass[q[(k + 2) % 4]].dim != 2) return false;
+    const Vec3 ea = m.points[q[(k + 1) % 4]] - m.points[c];
+    const Vec3 eb = m.points[q[(k + 3) % 4]] - m.points[c];
+    return std::atan2(norm(cross(ea, eb)), dot(ea, eb)) * 180 / std::numbers::pi < kCuspDeg;
+  };
+  bool any = false;
+  for (const auto& q : m.quads)
+    for (int k = 0; k < 4 && !any; ++k) any = sharp_at(q, k);
+  if (!any) return;
+  const auto v2q = detail::vertex_quads(m);
+  std::vector<char> in_triangle(static_cast<std::size_t>(m.num_vertices()), 0);
+  for (const auto& t : m.triangles)
+    for (const LO v : t) in_triangle[v] = 1;
+  const auto quad_points = [&](LO q) {
+    const auto& c = m.quads[q];
+    return std::array<Vec3, 4>{m.points[c[0]], m.points[c[1]], m.points[c[2]], m.points[c[3]]};
+  };
+  const auto oriented_sicn = [&](LO q, const Vec3& normal) {
+    const auto corners = mesh::quad_corners(quad_points(q));
+    return dot(corners.sum, normal) > 0 ? mesh::quad_sicn_from(corners) : -1.0;
+  };
+  for (LO tip = 0; tip < static_cast<LO>(m.quads.size()); ++tip)
+    for (int k = 0; k < 4; ++k) {
+      const auto& q = m.quads[tip];
+      const LO c = q[k], a = q[(k + 1) % 4], x = q[(k + 2) % 4], b = q[(k + 3) % 4];
+      if (!sharp_at(q, k) || v2q[c].size() != 1 || in_triangle[x] != 0) continue;
+      const Vec2 mid = (m.uv[a] + m.uv[b]) * 0.5;
+      const Vec2 axis = mid - m.uv[c];
+      const double length = norm(axis), rung = norm(m.uv[a] - m.uv[b]);
+      if (!(length > 0) || !(rung > 0)) continue;
+      // The orientation of each quad around x, from the surface normal at x: a move never flips.
+      const auto at_x = surface.eval(m.uv[x]);
+      Vec3 normal = cross(at_x.du, at_x.dv);
+      if (!(norm(normal) > 0)) continue;
+      if (dot(mesh::quad_corners(quad_points(tip)).sum, normal) < 0) normal = normal * -1.0;
+      const auto score = [&](double& tip_sicn) {
+        double worst = std::numeric_limits<double>::infinity();
+        for (const LO o : v2q[x]) {
+          const double s = oriented_sicn(o, normal);
+          if (o == tip)
+            tip_sicn = s;
+          else
+            worst = std::min(worst, s);
+        }
+        return worst;
+      };
+      double tip_before = 0;
+      double best = score(tip_before);
+      const Vec2 uv0 = m.uv[x];
+      const Vec3 p0 = m.points[x];
+      Vec2 best_uv = uv0;
+      Vec3 best_p = p0;
+      for (const double f : {0.05, 0.1, 0.2, 0.35, 0.5}) {
+        const Vec2 uv = mid + axis * (f * rung / length);
+        m.uv[x] = uv;
+        m.points[x] = surface.eval(uv).p;
+        double tip_after = 0;
+        const double s = score(tip_after);
+        if (s > best && tip_after > 0 && tip_after >= std::min(tip_before, 0.0) &&
+            (tip_before <= 0 || tip_after >= tip_before)) {
+          best = s;
+          best_uv = uv;
+          best_p = m.points[x];
+        }
+      }
+      m.uv[x] = best_uv;
+      m.points[x] = best_p;
+    }
+}
+
 }  // namespace
 
 mesh::FaceMesh smooth_face(const mesh::FaceMesh& input, const cad::FaceGeometry& surface,
@@ -496,6 +580,7 @@ mesh::FaceMesh smooth_face(const mesh::FaceMesh& input, const cad::FaceGeometry&
       }
       st.method += st.method.empty() ? "kernels" : "+kernels";
     }
+    place_cusp_apices(m, surface);
     detail::sync_interior_params(m);
   }
   if (st.stopped_early) {

@@ -1,18 +1,24 @@
 #include "holo_shapes.hpp"
 
+#include <BRepAdaptor_Surface.hxx>
 #include <BRepAlgoAPI_Cut.hxx>
+#include <BRepAlgoAPI_Fuse.hxx>
 #include <BRepBuilderAPI_MakeEdge.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepBuilderAPI_MakePolygon.hxx>
 #include <BRepBuilderAPI_MakeWire.hxx>
+#include <BRepFilletAPI_MakeFillet.hxx>
 #include <BRepFilletAPI_MakeFillet2d.hxx>
 #include <BRepPrimAPI_MakeCylinder.hxx>
 #include <BRepTools.hxx>
+#include <BRep_Builder.hxx>
 #include <TopExp.hxx>
+#include <TopExp_Explorer.hxx>
 #include <TopTools_IndexedMapOfShape.hxx>
 #include <TopoDS.hxx>
 #include <TopoDS_Face.hxx>
 #include <TopoDS_Shape.hxx>
+#include <TopoDS_Shell.hxx>
 #include <gp_Ax2.hxx>
 #include <gp_Circ.hxx>
 #include <gp_Pln.hxx>
@@ -86,6 +92,73 @@ std::string write_rounded_plate_with_holes(double length, double width, double c
   TopoDS_Shape plate = fillet.Shape();
   for (const auto& h : holes) plate = drill(plate, h[0], h[1], h[2]);
   return write(plate, path);
+}
+
+std::string write_t_duct(double main_radius, double half_length, double branch_radius,
+                         double branch_height, double fillet, const std::string& path) {
+  // The main pipe's local x axis (its seam) points down, the branch's along -x.
+  const gp_Ax2 main_axis(gp_Pnt(-half_length, 0, 0), gp_Dir(1, 0, 0), gp_Dir(0, 0, -1));
+  const gp_Ax2 branch_axis(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1), gp_Dir(-1, 0, 0));
+  const TopoDS_Shape main_pipe =
+      BRepPrimAPI_MakeCylinder(main_axis, main_radius, 2 * half_length).Shape();
+  const TopoDS_Shape branch =
+      BRepPrimAPI_MakeCylinder(branch_axis, branch_radius, branch_height).Shape();
+  BRepAlgoAPI_Fuse fuse(main_pipe, branch);
+  fuse.Build();
+  if (!fuse.IsDone()) throw std::runtime_error("boolean fuse failed");
+  TopoDS_Shape solid = fuse.Shape();
+  if (fillet > 0) {
+    // The junction's edges: those of no planar face (the caps' circles are on planes).
+    TopTools_IndexedMapOfShape cap_edges;
+    for (TopExp_Explorer f(solid, TopAbs_FACE); f.More(); f.Next())
+      if (BRepAdaptor_Surface(TopoDS::Face(f.Current())).GetType() == GeomAbs_Plane)
+        TopExp::MapShapes(f.Current(), TopAbs_EDGE, cap_edges);
+    BRepFilletAPI_MakeFillet round(solid);
+    TopTools_IndexedMapOfShape edges;
+    TopExp::MapShapes(solid, TopAbs_EDGE, edges);
+    for (int i = 1; i <= edges.Extent(); ++i)
+      if (!cap_edges.Contains(edges(i))) {
+        // Seams (an edge used twice by one face) are not junctions either.
+        bool seam = false;
+        for (TopExp_Explorer f(solid, TopAbs_FACE); f.More() && !seam; f.Next()) {
+          int uses = 0;
+          for (TopExp_Explorer e(f.Current(), TopAbs_EDGE); e.More(); e.Next())
+            if (e.Current().IsSame(edges(i))) ++uses;
+          seam = uses == 2;
+        }
+        if (!seam) round.Add(fillet, TopoDS::Edge(edges(i)));
+      }
+    round.Build();
+    if (!round.IsDone()) throw std::runtime_error("fillet failed");
+    solid = round.Shape();
+  }
+  BRep_Builder builder;
+  TopoDS_Shell shell;
+  builder.MakeShell(shell);
+  for (TopExp_Explorer f(solid, TopAbs_FACE); f.More(); f.Next())
+    if (BRepAdaptor_Surface(TopoDS::Face(f.Current())).GetType() != GeomAbs_Plane)
+      builder.Add(shell, f.Current());
+  return write(shell, path);
+}
+
+std::string write_two_piece_pipe(double radius, double half_length, const std::string& path) {
+  const TopoDS_Shape lower =
+      BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), radius, half_length)
+          .Shape();
+  const TopoDS_Shape upper =
+      BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(0, 0, half_length), gp_Dir(0, 0, 1)), radius,
+                               half_length)
+          .Shape();
+  BRepAlgoAPI_Fuse fuse(lower, upper);
+  fuse.Build();
+  if (!fuse.IsDone()) throw std::runtime_error("boolean fuse failed");
+  BRep_Builder builder;
+  TopoDS_Shell shell;
+  builder.MakeShell(shell);
+  for (TopExp_Explorer f(fuse.Shape(), TopAbs_FACE); f.More(); f.Next())
+    if (BRepAdaptor_Surface(TopoDS::Face(f.Current())).GetType() != GeomAbs_Plane)
+      builder.Add(shell, f.Current());
+  return write(shell, path);
 }
 
 }  // namespace qsmesh::test

@@ -267,6 +267,92 @@ TEST(Holomorphic, BasisOnALargerPolyAnnulusHasTheRightPeriodsAndIsHarmonic) {
   }
 }
 
+// Equal loop counts for the annulus grid (balance_annulus_counts): a planar annulus's two circles
+// (two loops), the cylindrical hole of a box (one loop with a seam), a plate with a hole (square
+// corners: left alone).
+std::vector<mesh::CurveMesh> background_curves(const cad::CadModel& model, double size) {
+  background::BackgroundOptions options;
+  options.sizes.size = size;
+  return background::mesh_curves(model, options.sizes, TaskArena(1));
+}
+
+TEST(Holomorphic, AnnulusCountsAreMadeEqualWithinTheirRoom) {
+  const cad::CadModel model = cad::load_cad(test::write_annulus(1.0, 2.0, tmp("bal_ann.brep")));
+  ASSERT_EQ(model.num_faces(), 1);
+  ASSERT_EQ(model.num_curves(), 2);
+  const auto chains = annulus_chains(model, 0);
+  ASSERT_EQ(chains.size(), 2u);
+  const auto curves = background_curves(model, 0.2);
+  const LO outer = model.curves()[0].length > model.curves()[1].length ? 0 : 1;
+  std::vector<int> edges(2);
+  edges[static_cast<std::size_t>(outer)] = 40;
+  edges[static_cast<std::size_t>(1 - outer)] = 32;
+  const std::vector<double> ideal(edges.begin(), edges.end());
+  const std::vector<LO> no_chord(2, kNoIndex);
+  AnnulusCountReport report;
+  const auto out = balance_annulus_counts(model, curves, edges, ideal, no_chord, {}, {}, &report);
+  // The short loop raised (room: 35% of 32 = 11.2 edges).
+  EXPECT_EQ(out[static_cast<std::size_t>(1 - outer)], 40);
+  EXPECT_EQ(out[static_cast<std::size_t>(outer)], 40);
+  EXPECT_EQ(report.annuli, 1);
+  EXPECT_EQ(report.equal_before, 0);
+  EXPECT_EQ(report.equal_after, 1);
+  EXPECT_EQ(report.curves_changed, 1);
+  // The inner circle prescribed: the outer comes down instead.
+  const std::vector<LO> fixed{1 - outer};
+  const auto down =
+      balance_annulus_counts(model, curves, edges, ideal, no_chord, fixed, {}, &report);
+  EXPECT_EQ(down[static_cast<std::size_t>(outer)], 32);
+  EXPECT_EQ(down[static_cast<std::size_t>(1 - outer)], 32);
+  // Loops further apart than 20% (40 against 24) are left alone, as is a face whose room does
+  // not reach (the inner prescribed, the outer's room 14 < 16, with the limit lifted).
+  edges[static_cast<std::size_t>(1 - outer)] = 24;
+  EXPECT_EQ(balance_annulus_counts(model, curves, edges, ideal, no_chord, {}, {}, &report), edges);
+  EXPECT_EQ(report.equal_after, 0);
+  AnnulusCountOptions wide;
+  wide.max_loop_difference = 1;
+  const std::vector<double> ideal2(edges.begin(), edges.end());
+  EXPECT_EQ(balance_annulus_counts(model, curves, edges, ideal2, no_chord, fixed, wide, &report),
+            edges);
+  const auto both = balance_annulus_counts(model, curves, edges, ideal2, no_chord, {}, wide);
+  EXPECT_EQ(both[0], 32);  // inner up by 8, outer down by 8
+  EXPECT_EQ(both[1], 32);
+}
+
+TEST(Holomorphic, AnnulusCountsOnACylinderSideAndNotOnASquarePlate) {
+  const cad::CadModel box = cad::load_cad(test::write_box_with_hole(tmp("bal_box.brep")));
+  LO side = kNoIndex;
+  for (LO f = 0; f < box.num_faces(); ++f)
+    if (box.faces()[static_cast<std::size_t>(f)].type == cad::SurfaceType::Cylinder) side = f;
+  ASSERT_NE(side, kNoIndex);
+  const auto chains = annulus_chains(box, side);
+  ASSERT_EQ(chains.size(), 2u);  // the two circles, the seam's uses removed
+  const auto curves = background_curves(box, 0.5);
+  std::vector<int> edges(static_cast<std::size_t>(box.num_curves()), 8);
+  const LO a = chains[0][0].curve, b = chains[1][0].curve;
+  edges[static_cast<std::size_t>(a)] = 20;
+  edges[static_cast<std::size_t>(b)] = 24;
+  const std::vector<double> ideal(edges.begin(), edges.end());
+  const std::vector<LO> no_chord(edges.size(), kNoIndex);
+  AnnulusCountReport report;
+  const auto out = balance_annulus_counts(box, curves, edges, ideal, no_chord, {}, {}, &report);
+  EXPECT_EQ(out[static_cast<std::size_t>(a)], 24);  // the short loop raised
+  EXPECT_EQ(out[static_cast<std::size_t>(b)], 24);
+  EXPECT_EQ(report.equal_after, 1);
+  // The box's faces with the hole are annuli with four 90-degree corners: not counted.
+  EXPECT_EQ(report.annuli, 1);
+
+  const cad::CadModel plate =
+      cad::load_cad(test::write_plate_with_holes(8, 4, {{{4, 2, 1}}}, tmp("bal_plate.brep")));
+  ASSERT_EQ(annulus_chains(plate, 0).size(), 2u);
+  std::vector<int> pe(static_cast<std::size_t>(plate.num_curves()), 10);
+  const std::vector<double> pi(pe.begin(), pe.end());
+  const auto pout = balance_annulus_counts(plate, background_curves(plate, 0.5), pe, pi,
+                                           std::vector<LO>(pe.size(), kNoIndex), {}, {}, &report);
+  EXPECT_EQ(pout, pe);
+  EXPECT_EQ(report.annuli, 0);
+}
+
 TEST(Holomorphic, PolicyKeepsTheHolomorphicMeshOnlyWhenItWins) {
   HolomorphicReport ok;
   ok.ok = true;

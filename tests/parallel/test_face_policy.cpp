@@ -235,5 +235,43 @@ TEST(FacePolicy, OnlyValidAllQuadUnstructuredFacesAreImproved) {
   EXPECT_FALSE(wants_improvement(failed));
 }
 
+// The second pass of the improvement is kept only when it removes irregular vertices at a bounded
+// price in mean SICN, per vertex and summed over the face's quads, without a poor quad.
+TEST(FacePolicy, SecondPassKeptOnlyWhenItsIrregularVerticesAreCheap) {
+  const auto stats = [](std::int64_t quads, std::int64_t irregular, double min, double avg) {
+    mesh::FaceQuadStats s;
+    s.quads = quads;
+    s.irregular_interior = irregular;
+    s.sicn_min = min;
+    s.sicn_avg = avg;
+    return s;
+  };
+  const double per = 0.02, sum = 12, good = 0.6, keep = 0.8;
+  const mesh::FaceQuadStats first = stats(800, 8, 0.62, 0.954);
+  // wing_fuselage's wing tip at size factor 0.006: 8 -> 2 for 0.954 -> 0.922 (25 over 800 quads).
+  EXPECT_TRUE(second_pass_wins(first, stats(600, 2, 0.62, 0.922), per, sum, good, keep));
+  // No fewer irregular vertices, or more: never, however good the mean.
+  EXPECT_FALSE(second_pass_wins(first, stats(800, 8, 0.7, 0.99), per, sum, good, keep));
+  EXPECT_FALSE(second_pass_wins(first, stats(800, 9, 0.7, 0.99), per, sum, good, keep));
+  // Too dear per vertex in the mean: 2 fewer for 0.05.
+  EXPECT_FALSE(second_pass_wins(first, stats(800, 6, 0.62, 0.904), per, sum, good, keep));
+  // Cheap in the mean but dear summed over a large face: 4 fewer for 0.01 over 6000 quads (60).
+  EXPECT_FALSE(second_pass_wins(stats(6000, 20, 0.7, 0.97), stats(6000, 16, 0.7, 0.96), per, sum,
+                                good, keep));
+  EXPECT_TRUE(second_pass_wins(stats(6000, 20, 0.7, 0.97), stats(6000, 16, 0.7, 0.963), per, sum,
+                               good, keep));
+  // The minimum may drop to keep_ratio x the first's (0.496 here), not below; above good_sicn
+  // it may drop freely.
+  EXPECT_TRUE(second_pass_wins(first, stats(600, 2, 0.5, 0.95), per, sum, good, keep));
+  EXPECT_FALSE(second_pass_wins(first, stats(600, 2, 0.49, 0.95), per, sum, good, keep));
+  EXPECT_TRUE(
+      second_pass_wins(stats(800, 8, 0.9, 0.95), stats(800, 6, 0.61, 0.95), per, sum, good, keep));
+  // Triangles where the first had none: never. Off: never.
+  mesh::FaceQuadStats tri = stats(600, 2, 0.62, 0.95);
+  tri.triangles = 1;
+  EXPECT_FALSE(second_pass_wins(first, tri, per, sum, good, keep));
+  EXPECT_FALSE(second_pass_wins(first, stats(600, 2, 0.62, 0.95), 0, sum, good, keep));
+}
+
 }  // namespace
 }  // namespace qsmesh::parallel

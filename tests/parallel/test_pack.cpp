@@ -88,6 +88,7 @@ FaceOutput full_output() {
   o.quasi.improvement.defects_after = 2;
   o.quasi.improvement.disk_replaced = 6;
   o.quasi.improvement.time_budget_hit = true;
+  o.quasi.improvement.second_pass_kept = true;
   o.stats.vertices = 4;
   o.stats.quads = 1;
   o.stats.triangles = 1;
@@ -104,9 +105,9 @@ FaceOutput full_output() {
 TEST(Pack, EveryFieldOfAFaceOutputRoundTrips) {
   const FaceOutput a = full_output();
   // 10 parts; the counts of their fields: mesh 1 (packed whole), background report 5, cross field
-  // 11, sizes 3, unstructured 7, quasi 11 + improvement 7, stats 7, seconds 1, times 11, field
+  // 11, sizes 3, unstructured 7, quasi 11 + improvement 8, stats 7, seconds 1, times 11, field
   // grids 1 (a vector of records).
-  ASSERT_EQ(count_fields(a), 1 + 5 + 11 + 3 + 7 + 18 + 7 + 1 + 11 + 1)
+  ASSERT_EQ(count_fields(a), 1 + 5 + 11 + 3 + 7 + 19 + 7 + 1 + 11 + 1)
       << "a field was added to a report: set it in full_output() and check it here";
   std::vector<char> buf;
   write_record(buf, a);
@@ -173,6 +174,7 @@ TEST(Pack, EveryFieldOfAFaceOutputRoundTrips) {
   EXPECT_EQ(q.defects_after, 2);
   EXPECT_EQ(q.disk_replaced, 6);
   EXPECT_TRUE(q.time_budget_hit);
+  EXPECT_TRUE(q.second_pass_kept);
   EXPECT_EQ(b.stats.vertices, 4);
   EXPECT_EQ(b.stats.quads, 1);
   EXPECT_EQ(b.stats.triangles, 1);

@@ -5,6 +5,7 @@
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepBuilderAPI_MakePolygon.hxx>
 #include <BRepBuilderAPI_MakeWire.hxx>
+#include <BRepPrimAPI_MakePrism.hxx>
 #include <BRepTools.hxx>
 #include <TopoDS.hxx>
 #include <TopoDS_Face.hxx>
@@ -131,6 +132,7 @@ std::pair<CurveSizes, std::vector<FaceSizes>> full_flow(const Model& m, const Si
   sizes.unpack(reduced);
   grade_curves(m.cad, m.curves, o.gradation, sizes);
   std::vector<FaceSizes> final_fields;
+  final_fields.reserve(static_cast<std::size_t>(m.cad.num_faces()));
   for (LO f = 0; f < m.cad.num_faces(); ++f)
     final_fields.push_back(face_sizes(m.faces[f], cf_of(m, f), m.curves, sizes, n[f], o));
   return {std::move(sizes), std::move(final_fields)};
@@ -595,25 +597,101 @@ TEST(SizeMap, ThinAspectCapsTheSizeAlongAStripOnly) {
   EXPECT_THROW((void)initial_curve_sizes(m.cad, m.curves, o, TaskArena(1)), InputError);
 }
 
+/// The triangle (0, 0), (8, 0), (8, 8 tan(corner)): a wedge of `corner` degrees at the origin.
+std::vector<std::pair<double, double>> wedge(double corner_deg) {
+  return {{0, 0}, {8, 0}, {8, 8 * std::tan(corner_deg * std::numbers::pi / 180)}};
+}
+
 TEST(SizeMap, ThinAspectLeavesWideFacesAndSidesMeetingAtACornerAlone) {
-  // A 10 x 0.6 rectangle at size 1: 0.6 apart is more than half the size, not thin. A triangle
-  // with a 3-degree corner: its two long sides are close near the corner, but they share it (a
-  // cusp's tail; grading toward it reached the faces beside it, see limit_by_face_width).
+  // A 10 x 0.6 rectangle at size 1: 0.6 apart is more than half the size, not thin. A prism on a
+  // triangle with a 3-degree corner: the long sides of its end faces are close near the corner and
+  // share it (a cusp's tail), but each also bounds a side face of the prism, which would take the
+  // tail's graded counts (see background::limit_by_face_width): the tail keeps its sizes, and the
+  // tip is where it is thinner than a sixth of the size, x < (1 / 6) / sin(3 degrees) = 3.18.
   SizeMapOptions o;
   o.method = Method::Features;
   o.size_max = 1.0;
   o.size_min = 0.17;
-  const double tip = 8 * std::tan(3 * std::numbers::pi / 180);
-  for (const auto& xy :
-       {std::vector<std::pair<double, double>>{{0, 0}, {10, 0}, {10, 0.6}, {0, 0.6}},
-        std::vector<std::pair<double, double>>{{0, 0}, {8, 0}, {8, tip}}}) {
-    const Model m = prepare(polygon_face(xy, "sm_thin_alone.brep"), 1.0, false);
+  BRepBuilderAPI_MakePolygon polygon;
+  for (const auto& [x, y] : wedge(3)) polygon.Add(gp_Pnt(x, y, 0));
+  polygon.Close();
+  const TopoDS_Shape prism =
+      BRepPrimAPI_MakePrism(BRepBuilderAPI_MakeFace(polygon.Wire(), true).Face(), gp_Vec(0, 0, 2))
+          .Shape();
+  const Model wide = prepare(
+      polygon_face({{0, 0}, {10, 0}, {10, 0.6}, {0, 0.6}}, "sm_thin_alone.brep"), 1.0, false);
+  const Model m = prepare(load_shape(prism, "sm_wedge_prism.brep"), 1.0, false);
+  for (const Model* model : {&wide, &m}) {
     o.thin_aspect = 0;
-    const CurveSizes off = initial_curve_sizes(m.cad, m.curves, o, TaskArena(1));
+    const CurveSizes off = initial_curve_sizes(model->cad, model->curves, o, TaskArena(1));
     o.thin_aspect = 4;
-    const CurveSizes on = initial_curve_sizes(m.cad, m.curves, o, TaskArena(1));
-    EXPECT_EQ(off.pack(), on.pack());
+    const CurveSizes on = initial_curve_sizes(model->cad, model->curves, o, TaskArena(1));
+    if (model == &wide) {
+      EXPECT_EQ(off.pack(), on.pack());
+      EXPECT_TRUE(on.tips.empty());
+      continue;
+    }
+    // Two long sides at each of the prism's two sharp corners.
+    ASSERT_EQ(on.tips.size(), 4u);
+    const double limit = (1.0 / 6) / std::sin(3 * std::numbers::pi / 180);
+    for (const auto& tip : on.tips) {
+      EXPECT_TRUE(tip.shared);
+      EXPECT_GT(tip.length, 0.8 * limit);
+      EXPECT_LE(tip.length, limit * (1 + 1e-9));
+      const auto& pts = m.curves[tip.curve].points;
+      const Vec3 corner = tip.end == 0 ? pts.front() : pts.back();
+      for (std::size_t i = 0; i < pts.size(); ++i) {
+        if (distance(pts[i], corner) < tip.length) {
+          EXPECT_DOUBLE_EQ(on.at[tip.curve][i], tip.length);
+        } else {
+          EXPECT_DOUBLE_EQ(on.at[tip.curve][i], off.at[tip.curve][i]);  // no graded tail
+        }
+      }
+    }
   }
+}
+
+TEST(SizeMap, ThinAspectGradesASharpWedgeTailAndHoldsItsTipInOneEdge) {
+  // The 3-degree wedge as one face at size 1, floor 0.17, K = 4. Its two long sides share the
+  // corner: along the tail the width w = x sin(3 degrees) caps the sizes at 3/4 K w; where the
+  // sides are closer than a tenth of the floor (x < 0.0170 / sin(3 degrees) = 0.325) is the tip,
+  // one edge as long as that stretch.
+  SizeMapOptions o;
+  o.method = Method::Features;
+  o.size_max = 1.0;
+  o.size_min = 0.17;
+  const double sine = std::sin(3 * std::numbers::pi / 180);
+  const Model m = prepare(polygon_face(wedge(3), "sm_wedge.brep"), 1.0, false);
+  const CurveSizes off = initial_curve_sizes(m.cad, m.curves, o, TaskArena(1));
+  EXPECT_TRUE(off.tips.empty());
+  o.thin_aspect = 4;
+  const CurveSizes on = initial_curve_sizes(m.cad, m.curves, o, TaskArena(2));
+  EXPECT_EQ(on.pack(), initial_curve_sizes(m.cad, m.curves, o, TaskArena(1)).pack());
+  ASSERT_EQ(on.tips.size(), 2u);  // the bottom and the slanted side, at the origin
+  int bottom = 0, tail = 0;
+  for (const auto& tip : on.tips) {
+    const auto& pts = m.curves[tip.curve].points;
+    const Vec3 corner = tip.end == 0 ? pts.front() : pts.back();
+    EXPECT_LT(norm(corner), 1e-9);
+    EXPECT_GT(tip.length, 0.2);
+    EXPECT_LE(tip.length, 0.0170 / sine + 1e-9);
+    const bool flat = std::abs(pts.front().y) < 1e-9 && std::abs(pts.back().y) < 1e-9;
+    bottom += flat ? 1 : 0;
+    for (std::size_t i = 0; i < pts.size(); ++i) {
+      const double r = norm(pts[i]);
+      if (r < tip.length) {
+        EXPECT_DOUBLE_EQ(on.at[tip.curve][i], tip.length) << "r " << r;
+      } else if (flat && r > 0.5 && r < 3) {
+        ++tail;
+        EXPECT_LE(on.at[tip.curve][i], 0.75 * 4 * r * sine * (1 + 1e-6)) << "r " << r;
+        EXPECT_LT(on.at[tip.curve][i], off.at[tip.curve][i]) << "r " << r;
+      }
+    }
+  }
+  EXPECT_EQ(bottom, 1);
+  // The background curve meshes resolve the tail (at most twice its width apart beyond a tenth of
+  // the background floor): dozens of vertices where the size alone gave three.
+  EXPECT_GT(tail, 15);
 }
 
 TEST(SizeMap, ThinAspectLeavesTheBluntedTipOfAWedgeAlone) {

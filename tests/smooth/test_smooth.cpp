@@ -6,7 +6,9 @@
 #include <algorithm>
 #include <array>
 #include <bit>
+#include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <gp_Ax3.hxx>
 #include <gp_Cylinder.hxx>
 #include <gp_Pln.hxx>
@@ -319,6 +321,60 @@ TEST(Smooth, IrregularVerticesUseAngleKernel) {
     EXPECT_EQ(st.after.invalid, 0);
     expect_boundary_locked_and_on_surface(in, out, *c.geometry, c.model.diagonal());
   }
+}
+
+// A 5-degree wedge on the plate, tip at (1, 3), axis along +x: one quad holds the tip (c, a1, x,
+// b1), rungs across the wedge at r = 0.4, 0.5, 0.62, 0.77 from the tip, their middles inner
+// vertices (the last one locked). The tip quad's inner vertex x starts at r = 0.55, ahead of the
+// second rung's middle: the quads behind the first rung get a sharp angle there. The tip quad's
+// minimum is its 5-degree corner whatever x does, so only the cusp rule moves x back: just past
+// the first rung, where the quads behind it are near rectangles.
+TEST(Smooth, CuspQuadInnerVertexSitsJustPastTheFirstRung) {
+  const Case c = load_face(write_plate(), cad::SurfaceType::Plane);
+  const double t = std::tan(2.5 * std::numbers::pi / 180);
+  const std::array<double, 4> r{0.4, 0.5, 0.62, 0.77};
+  mesh::FaceMesh m;
+  m.face = 0;
+  auto add = [&](double x, double y, int dim, LO entity, LO index) {
+    mesh::VertexClass vc;
+    vc.dim = dim;
+    vc.entity = entity;
+    vc.index = index;
+    if (dim == 2) vc.param = {x, y};
+    m.uv.push_back({x, y});
+    m.points.push_back(c.geometry->eval({x, y}).p);
+    m.vclass.push_back(vc);
+    return static_cast<LO>(m.uv.size()) - 1;
+  };
+  const LO tip = add(1, 3, 0, 0, 0);
+  std::array<LO, 4> a{}, b{}, mid{};
+  for (int i = 0; i < 4; ++i) {
+    a[i] = add(1 + r[i], 3 - r[i] * t, 1, 0, i + 1);
+    b[i] = add(1 + r[i], 3 + r[i] * t, 1, 1, i + 1);
+    if (i > 0) mid[i] = i == 3 ? add(1 + r[i], 3, 1, 2, 1) : add(1 + r[i], 3, 2, 0, 0);
+  }
+  const LO x = add(1.55, 3, 2, 0, 0);
+  m.quads.push_back({tip, a[0], x, b[0]});
+  m.quads.push_back({a[0], a[1], mid[1], x});
+  m.quads.push_back({x, mid[1], b[1], b[0]});
+  for (int i = 1; i < 3; ++i) {
+    m.quads.push_back({a[i], a[i + 1], mid[i + 1], mid[i]});
+    m.quads.push_back({mid[i], mid[i + 1], b[i + 1], b[i]});
+  }
+  const auto out = smooth_face(m, *c.geometry, SmoothOptions{});
+  double away = 1;
+  for (std::size_t q = 1; q < out.quads.size(); ++q) {
+    const auto& v = out.quads[q];
+    away = std::min(away, mesh::quad_sicn({out.points[v[0]], out.points[v[1]], out.points[v[2]],
+                                           out.points[v[3]]}));
+  }
+  std::printf("cusp quad: inner vertex at r = %.4f (first rung 0.4), SICN min of the others %.4f\n",
+              out.uv[x].u - 1, away);
+  EXPECT_GE(out.uv[x].u, 1 + r[0]);
+  EXPECT_LE(out.uv[x].u, 1 + r[0] + r[0] * t);  // within half the rung past it
+  EXPECT_NEAR(out.uv[x].v, 3, 1e-9);
+  EXPECT_GE(away, 0.3);
+  expect_boundary_locked_and_on_surface(m, out, *c.geometry, c.model.diagonal());
 }
 
 TEST(Smooth, OptimalGridIsNotMadeWorse) {

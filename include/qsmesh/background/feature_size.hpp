@@ -39,4 +39,42 @@ void limit_by_face_width(const cad::CadModel& model, std::span<const std::vector
                          std::vector<std::vector<double>>& sizes, double touching, double sliver,
                          const TaskArena& tasks);
 
+/// Resolution inside sharp wedges (a cusp's tail): lowers sizes[c][k] to twice the distance d from
+/// polyline vertex k of curve c to another side of one of its faces that shares a corner with c,
+/// where d is below sin(sharp_deg) x the distance to that corner, searching within half the
+/// current size; distances up to `touching` are ignored. The background curve meshes need it so
+/// that the sizes graded along such a tail (sizemap::SizeMapOptions::thin_aspect) have vertices
+/// to live on. Deterministic, whatever the thread count of `tasks`.
+void limit_in_sharp_wedges(const cad::CadModel& model, std::span<const std::vector<Vec3>> polylines,
+                           std::vector<std::vector<double>>& sizes, double touching,
+                           double sharp_deg, const TaskArena& tasks);
+
+/// The tip of a sharp wedge: where curve `curve` leaves its corner at end `end` (0: its first
+/// corner, 1: its last) inside a wedge sharper than the given angle with another side of one of its
+/// faces sharing that corner (a cusp, a sliver's end), the stretch of it, `length` (model units,
+/// straight from the corner), that one quad holds. `shared`: the two sides do not bound that face
+/// alone (see sharp_wedge_tips).
+struct SharpTip {
+  LO curve = kNoIndex;
+  int end = 0;
+  double length = 0;
+  bool shared = false;
+};
+
+/// Every sharp wedge tip of the model: for each curve end at a corner shared with another side of
+/// one of its faces, the polyline vertices of the curve (polylines[c], dense enough to stand for
+/// the curve; sizes[c], the mesh size at each) walked away from the corner while the distance d to
+/// the other side's polyline stays below sin(sharp_deg) x the distance r to the corner (the wedge
+/// sharper than sharp_deg there) and below the tip's width; the tip's length is the largest such
+/// r, at most half the curve's chord. The tip's width: `touching` where both sides bound that face
+/// and no other (their tail behind the tip is graded with its width, limit_in_sharp_wedges), else
+/// shared_ratio x the size (the tail keeps the sizes of the faces beside it, so the tip takes all
+/// of it that is too thin for them). Ends with no such vertex give no tip. Ordered by curve, then
+/// end. Deterministic (no threads).
+[[nodiscard]] std::vector<SharpTip> sharp_wedge_tips(const cad::CadModel& model,
+                                                     std::span<const std::vector<Vec3>> polylines,
+                                                     std::span<const std::vector<double>> sizes,
+                                                     double touching, double shared_ratio,
+                                                     double sharp_deg);
+
 }  // namespace qsmesh::background

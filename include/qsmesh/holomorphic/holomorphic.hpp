@@ -204,6 +204,9 @@ struct HolomorphicOptions {
   /// are thin in 3D (a critical curve close to a loop on one side), which the smoothing widens.
   bool smooth_patches = true;
   smooth::SmoothOptions smoothing;
+  /// mesh_group (group.hpp): Laplacian sweeps over the group mesh's interior vertices when
+  /// smooth_patches (smooth_face works in one parameter plane, a group spans several).
+  int group_sweeps = 10;
 };
 
 /// What the holomorphic path did on one face.
@@ -262,6 +265,52 @@ struct HolomorphicReport {
                                                const cad::FaceGeometry& surface,
                                                const HolomorphicOptions& options,
                                                HolomorphicReport* report);
+
+struct AnnulusCountOptions {
+  /// A curve's count may move by even steps up to this fraction of its ideal value
+  /// (Quantization::ideal) away from it, and always by 2 (qstruct::BalanceOptions::max_change).
+  double max_change = 0.35;
+  /// Faces whose loops turn by more than this at a corner are left alone: mesh_annulus refuses
+  /// them (HolomorphicOptions::max_corner_turn_deg).
+  double max_corner_turn_deg = 30;
+  /// Loops whose counts differ by more than this fraction of the larger are left apart: the
+  /// moves reach other faces through the chords (t20_data's annulus, 224 against 312 edges, made
+  /// equal cost its chamfer faces 4 to 10 irregular vertices each, docs/benchmarks.md).
+  double max_loop_difference = 0.2;
+};
+
+struct AnnulusCountReport {
+  LO annuli = 0;          ///< faces that are annuli (two loops, seams merged) without sharp corner
+  LO equal_before = 0;    ///< of those, with equal loop counts from the quantization
+  LO equal_after = 0;     ///< and after balancing
+  LO curves_changed = 0;  ///< curves whose count changed
+};
+
+/// The two boundary chains of face f when its topology is an annulus: two loops and no seam, or
+/// one loop with one seam curve used twice (a cylinder's side), the seam's uses removed; no
+/// degenerate curve. Each chain lists the curve uses in loop order. Empty otherwise.
+[[nodiscard]] std::vector<std::vector<cad::CurveUse>> annulus_chains(const cad::CadModel& model,
+                                                                     LO f);
+
+/// Loop counts a grid can join (mesh_annulus needs equal counts on the two loops; the
+/// quantization, which does not know the method, leaves them apart): for `--method holomorphic`
+/// and `auto`, every face that is an annulus (annulus_chains) without a corner sharper than
+/// options.max_corner_turn_deg (measured on the background curve meshes `curves`) and whose two
+/// loops' counts differ gets them equal, in face id order: the short loop's free curves raised
+/// by even steps, then, where their room (options.max_change) does not suffice, the long loop's
+/// lowered. A step moves one variable by 2 edges on each of its curves: a chord (curve2chord:
+/// the curves of a chord move together, so that the four-sided faces across it keep their equal
+/// opposite counts) or a curve in no chord, the one of fewest curves, then least count / ideal
+/// (up; most, down), then first found; never past what the loops still differ by. Loops further
+/// apart than options.max_loop_difference are left alone. A variable moves only when none of its
+/// curves is in `fixed` (user prescriptions), degenerate, on the other loop, or on a loop of an
+/// annulus done before (so that it stays balanced). A face that cannot be balanced keeps its
+/// counts. Parities and loop parities are kept (even steps). Deterministic; returns the new
+/// counts (`edges` otherwise).
+[[nodiscard]] std::vector<int> balance_annulus_counts(
+    const cad::CadModel& model, std::span<const mesh::CurveMesh> curves, std::span<const int> edges,
+    std::span<const double> ideal, std::span<const LO> curve2chord, std::span<const LO> fixed,
+    const AnnulusCountOptions& options, AnnulusCountReport* report = nullptr);
 
 /// The per-face method of the quad stage.
 enum class Method { Default, Holomorphic, Auto };

@@ -48,6 +48,8 @@ struct ImprovementReport {
   /// Cavity remeshing stopped by CavityOptions::time_budget_s on this face (the mesh reached
   /// then is kept: every accepted step is valid).
   bool time_budget_hit = false;
+  /// The face kept the result of the second pass (PipelineOptions::second_pass_cavities).
+  bool second_pass_kept = false;
 
   /// Takes the cavity remeshing's counts (qstruct::remesh_cavities).
   void record(const qstruct::CavityReport& r) {
@@ -88,8 +90,21 @@ struct ImprovementReport {
     visit("disk_defects_after", self.defects_after);
     visit("disk_cavities_replaced", self.disk_replaced);
     visit("faces_time_budget_hit", self.time_budget_hit);
+    visit("faces_second_pass_kept", self.second_pass_kept);
   }
 };
+
+/// Whether a face keeps the result of the second pass of the topological improvement
+/// (PipelineOptions::second_pass_cavities) over the first pass's: it has fewer interior
+/// irregular vertices, no more triangles, its SICN minimum is at least min(good_sicn, keep_ratio
+/// x the first's) (the acceptance of a cavity replacement, qstruct::CavityOptions), and for
+/// each irregular vertex it removes, its mean SICN is lower by at most avg_per_irregular and
+/// the SICN summed over the first pass's quads by at most sum_per_irregular (a large face may
+/// not spread a small mean loss over thousands of quads). False when avg_per_irregular <= 0
+/// (off). Serial, pure.
+[[nodiscard]] bool second_pass_wins(const mesh::FaceQuadStats& first,
+                                    const mesh::FaceQuadStats& second, double avg_per_irregular,
+                                    double sum_per_irregular, double good_sicn, double keep_ratio);
 
 /// How the quasi-structured stage treated one face. Its fields are declared once, in fields(), the
 /// countable ones named by their total over the faces in the drivers' --stats (as

@@ -19,6 +19,7 @@
 #include <utility>
 #include <vector>
 
+#include "qsmesh/background/feature_size.hpp"
 #include "qsmesh/cad/model.hpp"
 #include "qsmesh/core/tasks.hpp"
 #include "qsmesh/core/types.hpp"
@@ -73,7 +74,10 @@ struct SizeMapOptions {
   /// wide (2 across) and L long has SICN about w / L: K = 4 keeps it near 0.25. Only along the
   /// strip (local anisotropy; the count across stays that of the quantization), and below the
   /// floor, which would otherwise make flat quads in strips narrower than floor / K; gaps under a
-  /// tenth of the floor (curves touching) do not count.
+  /// tenth of the floor (curves touching) do not count. Inside a wedge sharper than 10 degrees
+  /// (sides sharing a corner: a cusp's tail) the tip is one edge (CurveSizes::tips) and, where
+  /// both sides bound that face alone, the tail behind it is capped at 3/4 K x its width
+  /// (background::limit_by_face_width, background::sharp_wedge_tips).
   double thin_aspect = 0;
   /// N, the target number of quads of the whole model; 0: total area / size_max^2.
   double target_quads = 0;
@@ -95,6 +99,10 @@ struct CurveSizes {
   std::vector<std::vector<double>> at;
   /// corner[k]: the value at corner k (what faces read at their dim-0 vertices).
   std::vector<double> corner;
+  /// The tips of sharp wedges (thin_aspect, initial_curve_sizes): one quad holds each, so
+  /// grade_curves sets the curve's sizes within `length` of the corner to `length` (one edge),
+  /// whatever the gradation gave them. The same on every rank; not part of pack().
+  std::vector<background::SharpTip> tips;
 
   /// Every value in one flat array: at[0], at[1], ..., then corner (for an MPI min-reduction).
   [[nodiscard]] std::vector<double> pack() const;

@@ -72,6 +72,13 @@ struct SmoothStats {
 ///     after `iterations` - 1 passes or after the pass that converged), the new point S(uv), so
 ///     every vertex lies on the CAD surface at its uv. A move is kept only when the minimum SICN of
 ///     the incident quads does not drop and none of them flips against the face normal.
+///  3) Cusp quads: a quad that alone holds a dim-0 vertex where its angle is under 10 degrees has
+///     its minimum SICN fixed by that corner, so step 2 lets its opposite (free) vertex wander.
+///     That vertex is put on the line in (u, v) from the corner through the middle of the other
+///     two vertices (the rung), 0.05 to 0.5 rung lengths past it, where the minimum SICN of its
+///     other quads is highest, if higher than where it is; the cusp quad stays valid (oriented as
+///     before) and no worse. Without it the quads behind the rung got a sharp or a flat angle
+///     there.
 /// Measures before and after; when the minimum SICN dropped or more quads are invalid, returns the
 /// input (stats->rolled_back). Deterministic: no randomness, fixed order, no threads.
 /// Returns the smoothed mesh (same topology and classification; dim-2 vclass.param = new uv).
