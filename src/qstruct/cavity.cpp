@@ -478,7 +478,7 @@ class Remesher {
       : w_(work), s_(surface), o_(o), sign_(sign) {}
 
   // Why build() refused a replacement.
-  enum class Refusal { None, Layout, Invalid, MinSicn, AvgSicn };
+  enum class Refusal { None, Layout, Screened, Invalid, MinSicn, AvgSicn };
 
   // Builds, lays out, smooths and measures the replacement of cavity c by `match` of `patterns`;
   // false with `why` set when it is refused.
@@ -604,22 +604,48 @@ class Remesher {
       lm.points[i] = s_.eval(lm.uv[i]).p;
       lm.vclass[i] = mesh::VertexClass{2, w_.face, kNoIndex, {lm.uv[i].u, lm.uv[i].v}};
     }
-    lm = smooth::smooth_face(lm, s_, o_.smooth);
-
-    double after = std::numeric_limits<double>::max(), after_sum = 0;
-    for (LO q = 0; q < static_cast<LO>(lm.quads.size()); ++q) {
-      const double x = quad_quality(lm.points, lm.uv, lm.quads[q], s_, sign_);
-      after = std::min(after, x);
-      if (q < n_new_quads) after_sum += x;
-    }
+    // (minimum over the touched quads, mean over the new ones) of a local mesh.
+    const auto measure = [&](const mesh::FaceMesh& m) {
+      double low = std::numeric_limits<double>::max(), sum = 0;
+      for (LO q = 0; q < static_cast<LO>(m.quads.size()); ++q) {
+        const double x = quad_quality(m.points, m.uv, m.quads[q], s_, sign_);
+        low = std::min(low, x);
+        if (q < n_new_quads) sum += x;
+      }
+      return std::pair{low, sum / static_cast<double>(n_new_quads)};
+    };
     const double need = std::max(o_.min_sicn, std::min(o_.good_sicn, o_.keep_ratio * before));
+    const double avg_need = o_.keep_avg_ratio * (before_sum / static_cast<double>(c.quads.size()));
+    smooth::SmoothOptions so = o_.smooth;
+    std::pair<double, double> previous{0, 0};
+    if (o_.screen_passes >= 2 && o_.screen_passes < so.iterations)
+      so.after_pass = [&](int pass, const mesh::FaceMesh& m) {
+        if (pass + 1 < o_.screen_passes || pass > o_.screen_passes) return true;
+        const auto now = measure(m);
+        if (pass < o_.screen_passes) {
+          previous = now;
+          return true;
+        }
+        // Each pass gains less than the one before it (measured, CavityOptions::screen_passes):
+        // the passes left, each at the last pass's gain, bound what the candidate can reach.
+        const double rest = so.iterations - pass;
+        const double reach_min = now.first + rest * std::max(0.0, now.first - previous.first);
+        const double reach_avg = now.second + rest * std::max(0.0, now.second - previous.second);
+        return reach_min + o_.screen_min_margin >= need &&
+               reach_avg + o_.screen_avg_margin >= avg_need;
+      };
+    smooth::SmoothStats ss;
+    lm = smooth::smooth_face(lm, s_, so, &ss);
+    why = Refusal::Screened;
+    if (ss.stopped_early) return false;
+
+    const auto [after, after_avg] = measure(lm);
     why = Refusal::Invalid;
     if (!(after > o_.min_sicn)) return false;
     why = Refusal::MinSicn;
     if (after < need) return false;
-    const double avg_before = before_sum / static_cast<double>(c.quads.size());
     why = Refusal::AvgSicn;
-    if (after_sum / static_cast<double>(n_new_quads) < o_.keep_avg_ratio * avg_before) return false;
+    if (after_avg < avg_need) return false;
     why = Refusal::None;
 
     for (LO i = nold; i < nold + n_new; ++i) {
@@ -908,6 +934,9 @@ mesh::FaceMesh remesh_cavities(const mesh::FaceMesh& input, const cad::FaceGeome
             switch (why) {
               case Remesher::Refusal::Layout:
                 ++d.refused_layout;
+                break;
+              case Remesher::Refusal::Screened:
+                ++d.refused_screened;
                 break;
               case Remesher::Refusal::Invalid:
                 ++d.refused_invalid;

@@ -212,6 +212,16 @@ mesh::FaceMesh move_irregular_vertices(LO f, const cad::Face& face,
     max_evaluations = static_cast<int>(std::min<double>(
         max_evaluations, std::floor(options.move_work_ratio * options.size_map_quads *
                                     options.move_evaluations / start_quads)));
+  // A search cut short inside the coarse sweeps of its vectors samples part of one range and
+  // leaves the fill as it was, or nearly (PatternFaceOptions::move_min_layouts_per_vector).
+  if (max_evaluations <
+      options.move_min_layouts_per_vector * static_cast<std::int64_t>(moves.size())) {
+    rep.chords = start.match.chords;
+    rep.sicn_min = q.sicn_min;
+    rep.sicn_avg = q.sicn_avg;
+    rep.quads = static_cast<std::int64_t>(mesh.quads.size());
+    return mesh;
+  }
   // The layouts are compared after a few smoothing passes, the winner smoothed fully at the end;
   // the start is compared as the others are (the caller's mesh of it had every pass).
   smooth::SmoothOptions search = options.smooth;
@@ -518,6 +528,7 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
       ++rep.lifts;
       smooth::UntangleOptions uo;
       uo.target = min_sicn + 0.05;
+      uo.max_rings = std::max(uo.rings, options.lift_max_rings);
       mesh = smooth::untangle_face(mesh, surface, uo);
       q = smooth::measure(mesh);
     }

@@ -564,6 +564,10 @@ mesh::FaceMesh smooth_face(const mesh::FaceMesh& input, const cad::FaceGeometry&
         sm.set_exact(last);
         const double moved = sm.pass();
         ++st.iterations;
+        if (options.after_pass && !options.after_pass(st.iterations, m)) {
+          st.stopped_early = true;
+          break;
+        }
         if (last) break;
         if (moved <= 1e-9 * size) {
           if (approx) {
@@ -578,6 +582,11 @@ mesh::FaceMesh smooth_face(const mesh::FaceMesh& input, const cad::FaceGeometry&
     }
     place_cusp_apices(m, surface);
     detail::sync_interior_params(m);
+  }
+  if (st.stopped_early) {
+    st.after = measure(m);
+    if (stats) *stats = st;
+    return m;
   }
   st.rolled_back =
       detail::keep_or_roll_back(m, input, st.before, detail::Accept::kNoDrop, st.after);

@@ -162,6 +162,7 @@ int main(int argc, char** argv) {
         b.refused_invalid += a.refused_invalid;
         b.refused_min += a.refused_min;
         b.refused_avg += a.refused_avg;
+        b.refused_screened += a.refused_screened;
         b.skipped_futile += a.skipped_futile;
       }
       if (per_face)
@@ -190,9 +191,9 @@ int main(int argc, char** argv) {
                 << b.stop_concave << "/" << b.stop_max_quads << "/" << b.stop_no_frontier << "/"
                 << b.stop_fan << "/" << b.stop_found << "; checks " << b.checks << " (no pattern "
                 << b.no_pattern << ", no match " << b.no_match << ", not better " << b.not_better
-                << "); refused layout/invalid/min/avg " << b.refused_layout << "/"
-                << b.refused_invalid << "/" << b.refused_min << "/" << b.refused_avg
-                << "; skipped (nothing changed) " << b.skipped_futile << "\n";
+                << "); refused layout/screened/invalid/min/avg " << b.refused_layout << "/"
+                << b.refused_screened << "/" << b.refused_invalid << "/" << b.refused_min << "/"
+                << b.refused_avg << "; skipped (nothing changed) " << b.skipped_futile << "\n";
     }
     std::cout << "  remesh_cavities time " << seconds << " s\n";
   });

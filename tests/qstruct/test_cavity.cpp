@@ -557,6 +557,51 @@ TEST(Cavity, MinusOneSingularityAbsorbsAPair) {
   absorb_pair("pentagon", -1, only2, 2);
 }
 
+// CavityOptions::screen_passes: candidates stopped after a few smoothing passes are ones the
+// acceptance would refuse after all of them, and the passes of the others are unchanged, so the
+// result is the unscreened one, bit for bit.
+TEST(Cavity, ScreenedCandidatesLeaveTheResultUnchanged) {
+  const Plane plane;
+  // Graded along x (cells 0.2 to 3.8 wide): the grid replacements of the pairs' cavities are
+  // laid out evenly, and many are refused.
+  mesh::FaceMesh in =
+      perturbed(plane, 24, 12, {{4, 4, 5, 4}, {18, 6, 18, 7}, {11, 8, 12, 8}, {11, 3, 11, 4}});
+  for (LO v = 0; v < in.num_vertices(); ++v) {
+    const double x = in.uv[v].u / 24;
+    in.uv[v].u = 24 * x * (0.1 + 0.9 * x);
+    in.points[v] = {in.uv[v].u, in.uv[v].v, 0};
+    if (in.vclass[v].dim == 2) in.vclass[v].param = {in.uv[v].u, in.uv[v].v};
+  }
+  const auto patterns = builtin_patterns();
+  CavityOptions screened, unscreened;
+  unscreened.screen_passes = 0;
+  screened.max_quads_maximal = unscreened.max_quads_maximal = 80;
+  // A stricter mean than the default's: some candidates are refused (54), some kept.
+  screened.keep_avg_ratio = unscreened.keep_avg_ratio = 1.1;
+  CavityReport a, b;
+  const mesh::FaceMesh out_a = remesh_cavities(in, plane, {}, patterns, screened, &a);
+  const mesh::FaceMesh out_b = remesh_cavities(in, plane, {}, patterns, unscreened, &b);
+  ASSERT_TRUE(a.skipped.empty()) << a.skipped;
+  EXPECT_LT(a.irregular_after, a.irregular_before);
+  EXPECT_EQ(out_a.quads, out_b.quads);
+  ASSERT_EQ(out_a.points.size(), out_b.points.size());
+  for (std::size_t i = 0; i < out_a.points.size(); ++i)
+    EXPECT_EQ(out_a.points[i], out_b.points[i]) << "vertex " << i;
+  std::int64_t stopped = 0, stopped_without = 0, refused = 0, refused_without = 0;
+  for (int k = 0; k < 4; ++k) {
+    const auto& x = a.diagnostics[k];
+    const auto& y = b.diagnostics[k];
+    stopped += x.refused_screened;
+    stopped_without += y.refused_screened;
+    refused += x.refused_screened + x.refused_invalid + x.refused_min + x.refused_avg;
+    refused_without += y.refused_invalid + y.refused_min + y.refused_avg;
+    EXPECT_EQ(a.remeshed[k], b.remeshed[k]);
+  }
+  EXPECT_EQ(stopped_without, 0);
+  EXPECT_GT(stopped, 0);
+  EXPECT_EQ(refused, refused_without);
+}
+
 TEST(Cavity, Deterministic) {
   const Plane plane;
   const mesh::FaceMesh in = perturbed(plane, 12, 10, {{4, 4, 5, 4}, {9, 2, 9, 3}});

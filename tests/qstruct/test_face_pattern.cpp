@@ -402,6 +402,7 @@ TEST(FacePattern, SearchWorkIsBoundedByTheFacesQuads) {
   ASSERT_TRUE(fixed.ok) << fixed.reason;
   PatternFaceOptions o;
   o.move_work_ratio = 1;
+  o.move_min_layouts_per_vector = 0;  // searches of a layout or two too (tested below)
   (void)mesh_face_pattern(pc.model, 0, pc.curves, patterns, o, &free);  // size map unknown
   ASSERT_TRUE(free.ok) << free.reason;
   const auto quads = static_cast<double>(fixed.quads);
@@ -427,6 +428,42 @@ TEST(FacePattern, SearchWorkIsBoundedByTheFacesQuads) {
   (void)mesh_face_pattern(pc.model, 0, pc.curves, patterns, o, &loose);
   EXPECT_EQ(loose.moves, free.moves);
   EXPECT_EQ(loose.chords, free.chords);
+}
+
+// PatternFaceOptions::move_min_layouts_per_vector: a search the work bound would cut inside the
+// coarse sweeps of its vectors is not started, and the fill is the balanced one; with layouts
+// enough for them it runs.
+TEST(FacePattern, SearchTooShortForItsCoarseSweepsIsNotStarted) {
+  const auto pc = flared_strip("qs_flare_sweep.brep");
+  const auto patterns = builtin_patterns();
+  PatternFaceReport fixed, unbounded;
+  const auto m0 = mesh_face_pattern(pc.model, 0, pc.curves, patterns, without_moves(), &fixed);
+  ASSERT_TRUE(fixed.ok) << fixed.reason;
+  PatternFaceOptions o;
+  o.move_work_ratio = 1;
+  (void)mesh_face_pattern(pc.model, 0, pc.curves, patterns, o, &unbounded);
+  ASSERT_GT(unbounded.moves, 0);
+  const auto quads = static_cast<double>(fixed.quads);
+  // Three layouts of the balanced fill's size: fewer than 4 per vector.
+  o.size_map_quads = 3.0 * quads / o.move_evaluations;
+  PatternFaceReport cut, allowed;
+  const auto m1 = mesh_face_pattern(pc.model, 0, pc.curves, patterns, o, &cut);
+  ASSERT_TRUE(cut.ok) << cut.reason;
+  EXPECT_EQ(cut.moves, 0);
+  EXPECT_EQ(cut.chords, fixed.chords);
+  EXPECT_EQ(m1.quads, m0.quads);
+  EXPECT_EQ(m1.points, m0.points);
+  // The same bound, with the rule off: the search runs and moves.
+  o.move_min_layouts_per_vector = 0;
+  (void)mesh_face_pattern(pc.model, 0, pc.curves, patterns, o, &allowed);
+  EXPECT_GT(allowed.moves, 0);
+  // Layouts enough for every coarse sweep: the search runs with the rule on.
+  PatternFaceOptions enough;
+  enough.move_work_ratio = 1;
+  enough.size_map_quads = quads;
+  PatternFaceReport full;
+  (void)mesh_face_pattern(pc.model, 0, pc.curves, patterns, enough, &full);
+  EXPECT_EQ(full.moves, unbounded.moves);
 }
 
 // qstruct::boundary_held_sicn is the SICN of the rectangle on the two edges, and no quad on them
@@ -494,6 +531,62 @@ TEST(FacePattern, UntanglerOnlyForFewPoorQuads) {
   o.lift_poor_quads = false;
   (void)mesh_face_pattern(pc.model, 0, pc.curves, patterns, o, &rep);
   EXPECT_EQ(rep.lifts, 0);
+}
+
+// PatternFaceOptions::lift_max_rings: the untangler moves only vertices within that many quad
+// rings of the quads it lifts. A transition fill with a few quads under a high min_sicn (0.85),
+// lifted, against the same fill not lifted.
+TEST(FacePattern, LiftStaysWithinItsRings) {
+  const XY xy = {{0, 0}, {30, 0}, {30, 15}, {0, 15}};
+  const auto pc = polygon(xy, {33, 12, 27, 18}, "qs_lift_rings.brep");
+  const auto patterns = builtin_patterns();
+  PatternFaceOptions o;
+  o.min_sicn = 0.85;
+  o.min_sicn_avg = 0;
+  o.max_candidates = 1;
+  o.lift_max_poor_fraction = 1;
+  o.move_evaluations = 0;
+  const auto fill = [&](bool lift, int rings) {
+    PatternFaceOptions p = o;
+    p.lift_poor_quads = lift;
+    p.lift_max_rings = rings;
+    PatternFaceReport rep;
+    mesh::FaceMesh m = mesh_face_pattern(pc.model, 0, pc.curves, patterns, p, &rep);
+    EXPECT_EQ(rep.lifts, lift ? 1 : 0);
+    return rep.ok ? m : rep.refused_mesh;
+  };
+  const mesh::FaceMesh plain = fill(false, 2);
+  ASSERT_FALSE(plain.quads.empty());
+  // Vertices within r quad rings of the quads the untangler starts from (SICN <= its target).
+  const double target = o.min_sicn + 0.05;
+  const auto within = [&](int r) {
+    std::vector<char> near(plain.points.size(), 0), seen(plain.quads.size(), 0);
+    for (std::size_t q = 0; q < plain.quads.size(); ++q) {
+      const auto& qd = plain.quads[q];
+      if (mesh::quad_sicn({plain.points[qd[0]], plain.points[qd[1]], plain.points[qd[2]],
+                           plain.points[qd[3]]}) <= target)
+        for (const LO v : qd) near[v] = 1;
+    }
+    for (int k = 0; k < r; ++k) {
+      std::vector<char> next = near;
+      for (const auto& qd : plain.quads)
+        if (near[qd[0]] || near[qd[1]] || near[qd[2]] || near[qd[3]])
+          for (const LO v : qd) next[v] = 1;
+      near = std::move(next);
+    }
+    return near;
+  };
+  const auto moved_outside = [&](const mesh::FaceMesh& m, int r) {
+    EXPECT_EQ(m.quads, plain.quads);
+    const std::vector<char> near = within(r);
+    int n = 0;
+    for (std::size_t v = 0; v < plain.points.size(); ++v)
+      n += !near[v] && !(m.points[v] == plain.points[v]) ? 1 : 0;
+    return n;
+  };
+  EXPECT_EQ(moved_outside(fill(true, 2), 2), 0);
+  // The untangler's own bound (8 rings) reaches farther on this fill.
+  EXPECT_GT(moved_outside(fill(true, 8), 2), 0);
 }
 
 TEST(FacePattern, TriangleAndPentagonGetTheirIrregularVertex) {

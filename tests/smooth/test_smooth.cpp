@@ -414,6 +414,47 @@ TEST(Smooth, InvertedInputIsUntangledOrRolledBack) {
   EXPECT_GT(st.after.sicn_min, 0.99);
 }
 
+// SmoothOptions::after_pass sees every pass and can stop them; a hook that lets every pass run
+// leaves the result bit for bit as without it.
+TEST(Smooth, AfterPassSeesEachPassAndCanStopThem) {
+  const Case c = load_face(write_cylinder_patch(), cad::SurfaceType::Cylinder);
+  const auto in = split_triangles(*c.geometry, c.model.faces()[c.face].uv_box, 5, 5, 0.8, 17);
+  SmoothOptions plain;
+  plain.laplacian_uv = false;  // the kernels alone: several passes before they settle
+  plain.iterations = 6;
+  SmoothStats sp;
+  const auto a = smooth_face(in, *c.geometry, plain, &sp);
+  ASSERT_GE(sp.iterations, 3);
+  std::vector<int> seen;
+  SmoothOptions watched = plain;
+  watched.after_pass = [&](int pass, const mesh::FaceMesh&) {
+    seen.push_back(pass);
+    return true;
+  };
+  SmoothStats sw;
+  const auto b = smooth_face(in, *c.geometry, watched, &sw);
+  EXPECT_FALSE(sw.stopped_early);
+  ASSERT_EQ(static_cast<int>(seen.size()), sp.iterations);
+  for (std::size_t k = 0; k < seen.size(); ++k) EXPECT_EQ(seen[k], static_cast<int>(k) + 1);
+  for (std::size_t v = 0; v < a.points.size(); ++v) {
+    EXPECT_TRUE(a.points[v] == b.points[v]);
+    EXPECT_TRUE(a.uv[v] == b.uv[v]);
+  }
+  // Stopped after pass 2: two passes, and what the mesh was then.
+  SmoothOptions stopped = plain;
+  std::vector<Vec3> at_two;
+  stopped.after_pass = [&](int pass, const mesh::FaceMesh& m) {
+    if (pass == 2) at_two = m.points;
+    return pass < 2;
+  };
+  SmoothStats ss;
+  const auto d = smooth_face(in, *c.geometry, stopped, &ss);
+  EXPECT_TRUE(ss.stopped_early);
+  EXPECT_EQ(ss.iterations, 2);
+  EXPECT_EQ(d.points, at_two);
+  EXPECT_FALSE(d.points == a.points);
+}
+
 TEST(Smooth, Deterministic) {
   const Case c = load_face(write_cylinder_patch(), cad::SurfaceType::Cylinder);
   const auto in = split_triangles(*c.geometry, c.model.faces()[c.face].uv_box, 5, 5, 0.8, 17);

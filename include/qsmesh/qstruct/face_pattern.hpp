@@ -80,6 +80,14 @@ struct PatternFaceOptions {
   /// face 380 with many folded quads took 10.7 s in the untangler and stayed folded).
   double lift_max_poor_fraction = 0.01;
   std::int64_t lift_min_poor_quads = 8;
+  /// ... and within this many quad rings of them (smooth::UntangleOptions::max_rings; its rings,
+  /// 2, at least). On the shared models at their reference counts every lift that let its fill
+  /// pass did so within 2 rings (Block's faces 25, 85, 272, 410-420, 476; A319's 20 and 39);
+  /// those that grew to the untangler's 8 either failed (Block's faces 400-436, three folded
+  /// quads each: SICN min 0.112, mean 0.552, 0.2 s each, a tenth of the run) or, on Block's face
+  /// 335, gained 0.00002 in the minimum for 0.028 of the mean. With 2, that face keeps the mean
+  /// (0.907 -> 0.935) and every other mesh is byte-identical (docs/benchmarks.md, issue 27).
+  int lift_max_rings = 2;
   /// Largest quad count a pattern mesh of the face may have (0: no bound). A pattern fill is
   /// structured, so a size transition along one side runs across the whole face: [96, 342, 26,
   /// 342] on wing_fuselage.step gives 22k quads where the size map asks for 4k. The pipeline
@@ -114,6 +122,15 @@ struct PatternFaceOptions {
   /// unstructured mesh has 792), laid out 18 times each and refused (docs/benchmarks.md).
   double size_map_quads = 0;
   double move_work_ratio = 2;
+  /// The search is not started when that bound leaves it fewer layouts than this per move
+  /// vector: it lays out 4 points of each vector's range before refining around the best, so it
+  /// would stop inside the first vectors' coarse sweeps. Measured on the six shared models at
+  /// their reference counts (docs/benchmarks.md, issue 27, branch `speed`): every search so
+  /// short (A319's faces 6, 10, 21, 24, 25 with 5-7 layouts for 2 vectors, t20's face 13,
+  /// wing_fuselage's faces 7 and 15 with 6) ended at a mean SICN of 0.36 at most, against the
+  /// 0.7 asked, and its face took the unstructured mesh; the meshes are byte-identical without
+  /// those searches, and wing_fuselage's patterns stage loses 0.5 s of its 1.5 s. 0: always.
+  int move_min_layouts_per_vector = 4;
   /// Matches tried geometrically (laid out, smoothed, measured) before giving up, best first.
   int max_candidates = 4;
   /// A loop point where a candidate puts a single quad holds that quad's two boundary edges there,

@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <string>
 
 #include "qsmesh/cad/geometry.hpp"
@@ -34,12 +35,20 @@ struct SmoothOptions {
   /// Wall-clock bound on the explicit passes, checked between passes (0: none). When it stops a
   /// run early the result depends on timing; leave 0 where reproducibility matters.
   double time_budget_s = 0;
+  /// Called after each explicit pass (`pass` = 1, 2, ...) with the mesh as it stands (points and
+  /// uv current, the dim-2 vclass.param not yet synced): false stops the smoothing there, and
+  /// smooth_face returns that mesh as is, without the roll-back (SmoothStats::stopped_early).
+  /// For a caller that refuses results below a threshold and can tell after a few passes that a
+  /// candidate will not reach it (qstruct::remesh_cavities); the passes that run are the same
+  /// as without it, so a mesh it lets through is bit for bit the mesh without it. Empty: none.
+  std::function<bool(int pass, const mesh::FaceMesh& mesh)> after_pass;
 };
 
 struct SmoothStats {
   QualityReport before, after;
-  int iterations = 0;        ///< explicit passes done
-  bool rolled_back = false;  ///< the output is the input because the minimum SICN dropped
+  int iterations = 0;          ///< explicit passes done
+  bool rolled_back = false;    ///< the output is the input because the minimum SICN dropped
+  bool stopped_early = false;  ///< SmoothOptions::after_pass stopped the passes
   /// Steps applied, e.g. "uv_laplacian+kernels", "uv_laplacian(rejected)+kernels",
   /// "uv_laplacian(skipped:seam)+kernels".
   std::string method;
