@@ -4,14 +4,18 @@
 #include <array>
 #include <atomic>
 #include <cmath>
+#include <map>
+#include <memory>
 #include <numeric>
 #include <optional>
+#include <set>
 #include <span>
 
 #include "exchange.hpp"
 #include "field_stage.hpp"
 #include "improve.hpp"
 #include "qsmesh/background/curve_mesh.hpp"
+#include "qsmesh/background/face_mesh.hpp"
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/mesh/assemble.hpp"
 #include "qsmesh/parallel/face_task.hpp"
@@ -138,13 +142,17 @@ sizemap::CurveSizes size_map_stage(const Context& cx, std::span<const mesh::Curv
 // balance, curves_refined_for_crossings and quantized_curves (the final curve meshes; each face
 // halves its own loops from them, background::halved_face_boundary).
 void quantize_stage(const Context& cx, std::span<const mesh::CurveMesh> curves,
-                    const std::vector<FaceTask>& faces, PipelineResult& result) {
+                    const std::vector<FaceTask>& faces,
+                    std::span<const std::pair<LO, int>> group_counts, PipelineResult& result) {
   const PipelineOptions& options = cx.options;
   const cad::CadModel& model = cx.model;
+  // The smooth groups' outer counts (group_counts) are prescribed as the user's are.
+  quantize::QuantizeOptions qo = options.quantize;
+  qo.prescribed.insert(qo.prescribed.end(), group_counts.begin(), group_counts.end());
   std::vector<LO> fixed;  // user prescriptions: never changed
-  for (const auto& [c, n] : options.quantize.prescribed) fixed.push_back(c);
+  for (const auto& [c, n] : qo.prescribed) fixed.push_back(c);
   const std::vector<double> ideal = quantize::ideal_edge_counts(curves, result.curve_sizes.at);
-  result.quantization = quantize::quantize_curves(model, ideal, options.quantize);
+  result.quantization = quantize::quantize_curves(model, ideal, qo);
   if (options.balance_counts) {
     // Every rank balances the whole model the same way (deterministic, model-wide data only).
     const auto patterns = qstruct::builtin_patterns();
@@ -409,11 +417,20 @@ void gather_stage(const Context& cx, std::vector<FaceTask>& faces,
   const LO nfaces = cx.model.num_faces();
   std::vector<std::int64_t> counts(3 * static_cast<std::size_t>(nfaces), 0);
   for (const FaceTask& t : faces) {
-    const mesh::FaceContribution c = mesh::face_contribution(quads ? t.quad_mesh : t.background);
+    const mesh::FaceMesh& m = quads ? t.quad_mesh : t.background;
+    if (!t.group_quad_face.empty()) {
+      // A smooth group's mesh, held by its first face, counts on the faces it gives its quads
+      // and interior vertices to (mesh::MeshAssembler::add_group); the other faces bring none.
+      for (const mesh::VertexClass& vc : m.vclass)
+        if (vc.dim == 2) ++counts[3 * static_cast<std::size_t>(vc.entity)];
+      for (const LO f : t.group_quad_face) ++counts[3 * static_cast<std::size_t>(f) + 2];
+      continue;
+    }
+    const mesh::FaceContribution c = mesh::face_contribution(m);
     const auto at = 3 * static_cast<std::size_t>(t.face);
-    counts[at] = c.interior_vertices;
-    counts[at + 1] = c.triangles;
-    counts[at + 2] = c.quads;
+    counts[at] += c.interior_vertices;
+    counts[at + 1] += c.triangles;
+    counts[at + 2] += c.quads;
   }
   cx.comm.allreduce_sum(counts);  // each face's entries are set by its owner alone
   std::vector<char> buffer;
@@ -454,12 +471,18 @@ void gather_stage(const Context& cx, std::vector<FaceTask>& faces,
       QSMESH_CHECK(f >= 0 && f < nfaces, "gathered report for unknown face " << f);
       result.reports[f] = std::move(out.report);
       out.mesh.face = f;
-      const std::vector<GO> global = assembler->add_face(f, out.mesh);
-      if (quads) {
-        for (fieldmesh::RegionGrid& g : out.field_grids)
-          for (GO& v : g.vertices) v = global[static_cast<std::size_t>(v)];
-        result.field_grids[f] = std::move(out.field_grids);
+      if (out.group_first != kNoIndex && out.group_quad_face.empty()) {
+        // A face of a smooth group: its quads came with the group's first face.
+      } else if (!out.group_quad_face.empty()) {
+        (void)assembler->add_group(out.mesh, out.group_quad_face);
+      } else {
+        const std::vector<GO> global = assembler->add_face(f, out.mesh);
+        if (quads) {
+          for (fieldmesh::RegionGrid& g : out.field_grids)
+            for (GO& v : g.vertices) v = global[static_cast<std::size_t>(v)];
+        }
       }
+      if (quads) result.field_grids[f] = std::move(out.field_grids);
       if (keep_background) result.background[f] = std::move(out.mesh);
       if (options.cross_fields) result.cross_fields[f] = std::move(out.cross_field);
       if (options.size_map) result.face_sizes[f] = std::move(out.sizes);
@@ -474,6 +497,227 @@ void gather_stage(const Context& cx, std::vector<FaceTask>& faces,
     std::vector<char>().swap(bytes);
   });
   if (cx.comm.rank() == 0) result.mesh = assembler->finish();
+}
+
+// --- Smooth groups (PipelineOptions::smooth_groups) ----------------------------------------------
+
+// The groups of two faces or more (holomorphic::smooth_face_groups), and each face's group's first
+// face (itself when alone). Every rank computes the same, from the model only.
+struct SmoothGroups {
+  std::vector<std::vector<LO>> groups;
+  std::vector<LO> face_group;
+};
+
+SmoothGroups find_smooth_groups(const cad::CadModel& model,
+                                const holomorphic::GroupOptions& options) {
+  SmoothGroups out;
+  out.face_group.resize(static_cast<std::size_t>(model.num_faces()));
+  for (auto& g : holomorphic::smooth_face_groups(model, options)) {
+    for (const LO f : g) out.face_group[static_cast<std::size_t>(f)] = g.front();
+    if (g.size() > 1) out.groups.push_back(std::move(g));
+  }
+  return out;
+}
+
+// A group glued from this rank's tasks (the partition keeps a group on one rank), each face's
+// loops on `curves`; the surfaces of its faces go to `owned`. Never throws for the group.
+holomorphic::GluedGroup glue_local(const cad::CadModel& model, std::span<const LO> group,
+                                   const std::vector<FaceTask>& faces,
+                                   const std::map<LO, std::size_t>& local_of,
+                                   std::span<const mesh::CurveMesh> curves,
+                                   std::vector<std::unique_ptr<cad::FaceGeometry>>& owned) {
+  holomorphic::GluedGroup failed;
+  std::vector<mesh::FaceMesh> backgrounds;
+  std::vector<std::vector<mesh::BoundaryLoop>> loops;
+  owned.clear();
+  try {
+    for (const LO f : group) {
+      const FaceTask& t = faces[local_of.at(f)];
+      if (!t.background_report.ok || t.background.triangles.empty()) {
+        failed.reason = "face " + std::to_string(f) + " has no background mesh";
+        return failed;
+      }
+      backgrounds.push_back(t.background);
+      owned.push_back(model.face_geometry(f));
+      loops.push_back(background::face_boundary(model, f, *owned.back(), curves));
+    }
+  } catch (const std::exception& e) {
+    failed.reason = std::string("boundary: ") + e.what();
+    return failed;
+  }
+  return holomorphic::glue_group(group, backgrounds, loops);
+}
+
+// The counts of the groups' outer loops from their optimised forms (paper 004 Sec. 4: the loops'
+// periods add up, and so must the counts of a conforming mesh; holomorphic::loop_periods,
+// balanced_loop_counts), as prescriptions (curve, count) for the quantization. The target edge
+// length is the one at which the loops' summed ideal counts (the size map's) are kept. A loop of
+// several curves shares its count by their ideal counts. Each group is computed by the rank
+// holding it; a max-reduction gives every rank the same list. Curves the user prescribed keep
+// their counts (a group then meshes only if they add up).
+std::vector<std::pair<LO, int>> group_loop_counts(const Context& cx, const SmoothGroups& sg,
+                                                  std::span<const mesh::CurveMesh> curves,
+                                                  const std::vector<FaceTask>& faces,
+                                                  const PipelineResult& result) {
+  const cad::CadModel& model = cx.model;
+  const std::vector<double> ideal = quantize::ideal_edge_counts(curves, result.curve_sizes.at);
+  std::set<LO> user;
+  for (const auto& [c, n] : cx.options.quantize.prescribed) user.insert(c);
+  std::map<LO, std::size_t> local_of;
+  for (std::size_t i = 0; i < faces.size(); ++i) local_of[faces[i].face] = i;
+  // Minus each curve's count (0: none), so that the minimum over ranks is the largest count.
+  std::vector<double> count(static_cast<std::size_t>(model.num_curves()), 0.0);
+  for (const auto& group : sg.groups) {
+    if (local_of.count(group.front()) == 0) continue;
+    std::vector<std::unique_ptr<cad::FaceGeometry>> owned;
+    const holomorphic::GluedGroup glued = glue_local(model, group, faces, local_of, curves, owned);
+    const auto skip = [&](const std::string& why) {
+      cx.log.info(cat("smooth group of face ", group.front(), ": no loop counts (", why, ")"));
+    };
+    if (!glued.ok) {
+      skip(glued.reason);
+      continue;
+    }
+    try {
+      const holomorphic::PolyAnnulus s = holomorphic::poly_annulus(glued.background);
+      if (!s.ok) {
+        skip(s.reason);
+        continue;
+      }
+      const auto& ho = cx.options.holomorphic;
+      const holomorphic::HolomorphicBasis B = holomorphic::holomorphic_basis(s, ho.basis, nullptr);
+      const holomorphic::EnergyResult E = holomorphic::minimize_area_distortion(s, B, ho.energy);
+      const std::vector<double> periods = holomorphic::loop_periods(s, combine(B, E.lambda));
+      // The curves of each loop, read from the classification of its merged vertices.
+      std::map<LO, LO> merged_curve;
+      for (std::size_t v = 0; v < glued.background.vclass.size(); ++v)
+        if (glued.background.vclass[v].dim == 1)
+          merged_curve[s.face2merged[v]] = glued.background.vclass[v].entity;
+      std::vector<std::vector<LO>> loop_curves(s.loops.size());
+      double period_sum = 0, ideal_sum = 0;
+      for (std::size_t l = 0; l < s.loops.size(); ++l) {
+        std::set<LO> on;
+        for (const LO x : s.loops[l])
+          if (const auto it = merged_curve.find(x); it != merged_curve.end()) on.insert(it->second);
+        loop_curves[l].assign(on.begin(), on.end());
+        for (const LO c : on) ideal_sum += ideal[static_cast<std::size_t>(c)];
+        period_sum += std::abs(periods[l]);
+      }
+      if (ideal_sum <= 0 || period_sum <= 0) {
+        skip("no loop length");
+        continue;
+      }
+      const std::vector<LO> counts =
+          holomorphic::balanced_loop_counts(periods, period_sum / ideal_sum);
+      for (std::size_t l = 0; l < s.loops.size(); ++l) {
+        const auto& cs = loop_curves[l];
+        if (cs.empty()) continue;
+        // Largest remainders of the loop's count split by the curves' ideal counts, one edge at
+        // least each.
+        double loop_ideal = 0;
+        for (const LO c : cs) loop_ideal += ideal[static_cast<std::size_t>(c)];
+        std::vector<std::int64_t> n(cs.size(), 1);
+        std::vector<std::pair<double, std::size_t>> rest;
+        std::int64_t given = 0;
+        for (std::size_t k = 0; k < cs.size(); ++k) {
+          const double share =
+              double(counts[l]) * ideal[static_cast<std::size_t>(cs[k])] / loop_ideal;
+          n[k] = std::max<std::int64_t>(1, static_cast<std::int64_t>(std::floor(share)));
+          rest.emplace_back(-(share - std::floor(share)), k);
+          given += n[k];
+        }
+        std::sort(rest.begin(), rest.end());
+        for (std::size_t k = 0; given < counts[l] && k < rest.size(); ++k, ++given)
+          ++n[rest[k].second];
+        for (std::size_t k = 0; k < cs.size(); ++k)
+          if (user.count(cs[k]) == 0) {
+            double& at = count[static_cast<std::size_t>(cs[k])];
+            at = std::min(at, -double(n[k]));
+          }
+      }
+    } catch (const std::exception& e) {
+      skip(e.what());
+    }
+  }
+  cx.comm.allreduce_min(count);
+  std::vector<std::pair<LO, int>> out;
+  for (LO c = 0; c < model.num_curves(); ++c)
+    if (count[static_cast<std::size_t>(c)] < 0)
+      out.emplace_back(c, static_cast<int>(-count[static_cast<std::size_t>(c)]));
+  return out;
+}
+
+// A group's mesh on the final curve meshes (holomorphic::mesh_group), made while its faces'
+// background meshes are still there; empty with the reason when it fails.
+struct GroupResult {
+  std::vector<LO> faces;
+  holomorphic::GroupMesh mesh;
+  std::string reason;
+};
+
+std::vector<GroupResult> mesh_smooth_groups(const Context& cx, const SmoothGroups& sg,
+                                            const std::vector<FaceTask>& faces,
+                                            const PipelineResult& result) {
+  std::map<LO, std::size_t> local_of;
+  for (std::size_t i = 0; i < faces.size(); ++i) local_of[faces[i].face] = i;
+  std::vector<GroupResult> out;
+  for (const auto& group : sg.groups) {
+    if (local_of.count(group.front()) == 0) continue;
+    GroupResult& r = out.emplace_back();
+    r.faces = group;
+    std::vector<std::unique_ptr<cad::FaceGeometry>> owned;
+    const holomorphic::GluedGroup glued =
+        glue_local(cx.model, group, faces, local_of, result.quantized_curves, owned);
+    if (!glued.ok) {
+      r.reason = glued.reason;
+      continue;
+    }
+    std::vector<const cad::FaceGeometry*> surfaces;
+    for (const auto& o : owned) surfaces.push_back(o.get());
+    holomorphic::HolomorphicReport report;
+    try {
+      r.mesh = holomorphic::mesh_group(glued, surfaces, cx.options.holomorphic, &report);
+    } catch (const std::exception& e) {
+      report.ok = false;
+      report.reason = e.what();
+    }
+    if (!report.ok || r.mesh.mesh.quads.empty()) {
+      r.reason = report.reason.empty() ? "no quads" : report.reason;
+      r.mesh = holomorphic::GroupMesh{};
+    }
+    cx.log.info(cat("smooth group of face ", group.front(), " (", group.size(), " faces): ",
+                    r.reason.empty() ? cat(r.mesh.mesh.quads.size(), " quads") : r.reason));
+  }
+  return out;
+}
+
+// Each group meshed replaces its faces' own meshes: the first face's task holds the group's mesh
+// and the face of each quad, the others are left empty and point to it. A group that failed
+// keeps its faces' meshes, the reason in each face's QuasiReport::holomorphic.
+void apply_smooth_groups(std::vector<GroupResult>& groups, std::vector<FaceTask>& faces) {
+  std::map<LO, std::size_t> local_of;
+  for (std::size_t i = 0; i < faces.size(); ++i) local_of[faces[i].face] = i;
+  for (GroupResult& r : groups) {
+    std::string name = "group of faces";
+    for (const LO f : r.faces) name += cat(" ", f);
+    for (const LO f : r.faces) {
+      FaceTask& t = faces[local_of.at(f)];
+      if (!r.reason.empty()) {
+        t.quasi.holomorphic = name + " not meshed (" + r.reason + "); face: " + t.quasi.holomorphic;
+        continue;
+      }
+      t.quasi.by_holomorphic = true;
+      t.quasi.holomorphic = "kept: " + name;
+      t.group_first = r.faces.front();
+      t.field_grids.clear();
+      t.quad_mesh = mesh::FaceMesh{};
+      if (f == r.faces.front()) {
+        t.quad_mesh = std::move(r.mesh.mesh);
+        t.quad_mesh.face = f;
+        t.group_quad_face = std::move(r.mesh.quad_face);
+      }
+    }
+  }
 }
 
 }  // namespace
@@ -510,6 +754,18 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
   clock.start();
   result.face_rank = partition_faces(
       model.face2faces(), estimate_face_costs(model, options.background.sizes.size), nranks);
+  // A smooth group is meshed as one surface: its faces go to the rank of its first face (the
+  // partition is the same on every rank, so is this).
+  const bool by_groups =
+      options.smooth_groups && quads && options.face_method != holomorphic::Method::Default;
+  SmoothGroups smooth_groups;
+  if (by_groups) {
+    smooth_groups = find_smooth_groups(model, options.groups);
+    for (LO f = 0; f < nfaces; ++f)
+      result.face_rank[f] = result.face_rank[smooth_groups.face_group[static_cast<std::size_t>(f)]];
+    result.face_group = smooth_groups.face_group;
+    log.info(cat("smooth groups: ", smooth_groups.groups.size(), " of two faces or more"));
+  }
   std::vector<FaceTask> faces;
   for (LO f = 0; f < nfaces; ++f)
     if (result.face_rank[f] == rank) faces.emplace_back().face = f;
@@ -546,7 +802,10 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     result.curve_sizes = size_map_stage(cx, curves, faces, cf_sizes);
     clock.end("sizemap", true);
     clock.start();
-    quantize_stage(cx, curves, faces, result);
+    const std::vector<std::pair<LO, int>> group_counts =
+        by_groups ? group_loop_counts(cx, smooth_groups, curves, faces, result)
+                  : std::vector<std::pair<LO, int>>{};
+    quantize_stage(cx, curves, faces, group_counts, result);
     clock.end("quantize", false);
   }
 
@@ -574,6 +833,12 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     each_face(cx, faces, "holomorphic", [&](FaceTask& t) {
       make_holomorphic_candidate(t, model, result.quantized_curves, options.holomorphic);
     });
+  std::vector<GroupResult> group_meshes;
+  if (by_groups) {
+    clock.start();
+    group_meshes = mesh_smooth_groups(cx, smooth_groups, faces, result);
+    clock.end("groups", true);
+  }
   if (quads) {
     clock.start();
     unstructured_stage(cx, faces, result.quantized_curves, quasi);
@@ -593,6 +858,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
       choose_face_method(t, options.face_method, options.holomorphic_sicn_tolerance);
     });
   for (std::size_t i = 0; i < faces.size(); ++i) take_field_mesh(faces[i], std::move(by_field[i]));
+  apply_smooth_groups(group_meshes, faces);
 
   clock.start();
   const std::span<const mesh::CurveMesh> final_curves =

@@ -44,6 +44,12 @@ class MeshAssembler {
   /// its counts differ from the contribution given for f or its classification is out of range.
   /// Returns the assembled mesh's id of each vertex of `face` (its numbering in the result).
   std::vector<GO> add_face(LO f, const FaceMesh& face);
+  /// Adds the mesh of a group of faces meshed as one surface (holomorphic::mesh_group): quad q
+  /// goes to face quad_face[q], a dim-2 vertex to the face it is classified on (vclass.entity),
+  /// so a vertex may be shared by quads of two faces. Every face it names counts as added; the
+  /// contributions of those faces must be its quads and interior vertices split that way.
+  /// Returns the assembled mesh's id of each vertex of `group`.
+  std::vector<GO> add_group(const FaceMesh& group, std::span<const LO> quad_face);
   /// The mesh; throws Error unless every face with a non-zero contribution was added.
   [[nodiscard]] SurfaceMesh finish();
 
