@@ -34,7 +34,8 @@ FaceContribution face_contribution(const FaceMesh& face) {
 }
 
 MeshAssembler::MeshAssembler(const cad::CadModel& model, std::span<const CurveMesh> curves,
-                             std::span<const FaceContribution> contributions)
+                             std::span<const FaceContribution> contributions,
+                             std::span<const char> inner_curves)
     : model_(model), curves_(curves) {
   const LO nc = model.num_corners();
   const LO ncurves = model.num_curves();
@@ -89,7 +90,7 @@ MeshAssembler::MeshAssembler(const cad::CadModel& model, std::span<const CurveMe
   for (LO c = 0; c < ncurves; ++c) {
     const CurveMesh& cm = curves[c];
     const auto& cc = model.curves()[c];
-    if (cc.degenerate) continue;
+    if (cc.degenerate || (!inner_curves.empty() && inner_curves[c] != 0)) continue;
     auto id = [&](LO i) -> GO {
       if (i == 0) return cc.corners[0];
       if (i == cm.num_edges()) return cc.corners[1];

@@ -18,6 +18,7 @@
 #include "qsmesh/background/face_mesh.hpp"
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/mesh/assemble.hpp"
+#include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/parallel/face_task.hpp"
 #include "qsmesh/parallel/partition.hpp"
 #include "qsmesh/parallel/record.hpp"
@@ -406,13 +407,22 @@ void compare_stage(const Context& cx, std::vector<FaceTask>& faces,
   });
 }
 
+// What the assembly needs of the groups meshed on this rank (PipelineOptions::smooth_groups;
+// empty on every rank otherwise).
+struct GroupsForOutput {
+  std::map<LO, mesh::FaceQuadStats> stats;  ///< by face of a group meshed
+  /// By curve: 1 when used twice by the faces of a group meshed (inside it: a curve between two
+  /// of its faces, or a seam of one), so that its quads cross it and it gets no bars.
+  std::vector<std::int64_t> inner_curves;
+};
+
 // Gathers every face on rank 0 and assembles them (collective; faces is emptied). The assembled
 // mesh is sized first from every face's counts; the faces then arrive one rank at a time and
 // each is written in place and dropped, so that rank 0 holds the assembled mesh and one rank's
 // faces, not every face twice over. Fills result's per-face vectors and mesh on rank 0.
 void gather_stage(const Context& cx, std::vector<FaceTask>& faces,
                   std::span<const mesh::CurveMesh> final_curves, bool quads, bool quasi,
-                  PipelineResult& result) {
+                  GroupsForOutput& groups, PipelineResult& result) {
   const PipelineOptions& options = cx.options;
   const LO nfaces = cx.model.num_faces();
   std::vector<std::int64_t> counts(3 * static_cast<std::size_t>(nfaces), 0);
@@ -434,9 +444,22 @@ void gather_stage(const Context& cx, std::vector<FaceTask>& faces,
   }
   cx.comm.allreduce_sum(counts);  // each face's entries are set by its owner alone
   std::vector<char> buffer;
-  for (FaceTask& t : faces) write_record(buffer, take_output(std::move(t), quads));
+  for (FaceTask& t : faces) {
+    FaceOutput out = take_output(std::move(t), quads);
+    // A smooth group's faces: their own parts of the group's mesh (group_face_stats).
+    if (const auto it = groups.stats.find(out.report.face); quads && it != groups.stats.end())
+      out.stats = it->second;
+    write_record(buffer, out);
+  }
   faces.clear();
   std::optional<mesh::MeshAssembler> assembler;
+  // The curves inside the groups meshed get no bars (every rank takes part in the sum when any
+  // group was formed; the flags are empty otherwise).
+  std::vector<char> inner;
+  if (!groups.inner_curves.empty()) {
+    cx.comm.allreduce_sum(groups.inner_curves);
+    for (const std::int64_t x : groups.inner_curves) inner.push_back(x > 0 ? 1 : 0);
+  }
   const bool size_map = options.size_map || quads;
   const bool keep_background = size_map && !quads;  // the size map's output draws them
   if (cx.comm.rank() == 0) {
@@ -445,7 +468,7 @@ void gather_stage(const Context& cx, std::vector<FaceTask>& faces,
       const auto at = 3 * static_cast<std::size_t>(f);
       contributions[f] = {counts[at], counts[at + 1], counts[at + 2]};
     }
-    assembler.emplace(cx.model, final_curves, contributions);
+    assembler.emplace(cx.model, final_curves, contributions, inner);
     const auto n = static_cast<std::size_t>(nfaces);
     result.reports.resize(n);
     if (options.cross_fields) result.cross_fields.resize(n);
@@ -694,10 +717,61 @@ std::vector<GroupResult> mesh_smooth_groups(const Context& cx, const SmoothGroup
 // Each group meshed replaces its faces' own meshes: the first face's task holds the group's mesh
 // and the face of each quad, the others are left empty and point to it. A group that failed
 // keeps its faces' meshes, the reason in each face's QuasiReport::holomorphic.
-void apply_smooth_groups(std::vector<GroupResult>& groups, std::vector<FaceTask>& faces) {
+// The statistics of each face of a group meshed (for --stats' face_stats): its quads and their
+// SICN, its interior vertices (those on the face) with their valence among all the group's
+// quads; the group's irregular boundary vertices are counted on its first face.
+void group_face_stats(const GroupResult& r, std::map<LO, mesh::FaceQuadStats>& stats) {
+  const mesh::FaceMesh& m = r.mesh.mesh;
+  const mesh::FaceQuadStats whole = mesh::face_quad_stats(m);
+  std::vector<int> valence(m.points.size(), 0);
+  for (const auto& q : m.quads)
+    for (const LO v : q) ++valence[static_cast<std::size_t>(v)];
+  for (const LO f : r.faces) {
+    mesh::FaceQuadStats s;
+    std::vector<char> used(m.points.size(), 0);
+    double sum = 0;
+    s.sicn_min = 0;
+    for (std::size_t k = 0; k < m.quads.size(); ++k) {
+      if (r.mesh.quad_face[k] != f) continue;
+      std::array<Vec3, 4> x{};
+      for (std::size_t i = 0; i < 4; ++i) {
+        const auto v = static_cast<std::size_t>(m.quads[k][i]);
+        used[v] = 1;
+        x[i] = m.points[v];
+      }
+      const double q = mesh::quad_sicn(x);
+      s.sicn_min = s.quads == 0 ? q : std::min(s.sicn_min, q);
+      sum += q;
+      ++s.quads;
+    }
+    if (s.quads > 0) s.sicn_avg = sum / double(s.quads);
+    for (std::size_t v = 0; v < m.points.size(); ++v) {
+      s.vertices += used[v];
+      if (m.vclass[v].dim == 2 && m.vclass[v].entity == f && valence[v] != 4)
+        ++s.irregular_interior;
+    }
+    if (f == r.faces.front()) s.irregular_boundary = whole.irregular_boundary;
+    stats[f] = s;
+  }
+}
+
+GroupsForOutput apply_smooth_groups(const cad::CadModel& model, std::vector<GroupResult>& groups,
+                                    std::vector<FaceTask>& faces) {
+  GroupsForOutput out;
+  out.inner_curves.assign(static_cast<std::size_t>(model.num_curves()), 0);
+  auto& stats = out.stats;
   std::map<LO, std::size_t> local_of;
   for (std::size_t i = 0; i < faces.size(); ++i) local_of[faces[i].face] = i;
   for (GroupResult& r : groups) {
+    if (r.reason.empty()) {
+      group_face_stats(r, stats);
+      std::map<LO, int> uses;
+      for (const LO f : r.faces)
+        for (const auto& loop : model.faces()[static_cast<std::size_t>(f)].loops)
+          for (const auto& use : loop.uses) ++uses[use.curve];
+      for (const auto& [c, n] : uses)
+        if (n >= 2) out.inner_curves[static_cast<std::size_t>(c)] = 1;
+    }
     std::string name = "group of faces";
     for (const LO f : r.faces) name += cat(" ", f);
     for (const LO f : r.faces) {
@@ -718,6 +792,7 @@ void apply_smooth_groups(std::vector<GroupResult>& groups, std::vector<FaceTask>
       }
     }
   }
+  return out;
 }
 
 }  // namespace
@@ -858,13 +933,14 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
       choose_face_method(t, options.face_method, options.holomorphic_sicn_tolerance);
     });
   for (std::size_t i = 0; i < faces.size(); ++i) take_field_mesh(faces[i], std::move(by_field[i]));
-  apply_smooth_groups(group_meshes, faces);
+  GroupsForOutput groups_out =
+      by_groups ? apply_smooth_groups(model, group_meshes, faces) : GroupsForOutput{};
 
   clock.start();
   const std::span<const mesh::CurveMesh> final_curves =
       quads ? std::span<const mesh::CurveMesh>(result.quantized_curves)
             : std::span<const mesh::CurveMesh>(curves);
-  gather_stage(cx, faces, final_curves, quads, quasi, result);
+  gather_stage(cx, faces, final_curves, quads, quasi, groups_out, result);
   clock.end("assemble", false);
   result.rank_busy_seconds.assign(static_cast<std::size_t>(nranks), 0.0);
   result.rank_busy_seconds[static_cast<std::size_t>(rank)] = clock.busy();

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <iostream>
+#include <map>
 #include <sstream>
 
 #include "holo_shapes.hpp"
@@ -158,6 +159,14 @@ TEST(HolomorphicPipeline, FilletedTDuctIsOneGroupOnEveryRankCount) {
   }
   EXPECT_EQ(eight, 1);
   EXPECT_EQ(other, 0);
+  // Bars only on the group's outer curves (used once by its faces' loops): the fillet's curves
+  // and the seams are crossed by quads.
+  std::map<LO, int> uses;
+  for (const auto& f : model.faces())
+    for (const auto& loop : f.loops)
+      for (const auto& use : loop.uses) ++uses[use.curve];
+  ASSERT_FALSE(dist.mesh.bars.empty());
+  for (const LO c : dist.mesh.bar_curve) EXPECT_EQ(uses[c], 1) << "bar on curve " << c;
   EXPECT_GT(unused, 0);
   EXPECT_GT(sicn_min, 0.3);
   for (const int n : per_face) EXPECT_GT(n, 0);
