@@ -388,6 +388,8 @@ Arguments parse(const std::vector<std::string>& args) {
     }
     if (a.smooth_groups && a.method != "holomorphic" && a.method != "auto")
       throw InputError("--smooth-groups: only with --method holomorphic or auto");
+    if (a.smooth_groups && a.until == "background")
+      throw InputError("--smooth-groups needs a quad mesh: not with --until background");
     if (a.smooth_groups && a.block_structured)
       throw InputError(
           "--smooth-groups: a group's quads cross its faces' curves, which the blocks of "

@@ -632,6 +632,10 @@ std::vector<std::pair<LO, int>> group_loop_counts(const Context& cx, const Smoot
       }
       const std::vector<LO> counts =
           holomorphic::balanced_loop_counts(periods, period_sum / ideal_sum);
+      std::string line = cat("smooth group of face ", group.front(), ": loop periods / counts");
+      for (std::size_t l = 0; l < s.loops.size(); ++l)
+        line += cat(" ", periods[l], " / ", counts[l]);
+      cx.log.info(line);
       for (std::size_t l = 0; l < s.loops.size(); ++l) {
         const auto& cs = loop_curves[l];
         if (cs.empty()) continue;
