@@ -144,15 +144,30 @@ sizemap::CurveSizes size_map_stage(const Context& cx, std::span<const mesh::Curv
 // halves its own loops from them, background::halved_face_boundary).
 void quantize_stage(const Context& cx, std::span<const mesh::CurveMesh> curves,
                     const std::vector<FaceTask>& faces,
-                    std::span<const std::pair<LO, int>> group_counts, PipelineResult& result) {
+                    std::span<const std::vector<std::pair<LO, int>>> group_counts,
+                    PipelineResult& result) {
   const PipelineOptions& options = cx.options;
   const cad::CadModel& model = cx.model;
-  // The smooth groups' outer counts (group_counts) are prescribed as the user's are.
+  const std::vector<double> ideal = quantize::ideal_edge_counts(curves, result.curve_sizes.at);
+  // The smooth groups' outer counts (group_counts, one list per group) are prescribed as the
+  // user's are, group by group where the quantization can meet them: a group's counts may clash
+  // with a chord of four-sided faces outside it (cube_filet), and the group then keeps the
+  // quantization's counts (its mesh falls back unless they add up). Same on every rank.
   quantize::QuantizeOptions qo = options.quantize;
-  qo.prescribed.insert(qo.prescribed.end(), group_counts.begin(), group_counts.end());
+  for (const auto& list : group_counts) {
+    if (list.empty()) continue;
+    quantize::QuantizeOptions trial = qo;
+    trial.prescribed.insert(trial.prescribed.end(), list.begin(), list.end());
+    try {
+      (void)quantize::quantize_curves(model, ideal, trial);
+      qo = std::move(trial);
+    } catch (const InputError& e) {
+      cx.log.info(cat("quantize: loop counts of the smooth group with curve ", list.front().first,
+                      " not prescribed (", e.what(), ")"));
+    }
+  }
   std::vector<LO> fixed;  // user prescriptions: never changed
   for (const auto& [c, n] : qo.prescribed) fixed.push_back(c);
-  const std::vector<double> ideal = quantize::ideal_edge_counts(curves, result.curve_sizes.at);
   result.quantization = quantize::quantize_curves(model, ideal, qo);
   if (options.balance_counts) {
     // Every rank balances the whole model the same way (deterministic, model-wide data only).
@@ -576,12 +591,11 @@ holomorphic::GluedGroup glue_local(const cad::CadModel& model, std::span<const L
 // balanced_loop_counts), as prescriptions (curve, count) for the quantization. The target edge
 // length is the one at which the loops' summed ideal counts (the size map's) are kept. A loop of
 // several curves shares its count by their ideal counts. Each group is computed by the rank
-// holding it; a max-reduction gives every rank the same list. Curves the user prescribed keep
-// their counts (a group then meshes only if they add up).
-std::vector<std::pair<LO, int>> group_loop_counts(const Context& cx, const SmoothGroups& sg,
-                                                  std::span<const mesh::CurveMesh> curves,
-                                                  const std::vector<FaceTask>& faces,
-                                                  const PipelineResult& result) {
+// holding it; a max-reduction gives every rank the same lists (one per group of sg.groups). Curves
+// the user prescribed keep their counts (a group then meshes only if they add up).
+std::vector<std::vector<std::pair<LO, int>>> group_loop_counts(
+    const Context& cx, const SmoothGroups& sg, std::span<const mesh::CurveMesh> curves,
+    const std::vector<FaceTask>& faces, const PipelineResult& result) {
   const cad::CadModel& model = cx.model;
   const std::vector<double> ideal = quantize::ideal_edge_counts(curves, result.curve_sizes.at);
   std::set<LO> user;
@@ -667,10 +681,22 @@ std::vector<std::pair<LO, int>> group_loop_counts(const Context& cx, const Smoot
     }
   }
   cx.comm.allreduce_min(count);
-  std::vector<std::pair<LO, int>> out;
-  for (LO c = 0; c < model.num_curves(); ++c)
-    if (count[static_cast<std::size_t>(c)] < 0)
-      out.emplace_back(c, static_cast<int>(-count[static_cast<std::size_t>(c)]));
+  // Each curve's count to the first group with a face on it (groups in sg.groups order).
+  std::vector<LO> group_of_face(static_cast<std::size_t>(model.num_faces()), kNoIndex);
+  for (std::size_t g = sg.groups.size(); g-- > 0;)
+    for (const LO f : sg.groups[g]) group_of_face[static_cast<std::size_t>(f)] = static_cast<LO>(g);
+  std::vector<std::vector<std::pair<LO, int>>> out(sg.groups.size());
+  for (LO c = 0; c < model.num_curves(); ++c) {
+    if (count[static_cast<std::size_t>(c)] >= 0) continue;
+    LO g = kNoIndex;
+    for (const LO f : model.curve2faces()[c]) {
+      const LO gf = group_of_face[static_cast<std::size_t>(f)];
+      if (gf != kNoIndex && (g == kNoIndex || gf < g)) g = gf;
+    }
+    if (g != kNoIndex)
+      out[static_cast<std::size_t>(g)].emplace_back(
+          c, static_cast<int>(-count[static_cast<std::size_t>(c)]));
+  }
   return out;
 }
 
@@ -881,9 +907,9 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     result.curve_sizes = size_map_stage(cx, curves, faces, cf_sizes);
     clock.end("sizemap", true);
     clock.start();
-    const std::vector<std::pair<LO, int>> group_counts =
+    const std::vector<std::vector<std::pair<LO, int>>> group_counts =
         by_groups ? group_loop_counts(cx, smooth_groups, curves, faces, result)
-                  : std::vector<std::pair<LO, int>>{};
+                  : std::vector<std::vector<std::pair<LO, int>>>{};
     quantize_stage(cx, curves, faces, group_counts, result);
     clock.end("quantize", false);
   }
