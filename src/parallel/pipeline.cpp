@@ -744,9 +744,6 @@ std::vector<GroupResult> mesh_smooth_groups(const Context& cx, const SmoothGroup
   return out;
 }
 
-// Each group meshed replaces its faces' own meshes: the first face's task holds the group's mesh
-// and the face of each quad, the others are left empty and point to it. A group that failed
-// keeps its faces' meshes, the reason in each face's QuasiReport::holomorphic.
 // The statistics of each face of a group meshed (for --stats' face_stats): its quads and their
 // SICN, its interior vertices (those on the face) with their valence among all the group's
 // quads; the group's irregular boundary vertices are counted on its first face.
@@ -785,14 +782,44 @@ void group_face_stats(const GroupResult& r, std::map<LO, mesh::FaceQuadStats>& s
   }
 }
 
+// Each group meshed replaces its faces' own meshes where the face policy keeps it (under auto:
+// when it is better than they are): the first face's task holds the group's mesh
+// and the face of each quad, the others are left empty and point to it. A group that failed
+// keeps its faces' meshes, the reason in each face's QuasiReport::holomorphic.
 GroupsForOutput apply_smooth_groups(const cad::CadModel& model, std::vector<GroupResult>& groups,
-                                    std::vector<FaceTask>& faces) {
+                                    std::vector<FaceTask>& faces, holomorphic::Method method,
+                                    double sicn_tolerance) {
   GroupsForOutput out;
   out.inner_curves.assign(static_cast<std::size_t>(model.num_curves()), 0);
   auto& stats = out.stats;
   std::map<LO, std::size_t> local_of;
   for (std::size_t i = 0; i < faces.size(); ++i) local_of[faces[i].face] = i;
   for (GroupResult& r : groups) {
+    if (r.reason.empty()) {
+      // The policy of a face (holomorphic::keep_holomorphic) on the group against its faces' own
+      // meshes taken together: under auto, fewer interior irregular vertices at SICN min and avg
+      // within the tolerance; either way no quad with SICN <= 0.
+      mesh::FaceQuadStats theirs;
+      double weighted = 0;
+      theirs.sicn_min = 1;
+      for (const LO f : r.faces) {
+        const mesh::FaceQuadStats s = mesh::face_quad_stats(faces[local_of.at(f)].quad_mesh);
+        theirs.quads += s.quads;
+        theirs.triangles += s.triangles;
+        theirs.irregular_interior += s.irregular_interior;
+        if (s.quads > 0) theirs.sicn_min = std::min(theirs.sicn_min, s.sicn_min);
+        weighted += s.sicn_avg * double(s.quads);
+      }
+      if (theirs.quads > 0) theirs.sicn_avg = weighted / double(theirs.quads);
+      const mesh::FaceQuadStats mine = mesh::face_quad_stats(r.mesh.mesh);
+      holomorphic::HolomorphicReport ok;
+      ok.ok = true;
+      if (!holomorphic::keep_holomorphic(method, ok, mine, theirs, sicn_tolerance))
+        r.reason =
+            cat("the faces' own meshes kept: group ", mine.irregular_interior,
+                " interior irregular, SICN ", mine.sicn_min, " / ", mine.sicn_avg, "; faces ",
+                theirs.irregular_interior, ", ", theirs.sicn_min, " / ", theirs.sicn_avg);
+    }
     if (r.reason.empty()) {
       group_face_stats(r, stats);
       std::map<LO, int> uses;
@@ -964,7 +991,9 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     });
   for (std::size_t i = 0; i < faces.size(); ++i) take_field_mesh(faces[i], std::move(by_field[i]));
   GroupsForOutput groups_out =
-      by_groups ? apply_smooth_groups(model, group_meshes, faces) : GroupsForOutput{};
+      by_groups ? apply_smooth_groups(model, group_meshes, faces, options.face_method,
+                                      options.holomorphic_sicn_tolerance)
+                : GroupsForOutput{};
 
   clock.start();
   const std::span<const mesh::CurveMesh> final_curves =
