@@ -138,12 +138,175 @@ sizemap::CurveSizes size_map_stage(const Context& cx, std::span<const mesh::Curv
   return united;
 }
 
+// --- Smooth groups (PipelineOptions::smooth_groups) ----------------------------------------------
+
+// The groups of two faces or more (holomorphic::smooth_face_groups), and each face's group's first
+// face (itself when alone). Every rank computes the same, from the model only.
+struct SmoothGroups {
+  std::vector<std::vector<LO>> groups;
+  std::vector<LO> face_group;
+};
+
+SmoothGroups find_smooth_groups(const cad::CadModel& model,
+                                const holomorphic::GroupOptions& options) {
+  SmoothGroups out;
+  out.face_group.resize(static_cast<std::size_t>(model.num_faces()));
+  for (auto& g : holomorphic::smooth_face_groups(model, options)) {
+    for (const LO f : g) out.face_group[static_cast<std::size_t>(f)] = g.front();
+    if (g.size() > 1) out.groups.push_back(std::move(g));
+  }
+  return out;
+}
+
+// A group glued from this rank's tasks (the partition keeps a group on one rank), each face's
+// loops on `curves`; the surfaces of its faces go to `owned`. Never throws for the group.
+holomorphic::GluedGroup glue_local(const cad::CadModel& model, std::span<const LO> group,
+                                   const std::vector<FaceTask>& faces,
+                                   const std::map<LO, std::size_t>& local_of,
+                                   std::span<const mesh::CurveMesh> curves,
+                                   std::vector<std::unique_ptr<cad::FaceGeometry>>& owned) {
+  holomorphic::GluedGroup failed;
+  std::vector<mesh::FaceMesh> backgrounds;
+  std::vector<std::vector<mesh::BoundaryLoop>> loops;
+  owned.clear();
+  try {
+    for (const LO f : group) {
+      const FaceTask& t = faces[local_of.at(f)];
+      if (!t.background_report.ok || t.background.triangles.empty()) {
+        failed.reason = "face " + std::to_string(f) + " has no background mesh";
+        return failed;
+      }
+      backgrounds.push_back(t.background);
+      owned.push_back(model.face_geometry(f));
+      loops.push_back(background::face_boundary(model, f, *owned.back(), curves));
+    }
+  } catch (const std::exception& e) {
+    failed.reason = std::string("boundary: ") + e.what();
+    return failed;
+  }
+  return holomorphic::glue_group(group, backgrounds, loops);
+}
+
+// The counts of the groups' outer loops from their optimised forms (paper 004 Sec. 4: the loops'
+// periods add up, and so must the counts of a conforming mesh; holomorphic::loop_periods,
+// balanced_loop_counts), as prescriptions (curve, count) for the quantization. The target edge
+// length is the one at which the loops' summed ideal counts (the size map's) are kept. A loop of
+// several curves shares its count by their ideal counts. Each group is computed by the rank
+// holding it; a max-reduction gives every rank the same lists (one per group of sg.groups). Curves
+// the user prescribed keep their counts (a group then meshes only if they add up).
+std::vector<std::vector<std::pair<LO, int>>> group_loop_counts(
+    const Context& cx, const SmoothGroups& sg, std::span<const mesh::CurveMesh> curves,
+    const std::vector<FaceTask>& faces, const PipelineResult& result) {
+  const cad::CadModel& model = cx.model;
+  const std::vector<double> ideal = quantize::ideal_edge_counts(curves, result.curve_sizes.at);
+  std::set<LO> user;
+  for (const auto& [c, n] : cx.options.quantize.prescribed) user.insert(c);
+  std::map<LO, std::size_t> local_of;
+  for (std::size_t i = 0; i < faces.size(); ++i) local_of[faces[i].face] = i;
+  // Minus each curve's count (0: none), so that the minimum over ranks is the largest count.
+  std::vector<double> count(static_cast<std::size_t>(model.num_curves()), 0.0);
+  for (const auto& group : sg.groups) {
+    if (local_of.count(group.front()) == 0) continue;
+    std::vector<std::unique_ptr<cad::FaceGeometry>> owned;
+    const holomorphic::GluedGroup glued = glue_local(model, group, faces, local_of, curves, owned);
+    const auto skip = [&](const std::string& why) {
+      cx.log.info(cat("smooth group of face ", group.front(), ": no loop counts (", why, ")"));
+    };
+    if (!glued.ok) {
+      skip(glued.reason);
+      continue;
+    }
+    try {
+      const holomorphic::PolyAnnulus s = holomorphic::poly_annulus(glued.background);
+      if (!s.ok) {
+        skip(s.reason);
+        continue;
+      }
+      const auto& ho = cx.options.holomorphic;
+      const holomorphic::HolomorphicBasis B = holomorphic::holomorphic_basis(s, ho.basis, nullptr);
+      const holomorphic::EnergyResult E = holomorphic::minimize_area_distortion(s, B, ho.energy);
+      const std::vector<double> periods = holomorphic::loop_periods(s, combine(B, E.lambda));
+      // The curves of each loop, read from the classification of its merged vertices.
+      std::map<LO, LO> merged_curve;
+      for (std::size_t v = 0; v < glued.background.vclass.size(); ++v)
+        if (glued.background.vclass[v].dim == 1)
+          merged_curve[s.face2merged[v]] = glued.background.vclass[v].entity;
+      std::vector<std::vector<LO>> loop_curves(s.loops.size());
+      double period_sum = 0, ideal_sum = 0;
+      for (std::size_t l = 0; l < s.loops.size(); ++l) {
+        std::set<LO> on;
+        for (const LO x : s.loops[l])
+          if (const auto it = merged_curve.find(x); it != merged_curve.end()) on.insert(it->second);
+        loop_curves[l].assign(on.begin(), on.end());
+        for (const LO c : on) ideal_sum += ideal[static_cast<std::size_t>(c)];
+        period_sum += std::abs(periods[l]);
+      }
+      if (ideal_sum <= 0 || period_sum <= 0) {
+        skip("no loop length");
+        continue;
+      }
+      const std::vector<LO> counts =
+          holomorphic::balanced_loop_counts(periods, period_sum / ideal_sum);
+      std::string line = cat("smooth group of face ", group.front(), ": loop periods / counts");
+      for (std::size_t l = 0; l < s.loops.size(); ++l)
+        line += cat(" ", periods[l], " / ", counts[l]);
+      cx.log.info(line);
+      for (std::size_t l = 0; l < s.loops.size(); ++l) {
+        const auto& cs = loop_curves[l];
+        if (cs.empty()) continue;
+        // Largest remainders of the loop's count split by the curves' ideal counts, one edge at
+        // least each.
+        double loop_ideal = 0;
+        for (const LO c : cs) loop_ideal += ideal[static_cast<std::size_t>(c)];
+        std::vector<std::int64_t> n(cs.size(), 1);
+        std::vector<std::pair<double, std::size_t>> rest;
+        std::int64_t given = 0;
+        for (std::size_t k = 0; k < cs.size(); ++k) {
+          const double share =
+              double(counts[l]) * ideal[static_cast<std::size_t>(cs[k])] / loop_ideal;
+          n[k] = std::max<std::int64_t>(1, static_cast<std::int64_t>(std::floor(share)));
+          rest.emplace_back(-(share - std::floor(share)), k);
+          given += n[k];
+        }
+        std::sort(rest.begin(), rest.end());
+        for (std::size_t k = 0; given < counts[l] && k < rest.size(); ++k, ++given)
+          ++n[rest[k].second];
+        for (std::size_t k = 0; k < cs.size(); ++k)
+          if (user.count(cs[k]) == 0) {
+            double& at = count[static_cast<std::size_t>(cs[k])];
+            at = std::min(at, -double(n[k]));
+          }
+      }
+    } catch (const std::exception& e) {
+      skip(e.what());
+    }
+  }
+  cx.comm.allreduce_min(count);
+  // Each curve's count to the first group with a face on it (groups in sg.groups order).
+  std::vector<LO> group_of_face(static_cast<std::size_t>(model.num_faces()), kNoIndex);
+  for (std::size_t g = sg.groups.size(); g-- > 0;)
+    for (const LO f : sg.groups[g]) group_of_face[static_cast<std::size_t>(f)] = static_cast<LO>(g);
+  std::vector<std::vector<std::pair<LO, int>>> out(sg.groups.size());
+  for (LO c = 0; c < model.num_curves(); ++c) {
+    if (count[static_cast<std::size_t>(c)] >= 0) continue;
+    LO g = kNoIndex;
+    for (const LO f : model.curve2faces()[c]) {
+      const LO gf = group_of_face[static_cast<std::size_t>(f)];
+      if (gf != kNoIndex && (g == kNoIndex || gf < g)) g = gf;
+    }
+    if (g != kNoIndex)
+      out[static_cast<std::size_t>(g)].emplace_back(
+          c, static_cast<int>(-count[static_cast<std::size_t>(c)]));
+  }
+  return out;
+}
+
 // Quantization (paper 000 Sec. 4.3), balanced against the patterns and repaired where a face
 // boundary crosses itself, computed identically on every rank: fills result.quantization,
 // balance, curves_refined_for_crossings and quantized_curves (the final curve meshes; each face
 // halves its own loops from them, background::halved_face_boundary).
 void quantize_stage(const Context& cx, std::span<const mesh::CurveMesh> curves,
-                    const std::vector<FaceTask>& faces,
+                    const std::vector<FaceTask>& faces, const SmoothGroups& sg,
                     std::span<const std::vector<std::pair<LO, int>>> group_counts,
                     PipelineResult& result) {
   const PipelineOptions& options = cx.options;
@@ -154,17 +317,61 @@ void quantize_stage(const Context& cx, std::span<const mesh::CurveMesh> curves,
   // with a chord of four-sided faces outside it (cube_filet), and the group then keeps the
   // quantization's counts (its mesh falls back unless they add up). Same on every rank.
   quantize::QuantizeOptions qo = options.quantize;
-  for (const auto& list : group_counts) {
+  std::vector<char> accepted(group_counts.size(), 0);
+  for (std::size_t g = 0; g < group_counts.size(); ++g) {
+    const auto& list = group_counts[g];
     if (list.empty()) continue;
     quantize::QuantizeOptions trial = qo;
     trial.prescribed.insert(trial.prescribed.end(), list.begin(), list.end());
     try {
       (void)quantize::quantize_curves(model, ideal, trial);
       qo = std::move(trial);
+      accepted[g] = 1;
     } catch (const InputError& e) {
       cx.log.info(cat("quantize: loop counts of the smooth group with curve ", list.front().first,
                       " not prescribed (", e.what(), ")"));
     }
+  }
+  if (std::find(accepted.begin(), accepted.end(), 1) != accepted.end()) {
+    // A group whose mesh fails for reasons other than its counts (zeros of the form on a loop,
+    // sharp corners) would leave its faces' own meshes on counts chosen for the group, worse
+    // than the quantization's (Block: interior irregular vertices of those faces 660 -> 890).
+    // So each group is meshed once on curve meshes with the counts prescribed (its own curves'
+    // counts are then final), and only the groups that mesh keep their prescriptions.
+    const quantize::Quantization q = quantize::quantize_curves(model, ideal, qo);
+    const std::vector<mesh::CurveMesh> placed = quantize::place_vertices(
+        model, curves, result.curve_sizes.at, q, /*halved=*/false, cx.tasks, options.place);
+    std::map<LO, std::size_t> local_of;
+    for (std::size_t i = 0; i < faces.size(); ++i) local_of[faces[i].face] = i;
+    std::vector<std::int64_t> failed(group_counts.size(), 0);
+    for (std::size_t g = 0; g < group_counts.size(); ++g) {
+      if (accepted[g] == 0 || local_of.count(sg.groups[g].front()) == 0) continue;
+      std::vector<std::unique_ptr<cad::FaceGeometry>> owned;
+      const holomorphic::GluedGroup glued =
+          glue_local(model, sg.groups[g], faces, local_of, placed, owned);
+      holomorphic::HolomorphicReport report;
+      if (glued.ok) {
+        std::vector<const cad::FaceGeometry*> surfaces;
+        for (const auto& o : owned) surfaces.push_back(o.get());
+        try {
+          (void)holomorphic::mesh_group(glued, surfaces, options.holomorphic, &report);
+        } catch (const std::exception& e) {
+          report.ok = false;
+          report.reason = e.what();
+        }
+      }
+      if (!glued.ok || !report.ok) {
+        failed[g] = 1;
+        cx.log.info(
+            cat("quantize: loop counts of the smooth group of face ", sg.groups[g].front(),
+                " not prescribed (its mesh fails: ", glued.ok ? report.reason : glued.reason, ")"));
+      }
+    }
+    cx.comm.allreduce_sum(failed);
+    qo = options.quantize;
+    for (std::size_t g = 0; g < group_counts.size(); ++g)
+      if (accepted[g] != 0 && failed[g] == 0)
+        qo.prescribed.insert(qo.prescribed.end(), group_counts[g].begin(), group_counts[g].end());
   }
   std::vector<LO> fixed;  // user prescriptions: never changed
   for (const auto& [c, n] : qo.prescribed) fixed.push_back(c);
@@ -537,169 +744,6 @@ void gather_stage(const Context& cx, std::vector<FaceTask>& faces,
   if (cx.comm.rank() == 0) result.mesh = assembler->finish();
 }
 
-// --- Smooth groups (PipelineOptions::smooth_groups) ----------------------------------------------
-
-// The groups of two faces or more (holomorphic::smooth_face_groups), and each face's group's first
-// face (itself when alone). Every rank computes the same, from the model only.
-struct SmoothGroups {
-  std::vector<std::vector<LO>> groups;
-  std::vector<LO> face_group;
-};
-
-SmoothGroups find_smooth_groups(const cad::CadModel& model,
-                                const holomorphic::GroupOptions& options) {
-  SmoothGroups out;
-  out.face_group.resize(static_cast<std::size_t>(model.num_faces()));
-  for (auto& g : holomorphic::smooth_face_groups(model, options)) {
-    for (const LO f : g) out.face_group[static_cast<std::size_t>(f)] = g.front();
-    if (g.size() > 1) out.groups.push_back(std::move(g));
-  }
-  return out;
-}
-
-// A group glued from this rank's tasks (the partition keeps a group on one rank), each face's
-// loops on `curves`; the surfaces of its faces go to `owned`. Never throws for the group.
-holomorphic::GluedGroup glue_local(const cad::CadModel& model, std::span<const LO> group,
-                                   const std::vector<FaceTask>& faces,
-                                   const std::map<LO, std::size_t>& local_of,
-                                   std::span<const mesh::CurveMesh> curves,
-                                   std::vector<std::unique_ptr<cad::FaceGeometry>>& owned) {
-  holomorphic::GluedGroup failed;
-  std::vector<mesh::FaceMesh> backgrounds;
-  std::vector<std::vector<mesh::BoundaryLoop>> loops;
-  owned.clear();
-  try {
-    for (const LO f : group) {
-      const FaceTask& t = faces[local_of.at(f)];
-      if (!t.background_report.ok || t.background.triangles.empty()) {
-        failed.reason = "face " + std::to_string(f) + " has no background mesh";
-        return failed;
-      }
-      backgrounds.push_back(t.background);
-      owned.push_back(model.face_geometry(f));
-      loops.push_back(background::face_boundary(model, f, *owned.back(), curves));
-    }
-  } catch (const std::exception& e) {
-    failed.reason = std::string("boundary: ") + e.what();
-    return failed;
-  }
-  return holomorphic::glue_group(group, backgrounds, loops);
-}
-
-// The counts of the groups' outer loops from their optimised forms (paper 004 Sec. 4: the loops'
-// periods add up, and so must the counts of a conforming mesh; holomorphic::loop_periods,
-// balanced_loop_counts), as prescriptions (curve, count) for the quantization. The target edge
-// length is the one at which the loops' summed ideal counts (the size map's) are kept. A loop of
-// several curves shares its count by their ideal counts. Each group is computed by the rank
-// holding it; a max-reduction gives every rank the same lists (one per group of sg.groups). Curves
-// the user prescribed keep their counts (a group then meshes only if they add up).
-std::vector<std::vector<std::pair<LO, int>>> group_loop_counts(
-    const Context& cx, const SmoothGroups& sg, std::span<const mesh::CurveMesh> curves,
-    const std::vector<FaceTask>& faces, const PipelineResult& result) {
-  const cad::CadModel& model = cx.model;
-  const std::vector<double> ideal = quantize::ideal_edge_counts(curves, result.curve_sizes.at);
-  std::set<LO> user;
-  for (const auto& [c, n] : cx.options.quantize.prescribed) user.insert(c);
-  std::map<LO, std::size_t> local_of;
-  for (std::size_t i = 0; i < faces.size(); ++i) local_of[faces[i].face] = i;
-  // Minus each curve's count (0: none), so that the minimum over ranks is the largest count.
-  std::vector<double> count(static_cast<std::size_t>(model.num_curves()), 0.0);
-  for (const auto& group : sg.groups) {
-    if (local_of.count(group.front()) == 0) continue;
-    std::vector<std::unique_ptr<cad::FaceGeometry>> owned;
-    const holomorphic::GluedGroup glued = glue_local(model, group, faces, local_of, curves, owned);
-    const auto skip = [&](const std::string& why) {
-      cx.log.info(cat("smooth group of face ", group.front(), ": no loop counts (", why, ")"));
-    };
-    if (!glued.ok) {
-      skip(glued.reason);
-      continue;
-    }
-    try {
-      const holomorphic::PolyAnnulus s = holomorphic::poly_annulus(glued.background);
-      if (!s.ok) {
-        skip(s.reason);
-        continue;
-      }
-      const auto& ho = cx.options.holomorphic;
-      const holomorphic::HolomorphicBasis B = holomorphic::holomorphic_basis(s, ho.basis, nullptr);
-      const holomorphic::EnergyResult E = holomorphic::minimize_area_distortion(s, B, ho.energy);
-      const std::vector<double> periods = holomorphic::loop_periods(s, combine(B, E.lambda));
-      // The curves of each loop, read from the classification of its merged vertices.
-      std::map<LO, LO> merged_curve;
-      for (std::size_t v = 0; v < glued.background.vclass.size(); ++v)
-        if (glued.background.vclass[v].dim == 1)
-          merged_curve[s.face2merged[v]] = glued.background.vclass[v].entity;
-      std::vector<std::vector<LO>> loop_curves(s.loops.size());
-      double period_sum = 0, ideal_sum = 0;
-      for (std::size_t l = 0; l < s.loops.size(); ++l) {
-        std::set<LO> on;
-        for (const LO x : s.loops[l])
-          if (const auto it = merged_curve.find(x); it != merged_curve.end()) on.insert(it->second);
-        loop_curves[l].assign(on.begin(), on.end());
-        for (const LO c : on) ideal_sum += ideal[static_cast<std::size_t>(c)];
-        period_sum += std::abs(periods[l]);
-      }
-      if (ideal_sum <= 0 || period_sum <= 0) {
-        skip("no loop length");
-        continue;
-      }
-      const std::vector<LO> counts =
-          holomorphic::balanced_loop_counts(periods, period_sum / ideal_sum);
-      std::string line = cat("smooth group of face ", group.front(), ": loop periods / counts");
-      for (std::size_t l = 0; l < s.loops.size(); ++l)
-        line += cat(" ", periods[l], " / ", counts[l]);
-      cx.log.info(line);
-      for (std::size_t l = 0; l < s.loops.size(); ++l) {
-        const auto& cs = loop_curves[l];
-        if (cs.empty()) continue;
-        // Largest remainders of the loop's count split by the curves' ideal counts, one edge at
-        // least each.
-        double loop_ideal = 0;
-        for (const LO c : cs) loop_ideal += ideal[static_cast<std::size_t>(c)];
-        std::vector<std::int64_t> n(cs.size(), 1);
-        std::vector<std::pair<double, std::size_t>> rest;
-        std::int64_t given = 0;
-        for (std::size_t k = 0; k < cs.size(); ++k) {
-          const double share =
-              double(counts[l]) * ideal[static_cast<std::size_t>(cs[k])] / loop_ideal;
-          n[k] = std::max<std::int64_t>(1, static_cast<std::int64_t>(std::floor(share)));
-          rest.emplace_back(-(share - std::floor(share)), k);
-          given += n[k];
-        }
-        std::sort(rest.begin(), rest.end());
-        for (std::size_t k = 0; given < counts[l] && k < rest.size(); ++k, ++given)
-          ++n[rest[k].second];
-        for (std::size_t k = 0; k < cs.size(); ++k)
-          if (user.count(cs[k]) == 0) {
-            double& at = count[static_cast<std::size_t>(cs[k])];
-            at = std::min(at, -double(n[k]));
-          }
-      }
-    } catch (const std::exception& e) {
-      skip(e.what());
-    }
-  }
-  cx.comm.allreduce_min(count);
-  // Each curve's count to the first group with a face on it (groups in sg.groups order).
-  std::vector<LO> group_of_face(static_cast<std::size_t>(model.num_faces()), kNoIndex);
-  for (std::size_t g = sg.groups.size(); g-- > 0;)
-    for (const LO f : sg.groups[g]) group_of_face[static_cast<std::size_t>(f)] = static_cast<LO>(g);
-  std::vector<std::vector<std::pair<LO, int>>> out(sg.groups.size());
-  for (LO c = 0; c < model.num_curves(); ++c) {
-    if (count[static_cast<std::size_t>(c)] >= 0) continue;
-    LO g = kNoIndex;
-    for (const LO f : model.curve2faces()[c]) {
-      const LO gf = group_of_face[static_cast<std::size_t>(f)];
-      if (gf != kNoIndex && (g == kNoIndex || gf < g)) g = gf;
-    }
-    if (g != kNoIndex)
-      out[static_cast<std::size_t>(g)].emplace_back(
-          c, static_cast<int>(-count[static_cast<std::size_t>(c)]));
-  }
-  return out;
-}
-
 // A group's mesh on the final curve meshes (holomorphic::mesh_group), made while its faces'
 // background meshes are still there; empty with the reason when it fails.
 struct GroupResult {
@@ -937,7 +981,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     const std::vector<std::vector<std::pair<LO, int>>> group_counts =
         by_groups ? group_loop_counts(cx, smooth_groups, curves, faces, result)
                   : std::vector<std::vector<std::pair<LO, int>>>{};
-    quantize_stage(cx, curves, faces, group_counts, result);
+    quantize_stage(cx, curves, faces, smooth_groups, group_counts, result);
     clock.end("quantize", false);
   }
 
