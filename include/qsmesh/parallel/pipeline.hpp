@@ -130,9 +130,12 @@ struct PipelineOptions {
   /// (holomorphic::smooth_face_groups) are meshed as one surface (holomorphic::mesh_group), each
   /// group on one rank (the partition moves a group's faces to the rank of its first face). The
   /// counts of a group's outer loops come from its optimised form's periods
-  /// (holomorphic::balanced_loop_counts), prescribed to the quantization like `--curve-edges`;
-  /// the group's quads cross its inner curves and go to the face that holds their centre. A group
-  /// whose mesh fails keeps its faces' own meshes, the reason in QuasiReport::holomorphic.
+  /// (holomorphic::balanced_loop_counts), prescribed to the quantization like `--curve-edges`
+  /// where it can meet them and the group meshes on them (a trial in the quantize stage);
+  /// the group's quads cross its inner curves and go to the face that holds their centre. The
+  /// face policy (holomorphic::keep_holomorphic, the group against its faces' own meshes taken
+  /// together) decides; a group not kept keeps its faces' meshes, the reason in
+  /// QuasiReport::holomorphic.
   bool smooth_groups = false;
   holomorphic::GroupOptions groups;
   /// Paper 003 (fieldmesh::face_method per face): faces of `given_fields` (--cross-field; null:
