@@ -352,6 +352,7 @@ void quantize_stage(const Context& cx, std::span<const mesh::CurveMesh> curves,
       holomorphic::HolomorphicReport report;
       if (glued.ok) {
         std::vector<const cad::FaceGeometry*> surfaces;
+        surfaces.reserve(owned.size());
         for (const auto& o : owned) surfaces.push_back(o.get());
         try {
           (void)holomorphic::mesh_group(glued, surfaces, options.holomorphic, &report);
@@ -770,6 +771,7 @@ std::vector<GroupResult> mesh_smooth_groups(const Context& cx, const SmoothGroup
       continue;
     }
     std::vector<const cad::FaceGeometry*> surfaces;
+    surfaces.reserve(owned.size());
     for (const auto& o : owned) surfaces.push_back(o.get());
     holomorphic::HolomorphicReport report;
     try {
