@@ -184,7 +184,9 @@ Arguments parse(const std::vector<std::string>& args) {
           a.method != "auto")
         throw InputError("--method: expected default, holomorphic, auto or separatrix, got '" +
                          a.method + "'");
-    } else if (opt == "--threads")
+    } else if (opt == "--smooth-groups" && a.command == Command::Mesh)
+      a.smooth_groups = true;
+    else if (opt == "--threads")
       a.threads = parse_threads(value());
     else if (opt == "--face-time-budget" && a.command == Command::Mesh)
       a.face_time_budget = parse_positive(opt, value());
@@ -390,6 +392,14 @@ Arguments parse(const std::vector<std::string>& args) {
                          ": PLOT3D blocks of high-order quads are not written");
       a.block_structured = true;
     }
+    if (a.smooth_groups && a.method != "holomorphic" && a.method != "auto")
+      throw InputError("--smooth-groups: only with --method holomorphic or auto");
+    if (a.smooth_groups && a.until == "background")
+      throw InputError("--smooth-groups needs a quad mesh: not with --until background");
+    if (a.smooth_groups && a.block_structured)
+      throw InputError(
+          "--smooth-groups: a group's quads cross its faces' curves, which the blocks of "
+          "--block-structured follow; not together");
     if (layout_given && !a.block_structured)
       throw InputError("--layout: only with --block-structured (or -o FILE.xyz)");
     if (a.block_structured) {
@@ -490,6 +500,11 @@ std::string help(const std::string& topic) {
           "                        (paper 003's partition into four-sided regions on the mesher's\n"
           "                        own cross field, filled by transfinite interpolation; a face\n"
           "                        where it fails keeps the default mesh, \"field_refusal\")\n"
+          "  --smooth-groups       with --method holomorphic or auto: faces joined across smooth\n"
+          "                        (G1) curves, such as a fillet between two pipes, meshed as one\n"
+          "                        surface from its holomorphic 1-form; the quads cross the inner\n"
+          "                        curves and each goes to the face holding its centre; the outer\n"
+          "                        loops' counts come from the form (not with --block-structured)\n"
           "  --order N             high-order elements, N = 2..5: Lagrange quads of (N+1)^2 nodes\n"
           "                        and bars of N+1 nodes, the new nodes on the CAD, quads that\n"
           "                        would fold straightened (CGNS QUAD_9/16/25 and BAR_3/4/5, so\n"

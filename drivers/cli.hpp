@@ -43,6 +43,9 @@ struct Arguments {
   /// mesher's own cross field for the other faces.
   std::string cross_field;
   bool separatrix_method = false;
+  /// --smooth-groups (with --method holomorphic|auto): faces joined across smooth curves meshed
+  /// as one surface (PipelineOptions::smooth_groups).
+  bool smooth_groups = false;
   /// --layout coarse|dense (with --block-structured): the coarse conforming layout of paper 002
   /// Sec. III-IV (layout::build_coarse_layout, a new mesh) or the dense layout of the mesh as it
   /// is (the default: see --help for why).

@@ -34,7 +34,8 @@ FaceContribution face_contribution(const FaceMesh& face) {
 }
 
 MeshAssembler::MeshAssembler(const cad::CadModel& model, std::span<const CurveMesh> curves,
-                             std::span<const FaceContribution> contributions)
+                             std::span<const FaceContribution> contributions,
+                             std::span<const char> inner_curves)
     : model_(model), curves_(curves) {
   const LO nc = model.num_corners();
   const LO ncurves = model.num_curves();
@@ -89,7 +90,7 @@ MeshAssembler::MeshAssembler(const cad::CadModel& model, std::span<const CurveMe
   for (LO c = 0; c < ncurves; ++c) {
     const CurveMesh& cm = curves[c];
     const auto& cc = model.curves()[c];
-    if (cc.degenerate) continue;
+    if (cc.degenerate || (!inner_curves.empty() && inner_curves[c] != 0)) continue;
     auto id = [&](LO i) -> GO {
       if (i == 0) return cc.corners[0];
       if (i == cm.num_edges()) return cc.corners[1];
@@ -157,6 +158,68 @@ std::vector<GO> MeshAssembler::add_face(LO f, const FaceMesh& fm) {
     out_.quads[q_out] = {local2global[q[0]], local2global[q[1]], local2global[q[2]],
                          local2global[q[3]]};
     out_.quad_face[q_out++] = f;
+  }
+  return local2global;
+}
+
+std::vector<GO> MeshAssembler::add_group(const FaceMesh& fm, std::span<const LO> quad_face) {
+  const LO nc = model_.num_corners();
+  const LO ncurves = model_.num_curves();
+  const LO nfaces = model_.num_faces();
+  QSMESH_CHECK(quad_face.size() == fm.quads.size(), "assembly: one face per quad of a group");
+  QSMESH_CHECK(fm.triangles.empty(), "assembly: a group mesh has quads only");
+  std::vector<char> in_group(static_cast<std::size_t>(nfaces), 0);
+  const auto take = [&](LO f) {
+    QSMESH_CHECK(f >= 0 && f < nfaces, "assembly: group face " << f << " out of range");
+    if (in_group[f] != 0) return;
+    QSMESH_CHECK(!added_[f], "assembly: face " << f << " added twice");
+    in_group[f] = 1;
+  };
+  for (const LO f : quad_face) take(f);
+  for (const VertexClass& vc : fm.vclass)
+    if (vc.dim == 2) take(vc.entity);
+  std::vector<GO> next_interior(numbering_.face_offset.begin(), numbering_.face_offset.end() - 1);
+  std::vector<GO> next_quad(quad_offset_.begin(), quad_offset_.end() - 1);
+  std::vector<GO> local2global(fm.vclass.size(), -1);
+  for (std::size_t i = 0; i < fm.vclass.size(); ++i) {
+    const VertexClass& vc = fm.vclass[i];
+    GO g = -1;
+    if (vc.dim == 0) {
+      QSMESH_CHECK(vc.entity >= 0 && vc.entity < nc, "group: bad corner id " << vc.entity);
+      g = vc.entity;
+    } else if (vc.dim == 1) {
+      QSMESH_CHECK(vc.entity >= 0 && vc.entity < ncurves, "group: bad curve id " << vc.entity);
+      const CurveMesh& cm = curves_[vc.entity];
+      QSMESH_CHECK(vc.index >= 1 && vc.index < cm.num_edges(),
+                   "group: vertex index " << vc.index << " outside curve " << vc.entity);
+      g = numbering_.curve_offset[vc.entity] + vc.index - 1;
+    } else {
+      const LO f = vc.entity;
+      QSMESH_CHECK(next_interior[f] < numbering_.face_offset[f + 1],
+                   "assembly: group face " << f << " has more interior vertices than announced");
+      g = next_interior[f]++;
+      out_.points[g] = fm.points[i];
+      out_.vclass[g] = vc;
+      out_.vclass[g].index = kNoIndex;
+    }
+    local2global[i] = g;
+  }
+  for (std::size_t q = 0; q < fm.quads.size(); ++q) {
+    const LO f = quad_face[q];
+    QSMESH_CHECK(next_quad[f] < quad_offset_[f + 1],
+                 "assembly: group face " << f << " has more quads than announced");
+    const auto& quad = fm.quads[q];
+    out_.quads[next_quad[f]] = {local2global[quad[0]], local2global[quad[1]], local2global[quad[2]],
+                                local2global[quad[3]]};
+    out_.quad_face[next_quad[f]++] = f;
+  }
+  for (LO f = 0; f < nfaces; ++f) {
+    if (in_group[f] == 0) continue;
+    QSMESH_CHECK(next_interior[f] == numbering_.face_offset[f + 1] &&
+                     next_quad[f] == quad_offset_[f + 1] &&
+                     triangle_offset_[f] == triangle_offset_[f + 1],
+                 "assembly: group face " << f << " has other counts than announced");
+    added_[f] = 1;
   }
   return local2global;
 }

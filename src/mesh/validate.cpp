@@ -25,11 +25,15 @@ struct EdgeUse {
 };
 }  // namespace
 
-ConformityReport check_conformity(const SurfaceMesh& mesh, const cad::CadModel& model) {
+ConformityReport check_conformity(const SurfaceMesh& mesh, const cad::CadModel& model,
+                                  std::span<const LO> face_group) {
   ConformityReport r;
+  // Elements are compared by their face's group (a face alone is its own).
+  const auto group = [&](LO f) { return face_group.empty() ? f : face_group[f]; };
   std::unordered_map<std::uint64_t, std::vector<EdgeUse>> uses;
   std::vector<std::int64_t> per_face(static_cast<std::size_t>(model.num_faces()), 0);
-  auto add = [&](const GO* v, int n, LO face) {
+  auto add = [&](const GO* v, int n, LO f) {
+    const LO face = group(f);
     ++per_face[face];
     for (int i = 0; i < n; ++i)
       for (int j = i + 1; j < n; ++j)
@@ -84,7 +88,7 @@ ConformityReport check_conformity(const SurfaceMesh& mesh, const cad::CadModel& 
     }
   }
   for (LO f = 0; f < model.num_faces(); ++f)
-    if (per_face[f] == 0) ++r.faces_without_elements;
+    if (group(f) == f && per_face[f] == 0) ++r.faces_without_elements;
   return r;
 }
 

@@ -73,6 +73,8 @@ FaceOutput take_output(FaceTask&& task, bool quads) {
   out.seconds = task.seconds;
   out.times = task.times;
   if (quads) out.field_grids = std::move(task.field_grids);
+  out.group_quad_face = std::move(task.group_quad_face);
+  out.group_first = task.group_first;
   task = FaceTask{};
   return out;
 }

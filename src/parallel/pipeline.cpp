@@ -4,16 +4,21 @@
 #include <array>
 #include <atomic>
 #include <cmath>
+#include <map>
+#include <memory>
 #include <numeric>
 #include <optional>
+#include <set>
 #include <span>
 
 #include "exchange.hpp"
 #include "field_stage.hpp"
 #include "improve.hpp"
 #include "qsmesh/background/curve_mesh.hpp"
+#include "qsmesh/background/face_mesh.hpp"
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/mesh/assemble.hpp"
+#include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/parallel/face_task.hpp"
 #include "qsmesh/parallel/partition.hpp"
 #include "qsmesh/parallel/record.hpp"
@@ -133,18 +138,245 @@ sizemap::CurveSizes size_map_stage(const Context& cx, std::span<const mesh::Curv
   return united;
 }
 
+// --- Smooth groups (PipelineOptions::smooth_groups) ----------------------------------------------
+
+// The groups of two faces or more (holomorphic::smooth_face_groups), and each face's group's first
+// face (itself when alone). Every rank computes the same, from the model only.
+struct SmoothGroups {
+  std::vector<std::vector<LO>> groups;
+  std::vector<LO> face_group;
+};
+
+SmoothGroups find_smooth_groups(const cad::CadModel& model,
+                                const holomorphic::GroupOptions& options) {
+  SmoothGroups out;
+  out.face_group.resize(static_cast<std::size_t>(model.num_faces()));
+  for (auto& g : holomorphic::smooth_face_groups(model, options)) {
+    for (const LO f : g) out.face_group[static_cast<std::size_t>(f)] = g.front();
+    if (g.size() > 1) out.groups.push_back(std::move(g));
+  }
+  return out;
+}
+
+// A group glued from this rank's tasks (the partition keeps a group on one rank), each face's
+// loops on `curves`; the surfaces of its faces go to `owned`. Never throws for the group.
+holomorphic::GluedGroup glue_local(const cad::CadModel& model, std::span<const LO> group,
+                                   const std::vector<FaceTask>& faces,
+                                   const std::map<LO, std::size_t>& local_of,
+                                   std::span<const mesh::CurveMesh> curves,
+                                   std::vector<std::unique_ptr<cad::FaceGeometry>>& owned) {
+  holomorphic::GluedGroup failed;
+  std::vector<mesh::FaceMesh> backgrounds;
+  std::vector<std::vector<mesh::BoundaryLoop>> loops;
+  owned.clear();
+  try {
+    for (const LO f : group) {
+      const FaceTask& t = faces[local_of.at(f)];
+      if (!t.background_report.ok || t.background.triangles.empty()) {
+        failed.reason = "face " + std::to_string(f) + " has no background mesh";
+        return failed;
+      }
+      backgrounds.push_back(t.background);
+      owned.push_back(model.face_geometry(f));
+      loops.push_back(background::face_boundary(model, f, *owned.back(), curves));
+    }
+  } catch (const std::exception& e) {
+    failed.reason = std::string("boundary: ") + e.what();
+    return failed;
+  }
+  return holomorphic::glue_group(group, backgrounds, loops);
+}
+
+// The counts of the groups' outer loops from their optimised forms (paper 004 Sec. 4: the loops'
+// periods add up, and so must the counts of a conforming mesh; holomorphic::loop_periods,
+// balanced_loop_counts), as prescriptions (curve, count) for the quantization. The target edge
+// length is the one at which the loops' summed ideal counts (the size map's) are kept. A loop of
+// several curves shares its count by their ideal counts. Each group is computed by the rank
+// holding it; a max-reduction gives every rank the same lists (one per group of sg.groups). Curves
+// the user prescribed keep their counts (a group then meshes only if they add up).
+std::vector<std::vector<std::pair<LO, int>>> group_loop_counts(
+    const Context& cx, const SmoothGroups& sg, std::span<const mesh::CurveMesh> curves,
+    const std::vector<FaceTask>& faces, const PipelineResult& result) {
+  const cad::CadModel& model = cx.model;
+  const std::vector<double> ideal = quantize::ideal_edge_counts(curves, result.curve_sizes.at);
+  std::set<LO> user;
+  for (const auto& [c, n] : cx.options.quantize.prescribed) user.insert(c);
+  std::map<LO, std::size_t> local_of;
+  for (std::size_t i = 0; i < faces.size(); ++i) local_of[faces[i].face] = i;
+  // Minus each curve's count (0: none), so that the minimum over ranks is the largest count.
+  std::vector<double> count(static_cast<std::size_t>(model.num_curves()), 0.0);
+  for (const auto& group : sg.groups) {
+    if (local_of.count(group.front()) == 0) continue;
+    std::vector<std::unique_ptr<cad::FaceGeometry>> owned;
+    const holomorphic::GluedGroup glued = glue_local(model, group, faces, local_of, curves, owned);
+    const auto skip = [&](const std::string& why) {
+      cx.log.info(cat("smooth group of face ", group.front(), ": no loop counts (", why, ")"));
+    };
+    if (!glued.ok) {
+      skip(glued.reason);
+      continue;
+    }
+    try {
+      const holomorphic::PolyAnnulus s = holomorphic::poly_annulus(glued.background);
+      if (!s.ok) {
+        skip(s.reason);
+        continue;
+      }
+      const auto& ho = cx.options.holomorphic;
+      const holomorphic::HolomorphicBasis B = holomorphic::holomorphic_basis(s, ho.basis, nullptr);
+      const holomorphic::EnergyResult E = holomorphic::minimize_area_distortion(s, B, ho.energy);
+      const std::vector<double> periods = holomorphic::loop_periods(s, combine(B, E.lambda));
+      // The curves of each loop, read from the classification of its merged vertices.
+      std::map<LO, LO> merged_curve;
+      for (std::size_t v = 0; v < glued.background.vclass.size(); ++v)
+        if (glued.background.vclass[v].dim == 1)
+          merged_curve[s.face2merged[v]] = glued.background.vclass[v].entity;
+      std::vector<std::vector<LO>> loop_curves(s.loops.size());
+      double period_sum = 0, ideal_sum = 0;
+      for (std::size_t l = 0; l < s.loops.size(); ++l) {
+        std::set<LO> on;
+        for (const LO x : s.loops[l])
+          if (const auto it = merged_curve.find(x); it != merged_curve.end()) on.insert(it->second);
+        loop_curves[l].assign(on.begin(), on.end());
+        for (const LO c : on) ideal_sum += ideal[static_cast<std::size_t>(c)];
+        period_sum += std::abs(periods[l]);
+      }
+      if (ideal_sum <= 0 || period_sum <= 0) {
+        skip("no loop length");
+        continue;
+      }
+      const std::vector<LO> counts =
+          holomorphic::balanced_loop_counts(periods, period_sum / ideal_sum);
+      std::string line = cat("smooth group of face ", group.front(), ": loop periods / counts");
+      for (std::size_t l = 0; l < s.loops.size(); ++l)
+        line += cat(" ", periods[l], " / ", counts[l]);
+      cx.log.info(line);
+      for (std::size_t l = 0; l < s.loops.size(); ++l) {
+        const auto& cs = loop_curves[l];
+        if (cs.empty()) continue;
+        // Largest remainders of the loop's count split by the curves' ideal counts, one edge at
+        // least each.
+        double loop_ideal = 0;
+        for (const LO c : cs) loop_ideal += ideal[static_cast<std::size_t>(c)];
+        std::vector<std::int64_t> n(cs.size(), 1);
+        std::vector<std::pair<double, std::size_t>> rest;
+        std::int64_t given = 0;
+        for (std::size_t k = 0; k < cs.size(); ++k) {
+          const double share =
+              double(counts[l]) * ideal[static_cast<std::size_t>(cs[k])] / loop_ideal;
+          n[k] = std::max<std::int64_t>(1, static_cast<std::int64_t>(std::floor(share)));
+          rest.emplace_back(-(share - std::floor(share)), k);
+          given += n[k];
+        }
+        std::sort(rest.begin(), rest.end());
+        for (std::size_t k = 0; given < counts[l] && k < rest.size(); ++k, ++given)
+          ++n[rest[k].second];
+        for (std::size_t k = 0; k < cs.size(); ++k)
+          if (user.count(cs[k]) == 0) {
+            double& at = count[static_cast<std::size_t>(cs[k])];
+            at = std::min(at, -double(n[k]));
+          }
+      }
+    } catch (const std::exception& e) {
+      skip(e.what());
+    }
+  }
+  cx.comm.allreduce_min(count);
+  // Each curve's count to the first group with a face on it (groups in sg.groups order).
+  std::vector<LO> group_of_face(static_cast<std::size_t>(model.num_faces()), kNoIndex);
+  for (std::size_t g = sg.groups.size(); g-- > 0;)
+    for (const LO f : sg.groups[g]) group_of_face[static_cast<std::size_t>(f)] = static_cast<LO>(g);
+  std::vector<std::vector<std::pair<LO, int>>> out(sg.groups.size());
+  for (LO c = 0; c < model.num_curves(); ++c) {
+    if (count[static_cast<std::size_t>(c)] >= 0) continue;
+    LO g = kNoIndex;
+    for (const LO f : model.curve2faces()[c]) {
+      const LO gf = group_of_face[static_cast<std::size_t>(f)];
+      if (gf != kNoIndex && (g == kNoIndex || gf < g)) g = gf;
+    }
+    if (g != kNoIndex)
+      out[static_cast<std::size_t>(g)].emplace_back(
+          c, static_cast<int>(-count[static_cast<std::size_t>(c)]));
+  }
+  return out;
+}
+
 // Quantization (paper 000 Sec. 4.3), balanced against the patterns and repaired where a face
 // boundary crosses itself, computed identically on every rank: fills result.quantization,
 // balance, curves_refined_for_crossings and quantized_curves (the final curve meshes; each face
 // halves its own loops from them, background::halved_face_boundary).
 void quantize_stage(const Context& cx, std::span<const mesh::CurveMesh> curves,
-                    const std::vector<FaceTask>& faces, PipelineResult& result) {
+                    const std::vector<FaceTask>& faces, const SmoothGroups& sg,
+                    std::span<const std::vector<std::pair<LO, int>>> group_counts,
+                    PipelineResult& result) {
   const PipelineOptions& options = cx.options;
   const cad::CadModel& model = cx.model;
-  std::vector<LO> fixed;  // user prescriptions: never changed
-  for (const auto& [c, n] : options.quantize.prescribed) fixed.push_back(c);
   const std::vector<double> ideal = quantize::ideal_edge_counts(curves, result.curve_sizes.at);
-  result.quantization = quantize::quantize_curves(model, ideal, options.quantize);
+  // The smooth groups' outer counts (group_counts, one list per group) are prescribed as the
+  // user's are, group by group where the quantization can meet them: a group's counts may clash
+  // with a chord of four-sided faces outside it (cube_filet), and the group then keeps the
+  // quantization's counts (its mesh falls back unless they add up). Same on every rank.
+  quantize::QuantizeOptions qo = options.quantize;
+  std::vector<char> accepted(group_counts.size(), 0);
+  for (std::size_t g = 0; g < group_counts.size(); ++g) {
+    const auto& list = group_counts[g];
+    if (list.empty()) continue;
+    quantize::QuantizeOptions trial = qo;
+    trial.prescribed.insert(trial.prescribed.end(), list.begin(), list.end());
+    try {
+      (void)quantize::quantize_curves(model, ideal, trial);
+      qo = std::move(trial);
+      accepted[g] = 1;
+    } catch (const InputError& e) {
+      cx.log.info(cat("quantize: loop counts of the smooth group with curve ", list.front().first,
+                      " not prescribed (", e.what(), ")"));
+    }
+  }
+  if (std::find(accepted.begin(), accepted.end(), 1) != accepted.end()) {
+    // A group whose mesh fails for reasons other than its counts (zeros of the form on a loop,
+    // sharp corners) would leave its faces' own meshes on counts chosen for the group, worse
+    // than the quantization's (Block: interior irregular vertices of those faces 660 -> 890).
+    // So each group is meshed once on curve meshes with the counts prescribed (its own curves'
+    // counts are then final), and only the groups that mesh keep their prescriptions.
+    const quantize::Quantization q = quantize::quantize_curves(model, ideal, qo);
+    const std::vector<mesh::CurveMesh> placed = quantize::place_vertices(
+        model, curves, result.curve_sizes.at, q, /*halved=*/false, cx.tasks, options.place);
+    std::map<LO, std::size_t> local_of;
+    for (std::size_t i = 0; i < faces.size(); ++i) local_of[faces[i].face] = i;
+    std::vector<std::int64_t> failed(group_counts.size(), 0);
+    for (std::size_t g = 0; g < group_counts.size(); ++g) {
+      if (accepted[g] == 0 || local_of.count(sg.groups[g].front()) == 0) continue;
+      std::vector<std::unique_ptr<cad::FaceGeometry>> owned;
+      const holomorphic::GluedGroup glued =
+          glue_local(model, sg.groups[g], faces, local_of, placed, owned);
+      holomorphic::HolomorphicReport report;
+      if (glued.ok) {
+        std::vector<const cad::FaceGeometry*> surfaces;
+        surfaces.reserve(owned.size());
+        for (const auto& o : owned) surfaces.push_back(o.get());
+        try {
+          (void)holomorphic::mesh_group(glued, surfaces, options.holomorphic, &report);
+        } catch (const std::exception& e) {
+          report.ok = false;
+          report.reason = e.what();
+        }
+      }
+      if (!glued.ok || !report.ok) {
+        failed[g] = 1;
+        cx.log.info(
+            cat("quantize: loop counts of the smooth group of face ", sg.groups[g].front(),
+                " not prescribed (its mesh fails: ", glued.ok ? report.reason : glued.reason, ")"));
+      }
+    }
+    cx.comm.allreduce_sum(failed);
+    qo = options.quantize;
+    for (std::size_t g = 0; g < group_counts.size(); ++g)
+      if (accepted[g] != 0 && failed[g] == 0)
+        qo.prescribed.insert(qo.prescribed.end(), group_counts[g].begin(), group_counts[g].end());
+  }
+  std::vector<LO> fixed;  // user prescriptions: never changed
+  for (const auto& [c, n] : qo.prescribed) fixed.push_back(c);
+  result.quantization = quantize::quantize_curves(model, ideal, qo);
   if (options.balance_counts) {
     // Every rank balances the whole model the same way (deterministic, model-wide data only).
     const auto patterns = qstruct::builtin_patterns();
@@ -403,28 +635,59 @@ void compare_stage(const Context& cx, std::vector<FaceTask>& faces,
   });
 }
 
+// What the assembly needs of the groups meshed on this rank (PipelineOptions::smooth_groups;
+// empty on every rank otherwise).
+struct GroupsForOutput {
+  std::map<LO, mesh::FaceQuadStats> stats;  ///< by face of a group meshed
+  /// By curve: 1 when used twice by the faces of a group meshed (inside it: a curve between two
+  /// of its faces, or a seam of one), so that its quads cross it and it gets no bars.
+  std::vector<std::int64_t> inner_curves;
+};
+
 // Gathers every face on rank 0 and assembles them (collective; faces is emptied). The assembled
 // mesh is sized first from every face's counts; the faces then arrive one rank at a time and
 // each is written in place and dropped, so that rank 0 holds the assembled mesh and one rank's
 // faces, not every face twice over. Fills result's per-face vectors and mesh on rank 0.
 void gather_stage(const Context& cx, std::vector<FaceTask>& faces,
                   std::span<const mesh::CurveMesh> final_curves, bool quads, bool quasi,
-                  PipelineResult& result) {
+                  GroupsForOutput& groups, PipelineResult& result) {
   const PipelineOptions& options = cx.options;
   const LO nfaces = cx.model.num_faces();
   std::vector<std::int64_t> counts(3 * static_cast<std::size_t>(nfaces), 0);
   for (const FaceTask& t : faces) {
-    const mesh::FaceContribution c = mesh::face_contribution(quads ? t.quad_mesh : t.background);
+    const mesh::FaceMesh& m = quads ? t.quad_mesh : t.background;
+    if (!t.group_quad_face.empty()) {
+      // A smooth group's mesh, held by its first face, counts on the faces it gives its quads
+      // and interior vertices to (mesh::MeshAssembler::add_group); the other faces bring none.
+      for (const mesh::VertexClass& vc : m.vclass)
+        if (vc.dim == 2) ++counts[3 * static_cast<std::size_t>(vc.entity)];
+      for (const LO f : t.group_quad_face) ++counts[3 * static_cast<std::size_t>(f) + 2];
+      continue;
+    }
+    const mesh::FaceContribution c = mesh::face_contribution(m);
     const auto at = 3 * static_cast<std::size_t>(t.face);
-    counts[at] = c.interior_vertices;
-    counts[at + 1] = c.triangles;
-    counts[at + 2] = c.quads;
+    counts[at] += c.interior_vertices;
+    counts[at + 1] += c.triangles;
+    counts[at + 2] += c.quads;
   }
   cx.comm.allreduce_sum(counts);  // each face's entries are set by its owner alone
   std::vector<char> buffer;
-  for (FaceTask& t : faces) write_record(buffer, take_output(std::move(t), quads));
+  for (FaceTask& t : faces) {
+    FaceOutput out = take_output(std::move(t), quads);
+    // A smooth group's faces: their own parts of the group's mesh (group_face_stats).
+    if (const auto it = groups.stats.find(out.report.face); quads && it != groups.stats.end())
+      out.stats = it->second;
+    write_record(buffer, out);
+  }
   faces.clear();
   std::optional<mesh::MeshAssembler> assembler;
+  // The curves inside the groups meshed get no bars (every rank takes part in the sum when any
+  // group was formed; the flags are empty otherwise).
+  std::vector<char> inner;
+  if (!groups.inner_curves.empty()) {
+    cx.comm.allreduce_sum(groups.inner_curves);
+    for (const std::int64_t x : groups.inner_curves) inner.push_back(x > 0 ? 1 : 0);
+  }
   const bool size_map = options.size_map || quads;
   const bool keep_background = size_map && !quads;  // the size map's output draws them
   if (cx.comm.rank() == 0) {
@@ -433,7 +696,7 @@ void gather_stage(const Context& cx, std::vector<FaceTask>& faces,
       const auto at = 3 * static_cast<std::size_t>(f);
       contributions[f] = {counts[at], counts[at + 1], counts[at + 2]};
     }
-    assembler.emplace(cx.model, final_curves, contributions);
+    assembler.emplace(cx.model, final_curves, contributions, inner);
     const auto n = static_cast<std::size_t>(nfaces);
     result.reports.resize(n);
     if (options.cross_fields) result.cross_fields.resize(n);
@@ -459,12 +722,18 @@ void gather_stage(const Context& cx, std::vector<FaceTask>& faces,
       QSMESH_CHECK(f >= 0 && f < nfaces, "gathered report for unknown face " << f);
       result.reports[f] = std::move(out.report);
       out.mesh.face = f;
-      const std::vector<GO> global = assembler->add_face(f, out.mesh);
-      if (quads) {
-        for (fieldmesh::RegionGrid& g : out.field_grids)
-          for (GO& v : g.vertices) v = global[static_cast<std::size_t>(v)];
-        result.field_grids[f] = std::move(out.field_grids);
+      if (out.group_first != kNoIndex && out.group_quad_face.empty()) {
+        // A face of a smooth group: its quads came with the group's first face.
+      } else if (!out.group_quad_face.empty()) {
+        (void)assembler->add_group(out.mesh, out.group_quad_face);
+      } else {
+        const std::vector<GO> global = assembler->add_face(f, out.mesh);
+        if (quads) {
+          for (fieldmesh::RegionGrid& g : out.field_grids)
+            for (GO& v : g.vertices) v = global[static_cast<std::size_t>(v)];
+        }
       }
+      if (quads) result.field_grids[f] = std::move(out.field_grids);
       if (keep_background) result.background[f] = std::move(out.mesh);
       if (options.cross_fields) result.cross_fields[f] = std::move(out.cross_field);
       if (options.size_map) result.face_sizes[f] = std::move(out.sizes);
@@ -479,6 +748,159 @@ void gather_stage(const Context& cx, std::vector<FaceTask>& faces,
     std::vector<char>().swap(bytes);
   });
   if (cx.comm.rank() == 0) result.mesh = assembler->finish();
+}
+
+// A group's mesh on the final curve meshes (holomorphic::mesh_group), made while its faces'
+// background meshes are still there; empty with the reason when it fails.
+struct GroupResult {
+  std::vector<LO> faces;
+  holomorphic::GroupMesh mesh;
+  std::string reason;
+};
+
+std::vector<GroupResult> mesh_smooth_groups(const Context& cx, const SmoothGroups& sg,
+                                            const std::vector<FaceTask>& faces,
+                                            const PipelineResult& result) {
+  std::map<LO, std::size_t> local_of;
+  for (std::size_t i = 0; i < faces.size(); ++i) local_of[faces[i].face] = i;
+  std::vector<GroupResult> out;
+  for (const auto& group : sg.groups) {
+    if (local_of.count(group.front()) == 0) continue;
+    GroupResult& r = out.emplace_back();
+    r.faces = group;
+    std::vector<std::unique_ptr<cad::FaceGeometry>> owned;
+    const holomorphic::GluedGroup glued =
+        glue_local(cx.model, group, faces, local_of, result.quantized_curves, owned);
+    if (!glued.ok) {
+      r.reason = glued.reason;
+      continue;
+    }
+    std::vector<const cad::FaceGeometry*> surfaces;
+    surfaces.reserve(owned.size());
+    for (const auto& o : owned) surfaces.push_back(o.get());
+    holomorphic::HolomorphicReport report;
+    try {
+      r.mesh = holomorphic::mesh_group(glued, surfaces, cx.options.holomorphic, &report);
+    } catch (const std::exception& e) {
+      report.ok = false;
+      report.reason = e.what();
+    }
+    if (!report.ok || r.mesh.mesh.quads.empty()) {
+      r.reason = report.reason.empty() ? "no quads" : report.reason;
+      r.mesh = holomorphic::GroupMesh{};
+    }
+    cx.log.info(cat("smooth group of face ", group.front(), " (", group.size(), " faces): ",
+                    r.reason.empty() ? cat(r.mesh.mesh.quads.size(), " quads") : r.reason));
+  }
+  return out;
+}
+
+// The statistics of each face of a group meshed (for --stats' face_stats): its quads and their
+// SICN, its interior vertices (those on the face) with their valence among all the group's
+// quads; the group's irregular boundary vertices are counted on its first face.
+void group_face_stats(const GroupResult& r, std::map<LO, mesh::FaceQuadStats>& stats) {
+  const mesh::FaceMesh& m = r.mesh.mesh;
+  const mesh::FaceQuadStats whole = mesh::face_quad_stats(m);
+  std::vector<int> valence(m.points.size(), 0);
+  for (const auto& q : m.quads)
+    for (const LO v : q) ++valence[static_cast<std::size_t>(v)];
+  for (const LO f : r.faces) {
+    mesh::FaceQuadStats s;
+    std::vector<char> used(m.points.size(), 0);
+    double sum = 0;
+    s.sicn_min = 0;
+    for (std::size_t k = 0; k < m.quads.size(); ++k) {
+      if (r.mesh.quad_face[k] != f) continue;
+      std::array<Vec3, 4> x{};
+      for (std::size_t i = 0; i < 4; ++i) {
+        const auto v = static_cast<std::size_t>(m.quads[k][i]);
+        used[v] = 1;
+        x[i] = m.points[v];
+      }
+      const double q = mesh::quad_sicn(x);
+      s.sicn_min = s.quads == 0 ? q : std::min(s.sicn_min, q);
+      sum += q;
+      ++s.quads;
+    }
+    if (s.quads > 0) s.sicn_avg = sum / double(s.quads);
+    for (std::size_t v = 0; v < m.points.size(); ++v) {
+      s.vertices += used[v];
+      if (m.vclass[v].dim == 2 && m.vclass[v].entity == f && valence[v] != 4)
+        ++s.irregular_interior;
+    }
+    if (f == r.faces.front()) s.irregular_boundary = whole.irregular_boundary;
+    stats[f] = s;
+  }
+}
+
+// Each group meshed replaces its faces' own meshes where the face policy keeps it (under auto:
+// when it is better than they are): the first face's task holds the group's mesh
+// and the face of each quad, the others are left empty and point to it. A group that failed
+// keeps its faces' meshes, the reason in each face's QuasiReport::holomorphic.
+GroupsForOutput apply_smooth_groups(const cad::CadModel& model, std::vector<GroupResult>& groups,
+                                    std::vector<FaceTask>& faces, holomorphic::Method method,
+                                    double sicn_tolerance) {
+  GroupsForOutput out;
+  out.inner_curves.assign(static_cast<std::size_t>(model.num_curves()), 0);
+  auto& stats = out.stats;
+  std::map<LO, std::size_t> local_of;
+  for (std::size_t i = 0; i < faces.size(); ++i) local_of[faces[i].face] = i;
+  for (GroupResult& r : groups) {
+    if (r.reason.empty()) {
+      // The policy of a face (holomorphic::keep_holomorphic) on the group against its faces' own
+      // meshes taken together: under auto, fewer interior irregular vertices at SICN min and avg
+      // within the tolerance; either way no quad with SICN <= 0.
+      mesh::FaceQuadStats theirs;
+      double weighted = 0;
+      theirs.sicn_min = 1;
+      for (const LO f : r.faces) {
+        const mesh::FaceQuadStats s = mesh::face_quad_stats(faces[local_of.at(f)].quad_mesh);
+        theirs.quads += s.quads;
+        theirs.triangles += s.triangles;
+        theirs.irregular_interior += s.irregular_interior;
+        if (s.quads > 0) theirs.sicn_min = std::min(theirs.sicn_min, s.sicn_min);
+        weighted += s.sicn_avg * double(s.quads);
+      }
+      if (theirs.quads > 0) theirs.sicn_avg = weighted / double(theirs.quads);
+      const mesh::FaceQuadStats mine = mesh::face_quad_stats(r.mesh.mesh);
+      holomorphic::HolomorphicReport ok;
+      ok.ok = true;
+      if (!holomorphic::keep_holomorphic(method, ok, mine, theirs, sicn_tolerance))
+        r.reason =
+            cat("the faces' own meshes kept: group ", mine.irregular_interior,
+                " interior irregular, SICN ", mine.sicn_min, " / ", mine.sicn_avg, "; faces ",
+                theirs.irregular_interior, ", ", theirs.sicn_min, " / ", theirs.sicn_avg);
+    }
+    if (r.reason.empty()) {
+      group_face_stats(r, stats);
+      std::map<LO, int> uses;
+      for (const LO f : r.faces)
+        for (const auto& loop : model.faces()[static_cast<std::size_t>(f)].loops)
+          for (const auto& use : loop.uses) ++uses[use.curve];
+      for (const auto& [c, n] : uses)
+        if (n >= 2) out.inner_curves[static_cast<std::size_t>(c)] = 1;
+    }
+    std::string name = "group of faces";
+    for (const LO f : r.faces) name += cat(" ", f);
+    for (const LO f : r.faces) {
+      FaceTask& t = faces[local_of.at(f)];
+      if (!r.reason.empty()) {
+        t.quasi.holomorphic = name + " not meshed (" + r.reason + "); face: " + t.quasi.holomorphic;
+        continue;
+      }
+      t.quasi.by_holomorphic = true;
+      t.quasi.holomorphic = "kept: " + name;
+      t.group_first = r.faces.front();
+      t.field_grids.clear();
+      t.quad_mesh = mesh::FaceMesh{};
+      if (f == r.faces.front()) {
+        t.quad_mesh = std::move(r.mesh.mesh);
+        t.quad_mesh.face = f;
+        t.group_quad_face = std::move(r.mesh.quad_face);
+      }
+    }
+  }
+  return out;
 }
 
 }  // namespace
@@ -515,6 +937,18 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
   clock.start();
   result.face_rank = partition_faces(
       model.face2faces(), estimate_face_costs(model, options.background.sizes.size), nranks);
+  // A smooth group is meshed as one surface: its faces go to the rank of its first face (the
+  // partition is the same on every rank, so is this).
+  const bool by_groups =
+      options.smooth_groups && quads && options.face_method != holomorphic::Method::Default;
+  SmoothGroups smooth_groups;
+  if (by_groups) {
+    smooth_groups = find_smooth_groups(model, options.groups);
+    for (LO f = 0; f < nfaces; ++f)
+      result.face_rank[f] = result.face_rank[smooth_groups.face_group[static_cast<std::size_t>(f)]];
+    result.face_group = smooth_groups.face_group;
+    log.info(cat("smooth groups: ", smooth_groups.groups.size(), " of two faces or more"));
+  }
   std::vector<FaceTask> faces;
   for (LO f = 0; f < nfaces; ++f)
     if (result.face_rank[f] == rank) faces.emplace_back().face = f;
@@ -551,7 +985,10 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     result.curve_sizes = size_map_stage(cx, curves, faces, cf_sizes);
     clock.end("sizemap", true);
     clock.start();
-    quantize_stage(cx, curves, faces, result);
+    const std::vector<std::vector<std::pair<LO, int>>> group_counts =
+        by_groups ? group_loop_counts(cx, smooth_groups, curves, faces, result)
+                  : std::vector<std::vector<std::pair<LO, int>>>{};
+    quantize_stage(cx, curves, faces, smooth_groups, group_counts, result);
     clock.end("quantize", false);
   }
 
@@ -579,6 +1016,12 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     each_face(cx, faces, "holomorphic", [&](FaceTask& t) {
       make_holomorphic_candidate(t, model, result.quantized_curves, options.holomorphic);
     });
+  std::vector<GroupResult> group_meshes;
+  if (by_groups) {
+    clock.start();
+    group_meshes = mesh_smooth_groups(cx, smooth_groups, faces, result);
+    clock.end("groups", true);
+  }
   if (quads) {
     clock.start();
     unstructured_stage(cx, faces, result.quantized_curves, quasi);
@@ -598,12 +1041,16 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
       choose_face_method(t, options.face_method, options.holomorphic_sicn_tolerance);
     });
   for (std::size_t i = 0; i < faces.size(); ++i) take_field_mesh(faces[i], std::move(by_field[i]));
+  GroupsForOutput groups_out =
+      by_groups ? apply_smooth_groups(model, group_meshes, faces, options.face_method,
+                                      options.holomorphic_sicn_tolerance)
+                : GroupsForOutput{};
 
   clock.start();
   const std::span<const mesh::CurveMesh> final_curves =
       quads ? std::span<const mesh::CurveMesh>(result.quantized_curves)
             : std::span<const mesh::CurveMesh>(curves);
-  gather_stage(cx, faces, final_curves, quads, quasi, result);
+  gather_stage(cx, faces, final_curves, quads, quasi, groups_out, result);
   clock.end("assemble", false);
   result.rank_busy_seconds.assign(static_cast<std::size_t>(nranks), 0.0);
   result.rank_busy_seconds[static_cast<std::size_t>(rank)] = clock.busy();

@@ -114,5 +114,53 @@ TEST(Assemble, WrongAnnouncementsAreRefused) {
   EXPECT_THROW(MeshAssembler(model, p.curves, counts), Error);
 }
 
+// A group of faces meshed as one surface (MeshAssembler::add_group): two quads of faces 0 and 1
+// share two interior vertices, one of them lying on face 0 and one on face 1; each vertex is
+// numbered once on the face it lies on, each quad on its face, and a curve inside the group gets
+// no bars.
+TEST(Assemble, AGroupSharesItsInteriorVerticesAcrossItsFaces) {
+  const cad::CadModel model =
+      cad::load_cad(test::write_box_with_hole(test::tmp_dir() + "/as_group.brep"));
+  const Pieces p = background_pieces(model, 1.0);
+  FaceMesh g;
+  // Vertices 0-2 on face 0, 3-5 on face 1; quads (0 1 4 3) on face 0 and (1 2 5 4) on face 1.
+  for (int i = 0; i < 6; ++i) {
+    g.points.push_back({double(i % 3), double(i / 3), 0});
+    g.uv.push_back({double(i % 3), double(i / 3)});
+    g.vclass.push_back(VertexClass{2, i < 3 ? 0 : 1, kNoIndex, {double(i), 0}});
+  }
+  g.quads = {{0, 1, 4, 3}, {1, 2, 5, 4}};
+  const std::vector<LO> quad_face{0, 1};
+  std::vector<FaceContribution> counts(static_cast<std::size_t>(model.num_faces()));
+  counts[0] = {3, 0, 1};
+  counts[1] = {3, 0, 1};
+  std::vector<char> inner(static_cast<std::size_t>(model.num_curves()), 0);
+  inner[0] = 1;
+  MeshAssembler assembler(model, p.curves, counts, inner);
+  const std::vector<GO> ids = assembler.add_group(g, quad_face);
+  ASSERT_EQ(ids.size(), 6u);
+  std::vector<GO> sorted = ids;
+  std::sort(sorted.begin(), sorted.end());
+  EXPECT_EQ(std::unique(sorted.begin(), sorted.end()), sorted.end()) << "one id per vertex";
+  EXPECT_THROW(assembler.add_face(0, FaceMesh{}), Error);  // added with the group
+  const SurfaceMesh m = assembler.finish();
+  ASSERT_EQ(m.quads.size(), 2u);
+  EXPECT_EQ(m.quad_face, (std::vector<LO>{0, 1}));
+  // The shared edge 1-4 is one edge of both quads.
+  EXPECT_EQ(m.quads[0][1], m.quads[1][0]);
+  EXPECT_EQ(m.quads[0][2], m.quads[1][3]);
+  EXPECT_EQ(m.vclass[static_cast<std::size_t>(ids[1])].entity, 0);
+  EXPECT_EQ(m.vclass[static_cast<std::size_t>(ids[4])].entity, 1);
+  for (const LO c : m.bar_curve) EXPECT_NE(c, 0);
+  EXPECT_FALSE(m.bars.empty());
+
+  // Counts that differ from the group's split are refused.
+  std::vector<FaceContribution> off = counts;
+  off[0] = {2, 0, 1};
+  off[1] = {4, 0, 1};
+  MeshAssembler wrong(model, p.curves, off);
+  EXPECT_THROW((void)wrong.add_group(g, quad_face), Error);
+}
+
 }  // namespace
 }  // namespace qsmesh::mesh

@@ -60,6 +60,29 @@ TEST(Cli, CrossFieldAndSeparatrixMethod) {
   EXPECT_NE(help("mesh").find("--cross-field FIELD"), std::string::npos);
 }
 
+// --smooth-groups is an opt-in of paper 004's methods, refused up front elsewhere.
+TEST(Cli, SmoothGroupsOnlyWithTheHolomorphicMethods) {
+  EXPECT_FALSE(p({"mesh", "m.step", "-o", "o.msh", "--method", "holomorphic"}).smooth_groups);
+  EXPECT_TRUE(p({"mesh", "m.step", "-o", "o.msh", "--method", "holomorphic", "--smooth-groups"})
+                  .smooth_groups);
+  EXPECT_TRUE(
+      p({"mesh", "m.step", "-o", "o.msh", "--smooth-groups", "--method", "auto"}).smooth_groups);
+  EXPECT_EQ(error_of({"mesh", "m.step", "-o", "o.msh", "--smooth-groups"}),
+            "--smooth-groups: only with --method holomorphic or auto");
+  EXPECT_EQ(
+      error_of({"mesh", "m.step", "-o", "o.msh", "--smooth-groups", "--method", "separatrix"}),
+      "--smooth-groups: only with --method holomorphic or auto");
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.cgns", "--method", "auto", "--smooth-groups",
+                      "--block-structured"})
+                .find("not together"),
+            std::string::npos);
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.msh", "--method", "auto", "--smooth-groups",
+                      "--until", "background"})
+                .find("needs a quad mesh"),
+            std::string::npos);
+  EXPECT_NE(help("mesh").find("--smooth-groups"), std::string::npos);
+}
+
 TEST(Cli, SecondOrder) {
   EXPECT_EQ(p({"mesh", "m.step", "-o", "o.cgns"}).order, 1);
   EXPECT_EQ(p({"mesh", "m.step", "-o", "o.msh", "--order", "2"}).order, 2);

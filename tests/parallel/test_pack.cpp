@@ -99,15 +99,17 @@ FaceOutput full_output() {
   o.seconds = 2.5;
   o.times = {0.5, 1.5, 2.5, 3.5, 4.5, 5.5, 6.5, 77.5, 42, 1001, {0.25, 0.75}};
   o.field_grids = {fieldmesh::RegionGrid{1, 1, {0, 1, 2, 3}}, fieldmesh::RegionGrid{2, 1, {}}};
+  o.group_quad_face = {4, 5, 4};
+  o.group_first = 4;
   return o;
 }
 
 TEST(Pack, EveryFieldOfAFaceOutputRoundTrips) {
   const FaceOutput a = full_output();
-  // 10 parts; the counts of their fields: mesh 1 (packed whole), background report 5, cross field
+  // 12 parts; the counts of their fields: mesh 1 (packed whole), background report 5, cross field
   // 11, sizes 3, unstructured 7, quasi 11 + improvement 8, stats 7, seconds 1, times 11, field
-  // grids 1 (a vector of records).
-  ASSERT_EQ(count_fields(a), 1 + 5 + 11 + 3 + 7 + 19 + 7 + 1 + 11 + 1)
+  // grids 1 (a vector of records), a smooth group's quad faces 1 and first face 1.
+  ASSERT_EQ(count_fields(a), 1 + 5 + 11 + 3 + 7 + 19 + 7 + 1 + 11 + 1 + 2)
       << "a field was added to a report: set it in full_output() and check it here";
   std::vector<char> buf;
   write_record(buf, a);
@@ -199,6 +201,8 @@ TEST(Pack, EveryFieldOfAFaceOutputRoundTrips) {
   EXPECT_EQ(b.field_grids[0].vertices, (std::vector<GO>{0, 1, 2, 3}));
   EXPECT_EQ(b.field_grids[1].ni, 2);
   EXPECT_TRUE(b.field_grids[1].vertices.empty());
+  EXPECT_EQ(b.group_quad_face, (std::vector<LO>{4, 5, 4}));
+  EXPECT_EQ(b.group_first, 4);
 
   // The record after it came back at its defaults.
   EXPECT_TRUE(empty.mesh.points.empty());
@@ -207,6 +211,8 @@ TEST(Pack, EveryFieldOfAFaceOutputRoundTrips) {
   EXPECT_FALSE(empty.quasi.by_pattern);
   EXPECT_EQ(empty.quasi.improvement.disk_replaced, 0);
   EXPECT_TRUE(empty.field_grids.empty());
+  EXPECT_TRUE(empty.group_quad_face.empty());
+  EXPECT_EQ(empty.group_first, kNoIndex);
 }
 
 TEST(Pack, PatternFillRoundTrips) {

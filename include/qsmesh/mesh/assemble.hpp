@@ -38,12 +38,21 @@ class MeshAssembler {
   /// `curves` indexed by curve id (kept by reference until finish); `contributions[f]` the counts
   /// of the mesh that add_face will be given for face f (face_contribution). Throws Error when
   /// the sizes do not match the model.
+  /// `inner_curves` (empty, or one flag per curve): curves that get no bars, those inside a group
+  /// of faces meshed as one surface (add_group), whose quads cross them.
   MeshAssembler(const cad::CadModel& model, std::span<const CurveMesh> curves,
-                std::span<const FaceContribution> contributions);
+                std::span<const FaceContribution> contributions,
+                std::span<const char> inner_curves = {});
   /// Adds the mesh of face f (once per face; faces never added stay empty). Throws Error when
   /// its counts differ from the contribution given for f or its classification is out of range.
   /// Returns the assembled mesh's id of each vertex of `face` (its numbering in the result).
   std::vector<GO> add_face(LO f, const FaceMesh& face);
+  /// Adds the mesh of a group of faces meshed as one surface (holomorphic::mesh_group): quad q
+  /// goes to face quad_face[q], a dim-2 vertex to the face it is classified on (vclass.entity),
+  /// so a vertex may be shared by quads of two faces. Every face it names counts as added; the
+  /// contributions of those faces must be its quads and interior vertices split that way.
+  /// Returns the assembled mesh's id of each vertex of `group`.
+  std::vector<GO> add_group(const FaceMesh& group, std::span<const LO> quad_face);
   /// The mesh; throws Error unless every face with a non-zero contribution was added.
   [[nodiscard]] SurfaceMesh finish();
 

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cstdint>
+#include <span>
 #include <string>
 
 #include "qsmesh/cad/model.hpp"
@@ -28,9 +29,13 @@ struct ConformityReport {
 };
 
 /// Checks that elements of a face meet edge to edge, that faces meet along the curve meshes and
-/// nowhere else, and that each face is consistently oriented.
-[[nodiscard]] ConformityReport check_conformity(const SurfaceMesh& mesh,
-                                                const cad::CadModel& model);
+/// nowhere else, and that each face is consistently oriented. `face_group` (empty: each face
+/// alone) gives each face's group of faces meshed as one surface (the first face of its group,
+/// holomorphic::mesh_group): within a group, elements of two faces meet edge to edge like those
+/// of one face (the group's quads cross its inner curves, which then carry no element edge), and
+/// a group rather than each of its faces must have elements.
+[[nodiscard]] ConformityReport check_conformity(const SurfaceMesh& mesh, const cad::CadModel& model,
+                                                std::span<const LO> face_group = {});
 
 /// Largest distance (model units) between a vertex and its CAD entity evaluated at the vertex's
 /// parameters (corner point, C(t), S(u, v)).

@@ -19,6 +19,7 @@
 #include "qsmesh/cad/model.hpp"
 #include "qsmesh/crossfield/cross_field.hpp"
 #include "qsmesh/fieldmesh/field_mesh.hpp"
+#include "qsmesh/holomorphic/group.hpp"
 #include "qsmesh/holomorphic/holomorphic.hpp"
 #include "qsmesh/linalg/solver.hpp"
 #include "qsmesh/mesh/quality.hpp"
@@ -265,6 +266,12 @@ struct FaceTask {
   /// Meshed from a cross field (quasi.by_field): the partition's regions as grids of quad_mesh's
   /// vertices (fieldmesh::FieldMeshReport::grids), the face's blocks in block-structured output.
   std::vector<fieldmesh::RegionGrid> field_grids;
+  /// A smooth group's mesh (PipelineOptions::smooth_groups), held by the task of the group's first
+  /// face: quad_mesh is then the whole group's mesh, group_quad_face the face of each quad, and
+  /// its dim-2 vertices are classified on the face they lie on. The other faces of a kept group
+  /// have an empty quad_mesh and group_first set to the group's first face.
+  std::vector<LO> group_quad_face;
+  LO group_first = kNoIndex;
 };
 
 /// Background triangulation of task.face (background::mesh_face_background) into task.background
@@ -293,6 +300,8 @@ struct FaceOutput {
   double seconds = 0;
   FaceTimes times;
   std::vector<fieldmesh::RegionGrid> field_grids;  ///< FaceTask::field_grids, of `mesh`
+  std::vector<LO> group_quad_face;                 ///< FaceTask::group_quad_face
+  LO group_first = kNoIndex;                       ///< FaceTask::group_first
   template <class S, class V>
   static void fields(S& self, V&& visit) {
     visit("mesh", self.mesh);
@@ -305,6 +314,8 @@ struct FaceOutput {
     visit("seconds", self.seconds);
     visit("times", self.times);
     visit("field_grids", self.field_grids);
+    visit("group_quad_face", self.group_quad_face);
+    visit("group_first", self.group_first);
   }
 };
 

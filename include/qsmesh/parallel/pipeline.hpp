@@ -14,6 +14,7 @@
 #include "qsmesh/core/timer.hpp"
 #include "qsmesh/crossfield/cross_field.hpp"
 #include "qsmesh/fieldmesh/field_file.hpp"
+#include "qsmesh/holomorphic/group.hpp"
 #include "qsmesh/holomorphic/holomorphic.hpp"
 #include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/mesh/surface_mesh.hpp"
@@ -165,6 +166,18 @@ struct PipelineOptions {
   /// Method::Auto: how much lower the holomorphic mesh's SICN min and avg may each be than the
   /// default mesh's (it must have fewer interior irregular vertices).
   double holomorphic_sicn_tolerance = 0.02;
+  /// With face_method Holomorphic or Auto (`--smooth-groups`): faces joined across smooth curves
+  /// (holomorphic::smooth_face_groups) are meshed as one surface (holomorphic::mesh_group), each
+  /// group on one rank (the partition moves a group's faces to the rank of its first face). The
+  /// counts of a group's outer loops come from its optimised form's periods
+  /// (holomorphic::balanced_loop_counts), prescribed to the quantization like `--curve-edges`
+  /// where it can meet them and the group meshes on them (a trial in the quantize stage);
+  /// the group's quads cross its inner curves and go to the face that holds their centre. The
+  /// face policy (holomorphic::keep_holomorphic, the group against its faces' own meshes taken
+  /// together) decides; a group not kept keeps its faces' meshes, the reason in
+  /// QuasiReport::holomorphic.
+  bool smooth_groups = false;
+  holomorphic::GroupOptions groups;
   /// Paper 003 (fieldmesh::face_method per face): faces of `given_fields` (--cross-field; null:
   /// none) are meshed from their field, the others from the mesher's own cross field when
   /// `separatrix_method` (--method separatrix); a valid result replaces the face's default mesh.
@@ -198,6 +211,9 @@ struct PipelineResult {
   /// empty for the other faces. Their blocks in block-structured output.
   std::vector<std::vector<fieldmesh::RegionGrid>> field_grids;
   std::vector<int> face_rank;  ///< rank that meshed each face (every rank)
+  /// With smooth_groups: the first face of each face's group (itself when alone; every rank),
+  /// for mesh::check_conformity. Empty otherwise.
+  std::vector<LO> face_group;
   /// Wall time (s) each rank spent in the stages split by faces (background to the comparison of
   /// refused pattern fills), its own work without its waits for the others (every rank). Their
   /// spread is the load imbalance of the METIS partition (max / mean, 1 on one rank).
