@@ -6,22 +6,25 @@
 # output vertices, and the ratios qsmesh / Gmsh, also per 1000 vertices. On a machine shared with
 # other jobs the wall seconds follow the load; the CPU seconds much less. Gmsh is not a dependency of qsmesh: install it for this benchmark only
 # (`apt-get install gmsh`).
-# Usage: scripts/bench_floor.sh [MODEL] [--size-factor F] [--clscale C] [--repeat N]
+# Usage: scripts/bench_floor.sh [MODEL] [--size-factor F] [--clscale C] [--repeat N] [-- ARGS]
 #   defaults: ../shared/cad/Block.stp, F = 0.00463 (its reference count, docs/benchmarks.md),
-#   C = 0.048 (Gmsh's mesh size factor giving about that vertex count), N = 3.
+#   C = 0.048 (Gmsh's mesh size factor giving about that vertex count), N = 3; ARGS: more
+#   options for qsmesh mesh (e.g. -- --second-pass-quads 0).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-usage() { sed -n '8,10p' "$0" | sed 's/^# \{0,1\}//' >&2; exit 2; }
+usage() { sed -n '9,12p' "$0" | sed 's/^# \{0,1\}//' >&2; exit 2; }
 model=../shared/cad/Block.stp
 factor=0.00463
 clscale=0.048
 repeat=3
+extra=()
 while [ $# -gt 0 ]; do
   case "$1" in
     --size-factor) factor=$2; shift 2 ;;
     --clscale) clscale=$2; shift 2 ;;
     --repeat) repeat=$2; shift 2 ;;
     -h|--help) usage ;;
+    --) shift; extra=("$@"); break ;;
     -*) echo "bench_floor: unknown option $1" >&2; usage ;;
     *) model=$1; shift ;;
   esac
@@ -44,7 +47,7 @@ cpu_last() { awk '{print $1 + $2}' "$work/cpu"; }
 q_times=() g_times=() q_cpu=() g_cpu=()
 for ((k = 0; k < repeat; k++)); do
   t0=$(now)
-  cpu_of "$qsmesh" mesh "$model" -o "$work/q.msh" --size-factor "$factor" --threads 1 -q
+  cpu_of "$qsmesh" mesh "$model" -o "$work/q.msh" --size-factor "$factor" --threads 1 -q ${extra[@]+"${extra[@]}"}
   q_times+=("$(calc "$(now) - $t0")")
   q_cpu+=("$(cpu_last)")
   t0=$(now)
@@ -59,6 +62,6 @@ qc=$(median "${q_cpu[@]}"); gc=$(median "${g_cpu[@]}")
 qv=$(msh_vertices "$work/q.msh"); gv=$(msh_vertices "$work/g.msh")
 echo "| tool | command | vertices | seconds (median of $repeat) | CPU seconds (median) | s per 1000 vertices |"
 echo "|---|---|---|---|---|---|"
-printf '| qsmesh | mesh %s --size-factor %s --threads 1 | %s | %.1f | %.1f | %.3f |\n' "$(basename "$model")" "$factor" "$qv" "$qt" "$qc" "$(calc "1000 * $qt / $qv")"
+printf '| qsmesh | mesh %s --size-factor %s --threads 1%s | %s | %.1f | %.1f | %.3f |\n' "$(basename "$model")" "$factor" "${extra[*]+ ${extra[*]}}" "$qv" "$qt" "$qc" "$(calc "1000 * $qt / $qv")"
 printf '| gmsh %s | -2 -algo front2d -clscale %s -nt 1 | %s | %.1f | %.1f | %.3f |\n' "$(gmsh --version 2>&1 | head -1)" "$clscale" "$gv" "$gt" "$gc" "$(calc "1000 * $gt / $gv")"
 printf '\nqsmesh / gmsh: %.2f in time, %.2f per 1000 vertices; %.2f in CPU time, %.2f per 1000 vertices\n' "$(calc "$qt / $gt")" "$(calc "($qt / $qv) / ($gt / $gv)")" "$(calc "$qc / $gc")" "$(calc "($qc / $qv) / ($gc / $gv)")"
