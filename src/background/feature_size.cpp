@@ -215,16 +215,7 @@ void limit_by_face_width(const cad::CadModel& model, std::span<const std::vector
                          std::vector<std::vector<double>>& sizes, double touching, double sliver,
                          const TaskArena& tasks) {
   // The faces of each curve, sorted: two curves are sides of one face when the lists intersect.
-  std::vector<std::vector<LO>> faces(polylines.size());
-  for (LO f = 0; f < model.num_faces(); ++f)
-    for (const auto& loop : model.faces()[f].loops)
-      for (const auto& use : loop.uses)
-        if (use.curve >= 0 && use.curve < static_cast<LO>(faces.size()))
-          faces[use.curve].push_back(f);
-  for (auto& list : faces) {
-    std::sort(list.begin(), list.end());
-    list.erase(std::unique(list.begin(), list.end()), list.end());
-  }
+  const std::vector<std::vector<LO>> faces = faces_of_curves(model, polylines.size());
   const auto share_face = [&](LO a, LO b) {
     const auto &fa = faces[a], &fb = faces[b];
     auto i = fa.begin(), j = fb.begin();

@@ -158,6 +158,13 @@ SmoothGroups find_smooth_groups(const cad::CadModel& model,
   return out;
 }
 
+// The index in `faces` (this rank's tasks) of each face it holds.
+std::map<LO, std::size_t> local_index(const std::vector<FaceTask>& faces) {
+  std::map<LO, std::size_t> local_of;
+  for (std::size_t i = 0; i < faces.size(); ++i) local_of[faces[i].face] = i;
+  return local_of;
+}
+
 // A group glued from this rank's tasks (the partition keeps a group on one rank), each face's
 // loops on `curves`; the surfaces of its faces go to `owned`. Never throws for the group.
 holomorphic::GluedGroup glue_local(const cad::CadModel& model, std::span<const LO> group,
@@ -187,6 +194,40 @@ holomorphic::GluedGroup glue_local(const cad::CadModel& model, std::span<const L
   return holomorphic::glue_group(group, backgrounds, loops);
 }
 
+// The group's mesh on `curves` (holomorphic::mesh_group on glue_local's triangulation); empty,
+// with the reason in `reason`, when gluing or meshing fails or gives no quad. Never throws for
+// the group.
+holomorphic::GroupMesh mesh_local_group(const cad::CadModel& model, std::span<const LO> group,
+                                        const std::vector<FaceTask>& faces,
+                                        const std::map<LO, std::size_t>& local_of,
+                                        std::span<const mesh::CurveMesh> curves,
+                                        const holomorphic::HolomorphicOptions& options,
+                                        std::string& reason) {
+  std::vector<std::unique_ptr<cad::FaceGeometry>> owned;
+  const holomorphic::GluedGroup glued = glue_local(model, group, faces, local_of, curves, owned);
+  if (!glued.ok) {
+    reason = glued.reason;
+    return {};
+  }
+  std::vector<const cad::FaceGeometry*> surfaces;
+  surfaces.reserve(owned.size());
+  for (const auto& o : owned) surfaces.push_back(o.get());
+  holomorphic::HolomorphicReport report;
+  holomorphic::GroupMesh mesh;
+  try {
+    mesh = holomorphic::mesh_group(glued, surfaces, options, &report);
+  } catch (const std::exception& e) {
+    report.ok = false;
+    report.reason = e.what();
+  }
+  if (!report.ok || mesh.mesh.quads.empty()) {
+    reason = report.reason.empty() ? "no quads" : report.reason;
+    return {};
+  }
+  reason.clear();
+  return mesh;
+}
+
 // The counts of the groups' outer loops from their optimised forms (paper 004 Sec. 4: the loops'
 // periods add up, and so must the counts of a conforming mesh; holomorphic::loop_periods,
 // balanced_loop_counts), as prescriptions (curve, count) for the quantization. The target edge
@@ -201,8 +242,7 @@ std::vector<std::vector<std::pair<LO, int>>> group_loop_counts(
   const std::vector<double> ideal = quantize::ideal_edge_counts(curves, result.curve_sizes.at);
   std::set<LO> user;
   for (const auto& [c, n] : cx.options.quantize.prescribed) user.insert(c);
-  std::map<LO, std::size_t> local_of;
-  for (std::size_t i = 0; i < faces.size(); ++i) local_of[faces[i].face] = i;
+  const std::map<LO, std::size_t> local_of = local_index(faces);
   // Minus each curve's count (0: none), so that the minimum over ranks is the largest count.
   std::vector<double> count(static_cast<std::size_t>(model.num_curves()), 0.0);
   for (const auto& group : sg.groups) {
@@ -341,31 +381,17 @@ void quantize_stage(const Context& cx, std::span<const mesh::CurveMesh> curves,
     const quantize::Quantization q = quantize::quantize_curves(model, ideal, qo);
     const std::vector<mesh::CurveMesh> placed = quantize::place_vertices(
         model, curves, result.curve_sizes.at, q, /*halved=*/false, cx.tasks, options.place);
-    std::map<LO, std::size_t> local_of;
-    for (std::size_t i = 0; i < faces.size(); ++i) local_of[faces[i].face] = i;
+    const std::map<LO, std::size_t> local_of = local_index(faces);
     std::vector<std::int64_t> failed(group_counts.size(), 0);
     for (std::size_t g = 0; g < group_counts.size(); ++g) {
       if (accepted[g] == 0 || local_of.count(sg.groups[g].front()) == 0) continue;
-      std::vector<std::unique_ptr<cad::FaceGeometry>> owned;
-      const holomorphic::GluedGroup glued =
-          glue_local(model, sg.groups[g], faces, local_of, placed, owned);
-      holomorphic::HolomorphicReport report;
-      if (glued.ok) {
-        std::vector<const cad::FaceGeometry*> surfaces;
-        surfaces.reserve(owned.size());
-        for (const auto& o : owned) surfaces.push_back(o.get());
-        try {
-          (void)holomorphic::mesh_group(glued, surfaces, options.holomorphic, &report);
-        } catch (const std::exception& e) {
-          report.ok = false;
-          report.reason = e.what();
-        }
-      }
-      if (!glued.ok || !report.ok) {
+      std::string why;
+      (void)mesh_local_group(model, sg.groups[g], faces, local_of, placed, options.holomorphic,
+                             why);
+      if (!why.empty()) {
         failed[g] = 1;
-        cx.log.info(
-            cat("quantize: loop counts of the smooth group of face ", sg.groups[g].front(),
-                " not prescribed (its mesh fails: ", glued.ok ? report.reason : glued.reason, ")"));
+        cx.log.info(cat("quantize: loop counts of the smooth group of face ", sg.groups[g].front(),
+                        " not prescribed (its mesh fails: ", why, ")"));
       }
     }
     cx.comm.allreduce_sum(failed);
@@ -761,34 +787,14 @@ struct GroupResult {
 std::vector<GroupResult> mesh_smooth_groups(const Context& cx, const SmoothGroups& sg,
                                             const std::vector<FaceTask>& faces,
                                             const PipelineResult& result) {
-  std::map<LO, std::size_t> local_of;
-  for (std::size_t i = 0; i < faces.size(); ++i) local_of[faces[i].face] = i;
+  const std::map<LO, std::size_t> local_of = local_index(faces);
   std::vector<GroupResult> out;
   for (const auto& group : sg.groups) {
     if (local_of.count(group.front()) == 0) continue;
     GroupResult& r = out.emplace_back();
     r.faces = group;
-    std::vector<std::unique_ptr<cad::FaceGeometry>> owned;
-    const holomorphic::GluedGroup glued =
-        glue_local(cx.model, group, faces, local_of, result.quantized_curves, owned);
-    if (!glued.ok) {
-      r.reason = glued.reason;
-      continue;
-    }
-    std::vector<const cad::FaceGeometry*> surfaces;
-    surfaces.reserve(owned.size());
-    for (const auto& o : owned) surfaces.push_back(o.get());
-    holomorphic::HolomorphicReport report;
-    try {
-      r.mesh = holomorphic::mesh_group(glued, surfaces, cx.options.holomorphic, &report);
-    } catch (const std::exception& e) {
-      report.ok = false;
-      report.reason = e.what();
-    }
-    if (!report.ok || r.mesh.mesh.quads.empty()) {
-      r.reason = report.reason.empty() ? "no quads" : report.reason;
-      r.mesh = holomorphic::GroupMesh{};
-    }
+    r.mesh = mesh_local_group(cx.model, group, faces, local_of, result.quantized_curves,
+                              cx.options.holomorphic, r.reason);
     cx.log.info(cat("smooth group of face ", group.front(), " (", group.size(), " faces): ",
                     r.reason.empty() ? cat(r.mesh.mesh.quads.size(), " quads") : r.reason));
   }
@@ -843,8 +849,7 @@ GroupsForOutput apply_smooth_groups(const cad::CadModel& model, std::vector<Grou
   GroupsForOutput out;
   out.inner_curves.assign(static_cast<std::size_t>(model.num_curves()), 0);
   auto& stats = out.stats;
-  std::map<LO, std::size_t> local_of;
-  for (std::size_t i = 0; i < faces.size(); ++i) local_of[faces[i].face] = i;
+  const std::map<LO, std::size_t> local_of = local_index(faces);
   for (GroupResult& r : groups) {
     if (r.reason.empty()) {
       // The policy of a face (holomorphic::keep_holomorphic) on the group against its faces' own

@@ -20,6 +20,7 @@
 #include "qsmesh/mesh/quality.hpp"
 #include "shapes.hpp"
 #include "tmp_dir.hpp"
+#include "valences.hpp"
 
 namespace qsmesh::holomorphic {
 namespace {
@@ -70,27 +71,8 @@ TEST(HolomorphicGroup, BalancedLoopCountsAddUp) {
   for (const LO n : counts) EXPECT_EQ(n % 2, 0);
 }
 
-struct Valences {
-  LO eight = 0, other_irregular = 0, boundary_irregular = 0;
-};
-
-Valences valences(const mesh::FaceMesh& q) {
-  std::vector<int> count(q.points.size(), 0);
-  for (const auto& quad : q.quads)
-    for (const LO v : quad) ++count[static_cast<std::size_t>(v)];
-  Valences out;
-  for (std::size_t v = 0; v < q.points.size(); ++v) {
-    if (q.vclass[v].dim < 2) {
-      out.boundary_irregular += count[v] != 2 ? 1 : 0;
-      continue;
-    }
-    if (count[v] == 8)
-      ++out.eight;
-    else if (count[v] != 4)
-      ++out.other_irregular;
-  }
-  return out;
-}
+using test::Valences;
+using test::valences;
 
 // The filleted T-duct meshed as one group: the basis and the energy on the glued triangulation
 // (three faces, their seams and the two fillet curves inside it), loop counts from the optimised

@@ -16,6 +16,7 @@
 #include "qsmesh/mesh/quality.hpp"
 #include "shapes.hpp"
 #include "tmp_dir.hpp"
+#include "valences.hpp"
 
 namespace qsmesh::holomorphic {
 namespace {
@@ -85,27 +86,8 @@ MeshedFace mesh_face(const std::string& path, double size, double hole_length, L
   return m;
 }
 
-struct Valences {
-  LO eight = 0, other_irregular = 0, boundary_irregular = 0;
-};
-
-Valences valences(const mesh::FaceMesh& q) {
-  std::vector<int> count(q.points.size(), 0);
-  for (const auto& quad : q.quads)
-    for (const LO v : quad) ++count[static_cast<std::size_t>(v)];
-  Valences out;
-  for (std::size_t v = 0; v < q.points.size(); ++v) {
-    if (q.vclass[v].dim < 2) {
-      out.boundary_irregular += count[v] != 2 ? 1 : 0;
-      continue;
-    }
-    if (count[v] == 8)
-      ++out.eight;
-    else if (count[v] != 4)
-      ++out.other_irregular;
-  }
-  return out;
-}
+using test::Valences;
+using test::valences;
 
 // The quad mesh's boundary edges are exactly the final loops' segments (conforming with the
 // neighbouring faces), and no edge has more than two quads.
