@@ -94,7 +94,7 @@ struct Candidate {
 };
 
 mesh::FaceMesh build_mesh(LO f, const cad::Face& face, const cad::FaceGeometry& surface,
-                          const FaceSides& fs, const Candidate& cand) {
+                          const FaceSides& fs, const Candidate& cand, linalg::SolverCache* cache) {
   const LO nb = static_cast<LO>(fs.points.size());
   const RefinedPattern& r = cand.refined;
   std::vector<LO> r2m(static_cast<std::size_t>(r.num_vertices), kNoIndex);
@@ -121,7 +121,8 @@ mesh::FaceMesh build_mesh(LO f, const cad::Face& face, const cad::FaceGeometry& 
     const std::array<LO, 4> t{r2m[q[0]], r2m[q[1]], r2m[q[2]], r2m[q[3]]};
     m.quads.push_back(flip ? std::array<LO, 4>{t[0], t[3], t[2], t[1]} : t);
   }
-  QSMESH_CHECK(smooth::chord_laplace_uv(m.quads, nb, m.uv), "the Laplace layout is not finite");
+  QSMESH_CHECK(smooth::chord_laplace_uv(m.quads, nb, m.uv, cache),
+               "the Laplace layout is not finite");
   if (!fs.poles.empty()) {
     // Around a pole the parameter plane stretches without bound, and a (u, v) layout crowds the
     // quads there (cube_filet's corner patches: SICN min 0.52 against 0.86 for the same topology
@@ -132,8 +133,9 @@ mesh::FaceMesh build_mesh(LO f, const cad::Face& face, const cad::FaceGeometry& 
       xy[i] = {m.points[i].x, m.points[i].y};
       z[i] = {m.points[i].z, 0};
     }
-    QSMESH_CHECK(smooth::laplace_uv(m.quads, nb, xy) && smooth::laplace_uv(m.quads, nb, z),
-                 "the 3D Laplace layout is not finite");
+    QSMESH_CHECK(
+        smooth::laplace_uv(m.quads, nb, xy, cache) && smooth::laplace_uv(m.quads, nb, z, cache),
+        "the 3D Laplace layout is not finite");
     for (LO v = nb; v < next; ++v)
       m.uv[v] = surface.project(Vec3{xy[v].u, xy[v].v, z[v].u}, m.uv[v], nullptr);
   }
@@ -194,7 +196,7 @@ mesh::FaceMesh move_irregular_vertices(LO f, const cad::Face& face,
                                        const Pattern& pattern, const Candidate& start,
                                        mesh::FaceMesh mesh, smooth::QualityReport q,
                                        double min_sicn, const PatternFaceOptions& options,
-                                       PatternFaceReport& rep) {
+                                       PatternFaceReport& rep, linalg::SolverCache* cache) {
   // Without corner the pattern may also turn along the loop: an empty vector stands for that
   // shift (t loop points), searched last, over a quarter of the loop each way.
   const LO nb = static_cast<LO>(fs.points.size());
@@ -231,7 +233,8 @@ mesh::FaceMesh move_irregular_vertices(LO f, const cad::Face& face,
   const mesh::FaceMesh given = light ? mesh : mesh::FaceMesh{};
   const smooth::QualityReport given_q = q;
   if (light && q.invalid == 0) {
-    mesh = smooth::smooth_face(build_mesh(f, face, surface, fs, start), surface, search);
+    mesh = smooth::smooth_face(build_mesh(f, face, surface, fs, start, cache), surface, search,
+                               nullptr, cache);
     q = smooth::measure(mesh);
   }
   // The mean, less twice the shortfall of the minimum below its threshold: a refused fill climbs
@@ -263,7 +266,8 @@ mesh::FaceMesh move_irregular_vertices(LO f, const cad::Face& face,
         static_cast<std::int64_t>(c.refined.quads.size()) > options.max_quads)
       return false;
     ++evaluations;
-    mesh::FaceMesh m = smooth::smooth_face(build_mesh(f, face, surface, fs, c), surface, search);
+    mesh::FaceMesh m = smooth::smooth_face(build_mesh(f, face, surface, fs, c, cache), surface,
+                                           search, nullptr, cache);
     const smooth::QualityReport mq = smooth::measure(m);
     if (mq.invalid != 0) return false;
     if (!beats(mq, q, 1e-4)) return false;
@@ -305,8 +309,8 @@ mesh::FaceMesh move_irregular_vertices(LO f, const cad::Face& face,
     }
   }
   if (light && rep.moves > moves_before) {
-    mesh::FaceMesh full =
-        smooth::smooth_face(build_mesh(f, face, surface, fs, best), surface, options.smooth);
+    mesh::FaceMesh full = smooth::smooth_face(build_mesh(f, face, surface, fs, best, cache),
+                                              surface, options.smooth, nullptr, cache);
     const smooth::QualityReport fq = smooth::measure(full);
     // The given mesh may have been lifted (untangled) where the light start was not: the moved
     // fill wins only when it is also better smoothed fully.
@@ -368,7 +372,8 @@ LO ring_layers(const FaceSides& fs) {
 // (ok, or the refusal and its reason) and returns the mesh kept, or an empty one.
 mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& surface,
                          const FaceSides& fs, std::span<const Pattern> patterns,
-                         const PatternFaceOptions& options, PatternFaceReport& rep) {
+                         const PatternFaceOptions& options, PatternFaceReport& rep,
+                         linalg::SolverCache* cache) {
   const ErrorContext context{"qstruct", 2, f};
   mesh::FaceMesh empty;
   empty.face = f;
@@ -487,7 +492,7 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
       none.sicn_avg = -1;
       mesh::FaceMesh moved =
           move_irregular_vertices(f, face, surface, fs, patterns[c.match.pattern], c,
-                                  mesh::FaceMesh{}, none, min_sicn, options, rep);
+                                  mesh::FaceMesh{}, none, min_sicn, options, rep, cache);
       if (rep.moves > 0) {
         ++rep.candidates;
         // A move is kept only when its fill is valid, so the moved fill is.
@@ -517,8 +522,8 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
     // laid out, for the caller's comparison.
     const bool held = c.held < options.held_sicn_ratio * min_sicn;
     if (held && k > 0) continue;
-    mesh::FaceMesh mesh =
-        smooth::smooth_face(build_mesh(f, face, surface, fs, c), surface, options.smooth);
+    mesh::FaceMesh mesh = smooth::smooth_face(build_mesh(f, face, surface, fs, c, cache), surface,
+                                              options.smooth, nullptr, cache);
     smooth::QualityReport q = smooth::measure(mesh);
     // A layout good on average but with a few poor quads (usually next to an irregular vertex of
     // the pattern, or a folded corner of a size transition) is worth lifting locally; the
@@ -541,7 +546,7 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
         q.sicn_avg < options.move_below_avg) {
       PatternFaceReport trial;
       mesh = move_irregular_vertices(f, face, surface, fs, patterns[c.match.pattern], c,
-                                     std::move(mesh), q, min_sicn, options, trial);
+                                     std::move(mesh), q, min_sicn, options, trial, cache);
       rep.moves += trial.moves;
       q.sicn_min = trial.sicn_min;
       q.sicn_avg = trial.sicn_avg;
@@ -570,7 +575,7 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
     if (m != 0 && best_good) {
       if (options.move_evaluations > 0 && best_q.sicn_avg < options.move_below_avg)
         best = move_irregular_vertices(f, face, surface, fs, patterns[c.match.pattern], c,
-                                       std::move(best), best_q, min_sicn, options, rep);
+                                       std::move(best), best_q, min_sicn, options, rep, cache);
       return keep(std::move(best));
     }
   }
@@ -580,7 +585,7 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
     // corner every start was moved already.
     const Candidate& c = cands[best_k];
     best = move_irregular_vertices(f, face, surface, fs, patterns[c.match.pattern], c,
-                                   std::move(best), best_q, min_sicn, options, rep);
+                                   std::move(best), best_q, min_sicn, options, rep, cache);
     if (passes_sicn(rep.sicn_min, rep.sicn_avg, static_cast<std::int64_t>(best.quads.size()),
                     min_sicn, options))
       return keep(std::move(best));
@@ -740,7 +745,9 @@ mesh::FaceMesh mesh_face_pattern(const cad::CadModel& model, LO f,
     } catch (const Error& e) {
       return refuse(Refusal::Degenerate, e.message());
     }
-    mesh::FaceMesh out = try_sides(f, face, *surface, fs, patterns, options, rep);
+    // One cache for the face's layouts: the move search lays out the same quads again and again.
+    linalg::SolverCache cache;
+    mesh::FaceMesh out = try_sides(f, face, *surface, fs, patterns, options, rep, &cache);
     if (rep.ok) return out;
     // Convex but blunt corners may be better taken as flat: one more try without them.
     FaceSides soft = fs;
@@ -750,7 +757,7 @@ mesh::FaceMesh mesh_face_pattern(const cad::CadModel& model, LO f,
     if (soft.corners.size() == fs.corners.size()) return out;
     set_side_edges(soft);
     PatternFaceReport second;
-    out = try_sides(f, face, *surface, soft, patterns, options, second);
+    out = try_sides(f, face, *surface, soft, patterns, options, second, &cache);
     // Report the attempt that got further (a quality refusal says more than no pattern).
     // Between two quality refusals, the one whose valid candidate has the higher minimum.
     const bool second_better =
