@@ -201,6 +201,7 @@ struct FaceTimes {
   double unstructured = 0;  ///< the unstructured mesh (METIS partition)
   double improvement = 0;   ///< cavity, disk remeshing, final smoothing (dealt out)
   double compare = 0;       ///< second fill and comparison (METIS partition)
+  double distance = 0;      ///< its final mesh's distance to the CAD (METIS partition)
   /// The pattern stage deals the faces out by this, largest first (the size map's quads).
   double expected_quads = 0;
   /// The improvement deals its faces out by this, largest first (the unstructured mesh's quads;
@@ -222,6 +223,7 @@ struct FaceTimes {
     visit("unstructured", self.unstructured);
     visit("improvement", self.improvement);
     visit("pattern_compare", self.compare);
+    visit("distance", self.distance);
     visit("expected_quads", self.expected_quads);
     visit("improvement_quads", self.improvement_quads);
     visit("bytes", self.bytes);
