@@ -482,6 +482,14 @@ void quantize_stage(const Context& cx, std::span<const mesh::CurveMesh> curves,
                   " chords, ", result.quantization.total_edges, " edges"));
 }
 
+// A face's pattern time and its move search's counts (the scaling simulation's batches).
+void set_pattern_times(FaceTimes& times, const PatternFill& fill) {
+  times.patterns = fill.seconds;
+  times.pattern_layouts = fill.report.layouts;
+  times.pattern_batches = fill.report.batches;
+  times.pattern_search = fill.report.search_seconds;
+}
+
 // Simple CAD faces meshed directly by a pattern (paper 000 Sec. 6.1.2, pipeline step 4); the
 // others go through the unstructured path. A fill needs only the model, the curve meshes (every
 // rank has them) and the face's quad bound (if any), which its owner computes from its size map
@@ -518,6 +526,7 @@ std::vector<std::int64_t> pattern_stage(const Context& cx, std::vector<FaceTask>
     const auto f = static_cast<std::size_t>(order[static_cast<std::size_t>(k)]);
     qstruct::PatternFaceOptions po = options.patterns;
     po.size_map_quads = expected[f];
+    po.tasks = &cx.tasks;  // one face's move search split over this rank's threads
     fills[f] = mesh_face_fill(cx.model, static_cast<LO>(f), result.quantized_curves, patterns, po,
                               fill_bound[f], options.pattern_compare_tolerance >= 0);
     filled[f] = 1;
@@ -533,7 +542,7 @@ std::vector<std::int64_t> pattern_stage(const Context& cx, std::vector<FaceTask>
     PatternFill& fill = fills[static_cast<std::size_t>(f)];
     const std::int64_t i = local_of[static_cast<std::size_t>(f)];
     if (i >= 0) {
-      faces[static_cast<std::size_t>(i)].times.patterns = fill.seconds;
+      set_pattern_times(faces[static_cast<std::size_t>(i)].times, fill);
       take_fill(faces[static_cast<std::size_t>(i)], std::move(fill), options.patterns);
     } else
       to_owners.add(result.face_rank[f], f, fill);
@@ -544,7 +553,7 @@ std::vector<std::int64_t> pattern_stage(const Context& cx, std::vector<FaceTask>
                  "pattern fill of face " << f << " sent to rank " << cx.comm.rank()
                                          << ", which does not own it");
     FaceTask& t = faces[static_cast<std::size_t>(local_of[static_cast<std::size_t>(f)])];
-    t.times.patterns = fill.seconds;
+    set_pattern_times(t.times, fill);
     take_fill(t, std::move(fill), options.patterns);
   });
   return fill_bound;

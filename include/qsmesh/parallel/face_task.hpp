@@ -214,6 +214,11 @@ struct FaceTimes {
   /// first cut's pieces (dealt with the whole faces) then the second cut's (dealt after them).
   /// Their sum and the cutting and merging make `improvement`. Empty: one task.
   std::vector<double> improvement_tasks;
+  /// The pattern fill's move search (qstruct::PatternFaceReport: layouts, batches,
+  /// search_seconds): the part of `patterns` that its batches split over the threads.
+  std::int64_t pattern_layouts = 0;
+  std::int64_t pattern_batches = 0;
+  double pattern_search = 0;
   template <class S, class V>
   static void fields(S& self, V&& visit) {
     visit("background", self.background);
@@ -228,6 +233,9 @@ struct FaceTimes {
     visit("improvement_quads", self.improvement_quads);
     visit("bytes", self.bytes);
     visit("improvement_tasks", self.improvement_tasks);
+    visit("pattern_layouts", self.pattern_layouts);
+    visit("pattern_batches", self.pattern_batches);
+    visit("pattern_search", self.pattern_search);
   }
 };
 
