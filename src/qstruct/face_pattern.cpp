@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <map>
 #include <memory>
@@ -284,6 +285,9 @@ mesh::FaceMesh move_irregular_vertices(const cad::CadModel& model, LO f, const c
     Candidate c;
     mesh::FaceMesh mesh;
     smooth::QualityReport q;
+    /// What laying it out threw, in a batch: thrown when the rules read it, as the serial search
+    /// would have thrown there (a layout they never read must not fail the face).
+    std::exception_ptr error;
   };
   const auto lay_out = [&](Candidate c, const cad::FaceGeometry& on) {
     Layout l;
@@ -316,8 +320,12 @@ mesh::FaceMesh move_irregular_vertices(const cad::CadModel& model, LO f, const c
     std::vector<Layout> out(todo.size());
     options.tasks->parallel_for(static_cast<std::int64_t>(todo.size()), [&](std::int64_t k) {
       const auto u = static_cast<std::size_t>(k);
-      const std::unique_ptr<cad::FaceGeometry> own = model.face_geometry(f);
-      out[u] = lay_out(std::move(todo[u].second), *own);
+      try {
+        const std::unique_ptr<cad::FaceGeometry> own = model.face_geometry(f);
+        out[u] = lay_out(std::move(todo[u].second), *own);
+      } catch (...) {
+        out[u].error = std::current_exception();
+      }
     });
     for (std::size_t u = 0; u < todo.size(); ++u) laid.emplace(todo[u].first, std::move(out[u]));
   };
@@ -340,6 +348,7 @@ mesh::FaceMesh move_irregular_vertices(const cad::CadModel& model, LO f, const c
     ++evaluations;
     ++rep.layouts;
     const Layout& l = it->second;
+    if (l.error) std::rethrow_exception(l.error);
     if (l.q.invalid != 0) return false;
     if (!beats(l.q, q, 1e-4)) return false;
     best = l.c;
