@@ -906,7 +906,9 @@ int run_mesh(const Arguments& args) {
       Checks::Blocks b;
       std::optional<layout::CoarseResult> coarse;
       if (args.coarse_layout) {
-        coarse = layout::build_coarse_layout(result.mesh, s.model);
+        layout::CoarseOptions co;
+        co.loop_balance = args.loop_balance;
+        coarse = layout::build_coarse_layout(result.mesh, s.model, co);
         b.coarse = coarse->stats;
         if (!coarse->ok) {
           b.fallback = true;
