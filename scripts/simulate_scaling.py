@@ -259,6 +259,8 @@ class Simulator:
         search's seconds / layouts); the rest of the face's pattern work is serial. The other
         faces the rank's threads take meanwhile are not modelled (the batches matter where the
         face is the stage's tail, when the other threads are free)."""
+        if self.run.threads > 1:  # measured with its batches already split (a replayed 1xT run)
+            return self.run.t["patterns"][f]
         return batched_schedule(self.run.t["patterns"][f], self.run.pattern_search[f],
                                 self.run.pattern_layouts[f], self.run.pattern_batches[f], t)
 

@@ -153,6 +153,12 @@ class Batches(unittest.TestCase):
         s = sim.Simulator(sim.Run(st), comm=NO_COMM)
         self.assertAlmostEqual(s.predict(1, 4)["patterns"], 4.0, places=6)
         self.assertAlmostEqual(s.predict(4, 1)["patterns"], 10.0, places=6)
+        # A run on two threads measured its face with the batches split already: replayed as is.
+        st2 = stats([(0, 6, 0, 0, 5, 0)], {"patterns": 6.0}, threads=2)
+        st2["face_stats"][0]["stage_seconds"].update(pattern_layouts=8, pattern_batches=2,
+                                                     pattern_search=4.0)
+        s2 = sim.Simulator(sim.Run(st2), comm=NO_COMM)
+        self.assertAlmostEqual(s2.predict(1, 2)["patterns"], 6.0, places=6)
 
 
 class Pieces(unittest.TestCase):
