@@ -459,8 +459,7 @@ LO ring_layers(const FaceSides& fs) {
 mesh::FaceMesh try_sides(const cad::CadModel& model, LO f, const cad::Face& face,
                          const cad::FaceGeometry& surface, const FaceSides& fs,
                          std::span<const Pattern> patterns, const PatternFaceOptions& options,
-                         PatternFaceReport& rep,
-                         linalg::SolverCache* cache) {
+                         PatternFaceReport& rep, linalg::SolverCache* cache) {
   const ErrorContext context{"qstruct", 2, f};
   mesh::FaceMesh empty;
   empty.face = f;
