@@ -372,7 +372,11 @@ class Grower {
       ++res.no_pattern;
       return false;
     }
-    const std::vector<PatternMatch> matches = match_patterns(o_.patterns, c.side_edges, o_.match);
+    std::vector<PatternMatch> fresh;
+    if (o_.match_cache == nullptr) fresh = match_patterns(o_.patterns, c.side_edges, o_.match);
+    const std::vector<PatternMatch>& matches =
+        o_.match_cache != nullptr ? o_.match_cache->matches(o_.patterns, c.side_edges, o_.match)
+                                  : fresh;
     if (matches.empty()) {
       ++res.no_match;
       return false;
@@ -962,6 +966,9 @@ mesh::FaceMesh remesh_cavities(const mesh::FaceMesh& input, const cad::FaceGeome
       memo_impl->adopt(options);
     }
     Remesher remesher(work, surface, options, sign, memo_impl);
+    // The growths match the same side counts against the same lists (grid, four, tri, pent,
+    // alive for the whole call) again and again.
+    MatchCache match_cache;
     const Stopwatch clock;
     std::int64_t started = 0;
     bool stop = false;
@@ -1051,6 +1058,7 @@ mesh::FaceMesh remesh_cavities(const mesh::FaceMesh& input, const cad::FaceGeome
       go.match = options.match;
       go.max_backtracks = options.max_backtracks;
       go.max_remeshable = maximal ? 0 : std::max(1, options.max_minimal_tries);
+      go.match_cache = &match_cache;
       const GrowResult g = grow_cavity(work, topo, seed, singular, go);
       auto& d = rep.diagnostics[step];
       switch (g.stop) {

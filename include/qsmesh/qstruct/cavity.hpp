@@ -81,6 +81,9 @@ struct GrowOptions {
   /// minimal cavity; more give larger fallbacks when the smallest is refused geometrically).
   int max_remeshable = 1;
   MatchOptions match;
+  /// Optional: match_patterns' results kept across growths (same matches, less work). The
+  /// caller's, for one thread; `patterns` must stay alive while it is used.
+  MatchCache* match_cache = nullptr;
 };
 
 /// A remeshable cavity and how to remesh it.
