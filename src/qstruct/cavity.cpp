@@ -32,36 +32,39 @@ QuadTopology::QuadTopology(const mesh::FaceMesh& mesh) {
   v2q_ = Adjacency::from_pairs(n, std::move(pairs));
   q2q_.assign(static_cast<std::size_t>(nq), {kNoIndex, kNoIndex, kNoIndex, kNoIndex});
   on_boundary_.assign(static_cast<std::size_t>(n), 0);
-  // (low, high, quad, edge, forward): equal keys are the uses of one edge.
-  std::vector<std::tuple<LO, LO, LO, int, bool>> edges;
-  edges.reserve(4 * static_cast<std::size_t>(nq));
+  // The uses of each edge, found among the quads of its first vertex (a handful): no sort of
+  // the 4 nq edge uses, as this runs after every committed cavity.
   for (LO q = 0; q < nq; ++q)
     for (int k = 0; k < 4; ++k) {
       const LO a = mesh.quads[q][k], b = mesh.quads[q][(k + 1) % 4];
-      edges.emplace_back(std::min(a, b), std::max(a, b), q, k, a < b);
+      int uses = 0;
+      LO other = kNoIndex;
+      bool other_forward = false;
+      LO previous = kNoIndex;
+      for (const LO p : v2q_[a]) {
+        if (p == previous) continue;  // a vertex twice in one quad
+        previous = p;
+        for (int k2 = 0; k2 < 4; ++k2) {
+          const LO x = mesh.quads[p][k2], y = mesh.quads[p][(k2 + 1) % 4];
+          if (!((x == a && y == b) || (x == b && y == a))) continue;
+          ++uses;
+          if (p != q || k2 != k) {
+            other = p;
+            other_forward = x < y;
+          }
+        }
+      }
+      QSMESH_CHECK(uses <= 2, "edge (" << std::min(a, b) << ", " << std::max(a, b)
+                                       << ") is used by " << uses << " quads");
+      if (uses == 1) {
+        on_boundary_[a] = 1;
+        on_boundary_[b] = 1;
+      } else {
+        QSMESH_CHECK((a < b) != other_forward, "edge (" << std::min(a, b) << ", " << std::max(a, b)
+                                                        << ") is used twice in one direction");
+        q2q_[q][k] = other;
+      }
     }
-  std::sort(edges.begin(), edges.end());
-  for (std::size_t i = 0; i < edges.size();) {
-    std::size_t j = i + 1;
-    while (j < edges.size() && std::get<0>(edges[j]) == std::get<0>(edges[i]) &&
-           std::get<1>(edges[j]) == std::get<1>(edges[i]))
-      ++j;
-    const auto& e = edges[i];
-    QSMESH_CHECK(j - i <= 2, "edge (" << std::get<0>(e) << ", " << std::get<1>(e) << ") is used by "
-                                      << j - i << " quads");
-    if (j - i == 1) {
-      on_boundary_[std::get<0>(e)] = 1;
-      on_boundary_[std::get<1>(e)] = 1;
-    } else {
-      const auto& f = edges[i + 1];
-      QSMESH_CHECK(std::get<4>(e) != std::get<4>(f), "edge ("
-                                                         << std::get<0>(e) << ", " << std::get<1>(e)
-                                                         << ") is used twice in one direction");
-      q2q_[std::get<2>(e)][std::get<3>(e)] = std::get<2>(f);
-      q2q_[std::get<2>(f)][std::get<3>(f)] = std::get<2>(e);
-    }
-    i = j;
-  }
 }
 
 namespace {
