@@ -5,16 +5,15 @@
 namespace qsmesh {
 
 Adjacency Adjacency::from_pairs(LO n_a, std::vector<std::pair<LO, LO>> pairs) {
-  std::stable_sort(pairs.begin(), pairs.end(),
-                   [](const auto& x, const auto& y) { return x.first < y.first; });
+  // A counting sort by the first entry, stable: the targets of each a keep their input order.
   Adjacency a2b;
   a2b.offsets.assign(static_cast<std::size_t>(n_a) + 1, 0);
-  a2b.targets.reserve(pairs.size());
-  for (const auto& [a, b] : pairs) {
-    ++a2b.offsets[static_cast<std::size_t>(a) + 1];
-    a2b.targets.push_back(b);
-  }
+  for (const auto& [a, b] : pairs) ++a2b.offsets[static_cast<std::size_t>(a) + 1];
   for (LO a = 0; a < n_a; ++a) a2b.offsets[a + 1] += a2b.offsets[a];
+  a2b.targets.resize(pairs.size());
+  std::vector<LO> next(a2b.offsets.begin(), a2b.offsets.end() - 1);
+  for (const auto& [a, b] : pairs)
+    a2b.targets[static_cast<std::size_t>(next[static_cast<std::size_t>(a)]++)] = b;
   return a2b;
 }
 

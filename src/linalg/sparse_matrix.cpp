@@ -34,9 +34,15 @@ SparseMatrix::SparseMatrix(LO n, std::span<const Triplet> triplets) : n_(n) {
   for (LO r = 0; r < n; ++r) {
     const auto begin = order.begin() + row_count[static_cast<std::size_t>(r)];
     const auto end = order.begin() + row_count[static_cast<std::size_t>(r) + 1];
-    std::stable_sort(begin, end, [&](std::int64_t a, std::int64_t b) {
-      return triplets[static_cast<std::size_t>(a)].col < triplets[static_cast<std::size_t>(b)].col;
-    });
+    // Rows hold a few entries (the Laplacians of the per-face systems: about 5-10): a stable
+    // insertion sort, without std::stable_sort's buffer allocation. Same order.
+    for (auto it = begin + (begin == end ? 0 : 1); it < end; ++it) {
+      const std::int64_t x = *it;
+      const LO c = triplets[static_cast<std::size_t>(x)].col;
+      auto j = it;
+      for (; j != begin && triplets[static_cast<std::size_t>(*(j - 1))].col > c; --j) *j = *(j - 1);
+      *j = x;
+    }
     for (auto it = begin; it != end; ++it) {
       const Triplet& t = triplets[static_cast<std::size_t>(*it)];
       const auto row_start = offsets_[static_cast<std::size_t>(r)];

@@ -80,7 +80,7 @@ struct Result {
 Result improve_pass(LO face, mesh::FaceMesh mesh, const cad::FaceGeometry* surface,
                     std::span<const crossfield::Singularity> singularities,
                     const ImproveSettings& settings, const qstruct::CavityOptions& cavities,
-                    Logger& log, std::int64_t& flagged_kept) {
+                    qstruct::CavityMemo& memo, Logger& log, std::int64_t& flagged_kept) {
   Result r;
   r.done = true;
   flagged_kept = 0;
@@ -102,7 +102,7 @@ Result improve_pass(LO face, mesh::FaceMesh mesh, const cad::FaceGeometry* surfa
   step(0, "cavity remeshing", [&](const cad::FaceGeometry& s) {
     qstruct::CavityReport cr;
     mesh::FaceMesh out =
-        qstruct::remesh_cavities(mesh, s, singularities, settings.patterns, cavities, &cr);
+        qstruct::remesh_cavities(mesh, s, singularities, settings.patterns, cavities, &cr, &memo);
     r.report.record(cr);
     flagged_kept = cr.flagged_kept;
     return out;
@@ -157,15 +157,18 @@ Result improve_one(const cad::CadModel& model, LO face, mesh::FaceMesh mesh,
   std::optional<mesh::FaceMesh> input;
   if (second_pass) input = mesh;
   std::int64_t flagged = 0;
+  // The candidates the first pass refused are refused by the second too when its bounds still
+  // refuse them: it starts from the same mesh (qstruct::CavityMemo). One memo per task.
+  qstruct::CavityMemo memo;
   Result r = improve_pass(face, std::move(mesh), surface.get(), singularities, settings,
-                          settings.cavities, log, flagged);
+                          settings.cavities, memo, log, flagged);
   if (second_pass && !r.report.time_budget_hit) {
     const mesh::FaceQuadStats first = mesh::face_quad_stats(r.mesh);
     if (first.irregular_interior - flagged >= settings.second_pass_min_unnecessary &&
         (settings.second_pass_max_quads <= 0 || first.quads <= settings.second_pass_max_quads)) {
       std::int64_t flagged2 = 0;
       Result again = improve_pass(face, std::move(*input), surface.get(), singularities, settings,
-                                  settings.second_pass_cavities, log, flagged2);
+                                  settings.second_pass_cavities, memo, log, flagged2);
       for (std::size_t k = 0; k < r.steps.size(); ++k) again.steps[k] += r.steps[k];
       if (!again.report.time_budget_hit &&
           second_pass_wins(

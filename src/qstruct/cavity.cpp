@@ -5,7 +5,9 @@
 #include <cmath>
 #include <limits>
 #include <set>
+#include <string>
 #include <tuple>
+#include <unordered_map>
 #include <utility>
 
 #include "qsmesh/core/error.hpp"
@@ -30,36 +32,39 @@ QuadTopology::QuadTopology(const mesh::FaceMesh& mesh) {
   v2q_ = Adjacency::from_pairs(n, std::move(pairs));
   q2q_.assign(static_cast<std::size_t>(nq), {kNoIndex, kNoIndex, kNoIndex, kNoIndex});
   on_boundary_.assign(static_cast<std::size_t>(n), 0);
-  // (low, high, quad, edge, forward): equal keys are the uses of one edge.
-  std::vector<std::tuple<LO, LO, LO, int, bool>> edges;
-  edges.reserve(4 * static_cast<std::size_t>(nq));
+  // The uses of each edge, found among the quads of its first vertex (a handful): no sort of
+  // the 4 nq edge uses, as this runs after every committed cavity.
   for (LO q = 0; q < nq; ++q)
     for (int k = 0; k < 4; ++k) {
       const LO a = mesh.quads[q][k], b = mesh.quads[q][(k + 1) % 4];
-      edges.emplace_back(std::min(a, b), std::max(a, b), q, k, a < b);
+      int uses = 0;
+      LO other = kNoIndex;
+      bool other_forward = false;
+      LO previous = kNoIndex;
+      for (const LO p : v2q_[a]) {
+        if (p == previous) continue;  // a vertex twice in one quad
+        previous = p;
+        for (int k2 = 0; k2 < 4; ++k2) {
+          const LO x = mesh.quads[p][k2], y = mesh.quads[p][(k2 + 1) % 4];
+          if (!((x == a && y == b) || (x == b && y == a))) continue;
+          ++uses;
+          if (p != q || k2 != k) {
+            other = p;
+            other_forward = x < y;
+          }
+        }
+      }
+      QSMESH_CHECK(uses <= 2, "edge (" << std::min(a, b) << ", " << std::max(a, b)
+                                       << ") is used by " << uses << " quads");
+      if (uses == 1) {
+        on_boundary_[a] = 1;
+        on_boundary_[b] = 1;
+      } else {
+        QSMESH_CHECK((a < b) != other_forward, "edge (" << std::min(a, b) << ", " << std::max(a, b)
+                                                        << ") is used twice in one direction");
+        q2q_[q][k] = other;
+      }
     }
-  std::sort(edges.begin(), edges.end());
-  for (std::size_t i = 0; i < edges.size();) {
-    std::size_t j = i + 1;
-    while (j < edges.size() && std::get<0>(edges[j]) == std::get<0>(edges[i]) &&
-           std::get<1>(edges[j]) == std::get<1>(edges[i]))
-      ++j;
-    const auto& e = edges[i];
-    QSMESH_CHECK(j - i <= 2, "edge (" << std::get<0>(e) << ", " << std::get<1>(e) << ") is used by "
-                                      << j - i << " quads");
-    if (j - i == 1) {
-      on_boundary_[std::get<0>(e)] = 1;
-      on_boundary_[std::get<1>(e)] = 1;
-    } else {
-      const auto& f = edges[i + 1];
-      QSMESH_CHECK(std::get<4>(e) != std::get<4>(f), "edge ("
-                                                         << std::get<0>(e) << ", " << std::get<1>(e)
-                                                         << ") is used twice in one direction");
-      q2q_[std::get<2>(e)][std::get<3>(e)] = std::get<2>(f);
-      q2q_[std::get<2>(f)][std::get<3>(f)] = std::get<2>(e);
-    }
-    i = j;
-  }
 }
 
 namespace {
@@ -370,7 +375,11 @@ class Grower {
       ++res.no_pattern;
       return false;
     }
-    const std::vector<PatternMatch> matches = match_patterns(o_.patterns, c.side_edges, o_.match);
+    std::vector<PatternMatch> fresh;
+    if (o_.match_cache == nullptr) fresh = match_patterns(o_.patterns, c.side_edges, o_.match);
+    const std::vector<PatternMatch>& matches =
+        o_.match_cache != nullptr ? o_.match_cache->matches(o_.patterns, c.side_edges, o_.match)
+                                  : fresh;
     if (matches.empty()) {
       ++res.no_match;
       return false;
@@ -472,11 +481,111 @@ struct Replacement {
   LO new_irregular = kNoIndex;  // work id of the one irregular new vertex (if one)
 };
 
+// What the layout and smoothing of a candidate gave (CavityMemo).
+struct MemoRecord {
+  bool layout_failed = false;
+  bool reached_screen = false;  // the screen's pass ran: previous and now are its measures
+  std::pair<double, double> previous{0, 0}, now{0, 0};
+  bool completed = false;  // the smoothing ran to its end: after, after_avg
+  double after = 0, after_avg = 0;
+};
+
+template <class T>
+void append_bytes(std::string& key, const T& x) {
+  key.append(reinterpret_cast<const char*>(&x), sizeof(T));
+}
+
+// The local problem of a candidate, as bytes: everything its layout, smoothing and measures read.
+std::string memo_key(const mesh::FaceMesh& lm, LO nold, LO n_new_quads, double before,
+                     double before_sum, std::size_t cavity_quads) {
+  std::string key;
+  key.reserve(64 + lm.points.size() * 64 + lm.quads.size() * 16);
+  append_bytes(key, nold);
+  append_bytes(key, n_new_quads);
+  append_bytes(key, lm.num_vertices());
+  append_bytes(key, before);
+  append_bytes(key, before_sum);
+  append_bytes(key, static_cast<std::uint64_t>(cavity_quads));
+  for (LO i = 0; i < lm.num_vertices(); ++i) {
+    const Vec3& p = lm.points[i];
+    const Vec2& uv = lm.uv[i];
+    const mesh::VertexClass& vc = lm.vclass[i];
+    for (const double x : {p.x, p.y, p.z, uv.u, uv.v, vc.param[0], vc.param[1]})
+      append_bytes(key, x);
+    append_bytes(key, vc.dim);
+    append_bytes(key, vc.entity);
+    append_bytes(key, vc.index);
+  }
+  for (const auto& q : lm.quads)
+    for (const LO v : q) append_bytes(key, v);
+  return key;
+}
+
+}  // namespace
+
+struct CavityMemo::Impl {
+  std::int64_t max_bytes = 0, bytes = 0, hits = 0;
+  // The smoothing options the records were made under.
+  bool have_options = false;
+  int iterations = 0, screen_passes = 0;
+  bool laplacian_uv = false, winslow = false, approximate_projection = false;
+  std::unordered_map<std::string, MemoRecord> records;
+
+  // Forgets the records made under other smoothing options.
+  void adopt(const CavityOptions& o) {
+    const auto& s = o.smooth;
+    if (have_options && iterations == s.iterations && screen_passes == o.screen_passes &&
+        laplacian_uv == s.laplacian_uv && winslow == s.winslow &&
+        approximate_projection == s.approximate_projection)
+      return;
+    records.clear();
+    bytes = 0;
+    have_options = true;
+    iterations = s.iterations;
+    screen_passes = o.screen_passes;
+    laplacian_uv = s.laplacian_uv;
+    winslow = s.winslow;
+    approximate_projection = s.approximate_projection;
+  }
+  [[nodiscard]] const MemoRecord* find(const std::string& key) const {
+    const auto it = records.find(key);
+    return it == records.end() ? nullptr : &it->second;
+  }
+  bool hit() {
+    ++hits;
+    return false;
+  }
+  void store(const std::string& key, const MemoRecord& r) {
+    const auto it = records.find(key);
+    if (it != records.end()) {
+      it->second = r;
+      return;
+    }
+    const auto size = static_cast<std::int64_t>(key.size() + sizeof(MemoRecord) + 64);
+    if (bytes + size > max_bytes) return;
+    bytes += size;
+    records.emplace(key, r);
+  }
+};
+
+CavityMemo::CavityMemo(std::int64_t max_bytes) : impl_(std::make_unique<Impl>()) {
+  impl_->max_bytes = max_bytes;
+}
+CavityMemo::~CavityMemo() = default;
+CavityMemo::CavityMemo(CavityMemo&&) noexcept = default;
+CavityMemo& CavityMemo::operator=(CavityMemo&&) noexcept = default;
+std::int64_t CavityMemo::hits() const { return impl_->hits; }
+std::int64_t CavityMemo::records() const {
+  return static_cast<std::int64_t>(impl_->records.size());
+}
+
+namespace {
+
 class Remesher {
  public:
   Remesher(mesh::FaceMesh& work, const cad::FaceGeometry& surface, const CavityOptions& o,
-           double sign)
-      : w_(work), s_(surface), o_(o), sign_(sign) {}
+           double sign, CavityMemo::Impl* memo)
+      : w_(work), s_(surface), o_(o), sign_(sign), memo_(memo) {}
 
   // Why build() refused a replacement.
   enum class Refusal { None, Layout, Screened, Invalid, MinSicn, AvgSicn };
@@ -596,10 +705,57 @@ class Remesher {
       const auto& qd = w_.quads[q];
       lm.quads.push_back({local(qd[0]), local(qd[1]), local(qd[2]), local(qd[3])});
     }
+    const double need = std::max(o_.min_sicn, std::min(o_.good_sicn, o_.keep_ratio * before));
+    const double avg_need = o_.keep_avg_ratio * (before_sum / static_cast<double>(c.quads.size()));
+    const bool screen = o_.screen_passes >= 2 && o_.screen_passes < o_.smooth.iterations;
+    // Each pass gains less than the one before it (measured, CavityOptions::screen_passes): the
+    // passes left, each at the last pass's gain, bound what the candidate can reach.
+    const auto passes_screen = [&](std::pair<double, double> previous,
+                                   std::pair<double, double> now) {
+      const double rest = o_.smooth.iterations - o_.screen_passes;
+      const double reach_min = now.first + rest * std::max(0.0, now.first - previous.first);
+      const double reach_avg = now.second + rest * std::max(0.0, now.second - previous.second);
+      return reach_min + o_.screen_min_margin >= need &&
+             reach_avg + o_.screen_avg_margin >= avg_need;
+    };
+    // The acceptance of a smoothed candidate (minimum over the touched quads, mean of the new).
+    const auto refusal = [&](double after, double after_avg) {
+      if (!(after > o_.min_sicn)) return Refusal::Invalid;
+      if (after < need) return Refusal::MinSicn;
+      if (after_avg < avg_need) return Refusal::AvgSicn;
+      return Refusal::None;
+    };
+
+    // A candidate refused before with this very local problem (CavityMemo).
+    std::string key;
+    MemoRecord record;
+    if (memo_ != nullptr) {
+      key = memo_key(lm, nold, n_new_quads, before, before_sum, c.quads.size());
+      if (const MemoRecord* m = memo_->find(key)) {
+        why = Refusal::Layout;
+        if (m->layout_failed) return memo_->hit();
+        why = Refusal::Screened;
+        if (screen && m->reached_screen && !passes_screen(m->previous, m->now)) return memo_->hit();
+        if (m->completed) {
+          why = refusal(m->after, m->after_avg);
+          if (why != Refusal::None) return memo_->hit();
+        }
+        record = *m;  // not decided by the record: laid out and smoothed again
+        why = Refusal::Layout;
+      }
+    }
+    const auto remember = [&] {
+      if (memo_ != nullptr) memo_->store(key, record);
+    };
+
     // Laplace layout of the new vertices on the new quads only, the cavity boundary fixed.
     {
       std::vector<std::array<LO, 4>> nq(lm.quads.begin(), lm.quads.begin() + n_new_quads);
-      if (!laplace_uv(nq, nold, lm.uv, cache_)) return false;
+      if (!laplace_uv(nq, nold, lm.uv, cache_)) {
+        record.layout_failed = true;
+        remember();
+        return false;
+      }
     }
     for (LO i = nold; i < nold + n_new; ++i) {
       lm.points[i] = s_.eval(lm.uv[i]).p;
@@ -615,11 +771,9 @@ class Remesher {
       }
       return std::pair{low, sum / static_cast<double>(n_new_quads)};
     };
-    const double need = std::max(o_.min_sicn, std::min(o_.good_sicn, o_.keep_ratio * before));
-    const double avg_need = o_.keep_avg_ratio * (before_sum / static_cast<double>(c.quads.size()));
     smooth::SmoothOptions so = o_.smooth;
     std::pair<double, double> previous{0, 0};
-    if (o_.screen_passes >= 2 && o_.screen_passes < so.iterations)
+    if (screen)
       so.after_pass = [&](int pass, const mesh::FaceMesh& m) {
         if (pass + 1 < o_.screen_passes || pass > o_.screen_passes) return true;
         const auto now = measure(m);
@@ -627,27 +781,28 @@ class Remesher {
           previous = now;
           return true;
         }
-        // Each pass gains less than the one before it (measured, CavityOptions::screen_passes):
-        // the passes left, each at the last pass's gain, bound what the candidate can reach.
-        const double rest = so.iterations - pass;
-        const double reach_min = now.first + rest * std::max(0.0, now.first - previous.first);
-        const double reach_avg = now.second + rest * std::max(0.0, now.second - previous.second);
-        return reach_min + o_.screen_min_margin >= need &&
-               reach_avg + o_.screen_avg_margin >= avg_need;
+        record.reached_screen = true;
+        record.previous = previous;
+        record.now = now;
+        return passes_screen(previous, now);
       };
     smooth::SmoothStats ss;
     lm = smooth::smooth_face(lm, s_, so, &ss, &cache_);
     why = Refusal::Screened;
-    if (ss.stopped_early) return false;
+    if (ss.stopped_early) {
+      remember();
+      return false;
+    }
 
     const auto [after, after_avg] = measure(lm);
-    why = Refusal::Invalid;
-    if (!(after > o_.min_sicn)) return false;
-    why = Refusal::MinSicn;
-    if (after < need) return false;
-    why = Refusal::AvgSicn;
-    if (after_avg < avg_need) return false;
-    why = Refusal::None;
+    record.completed = true;
+    record.after = after;
+    record.after_avg = after_avg;
+    why = refusal(after, after_avg);
+    if (why != Refusal::None) {
+      remember();
+      return false;
+    }
 
     for (LO i = nold; i < nold + n_new; ++i) {
       out.new_uv.push_back(lm.uv[i]);
@@ -691,6 +846,7 @@ class Remesher {
   const cad::FaceGeometry& s_;
   const CavityOptions& o_;
   double sign_;
+  CavityMemo::Impl* memo_;
   // The candidates' layouts repeat the same refined patterns (one remesh_cavities call, one
   // thread): their solvers' analyses are kept.
   mutable linalg::SolverCache cache_;
@@ -737,7 +893,7 @@ std::int64_t count_irregular(const mesh::FaceMesh& mesh) {
 mesh::FaceMesh remesh_cavities(const mesh::FaceMesh& input, const cad::FaceGeometry& surface,
                                std::span<const crossfield::Singularity> singularities,
                                std::span<const Pattern> patterns, const CavityOptions& options,
-                               CavityReport* report) {
+                               CavityReport* report, CavityMemo* memo) {
   CavityReport local;
   CavityReport& rep = report != nullptr ? *report : local;
   rep = CavityReport{};
@@ -806,7 +962,16 @@ mesh::FaceMesh remesh_cavities(const mesh::FaceMesh& input, const cad::FaceGeome
     const std::vector<Pattern> tri = select(patterns, 3, false);
     const std::vector<Pattern> pent = select(patterns, 5, false);
 
-    Remesher remesher(work, surface, options, sign);
+    // The memo needs reproducible smoothing: no time budget, no caller's pass hook.
+    CavityMemo::Impl* memo_impl = nullptr;
+    if (memo != nullptr && options.smooth.time_budget_s <= 0 && !options.smooth.after_pass) {
+      memo_impl = &memo->impl();
+      memo_impl->adopt(options);
+    }
+    Remesher remesher(work, surface, options, sign, memo_impl);
+    // The growths match the same side counts against the same lists (grid, four, tri, pent,
+    // alive for the whole call) again and again.
+    MatchCache match_cache;
     const Stopwatch clock;
     std::int64_t started = 0;
     bool stop = false;
@@ -896,6 +1061,7 @@ mesh::FaceMesh remesh_cavities(const mesh::FaceMesh& input, const cad::FaceGeome
       go.match = options.match;
       go.max_backtracks = options.max_backtracks;
       go.max_remeshable = maximal ? 0 : std::max(1, options.max_minimal_tries);
+      go.match_cache = &match_cache;
       const GrowResult g = grow_cavity(work, topo, seed, singular, go);
       auto& d = rep.diagnostics[step];
       switch (g.stop) {

@@ -257,4 +257,27 @@ std::vector<PatternMatch> match_patterns(std::span<const Pattern> patterns,
   return out;
 }
 
+std::size_t MatchCache::KeyHash::operator()(const Key& k) const {
+  std::size_t h = std::hash<const void*>()(k.list) ^ (k.size * 0x9e3779b97f4a7c15ULL);
+  h ^= static_cast<std::size_t>(k.max_attempts) * 31 + (k.cornerless ? 17 : 0);
+  for (const LO x : k.sides) h = h * 1000003 ^ static_cast<std::size_t>(x);
+  return h;
+}
+
+const std::vector<PatternMatch>& MatchCache::matches(std::span<const Pattern> patterns,
+                                                     std::span<const LO> side_edges,
+                                                     const MatchOptions& options, bool cornerless) {
+  Key key{patterns.data(), patterns.size(), options.max_attempts, cornerless,
+          std::vector<LO>(side_edges.begin(), side_edges.end())};
+  const auto it = results_.find(key);
+  if (it != results_.end()) {
+    ++hits_;
+    return it->second;
+  }
+  ++misses_;
+  if (results_.size() >= max_entries_) results_.clear();
+  return results_.emplace(std::move(key), match_patterns(patterns, side_edges, options, cornerless))
+      .first->second;
+}
+
 }  // namespace qsmesh::qstruct

@@ -37,12 +37,6 @@ double oriented_sicn(const std::array<Vec3, 4>& x, const Vec3& normal, double si
 
 namespace {
 
-std::uint64_t edge_key(LO a, LO b) {
-  const auto [lo, hi] = std::minmax(a, b);
-  return (static_cast<std::uint64_t>(static_cast<std::uint32_t>(lo)) << 32) |
-         static_cast<std::uint32_t>(hi);
-}
-
 // Unique edges of `quads` and, per quad, its four edge ids (edge k joins corners k and k+1).
 struct QuadEdges {
   std::vector<std::array<LO, 2>> ends;
@@ -52,23 +46,45 @@ struct QuadEdges {
 };
 
 QuadEdges quad_edges(const std::vector<std::array<LO, 4>>& quads) {
-  // Edges numbered in order of first appearance (quad by quad, corner by corner), found by
-  // sorting the (edge, position) pairs: a hash map allocated a node per edge, and this runs
-  // for every layout of every pattern and cavity.
+  // Edges numbered in order of first appearance (quad by quad, corner by corner). The (quad,
+  // corner) positions are bucketed by the edge's lower vertex (counting sort), and each position
+  // finds the first one of its edge among the few before it in its bucket: no sort and no hash
+  // map (a node per edge), as this runs for every layout of every pattern and cavity.
   QuadEdges e;
   const auto nq = static_cast<LO>(quads.size());
-  std::vector<std::pair<std::uint64_t, LO>> keyed(static_cast<std::size_t>(nq) * 4);
-  for (LO q = 0; q < nq; ++q)
-    for (int k = 0; k < 4; ++k)
-      keyed[4 * q + k] = {edge_key(quads[q][k], quads[q][(k + 1) % 4]), 4 * q + k};
-  std::sort(keyed.begin(), keyed.end());
-  std::vector<LO> group_of(keyed.size());
-  LO groups = 0;
-  for (std::size_t i = 0; i < keyed.size(); ++i) {
-    if (i > 0 && keyed[i].first != keyed[i - 1].first) ++groups;
-    group_of[keyed[i].second] = groups;
+  const auto np = static_cast<std::size_t>(nq) * 4;
+  LO nv = 0;
+  for (const auto& q : quads)
+    for (const LO v : q) nv = std::max(nv, v + 1);
+  std::vector<LO> start(static_cast<std::size_t>(nv) + 1, 0);
+  const auto ends_at = [&](std::size_t p) {
+    const auto& q = quads[p / 4];
+    return std::minmax(q[p % 4], q[(p + 1) % 4]);
+  };
+  for (std::size_t p = 0; p < np; ++p) ++start[static_cast<std::size_t>(ends_at(p).first) + 1];
+  for (std::size_t v = 0; v < static_cast<std::size_t>(nv); ++v) start[v + 1] += start[v];
+  std::vector<LO> slot(np);
+  {
+    std::vector<LO> fill(start.begin(), start.end() - 1);
+    for (std::size_t p = 0; p < np; ++p)
+      slot[static_cast<std::size_t>(fill[static_cast<std::size_t>(ends_at(p).first)]++)] =
+          static_cast<LO>(p);
   }
-  std::vector<LO> id_of(keyed.empty() ? 0 : static_cast<std::size_t>(groups) + 1, kNoIndex);
+  std::vector<LO> group_of(np);  // the edge's first position
+  for (std::size_t v = 0; v < static_cast<std::size_t>(nv); ++v)
+    for (LO i = start[v]; i < start[v + 1]; ++i) {
+      const auto p = static_cast<std::size_t>(slot[static_cast<std::size_t>(i)]);
+      const LO hi = ends_at(p).second;
+      group_of[p] = static_cast<LO>(p);
+      for (LO j = start[v]; j < i; ++j) {
+        const auto r = static_cast<std::size_t>(slot[static_cast<std::size_t>(j)]);
+        if (ends_at(r).second == hi) {
+          group_of[p] = group_of[r];
+          break;
+        }
+      }
+    }
+  std::vector<LO> id_of(np, kNoIndex);
   e.quad2edges.resize(quads.size());
   for (LO q = 0; q < nq; ++q)
     for (int k = 0; k < 4; ++k) {

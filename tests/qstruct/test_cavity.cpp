@@ -602,6 +602,94 @@ TEST(Cavity, ScreenedCandidatesLeaveTheResultUnchanged) {
   EXPECT_EQ(refused, refused_without);
 }
 
+// The graded grid of the screen's test, whose candidates are refused in numbers.
+mesh::FaceMesh graded_grid(const Plane& plane) {
+  mesh::FaceMesh in =
+      perturbed(plane, 24, 12, {{4, 4, 5, 4}, {18, 6, 18, 7}, {11, 8, 12, 8}, {11, 3, 11, 4}});
+  for (LO v = 0; v < in.num_vertices(); ++v) {
+    const double x = in.uv[v].u / 24;
+    in.uv[v].u = 24 * x * (0.1 + 0.9 * x);
+    in.points[v] = {in.uv[v].u, in.uv[v].v, 0};
+    if (in.vclass[v].dim == 2) in.vclass[v].param = {in.uv[v].u, in.uv[v].v};
+  }
+  return in;
+}
+
+void expect_same_mesh(const mesh::FaceMesh& a, const mesh::FaceMesh& b) {
+  EXPECT_EQ(a.quads, b.quads);
+  ASSERT_EQ(a.points.size(), b.points.size());
+  for (std::size_t i = 0; i < a.points.size(); ++i) {
+    EXPECT_EQ(a.points[i], b.points[i]) << "vertex " << i;
+    EXPECT_EQ(a.uv[i], b.uv[i]) << "vertex " << i;
+  }
+}
+
+// CavityMemo: candidates refused before with the same local problem are refused from the record,
+// and the result is bit for bit the one without a memo, refusals counted alike.
+TEST(Cavity, MemoLeavesTheResultUnchanged) {
+  const Plane plane;
+  const mesh::FaceMesh in = graded_grid(plane);
+  const auto patterns = builtin_patterns();
+  CavityOptions options;
+  options.max_quads_maximal = 80;
+  options.keep_avg_ratio = 1.1;
+  CavityReport a, b;
+  CavityMemo memo;
+  const mesh::FaceMesh with = remesh_cavities(in, plane, {}, patterns, options, &a, &memo);
+  const mesh::FaceMesh without = remesh_cavities(in, plane, {}, patterns, options, &b);
+  ASSERT_TRUE(a.skipped.empty()) << a.skipped;
+  EXPECT_LT(a.irregular_after, a.irregular_before);
+  expect_same_mesh(with, without);
+  for (int k = 0; k < 4; ++k) {
+    const auto& x = a.diagnostics[k];
+    const auto& y = b.diagnostics[k];
+    EXPECT_EQ(a.remeshed[k], b.remeshed[k]);
+    EXPECT_EQ(x.refused_layout, y.refused_layout);
+    EXPECT_EQ(x.refused_screened, y.refused_screened);
+    EXPECT_EQ(x.refused_invalid, y.refused_invalid);
+    EXPECT_EQ(x.refused_min, y.refused_min);
+    EXPECT_EQ(x.refused_avg, y.refused_avg);
+  }
+  EXPECT_GT(memo.records(), 0);
+  EXPECT_GT(memo.hits(), 0);  // the rounds meet refused candidates again
+}
+
+// A memo handed on to a second call on the same mesh: under the same bounds every candidate the
+// first refused is refused from its record; under looser bounds (the second pass's) some are laid
+// out again, and the result is the one of a fresh call either way.
+TEST(Cavity, MemoIsHandedOnToALaterCall) {
+  const Plane plane;
+  const mesh::FaceMesh in = graded_grid(plane);
+  const auto patterns = builtin_patterns();
+  CavityOptions strict;
+  strict.max_quads_maximal = 80;
+  strict.keep_avg_ratio = 1.1;
+  CavityOptions loose = strict;
+  loose.keep_avg_ratio = 1.08;
+  loose.max_backtracks = 16;
+  CavityMemo memo;
+  (void)remesh_cavities(in, plane, {}, patterns, strict, nullptr, &memo);
+  const std::int64_t hits = memo.hits();
+  CavityReport again;
+  const mesh::FaceMesh same = remesh_cavities(in, plane, {}, patterns, strict, &again, &memo);
+  std::int64_t refused = 0;
+  for (const auto& d : again.diagnostics)
+    refused +=
+        d.refused_layout + d.refused_screened + d.refused_invalid + d.refused_min + d.refused_avg;
+  EXPECT_EQ(memo.hits() - hits, refused);  // nothing refused was laid out again
+  expect_same_mesh(same, remesh_cavities(in, plane, {}, patterns, strict));
+
+  const std::int64_t before_loose = memo.hits();
+  const mesh::FaceMesh looser = remesh_cavities(in, plane, {}, patterns, loose, nullptr, &memo);
+  EXPECT_GT(memo.hits(), before_loose);
+  expect_same_mesh(looser, remesh_cavities(in, plane, {}, patterns, loose));
+  // Other smoothing options: the records are forgotten, the result still the fresh one.
+  CavityOptions other = strict;
+  other.smooth.iterations = 6;
+  const mesh::FaceMesh o = remesh_cavities(in, plane, {}, patterns, other, nullptr, &memo);
+  expect_same_mesh(o, remesh_cavities(in, plane, {}, patterns, other));
+}
+
 TEST(Cavity, Deterministic) {
   const Plane plane;
   const mesh::FaceMesh in = perturbed(plane, 12, 10, {{4, 4, 5, 4}, {9, 2, 9, 3}});

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <array>
 #include <map>
 #include <set>
 #include <string>
@@ -352,6 +353,52 @@ TEST(Match, UTurnAndAlignedPairGiveTheirSystems) {
     expect_solves_eq14(a, m, n2);
   }
   EXPECT_TRUE(aligned);
+}
+
+bool same_matches(const std::vector<PatternMatch>& a, const std::vector<PatternMatch>& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    if (a[i].pattern != b[i].pattern || a[i].start != b[i].start ||
+        a[i].reversed != b[i].reversed || a[i].chords != b[i].chords || a[i].energy != b[i].energy)
+      return false;
+  return true;
+}
+
+// MatchCache: the matches of match_patterns, for every list, side counts and option met, kept
+// apart by list (a sub-list of the same patterns is another key) and by options.
+TEST(Match, CacheGivesTheSameMatches) {
+  const auto all = builtin_patterns();
+  std::vector<Pattern> four;
+  for (const auto& p : all)
+    if (p.num_sides() == 4) four.push_back(p);
+  const std::vector<std::vector<LO>> sides{{4, 4, 4, 4},    {3, 5, 4, 6}, {2, 3, 4}, {6, 2, 6, 3},
+                                           {3, 3, 3, 3, 3}, {5, 5, 6},    {24},      {4, 4, 4, 4}};
+  MatchCache cache;
+  MatchOptions tight;
+  tight.max_attempts = 3;
+  std::int64_t calls = 0, nonempty = 0;
+  for (int round = 0; round < 2; ++round)
+    for (const auto& n : sides)
+      for (const bool cornerless : {false, true}) {
+        for (const std::vector<Pattern>* list :
+             std::array<const std::vector<Pattern>*, 2>{&all, &four}) {
+          const auto& got = cache.matches(*list, n, {}, cornerless);
+          EXPECT_TRUE(same_matches(got, match_patterns(*list, n, {}, cornerless)));
+          nonempty += got.empty() ? 0 : 1;
+          ++calls;
+        }
+        EXPECT_TRUE(same_matches(cache.matches(all, n, tight, cornerless),
+                                 match_patterns(all, n, tight, cornerless)));
+        ++calls;
+      }
+  EXPECT_GT(nonempty, 8);
+  EXPECT_EQ(cache.hits() + cache.misses(), calls);
+  // 7 distinct side counts x 2 x 3 keys, each computed once.
+  EXPECT_EQ(cache.misses(), 7 * 2 * 3);
+  // Full: starts over, still the same matches.
+  MatchCache small(2);
+  for (const auto& n : sides)
+    EXPECT_TRUE(same_matches(small.matches(all, n), match_patterns(all, n)));
 }
 
 TEST(Refine, GridAndTransitionTopology) {

@@ -13,6 +13,7 @@
 
 #include <array>
 #include <cstdint>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -80,6 +81,9 @@ struct GrowOptions {
   /// minimal cavity; more give larger fallbacks when the smallest is refused geometrically).
   int max_remeshable = 1;
   MatchOptions match;
+  /// Optional: match_patterns' results kept across growths (same matches, less work). The
+  /// caller's, for one thread; `patterns` must stay alive while it is used.
+  MatchCache* match_cache = nullptr;
 };
 
 /// A remeshable cavity and how to remesh it.
@@ -258,6 +262,44 @@ struct CavityReport {
   std::string skipped;  ///< why the face was left as it is (empty when processed)
 };
 
+/// The candidates of remesh_cavities that were laid out, smoothed and refused, each under the
+/// exact local problem it was (the touched quads' vertices with their points, uv and
+/// classification, the new quads, the quality before), with what its smoothing reached: the
+/// minimum and mean after the screen's passes and, when it ran to the end, after the last one.
+/// The rounds and steps grow the same cavities again from the same seeds while their surroundings
+/// do not change, and a growth whose candidates were all refused is grown again (only growths
+/// that found nothing are skipped, CavityOptions::skip_futile). A candidate met again with the
+/// same local problem is decided from what was recorded, under the acceptance bounds of the run
+/// that meets it: refused there without its layout and smoothing, or laid out and smoothed again
+/// when the record cannot tell (it would pass now, or was screened and would not be now). The
+/// layout and smoothing depend on the local problem alone, so the mesh is bit for bit the one
+/// without a memo. A memo can be handed on to a later call on the same face and surface (the
+/// second pass starts from the same mesh with looser bounds: PipelineOptions::
+/// second_pass_cavities); it forgets its records when that call's smoothing options differ.
+///
+/// One thread at a time; a memo belongs to the task that improves one face (or piece).
+class CavityMemo {
+ public:
+  /// Records of at most `max_bytes` bytes in all (keys and records); later candidates are not
+  /// recorded once it is full.
+  explicit CavityMemo(std::int64_t max_bytes = std::int64_t{64} << 20);
+  ~CavityMemo();
+  CavityMemo(CavityMemo&&) noexcept;
+  CavityMemo& operator=(CavityMemo&&) noexcept;
+  CavityMemo(const CavityMemo&) = delete;
+  CavityMemo& operator=(const CavityMemo&) = delete;
+  /// Candidates decided from a record (refused without layout and smoothing).
+  [[nodiscard]] std::int64_t hits() const;
+  /// Candidates recorded.
+  [[nodiscard]] std::int64_t records() const;
+
+  struct Impl;
+  [[nodiscard]] Impl& impl() { return *impl_; }
+
+ private:
+  std::unique_ptr<Impl> impl_;
+};
+
 /// Paper 000 Sec. 6.2.2 on the all-quad mesh of one face.
 ///  - Input: an all-quad FaceMesh oriented along the face (consistent uv; triangles: the mesh is
 ///    returned unchanged), its surface, the face's cross-field singularities (3D points, index
@@ -281,13 +323,12 @@ struct CavityReport {
 ///    be), survivors in their input order (CAD-classified vertices keep ids, points, uv and
 ///    vclass), new vertices after them, classified on the face; quads keep the orientation.
 /// Never throws for a face-level failure (report->skipped says why; the input is returned).
-/// Deterministic unless time_budget_s is set.
-[[nodiscard]] mesh::FaceMesh remesh_cavities(const mesh::FaceMesh& quads,
-                                             const cad::FaceGeometry& surface,
-                                             std::span<const crossfield::Singularity> singularities,
-                                             std::span<const Pattern> patterns,
-                                             const CavityOptions& options,
-                                             CavityReport* report = nullptr);
+/// Deterministic unless time_budget_s is set. `memo` (optional; CavityMemo) spares the candidates
+/// refused before, the result unchanged; it is not used when a time budget is set.
+[[nodiscard]] mesh::FaceMesh remesh_cavities(
+    const mesh::FaceMesh& quads, const cad::FaceGeometry& surface,
+    std::span<const crossfield::Singularity> singularities, std::span<const Pattern> patterns,
+    const CavityOptions& options, CavityReport* report = nullptr, CavityMemo* memo = nullptr);
 
 /// Interior vertices (vclass.dim 2, not on the mesh boundary, used by a quad) whose quad valence
 /// is not 4.

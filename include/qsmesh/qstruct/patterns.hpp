@@ -17,8 +17,10 @@
 #pragma once
 
 #include <array>
+#include <cstdint>
 #include <span>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
 #include "qsmesh/core/types.hpp"
@@ -125,6 +127,42 @@ struct PatternMatch {
                                                        std::span<const LO> side_edges,
                                                        const MatchOptions& options = {},
                                                        bool cornerless = false);
+
+/// match_patterns' results kept per (pattern list, side counts, options): a cavity growth matches
+/// every convex state it passes through, and the same side counts come back across the growths
+/// of a face (Block.stp at its reference count: most matches of remesh_cavities were repeats).
+/// match_patterns is a function of its arguments, so a kept result is the one it would give.
+/// A pattern list is identified by its address and size: it must stay alive and unchanged while
+/// the cache is used (remesh_cavities keeps its lists for the whole call). One thread at a time.
+class MatchCache {
+ public:
+  /// At most `max_entries` results are kept; when full, the cache starts over.
+  explicit MatchCache(std::size_t max_entries = 1 << 15) : max_entries_(max_entries) {}
+  /// match_patterns(patterns, side_edges, options, cornerless); the reference is valid until
+  /// the next call.
+  [[nodiscard]] const std::vector<PatternMatch>& matches(std::span<const Pattern> patterns,
+                                                         std::span<const LO> side_edges,
+                                                         const MatchOptions& options = {},
+                                                         bool cornerless = false);
+  [[nodiscard]] std::int64_t hits() const { return hits_; }
+  [[nodiscard]] std::int64_t misses() const { return misses_; }
+
+ private:
+  struct Key {
+    const Pattern* list;
+    std::size_t size;
+    int max_attempts;
+    bool cornerless;
+    std::vector<LO> sides;
+    bool operator==(const Key&) const = default;
+  };
+  struct KeyHash {
+    std::size_t operator()(const Key& k) const;
+  };
+  std::size_t max_entries_;
+  std::int64_t hits_ = 0, misses_ = 0;
+  std::unordered_map<Key, std::vector<PatternMatch>, KeyHash> results_;
+};
 
 /// Integer vectors spanning the kernel of the pattern's Eq. 14 matrix w: adding a multiple of one
 /// to a solution changes no side's count, only where the pattern's irregular vertices sit (e.g.
