@@ -29,6 +29,13 @@ constexpr double kSharpWedgeDeg = 10;
 /// the tips, 78 with 1/6.3: the counts the faces beside the slivers get vary).
 constexpr double kSharedTipWidth = 1 / 6.0;
 
+/// Gaps narrower than this fraction of the floor do not make a face thin (curves touching). A tenth
+/// of the floor, as rule (ii) uses, left strips 0.01-0.1 x the floor wide (Block's at size factor
+/// 0.02) meshed at nearly the full size along them: 132 quads below SICN 0.1 there, 40 with a
+/// hundredth (docs/benchmarks.md, issue 29). Inside sharp wedges and at blunted wedge tips the
+/// tenth stays (background::limit_by_face_width): there the tip ends the graded tail.
+constexpr double kThinTouching = 0.01;
+
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 [[noreturn]] void input_error(const std::string& what) { throw InputError("sizemap: " + what); }
@@ -265,7 +272,8 @@ CurveSizes initial_curve_sizes(const cad::CadModel& model, std::span<const mesh:
         width = h;
         for (auto& w : width)
           for (double& x : w) x *= 0.5;
-        background::limit_by_face_width(model, dense, width, touching, floor, tasks);
+        background::limit_by_face_width(model, dense, width, kThinTouching * floor, touching, floor,
+                                        tasks);
         // The tip of a sharp wedge is one edge. Where the tail behind it is graded (its sides
         // bound that face alone), the tip is where the sides are closer than `touching`, never
         // longer than the size: graded with the width down to the corner, the tail's quads would
