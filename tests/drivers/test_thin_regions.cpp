@@ -263,9 +263,10 @@ TEST(ThinRegions, FiveDegreeCornerQuadsAwayFromItStayAboveSicnPointTwo) {
 
 // The 5-degree wedge's polygon extruded by 2: the sides of each end face at the sharp corner also
 // bound the prism's side faces, so the tail keeps their sizes (graded, its counts would reach
-// them) and the tip quad takes the part of the tail thinner than a sixth of the size: a quad
-// past it, half the width across and the size along, has SICN about 1/6. The bar for such
-// models is 0.1 away from the sharp corners; without the tips 0.102, with them 0.155.
+// them) and the tip quad takes the part of the tail thinner than 0.18 x the size: a quad past
+// it, half the width across and the size along, has SICN about 0.18. The bar for such
+// models is 0.1 away from the sharp corners; without the tips 0.102, with them 0.171 (0.155 with
+// tips of a sixth of the size).
 TEST(ThinRegions, PrismOfTheFiveDegreeCornerQuadsAwayFromItStayAbovePointOneFive) {
   const double y = 6 * std::tan(5 * std::numbers::pi / 180);
   BRepBuilderAPI_MakePolygon polygon;
