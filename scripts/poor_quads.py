@@ -149,9 +149,9 @@ class Mesh:
         edges = [norm(sub(pts[(k + 1) % 4], pts[k])) for k in range(4)]
         long_edge = max(edges)
         corner = "-"
+        face_corners = {k for c in self.face_curves.get(f, []) for k in self.curve_corners.get(c, [])}
         corners = [(norm(sub(self.points[n], centre)), tag)
-                   for tag, n in self.corner_node.items()
-                   if any(tag in self.curve_corners.get(c, []) for c in self.face_curves.get(f, []))]
+                   for tag, n in self.corner_node.items() if tag in face_corners]
         if corners:
             d, tag = min(corners)
             a = self.corner_angle.get((f, self.corner_node[tag]))
