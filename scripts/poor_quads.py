@@ -149,7 +149,8 @@ class Mesh:
         edges = [norm(sub(pts[(k + 1) % 4], pts[k])) for k in range(4)]
         long_edge = max(edges)
         corner = "-"
-        face_corners = {k for c in self.face_curves.get(f, []) for k in self.curve_corners.get(c, [])}
+        face_corners = {k for c in self.face_curves.get(f, [])
+                        for k in self.curve_corners.get(c, [])}
         corners = [(norm(sub(self.points[n], centre)), tag)
                    for tag, n in self.corner_node.items() if tag in face_corners]
         if corners:
