@@ -215,6 +215,12 @@ Arguments parse(const std::vector<std::string>& args) {
         throw InputError("--layout: '" + v + "' is not coarse or dense");
       a.coarse_layout = v == "coarse";
       layout_given = true;
+    } else if (opt == "--loop-balance" && a.command == Command::Mesh) {
+      const std::string& v = value();
+      const auto b = parse_double(v);
+      if (!b || !(*b >= 0 && *b <= 1))
+        throw InputError("--loop-balance: '" + v + "' is not a number in [0, 1]");
+      a.loop_balance = *b;
     } else if (opt == "--order" && a.command == Command::Mesh) {
       const std::string& v = value();
       if (v.size() != 1 || v[0] < '1' || v[0] > '5')
@@ -525,6 +531,9 @@ std::string help(const std::string& topic) {
           "                        block side; its quads are still worse than the mesh it comes\n"
           "                        from (docs/benchmarks.md); when it fails, one log line and\n"
           "                        the dense layout\n"
+          "  --loop-balance B      with --layout coarse: quad-loop widths blended with weight B\n"
+          "                        (0..1) towards square fine quads in each coarse quad\n"
+          "                        (default 0: the input mesh's lengths alone)\n"
           "  --plot3d-stream       PLOT3D output without the Fortran record lengths (C stream\n"
           "                        binary: the same bytes, nothing between the records)\n"
           "  --plot3d-single       PLOT3D coordinates in single precision (float32)\n"

@@ -50,6 +50,8 @@ struct Arguments {
   /// Sec. III-IV (layout::build_coarse_layout, a new mesh) or the dense layout of the mesh as it
   /// is (the default: see --help for why).
   bool coarse_layout = false;
+  /// --loop-balance B (with --layout coarse): layout::CoarseOptions::loop_balance, in [0, 1].
+  double loop_balance = 0;
   /// --order N, 2..5: Lagrange quads ((N + 1)^2 nodes) and bars (N + 1 nodes) on the CAD
   /// (highorder::make_high_order); 1: linear.
   int order = 1;

@@ -870,6 +870,7 @@ int run_mesh(const Arguments& args) {
   }
   options.separatrix_method = args.separatrix_method;
   options.smooth_groups = args.smooth_groups;
+  options.distance_to_cad = true;
   // A face whose field system is above SolverOptions::petsc_threshold is solved by PETSc; with the
   // background at the geometry's resolution that takes a face far larger than its neighbours, or
   // --field-divisions 0 on a large one.
@@ -887,8 +888,8 @@ int run_mesh(const Arguments& args) {
     const mesh::MeshStats stats = mesh::compute_stats(result.mesh);
     Checks checks;
     checks.conformity = mesh::check_conformity(result.mesh, s.model, result.face_group);
-    checks.max_distance_to_cad =
-        mesh::max_distance_to_cad(result.mesh, s.model) / s.model.diagonal();
+    // The pipeline's distance stage measured it where the faces were (PipelineOptions).
+    checks.max_distance_to_cad = result.max_distance_to_cad / s.model.diagonal();
     s.times.add("statistics", clock.seconds());
     clock.reset();
     if (args.order > 1) {
@@ -905,7 +906,9 @@ int run_mesh(const Arguments& args) {
       Checks::Blocks b;
       std::optional<layout::CoarseResult> coarse;
       if (args.coarse_layout) {
-        coarse = layout::build_coarse_layout(result.mesh, s.model);
+        layout::CoarseOptions co;
+        co.loop_balance = args.loop_balance;
+        coarse = layout::build_coarse_layout(result.mesh, s.model, co);
         b.coarse = coarse->stats;
         if (!coarse->ok) {
           b.fallback = true;

@@ -4,13 +4,16 @@ rank, by replaying its measured per-face, per-stage times through the pipeline's
 (docs/architecture.md, "Parallel model"):
 
 - replicated stages (load, curves, partition, quantize): every rank does the same work; as measured.
-- partitioned stages (background, crossfield, sizemap, unstructured, pattern_compare): each rank
+- partitioned stages (background, crossfield, sizemap, unstructured, pattern_compare, distance):
+  each rank
   runs the faces the METIS partition gives it, as TBB tasks in face order on T threads (list
   scheduling in that order); the stage ends when the slowest rank is done.
 - dealt stages (patterns, improvement): all P x T threads take the next face from one shared
   counter, largest first by the pipeline's own keys (expected quads; the unstructured mesh's
   quads), i.e. list scheduling in that order over P x T workers; a face taken away from its owner
-  is read from it first (MPI_Get), and each result goes back to its owner. A face improved in
+  is read from it first (MPI_Get), and each result goes back to its owner. A face's pattern fill
+  splits its move search's batches over its rank's threads (batched_schedule; face_stats'
+  pattern_layouts, pattern_batches, pattern_search). A face improved in
   pieces (--task-quads; face_stats' stage_seconds.improvement_tasks: 2k + 1 piece times) is k
   tasks in the first round, dealt with the whole faces, and k + 1 in a second round after it
   (each piece keyed by the face's quads / pieces); its cutting and merging (its improvement time
@@ -41,7 +44,9 @@ import sys
 
 TOOL = "simulate_scaling"
 REPLICATED = ["load", "curves", "partition", "quantize"]
-PARTITIONED = ["background", "crossfield", "sizemap", "unstructured", "pattern_compare"]
+# distance: the final mesh's distance to the CAD, each face on its owner (its curves' share, split
+# over the ranks too, is in the stage's residual).
+PARTITIONED = ["background", "crossfield", "sizemap", "unstructured", "pattern_compare", "distance"]
 DEALT = ["patterns", "improvement"]
 GATHER = ["assemble"]
 # On-node defaults where no --comm is given (Open MPI, shared memory; mpi_costs on the 2-core
@@ -73,6 +78,17 @@ def list_schedule(durations, workers):
         assigned.append(w)
         heapq.heappush(free, (t, w))
     return max(end) if end else 0.0, assigned, end
+
+
+def batched_schedule(seconds, search, layouts, batches, threads):
+    """A face's time when its move search's `layouts` (taking `search` of its `seconds`) come in
+    `batches` laid out over `threads` at once: the serial rest, plus per batch ceil(layouts per
+    batch / threads) layouts. Never more than the serial time."""
+    if threads <= 1 or layouts <= 0 or batches <= 0 or search <= 0:
+        return seconds
+    search = min(search, seconds)
+    per = search / layouts
+    return min(seconds, seconds - search + per * batches * math.ceil(layouts / batches / threads))
 
 
 def greedy_partition(weights, parts):
@@ -111,6 +127,10 @@ class Run:
         self.improve_quads = [f["stage_seconds"].get("improvement_quads", 0) for f in self.faces]
         self.improve_tasks = [f["stage_seconds"].get("improvement_tasks", []) for f in self.faces]
         self.bytes = [f["stage_seconds"].get("bytes", 0) for f in self.faces]
+        # The pattern fill's move search: layouts read, the batches they come in, its seconds.
+        self.pattern_layouts = [f["stage_seconds"].get("pattern_layouts", 0) for f in self.faces]
+        self.pattern_batches = [f["stage_seconds"].get("pattern_batches", 0) for f in self.faces]
+        self.pattern_search = [f["stage_seconds"].get("pattern_search", 0.0) for f in self.faces]
         self.by_pattern = [f.get("method", "").startswith("pattern") for f in self.faces]
         self.face_rank = [f.get("rank", 0) for f in self.faces]
 
@@ -177,7 +197,7 @@ class Simulator:
         bw = self.comm["bandwidth_bytes_per_s"]
         fetch = self.comm["fetch_and_add_s"] if (messages and p > 1) else 0.0
         times, extra = {}, {}
-        patterns = [[(f, run.expected[f], 0, run.t["patterns"][f], run.bytes[f])
+        patterns = [[(f, run.expected[f], 0, self.pattern_seconds(f, t), run.bytes[f])
                      for f in range(run.n)]]
         improvement, owner_work = self.improvement_rounds()
         for s, rounds in (("patterns", patterns), ("improvement", improvement)):
@@ -231,6 +251,18 @@ class Simulator:
                 for r in range(p):
                     self.busy[r] += max(ends[r * t:(r + 1) * t])
         return times, extra
+
+    def pattern_seconds(self, f, t):
+        """Face f's pattern time on a worker of a rank with t threads (batched_schedule): its move
+        search's batches are laid out at once over the rank's threads (PatternFaceOptions::tasks),
+        each batch ceil(k / t) layouts long (k the face's mean layouts per batch, each layout the
+        search's seconds / layouts); the rest of the face's pattern work is serial. The other
+        faces the rank's threads take meanwhile are not modelled (the batches matter where the
+        face is the stage's tail, when the other threads are free)."""
+        if self.run.threads > 1:  # measured with its batches already split (a replayed 1xT run)
+            return self.run.t["patterns"][f]
+        return batched_schedule(self.run.t["patterns"][f], self.run.pattern_search[f],
+                                self.run.pattern_layouts[f], self.run.pattern_batches[f], t)
 
     def improvement_rounds(self):
         """The improvement's tasks, [first round, second round], each task (face, order key,

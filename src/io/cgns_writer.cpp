@@ -631,33 +631,71 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
   double root = 0;
   QSMESH_CG(cg_get_cgio(fn, &cgio));
   QSMESH_CG(cg_root_id(fn, &root));
+  double base_id = 0;
+  QSMESH_CGIO(cgio_get_node_id(cgio, root, ("/" + options.cgns_base_name).c_str(), &base_id));
+  // The block zones are written through cgio, not cg_zone_write and friends: cgnslib 3.4 checks a
+  // new node's name against every child of its parent (ADFH_Create iterates the parent's links),
+  // so zone k made under the base costs time in k, O(zones^2) in all (A319's 3,565 zones: 19 s of
+  // write). Each zone is made under a holder node with no other child, filled there, then moved
+  // under the base (ADFH_Move_Child iterates the holder only, and HDF5's move into the base's
+  // indexed group does not scan it); the holder is deleted at the end. cgnslib's own tree does
+  // not know these zones, which is why everything under them goes through cgio too.
+  double holder = 0;
+  new_node(cgio, root, "qsmesh zones being written", "UserDefinedData_t", "MT", 0, nullptr, nullptr,
+           &holder, path);
   auto zone_name = [&](GO k) { return block_name(layout, k, mesh.num_cad_faces); };
+  const float exponents[5] = {0, 1, 0, 0, 0};  // lengths: (mass, length, time, temp., angle)
+  const cgsize_t exponents_dims[1] = {5};
+  std::vector<double> coord;
   for (GO k = 0; k < nb; ++k) {
     const layout::Block& b = layout.blocks[static_cast<std::size_t>(k)];
     const std::string name = zone_name(k);
     QSMESH_CHECK(name.size() <= 32,
                  "CGNS block output " << path << ": zone name " << name << " too long");
-    cgsize_t size[6] = {b.ni + 1, b.nj + 1, b.ni, b.nj, 0, 0};
-    int zone = 0;
-    QSMESH_CG(cg_zone_write(fn, base, name.c_str(), size, CGNS_ENUMV(Structured), &zone));
+    // Zone_t: VertexSize, CellSize, VertexSizeBoundary per index, as cg_zone_write stores them.
+    const cgsize_t size[6] = {b.ni + 1, b.nj + 1, b.ni, b.nj, 0, 0};
+    const cgsize_t size_dims[2] = {2, 3};
+    double zone_id = 0;
+    new_node(cgio, holder, name, "Zone_t", "I4", 2, size_dims, size, &zone_id, path);
+    const std::string structured = "Structured";
+    const cgsize_t structured_size[1] = {static_cast<cgsize_t>(structured.size())};
+    new_leaf(cgio, zone_id, "ZoneType", "ZoneType_t", "C1", 1, structured_size, structured.data(),
+             path);
+    double coords_id = 0;
+    new_node(cgio, zone_id, "GridCoordinates", "GridCoordinates_t", "MT", 0, nullptr, nullptr,
+             &coords_id, path);
     const auto n = static_cast<std::size_t>(b.ni + 1) * static_cast<std::size_t>(b.nj + 1);
-    write_coordinates(
-        fn, base, zone, n,
-        [&](std::size_t i) {
-          return mesh.points[static_cast<std::size_t>(
-              layout.vertices[static_cast<std::size_t>(b.first) + i])];
-        },
-        path);
-    QSMESH_CG(cg_goto(fn, base, "Zone_t", zone, "end"));
-    QSMESH_CG(cg_famname_write(("Face_" + std::to_string(b.face)).c_str()));
+    const cgsize_t coord_dims[2] = {b.ni + 1, b.nj + 1};
+    coord.resize(n);
+    const char* names[3] = {"CoordinateX", "CoordinateY", "CoordinateZ"};
+    for (int d = 0; d < 3; ++d) {
+      for (std::size_t i = 0; i < n; ++i)
+        coord[i] = mesh.points[static_cast<std::size_t>(
+            layout.vertices[static_cast<std::size_t>(b.first) + i])][d];
+      double array_id = 0;
+      new_node(cgio, coords_id, names[d], "DataArray_t", "R8", 2, coord_dims, coord.data(),
+               &array_id, path);
+      new_leaf(cgio, array_id, "DimensionalExponents", "DimensionalExponents_t", "R4", 1,
+               exponents_dims, exponents, path);
+      release_node(cgio, array_id, path);
+    }
+    release_node(cgio, coords_id, path);
+    {
+      const std::string family = "Face_" + std::to_string(b.face);
+      const cgsize_t family_size[1] = {static_cast<cgsize_t>(family.size())};
+      new_leaf(cgio, zone_id, "FamilyName", "FamilyName_t", "C1", 1, family_size, family.data(),
+               path);
+    }
 
     // Per side: its 1-to-1 interfaces, its runs along the unstructured zone, its BCs.
     int connections = 0, boundaries = 0;
     double zgc_id = 0;  // the zone's ZoneGridConnectivity node, made with its first interface
+    double zbc_id = 0;  // its ZoneBC node, made with its first BC
     // The name of the zone's next connectivity node, the ZoneGridConnectivity made with the first.
     auto next_connection = [&] {
       if (zgc_id == 0)
-        zgc_id = new_zone_grid_connectivity(cgio, root, options.cgns_base_name, name, path);
+        new_node(cgio, zone_id, "ZoneGridConnectivity", "ZoneGridConnectivity_t", "MT", 0, nullptr,
+                 nullptr, &zgc_id, path);
       return connection_name(++connections);
     };
     const BlockLinks& links = joined.blocks[static_cast<std::size_t>(k)];
@@ -695,24 +733,35 @@ void write_cgns_blocks(const mesh::SurfaceMesh& mesh, const layout::QuadLayout& 
                        path);
         abutments.push_back(std::move(a));
       }
-      // Free edges: one BC per run of them on one curve.
+      // Free edges: one BC per run of them on one curve (BC_t FamilySpecified, a vertex point
+      // range, the curve's family), as cg_boco_write and cg_famname_write would make it.
       for (const BlockBoundary& r : links.boundaries) {
         if (r.side != s) continue;
         std::string bcname("BC");
         bcname += std::to_string(++boundaries);
-        int bc = 0;
-        QSMESH_CG(cg_boco_write(fn, base, zone, bcname.c_str(), CGNS_ENUMV(FamilySpecified),
-                                CGNS_ENUMV(PointRange), 2, r.range.data(), &bc));
-        std::string node(1, '/');
-        node.append(options.cgns_base_name).append("/").append(name).append("/ZoneBC/");
-        node.append(bcname).append("/PointRange");
-        fix_range_label(cgio, root, node, path);
-        QSMESH_CG(cg_goto(fn, base, "Zone_t", zone, "ZoneBC_t", 1, "BC_t", bc, "end"));
-        QSMESH_CG(cg_famname_write(("Curve_" + std::to_string(r.curve)).c_str()));
+        if (zbc_id == 0)
+          new_node(cgio, zone_id, "ZoneBC", "ZoneBC_t", "MT", 0, nullptr, nullptr, &zbc_id, path);
+        const std::string type = "FamilySpecified";
+        const cgsize_t type_size[1] = {static_cast<cgsize_t>(type.size())};
+        double bc_id = 0;
+        new_node(cgio, zbc_id, bcname, "BC_t", "C1", 1, type_size, type.data(), &bc_id, path);
+        const cgsize_t range_dims[2] = {2, 2};
+        new_leaf(cgio, bc_id, "PointRange", "IndexRange_t", "I4", 2, range_dims, r.range.data(),
+                 path);
+        const std::string family = "Curve_" + std::to_string(r.curve);
+        const cgsize_t family_size[1] = {static_cast<cgsize_t>(family.size())};
+        new_leaf(cgio, bc_id, "FamilyName", "FamilyName_t", "C1", 1, family_size, family.data(),
+                 path);
+        release_node(cgio, bc_id, path);
       }
     }
     if (zgc_id != 0) release_node(cgio, zgc_id, path);
+    if (zbc_id != 0) release_node(cgio, zbc_id, path);
+    QSMESH_CGIO(cgio_move_node(cgio, holder, zone_id, base_id));
+    release_node(cgio, zone_id, path);
   }
+  QSMESH_CGIO(cgio_delete_node(cgio, root, holder));
+  release_node(cgio, base_id, path);
 
   // Faces the layout could not cut into blocks: one unstructured zone with a section per face, and
   // a GridConnectivity back to every block run abutting it.

@@ -1027,6 +1027,39 @@ class Builder {
       const auto r = static_cast<std::size_t>(loops.find(static_cast<GO>(e)));
       cedges_[e].n = std::max<LO>(1, static_cast<LO>(std::lround(lsum[r] / lcnt[r])));
     }
+    if (opt_.loop_balance > 0) balance_loops(loops);
+  }
+
+  // CoarseOptions::loop_balance: each edge's target blended with the width that would make the
+  // fine quads of its coarse quad square at their current size (the geometric mean of the two
+  // fine edge lengths there), then each loop's width the rounded mean again.
+  void balance_loops(Dsu& loops) {
+    const double beta = std::min(1.0, opt_.loop_balance);
+    auto p = [&](GO g) {
+      return m_.points[static_cast<std::size_t>(center_[static_cast<std::size_t>(g)])];
+    };
+    std::vector<double> lsum(cedges_.size(), 0), lcnt(cedges_.size(), 0);
+    for (const CQuad& q : cquads_) {
+      // Mean lengths of the two pairs of opposite edges (straight, between the centres).
+      const double l0 = 0.5 * (distance(p(q.v[0]), p(q.v[1])) + distance(p(q.v[3]), p(q.v[2])));
+      const double l1 = 0.5 * (distance(p(q.v[1]), p(q.v[2])) + distance(p(q.v[0]), p(q.v[3])));
+      const LO n0 = cedges_[static_cast<std::size_t>(q.e[0])].n;
+      const LO n1 = cedges_[static_cast<std::size_t>(q.e[1])].n;
+      const double h = std::sqrt((l0 / n0) * (l1 / n1));
+      for (int k = 0; k < 4; ++k) {
+        const auto e = static_cast<std::size_t>(q.e[static_cast<std::size_t>(k)]);
+        const double input = cedges_[e].target / cedges_[e].target_count;
+        const double square = h > 0 ? (k % 2 == 0 ? l0 : l1) / h : input;
+        const auto r = static_cast<std::size_t>(loops.find(static_cast<GO>(e)));
+        lsum[r] += (1 - beta) * input + beta * square;
+        lcnt[r] += 1;
+      }
+    }
+    for (std::size_t e = 0; e < cedges_.size(); ++e) {
+      const auto r = static_cast<std::size_t>(loops.find(static_cast<GO>(e)));
+      if (lcnt[r] > 0)
+        cedges_[e].n = std::max<LO>(1, static_cast<LO>(std::lround(lsum[r] / lcnt[r])));
+    }
   }
 
   // ---------------------------------------------------------------- fine mesh (Sec. IV.D-E)

@@ -1,5 +1,14 @@
 // Eigen backend: sparse Cholesky (LDL^T, AMD ordering) for the small per-face systems, where
 // PETSc's per-call overhead and its one lane would cost more than the factorization itself.
+//
+// The ordering and the permuted upper triangle are computed here rather than inside
+// Eigen::SimplicialLDLT: Eigen builds the full symmetric matrix from one triangle, then A^T + A of
+// that for AMD, and twists the matrix again at every factorization. The matrices here are stored
+// full (SparseMatrix), so AMD runs on a copy of the matrix itself when its pattern is symmetric,
+// and the values of the permuted triangle are gathered through an index map. The ordering, the
+// permuted matrix and the factorization are bit for bit those of SimplicialLDLT<Lower, AMD> on the
+// same matrix (same AMD input arrays, same twisted triangle), at a fraction of the analysis cost
+// (the small Laplace systems of the cavity candidates: docs/benchmarks.md, issue 27).
 #include <Eigen/OrderingMethods>
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
@@ -10,6 +19,26 @@
 
 namespace qsmesh::linalg::detail {
 namespace {
+
+using EigenMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+using Permutation = Eigen::PermutationMatrix<Eigen::Dynamic, Eigen::Dynamic, int>;
+
+// True when the pattern of the CSR matrix A equals that of its transpose.
+bool symmetric_pattern(const SparseMatrix& A) {
+  const auto& off = A.row_offsets();
+  const auto& col = A.columns();
+  std::vector<std::int64_t> next(off.begin(), off.end() - 1);
+  // Walking the rows in order, the entries (c, r) with r ascending must come next in row c.
+  for (LO r = 0; r < A.size(); ++r)
+    for (auto k = off[static_cast<std::size_t>(r)]; k < off[static_cast<std::size_t>(r) + 1]; ++k) {
+      const LO c = col[static_cast<std::size_t>(k)];
+      auto& at = next[static_cast<std::size_t>(c)];
+      if (at >= off[static_cast<std::size_t>(c) + 1] || col[static_cast<std::size_t>(at)] != r)
+        return false;
+      ++at;
+    }
+  return true;
+}
 
 class EigenSolver final : public LinearSolver {
  public:
@@ -22,13 +51,37 @@ class EigenSolver final : public LinearSolver {
     // lower triangle of that is used by the factorization, i.e. the upper triangle of A, as in
     // the PETSc backend.
     const LO n = A.size();
-    matrix_ = Eigen::SparseMatrix<double, Eigen::ColMajor, int>(n, n);
-    matrix_.resizeNonZeros(static_cast<Eigen::Index>(A.nonzeros()));
+    EigenMatrix a(n, n);
+    a.resizeNonZeros(static_cast<Eigen::Index>(A.nonzeros()));
     for (LO i = 0; i <= n; ++i)
-      matrix_.outerIndexPtr()[i] = static_cast<int>(A.row_offsets()[static_cast<std::size_t>(i)]);
-    std::copy(A.columns().begin(), A.columns().end(), matrix_.innerIndexPtr());
-    std::copy(A.values().begin(), A.values().end(), matrix_.valuePtr());
-    ldlt_.analyzePattern(matrix_);
+      a.outerIndexPtr()[i] = static_cast<int>(A.row_offsets()[static_cast<std::size_t>(i)]);
+    std::copy(A.columns().begin(), A.columns().end(), a.innerIndexPtr());
+    // AMD's inverse permutation, as SimplicialLDLT<Lower, AMDOrdering> computes it: on the full
+    // symmetric matrix built from the lower triangle, symmetrised again (A^T + A). With a symmetric
+    // pattern both are the pattern of `a` itself, sorted, so AMD gets the same arrays from a copy.
+    Permutation pinv;
+    if (symmetric_pattern(A)) {
+      EigenMatrix c = a;
+      Eigen::internal::minimum_degree_ordering(c, pinv);
+    } else {
+      EigenMatrix c;
+      c = a.selfadjointView<Eigen::Lower>();
+      Eigen::AMDOrdering<int>()(c, pinv);
+    }
+    perm_ = pinv.size() > 0 ? Permutation(pinv.inverse()) : Permutation();
+    perm_inv_ = pinv;
+    // The permuted upper triangle (SimplicialCholeskyBase::ordering), its values traced back to
+    // A's: each entry carries its index into A.values() through the twist.
+    for (std::int64_t k = 0; k < A.nonzeros(); ++k) a.valuePtr()[k] = static_cast<double>(k);
+    upper_.resize(n, n);
+    if (perm_.size() > 0)
+      upper_.selfadjointView<Eigen::Upper>() = a.selfadjointView<Eigen::Lower>().twistedBy(perm_);
+    else
+      upper_.selfadjointView<Eigen::Upper>() = a.selfadjointView<Eigen::Lower>();
+    source_.resize(static_cast<std::size_t>(upper_.nonZeros()));
+    for (Eigen::Index k = 0; k < upper_.nonZeros(); ++k)
+      source_[static_cast<std::size_t>(k)] = static_cast<std::int64_t>(upper_.valuePtr()[k]);
+    ldlt_.analyzePattern(upper_);
     QSMESH_CHECK(ldlt_.info() == Eigen::Success,
                  "eigen: symbolic analysis failed for a matrix of size " << n);
   }
@@ -36,8 +89,11 @@ class EigenSolver final : public LinearSolver {
   void factorize(const SparseMatrix& A) override {
     pattern_.check(A, "eigen");
     factorized_ = false;
-    std::copy(A.values().begin(), A.values().end(), matrix_.valuePtr());
-    ldlt_.factorize(matrix_);
+    const std::vector<double>& v = A.values();
+    double* dst = upper_.valuePtr();
+    for (std::size_t k = 0; k < source_.size(); ++k)
+      dst[k] = v[static_cast<std::size_t>(source_[k])];
+    ldlt_.factorize(upper_);
     QSMESH_CHECK(ldlt_.info() == Eigen::Success,
                  "eigen: numeric factorization failed (zero pivot): the matrix of size "
                      << A.size() << " is singular or not positive definite");
@@ -58,7 +114,17 @@ class EigenSolver final : public LinearSolver {
                                                      << " entries for a system of size " << n);
     const Eigen::Map<const Eigen::VectorXd> bm(b.data(), static_cast<Eigen::Index>(n));
     Eigen::Map<Eigen::VectorXd> xm(x.data(), static_cast<Eigen::Index>(n));
-    xm = ldlt_.solve(bm);
+    // SimplicialLDLT's solve with its permutation: P b, the triangular and diagonal solves, P^-1.
+    if (perm_.size() > 0) {
+      work_ = perm_ * bm;
+      const bool has_l = ldlt_.matrixL().nestedExpression().nonZeros() > 0;
+      if (has_l) ldlt_.matrixL().solveInPlace(work_);
+      if (ldlt_.vectorD().size() > 0) work_ = ldlt_.vectorD().asDiagonal().inverse() * work_;
+      if (has_l) ldlt_.matrixU().solveInPlace(work_);
+      xm = perm_inv_ * work_;
+    } else {
+      xm = ldlt_.solve(bm);
+    }
   }
 
   [[nodiscard]] const char* name() const override { return "eigen/simplicial-ldlt"; }
@@ -66,10 +132,11 @@ class EigenSolver final : public LinearSolver {
  private:
   Pattern pattern_;
   bool factorized_ = false;
-  Eigen::SparseMatrix<double, Eigen::ColMajor, int> matrix_;
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double, Eigen::ColMajor, int>, Eigen::Lower,
-                        Eigen::AMDOrdering<int>>
-      ldlt_;
+  Permutation perm_, perm_inv_;
+  EigenMatrix upper_;                 // the permuted upper triangle, factorized in place
+  std::vector<std::int64_t> source_;  // upper_'s values: their indices in A.values()
+  Eigen::VectorXd work_;
+  Eigen::SimplicialLDLT<EigenMatrix, Eigen::Upper, Eigen::NaturalOrdering<int>> ldlt_;
 };
 
 }  // namespace

@@ -19,6 +19,7 @@
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/mesh/assemble.hpp"
 #include "qsmesh/mesh/quality.hpp"
+#include "qsmesh/mesh/validate.hpp"
 #include "qsmesh/parallel/face_task.hpp"
 #include "qsmesh/parallel/partition.hpp"
 #include "qsmesh/parallel/record.hpp"
@@ -481,6 +482,14 @@ void quantize_stage(const Context& cx, std::span<const mesh::CurveMesh> curves,
                   " chords, ", result.quantization.total_edges, " edges"));
 }
 
+// A face's pattern time and its move search's counts (the scaling simulation's batches).
+void set_pattern_times(FaceTimes& times, const PatternFill& fill) {
+  times.patterns = fill.seconds;
+  times.pattern_layouts = fill.report.layouts;
+  times.pattern_batches = fill.report.batches;
+  times.pattern_search = fill.report.search_seconds;
+}
+
 // Simple CAD faces meshed directly by a pattern (paper 000 Sec. 6.1.2, pipeline step 4); the
 // others go through the unstructured path. A fill needs only the model, the curve meshes (every
 // rank has them) and the face's quad bound (if any), which its owner computes from its size map
@@ -517,6 +526,7 @@ std::vector<std::int64_t> pattern_stage(const Context& cx, std::vector<FaceTask>
     const auto f = static_cast<std::size_t>(order[static_cast<std::size_t>(k)]);
     qstruct::PatternFaceOptions po = options.patterns;
     po.size_map_quads = expected[f];
+    po.tasks = &cx.tasks;  // one face's move search split over this rank's threads
     fills[f] = mesh_face_fill(cx.model, static_cast<LO>(f), result.quantized_curves, patterns, po,
                               fill_bound[f], options.pattern_compare_tolerance >= 0);
     filled[f] = 1;
@@ -532,7 +542,7 @@ std::vector<std::int64_t> pattern_stage(const Context& cx, std::vector<FaceTask>
     PatternFill& fill = fills[static_cast<std::size_t>(f)];
     const std::int64_t i = local_of[static_cast<std::size_t>(f)];
     if (i >= 0) {
-      faces[static_cast<std::size_t>(i)].times.patterns = fill.seconds;
+      set_pattern_times(faces[static_cast<std::size_t>(i)].times, fill);
       take_fill(faces[static_cast<std::size_t>(i)], std::move(fill), options.patterns);
     } else
       to_owners.add(result.face_rank[f], f, fill);
@@ -543,7 +553,7 @@ std::vector<std::int64_t> pattern_stage(const Context& cx, std::vector<FaceTask>
                  "pattern fill of face " << f << " sent to rank " << cx.comm.rank()
                                          << ", which does not own it");
     FaceTask& t = faces[static_cast<std::size_t>(local_of[static_cast<std::size_t>(f)])];
-    t.times.patterns = fill.seconds;
+    set_pattern_times(t.times, fill);
     take_fill(t, std::move(fill), options.patterns);
   });
   return fill_bound;
@@ -659,6 +669,32 @@ void compare_stage(const Context& cx, std::vector<FaceTask>& faces,
                        "): ", c.fill_taken ? "fill" : "unstructured"));
     t.times.compare += face_clock.seconds();
   });
+}
+
+// The largest distance between the final mesh's vertices and the CAD (mesh::max_distance_to_cad of
+// the mesh the gather assembles), split as the mesh is held: each face's interior vertices on its
+// rank, one task per face (face_stats' `distance`); the curve meshes' interior vertices (every
+// rank has them) by curve id over the ranks, a task per curve; max-reduced over the ranks. The
+// corners are the CAD's corner points (distance 0). A maximum, so the same at any numbers of ranks
+// and threads.
+double distance_stage(const Context& cx, std::vector<FaceTask>& faces,
+                      std::span<const mesh::CurveMesh> curves, bool quads) {
+  std::vector<double> worst(faces.size() + curves.size() + 1, 0.0);  // + 1: never empty
+  cx.tasks.parallel_for(static_cast<std::int64_t>(faces.size()), [&](std::int64_t i) {
+    FaceTask& t = faces[static_cast<std::size_t>(i)];
+    const Stopwatch face_clock;
+    const mesh::FaceMesh& m = quads ? t.quad_mesh : t.background;
+    worst[static_cast<std::size_t>(i)] = mesh::max_distance_to_cad(m.points, m.vclass, cx.model, 2);
+    t.times.distance = face_clock.seconds();
+  });
+  const int rank = cx.comm.rank(), nranks = cx.comm.size();
+  const auto mine = static_cast<std::int64_t>(
+      (static_cast<int>(curves.size()) + nranks - 1 - rank) / nranks);  // c = rank + k * nranks
+  cx.tasks.parallel_for(mine, [&](std::int64_t k) {
+    const std::size_t c = static_cast<std::size_t>(rank + k * nranks);
+    worst[faces.size() + c] = mesh::max_distance_to_cad(curves[c], cx.model);
+  });
+  return cx.comm.allreduce_max(*std::max_element(worst.begin(), worst.end()));
 }
 
 // What the assembly needs of the groups meshed on this rank (PipelineOptions::smooth_groups;
@@ -1051,10 +1087,15 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
                                       options.holomorphic_sicn_tolerance)
                 : GroupsForOutput{};
 
-  clock.start();
   const std::span<const mesh::CurveMesh> final_curves =
       quads ? std::span<const mesh::CurveMesh>(result.quantized_curves)
             : std::span<const mesh::CurveMesh>(curves);
+  if (options.distance_to_cad) {
+    clock.start();
+    result.max_distance_to_cad = distance_stage(cx, faces, final_curves, quads);
+    clock.end("distance", true);
+  }
+  clock.start();
   gather_stage(cx, faces, final_curves, quads, quasi, groups_out, result);
   clock.end("assemble", false);
   result.rank_busy_seconds.assign(static_cast<std::size_t>(nranks), 0.0);

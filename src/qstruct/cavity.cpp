@@ -453,9 +453,10 @@ double quad_quality(const std::vector<Vec3>& pts, const std::vector<Vec2>& uv,
 }
 
 // The Laplace layout of the cavity's new vertices; a solver failure counts as a failed layout.
-bool laplace_uv(const std::vector<std::array<LO, 4>>& quads, LO num_fixed, std::vector<Vec2>& uv) {
+bool laplace_uv(const std::vector<std::array<LO, 4>>& quads, LO num_fixed, std::vector<Vec2>& uv,
+                linalg::SolverCache& cache) {
   try {
-    return smooth::chord_laplace_uv(quads, num_fixed, uv);
+    return smooth::chord_laplace_uv(quads, num_fixed, uv, &cache);
   } catch (const Error&) {
     return false;
   }
@@ -598,7 +599,7 @@ class Remesher {
     // Laplace layout of the new vertices on the new quads only, the cavity boundary fixed.
     {
       std::vector<std::array<LO, 4>> nq(lm.quads.begin(), lm.quads.begin() + n_new_quads);
-      if (!laplace_uv(nq, nold, lm.uv)) return false;
+      if (!laplace_uv(nq, nold, lm.uv, cache_)) return false;
     }
     for (LO i = nold; i < nold + n_new; ++i) {
       lm.points[i] = s_.eval(lm.uv[i]).p;
@@ -635,7 +636,7 @@ class Remesher {
                reach_avg + o_.screen_avg_margin >= avg_need;
       };
     smooth::SmoothStats ss;
-    lm = smooth::smooth_face(lm, s_, so, &ss);
+    lm = smooth::smooth_face(lm, s_, so, &ss, &cache_);
     why = Refusal::Screened;
     if (ss.stopped_early) return false;
 
@@ -690,6 +691,9 @@ class Remesher {
   const cad::FaceGeometry& s_;
   const CavityOptions& o_;
   double sign_;
+  // The candidates' layouts repeat the same refined patterns (one remesh_cavities call, one
+  // thread): their solvers' analyses are kept.
+  mutable linalg::SolverCache cache_;
 };
 
 // Corners have valence 1, other boundary vertices valence 2: the pattern fits convex cavities.

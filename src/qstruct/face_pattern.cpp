@@ -2,14 +2,19 @@
 
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <map>
+#include <memory>
 #include <numbers>
+#include <optional>
 #include <sstream>
 #include <utility>
 
 #include "qsmesh/background/face_mesh.hpp"
 #include "qsmesh/core/error.hpp"
+#include "qsmesh/core/tasks.hpp"
+#include "qsmesh/core/timer.hpp"
 #include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/smooth/quad_tools.hpp"
 #include "qsmesh/smooth/untangle.hpp"
@@ -94,7 +99,7 @@ struct Candidate {
 };
 
 mesh::FaceMesh build_mesh(LO f, const cad::Face& face, const cad::FaceGeometry& surface,
-                          const FaceSides& fs, const Candidate& cand) {
+                          const FaceSides& fs, const Candidate& cand, linalg::SolverCache* cache) {
   const LO nb = static_cast<LO>(fs.points.size());
   const RefinedPattern& r = cand.refined;
   std::vector<LO> r2m(static_cast<std::size_t>(r.num_vertices), kNoIndex);
@@ -121,7 +126,8 @@ mesh::FaceMesh build_mesh(LO f, const cad::Face& face, const cad::FaceGeometry& 
     const std::array<LO, 4> t{r2m[q[0]], r2m[q[1]], r2m[q[2]], r2m[q[3]]};
     m.quads.push_back(flip ? std::array<LO, 4>{t[0], t[3], t[2], t[1]} : t);
   }
-  QSMESH_CHECK(smooth::chord_laplace_uv(m.quads, nb, m.uv), "the Laplace layout is not finite");
+  QSMESH_CHECK(smooth::chord_laplace_uv(m.quads, nb, m.uv, cache),
+               "the Laplace layout is not finite");
   if (!fs.poles.empty()) {
     // Around a pole the parameter plane stretches without bound, and a (u, v) layout crowds the
     // quads there (cube_filet's corner patches: SICN min 0.52 against 0.86 for the same topology
@@ -132,8 +138,9 @@ mesh::FaceMesh build_mesh(LO f, const cad::Face& face, const cad::FaceGeometry& 
       xy[i] = {m.points[i].x, m.points[i].y};
       z[i] = {m.points[i].z, 0};
     }
-    QSMESH_CHECK(smooth::laplace_uv(m.quads, nb, xy) && smooth::laplace_uv(m.quads, nb, z),
-                 "the 3D Laplace layout is not finite");
+    QSMESH_CHECK(
+        smooth::laplace_uv(m.quads, nb, xy, cache) && smooth::laplace_uv(m.quads, nb, z, cache),
+        "the 3D Laplace layout is not finite");
     for (LO v = nb; v < next; ++v)
       m.uv[v] = surface.project(Vec3{xy[v].u, xy[v].v, z[v].u}, m.uv[v], nullptr);
   }
@@ -189,12 +196,22 @@ void report_pattern(PatternFaceReport& rep, std::span<const Pattern> patterns, c
 // widens near one end (mambo's [102, 20, 102, 32] strips: rows of tall quads above the
 // transition, SICN avg 0.93). Moves along the kernel of Eq. 14 keep every side's count and shift
 // the pattern's irregular vertices; a local search over them keeps the best mean SICN.
-mesh::FaceMesh move_irregular_vertices(LO f, const cad::Face& face,
+//
+// The search is serial (each step starts from the best so far), but the layouts a step may ask
+// for are known before it: the four coarse points of a vector are offsets from where its search
+// started, and a halving step tries +step then -step from the same best. With
+// PatternFaceOptions::tasks of more than one thread each such batch is laid out at once, one task
+// per layout (each with its own surface evaluator: an evaluator serves one thread), and the
+// serial rules then read the layouts in their order: the same tries, counts and winner as the
+// serial search, so the same fill; a layout the serial search would not have reached is wasted.
+// With one thread the layouts are made when the rules reach them, as before.
+mesh::FaceMesh move_irregular_vertices(const cad::CadModel& model, LO f, const cad::Face& face,
                                        const cad::FaceGeometry& surface, const FaceSides& fs,
                                        const Pattern& pattern, const Candidate& start,
                                        mesh::FaceMesh mesh, smooth::QualityReport q,
                                        double min_sicn, const PatternFaceOptions& options,
-                                       PatternFaceReport& rep) {
+                                       PatternFaceReport& rep, linalg::SolverCache* cache) {
+  const Stopwatch search_clock;
   // Without corner the pattern may also turn along the loop: an empty vector stands for that
   // shift (t loop points), searched last, over a quarter of the loop each way.
   const LO nb = static_cast<LO>(fs.points.size());
@@ -231,7 +248,8 @@ mesh::FaceMesh move_irregular_vertices(LO f, const cad::Face& face,
   const mesh::FaceMesh given = light ? mesh : mesh::FaceMesh{};
   const smooth::QualityReport given_q = q;
   if (light && q.invalid == 0) {
-    mesh = smooth::smooth_face(build_mesh(f, face, surface, fs, start), surface, search);
+    mesh = smooth::smooth_face(build_mesh(f, face, surface, fs, start, cache), surface, search,
+                               nullptr, cache);
     q = smooth::measure(mesh);
   }
   // The mean, less twice the shortfall of the minimum below its threshold: a refused fill climbs
@@ -246,30 +264,102 @@ mesh::FaceMesh move_irregular_vertices(LO f, const cad::Face& face,
     const bool good_a = passes(a, min_sicn, options), good_b = passes(b, min_sicn, options);
     return good_a != good_b ? good_a : score(a) > score(b) + margin;
   };
-  // Lays out the best candidate moved by t along v; true (and best, mesh, q updated) when better.
-  const auto try_move = [&](const std::vector<LO>& v, LO t) {
-    if (t == 0 || evaluations >= max_evaluations) return false;
-    Candidate c = best;
+  // The candidate `origin` moved by t along v (by t loop points for the empty vector); none when
+  // a chord would drop below 1 or the fill exceed max_quads. Moves add up: origin moved by a,
+  // then by t - a, is origin moved by t.
+  const auto moved = [&](const Candidate& origin, const std::vector<LO>& v,
+                         LO t) -> std::optional<Candidate> {
+    Candidate c = origin;
     if (v.empty()) {
       for (LO& p : c.seq) p = (((p + t) % nb) + nb) % nb;
     } else {
       for (std::size_t j = 0; j < v.size(); ++j) {
         c.match.chords[j] += t * v[j];
-        if (c.match.chords[j] < 1) return false;
+        if (c.match.chords[j] < 1) return std::nullopt;
       }
       c.refined = refine_pattern(pattern, c.match.chords);
     }
     if (options.max_quads > 0 &&
         static_cast<std::int64_t>(c.refined.quads.size()) > options.max_quads)
-      return false;
+      return std::nullopt;
+    return c;
+  };
+  struct Layout {
+    Candidate c;
+    mesh::FaceMesh mesh;
+    smooth::QualityReport q;
+    /// What laying it out threw, in a batch: thrown when the rules read it, as the serial search
+    /// would have thrown there (a layout they never read must not fail the face).
+    std::exception_ptr error;
+  };
+  // `with` is the face's solver cache on the serial path, none in a batch's tasks: the cache is
+  // single-thread, and it gives the same bits as a fresh factorization.
+  const auto lay_out = [&](Candidate c, const cad::FaceGeometry& on, linalg::SolverCache* with) {
+    Layout l;
+    l.mesh = smooth::smooth_face(build_mesh(f, face, on, fs, c, with), on, search, nullptr, with);
+    l.q = smooth::measure(l.mesh);
+    l.c = std::move(c);
+    return l;
+  };
+  // The current vector's layouts, by offset from where its search started (`origin`).
+  Candidate origin = best;
+  std::map<LO, Layout> laid;
+  LO at = 0;                // offset of `best` from origin
+  bool used_batch = false;  // the rules read a layout of the current batch
+  // Lays out at once those of `offsets` not laid out yet that the rules may still read (at most
+  // the layouts left to the search), when there are threads for it.
+  const auto lay_out_batch = [&](const std::vector<LO>& v, const std::vector<LO>& offsets) {
+    used_batch = false;
+    if (options.tasks == nullptr || options.tasks->threads() < 2) return;
+    std::vector<std::pair<LO, Candidate>> todo;
+    for (const LO t : offsets) {
+      if (t == at || laid.count(t) != 0 ||
+          static_cast<int>(todo.size()) >= max_evaluations - evaluations)
+        continue;
+      bool again = false;
+      for (const auto& d : todo) again = again || d.first == t;
+      if (again) continue;
+      if (std::optional<Candidate> c = moved(origin, v, t)) todo.emplace_back(t, std::move(*c));
+    }
+    if (todo.size() < 2) return;  // nothing to gain; the rules lay it out when they get there
+    std::vector<Layout> out(todo.size());
+    options.tasks->parallel_for(static_cast<std::int64_t>(todo.size()), [&](std::int64_t k) {
+      const auto u = static_cast<std::size_t>(k);
+      try {
+        const std::unique_ptr<cad::FaceGeometry> own = model.face_geometry(f);
+        out[u] = lay_out(std::move(todo[u].second), *own, nullptr);
+      } catch (...) {
+        out[u].error = std::current_exception();
+      }
+    });
+    for (std::size_t u = 0; u < todo.size(); ++u) laid.emplace(todo[u].first, std::move(out[u]));
+  };
+  // The serial rule: lays out the best candidate moved to offset t along v (from `laid` when the
+  // batch made it); true (and best, mesh, q updated) when better.
+  const auto try_move = [&](const std::vector<LO>& v, LO t) {
+    if (t == at || evaluations >= max_evaluations) return false;
+    auto it = laid.find(t);
+    if (it == laid.end()) {
+      std::optional<Candidate> c = moved(origin, v, t);
+      if (!c) return false;
+      it = laid.emplace(t, lay_out(std::move(*c), surface, cache)).first;
+    }
+    // Counted by the batches the rules read from, whether or not they were laid out at once, so
+    // that a run on one thread tells what the batches would be on several.
+    if (!used_batch) {
+      used_batch = true;
+      ++rep.batches;
+    }
     ++evaluations;
-    mesh::FaceMesh m = smooth::smooth_face(build_mesh(f, face, surface, fs, c), surface, search);
-    const smooth::QualityReport mq = smooth::measure(m);
-    if (mq.invalid != 0) return false;
-    if (!beats(mq, q, 1e-4)) return false;
-    best = std::move(c);
-    mesh = std::move(m);
-    q = mq;
+    ++rep.layouts;
+    const Layout& l = it->second;
+    if (l.error) std::rethrow_exception(l.error);
+    if (l.q.invalid != 0) return false;
+    if (!beats(l.q, q, 1e-4)) return false;
+    best = l.c;
+    mesh = l.mesh;
+    q = l.q;
+    at = t;
     ++rep.moves;
     return true;
   };
@@ -289,24 +379,23 @@ mesh::FaceMesh move_irregular_vertices(LO f, const cad::Face& face,
         if (v[j] > 0) hi = std::max(hi, best.match.chords[j] / v[j]);
     }
     if (lo == std::numeric_limits<LO>::min() || hi - lo < 1) continue;
+    origin = best;
+    laid.clear();
+    at = 0;
     // Coarse: four points spread over the range; then halving steps around the best.
     const LO span = std::max<LO>(1, (hi - lo) / 5);
-    LO at = 0;  // offset of `best` from where this vector's search started
-    for (int k = 1; k <= 4; ++k) {
-      const LO t = lo + k * (hi - lo) / 5;
-      if (try_move(v, t - at)) at = t;
-    }
+    std::vector<LO> coarse;
+    for (int k = 1; k <= 4; ++k) coarse.push_back(lo + k * (hi - lo) / 5);
+    lay_out_batch(v, coarse);
+    for (const LO t : coarse) try_move(v, t);
     for (LO step = std::max<LO>(1, span / 2); step >= 1; step /= 2) {
-      if (try_move(v, step)) {
-        at += step;
-      } else if (try_move(v, -step)) {
-        at -= step;
-      }
+      lay_out_batch(v, {at + step, at - step});
+      if (!try_move(v, at + step)) try_move(v, at - step);
     }
   }
   if (light && rep.moves > moves_before) {
-    mesh::FaceMesh full =
-        smooth::smooth_face(build_mesh(f, face, surface, fs, best), surface, options.smooth);
+    mesh::FaceMesh full = smooth::smooth_face(build_mesh(f, face, surface, fs, best, cache),
+                                              surface, options.smooth, nullptr, cache);
     const smooth::QualityReport fq = smooth::measure(full);
     // The given mesh may have been lifted (untangled) where the light start was not: the moved
     // fill wins only when it is also better smoothed fully.
@@ -328,6 +417,7 @@ mesh::FaceMesh move_irregular_vertices(LO f, const cad::Face& face,
   rep.sicn_min = q.sicn_min;
   rep.sicn_avg = q.sicn_avg;
   rep.quads = static_cast<std::int64_t>(mesh.quads.size());
+  rep.search_seconds += search_clock.seconds();
   return mesh;
 }
 
@@ -366,9 +456,11 @@ LO ring_layers(const FaceSides& fs) {
 
 // Matching, ranking and geometric trials for one split of the boundary into sides. Fills `rep`
 // (ok, or the refusal and its reason) and returns the mesh kept, or an empty one.
-mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& surface,
-                         const FaceSides& fs, std::span<const Pattern> patterns,
-                         const PatternFaceOptions& options, PatternFaceReport& rep) {
+mesh::FaceMesh try_sides(const cad::CadModel& model, LO f, const cad::Face& face,
+                         const cad::FaceGeometry& surface, const FaceSides& fs,
+                         std::span<const Pattern> patterns, const PatternFaceOptions& options,
+                         PatternFaceReport& rep,
+                         linalg::SolverCache* cache) {
   const ErrorContext context{"qstruct", 2, f};
   mesh::FaceMesh empty;
   empty.face = f;
@@ -486,8 +578,8 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
       none.sicn_min = -1;
       none.sicn_avg = -1;
       mesh::FaceMesh moved =
-          move_irregular_vertices(f, face, surface, fs, patterns[c.match.pattern], c,
-                                  mesh::FaceMesh{}, none, min_sicn, options, rep);
+          move_irregular_vertices(model, f, face, surface, fs, patterns[c.match.pattern], c,
+                                  mesh::FaceMesh{}, none, min_sicn, options, rep, cache);
       if (rep.moves > 0) {
         ++rep.candidates;
         // A move is kept only when its fill is valid, so the moved fill is.
@@ -517,8 +609,8 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
     // laid out, for the caller's comparison.
     const bool held = c.held < options.held_sicn_ratio * min_sicn;
     if (held && k > 0) continue;
-    mesh::FaceMesh mesh =
-        smooth::smooth_face(build_mesh(f, face, surface, fs, c), surface, options.smooth);
+    mesh::FaceMesh mesh = smooth::smooth_face(build_mesh(f, face, surface, fs, c, cache), surface,
+                                              options.smooth, nullptr, cache);
     smooth::QualityReport q = smooth::measure(mesh);
     // A layout good on average but with a few poor quads (usually next to an irregular vertex of
     // the pattern, or a folded corner of a size transition) is worth lifting locally; the
@@ -540,9 +632,12 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
     if (!held && m == 0 && options.move_evaluations > 0 && q.invalid == 0 && q.sicn_min > 0 &&
         q.sicn_avg < options.move_below_avg) {
       PatternFaceReport trial;
-      mesh = move_irregular_vertices(f, face, surface, fs, patterns[c.match.pattern], c,
-                                     std::move(mesh), q, min_sicn, options, trial);
+      mesh = move_irregular_vertices(model, f, face, surface, fs, patterns[c.match.pattern], c,
+                                     std::move(mesh), q, min_sicn, options, trial, cache);
       rep.moves += trial.moves;
+      rep.layouts += trial.layouts;
+      rep.batches += trial.batches;
+      rep.search_seconds += trial.search_seconds;
       q.sicn_min = trial.sicn_min;
       q.sicn_avg = trial.sicn_avg;
       chords = trial.chords;
@@ -569,8 +664,8 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
       return keep(std::move(best));
     if (m != 0 && best_good) {
       if (options.move_evaluations > 0 && best_q.sicn_avg < options.move_below_avg)
-        best = move_irregular_vertices(f, face, surface, fs, patterns[c.match.pattern], c,
-                                       std::move(best), best_q, min_sicn, options, rep);
+        best = move_irregular_vertices(model, f, face, surface, fs, patterns[c.match.pattern], c,
+                                       std::move(best), best_q, min_sicn, options, rep, cache);
       return keep(std::move(best));
     }
   }
@@ -579,8 +674,8 @@ mesh::FaceMesh try_sides(LO f, const cad::Face& face, const cad::FaceGeometry& s
     // elsewhere (Block's half-disks [60, 78]: SICN avg 0.53 balanced, 0.84 moved). Without
     // corner every start was moved already.
     const Candidate& c = cands[best_k];
-    best = move_irregular_vertices(f, face, surface, fs, patterns[c.match.pattern], c,
-                                   std::move(best), best_q, min_sicn, options, rep);
+    best = move_irregular_vertices(model, f, face, surface, fs, patterns[c.match.pattern], c,
+                                   std::move(best), best_q, min_sicn, options, rep, cache);
     if (passes_sicn(rep.sicn_min, rep.sicn_avg, static_cast<std::int64_t>(best.quads.size()),
                     min_sicn, options))
       return keep(std::move(best));
@@ -740,7 +835,9 @@ mesh::FaceMesh mesh_face_pattern(const cad::CadModel& model, LO f,
     } catch (const Error& e) {
       return refuse(Refusal::Degenerate, e.message());
     }
-    mesh::FaceMesh out = try_sides(f, face, *surface, fs, patterns, options, rep);
+    // One cache for the face's layouts: the move search lays out the same quads again and again.
+    linalg::SolverCache cache;
+    mesh::FaceMesh out = try_sides(model, f, face, *surface, fs, patterns, options, rep, &cache);
     if (rep.ok) return out;
     // Convex but blunt corners may be better taken as flat: one more try without them.
     FaceSides soft = fs;
@@ -750,7 +847,7 @@ mesh::FaceMesh mesh_face_pattern(const cad::CadModel& model, LO f,
     if (soft.corners.size() == fs.corners.size()) return out;
     set_side_edges(soft);
     PatternFaceReport second;
-    out = try_sides(f, face, *surface, soft, patterns, options, second);
+    out = try_sides(model, f, face, *surface, soft, patterns, options, second, &cache);
     // Report the attempt that got further (a quality refusal says more than no pattern).
     // Between two quality refusals, the one whose valid candidate has the higher minimum.
     const bool second_better =
@@ -758,7 +855,17 @@ mesh::FaceMesh mesh_face_pattern(const cad::CadModel& model, LO f,
         (rep.refusal == Refusal::Quality && second.refusal == Refusal::Quality &&
          !second.refused_mesh.quads.empty() &&
          (rep.refused_mesh.quads.empty() || second.sicn_min > rep.sicn_min));
-    if (second_better) rep = std::move(second);
+    // The search's counts and time cover both attempts (the pattern stage's batched schedule).
+    second.layouts += rep.layouts;
+    second.batches += rep.batches;
+    second.search_seconds += rep.search_seconds;
+    if (second_better) {
+      rep = std::move(second);
+    } else {
+      rep.layouts = second.layouts;
+      rep.batches = second.batches;
+      rep.search_seconds = second.search_seconds;
+    }
     return out;
   } catch (const Error& e) {
     rep.quads = 0;

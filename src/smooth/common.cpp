@@ -6,6 +6,7 @@
 
 #include "internal.hpp"
 #include "qsmesh/linalg/solver.hpp"
+#include "qsmesh/linalg/solver_cache.hpp"
 #include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/smooth/quad_tools.hpp"
 #include "qsmesh/smooth/smooth.hpp"
@@ -88,7 +89,7 @@ QuadEdges quad_edges(const std::vector<std::array<LO, 4>>& quads) {
 // Minimises sum over edges of weight * |uv_a - uv_b|^2 over the free vertices (one sparse direct
 // solve per coordinate).
 bool weighted_laplace(const QuadEdges& e, const std::vector<double>& weight, LO num_fixed,
-                      std::vector<Vec2>& uv) {
+                      std::vector<Vec2>& uv, linalg::SolverCache* cache) {
   const LO n = static_cast<LO>(uv.size());
   const LO nu = n - num_fixed;
   if (nu == 0) return true;
@@ -113,11 +114,10 @@ bool weighted_laplace(const QuadEdges& e, const std::vector<double>& weight, LO 
   for (LO r = 0; r < nu; ++r) trip.push_back({r, r, diag[r]});
   const linalg::SparseMatrix A(nu, trip);
   std::vector<double> xu(static_cast<std::size_t>(nu)), xv(static_cast<std::size_t>(nu));
-  auto solver = linalg::make_solver(nu, linalg::SolverOptions{linalg::Backend::Eigen}, nullptr);
-  solver->analyze(A);
-  solver->factorize(A);
-  solver->solve(bu, xu);
-  solver->solve(bv, xv);
+  std::unique_ptr<linalg::LinearSolver> owner;
+  linalg::LinearSolver& solver = linalg::factorized_eigen(A, cache, owner);
+  solver.solve(bu, xu);
+  solver.solve(bv, xv);
   for (LO i = 0; i < nu; ++i) {
     if (!std::isfinite(xu[i]) || !std::isfinite(xv[i])) return false;
     uv[num_fixed + i] = {xu[i], xv[i]};
@@ -127,13 +127,14 @@ bool weighted_laplace(const QuadEdges& e, const std::vector<double>& weight, LO 
 
 }  // namespace
 
-bool laplace_uv(const std::vector<std::array<LO, 4>>& quads, LO num_fixed, std::vector<Vec2>& uv) {
+bool laplace_uv(const std::vector<std::array<LO, 4>>& quads, LO num_fixed, std::vector<Vec2>& uv,
+                linalg::SolverCache* cache) {
   const QuadEdges e = quad_edges(quads);
-  return weighted_laplace(e, std::vector<double>(e.ends.size(), 1.0), num_fixed, uv);
+  return weighted_laplace(e, std::vector<double>(e.ends.size(), 1.0), num_fixed, uv, cache);
 }
 
 bool chord_laplace_uv(const std::vector<std::array<LO, 4>>& quads, LO num_fixed,
-                      std::vector<Vec2>& uv) {
+                      std::vector<Vec2>& uv, linalg::SolverCache* cache) {
   const QuadEdges e = quad_edges(quads);
   const LO ne = static_cast<LO>(e.ends.size());
   std::vector<double> target(static_cast<std::size_t>(ne), -1.0);
@@ -183,7 +184,7 @@ bool chord_laplace_uv(const std::vector<std::array<LO, 4>>& quads, LO num_fixed,
   // A floor keeps the system well conditioned where a chord ends on a pole (zero width).
   for (LO i = 0; i < ne; ++i)
     weight[i] = 1.0 / std::max(target[i] > 0 ? target[i] : mean, 1e-3 * mean);
-  return weighted_laplace(e, weight, num_fixed, uv);
+  return weighted_laplace(e, weight, num_fixed, uv, cache);
 }
 
 namespace detail {

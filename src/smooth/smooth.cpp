@@ -380,7 +380,7 @@ double min_quality_all(const Smoother& sm, LO nquads) {
 }
 
 // Unweighted Laplacian of u and v over the free vertices, locked ones as Dirichlet values.
-bool laplacian_uv(mesh::FaceMesh& m, const Topology& t) {
+bool laplacian_uv(mesh::FaceMesh& m, const Topology& t, linalg::SolverCache* cache) {
   const LO n = m.num_vertices();
   std::vector<LO> unknown(static_cast<std::size_t>(n), kNoIndex);
   LO nu = 0;
@@ -405,11 +405,11 @@ bool laplacian_uv(mesh::FaceMesh& m, const Topology& t) {
   const linalg::SparseMatrix A(nu, trip);
   std::vector<double> xu(static_cast<std::size_t>(nu)), xv(static_cast<std::size_t>(nu));
   try {
-    auto solver = linalg::make_solver(nu, linalg::SolverOptions{linalg::Backend::Eigen}, nullptr);
-    solver->analyze(A);
-    solver->factorize(A);  // throws when a component of free vertices touches no locked one
-    solver->solve(bu, xu);
-    solver->solve(bv, xv);
+    std::unique_ptr<linalg::LinearSolver> owner;
+    // factorize throws when a component of free vertices touches no locked one
+    linalg::LinearSolver& solver = linalg::factorized_eigen(A, cache, owner);
+    solver.solve(bu, xu);
+    solver.solve(bv, xv);
   } catch (const Error&) {
     return false;
   }
@@ -510,7 +510,8 @@ void place_cusp_apices(mesh::FaceMesh& m, const cad::FaceGeometry& surface) {
 }  // namespace
 
 mesh::FaceMesh smooth_face(const mesh::FaceMesh& input, const cad::FaceGeometry& surface,
-                           const SmoothOptions& options, SmoothStats* stats) {
+                           const SmoothOptions& options, SmoothStats* stats,
+                           linalg::SolverCache* cache) {
   QSMESH_CHECK(input.uv.size() == input.points.size() && input.vclass.size() == input.points.size(),
                "face " << input.face << ": points, uv and vclass sizes differ");
   SmoothStats st;
@@ -535,7 +536,7 @@ mesh::FaceMesh smooth_face(const mesh::FaceMesh& input, const cad::FaceGeometry&
         const double q0 = min_quality_all(sm, nq);
         const std::vector<Vec2> uv0 = m.uv;
         const std::vector<Vec3> p0 = m.points;
-        bool kept = laplacian_uv(m, topo);
+        bool kept = laplacian_uv(m, topo, cache);
         if (kept) {
           for (LO v = 0; v < m.num_vertices(); ++v)
             if (!(m.uv[v] == uv0[v])) m.points[v] = surface.eval(m.uv[v]).p;

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <limits>
 #include <map>
 #include <sstream>
@@ -155,6 +156,39 @@ TEST(CoarseLayout, CylinderWithClosedCurves) {
   const CoarseResult r = build_coarse_layout(in.mesh, in.model);
   expect_conforming_blocks(r, in.model);
   EXPECT_GT(r.stats.ilp_variables, 0);
+}
+
+// Mean over the quads of |log(aspect)|, the aspect the ratio of a quad's two mean opposite edge
+// lengths: 0 for squares.
+double mean_log_aspect(const mesh::SurfaceMesh& m) {
+  double sum = 0;
+  for (const auto& q : m.quads) {
+    auto p = [&](int c) {
+      return m.points[static_cast<std::size_t>(q[static_cast<std::size_t>(c)])];
+    };
+    const double a = distance(p(0), p(1)) + distance(p(3), p(2));
+    const double b = distance(p(1), p(2)) + distance(p(0), p(3));
+    sum += std::abs(std::log(a / b));
+  }
+  return m.quads.empty() ? 0 : sum / static_cast<double>(m.quads.size());
+}
+
+TEST(CoarseLayout, LoopWidthsBalancedAgainstTheCoarseQuadsShapes) {
+  // The widths of the quad loops come from the input mesh's lengths; balanced fully against the
+  // coarse quads' shapes (loop_balance 1), they make squarer fine quads, and the layout stays
+  // conforming and valid.
+  const std::string path = test::write_box_with_hole(test::tmp("coarse_balance.brep"));
+  const Meshed in = mesh_model(path, 0.35);
+  const CoarseResult plain = build_coarse_layout(in.mesh, in.model);
+  CoarseOptions o;
+  o.loop_balance = 1;
+  const CoarseResult balanced = build_coarse_layout(in.mesh, in.model, o);
+  expect_conforming_blocks(plain, in.model);
+  expect_conforming_blocks(balanced, in.model);
+  EXPECT_LT(mean_log_aspect(balanced.mesh), mean_log_aspect(plain.mesh));
+  // The same blocks, other widths.
+  EXPECT_EQ(balanced.layout.blocks.size(), plain.layout.blocks.size());
+  EXPECT_NE(balanced.mesh.quads.size(), plain.mesh.quads.size());
 }
 
 TEST(CoarseLayout, AMeshWithTrianglesIsRefusedWithAReason) {

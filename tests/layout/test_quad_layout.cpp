@@ -5,12 +5,15 @@
 
 #include <algorithm>
 #include <array>
+#include <cstdio>
 #include <filesystem>
 #include <map>
+#include <sstream>
 #include <string>
 #include <vector>
 
 #include "cgns_blocks_check.hpp"
+#include "qsmesh/io/block_connections.hpp"
 #include "qsmesh/io/writer.hpp"
 #include "qsmesh/layout/quad_layout.hpp"
 #include "tmp_dir.hpp"
@@ -321,6 +324,68 @@ TEST(CgnsBlocks, TheReaderCatchesMissingConnections) {
   const std::string error = qsmesh::test::check_block_file(wall).error;
   EXPECT_NE(error.find("a BC on an edge another zone also has"), std::string::npos) << error;
 }
+
+#ifdef QSMESH_CGNSCHECK
+// cgnscheck's error lines for `path` (it exits 0 whatever it finds, so its report is read).
+std::vector<std::string> cgnscheck_errors(const std::string& path, std::string* report) {
+  const std::string cmd = std::string(QSMESH_CGNSCHECK) + " -w3 '" + path + "' 2>&1";
+  std::FILE* p = ::popen(cmd.c_str(), "r");
+  EXPECT_NE(p, nullptr);
+  if (p == nullptr) return {"popen failed"};
+  std::string out;
+  char buf[4096];
+  for (std::size_t n = 0; (n = std::fread(buf, 1, sizeof buf, p)) > 0;) out.append(buf, n);
+  ::pclose(p);
+  std::vector<std::string> errors;
+  std::istringstream in(out);
+  for (std::string line; std::getline(in, line);) {
+    std::string upper = line;
+    for (char& c : upper) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    if (upper.find("ERROR") != std::string::npos) errors.push_back(line);
+  }
+  *report = out;
+  return errors;
+}
+
+TEST(CgnsBlocks, CgnscheckFindsNoErrorInTheZonesMadeThroughCgio) {
+  // The block zones are written node by node through cgio (not cg_zone_write, which is quadratic
+  // in the zone count): cgnscheck must find each of them a valid structured zone, with its
+  // coordinates, family, interfaces and BCs, whatever the layout (two faces; a face whose blocks
+  // meet in a T-junction; blocks beside an unstructured zone).
+  const fs::path dir = fresh_dir("cgns_blocks_cgnscheck");
+  int n = 0;
+  for (const mesh::SurfaceMesh& m :
+       {two_faces(4, 2, 3), triangle_face(), two_faces_with_triangles()}) {
+    const QuadLayout l = extract_quad_layout(m);
+    const std::string path = (dir / ("m" + std::to_string(n++) + ".cgns")).string();
+    io::write_cgns_blocks(m, l, path);
+    std::string report;
+    const std::vector<std::string> errors = cgnscheck_errors(path, &report);
+    EXPECT_TRUE(errors.empty()) << report;
+    for (std::size_t k = 0; k < l.blocks.size(); ++k)
+      EXPECT_NE(report.find("checking zone \"" +
+                            io::block_name(l, static_cast<GO>(k), m.num_cad_faces) + "\""),
+                std::string::npos)
+          << report;
+  }
+  // And the check can fail: a zone whose coordinates no longer match its size.
+  const std::string good = (dir / "m0.cgns").string(), broken = (dir / "broken.cgns").string();
+  fs::copy_file(good, broken, fs::copy_options::overwrite_existing);
+  {
+    int cgio = 0;
+    ASSERT_EQ(cgio_open_file(broken.c_str(), CGIO_MODE_MODIFY, CGIO_FILE_NONE, &cgio),
+              CGIO_ERR_NONE);
+    double root = 0, id = 0;
+    ASSERT_EQ(cgio_get_root_id(cgio, &root), CGIO_ERR_NONE);
+    ASSERT_EQ(cgio_get_node_id(cgio, root, "/qsmesh/Block_000000_Face_000000", &id), CGIO_ERR_NONE);
+    const cgsize_t wrong[6] = {9, 9, 8, 8, 0, 0};
+    ASSERT_EQ(cgio_write_all_data(cgio, id, wrong), CGIO_ERR_NONE);
+    ASSERT_EQ(cgio_close_file(cgio), CGIO_ERR_NONE);
+  }
+  std::string report;
+  EXPECT_FALSE(cgnscheck_errors(broken, &report).empty()) << report;
+}
+#endif
 
 }  // namespace
 }  // namespace qsmesh::layout

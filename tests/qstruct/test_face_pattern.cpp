@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <iostream>
 #include <map>
 #include <numbers>
 #include <stdexcept>
@@ -10,6 +11,7 @@
 
 #include "qsmesh/background/face_mesh.hpp"
 #include "qsmesh/cad/model.hpp"
+#include "qsmesh/core/tasks.hpp"
 #include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/qstruct/balance.hpp"
 #include "qsmesh/qstruct/face_pattern.hpp"
@@ -364,6 +366,59 @@ TEST(FacePattern, MovesOfTheIrregularVerticesRaiseTheMeanSicn) {
   EXPECT_GT(after.moves, 0);
   EXPECT_GT(after.sicn_avg, before.sicn_avg + 0.01);
   EXPECT_GT(after.sicn_min, after.min_sicn);
+}
+
+// PatternFaceOptions::tasks: the move search's layouts made in batches, one task each, read by the
+// serial rules: the same fill, point for point, the same moves, layouts and batches; on one thread
+// or on four, and with the layouts cut short inside the search. Without corner (an ellipse, whose
+// starts are each moved, the loop shift among the vectors) as well.
+TEST(FacePattern, MoveSearchInBatchesGivesTheSameFill) {
+  const auto patterns = builtin_patterns();
+  const TaskArena one(1), four(4);
+  std::vector<std::pair<std::vector<std::pair<double, double>>, std::vector<LO>>> shapes = {
+      {{{0, 0}, {4, 0}, {4, 16}, {5.456, 20}, {0, 20}}, {8, 32, 8, 12, 40}}};
+  std::vector<std::pair<double, double>> ellipse;
+  for (int k = 0; k < 32; ++k) {
+    const double a = 2 * std::numbers::pi * k / 32;
+    ellipse.emplace_back(2 * std::cos(a), std::sin(a));
+  }
+  shapes.emplace_back(ellipse, std::vector<LO>(32, 2));
+  int searched = 0;
+  for (std::size_t k = 0; k < shapes.size(); ++k) {
+    const auto pc =
+        polygon(shapes[k].first, shapes[k].second, "qs_batches" + std::to_string(k) + ".brep");
+    for (const int evaluations : {40, 7}) {
+      PatternFaceOptions o;
+      o.move_evaluations = evaluations;  // 7: the search cut short inside its steps
+      o.move_min_layouts_per_vector = 0;
+      PatternFaceReport serial;
+      const auto m0 = mesh_face_pattern(pc.model, 0, pc.curves, patterns, o, &serial);
+      for (const TaskArena* arena : {&one, &four}) {
+        o.tasks = arena;
+        PatternFaceReport batched;
+        const auto m1 = mesh_face_pattern(pc.model, 0, pc.curves, patterns, o, &batched);
+        EXPECT_EQ(batched.ok, serial.ok) << k;
+        EXPECT_EQ(batched.chords, serial.chords) << k;
+        EXPECT_EQ(batched.moves, serial.moves) << k;
+        EXPECT_EQ(batched.layouts, serial.layouts) << k;
+        EXPECT_EQ(batched.batches, serial.batches) << k;
+        EXPECT_EQ(batched.sicn_avg, serial.sicn_avg) << k;
+        EXPECT_EQ(m1.quads, m0.quads) << k;
+        ASSERT_EQ(m1.points.size(), m0.points.size()) << k;
+        for (std::size_t i = 0; i < m0.points.size(); ++i)
+          ASSERT_EQ(distance(m1.points[i], m0.points[i]), 0.0) << k << " point " << i;
+      }
+      o.tasks = nullptr;
+      std::cout << "case " << k << ", " << evaluations
+                << " layouts at most: " << serial.pattern_name << ", " << serial.layouts
+                << " layouts in " << serial.batches << " batches, " << serial.moves << " moves\n";
+      if (serial.layouts > 0) ++searched;
+      // A batch holds one or more layouts the rules read.
+      EXPECT_LE(serial.batches, serial.layouts);
+      EXPECT_GE(serial.search_seconds, 0.0);
+    }
+  }
+  EXPECT_EQ(searched, 4);  // the test must exercise searches
 }
 
 // ... and a fill whose balanced subdivisions need more quads than max_quads may still fit the

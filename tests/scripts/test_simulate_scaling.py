@@ -121,6 +121,46 @@ class Stages(unittest.TestCase):
         self.assertAlmostEqual(s.bound(), 11.1, places=6)
 
 
+class Distance(unittest.TestCase):
+    def test_distance_is_partitioned(self):
+        # The distance stage (pipeline's, before the gather) goes by the METIS partition like the
+        # background: faces 1, 2, 3, 4 s on ranks {0, 3} / {1, 2} -> 5 s, + 0.5 s outside them.
+        st = stats([(0, 0, 0, 0, 1, 0)] * 4, {"distance": 10.5})
+        for i, f in enumerate(st["face_stats"]):
+            f["stage_seconds"]["distance"] = float(i + 1)
+        s = sim.Simulator(sim.Run(st), partitions={"2": [0, 1, 1, 0]}, comm=NO_COMM)
+        self.assertAlmostEqual(s.predict(2, 1)["distance"], 5.5, places=6)
+        self.assertAlmostEqual(s.predict(1, 1)["distance"], 10.5, places=6)
+
+
+class Batches(unittest.TestCase):
+    def test_batched_schedule(self):
+        # 10 s of which 8 s search: 8 layouts of 1 s in 2 batches of 4. One thread: serial; two:
+        # 2 + 2 batches x 2 layouts; four or more: 2 + 2 x 1; never above the serial time.
+        self.assertAlmostEqual(sim.batched_schedule(10, 8, 8, 2, 1), 10)
+        self.assertAlmostEqual(sim.batched_schedule(10, 8, 8, 2, 2), 6)
+        self.assertAlmostEqual(sim.batched_schedule(10, 8, 8, 2, 4), 4)
+        self.assertAlmostEqual(sim.batched_schedule(10, 8, 8, 2, 64), 4)
+        self.assertAlmostEqual(sim.batched_schedule(10, 8, 8, 8, 4), 10)  # one layout a batch
+        self.assertAlmostEqual(sim.batched_schedule(10, 0, 0, 0, 4), 10)  # no search
+
+    def test_pattern_stage_uses_the_rank_threads(self):
+        # One face, patterns 10 s, 8 of them the search (8 layouts, 2 batches): 1x4 takes 4 s, 4x1
+        # still 10 s (the batches stay on the face's rank).
+        st = stats([(0, 10, 0, 0, 5, 0)], {"patterns": 10.0})
+        ss = st["face_stats"][0]["stage_seconds"]
+        ss.update(pattern_layouts=8, pattern_batches=2, pattern_search=8.0)
+        s = sim.Simulator(sim.Run(st), comm=NO_COMM)
+        self.assertAlmostEqual(s.predict(1, 4)["patterns"], 4.0, places=6)
+        self.assertAlmostEqual(s.predict(4, 1)["patterns"], 10.0, places=6)
+        # A run on two threads measured its face with the batches split already: replayed as is.
+        st2 = stats([(0, 6, 0, 0, 5, 0)], {"patterns": 6.0}, threads=2)
+        st2["face_stats"][0]["stage_seconds"].update(pattern_layouts=8, pattern_batches=2,
+                                                     pattern_search=4.0)
+        s2 = sim.Simulator(sim.Run(st2), comm=NO_COMM)
+        self.assertAlmostEqual(s2.predict(1, 2)["patterns"], 6.0, places=6)
+
+
 class Pieces(unittest.TestCase):
     def test_pieces_are_tasks_in_two_rounds(self):
         # Face 0 (3000 quads) improved in pieces: 3 of 2 s in the first round, 4 of 1 s in the

@@ -20,6 +20,12 @@ struct CoarseOptions {
   /// Half-angle of the cone of the stopping rule and of the geometric consistency (4), radians.
   double alpha = 0.785398163397448;  // pi/4
   IlpOptions ilp;
+  /// Quad-loop widths (Sec. IV.D) balanced against the coarse quads' shapes, in [0, 1]: 0 takes
+  /// each loop's width from the input lengths alone (the mean of its edges' input lengths); b > 0
+  /// blends each edge's input length with (1 - b, b) the width that would make the fine quads of
+  /// its coarse quad square at their size (sqrt of the product of the two fine edge lengths
+  /// there). 0 by default: measured in docs/benchmarks.md ("Coarse block layout").
+  double loop_balance = 0;
   /// Passes of the smoother (smooth::smooth_face, Winslow kernels) on each face of the new mesh.
   int smoothing_iterations = 10;
 };

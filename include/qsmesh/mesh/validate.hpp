@@ -38,7 +38,22 @@ struct ConformityReport {
                                                 std::span<const LO> face_group = {});
 
 /// Largest distance (model units) between a vertex and its CAD entity evaluated at the vertex's
-/// parameters (corner point, C(t), S(u, v)).
+/// parameters (corner point, C(t), S(u, v)): the maximum of the by-dimension distances below over
+/// dimensions 0, 1 and 2.
 [[nodiscard]] double max_distance_to_cad(const SurfaceMesh& mesh, const cad::CadModel& model);
+
+/// The same distance over the vertices of `vclass` (positions `points`, same length) whose
+/// classification has dimension `dim` alone; 0 where there are none. A maximum does not depend on
+/// how the vertices are split, so the assembled mesh's distance is that of its corners, of each
+/// curve mesh's interior vertices (below) and of each face mesh's interior vertices, taken on the
+/// ranks and tasks that hold them and max-reduced (parallel's `distance` stage; the end-of-run
+/// statistics then do not take one rank through every vertex).
+[[nodiscard]] double max_distance_to_cad(std::span<const Vec3> points,
+                                         std::span<const VertexClass> vclass,
+                                         const cad::CadModel& model, int dim);
+
+/// The distance of a curve mesh's interior vertices (the assembled mesh's dimension-1 vertices of
+/// that curve: points[i] against C(t[i]), 0 < i < num_edges()).
+[[nodiscard]] double max_distance_to_cad(const CurveMesh& curve, const cad::CadModel& model);
 
 }  // namespace qsmesh::mesh

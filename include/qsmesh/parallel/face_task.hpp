@@ -201,6 +201,7 @@ struct FaceTimes {
   double unstructured = 0;  ///< the unstructured mesh (METIS partition)
   double improvement = 0;   ///< cavity, disk remeshing, final smoothing (dealt out)
   double compare = 0;       ///< second fill and comparison (METIS partition)
+  double distance = 0;      ///< its final mesh's distance to the CAD (METIS partition)
   /// The pattern stage deals the faces out by this, largest first (the size map's quads).
   double expected_quads = 0;
   /// The improvement deals its faces out by this, largest first (the unstructured mesh's quads;
@@ -213,6 +214,11 @@ struct FaceTimes {
   /// first cut's pieces (dealt with the whole faces) then the second cut's (dealt after them).
   /// Their sum and the cutting and merging make `improvement`. Empty: one task.
   std::vector<double> improvement_tasks;
+  /// The pattern fill's move search (qstruct::PatternFaceReport: layouts, batches,
+  /// search_seconds): the part of `patterns` that its batches split over the threads.
+  std::int64_t pattern_layouts = 0;
+  std::int64_t pattern_batches = 0;
+  double pattern_search = 0;
   template <class S, class V>
   static void fields(S& self, V&& visit) {
     visit("background", self.background);
@@ -222,10 +228,14 @@ struct FaceTimes {
     visit("unstructured", self.unstructured);
     visit("improvement", self.improvement);
     visit("pattern_compare", self.compare);
+    visit("distance", self.distance);
     visit("expected_quads", self.expected_quads);
     visit("improvement_quads", self.improvement_quads);
     visit("bytes", self.bytes);
     visit("improvement_tasks", self.improvement_tasks);
+    visit("pattern_layouts", self.pattern_layouts);
+    visit("pattern_batches", self.pattern_batches);
+    visit("pattern_search", self.pattern_search);
   }
 };
 

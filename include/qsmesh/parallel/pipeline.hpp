@@ -184,6 +184,10 @@ struct PipelineOptions {
   const fieldmesh::GivenFields* given_fields = nullptr;
   bool separatrix_method = false;
   fieldmesh::FieldMeshOptions fieldmesh;
+  /// The `distance` stage before the gather: PipelineResult::max_distance_to_cad of the final
+  /// mesh, each face's part on its rank and the curves' split over the ranks (the `mesh`
+  /// command's statistics; otherwise rank 0 would go through every vertex after the gather).
+  bool distance_to_cad = false;
 };
 
 struct PipelineResult {
@@ -222,6 +226,9 @@ struct PipelineResult {
   /// over the faces of all ranks, seconds (every rank). The stage itself is timed as one
   /// ("improvement"): its faces are dealt out dynamically, each face running the three in turn.
   std::array<double, 3> improvement_seconds{};
+  /// With PipelineOptions::distance_to_cad: mesh::max_distance_to_cad of the assembled mesh,
+  /// model units (every rank); -1 otherwise.
+  double max_distance_to_cad = -1;
   StageTimes times;  ///< wall time per stage (max over ranks)
 };
 

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "qsmesh/cad/model.hpp"
+#include "qsmesh/core/tasks.hpp"
 #include "qsmesh/mesh/delaunay.hpp"
 #include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/mesh/surface_mesh.hpp"
@@ -146,6 +147,12 @@ struct PatternFaceOptions {
   double held_sicn_ratio = 1;
   MatchOptions match;
   smooth::SmoothOptions smooth;
+  /// Threads for the move search (null or one thread: serial). Its steps stay serial, but the
+  /// layouts one step may read (a vector's four coarse points; a halving step's +step and -step)
+  /// are laid out at once, one task each, so that one large face's pattern work is split below
+  /// the face (issue 28). The fill is the same as the serial search's at any thread count; a
+  /// layout the serial search would not have read is wasted work.
+  const TaskArena* tasks = nullptr;
 };
 
 /// Why a face was not meshed by a pattern.
@@ -179,6 +186,13 @@ struct PatternFaceReport {
   int candidates = 0;      ///< matches tried geometrically
   int lifts = 0;           ///< candidates handed to the untangler (lift_poor_quads)
   int moves = 0;           ///< improving moves made by the search (over every start without corner)
+  /// The move search's layouts read by its rules (over every search of the face), the batches
+  /// they came in (a step of the search's critical path when its layouts are made at once:
+  /// PatternFaceOptions::tasks), and the searches' wall time, seconds: what the scaling
+  /// simulation splits the face's pattern time by (scripts/simulate_scaling.py).
+  int layouts = 0;
+  int batches = 0;
+  double search_seconds = 0;
   double sicn_min = 0, sicn_avg = 0;  ///< of the mesh kept (or of the best refused one)
   /// The min threshold applied (options.min_sicn, lowered at sharp corners: corner_sicn_factor).
   double min_sicn = 0;
@@ -202,6 +216,9 @@ struct PatternFaceReport {
     visit("candidates", self.candidates);
     visit("lifts", self.lifts);
     visit("moves", self.moves);
+    visit("layouts", self.layouts);
+    visit("batches", self.batches);
+    visit("search_seconds", self.search_seconds);
     visit("sicn_min", self.sicn_min);
     visit("sicn_avg", self.sicn_avg);
     visit("min_sicn", self.min_sicn);

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "qsmesh/cad/geometry.hpp"
+#include "qsmesh/linalg/solver_cache.hpp"
 #include "qsmesh/mesh/surface_mesh.hpp"
 
 namespace qsmesh::smooth {
@@ -27,9 +28,10 @@ namespace qsmesh::smooth {
 /// For a grid with evenly spaced sides this is the bilinear grid; the layout is invariant under
 /// affine maps of the parameter plane. Returns false, leaving the free uv unspecified, when a
 /// solved value is not finite; errors of the solver (a free vertex with no path to a fixed one)
-/// propagate as qsmesh::Error.
+/// propagate as qsmesh::Error. `cache` (optional, this thread's): the solver's analysis is reused
+/// when the same quads come again; the layout is the same with or without it.
 [[nodiscard]] bool laplace_uv(const std::vector<std::array<LO, 4>>& quads, LO num_fixed,
-                              std::vector<Vec2>& uv);
+                              std::vector<Vec2>& uv, linalg::SolverCache* cache = nullptr);
 
 /// Laplace layout that keeps the grading of the fixed boundary (paper 000 Sec. 6.1.2: the patterns
 /// are filled "with a layout following the boundary sizes"). Same inputs, outputs and errors as
@@ -42,6 +44,6 @@ namespace qsmesh::smooth {
 /// as transfinite interpolation), where the uniform Laplacian pulls it towards even spacing and
 /// skews the quads near the fine end.
 [[nodiscard]] bool chord_laplace_uv(const std::vector<std::array<LO, 4>>& quads, LO num_fixed,
-                                    std::vector<Vec2>& uv);
+                                    std::vector<Vec2>& uv, linalg::SolverCache* cache = nullptr);
 
 }  // namespace qsmesh::smooth

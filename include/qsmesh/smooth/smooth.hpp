@@ -7,6 +7,7 @@
 #include <string>
 
 #include "qsmesh/cad/geometry.hpp"
+#include "qsmesh/linalg/solver_cache.hpp"
 #include "qsmesh/mesh/surface_mesh.hpp"
 
 namespace qsmesh::smooth {
@@ -82,9 +83,11 @@ struct SmoothStats {
 /// Measures before and after; when the minimum SICN dropped or more quads are invalid, returns the
 /// input (stats->rolled_back). Deterministic: no randomness, fixed order, no threads.
 /// Returns the smoothed mesh (same topology and classification; dim-2 vclass.param = new uv).
+/// `cache` (optional, owned by the calling thread): step 1's solver analysis is reused when the
+/// same pattern comes again (linalg::SolverCache); the result is the same with or without it.
 [[nodiscard]] mesh::FaceMesh smooth_face(const mesh::FaceMesh& mesh,
                                          const cad::FaceGeometry& surface,
-                                         const SmoothOptions& options,
-                                         SmoothStats* stats = nullptr);
+                                         const SmoothOptions& options, SmoothStats* stats = nullptr,
+                                         linalg::SolverCache* cache = nullptr);
 
 }  // namespace qsmesh::smooth
