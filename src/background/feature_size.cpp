@@ -212,8 +212,8 @@ void limit_by_feature_distance(const cad::CadModel& model,
 }
 
 void limit_by_face_width(const cad::CadModel& model, std::span<const std::vector<Vec3>> polylines,
-                         std::vector<std::vector<double>>& sizes, double touching, double sliver,
-                         const TaskArena& tasks) {
+                         std::vector<std::vector<double>>& sizes, double touching,
+                         double wedge_touching, double sliver, const TaskArena& tasks) {
   // The faces of each curve, sorted: two curves are sides of one face when the lists intersect.
   const std::vector<std::vector<LO>> faces = faces_of_curves(model, polylines.size());
   const auto share_face = [&](LO a, LO b) {
@@ -267,15 +267,25 @@ void limit_by_face_width(const cad::CadModel& model, std::span<const std::vector
         double scale = 1;
         const double r = shared_corner_distance(model, c, other, p);
         if (std::isfinite(r)) {
-          if (!(d < sharp * r) || !own_wedge_sides(faces, c, other)) return 0;
+          // The tip, where the sides are closer than wedge_touching, is one edge
+          // (sharp_wedge_tips): the tail's grading stops there.
+          if (!(d < sharp * r) || !(d > wedge_touching) || !own_wedge_sides(faces, c, other))
+            return 0;
           scale = 0.75;
         }
         for (const LO a : model.curves()[c].corners)
           for (const LO b : model.curves()[other].corners) {
             if (a < 0) continue;
             auto it = std::lower_bound(joints.begin(), joints.end(), Joint{a, b, 0.0});
-            for (; it != joints.end() && it->a == a && it->b == b; ++it)
-              if (!(d <= 2 * it->length || d < sharp * distance(p, corners[a].point))) return 0;
+            for (; it != joints.end() && it->a == a && it->b == b; ++it) {
+              const double from_joint = distance(p, corners[a].point);
+              // Sides closer than wedge_touching next to the sliver (within 4 x its length) are
+              // the tip of a blunted wedge, not a strip: grading them toward the sliver gave
+              // wing_fuselage's fairings (the wing roots' 0.036-long trailing edges) 20 more
+              // interior irregular vertices at its reference size (docs/benchmarks.md).
+              if (!(d > wedge_touching) && from_joint < 4 * it->length) return 0;
+              if (!(d <= 2 * it->length || d < sharp * from_joint)) return 0;
+            }
           }
         return scale;
       });

@@ -26,8 +26,18 @@ constexpr double kSharpWedgeDeg = 10;
 /// along, has SICN about width / size. t20_data (0-degree cusps of its chamfer slivers) at size
 /// factors 0.02, 0.01 and its reference: the tips of 1/10 of the size left 24 avoidable quads below
 /// SICN 0.1 at the reference, 1/6.3 none, 1/4 none but 136 interior irregular vertices (87 without
-/// the tips, 78 with 1/6.3: the counts the faces beside the slivers get vary).
-constexpr double kSharedTipWidth = 1 / 6.0;
+/// the tips, 78 with 1/6.3: the counts the faces beside the slivers get vary). 1/6 left the
+/// trapezoids just past the tips at SICN 0.096 at size factor 0.01 (quads 1.2 x the size along:
+/// 12 avoidable below 0.1); 0.18 takes them above 0.12 at 0.02, 0.01, 0.005 and the reference,
+/// the reference mesh unchanged (docs/benchmarks.md, issue 29).
+constexpr double kSharedTipWidth = 0.18;
+
+/// Gaps narrower than this fraction of the floor do not make a face thin (curves touching). A tenth
+/// of the floor, as rule (ii) uses, left strips 0.01-0.1 x the floor wide (Block's at size factor
+/// 0.02) meshed at nearly the full size along them: 132 quads below SICN 0.1 there, 40 with a
+/// hundredth (docs/benchmarks.md, issue 29). Inside sharp wedges and at blunted wedge tips the
+/// tenth stays (background::limit_by_face_width): there the tip ends the graded tail.
+constexpr double kThinTouching = 0.01;
 
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
@@ -265,7 +275,8 @@ CurveSizes initial_curve_sizes(const cad::CadModel& model, std::span<const mesh:
         width = h;
         for (auto& w : width)
           for (double& x : w) x *= 0.5;
-        background::limit_by_face_width(model, dense, width, touching, floor, tasks);
+        background::limit_by_face_width(model, dense, width, kThinTouching * floor, touching, floor,
+                                        tasks);
         // The tip of a sharp wedge is one edge. Where the tail behind it is graded (its sides
         // bound that face alone), the tip is where the sides are closer than `touching`, never
         // longer than the size: graded with the width down to the corner, the tail's quads would

@@ -607,7 +607,7 @@ TEST(SizeMap, ThinAspectLeavesWideFacesAndSidesMeetingAtACornerAlone) {
   // triangle with a 3-degree corner: the long sides of its end faces are close near the corner and
   // share it (a cusp's tail), but each also bounds a side face of the prism, which would take the
   // tail's graded counts (see background::limit_by_face_width): the tail keeps its sizes, and the
-  // tip is where it is thinner than a sixth of the size, x < (1 / 6) / sin(3 degrees) = 3.18.
+  // tip is where it is thinner than 0.18 x the size, x < 0.18 / sin(3 degrees) = 3.44.
   SizeMapOptions o;
   o.method = Method::Features;
   o.size_max = 1.0;
@@ -633,7 +633,7 @@ TEST(SizeMap, ThinAspectLeavesWideFacesAndSidesMeetingAtACornerAlone) {
     }
     // Two long sides at each of the prism's two sharp corners.
     ASSERT_EQ(on.tips.size(), 4u);
-    const double limit = (1.0 / 6) / std::sin(3 * std::numbers::pi / 180);
+    const double limit = 0.18 / std::sin(3 * std::numbers::pi / 180);
     for (const auto& tip : on.tips) {
       EXPECT_TRUE(tip.shared);
       EXPECT_GT(tip.length, 0.8 * limit);

@@ -28,16 +28,18 @@ void limit_by_feature_distance(const cad::CadModel& model,
 /// The width of thin faces along their sides: lowers sizes[c][k] to the distance d from polyline
 /// vertex k of curve c to the nearest curve that bounds a face with c but shares no corner with it
 /// (the other side of a strip or a neck), searching only within the current sizes[c][k]; no floor.
-/// Distances up to `touching` are ignored. Curves near each other across a gap between two faces
-/// (a slot) do not count: neither face is thin there. Two curves whose ends are joined by a curve
-/// shorter than `sliver` (the end of a strip, or the blunted tip of a wedge) count only where d is
-/// at most twice that curve's length (a strip as wide as its end) or less than sin(10 degrees) x
-/// the distance from the vertex to the joint (a wedge sharper than that). The distance is taken in
-/// space, so it is at most the width inside the face. Same inputs and determinism as
-/// limit_by_feature_distance.
+/// Distances up to `touching` are ignored (curves touching), and up to `wedge_touching` between
+/// sides sharing a corner (inside a sharp wedge, where the tip sharp_wedge_tips finds with the
+/// same width is one edge) or joined by a sliver curve within 4 x its length of it (a blunted
+/// wedge's tip). Curves near each other across a gap between two faces (a slot) do not count:
+/// neither face is thin there. Two curves whose ends are joined by a curve shorter than `sliver`
+/// (the end of a strip, or the blunted tip of a wedge) count only where d is at most twice that
+/// curve's length (a strip as wide as its end) or less than sin(10 degrees) x the distance from the
+/// vertex to the joint (a wedge sharper than that). The distance is taken in space, so it is at
+/// most the width inside the face. Same inputs and determinism as limit_by_feature_distance.
 void limit_by_face_width(const cad::CadModel& model, std::span<const std::vector<Vec3>> polylines,
-                         std::vector<std::vector<double>>& sizes, double touching, double sliver,
-                         const TaskArena& tasks);
+                         std::vector<std::vector<double>>& sizes, double touching,
+                         double wedge_touching, double sliver, const TaskArena& tasks);
 
 /// Resolution inside sharp wedges (a cusp's tail): lowers sizes[c][k] to twice the distance d from
 /// polyline vertex k of curve c to another side of one of its faces that shares a corner with c,
