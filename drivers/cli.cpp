@@ -221,6 +221,10 @@ Arguments parse(const std::vector<std::string>& args) {
       if (!b || !(*b >= 0 && *b <= 1))
         throw InputError("--loop-balance: '" + v + "' is not a number in [0, 1]");
       a.loop_balance = *b;
+    } else if (opt == "--curves-are-walls" && a.command == Command::Mesh) {
+      a.sharp_and_smooth_walls = true;
+    } else if (opt == "--traces-cross-curves" && a.command == Command::Mesh) {
+      a.traces_cross_curves = true;
     } else if (opt == "--order" && a.command == Command::Mesh) {
       const std::string& v = value();
       if (v.size() != 1 || v[0] < '1' || v[0] > '5')
@@ -527,13 +531,20 @@ std::string help(const std::string& topic) {
           "                        along part of a side); faces that do not split into blocks go\n"
           "                        to one unstructured zone. coarse: a new mesh on a conforming\n"
           "                        layout (paper 002 Sec. III-IV: T-mesh, ILP, subdivision,\n"
-          "                        smoothing), every block side shared whole, every CAD curve a\n"
-          "                        block side; its quads are still worse than the mesh it comes\n"
+          "                        smoothing), every block side shared whole, every sharp CAD\n"
+          "                        curve a block side; its quads are still worse than the mesh it "
+          "comes\n"
           "                        from (docs/benchmarks.md); when it fails, one log line and\n"
           "                        the dense layout\n"
           "  --loop-balance B      with --layout coarse: quad-loop widths blended with weight B\n"
           "                        (0..1) towards square fine quads in each coarse quad\n"
           "                        (default 0: the input mesh's lengths alone)\n"
+          "  --curves-are-walls    with --layout coarse: every CAD curve a block side; by\n"
+          "                        default traces and blocks cross the curves where the surface\n"
+          "                        is smooth (normals within 10 degrees), sharp ones only are\n"
+          "                        walls\n"
+          "  --traces-cross-curves with --layout coarse: the T-mesh's traces run on across\n"
+          "                        smooth curves too (more blocks on A319: docs/benchmarks.md)\n"
           "  --plot3d-stream       PLOT3D output without the Fortran record lengths (C stream\n"
           "                        binary: the same bytes, nothing between the records)\n"
           "  --plot3d-single       PLOT3D coordinates in single precision (float32)\n"

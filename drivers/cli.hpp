@@ -52,6 +52,11 @@ struct Arguments {
   bool coarse_layout = false;
   /// --loop-balance B (with --layout coarse): layout::CoarseOptions::loop_balance, in [0, 1].
   double loop_balance = 0;
+  /// --curves-are-walls (with --layout coarse): every CAD curve a block side, smooth ones too
+  /// (layout::CoarseOptions::cross_smooth_curves = false).
+  bool sharp_and_smooth_walls = false;
+  /// --traces-cross-curves (with --layout coarse): CoarseOptions::traces_across_smooth_curves.
+  bool traces_cross_curves = false;
   /// --order N, 2..5: Lagrange quads ((N + 1)^2 nodes) and bars (N + 1 nodes) on the CAD
   /// (highorder::make_high_order); 1: linear.
   int order = 1;

@@ -455,6 +455,9 @@ std::string stats_json(const Arguments& args, const Session& session,
       j.value("ilp_rounds", static_cast<std::int64_t>(c->ilp_rounds));
       j.value("tmesh_patches", c->tmesh_patches);
       j.value("coarse_layout_repairs", static_cast<std::int64_t>(c->repairs));
+      j.value("smooth_curves_crossed", c->smooth_curves);
+      j.value("traces_across_curves", c->traces_across_curves);
+      j.value("blocks_across_curves", kept ? c->blocks_across_curves : std::int64_t{0});
       j.value("coarse_layout_seconds", c->seconds);
       j.value("block_mesh_quads", kept ? c->fine_quads : std::int64_t{0});
       j.value("block_mesh_sicn_min", kept ? c->sicn_min : 0.0);
@@ -908,6 +911,8 @@ int run_mesh(const Arguments& args) {
       if (args.coarse_layout) {
         layout::CoarseOptions co;
         co.loop_balance = args.loop_balance;
+        co.cross_smooth_curves = !args.sharp_and_smooth_walls;
+        co.traces_across_smooth_curves = args.traces_cross_curves;
         coarse = layout::build_coarse_layout(result.mesh, s.model, co);
         b.coarse = coarse->stats;
         if (!coarse->ok) {

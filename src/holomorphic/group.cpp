@@ -4,62 +4,19 @@
 #include <algorithm>
 #include <cmath>
 #include <map>
-#include <numbers>
 #include <numeric>
 #include <set>
 
 #include "detail.hpp"
+#include "qsmesh/cad/smooth.hpp"
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/smooth/approx_surface.hpp"
 
 namespace qsmesh::holomorphic {
 
-namespace {
-
-// The (loop, use) of curve c in face f's loops; {-1, -1} when f does not use it.
-std::pair<LO, LO> use_of(const cad::Face& f, LO c) {
-  for (std::size_t l = 0; l < f.loops.size(); ++l)
-    for (std::size_t k = 0; k < f.loops[l].uses.size(); ++k)
-      if (f.loops[l].uses[k].curve == c) return {static_cast<LO>(l), static_cast<LO>(k)};
-  return {-1, -1};
-}
-
-}  // namespace
-
 bool smooth_across(const cad::CadModel& model, LO c, const GroupOptions& options) {
-  const cad::Curve& curve = model.curves()[static_cast<std::size_t>(c)];
-  if (curve.degenerate) return false;
-  const auto faces = model.curve2faces()[c];
-  if (faces.size() != 2 || faces[0] == faces[1]) return false;
-  std::array<std::unique_ptr<cad::FaceGeometry>, 2> surface;
-  std::array<std::pair<LO, LO>, 2> use;
-  std::array<bool, 2> forward{};
-  for (std::size_t i = 0; i < 2; ++i) {
-    const cad::Face& f = model.faces()[static_cast<std::size_t>(faces[i])];
-    use[i] = use_of(f, c);
-    if (use[i].first < 0) return false;
-    surface[i] = model.face_geometry(faces[i]);
-    // The loops are the surface's natural orientation (du x dv); a reversed face's normal points
-    // the other way, and so does its boundary's direction relative to that normal.
-    forward[i] = f.loops[static_cast<std::size_t>(use[i].first)]
-                     .uses[static_cast<std::size_t>(use[i].second)]
-                     .reversed == f.reversed;
-  }
-  // In a consistently oriented shell the two faces traverse their common curve in opposite
-  // directions; traversed the same way, one of them is flipped and so is its normal.
-  const double sign = forward[0] != forward[1] ? 1.0 : -1.0;
-  const double cos_max = std::cos(options.max_normal_angle_deg * std::numbers::pi / 180);
-  int compared = 0;
-  for (int i = 1; i <= options.samples; ++i) {
-    const double t = curve.t0 + (curve.t1 - curve.t0) * double(i) / double(options.samples + 1);
-    const Vec3 n0 = surface[0]->normal(surface[0]->boundary_uv(use[0].first, use[0].second, t));
-    const Vec3 n1 = surface[1]->normal(surface[1]->boundary_uv(use[1].first, use[1].second, t));
-    if (norm(n0) == 0 || norm(n1) == 0) continue;  // a pole: no normal there
-    if (sign * dot(n0, n1) < cos_max) return false;
-    ++compared;
-  }
-  return compared > 0;
+  return cad::smooth_across(model, c, options.max_normal_angle_deg, options.samples);
 }
 
 std::vector<std::vector<LO>> smooth_face_groups(const cad::CadModel& model,

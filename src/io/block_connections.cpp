@@ -138,10 +138,29 @@ BlockConnections block_connections(const mesh::SurfaceMesh& mesh,
   // thus joined, once each way. Off the curves only sides of the same face: two faces on one
   // surface with one boundary (a face given twice) may have edges between the same boundary
   // vertices, but they meet on their curves only.
+  // A block of the coarse layout may span faces joined across smooth curves: the face of a side
+  // edge off the curves is that of the block's quad along it (found through quad2block), not the
+  // block's first face.
+  std::unordered_map<std::uint64_t, std::vector<GO>> side_quads;  // side edge -> quads with it
+  if (layout.quad2block.size() == mesh.quads.size())
+    for (std::size_t q = 0; q < mesh.quads.size(); ++q) {
+      const auto& quad = mesh.quads[q];
+      for (std::size_t c = 0; c < 4; ++c) {
+        const auto it = edge_uses.find(edge_key(quad[c], quad[(c + 1) % 4]));
+        if (it != edge_uses.end()) side_quads[it->first].push_back(static_cast<GO>(q));
+      }
+    }
+  auto face_at = [&](GO k, std::uint64_t e) {
+    const auto it = side_quads.find(e);
+    if (it != side_quads.end())
+      for (GO q : it->second)
+        if (layout.quad2block[static_cast<std::size_t>(q)] == k)
+          return mesh.quad_face[static_cast<std::size_t>(q)];
+    return layout.blocks[static_cast<std::size_t>(k)].face;
+  };
   const std::unordered_map<std::uint64_t, LO> edge_curve = mesh::bar_curves(mesh);
   auto joins = [&](GO k, std::uint64_t e, const Use& u) {
-    return edge_curve.count(e) > 0 || layout.blocks[static_cast<std::size_t>(u.block)].face ==
-                                          layout.blocks[static_cast<std::size_t>(k)].face;
+    return edge_curve.count(e) > 0 || face_at(u.block, e) == face_at(k, e);
   };
   auto abuts_unstructured = [&](std::uint64_t e) {
     return edge_curve.count(e) > 0 && unstructured_edges.count(e) > 0;

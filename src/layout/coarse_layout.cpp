@@ -16,6 +16,7 @@
 
 #include "grid.hpp"
 #include "qsmesh/cad/geometry.hpp"
+#include "qsmesh/cad/smooth.hpp"
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/core/timer.hpp"
 #include "qsmesh/mesh/edges.hpp"
@@ -127,6 +128,8 @@ class Builder {
       if (!m_.triangles.empty()) throw Reject{"the mesh has triangles"};
       if (m_.quads.empty()) throw Reject{"the mesh has no quad"};
       adjacency();
+      smooth_curves();
+      out.stats.smooth_curves = std::count(smooth_.begin(), smooth_.end(), 1);
       std::vector<char> extra(static_cast<std::size_t>(std::max<LO>(m_.num_cad_faces, 1)), 0);
       std::vector<LO> failed = tmesh(extra);
       if (!failed.empty()) {
@@ -139,6 +142,7 @@ class Builder {
       }
       arcs();
       out.stats.traces = static_cast<std::int64_t>(traces_.size());
+      out.stats.traces_across_curves = traces_across_;
       out.stats.tmesh_patches = static_cast<std::int64_t>(grids_.size());
       out.stats.tmesh_arcs = static_cast<std::int64_t>(arcs_.size());
       out.stats.tmesh_nodes = std::count(node_.begin(), node_.end(), 1);
@@ -149,7 +153,9 @@ class Builder {
       // program is solved again.
       for (int repair = 0;; ++repair) {
         for (int round = 0;; ++round) {
-          const IlpResult sol = solve_integer_program(ilp, opt_.ilp);
+          IlpOptions ilp_options = opt_.ilp;
+          if (opt_.traces_across_smooth_curves) ilp_options.preprocess = false;
+          const IlpResult sol = solve_integer_program(ilp, ilp_options);
           out.stats.ilp_seconds += sol.seconds;
           out.stats.ilp_status = sol.status;
           ++out.stats.ilp_rounds;
@@ -188,6 +194,7 @@ class Builder {
         out.stats.repairs = repair + 1;
       }
       out.stats.coarse_quads = static_cast<std::int64_t>(out.layout.blocks.size());
+      out.stats.blocks_across_curves = blocks_across_;
       out.stats.fine_quads = static_cast<std::int64_t>(out.mesh.quads.size());
       out.ok = true;
     } catch (const Reject& r) {
@@ -280,6 +287,47 @@ class Builder {
     return {next, left, left == side[0] ? side[1] : side[0]};
   }
 
+  // Smooth curves (CoarseOptions::cross_smooth_curves) and the CAD corners all of whose curves
+  // are smooth.
+  void smooth_curves() {
+    smooth_.assign(static_cast<std::size_t>(std::max<LO>(m_.num_cad_curves, 0)), 0);
+    corner_smooth_.assign(static_cast<std::size_t>(std::max<LO>(m_.num_cad_corners, 0)), 1);
+    if (!opt_.cross_smooth_curves) {
+      corner_smooth_.assign(corner_smooth_.size(), 0);
+      return;
+    }
+    for (LO c = 0; c < m_.num_cad_curves && c < model_.num_curves(); ++c)
+      smooth_[static_cast<std::size_t>(c)] = cad::smooth_across(model_, c, opt_.smooth_angle_deg);
+    for (LO c = 0; c < m_.num_cad_curves; ++c)
+      if (!smooth_[static_cast<std::size_t>(c)])
+        for (LO k : m_.curve_corners[static_cast<std::size_t>(c)])
+          if (k >= 0 && k < m_.num_cad_corners) corner_smooth_[static_cast<std::size_t>(k)] = 0;
+  }
+  [[nodiscard]] bool smooth_curve(LO c) const {
+    return c >= 0 && static_cast<std::size_t>(c) < smooth_.size() &&
+           smooth_[static_cast<std::size_t>(c)] != 0;
+  }
+
+  // Whether a trace reaching vertex cur from prev runs on across a smooth curve: cur lies on one,
+  // with two quads on each side (four in all), so that the straight continuation is the edge into
+  // the other face and the curve's two edges at cur are the ones left and right.
+  [[nodiscard]] bool crosses_smooth_curve(GO cur, GO prev) const {
+    const auto& k = vc(cur);
+    if (!opt_.traces_across_smooth_curves) return false;
+    if (k.dim != 1 || !smooth_curve(k.entity) || valence(cur) != 4) return false;
+    const EdgeRec& in = edge(cur, prev);
+    if (!interior(in)) return false;
+    const Cross c = cross_at(cur, prev);
+    const auto out = edges_.find(mesh::edge_key(cur, c.next));
+    const auto l = edges_.find(mesh::edge_key(cur, c.left));
+    const auto r = edges_.find(mesh::edge_key(cur, c.right));
+    if (out == edges_.end() || l == edges_.end() || r == edges_.end()) return false;
+    return interior(out->second) &&
+           m_.quad_face[static_cast<std::size_t>(out->second.q[0])] !=
+               m_.quad_face[static_cast<std::size_t>(in.q[0])] &&
+           l->second.curve == k.entity && r->second.curve == k.entity;
+  }
+
   // ---------------------------------------------------------------- T-mesh (Sec. III.A)
   struct Start {
     GO v, w;
@@ -324,6 +372,8 @@ class Builder {
   std::vector<LO> tmesh(const std::vector<char>& extra) {
     for (auto& [k, e] : edges_) e.traced = false;
     traces_.clear();
+    crossed_.clear();
+    traces_across_ = 0;
     std::vector<std::vector<Passage>> pass(static_cast<std::size_t>(nv_));
     const double tan_alpha = std::tan(opt_.alpha);
     std::vector<LO> live;
@@ -335,6 +385,7 @@ class Builder {
       t.path = {v, w};
       t.tan_alpha = tan_alpha;
       traces_.push_back(std::move(t));
+      crossed_.push_back(0);
       live.push_back(static_cast<LO>(traces_.size()) - 1);
     }
     std::vector<LO> next_live;
@@ -353,7 +404,12 @@ class Builder {
         Trace& tr = traces_[static_cast<std::size_t>(t)];
         const GO cur = tr.path.back(), prev = tr.path[tr.path.size() - 2];
         const auto step = static_cast<LO>(tr.path.size()) - 1;
-        if (!regular_interior(cur)) {
+        const bool across = crosses_smooth_curve(cur, prev);
+        if (across && !crossed_[static_cast<std::size_t>(t)]) {
+          crossed_[static_cast<std::size_t>(t)] = 1;
+          ++traces_across_;
+        }
+        if (!regular_interior(cur) && !across) {
           // The end: another irregular vertex (in the cone at distance 0) or a CAD curve, which
           // the origin must not reach (a face cannot pinch, an interior vertex stays inside).
           if (vc(cur).dim == 2)
@@ -1358,7 +1414,10 @@ class Builder {
     // The edge across vertex g from edge e (-1: g is no regular crossing).
     auto opposite = [&](GO g, GO e) -> GO {
       const auto& list = at[static_cast<std::size_t>(g)];
-      if (list.size() != 4 || vc(center_[static_cast<std::size_t>(g)]).dim == 0) return -1;
+      const auto& at_g = vc(center_[static_cast<std::size_t>(g)]);
+      if (list.size() != 4 ||
+          (at_g.dim == 0 && !corner_smooth_[static_cast<std::size_t>(at_g.entity)]))
+        return -1;
       std::vector<GO> edges;
       std::vector<std::pair<GO, GO>> paired;
       for (const auto& [q, k] : list) {
@@ -1384,9 +1443,16 @@ class Builder {
       }
       return out;
     };
+    // A chord may run along smooth curves (its two sides then lie on two faces), never along a
+    // sharp one.
+    auto chord_edge = [&](GO e) {
+      const LO c = cedges_[static_cast<std::size_t>(e)].curve;
+      return c == kNoIndex || smooth_curve(c);
+    };
     std::vector<char> removed(ne, 0), seen(ne, 0);
+    std::vector<std::vector<GO>> chords;  // the closed ones, each as its edges
     for (std::size_t e0 = 0; e0 < ne; ++e0) {
-      if (seen[e0] || cedges_[e0].curve != kNoIndex) continue;
+      if (seen[e0] || !chord_edge(static_cast<GO>(e0))) continue;
       std::vector<GO> chain{static_cast<GO>(e0)};
       std::vector<GO> verts{cedges_[e0].a};
       seen[e0] = 1;
@@ -1394,7 +1460,7 @@ class Builder {
       GO e = static_cast<GO>(e0), g = cedges_[e0].b;
       while (ok) {
         const GO next = opposite(g, e);
-        if (next < 0 || cedges_[static_cast<std::size_t>(next)].curve != kNoIndex) {
+        if (next < 0 || !chord_edge(next)) {
           ok = false;
           break;
         }
@@ -1417,17 +1483,8 @@ class Builder {
         g = ce.a == g ? ce.b : ce.a;
         e = next;
       }
-      if (ok && closed)
-        for (GO x : chain) removed[static_cast<std::size_t>(x)] = 1;
+      if (ok && closed) chords.push_back(std::move(chain));
     }
-    // Components across removed edges, each walked as a grid of (quad, orientation).
-    Dsu comp;
-    comp.resize(static_cast<GO>(nq));
-    for (std::size_t e = 0; e < ne; ++e)
-      if (removed[e] && cedges_[e].uses.size() == 2)
-        comp.unite(cedges_[e].uses[0].first, cedges_[e].uses[1].first);
-    std::map<GO, std::vector<std::size_t>> members;
-    for (std::size_t q = 0; q < nq; ++q) members[comp.find(static_cast<GO>(q))].push_back(q);
     struct Ori {
       std::size_t q;
       int k;
@@ -1456,19 +1513,12 @@ class Builder {
       if (k == 2) return {n0 - il, n1 - jl};
       return {jl, n1 - il};
     };
-    std::vector<GO> block_of(nq, -1);
-    std::vector<std::pair<LO, std::size_t>> order;  // (face, first quad) of each component
-    for (const auto& [r, list] : members)
-      order.emplace_back(cquads_[list.front()].face, list.front());
-    std::sort(order.begin(), order.end());
-    for (const auto& [face_of, first] : order) {
-      const LO face = face_of;  // a lambda below names it (clang 14 cannot capture bindings)
-      const std::vector<std::size_t>& list = members[comp.find(static_cast<GO>(first))];
-      // Rows of the component's grid, or each quad alone when it is not one.
-      std::vector<std::vector<Ori>> rows;
-      bool grid = false;
-      for (std::size_t q : list) {
-        for (int k = 0; k < 4 && !grid; ++k) {
+    // The rows of the grid that the quads `list` (joined across removed edges) make, walked as
+    // (quad, orientation); false when they make none (a band closed on itself, say).
+    auto grid_rows = [&](const std::vector<std::size_t>& list,
+                         std::vector<std::vector<Ori>>& rows) {
+      for (std::size_t q : list)
+        for (int k = 0; k < 4; ++k) {
           const Ori o{q, k};
           if (removed[static_cast<std::size_t>(edge_of(o, 0))] ||
               removed[static_cast<std::size_t>(edge_of(o, 3))])
@@ -1484,10 +1534,64 @@ class Builder {
             }
             if (rows.back().size() != rows.front().size()) bad = true;
           }
-          grid = !bad && count == list.size();
+          if (!bad && count == list.size()) return true;
         }
-        if (grid) break;
+      return false;
+    };
+    // Chords removed one by one, in order, each only when every component it joins is still a
+    // grid (removing all at once could close bands on themselves, whose quads would then all be
+    // blocks of their own).
+    Dsu comp;
+    comp.resize(static_cast<GO>(nq));
+    std::map<GO, std::vector<std::size_t>> members;
+    for (std::size_t q = 0; q < nq; ++q) members[static_cast<GO>(q)].push_back(q);
+    std::vector<std::vector<Ori>> trial_rows;
+    for (const std::vector<GO>& chord : chords) {
+      const std::vector<GO> saved = comp.parent;
+      std::vector<GO> old_roots;
+      for (GO x : chord) {
+        removed[static_cast<std::size_t>(x)] = 1;
+        for (const auto& [q, k] : cedges_[static_cast<std::size_t>(x)].uses)
+          old_roots.push_back(comp.find(q));
       }
+      std::sort(old_roots.begin(), old_roots.end());
+      old_roots.erase(std::unique(old_roots.begin(), old_roots.end()), old_roots.end());
+      for (GO x : chord) {
+        const CEdge& ce = cedges_[static_cast<std::size_t>(x)];
+        if (ce.uses.size() == 2) comp.unite(ce.uses[0].first, ce.uses[1].first);
+      }
+      std::map<GO, std::vector<std::size_t>> joined;
+      for (GO r : old_roots) {
+        auto& to = joined[comp.find(r)];
+        const auto& from = members[r];
+        to.insert(to.end(), from.begin(), from.end());
+      }
+      bool all_grids = true;
+      for (auto& [r, list] : joined) {
+        std::sort(list.begin(), list.end());
+        if (!grid_rows(list, trial_rows)) all_grids = false;
+        if (!all_grids) break;
+      }
+      if (!all_grids) {
+        for (GO x : chord) removed[static_cast<std::size_t>(x)] = 0;
+        comp.parent = saved;
+        continue;
+      }
+      for (GO r : old_roots) members.erase(r);
+      for (auto& [r, list] : joined) members[r] = std::move(list);
+    }
+    std::vector<GO> block_of(nq, -1);
+    blocks_across_ = 0;
+    std::vector<std::pair<LO, std::size_t>> order;  // (face, first quad) of each component
+    for (const auto& [r, list] : members)
+      order.emplace_back(cquads_[list.front()].face, list.front());
+    std::sort(order.begin(), order.end());
+    for (const auto& [face_of, first] : order) {
+      const LO face = face_of;  // a lambda below names it (clang 14 cannot capture bindings)
+      const std::vector<std::size_t>& list = members[comp.find(static_cast<GO>(first))];
+      // Rows of the component's grid, or each quad alone when it is not one.
+      std::vector<std::vector<Ori>> rows;
+      const bool grid = grid_rows(list, rows);
       auto emit = [&](const std::vector<std::vector<Ori>>& g) {
         const auto b = static_cast<GO>(lay.blocks.size());
         std::vector<LO> widths_i, widths_j;
@@ -1503,6 +1607,7 @@ class Builder {
         std::vector<GO> grid_v(static_cast<std::size_t>(blk.ni + 1) *
                                static_cast<std::size_t>(blk.nj + 1));
         LO j0 = 0;
+        bool across_faces = false;
         for (std::size_t r = 0; r < g.size(); ++r) {
           LO i0 = 0;
           for (std::size_t c = 0; c < g[r].size(); ++c) {
@@ -1521,12 +1626,14 @@ class Builder {
                                    static_cast<std::size_t>(i)])];
               }
             block_of[o.q] = b;
+            if (cq.face != face) across_faces = true;
             i0 += widths_i[c];
           }
           j0 += widths_j[r];
         }
         lay.vertices.insert(lay.vertices.end(), grid_v.begin(), grid_v.end());
         lay.blocks.push_back(blk);
+        if (across_faces) ++blocks_across_;
       };
       if (grid) {
         emit(rows);
@@ -1686,6 +1793,9 @@ class Builder {
   std::vector<std::size_t> bad_cquads_;
   std::int64_t bad_quads_ = 0;
   std::vector<std::vector<LO>> point_patches_;
+  std::vector<char> smooth_, corner_smooth_;  // per CAD curve, per CAD corner
+  std::vector<char> crossed_;                 // per trace: ran on across a smooth curve
+  std::int64_t traces_across_ = 0, blocks_across_ = 0;
 };
 
 }  // namespace

@@ -50,6 +50,7 @@ IlpResult solve_integer_program(const IntegerProgram& p, const IlpOptions& optio
   Cbc_setParameter(model.get(), "randomSeed", "1");
   Cbc_setParameter(model.get(), "randomCbcSeed", "1");
   if (options.time_limit_s > 0) Cbc_setMaximumSeconds(model.get(), options.time_limit_s);
+  if (!options.preprocess) Cbc_setParameter(model.get(), "preprocess", "off");
   const int rc = Cbc_solve(model.get());
   out.optimal = Cbc_isProvenOptimal(model.get()) != 0;
   const double* x = Cbc_getColSolution(model.get());

@@ -191,6 +191,33 @@ TEST(CoarseLayout, LoopWidthsBalancedAgainstTheCoarseQuadsShapes) {
   EXPECT_NE(balanced.mesh.quads.size(), plain.mesh.quads.size());
 }
 
+TEST(CoarseLayout, BlocksCrossSmoothCurvesNotSharpOnes) {
+  // A filleted box: the fillets meet the box's faces and each other along smooth curves, which
+  // blocks may cross; fewer blocks than with every curve a wall, still conforming.
+  const std::string path = test::write_filleted_box(test::tmp("coarse_fillet.step"));
+  const Meshed in = mesh_model(path, 0.6);
+  CoarseOptions walls;
+  walls.cross_smooth_curves = false;
+  const CoarseResult across = build_coarse_layout(in.mesh, in.model);
+  const CoarseResult walled = build_coarse_layout(in.mesh, in.model, walls);
+  expect_conforming_blocks(across, in.model);
+  expect_conforming_blocks(walled, in.model);
+  EXPECT_GT(across.stats.smooth_curves, 0);
+  EXPECT_EQ(walled.stats.smooth_curves, 0);
+  EXPECT_GT(across.stats.blocks_across_curves, 0);
+  EXPECT_EQ(walled.stats.blocks_across_curves, 0);
+  EXPECT_LT(across.layout.blocks.size(), walled.layout.blocks.size());
+  // The same new mesh: only the blocks change.
+  EXPECT_EQ(across.mesh.quads, walled.mesh.quads);
+  // The box with a hole has sharp curves only: nothing is crossed.
+  const std::string box = test::write_box_with_hole(test::tmp("coarse_sharp.brep"));
+  const Meshed sharp = mesh_model(box, 0.35);
+  const CoarseResult a = build_coarse_layout(sharp.mesh, sharp.model);
+  const CoarseResult w = build_coarse_layout(sharp.mesh, sharp.model, walls);
+  EXPECT_EQ(a.stats.smooth_curves, 0);
+  EXPECT_EQ(a.layout.blocks.size(), w.layout.blocks.size());
+}
+
 TEST(CoarseLayout, AMeshWithTrianglesIsRefusedWithAReason) {
   mesh::SurfaceMesh m;
   m.points = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};

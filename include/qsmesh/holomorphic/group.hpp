@@ -34,11 +34,8 @@ struct GroupOptions {
   int samples = 9;  ///< points per curve, at equal steps of its parameter, ends excluded
 };
 
-/// Whether the surface is smooth across curve c (GroupOptions): exactly two distinct faces use
-/// it, and their normals agree within the tolerance along it. The orientation of each face in
-/// the shell is read from the direction it traverses c (opposite in two faces of a consistently
-/// oriented shell; the same when one of them is flipped, which is then allowed for). Degenerate
-/// curves, seams (one face) and non-manifold curves (three faces or more) are not smooth.
+/// Whether the surface is smooth across curve c (GroupOptions): cad::smooth_across with the
+/// options' tolerance and samples.
 [[nodiscard]] bool smooth_across(const cad::CadModel& model, LO c, const GroupOptions& options);
 
 /// The groups of faces joined across smooth curves (connected components): every face is in

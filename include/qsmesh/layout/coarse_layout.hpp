@@ -2,8 +2,9 @@
 // of traces with the cone stopping rule, the ILP of its quantization (constraints (1)-(4),
 // objective (6)), then the coarse quad mesh extracted from the solution (patch splitting, merging
 // of zero-length groups, placement with CAD priorities), subdivided by quad loops and smoothed on
-// the CAD. Every CAD curve is a wall here: traces stop at curves and blocks end on them (crossing
-// smooth curves, as the paper does on aircraft skins, is not done).
+// the CAD. Sharp CAD curves are walls: traces stop at them and blocks end on them; curves where
+// the surface is smooth may be crossed by traces and by blocks (CoarseOptions::
+// cross_smooth_curves), as the paper's blocks cross the construction curves of aircraft skins.
 #pragma once
 
 #include <cstdint>
@@ -26,6 +27,19 @@ struct CoarseOptions {
   /// its coarse quad square at their size (sqrt of the product of the two fine edge lengths
   /// there). 0 by default: measured in docs/benchmarks.md ("Coarse block layout").
   double loop_balance = 0;
+  /// Blocks cross the CAD curves where the surface is smooth (cad::smooth_across within
+  /// smooth_angle_deg): the coarse quads on both sides of such a curve are joined into one block
+  /// where a whole closed chord of coarse edges, running along smooth curves and off the curves,
+  /// can go (through CAD corners whose curves are all smooth). Sharp curves (a crease) stay block
+  /// sides. false: every CAD curve is a block side. Chords are removed one at a time, each only
+  /// when the blocks it joins stay grids.
+  bool cross_smooth_curves = true;
+  double smooth_angle_deg = 10;
+  /// With cross_smooth_curves, T-mesh traces also run on across smooth curves into the next face
+  /// (where the curve vertex has two quads on each side), as in the paper's T-mesh on the whole
+  /// surface. Off by default: on A319 it made more patches and blocks (docs/benchmarks.md), as a
+  /// trace crossing a curve runs on until the cone rule stops it in the next face.
+  bool traces_across_smooth_curves = false;
   /// Passes of the smoother (smooth::smooth_face, Winslow kernels) on each face of the new mesh.
   int smoothing_iterations = 10;
 };
@@ -40,7 +54,10 @@ struct CoarseStats {
   /// collapsing, then at their input lengths (at most 12).
   int repairs = 0;
   std::string ilp_status;
-  std::int64_t coarse_quads = 0;  ///< blocks
+  std::int64_t smooth_curves = 0;  ///< CAD curves crossed (CoarseOptions::cross_smooth_curves)
+  std::int64_t traces_across_curves = 0;  ///< traces that ran on across a smooth curve
+  std::int64_t blocks_across_curves = 0;  ///< blocks whose quads lie on two faces or more
+  std::int64_t coarse_quads = 0;          ///< blocks
   std::int64_t fine_quads = 0;
   double sicn_min = 0, sicn_avg = 0;  ///< of the new mesh (after smoothing)
   double seconds = 0;                 ///< the whole stage

@@ -26,6 +26,11 @@ struct IlpOptions {
   /// Wall-clock bound on the branch and bound (0: none). A run stopped by it returns its best
   /// feasible solution, which then depends on timing: the default leaves it to the fallback.
   double time_limit_s = 120;
+  /// CBC's preprocessing of the integer program. Off for the T-meshes whose traces cross smooth
+  /// curves (CoarseOptions::traces_across_smooth_curves): on A319 Debian's CBC 2.10 stopped the
+  /// process there with a failed assertion in Clp (ClpNonLinearCost.cpp:1064, "lowerValue <=
+  /// upperValue") on the first solve, a program that the input lengths satisfy.
+  bool preprocess = true;
 };
 
 struct IlpResult {
