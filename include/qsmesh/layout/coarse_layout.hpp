@@ -60,7 +60,7 @@ struct CoarseStats {
   /// Coarse vertices inside smooth curves with other than four coarse quads: no chord runs along
   /// the curve through them (a trace of one face ending where the other face has none).
   std::int64_t smooth_curve_vertices_not_four = 0;
-  std::int64_t coarse_quads = 0;          ///< blocks
+  std::int64_t coarse_quads = 0;  ///< blocks
   std::int64_t fine_quads = 0;
   double sicn_min = 0, sicn_avg = 0;  ///< of the new mesh (after smoothing)
   double seconds = 0;                 ///< the whole stage
