@@ -4,7 +4,8 @@ rank, by replaying its measured per-face, per-stage times through the pipeline's
 (docs/architecture.md, "Parallel model"):
 
 - replicated stages (load, curves, partition, quantize): every rank does the same work; as measured.
-- partitioned stages (background, crossfield, sizemap, unstructured, pattern_compare, distance):
+- partitioned stages (background, crossfield, sizemap, unstructured, pattern_compare, distance,
+  pack):
   each rank
   runs the faces the METIS partition gives it, as TBB tasks in face order on T threads (list
   scheduling in that order); the stage ends when the slowest rank is done.
@@ -46,7 +47,8 @@ TOOL = "simulate_scaling"
 REPLICATED = ["load", "curves", "partition", "quantize"]
 # distance: the final mesh's distance to the CAD, each face on its owner (its curves' share, split
 # over the ranks too, is in the stage's residual).
-PARTITIONED = ["background", "crossfield", "sizemap", "unstructured", "pattern_compare", "distance"]
+PARTITIONED = ["background", "crossfield", "sizemap", "unstructured", "pattern_compare", "distance",
+               "pack"]
 DEALT = ["patterns", "improvement"]
 GATHER = ["assemble"]
 # On-node defaults where no --comm is given (Open MPI, shared memory; mpi_costs on the 2-core

@@ -97,7 +97,8 @@ FaceOutput full_output() {
   o.stats.sicn_min = 0.75;
   o.stats.sicn_avg = 0.875;
   o.seconds = 2.5;
-  o.times = {0.5, 1.5, 2.5, 3.5, 4.5, 5.5, 6.5, 7.5, 77.5, 42, 1001, {0.25, 0.75}, 9, 3, 0.125};
+  o.times = {0.5,  1.5,  2.5, 3.5,  4.5,          5.5, 6.5, 7.5,
+             8.25, 77.5, 42,  1001, {0.25, 0.75}, 9,   3,   0.125};
   o.field_grids = {fieldmesh::RegionGrid{1, 1, {0, 1, 2, 3}}, fieldmesh::RegionGrid{2, 1, {}}};
   o.group_quad_face = {4, 5, 4};
   o.group_first = 4;
@@ -193,6 +194,7 @@ TEST(Pack, EveryFieldOfAFaceOutputRoundTrips) {
   EXPECT_EQ(b.times.improvement, 5.5);
   EXPECT_EQ(b.times.compare, 6.5);
   EXPECT_EQ(b.times.distance, 7.5);
+  EXPECT_EQ(b.times.pack, 8.25);
   EXPECT_EQ(b.times.pattern_layouts, 9);
   EXPECT_EQ(b.times.pattern_batches, 3);
   EXPECT_EQ(b.times.pattern_search, 0.125);
