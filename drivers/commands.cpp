@@ -458,6 +458,8 @@ std::string stats_json(const Arguments& args, const Session& session,
       j.value("smooth_curves_crossed", c->smooth_curves);
       j.value("traces_across_curves", c->traces_across_curves);
       j.value("blocks_across_curves", kept ? c->blocks_across_curves : std::int64_t{0});
+      j.value("smooth_curve_vertices_not_four",
+              kept ? c->smooth_curve_vertices_not_four : std::int64_t{0});
       j.value("coarse_layout_seconds", c->seconds);
       j.value("block_mesh_quads", kept ? c->fine_quads : std::int64_t{0});
       j.value("block_mesh_sicn_min", kept ? c->sicn_min : 0.0);

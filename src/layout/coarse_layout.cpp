@@ -195,6 +195,7 @@ class Builder {
       }
       out.stats.coarse_quads = static_cast<std::int64_t>(out.layout.blocks.size());
       out.stats.blocks_across_curves = blocks_across_;
+      out.stats.smooth_curve_vertices_not_four = stuck_on_smooth_;
       out.stats.fine_quads = static_cast<std::int64_t>(out.mesh.quads.size());
       out.ok = true;
     } catch (const Reject& r) {
@@ -1580,6 +1581,15 @@ class Builder {
       for (GO r : old_roots) members.erase(r);
       for (auto& [r, list] : joined) members[r] = std::move(list);
     }
+    // Coarse vertices on smooth curves that no chord can run straight through (not four quads):
+    // each stops the chords along its curve.
+    stuck_on_smooth_ = 0;
+    for (GO g = 0; g < ng_; ++g) {
+      const auto& at_g = vc(center_[static_cast<std::size_t>(g)]);
+      if (at_g.dim == 1 && smooth_curve(at_g.entity) && !at[static_cast<std::size_t>(g)].empty() &&
+          at[static_cast<std::size_t>(g)].size() != 4)
+        ++stuck_on_smooth_;
+    }
     std::vector<GO> block_of(nq, -1);
     blocks_across_ = 0;
     std::vector<std::pair<LO, std::size_t>> order;  // (face, first quad) of each component
@@ -1795,7 +1805,7 @@ class Builder {
   std::vector<std::vector<LO>> point_patches_;
   std::vector<char> smooth_, corner_smooth_;  // per CAD curve, per CAD corner
   std::vector<char> crossed_;                 // per trace: ran on across a smooth curve
-  std::int64_t traces_across_ = 0, blocks_across_ = 0;
+  std::int64_t traces_across_ = 0, blocks_across_ = 0, stuck_on_smooth_ = 0;
 };
 
 }  // namespace

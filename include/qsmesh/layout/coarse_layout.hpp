@@ -57,7 +57,10 @@ struct CoarseStats {
   std::int64_t smooth_curves = 0;  ///< CAD curves crossed (CoarseOptions::cross_smooth_curves)
   std::int64_t traces_across_curves = 0;  ///< traces that ran on across a smooth curve
   std::int64_t blocks_across_curves = 0;  ///< blocks whose quads lie on two faces or more
-  std::int64_t coarse_quads = 0;          ///< blocks
+  /// Coarse vertices inside smooth curves with other than four coarse quads: no chord runs along
+  /// the curve through them (a trace of one face ending where the other face has none).
+  std::int64_t smooth_curve_vertices_not_four = 0;
+  std::int64_t coarse_quads = 0;  ///< blocks
   std::int64_t fine_quads = 0;
   double sicn_min = 0, sicn_avg = 0;  ///< of the new mesh (after smoothing)
   double seconds = 0;                 ///< the whole stage

@@ -29,9 +29,10 @@ namespace qsmesh::layout {
 
 /// One structured block: ni x nj quads of CAD face `face` (a block of the coarse layout may span
 /// faces joined across smooth curves, layout::CoarseOptions::cross_smooth_curves: `face` is then
-/// the face of its first coarse quad, and each quad keeps its own face in the mesh). Its (ni + 1) x (nj + 1) vertices are
-/// QuadLayout::vertices[first + j * (ni + 1) + i] (global mesh vertex ids, i fastest); the quads
-/// are counter-clockwise about the face normal in (i, j), i.e. the normal is along i x j.
+/// the face of its first coarse quad, and each quad keeps its own face in the mesh). Its (ni + 1) x
+/// (nj + 1) vertices are QuadLayout::vertices[first + j * (ni + 1) + i] (global mesh vertex ids, i
+/// fastest); the quads are counter-clockwise about the face normal in (i, j), i.e. the normal is
+/// along i x j.
 struct Block {
   LO face = kNoIndex;
   LO ni = 0, nj = 0;
