@@ -712,7 +712,8 @@ struct GroupsForOutput {
 // faces, not every face twice over. Fills result's per-face vectors and mesh on rank 0.
 void gather_stage(const Context& cx, std::vector<FaceTask>& faces,
                   std::span<const mesh::CurveMesh> final_curves, bool quads, bool quasi,
-                  GroupsForOutput& groups, PipelineResult& result) {
+                  GroupsForOutput& groups, StageClock& clock, PipelineResult& result) {
+  clock.start();
   const PipelineOptions& options = cx.options;
   const LO nfaces = cx.model.num_faces();
   std::vector<std::int64_t> counts(3 * static_cast<std::size_t>(nfaces), 0);
@@ -733,15 +734,32 @@ void gather_stage(const Context& cx, std::vector<FaceTask>& faces,
     counts[at + 2] += c.quads;
   }
   cx.comm.allreduce_sum(counts);  // each face's entries are set by its owner alone
-  std::vector<char> buffer;
-  for (FaceTask& t : faces) {
-    FaceOutput out = take_output(std::move(t), quads);
+  // Packing: each face's output and statistics, then its record, one task per face on this rank
+  // (per-face work: it runs where the face is, not on rank 0); the records are then joined in
+  // face order, so the gathered bytes are those of a serial loop.
+  std::vector<std::vector<char>> records(faces.size());
+  cx.tasks.parallel_for(static_cast<std::int64_t>(faces.size()), [&](std::int64_t i) {
+    const Stopwatch face_clock;
+    FaceOutput out = take_output(std::move(faces[static_cast<std::size_t>(i)]), quads);
     // A smooth group's faces: their own parts of the group's mesh (group_face_stats).
     if (const auto it = groups.stats.find(out.report.face); quads && it != groups.stats.end())
       out.stats = it->second;
-    write_record(buffer, out);
-  }
+    out.times.pack = face_clock.seconds();
+    write_record(records[static_cast<std::size_t>(i)], out);
+  });
   faces.clear();
+  std::size_t total_bytes = 0;
+  for (const auto& r : records) total_bytes += r.size();
+  std::vector<char> buffer;
+  buffer.reserve(total_bytes);
+  for (auto& r : records) {
+    buffer.insert(buffer.end(), r.begin(), r.end());
+    std::vector<char>().swap(r);
+  }
+  // Per face, but left out of the ranks' busy time (load_imbalance), which covers the meshing
+  // stages.
+  clock.end("pack", false);
+  clock.start();
   std::optional<mesh::MeshAssembler> assembler;
   // The curves inside the groups meshed get no bars (every rank takes part in the sum when any
   // group was formed; the flags are empty otherwise).
@@ -1095,8 +1113,8 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
     result.max_distance_to_cad = distance_stage(cx, faces, final_curves, quads);
     clock.end("distance", true);
   }
-  clock.start();
-  gather_stage(cx, faces, final_curves, quads, quasi, groups_out, result);
+  // Timed in two: "pack" (per face, on the faces' ranks) and "assemble" (rank 0).
+  gather_stage(cx, faces, final_curves, quads, quasi, groups_out, clock, result);
   clock.end("assemble", false);
   result.rank_busy_seconds.assign(static_cast<std::size_t>(nranks), 0.0);
   result.rank_busy_seconds[static_cast<std::size_t>(rank)] = clock.busy();

@@ -202,6 +202,9 @@ struct FaceTimes {
   double improvement = 0;   ///< cavity, disk remeshing, final smoothing (dealt out)
   double compare = 0;       ///< second fill and comparison (METIS partition)
   double distance = 0;      ///< its final mesh's distance to the CAD (METIS partition)
+  /// Its output taken for the gather on its own rank: the quad statistics (take_output), before
+  /// its record is written (METIS partition: every rank packs its own faces).
+  double pack = 0;
   /// The pattern stage deals the faces out by this, largest first (the size map's quads).
   double expected_quads = 0;
   /// The improvement deals its faces out by this, largest first (the unstructured mesh's quads;
@@ -229,6 +232,7 @@ struct FaceTimes {
     visit("improvement", self.improvement);
     visit("pattern_compare", self.compare);
     visit("distance", self.distance);
+    visit("pack", self.pack);
     visit("expected_quads", self.expected_quads);
     visit("improvement_quads", self.improvement_quads);
     visit("bytes", self.bytes);
