@@ -221,6 +221,12 @@ Arguments parse(const std::vector<std::string>& args) {
       if (!b || !(*b >= 0 && *b <= 1))
         throw InputError("--loop-balance: '" + v + "' is not a number in [0, 1]");
       a.loop_balance = *b;
+    } else if (opt == "--cone-angle" && a.command == Command::Mesh) {
+      const std::string& v = value();
+      const auto d = parse_double(v);
+      if (!d || !(*d > 0 && *d < 90))
+        throw InputError("--cone-angle: '" + v + "' is not a number of degrees in (0, 90)");
+      a.cone_angle_deg = *d;
     } else if (opt == "--curves-are-walls" && a.command == Command::Mesh) {
       a.sharp_and_smooth_walls = true;
     } else if (opt == "--traces-cross-curves" && a.command == Command::Mesh) {
@@ -539,6 +545,9 @@ std::string help(const std::string& topic) {
           "  --loop-balance B      with --layout coarse: quad-loop widths blended with weight B\n"
           "                        (0..1) towards square fine quads in each coarse quad\n"
           "                        (default 0: the input mesh's lengths alone)\n"
+          "  --cone-angle DEG      with --layout coarse: half-angle of the T-mesh traces' cone\n"
+          "                        (stopping rule and geometric consistency; default 45, the\n"
+          "                        paper's): larger gives fewer, more distorted blocks\n"
           "  --curves-are-walls    with --layout coarse: every CAD curve a block side; by\n"
           "                        default traces and blocks cross the curves where the surface\n"
           "                        is smooth (normals within 10 degrees), sharp ones only are\n"

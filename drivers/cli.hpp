@@ -52,6 +52,9 @@ struct Arguments {
   bool coarse_layout = false;
   /// --loop-balance B (with --layout coarse): layout::CoarseOptions::loop_balance, in [0, 1].
   double loop_balance = 0;
+  /// --cone-angle DEG (with --layout coarse): layout::CoarseOptions::alpha in degrees, in
+  /// (0, 90); 0: the option's default (the paper's 45 degrees).
+  double cone_angle_deg = 0;
   /// --curves-are-walls (with --layout coarse): every CAD curve a block side, smooth ones too
   /// (layout::CoarseOptions::cross_smooth_curves = false).
   bool sharp_and_smooth_walls = false;

@@ -460,6 +460,12 @@ std::string stats_json(const Arguments& args, const Session& session,
       j.value("blocks_across_curves", kept ? c->blocks_across_curves : std::int64_t{0});
       j.value("smooth_curve_vertices_not_four",
               kept ? c->smooth_curve_vertices_not_four : std::int64_t{0});
+      j.value("coarse_cells", kept ? c->cells : std::int64_t{0});
+      j.value("irregular_coarse_vertices", kept ? c->irregular_coarse_vertices : std::int64_t{0});
+      j.value("chords_removed", kept ? c->chords_removed : std::int64_t{0});
+      j.value("chords_closed_kept", kept ? c->chords_closed_kept : std::int64_t{0});
+      j.value("chords_open_at_irregular", kept ? c->chords_open_at_irregular : std::int64_t{0});
+      j.value("chords_open_elsewhere", kept ? c->chords_open_elsewhere : std::int64_t{0});
       j.value("coarse_layout_seconds", c->seconds);
       j.value("block_mesh_quads", kept ? c->fine_quads : std::int64_t{0});
       j.value("block_mesh_sicn_min", kept ? c->sicn_min : 0.0);
@@ -913,6 +919,7 @@ int run_mesh(const Arguments& args) {
       if (args.coarse_layout) {
         layout::CoarseOptions co;
         co.loop_balance = args.loop_balance;
+        if (args.cone_angle_deg > 0) co.alpha = args.cone_angle_deg * 3.14159265358979323846 / 180;
         co.cross_smooth_curves = !args.sharp_and_smooth_walls;
         co.traces_across_smooth_curves = args.traces_cross_curves;
         coarse = layout::build_coarse_layout(result.mesh, s.model, co);

@@ -194,6 +194,12 @@ class Builder {
         out.stats.repairs = repair + 1;
       }
       out.stats.coarse_quads = static_cast<std::int64_t>(out.layout.blocks.size());
+      out.stats.cells = static_cast<std::int64_t>(cquads_.size());
+      out.stats.irregular_coarse_vertices = irregular_coarse_;
+      out.stats.chords_removed = chord_counts_[0];
+      out.stats.chords_closed_kept = chord_counts_[1];
+      out.stats.chords_open_at_irregular = chord_counts_[2];
+      out.stats.chords_open_elsewhere = chord_counts_[3];
       out.stats.blocks_across_curves = blocks_across_;
       out.stats.smooth_curve_vertices_not_four = stuck_on_smooth_;
       out.stats.fine_quads = static_cast<std::int64_t>(out.mesh.quads.size());
@@ -288,21 +294,12 @@ class Builder {
     return {next, left, left == side[0] ? side[1] : side[0]};
   }
 
-  // Smooth curves (CoarseOptions::cross_smooth_curves) and the CAD corners all of whose curves
-  // are smooth.
+  // Smooth curves (CoarseOptions::cross_smooth_curves).
   void smooth_curves() {
     smooth_.assign(static_cast<std::size_t>(std::max<LO>(m_.num_cad_curves, 0)), 0);
-    corner_smooth_.assign(static_cast<std::size_t>(std::max<LO>(m_.num_cad_corners, 0)), 1);
-    if (!opt_.cross_smooth_curves) {
-      corner_smooth_.assign(corner_smooth_.size(), 0);
-      return;
-    }
+    if (!opt_.cross_smooth_curves) return;
     for (LO c = 0; c < m_.num_cad_curves && c < model_.num_curves(); ++c)
       smooth_[static_cast<std::size_t>(c)] = cad::smooth_across(model_, c, opt_.smooth_angle_deg);
-    for (LO c = 0; c < m_.num_cad_curves; ++c)
-      if (!smooth_[static_cast<std::size_t>(c)])
-        for (LO k : m_.curve_corners[static_cast<std::size_t>(c)])
-          if (k >= 0 && k < m_.num_cad_corners) corner_smooth_[static_cast<std::size_t>(k)] = 0;
   }
   [[nodiscard]] bool smooth_curve(LO c) const {
     return c >= 0 && static_cast<std::size_t>(c) < smooth_.size() &&
@@ -1412,13 +1409,13 @@ class Builder {
     for (std::size_t q = 0; q < nq; ++q)
       for (int k = 0; k < 4; ++k)
         at[static_cast<std::size_t>(cquads_[q].v[static_cast<std::size_t>(k)])].emplace_back(q, k);
-    // The edge across vertex g from edge e (-1: g is no regular crossing).
+    // The edge across vertex g from edge e (-1: g is no regular crossing). A CAD corner of four
+    // coarse quads whose edges pair up is a crossing too, whatever its curves: a chord through it
+    // crosses its curves (or runs along smooth ones, chord_edge), it never runs along a sharp one,
+    // so the corner stays on block sides, now inside one (A319: 48 blocks fewer).
     auto opposite = [&](GO g, GO e) -> GO {
       const auto& list = at[static_cast<std::size_t>(g)];
-      const auto& at_g = vc(center_[static_cast<std::size_t>(g)]);
-      if (list.size() != 4 ||
-          (at_g.dim == 0 && !corner_smooth_[static_cast<std::size_t>(at_g.entity)]))
-        return -1;
+      if (list.size() != 4) return -1;
       std::vector<GO> edges;
       std::vector<std::pair<GO, GO>> paired;
       for (const auto& [q, k] : list) {
@@ -1547,6 +1544,7 @@ class Builder {
     std::map<GO, std::vector<std::size_t>> members;
     for (std::size_t q = 0; q < nq; ++q) members[static_cast<GO>(q)].push_back(q);
     std::vector<std::vector<Ori>> trial_rows;
+    chord_counts_ = {};
     for (const std::vector<GO>& chord : chords) {
       const std::vector<GO> saved = comp.parent;
       std::vector<GO> old_roots;
@@ -1580,6 +1578,44 @@ class Builder {
       }
       for (GO r : old_roots) members.erase(r);
       for (auto& [r, list] : joined) members[r] = std::move(list);
+      ++chord_counts_[0];
+    }
+    chord_counts_[1] = static_cast<std::int64_t>(chords.size()) - chord_counts_[0];
+    // The chords left, walked both ways from each of their edges: those open at an irregular
+    // coarse vertex and the other open ones (what keeps blocks from joining; docs/benchmarks.md).
+    irregular_coarse_ = 0;
+    for (GO g = 0; g < ng_; ++g)
+      if (vc(center_[static_cast<std::size_t>(g)]).dim == 2 &&
+          !at[static_cast<std::size_t>(g)].empty() && at[static_cast<std::size_t>(g)].size() != 4)
+        ++irregular_coarse_;
+    {
+      std::vector<char> walked(ne, 0);
+      for (std::size_t e0 = 0; e0 < ne; ++e0) {
+        if (walked[e0] || removed[e0] || !chord_edge(static_cast<GO>(e0))) continue;
+        walked[e0] = 1;
+        bool closed = false, at_irregular = false;
+        for (int dir = 0; dir < 2 && !closed; ++dir) {
+          GO e = static_cast<GO>(e0), g = dir == 0 ? cedges_[e0].b : cedges_[e0].a;
+          for (;;) {
+            const GO next = opposite(g, e);
+            if (next < 0 || !chord_edge(next)) {
+              at_irregular = at_irregular || (vc(center_[static_cast<std::size_t>(g)]).dim == 2 &&
+                                              at[static_cast<std::size_t>(g)].size() != 4);
+              break;
+            }
+            if (next == static_cast<GO>(e0)) {
+              closed = true;
+              break;
+            }
+            if (walked[static_cast<std::size_t>(next)]) break;
+            walked[static_cast<std::size_t>(next)] = 1;
+            const CEdge& ce = cedges_[static_cast<std::size_t>(next)];
+            g = ce.a == g ? ce.b : ce.a;
+            e = next;
+          }
+        }
+        if (!closed) ++chord_counts_[at_irregular ? 2 : 3];
+      }
     }
     // Coarse vertices on smooth curves that no chord can run straight through (not four quads):
     // each stops the chords along its curve.
@@ -1803,9 +1839,12 @@ class Builder {
   std::vector<std::size_t> bad_cquads_;
   std::int64_t bad_quads_ = 0;
   std::vector<std::vector<LO>> point_patches_;
-  std::vector<char> smooth_, corner_smooth_;  // per CAD curve, per CAD corner
-  std::vector<char> crossed_;                 // per trace: ran on across a smooth curve
+  std::vector<char> smooth_;   // per CAD curve
+  std::vector<char> crossed_;  // per trace: ran on across a smooth curve
   std::int64_t traces_across_ = 0, blocks_across_ = 0, stuck_on_smooth_ = 0;
+  std::int64_t irregular_coarse_ = 0;
+  // Chords removed, closed but kept, open at an irregular coarse vertex, open elsewhere.
+  std::array<std::int64_t, 4> chord_counts_{};
 };
 
 }  // namespace

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <limits>
 #include <map>
 #include <sstream>
@@ -138,6 +139,12 @@ TEST(CoarseLayout, BoxWithHoleIsConformingValidAndDeterministic) {
   EXPECT_GT(r.mesh.quads.size(), in.mesh.quads.size() / 2);
   EXPECT_LT(r.mesh.quads.size(), in.mesh.quads.size() * 2);
   EXPECT_GT(r.stats.ilp_variables, 0);
+  // Blocks are the coarse quads joined across the removed chords: fewer exactly when some chord
+  // went. The box's holes make irregular coarse vertices, which stop chords.
+  const auto blocks = static_cast<std::int64_t>(r.layout.blocks.size());
+  EXPECT_GE(r.stats.cells, blocks);
+  EXPECT_EQ(r.stats.cells > blocks, r.stats.chords_removed > 0);
+  EXPECT_GT(r.stats.irregular_coarse_vertices + r.stats.chords_open_elsewhere, 0);
   // The CGNS file of the blocks reads back with every interface matching.
   const std::string out = test::tmp("coarse_box_hole.cgns");
   io::write_cgns_blocks(r.mesh, r.layout, out);

@@ -18,7 +18,9 @@
 namespace qsmesh::layout {
 
 struct CoarseOptions {
-  /// Half-angle of the cone of the stopping rule and of the geometric consistency (4), radians.
+  /// Half-angle of the cone of the stopping rule and of the geometric consistency (4), radians
+  /// (the paper's default pi/4). Larger: traces stop sooner and irregular vertices further off
+  /// each other's lines may align, so fewer coarse quads, more distorted (docs/benchmarks.md).
   double alpha = 0.785398163397448;  // pi/4
   IlpOptions ilp;
   /// Quad-loop widths (Sec. IV.D) balanced against the coarse quads' shapes, in [0, 1]: 0 takes
@@ -60,6 +62,18 @@ struct CoarseStats {
   /// Coarse vertices inside smooth curves with other than four coarse quads: no chord runs along
   /// the curve through them (a trace of one face ending where the other face has none).
   std::int64_t smooth_curve_vertices_not_four = 0;
+  /// Coarse quads of the quantization (the split patches, Sec. IV.A), before they are joined
+  /// into blocks across chords.
+  std::int64_t cells = 0;
+  /// Coarse vertices inside faces with other than four coarse quads: every chord through one
+  /// stops there (a block corner), so these bound how far cells join into blocks.
+  std::int64_t irregular_coarse_vertices = 0;
+  /// Chords of coarse edges: removed (closed, the blocks they join stay grids), closed but kept
+  /// (a block would not be a grid), open with an end at an irregular coarse vertex, and open
+  /// with both ends elsewhere (CAD corners of other than four quads, curve vertices of other
+  /// than four, free boundaries).
+  std::int64_t chords_removed = 0, chords_closed_kept = 0, chords_open_at_irregular = 0,
+               chords_open_elsewhere = 0;
   std::int64_t coarse_quads = 0;  ///< blocks
   std::int64_t fine_quads = 0;
   double sicn_min = 0, sicn_avg = 0;  ///< of the new mesh (after smoothing)
@@ -71,7 +85,8 @@ struct CoarseResult {
   std::string failure;     ///< why not, when !ok (one line)
   mesh::SurfaceMesh mesh;  ///< the new all-quad mesh (SurfaceMesh numbering and classification)
   /// Its blocks: the coarse quads, joined across chords that can go (closed loops of coarse edges
-  /// through regular vertices, off the curves); every side shared whole with one other side.
+  /// through vertices of four coarse quads, CAD corners included, along no sharp curve); every
+  /// side shared whole with one other side.
   QuadLayout layout;
   CoarseStats stats;
 };
