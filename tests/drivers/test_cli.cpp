@@ -119,6 +119,18 @@ TEST(Cli, LayoutDenseIsTheDefaultOfBlockStructured) {
             std::string::npos);
 }
 
+TEST(Cli, ConeAngleInDegreesBetweenZeroAndNinety) {
+  EXPECT_EQ(p({"mesh", "m.step", "-o", "o.xyz", "--layout", "coarse"}).cone_angle_deg, 0.0);
+  EXPECT_EQ(p({"mesh", "m.step", "-o", "o.xyz", "--layout", "coarse", "--cone-angle", "60"})
+                .cone_angle_deg,
+            60.0);
+  for (const char* bad : {"0", "90", "-5", "sixty"})
+    EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.xyz", "--layout", "coarse", "--cone-angle", bad})
+                  .find("--cone-angle"),
+              std::string::npos)
+        << bad;
+}
+
 TEST(Cli, BlockStructuredNeedsCgnsAndQuads) {
   EXPECT_TRUE(p({"mesh", "m.step", "-o", "o.cgns", "--block-structured"}).block_structured);
   EXPECT_FALSE(p({"mesh", "m.step", "-o", "o.cgns"}).block_structured);
