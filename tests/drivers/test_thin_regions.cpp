@@ -232,6 +232,31 @@ TEST(ThinRegions, NeckQuadsGetMostOfTheWayToSicnPointTwo) {
   EXPECT_GE(on.sicn_min_away, 0.15) << on.quads << " quads";
 }
 
+// The neck's two sides are aligned (quantize::align_thin_sides): the top segment, all of it
+// facing the bottom 0.02 away, keeps its vertices, and the bottom curve has one below each of
+// them. Without that the bottom's spacing (0.082 there) and the top's (0.067) sheared the quads
+// across.
+TEST(ThinRegions, NeckSidesHaveAlignedVertices) {
+  const std::string model = qsmesh::test::write_polygon_face(
+      {{0, 0}, {10, 0}, {10, 3}, {5.2, 0.02}, {4.8, 0.02}, {0, 3}}, tmp("thin_neck_aligned.brep"));
+  const std::string out = tmp("thin_neck_aligned.msh");
+  const std::string cmd =
+      std::string(QSMESH_EXE) + " mesh " + model + " -o " + out + " --size 1 --threads 2 -q";
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd;
+  const MshQuads m = read_msh(out);
+  std::vector<double> top, bottom;
+  for (const Vec3& p : m.points) {
+    if (std::abs(p.y - 0.02) < 1e-9 && p.x > 4.8 - 1e-9 && p.x < 5.2 + 1e-9) top.push_back(p.x);
+    if (std::abs(p.y) < 1e-9) bottom.push_back(p.x);
+  }
+  ASSERT_GE(top.size(), 4u);
+  for (const double x : top) {
+    double nearest = 1e9;
+    for (const double b : bottom) nearest = std::min(nearest, std::abs(b - x));
+    EXPECT_LT(nearest, 1e-6) << "no bottom vertex below the top one at x = " << x;
+  }
+}
+
 // Two arcs crossing at 1 degree. Each cusp is held by one quad; the tails between them narrow to
 // nothing, so their sizes are graded with the width (3/4 K w along each side, the sides sharing
 // the cusp and bounding this face alone) and the tip, where the sides are closer than a tenth of
