@@ -805,6 +805,25 @@ std::vector<mesh::CurveMesh> place_vertices(const cad::CadModel& model,
       for (int i = 1; i < n; ++i) m.points[i] = geometry->point(m.t[i]);
     }
   });
+  if (options.thin_side_ratio > 0) {
+    if (!halved) {
+      (void)align_thin_sides(model, curves, q, out, tasks, options.thin_side_ratio);
+    } else {
+      // The aligned full meshes keep the parity of the vertices they align: the halved meshes of
+      // the curves moved are their even vertices.
+      PlaceOptions own = options;
+      own.thin_side_ratio = 0;
+      std::vector<mesh::CurveMesh> full =
+          place_vertices(model, curves, sizes, q, /*halved=*/false, tasks, own);
+      for (const LO c : align_thin_sides(model, curves, q, full, tasks, options.thin_side_ratio)) {
+        auto& m = out[c];
+        for (std::size_t i = 0; i < m.t.size(); ++i) {
+          m.t[i] = full[c].t[2 * i];
+          m.points[i] = full[c].points[2 * i];
+        }
+      }
+    }
+  }
   return out;
 }
 

@@ -39,6 +39,11 @@ constexpr double kSharedTipWidth = 0.18;
 /// tenth stays (background::limit_by_face_width): there the tip ends the graded tail.
 constexpr double kThinTouching = 0.01;
 
+/// Growth of the sizes along a thin face, as a fraction of the gradation (initial_curve_sizes):
+/// 1 (the gradation itself) left the quads just past the test neck at SICN 0.198, 0.5 takes
+/// them to 0.2 and above (76 -> 84 quads; docs/benchmarks.md, issue 29).
+constexpr double kThinGradation = 0.5;
+
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 [[noreturn]] void input_error(const std::string& what) { throw InputError("sizemap: " + what); }
@@ -290,6 +295,9 @@ CurveSizes initial_curve_sizes(const cad::CadModel& model, std::span<const mesh:
         }
       }
       background::limit_by_feature_distance(model, dense, h, touching, floor, tasks);
+      // thin[c][i]: the thin-face cap set the size at vertex i of curve c.
+      std::vector<std::vector<char>> thin(static_cast<std::size_t>(nc));
+      for (LO c = 0; c < nc; ++c) thin[c].assign(original[c].size(), 0);
       // h only ever lowers the sizes it started from, and the ratio is at most 1.
       for (LO c = 0; c < nc; ++c)
         for (std::size_t i = 0; i < original[c].size(); ++i) {
@@ -302,9 +310,29 @@ CurveSizes initial_curve_sizes(const cad::CadModel& model, std::span<const mesh:
           // shape of the quads inside a strip).
           if (!width.empty()) {
             const double w = width[c][original[c][i]];
-            if (w < 0.5 * before) s = std::min(s, options.thin_aspect * w);
+            if (w < 0.5 * before && options.thin_aspect * w <= s) {
+              s = options.thin_aspect * w;
+              thin[c][i] = 1;
+            }
           }
         }
+      // Where the width changes, the quads at the narrow end of an edge are what counts: past a
+      // neck, two across, their narrow side half the neck's width, they came out at SICN 0.19
+      // with the gradation's growth (tests/drivers/test_thin_regions.cpp). Along a thin face the
+      // sizes grow at most kThinGradation x the gradation, up to the first vertex outside it.
+      for (LO c = 0; c < nc; ++c) {
+        const auto& flags = thin[c];
+        if (std::find(flags.begin(), flags.end(), 1) == flags.end()) continue;
+        auto& at = out.at[c];
+        const auto& p = curves[c].points;
+        const double g = kThinGradation * options.gradation;
+        for (std::size_t i = 1; i < at.size(); ++i)
+          if (flags[i] != 0 || flags[i - 1] != 0)
+            at[i] = std::min(at[i], at[i - 1] + g * distance(p[i], p[i - 1]));
+        for (std::size_t i = at.size() - 1; i-- > 0;)
+          if (flags[i] != 0 || flags[i + 1] != 0)
+            at[i] = std::min(at[i], at[i + 1] + g * distance(p[i], p[i + 1]));
+      }
     }
   }
 

@@ -134,6 +134,9 @@ struct PlaceOptions {
   double align_length_ratio = 1.5;
   /// Arc-length samples of the shared profile (>= 2).
   int profile_samples = 256;
+  /// Two curves of one face closer than this fraction of the edge length are the sides of a thin
+  /// face, and their vertices are aligned across it (align_thin_sides); 0: off.
+  double thin_side_ratio = 0.5;
 };
 
 /// Paper 000 Eq. 11: the final curve meshes, one per curve, indexed by curve id. Curve c gets
@@ -155,6 +158,30 @@ struct PlaceOptions {
     const cad::CadModel& model, std::span<const mesh::CurveMesh> curves,
     std::span<const std::vector<double>> sizes, const Quantization& q, bool halved,
     const TaskArena& tasks, const PlaceOptions& options = {});
+
+/// Aligned vertices on the two sides of thin faces (issue 29): where two curves of a face that
+/// share no corner (a neck's two sides, a slot's arc and the circle around it) lie closer than
+/// `width_ratio` x the local edge length, the quads across are two rows of slivers, and they shear
+/// when the vertices of the two sides do not face each other (Block.stp's face 520 at size factor
+/// 0.02: 12 and 6 edges, 20 quads below SICN 0.1). A vertex of one curve faces the other when its
+/// nearest point there is inside that curve, closer than `width_ratio` x the mean length of its
+/// edges, and not along its own tangent (within 60 degrees of normal to it). Of two curves facing
+/// each other, the one with the larger fraction of facing vertices is the master (its vertices
+/// stay); the other (the slave) gets a vertex at the foot of each of them, with the master's
+/// parity of index, so that the halved meshes (every even vertex while every count of the face is
+/// even) are aligned too; between and beyond those, its vertices are spread as before over the
+/// pieces with the rounded counts (every piece within 2:1 of its former spacing, else up to three
+/// feet at each end are dropped, else the slave keeps its vertices). Its count stays. A curve that
+/// is master anywhere is never a slave; opposite sides of a four-sided face in one chord are
+/// aligned already (PlaceOptions::align_chords) and skipped, as are faces with an odd curve,
+/// curves used twice by the face (seams) and closed curves. Works on the full curve meshes
+/// `full` (indexed by curve id) in place; `background` gives the curves' polylines. Returns the
+/// curves moved, increasing. The same on every rank, whatever the thread count of `tasks`.
+[[nodiscard]] std::vector<LO> align_thin_sides(const cad::CadModel& model,
+                                               std::span<const mesh::CurveMesh> background,
+                                               const Quantization& q,
+                                               std::vector<mesh::CurveMesh>& full,
+                                               const TaskArena& tasks, double width_ratio);
 
 /// The curves whose meshes make the boundary of face f cross itself in the face's parameter
 /// plane: two segments of its loops (background::face_boundary on `curves`) that cross properly
