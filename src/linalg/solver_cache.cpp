@@ -1,6 +1,7 @@
 #include "qsmesh/linalg/solver_cache.hpp"
 
 #include <algorithm>
+#include <cstring>
 
 #include "backends.hpp"
 
@@ -25,6 +26,22 @@ struct SolverCache::Entry {
   std::vector<std::int64_t> offsets;
   std::vector<LO> cols;
   std::unique_ptr<LinearSolver> solver;
+  std::vector<double> values;  // of the last factorization; empty when it failed
+  [[nodiscard]] bool same_values(const SparseMatrix& A) const {
+    // Bytes, not ==: 0.0 and -0.0 must not count as the same (they may round differently).
+    return !values.empty() && values.size() == A.values().size() &&
+           std::memcmp(values.data(), A.values().data(), values.size() * sizeof(double)) == 0;
+  }
+  // Factorizes with A's values unless the last factorization had the very same ones (smooth_face's
+  // uv Laplacian has unit weights: the same pattern is the same matrix).
+  // Returns whether it factorized.
+  bool factorize(const SparseMatrix& A) {
+    if (same_values(A)) return false;
+    values.clear();
+    solver->factorize(A);  // throws: values stay empty
+    values = A.values();
+    return true;
+  }
   [[nodiscard]] bool same_pattern(const SparseMatrix& A) const {
     return A.size() == n && A.row_offsets() == offsets && A.columns() == cols;
   }
@@ -40,6 +57,7 @@ LinearSolver& SolverCache::factorized(const SparseMatrix& A) {
     uncached_ = detail::make_eigen_solver();
     uncached_->analyze(A);
     uncached_->factorize(A);
+    ++factorizations_;
     return *uncached_;
   }
   const std::uint64_t h = pattern_hash(A);
@@ -48,7 +66,7 @@ LinearSolver& SolverCache::factorized(const SparseMatrix& A) {
     if (e->hash == h && e->same_pattern(A)) {
       ++hits_;
       e->used = clock_;
-      e->solver->factorize(A);
+      if (e->factorize(A)) ++factorizations_;
       return *e->solver;
     }
   ++misses_;
@@ -71,9 +89,10 @@ LinearSolver& SolverCache::factorized(const SparseMatrix& A) {
   e->solver->analyze(A);  // throws before the entry is kept
   held_ += nnz;
   entries_.push_back(std::move(e));
-  LinearSolver& s = *entries_.back()->solver;
-  s.factorize(A);
-  return s;
+  Entry& kept = *entries_.back();
+  kept.factorize(A);
+  ++factorizations_;
+  return *kept.solver;
 }
 
 LinearSolver& factorized_eigen(const SparseMatrix& A, SolverCache* cache,

@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <set>
 #include <string>
 #include <tuple>
@@ -521,6 +522,43 @@ std::string memo_key(const mesh::FaceMesh& lm, LO nold, LO n_new_quads, double b
   return key;
 }
 
+// Corners have valence 1, other boundary vertices valence 2: the pattern fits convex cavities.
+bool convex_pattern(const Pattern& p) {
+  std::vector<char> corner(static_cast<std::size_t>(p.num_vertices()), 0);
+  for (const LO s : p.side_start) corner[p.boundary[s]] = 1;
+  for (const LO v : p.boundary)
+    if (!corner[v] && p.valence[v] != 2) return false;
+  return true;
+}
+
+std::vector<Pattern> select(std::span<const Pattern> patterns, int sides, bool regular_only) {
+  std::vector<Pattern> out;
+  for (const auto& p : patterns)
+    if (p.num_sides() == sides && convex_pattern(p) && (!regular_only || p.irregular == 0))
+      out.push_back(p);
+  return out;
+}
+
+// The lists the steps grow with: the regular four-sided patterns (grid), all four-sided ones, the
+// three- and five-sided ones, each in the order of the pattern list.
+struct PatternLists {
+  std::vector<Pattern> grid, four, tri, pent;
+  explicit PatternLists(std::span<const Pattern> patterns)
+      : grid(select(patterns, 4, true)),
+        four(select(patterns, 4, false)),
+        tri(select(patterns, 3, false)),
+        pent(select(patterns, 5, false)) {}
+};
+
+// Whether two pattern lists are the same patterns (every other field of a Pattern follows from
+// its name, drawing and quads: make_pattern).
+bool same_patterns(std::span<const Pattern> a, std::span<const Pattern> b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    if (a[i].name != b[i].name || a[i].xy != b[i].xy || a[i].quads != b[i].quads) return false;
+  return true;
+}
+
 }  // namespace
 
 struct CavityMemo::Impl {
@@ -530,6 +568,25 @@ struct CavityMemo::Impl {
   int iterations = 0, screen_passes = 0;
   bool laplacian_uv = false, winslow = false, approximate_projection = false;
   std::unordered_map<std::string, MemoRecord> records;
+  // Kept across the calls of one face, whatever their options: the pattern lists, match_patterns'
+  // results (a function of their arguments) and the solvers' analyses (of the pattern alone). The
+  // first and second improvement passes grow the same cavities from the same mesh: a third of
+  // the matches of Block.stp were repeats from an earlier call.
+  std::vector<Pattern> source;  // the pattern list `lists` was selected from
+  std::optional<PatternLists> lists;
+  MatchCache matches;
+  linalg::SolverCache solvers;
+
+  // The lists selected from `patterns`, made again (and the match results forgotten: they are
+  // kept per list address) when `patterns` is not the list of the last call.
+  const PatternLists& lists_for(std::span<const Pattern> patterns) {
+    if (!lists || !same_patterns(source, patterns)) {
+      source.assign(patterns.begin(), patterns.end());
+      lists.emplace(patterns);
+      matches = MatchCache();
+    }
+    return *lists;
+  }
 
   // Forgets the records made under other smoothing options.
   void adopt(const CavityOptions& o) {
@@ -584,8 +641,8 @@ namespace {
 class Remesher {
  public:
   Remesher(mesh::FaceMesh& work, const cad::FaceGeometry& surface, const CavityOptions& o,
-           double sign, CavityMemo::Impl* memo)
-      : w_(work), s_(surface), o_(o), sign_(sign), memo_(memo) {}
+           double sign, CavityMemo::Impl* memo, linalg::SolverCache& cache)
+      : w_(work), s_(surface), o_(o), sign_(sign), memo_(memo), cache_(cache) {}
 
   // Why build() refused a replacement.
   enum class Refusal { None, Layout, Screened, Invalid, MinSicn, AvgSicn };
@@ -847,27 +904,10 @@ class Remesher {
   const CavityOptions& o_;
   double sign_;
   CavityMemo::Impl* memo_;
-  // The candidates' layouts repeat the same refined patterns (one remesh_cavities call, one
+  // The candidates' layouts repeat the same refined patterns (the calls on one face, one
   // thread): their solvers' analyses are kept.
-  mutable linalg::SolverCache cache_;
+  linalg::SolverCache& cache_;
 };
-
-// Corners have valence 1, other boundary vertices valence 2: the pattern fits convex cavities.
-bool convex_pattern(const Pattern& p) {
-  std::vector<char> corner(static_cast<std::size_t>(p.num_vertices()), 0);
-  for (const LO s : p.side_start) corner[p.boundary[s]] = 1;
-  for (const LO v : p.boundary)
-    if (!corner[v] && p.valence[v] != 2) return false;
-  return true;
-}
-
-std::vector<Pattern> select(std::span<const Pattern> patterns, int sides, bool regular_only) {
-  std::vector<Pattern> out;
-  for (const auto& p : patterns)
-    if (p.num_sides() == sides && convex_pattern(p) && (!regular_only || p.irregular == 0))
-      out.push_back(p);
-  return out;
-}
 
 }  // namespace
 
@@ -957,10 +997,22 @@ mesh::FaceMesh remesh_cavities(const mesh::FaceMesh& input, const cad::FaceGeome
     }
     rep.flagged = static_cast<std::int64_t>(flagged.size());
 
-    const std::vector<Pattern> grid = select(patterns, 4, true);
-    const std::vector<Pattern> four = select(patterns, 4, false);
-    const std::vector<Pattern> tri = select(patterns, 3, false);
-    const std::vector<Pattern> pent = select(patterns, 5, false);
+    // Without a memo, the lists, match results and analyses of this call alone.
+    std::optional<PatternLists> own_lists;
+    std::optional<MatchCache> own_matches;
+    std::optional<linalg::SolverCache> own_solvers;
+    if (memo == nullptr) {
+      own_lists.emplace(patterns);
+      own_matches.emplace();
+      own_solvers.emplace();
+    }
+    const PatternLists& lists = memo != nullptr ? memo->impl().lists_for(patterns) : *own_lists;
+    MatchCache& match_cache = memo != nullptr ? memo->impl().matches : *own_matches;
+    linalg::SolverCache& solvers = memo != nullptr ? memo->impl().solvers : *own_solvers;
+    const std::vector<Pattern>& grid = lists.grid;
+    const std::vector<Pattern>& four = lists.four;
+    const std::vector<Pattern>& tri = lists.tri;
+    const std::vector<Pattern>& pent = lists.pent;
 
     // The memo needs reproducible smoothing: no time budget, no caller's pass hook.
     CavityMemo::Impl* memo_impl = nullptr;
@@ -968,10 +1020,10 @@ mesh::FaceMesh remesh_cavities(const mesh::FaceMesh& input, const cad::FaceGeome
       memo_impl = &memo->impl();
       memo_impl->adopt(options);
     }
-    Remesher remesher(work, surface, options, sign, memo_impl);
+    Remesher remesher(work, surface, options, sign, memo_impl, solvers);
     // The growths match the same side counts against the same lists (grid, four, tri, pent,
-    // alive for the whole call) again and again.
-    MatchCache match_cache;
+    // alive for the whole call and, with a memo, for the memo's calls) again and again:
+    // match_cache.
     const Stopwatch clock;
     std::int64_t started = 0;
     bool stop = false;

@@ -4,7 +4,7 @@
 #include <cstdlib>
 #include <limits>
 #include <numeric>
-#include <set>
+#include <span>
 #include <utility>
 #include <vector>
 
@@ -17,33 +17,54 @@ namespace {
 
 using Int = std::int64_t;
 
-void reduce_row(std::vector<Int>& row) {
+// Divides a row by the gcd of its entries.
+void reduce_row(std::span<Int> row) {
   Int g = 0;
   for (const Int x : row) g = std::gcd(g, x);
   if (g > 1)
     for (Int& x : row) x /= g;
 }
 
+// The buffers of one solve, kept by match_patterns across its patterns and rotations (it solves
+// 2m systems per pattern for every side counts it is asked about, and these few small vectors,
+// allocated anew per solve, were half of its time on Block.stp).
+struct ChordWork {
+  std::vector<Int> slots, upper, rows, s, best;
+  std::vector<double> ideal;
+  std::vector<LO> pivots;
+  std::vector<char> fixed;
+  struct Step {
+    LO var;
+    LO pivot_row;  ///< kNoIndex: a free variable to enumerate
+  };
+  std::vector<Step> steps;
+};
+
 // Depth-first search over the integer echelon form, bottom row first (paper 000 Sec. 6.1.1).
+// rows: the echelon rows, each c + 1 entries ([w | N]), flat.
 class EchelonSearch {
  public:
-  EchelonSearch(std::vector<std::vector<Int>> rows, std::vector<LO> pivots,
-                std::vector<double> ideal, std::vector<Int> upper, std::span<const int> w,
-                std::span<const LO> rhs, int max_attempts)
-      : rows_(std::move(rows)),
-        pivots_(std::move(pivots)),
-        ideal_(std::move(ideal)),
-        upper_(std::move(upper)),
+  EchelonSearch(ChordWork& k, std::span<const int> w, std::span<const LO> rhs, int max_attempts)
+      : k_(k),
+        rows_(k.rows),
+        pivots_(k.pivots),
+        ideal_(k.ideal),
+        upper_(k.upper),
         w_(w),
         rhs_(rhs),
         max_attempts_(max_attempts),
-        c_(static_cast<LO>(ideal_.size())),
-        s_(ideal_.size(), 0) {
+        c_(static_cast<LO>(k.ideal.size())),
+        s_(k.s),
+        steps_(k.steps) {
+    s_.assign(ideal_.size(), 0);
+    steps_.clear();
+    k_.best.clear();
     // Steps: for each row from the bottom, its not yet fixed free variables, then its pivot.
-    std::vector<char> fixed(c_, 0);
+    std::vector<char>& fixed = k_.fixed;
+    fixed.assign(static_cast<std::size_t>(c_), 0);
     for (LO r = static_cast<LO>(pivots_.size()) - 1; r >= 0; --r) {
       for (LO j = pivots_[r] + 1; j < c_; ++j)
-        if (!fixed[j] && rows_[r][j] != 0) {
+        if (!fixed[j] && row(r)[j] != 0) {
           steps_.push_back({j, kNoIndex});
           fixed[j] = 1;
         }
@@ -57,16 +78,14 @@ class EchelonSearch {
   }
 
   void run() { descend(0); }
-  [[nodiscard]] bool found() const { return !best_.empty(); }
-  [[nodiscard]] const std::vector<Int>& best() const { return best_; }
+  [[nodiscard]] bool found() const { return !k_.best.empty(); }
   [[nodiscard]] double best_energy() const { return best_energy_; }
   [[nodiscard]] int attempts() const { return attempts_; }
 
  private:
-  struct Step {
-    LO var;
-    LO pivot_row;  ///< kNoIndex: a free variable to enumerate
-  };
+  [[nodiscard]] const Int* row(LO r) const {
+    return rows_.data() + static_cast<std::size_t>(r) * (c_ + 1);
+  }
 
   // Returns false when the attempt budget is spent.
   bool descend(std::size_t k) {
@@ -74,12 +93,12 @@ class EchelonSearch {
       leaf();
       return true;
     }
-    const Step& st = steps_[k];
+    const ChordWork::Step& st = steps_[k];
     if (st.pivot_row != kNoIndex) {
-      const auto& row = rows_[st.pivot_row];
-      Int sum = row[c_];
-      for (LO j = st.var + 1; j < c_; ++j) sum -= row[j] * s_[j];
-      const Int a = row[st.var];
+      const Int* r = row(st.pivot_row);
+      Int sum = r[c_];
+      for (LO j = st.var + 1; j < c_; ++j) sum -= r[j] * s_[j];
+      const Int a = r[st.var];
       if (sum % a != 0) return true;
       const Int v = sum / a;
       if (v < 1 || v > upper_[st.var]) return true;
@@ -114,26 +133,112 @@ class EchelonSearch {
     double e = 0;
     for (LO j = 0; j < c_; ++j)
       e += (static_cast<double>(s_[j]) - ideal_[j]) * (static_cast<double>(s_[j]) - ideal_[j]);
-    if (best_.empty() || e < best_energy_) {
-      best_ = s_;
+    if (k_.best.empty() || e < best_energy_) {
+      k_.best = s_;
       best_energy_ = e;
     }
   }
 
-  std::vector<std::vector<Int>> rows_;
-  std::vector<LO> pivots_;
-  std::vector<double> ideal_;
-  std::vector<Int> upper_;
+  ChordWork& k_;
+  const std::vector<Int>& rows_;
+  const std::vector<LO>& pivots_;
+  const std::vector<double>& ideal_;
+  const std::vector<Int>& upper_;
   std::span<const int> w_;
   std::span<const LO> rhs_;
   int max_attempts_;
   LO c_;
-  std::vector<Int> s_;
-  std::vector<Step> steps_;
-  std::vector<Int> best_;
+  std::vector<Int>& s_;
+  std::vector<ChordWork::Step>& steps_;
   double best_energy_ = std::numeric_limits<double>::max();
   int attempts_ = 0;
 };
+
+// solve_chords in the buffers of `k`: the ideal goes to k.ideal, the solution (when found) to
+// k.best; returns (found, energy, attempts).
+struct ChordResult {
+  bool found = false;
+  double energy = 0;
+  int attempts = 0;
+};
+
+ChordResult solve_chords_in(ChordWork& k, std::span<const int> w, int num_sides, LO num_chords,
+                            std::span<const LO> side_edges, const MatchOptions& options) {
+  const int m = num_sides;
+  const LO c = num_chords;
+  ChordResult out;
+  k.best.clear();
+
+  // Balanced ideal: each side's edges shared equally among its chord slots.
+  std::vector<Int>& slots = k.slots;
+  slots.assign(static_cast<std::size_t>(m), 0);
+  for (int i = 0; i < m; ++i)
+    for (LO j = 0; j < c; ++j) slots[i] += w[i * c + j];
+  k.ideal.assign(static_cast<std::size_t>(c), 1.0);
+  std::vector<Int>& upper = k.upper;
+  upper.assign(static_cast<std::size_t>(c), std::numeric_limits<Int>::max());
+  for (LO j = 0; j < c; ++j) {
+    double sum = 0;
+    Int count = 0;
+    for (int i = 0; i < m; ++i) {
+      const int wij = w[i * c + j];
+      if (wij == 0) continue;
+      sum += wij * static_cast<double>(side_edges[i]) / static_cast<double>(slots[i]);
+      count += wij;
+      // The other slots of the side take at least one edge each.
+      upper[j] = std::min(upper[j], (side_edges[i] - (slots[i] - wij)) / wij);
+    }
+    if (count > 0) k.ideal[j] = sum / static_cast<double>(count);
+    if (count == 0) upper[j] = 1;
+    if (upper[j] < 1) return out;
+  }
+
+  // Integer row echelon form of [w | N], fraction-free; rows of c + 1 entries, flat.
+  const std::size_t width = static_cast<std::size_t>(c) + 1;
+  std::vector<Int>& rows = k.rows;
+  rows.resize(static_cast<std::size_t>(m) * width);
+  const auto row = [&](int i) { return std::span<Int>(rows.data() + i * width, width); };
+  for (int i = 0; i < m; ++i) {
+    for (LO j = 0; j < c; ++j) rows[i * width + j] = w[i * c + j];
+    rows[i * width + c] = side_edges[i];
+  }
+  std::vector<LO>& pivots = k.pivots;
+  pivots.clear();
+  int r = 0;
+  for (LO col = 0; col < c && r < m; ++col) {
+    int best = -1;
+    for (int i = r; i < m; ++i)
+      if (rows[i * width + col] != 0 &&
+          (best < 0 || std::llabs(rows[i * width + col]) < std::llabs(rows[best * width + col])))
+        best = i;
+    if (best < 0) continue;
+    if (best != r) std::swap_ranges(row(r).begin(), row(r).end(), row(best).begin());
+    const std::span<Int> pr = row(r);
+    if (pr[col] < 0)
+      for (Int& x : pr) x = -x;
+    for (int i = r + 1; i < m; ++i) {
+      const std::span<Int> ri = row(i);
+      if (ri[col] == 0) continue;
+      const Int g = std::gcd(pr[col], ri[col]);
+      const Int fr = ri[col] / g, fi = pr[col] / g;
+      for (std::size_t j = 0; j < width; ++j) ri[j] = ri[j] * fi - pr[j] * fr;
+      reduce_row(ri);
+    }
+    pivots.push_back(col);
+    ++r;
+  }
+  for (int i = r; i < m; ++i)
+    if (rows[i * width + c] != 0) return out;  // 0 = nonzero: inconsistent counts
+  rows.resize(static_cast<std::size_t>(r) * width);
+
+  EchelonSearch search(k, w, side_edges, options.max_attempts);
+  search.run();
+  out.attempts = search.attempts();
+  if (!search.found()) return out;
+  out.found = true;
+  out.energy = search.best_energy();
+  return out;
+}
 
 }  // namespace
 
@@ -146,69 +251,15 @@ ChordSolution solve_chords(std::span<const int> w, int num_sides, LO num_chords,
                "solve_chords: w has " << w.size() << " entries, not " << m << " x " << c);
   QSMESH_CHECK(static_cast<int>(side_edges.size()) == m,
                "solve_chords: " << side_edges.size() << " side counts for " << m << " sides");
+  ChordWork k;
+  const ChordResult r = solve_chords_in(k, w, m, c, side_edges, options);
   ChordSolution out;
-
-  // Balanced ideal: each side's edges shared equally among its chord slots.
-  std::vector<Int> slots(m, 0);
-  for (int i = 0; i < m; ++i)
-    for (LO j = 0; j < c; ++j) slots[i] += w[i * c + j];
-  out.ideal.assign(c, 1.0);
-  std::vector<Int> upper(c, std::numeric_limits<Int>::max());
-  for (LO j = 0; j < c; ++j) {
-    double sum = 0;
-    Int count = 0;
-    for (int i = 0; i < m; ++i) {
-      const int wij = w[i * c + j];
-      if (wij == 0) continue;
-      sum += wij * static_cast<double>(side_edges[i]) / static_cast<double>(slots[i]);
-      count += wij;
-      // The other slots of the side take at least one edge each.
-      upper[j] = std::min(upper[j], (side_edges[i] - (slots[i] - wij)) / wij);
-    }
-    if (count > 0) out.ideal[j] = sum / static_cast<double>(count);
-    if (count == 0) upper[j] = 1;
-    if (upper[j] < 1) return out;
-  }
-
-  // Integer row echelon form of [w | N], fraction-free.
-  std::vector<std::vector<Int>> rows(m, std::vector<Int>(c + 1));
-  for (int i = 0; i < m; ++i) {
-    for (LO j = 0; j < c; ++j) rows[i][j] = w[i * c + j];
-    rows[i][c] = side_edges[i];
-  }
-  std::vector<LO> pivots;
-  int r = 0;
-  for (LO col = 0; col < c && r < m; ++col) {
-    int best = -1;
-    for (int i = r; i < m; ++i)
-      if (rows[i][col] != 0 && (best < 0 || std::llabs(rows[i][col]) < std::llabs(rows[best][col])))
-        best = i;
-    if (best < 0) continue;
-    std::swap(rows[r], rows[best]);
-    if (rows[r][col] < 0)
-      for (Int& x : rows[r]) x = -x;
-    for (int i = r + 1; i < m; ++i) {
-      if (rows[i][col] == 0) continue;
-      const Int g = std::gcd(rows[r][col], rows[i][col]);
-      const Int fr = rows[i][col] / g, fi = rows[r][col] / g;
-      for (LO j = 0; j <= c; ++j) rows[i][j] = rows[i][j] * fi - rows[r][j] * fr;
-      reduce_row(rows[i]);
-    }
-    pivots.push_back(col);
-    ++r;
-  }
-  for (int i = r; i < m; ++i)
-    if (rows[i][c] != 0) return out;  // 0 = nonzero: inconsistent counts
-  rows.resize(r);
-
-  EchelonSearch search(std::move(rows), std::move(pivots), out.ideal, std::move(upper), w,
-                       side_edges, options.max_attempts);
-  search.run();
-  out.attempts = search.attempts();
-  if (!search.found()) return out;
+  out.ideal = std::move(k.ideal);
+  out.attempts = r.attempts;
+  if (!r.found) return out;
   out.found = true;
-  out.s.assign(search.best().begin(), search.best().end());
-  out.energy = search.best_energy();
+  out.s.assign(k.best.begin(), k.best.end());
+  out.energy = r.energy;
   return out;
 }
 
@@ -218,34 +269,59 @@ std::vector<PatternMatch> match_patterns(std::span<const Pattern> patterns,
   const int m = static_cast<int>(side_edges.size());
   std::vector<PatternMatch> out;
   if (m == 0 || (cornerless && m != 1)) return out;
+  ChordWork work;
+  std::vector<LO> counts(static_cast<std::size_t>(m));
+  std::vector<LO> seen;
+  std::vector<std::size_t> seen_at;
   for (LO p = 0; p < static_cast<LO>(patterns.size()); ++p) {
     const Pattern& pat = patterns[p];
     if (pat.num_sides() != m || pat.cornerless() != cornerless) continue;
+    QSMESH_CHECK(
+        pat.num_chords >= 1 && pat.w.size() == static_cast<std::size_t>(m) * pat.num_chords,
+        "solve_chords: w has " << pat.w.size() << " entries, not " << m << " x " << pat.num_chords);
     // Subdivisions seen along each cavity side, in cavity order: equal ones give the same mesh.
-    std::set<std::vector<std::vector<LO>>> seen;
+    // Each key flat (per cavity side, its length then its subdivisions), the keys one after the
+    // other in `seen` from the offsets in `seen_at`: at most 2m of them, compared in turn.
+    seen.clear();
+    seen_at.clear();
     std::vector<PatternMatch> found;
+    const LO nb = static_cast<LO>(pat.boundary.size());
     for (const bool reversed : {false, true})
       for (int start = 0; start < m; ++start) {
-        std::vector<LO> counts(m);
         for (int i = 0; i < m; ++i)
           counts[i] = side_edges[(((reversed ? start - i : start + i) % m) + m) % m];
-        ChordSolution sol = solve_chords(pat.w, m, pat.num_chords, counts, options);
+        const ChordResult sol = solve_chords_in(work, pat.w, m, pat.num_chords, counts, options);
         if (!sol.found) continue;
-        std::vector<std::vector<LO>> key(m);
-        const LO nb = static_cast<LO>(pat.boundary.size());
-        for (int i = 0; i < m; ++i) {
-          const int side = (((reversed ? start - i : start + i) % m) + m) % m;
+        const std::size_t at = seen.size();
+        for (int side = 0; side < m; ++side) {
+          // The pattern side on this cavity side: side = start + i (reversed: start - i) mod m.
+          const int i = ((reversed ? start - side : side - start) % m + m) % m;
+          const LO first = pat.side_start[i];
           const LO end = i + 1 < m ? pat.side_start[i + 1] : nb;
-          for (LO k = pat.side_start[i]; k < end; ++k)
-            key[side].push_back(sol.s[pat.edge_chord[pat.boundary_edge[k]]]);
-          if (reversed) std::reverse(key[side].begin(), key[side].end());
+          seen.push_back(end - first);
+          for (LO k = first; k < end; ++k)
+            seen.push_back(static_cast<LO>(
+                work.best
+                    [pat.edge_chord[pat.boundary_edge[reversed ? end - 1 - (k - first) : k]]]));
         }
-        if (!seen.insert(std::move(key)).second) continue;
+        bool repeat = false;
+        for (std::size_t e = 0; e < seen_at.size() && !repeat; ++e) {
+          const std::size_t b = seen_at[e], n = (e + 1 < seen_at.size() ? seen_at[e + 1] : at) - b;
+          repeat =
+              n == seen.size() - at && std::equal(seen.begin() + static_cast<std::ptrdiff_t>(b),
+                                                  seen.begin() + static_cast<std::ptrdiff_t>(b + n),
+                                                  seen.begin() + static_cast<std::ptrdiff_t>(at));
+        }
+        if (repeat) {
+          seen.resize(at);
+          continue;
+        }
+        seen_at.push_back(at);
         PatternMatch match;
         match.pattern = p;
         match.start = start;
         match.reversed = reversed;
-        match.chords = std::move(sol.s);
+        match.chords.assign(work.best.begin(), work.best.end());
         match.energy = sol.energy;
         found.push_back(std::move(match));
       }

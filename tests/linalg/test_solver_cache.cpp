@@ -93,6 +93,28 @@ TEST(SolverCache, SameSolutionsAsAFreshSolver) {
   EXPECT_TRUE(same_bits(x, fresh_solution(A, b)));
 }
 
+TEST(SolverCache, SameValuesAreNotFactorizedAgain) {
+  SolverCache cache;
+  SparseMatrix A = irregular_spd(9, 4);
+  const std::vector<double> orig = A.values();
+  const std::vector<double> b = rhs(A.size(), 3);
+  std::vector<double> x(b.size());
+  cache.factorized(A).solve(b, x);
+  cache.factorized(A).solve(b, x);
+  EXPECT_EQ(cache.factorizations(), 1);
+  EXPECT_TRUE(same_bits(x, fresh_solution(A, b)));
+  // One value changed in its last bit: factorized again, the fresh solver's solution.
+  A.values()[0] = std::nextafter(A.values()[0], 2 * A.values()[0]);
+  cache.factorized(A).solve(b, x);
+  EXPECT_EQ(cache.factorizations(), 2);
+  EXPECT_TRUE(same_bits(x, fresh_solution(A, b)));
+  A.values() = orig;
+  cache.factorized(A).solve(b, x);
+  EXPECT_EQ(cache.factorizations(), 3);
+  EXPECT_TRUE(same_bits(x, fresh_solution(A, b)));
+  EXPECT_EQ(cache.hits(), 3);
+}
+
 TEST(SolverCache, FailedFactorizationThrowsAndTheCacheStaysUsable) {
   SolverCache cache;
   SparseMatrix A = irregular_spd(5, 3);

@@ -690,6 +690,27 @@ TEST(Cavity, MemoIsHandedOnToALaterCall) {
   expect_same_mesh(o, remesh_cavities(in, plane, {}, patterns, other));
 }
 
+// The memo keeps the pattern lists and match results across calls: a call with another pattern
+// list must select its lists again and forget the matches made with the old ones.
+TEST(Cavity, MemoFollowsThePatternList) {
+  const Plane plane;
+  const mesh::FaceMesh in = graded_grid(plane);
+  const auto patterns = builtin_patterns();
+  std::vector<Pattern> no_grid;  // no regular four-sided pattern: Steps 1 and 3 find nothing
+  for (const auto& p : patterns)
+    if (p.num_sides() != 4 || p.irregular != 0) no_grid.push_back(p);
+  ASSERT_LT(no_grid.size(), patterns.size());
+  CavityOptions options;
+  options.max_quads_maximal = 80;
+  const mesh::FaceMesh all = remesh_cavities(in, plane, {}, patterns, options);
+  const mesh::FaceMesh fewer = remesh_cavities(in, plane, {}, no_grid, options);
+  ASSERT_NE(all.quads, fewer.quads);  // the lists make a difference on this mesh
+  CavityMemo memo;
+  expect_same_mesh(remesh_cavities(in, plane, {}, patterns, options, nullptr, &memo), all);
+  expect_same_mesh(remesh_cavities(in, plane, {}, no_grid, options, nullptr, &memo), fewer);
+  expect_same_mesh(remesh_cavities(in, plane, {}, patterns, options, nullptr, &memo), all);
+}
+
 TEST(Cavity, Deterministic) {
   const Plane plane;
   const mesh::FaceMesh in = perturbed(plane, 12, 10, {{4, 4, 5, 4}, {9, 2, 9, 3}});

@@ -14,7 +14,8 @@ namespace qsmesh::linalg {
 /// of the same refined patterns again and again, and for those small systems AMD and the symbolic
 /// analysis cost more than the numeric factorization (docs/benchmarks.md, issue 27). The analysis
 /// depends on the pattern alone, so a cached solver gives bit for bit the solutions of a fresh
-/// one.
+/// one. A kept solver is not factorized again for the very values (bytes) it was last factorized
+/// with: smooth_face's uv Laplacian has unit weights, so there the same pattern is the same matrix.
 ///
 /// One object per thread of work: not thread-safe, and the solver it returns is valid until the
 /// next call. Never share one between tasks that may run on different threads.
@@ -33,13 +34,15 @@ class SolverCache {
 
   [[nodiscard]] std::int64_t hits() const { return hits_; }
   [[nodiscard]] std::int64_t misses() const { return misses_; }
+  /// Numeric factorizations done (a hit with the values of its last one does none).
+  [[nodiscard]] std::int64_t factorizations() const { return factorizations_; }
 
  private:
   struct Entry;
   std::int64_t max_nonzeros_;
   std::int64_t held_ = 0;  // nonzeros of the patterns held
   std::int64_t clock_ = 0;
-  std::int64_t hits_ = 0, misses_ = 0;
+  std::int64_t hits_ = 0, misses_ = 0, factorizations_ = 0;
   std::vector<std::unique_ptr<Entry>> entries_;
   std::unique_ptr<LinearSolver> uncached_;
 };

@@ -276,6 +276,11 @@ struct CavityReport {
 /// without a memo. A memo can be handed on to a later call on the same face and surface (the
 /// second pass starts from the same mesh with looser bounds: PipelineOptions::
 /// second_pass_cavities); it forgets its records when that call's smoothing options differ.
+/// It also keeps, for the calls it is handed to, what depends on their arguments alone: the
+/// pattern lists of the steps, match_patterns' results (MatchCache) and the analyses of the
+/// layouts' and smoothings' linear systems (linalg::SolverCache); the second pass grows the same
+/// cavities as the first (Block.stp: a third of the first pass's matches came again). A call with
+/// another pattern list selects its lists again and forgets the match results.
 ///
 /// One thread at a time; a memo belongs to the task that improves one face (or piece).
 class CavityMemo {
