@@ -33,6 +33,7 @@ CrossFieldOutput summarize(const crossfield::FaceCrossField& cf) {
   out.factorizations = cf.stats.factorizations;
   out.solves = cf.stats.solves;
   out.seconds = cf.stats.seconds;
+  out.solver = cf.stats.solver;
   return out;
 }
 
