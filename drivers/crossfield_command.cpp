@@ -69,6 +69,8 @@ int run_crossfield(const Arguments& args) {
   parallel::PipelineOptions options;
   options.background.sizes.size = s.size;
   options.background.sizes.field_divisions = field_divisions(args);
+  if (args.distributed_threshold)
+    options.crossfield.solver.distributed_threshold = *args.distributed_threshold;
   options.cross_fields = true;
   const parallel::PipelineResult result =
       parallel::run_pipeline(s.comm, s.model, options, *s.tasks, s.log, &lane);

@@ -84,6 +84,8 @@ int run_sizemap(const Arguments& args) {
   parallel::PipelineOptions options;
   options.background.sizes.size = s.size;
   options.background.sizes.field_divisions = field_divisions(args);
+  if (args.distributed_threshold)
+    options.crossfield.solver.distributed_threshold = *args.distributed_threshold;
   options.size_map = true;
   check_request(args, s);
   apply_size_options(args, s, options);

@@ -101,7 +101,7 @@ TEST(DistributedSolve, SplitsTheRowsAndGivesTheSameBitsAtEveryRankCount) {
   A.multiply(x, r);
   double worst = 0;
   for (std::size_t i = 0; i < n; ++i) worst = std::max(worst, std::abs(r[i] - b[i]));
-  EXPECT_LT(worst, 1e-13);
+  EXPECT_LT(worst, 1e-11);  // the solution is rounded to 2^-40 of its largest entry
   linalg::SolverOptions eigen;
   eigen.backend = linalg::Backend::Eigen;
   auto e = linalg::make_solver(A.size(), eigen, nullptr);
