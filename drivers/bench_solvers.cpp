@@ -85,7 +85,7 @@ struct Times {
   std::string name;
 };
 
-Times run(const SparseMatrix& A, Backend backend, qsmesh::linalg::PetscLane* lane,
+Times run(const SparseMatrix& A, Backend backend, qsmesh::linalg::SolverLane* lane,
           int block_size = 1, LO distributed_threshold = 2000000) {
   qsmesh::linalg::SolverOptions options;
   options.backend = backend;
@@ -227,7 +227,7 @@ int main(int argc, char** argv) {
         sizes.push_back(static_cast<LO>(std::atof(argv[i])));
     }
     if (sizes.empty()) sizes = {1000, 10000, 100000, 500000};
-    qsmesh::linalg::PetscLane lane;
+    qsmesh::linalg::SolverLane lane;
     if (split)
       split_benchmark(sizes, lane);
     else

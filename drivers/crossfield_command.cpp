@@ -65,7 +65,7 @@ int run_crossfield(const Arguments& args) {
   Session s(args, "crossfield");
   check_request(args, s);
   s.announce(args, "crossfield");
-  linalg::PetscLane lane;
+  linalg::SolverLane lane;
   parallel::PipelineOptions options;
   options.background.sizes.size = s.size;
   options.background.sizes.field_divisions = field_divisions(args);

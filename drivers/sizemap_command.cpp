@@ -80,7 +80,7 @@ int run_sizemap(const Arguments& args) {
   check_output_files(args);
 
   Session s(args, "sizemap");
-  linalg::PetscLane lane;
+  linalg::SolverLane lane;
   parallel::PipelineOptions options;
   options.background.sizes.size = s.size;
   options.background.sizes.field_divisions = field_divisions(args);

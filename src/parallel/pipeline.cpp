@@ -1031,7 +1031,7 @@ GroupsForOutput apply_smooth_groups(const cad::CadModel& model, std::vector<Grou
 
 PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
                             const PipelineOptions& options, const TaskArena& tasks, Logger& log,
-                            linalg::PetscLane* lane) {
+                            linalg::SolverLane* lane) {
   PipelineResult result;
   const Context cx{comm, model, options, tasks, log};
   const int rank = comm.rank();

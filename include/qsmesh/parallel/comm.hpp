@@ -13,7 +13,7 @@
 namespace qsmesh::parallel {
 
 /// Initialises MPI (thread level SERIALIZED: MPI is called from the main thread, except PETSc
-/// solves, which run on worker threads one at a time through linalg::PetscLane, and SharedCounter
+/// solves, which run on worker threads one at a time through linalg::SolverLane, and SharedCounter
 /// and SharedBytes, whose calls are serialised by their communicator's lock in stages without
 /// PETSc) and finalises it on
 /// destruction. Exactly one per process, created by the driver's main().

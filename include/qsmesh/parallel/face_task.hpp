@@ -307,7 +307,7 @@ void mesh_background(FaceTask& task, const cad::CadModel& model,
 /// task.cross_field (shrunk to what they read when not summarized). A face whose field throws
 /// gets field_summary.error (with stage and face id) and no field: later stages fall back.
 void compute_cross_field(FaceTask& task, const crossfield::CrossFieldOptions& options,
-                         bool summarize, bool keep, linalg::PetscLane* lane);
+                         bool summarize, bool keep, linalg::SolverLane* lane);
 
 /// The gathered view of a face: what rank 0 assembles and reports. Every field is exchanged
 /// (fields()); parts of stages that did not run stay empty.
