@@ -4,14 +4,19 @@
 // markdown table rows.
 //
 // Usage: qsmesh_bench_solvers [N ...]   (default: 1000 10000 100000 500000)
+//        mpirun -np P qsmesh_bench_solvers --split [N ...]: the cr matrices solved split over the
+//        P ranks (a group lane, MUMPS on MPIAIJ, solutions refined to the correctly rounded one)
+//        against rank 0 alone (one-rank MUMPS, and a group of one: the refinement's cost).
 //   poisson: 5-point Laplacian on a sqrt(N) x sqrt(N) grid + 0.01 * identity;
 //   cr:      Crouzeix-Raviart-like: 2 unknowns per edge of a triangulated grid (N/2 edges), the
 //            P1-nonconforming Laplacian coupled by a 2x2 block [1 .5; .5 1] + 0.01 * identity.
 #include <mpi.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
+#include <ctime>
 #include <exception>
 #include <string>
 #include <vector>
@@ -80,11 +85,12 @@ struct Times {
   std::string name;
 };
 
-Times run(const SparseMatrix& A, Backend backend, qsmesh::linalg::PetscLane* lane,
-          int block_size = 1) {
+Times run(const SparseMatrix& A, Backend backend, qsmesh::linalg::SolverLane* lane,
+          int block_size = 1, LO distributed_threshold = 2000000) {
   qsmesh::linalg::SolverOptions options;
   options.backend = backend;
   options.block_size = block_size;
+  options.distributed_threshold = distributed_threshold;
   auto solver = qsmesh::linalg::make_solver(A.size(), options, lane);
   Times t;
   Stopwatch w;
@@ -118,6 +124,92 @@ Times run(const SparseMatrix& A, Backend backend, qsmesh::linalg::PetscLane* lan
   return t;
 }
 
+double total(const Times& t) { return t.analyze + t.factorize + t.refactorize + 10 * t.solve; }
+
+// Eigen vs one-rank MUMPS vs CG-GAMG on both kinds of matrix.
+void backends_benchmark(const std::vector<LO>& sizes, qsmesh::linalg::SolverLane& lane) {
+  std::printf(
+      "| matrix | n | nonzeros | backend | analyze (s) | factorize (s) | refactorize (s) "
+      "| solve (s) | rel. residual | Eigen/PETSc: factorize | refactorize | solve | "
+      "analyze+2 fact.+10 solves | Eigen/CG-GAMG: analyze+2 fact.+10 solves |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  for (const char* kind : {"poisson", "cr"}) {
+    for (LO target : sizes) {
+      const SparseMatrix A =
+          std::string(kind) == "poisson" ? poisson(target) : crouzeix_raviart(target);
+      const Times e = run(A, Backend::Eigen, &lane);
+      const Times p = run(A, Backend::Petsc, &lane);
+      // The CR matrices hold 2 unknowns per edge: GAMG is told so.
+      const Times g = run(A, Backend::PetscMultigrid, &lane, std::string(kind) == "cr" ? 2 : 1);
+      for (const Times* t : {&e, &p, &g}) {
+        std::printf("| %s | %d | %lld | %s | %.4f | %.4f | %.4f | %.5f | %.1e |", kind, A.size(),
+                    static_cast<long long>(A.nonzeros()), t->name.c_str(), t->analyze, t->factorize,
+                    t->refactorize, t->solve, t->residual);
+        if (t == &e)
+          std::printf(" %.2f | %.2f | %.2f | %.2f | %.2f |\n", e.factorize / p.factorize,
+                      e.refactorize / p.refactorize, e.solve / p.solve, total(e) / total(p),
+                      total(e) / total(g));
+        else
+          std::printf("  |  |  |  |  |\n");
+      }
+      std::fflush(stdout);
+    }
+  }
+}
+
+// --split: the cr matrices split over every rank against rank 0 alone. Wall seconds (the ranks
+// start together); CPU seconds summed over the ranks that took part.
+void split_benchmark(const std::vector<LO>& sizes, qsmesh::linalg::SolverLane& lane) {
+  using qsmesh::linalg::SolverGroup;
+  using qsmesh::linalg::SolverLane;
+  int rank = 0, size = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  MPI_Comm world = MPI_COMM_WORLD, self = MPI_COMM_SELF;
+  const SolverGroup all(&world, rank, size), alone(&self, 0, 1);
+  if (rank == 0) {
+    std::printf(
+        "| n | nonzeros | solver | ranks | analyze (s) | factorize (s) | refactorize (s) | solve "
+        "(s) | refinement solves per solve | analyze+2 fact.+10 solves (s) | CPU s, all ranks | "
+        "rel. residual |\n");
+    std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|\n");
+  }
+  const auto row = [&](const SparseMatrix& A, const Times& t, int ranks, double refinements,
+                       double cpu) {
+    std::printf("| %d | %lld | %s | %d | %.3f | %.3f | %.3f | %.4f | %.2f | %.2f | %.2f | %.1e |\n",
+                A.size(), static_cast<long long>(A.nonzeros()), t.name.c_str(), ranks, t.analyze,
+                t.factorize, t.refactorize, t.solve, refinements, total(t), cpu, t.residual);
+    std::fflush(stdout);
+  };
+  for (const LO target : sizes) {
+    const SparseMatrix A = crouzeix_raviart(target);
+    // Split over every rank.
+    MPI_Barrier(MPI_COMM_WORLD);
+    std::clock_t cpu0 = std::clock();
+    SolverLane group_lane(lane, all);
+    const Times d = run(A, Backend::Automatic, &group_lane, 1, 0);
+    double cpu = static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC, cpu_all = 0;
+    MPI_Reduce(&cpu, &cpu_all, 1, MPI_DOUBLE, MPI_SUM, 0, MPI_COMM_WORLD);
+    const auto& rep = group_lane.report();
+    if (rank == 0)
+      row(A, d, size, static_cast<double>(rep.refinement_steps) / std::max(1, rep.solves), cpu_all);
+    MPI_Barrier(MPI_COMM_WORLD);
+    if (rank == 0) {
+      // Rank 0 alone: MUMPS on one rank, then the same split path on a group of one.
+      cpu0 = std::clock();
+      const Times p = run(A, Backend::Petsc, &lane);
+      row(A, p, 1, 0, static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC);
+      cpu0 = std::clock();
+      SolverLane one(lane, alone);
+      const Times g = run(A, Backend::Automatic, &one, 1, 0);
+      row(A, g, 1,
+          static_cast<double>(one.report().refinement_steps) / std::max(1, one.report().solves),
+          static_cast<double>(std::clock() - cpu0) / CLOCKS_PER_SEC);
+    }
+    MPI_Barrier(MPI_COMM_WORLD);
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -127,39 +219,19 @@ int main(int argc, char** argv) {
   int status = 0;
   try {
     std::vector<LO> sizes;
-    for (int i = 1; i < argc; ++i) sizes.push_back(static_cast<LO>(std::atof(argv[i])));
-    if (sizes.empty()) sizes = {1000, 10000, 100000, 500000};
-    qsmesh::linalg::PetscLane lane;
-    std::printf(
-        "| matrix | n | nonzeros | backend | analyze (s) | factorize (s) | refactorize (s) "
-        "| solve (s) | rel. residual | Eigen/PETSc: factorize | refactorize | solve | "
-        "analyze+2 fact.+10 solves | Eigen/CG-GAMG: analyze+2 fact.+10 solves |\n");
-    std::printf("|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n");
-    for (const char* kind : {"poisson", "cr"}) {
-      for (LO target : sizes) {
-        const SparseMatrix A =
-            std::string(kind) == "poisson" ? poisson(target) : crouzeix_raviart(target);
-        const Times e = run(A, Backend::Eigen, &lane);
-        const Times p = run(A, Backend::Petsc, &lane);
-        // The CR matrices hold 2 unknowns per edge: GAMG is told so.
-        const Times g = run(A, Backend::PetscMultigrid, &lane, std::string(kind) == "cr" ? 2 : 1);
-        const auto total = [](const Times& t) {
-          return t.analyze + t.factorize + t.refactorize + 10 * t.solve;
-        };
-        for (const Times* t : {&e, &p, &g}) {
-          std::printf("| %s | %d | %lld | %s | %.4f | %.4f | %.4f | %.5f | %.1e |", kind, A.size(),
-                      static_cast<long long>(A.nonzeros()), t->name.c_str(), t->analyze,
-                      t->factorize, t->refactorize, t->solve, t->residual);
-          if (t == &e)
-            std::printf(" %.2f | %.2f | %.2f | %.2f | %.2f |\n", e.factorize / p.factorize,
-                        e.refactorize / p.refactorize, e.solve / p.solve, total(e) / total(p),
-                        total(e) / total(g));
-          else
-            std::printf("  |  |  |  |  |\n");
-        }
-        std::fflush(stdout);
-      }
+    bool split = false;
+    for (int i = 1; i < argc; ++i) {
+      if (std::string(argv[i]) == "--split")
+        split = true;
+      else
+        sizes.push_back(static_cast<LO>(std::atof(argv[i])));
     }
+    if (sizes.empty()) sizes = {1000, 10000, 100000, 500000};
+    qsmesh::linalg::SolverLane lane;
+    if (split)
+      split_benchmark(sizes, lane);
+    else
+      backends_benchmark(sizes, lane);
   } catch (const std::exception& ex) {
     std::fprintf(stderr, "bench_solvers: %s\n", ex.what());
     status = 1;

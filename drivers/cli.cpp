@@ -200,6 +200,12 @@ Arguments parse(const std::vector<std::string>& args) {
                          "' is not 0 (the background follows the target size) or a number of "
                          "divisions in [1, 1e6]");
       a.field_divisions = *n;
+    } else if (opt == "--distributed-threshold" && meshing) {
+      const std::string& v = value();
+      const auto n = parse_double(v);
+      if (!n || !std::isfinite(*n) || *n < 1 || *n > 2e9 || *n != std::floor(*n))
+        throw InputError(opt + ": '" + v + "' is not a number of unknowns in [1, 2e9]");
+      a.distributed_threshold = static_cast<LO>(*n);
     } else if (opt == "--block-structured" && a.command == Command::Mesh)
       a.block_structured = true;
     else if (opt == "--plot3d-stream" && a.command == Command::Mesh)
@@ -581,6 +587,12 @@ std::string help(const std::string& topic) {
           "background\n"
           "                        follows the target size (paper 000 Sec. 3.1; its cost grows\n"
           "                        faster than the mesh)\n"
+          "  --distributed-threshold N\n"
+          "                        a face whose field system has at least N unknowns is solved\n"
+          "                        by all ranks together (MUMPS over the ranks; default "
+       << linalg::SolverOptions{}.distributed_threshold
+       << ");\n"
+          "                        the mesh is the same at any rank count\n"
           "  --face-time-budget S  at most S seconds of cavity remeshing (paper 000 Sec. 6.2) per\n"
           "                        face; a face that reaches it keeps the mesh it has (valid) and "
           "is\n"
@@ -632,7 +644,7 @@ std::string help(const std::string& topic) {
           "end\n"
           "                        with the line 'euler-consistent: K/N'\n"
           "  --size H, --size-factor F, --threads T, --stats FILE.json, --max-quads N,\n"
-          "  --field-divisions N, --sew, -q, -v: as for mesh\n";
+          "  --field-divisions N, --distributed-threshold N, --sew, -q, -v: as for mesh\n";
   } else if (topic == "sizemap") {
     os << "usage: [mpirun -np P] qsmesh sizemap MODEL -o OUT.vtu [options]\n\n"
           "Computes the size map (paper 000 Sec. 4.1-4.2) and the curve quantization (Sec. 4.3):\n"
@@ -690,7 +702,7 @@ std::string help(const std::string& topic) {
           "  --corner-size K:H,.., --curve-size C:H,.., --face-size F:H,..\n"
           "                        size constraints at corners, on curves, on faces (model units)\n"
           "  --size H, --size-factor F, --threads T, --stats FILE.json, --max-quads N,\n"
-          "  --field-divisions N, --sew, -q, -v: as for mesh\n";
+          "  --field-divisions N, --distributed-threshold N, --sew, -q, -v: as for mesh\n";
   } else if (topic == "example") {
     os << "usage: qsmesh example wing-body -o FILE\n\n"
           "Writes a built-in CAD model built with OpenCASCADE, as STEP (FILE.step, .stp) or BREP\n"

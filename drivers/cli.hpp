@@ -113,6 +113,8 @@ struct Arguments {
   /// resolution, each face's edges at most its bounding-box diagonal / N (and at most the target
   /// size's resolution); 0: the background follows the target size. See kDefaultFieldDivisions.
   std::optional<double> field_divisions;
+  /// --distributed-threshold (linalg::SolverOptions::distributed_threshold); unset: its default.
+  std::optional<LO> distributed_threshold;
   bool sew = false;
   bool quiet = false;
   bool verbose = false;

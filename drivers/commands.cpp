@@ -862,6 +862,8 @@ int run_mesh(const Arguments& args) {
   parallel::PipelineOptions options;
   options.background.sizes.size = s.size;
   options.background.sizes.field_divisions = field_divisions(args);
+  if (args.distributed_threshold)
+    options.crossfield.solver.distributed_threshold = *args.distributed_threshold;
   check_request(args, s);
   if (until >= parallel::Stage::Unstructured) apply_size_options(args, s, options);
   s.announce(args, "mesh");
@@ -884,8 +886,9 @@ int run_mesh(const Arguments& args) {
   options.distance_to_cad = true;
   // A face whose field system is above SolverOptions::petsc_threshold is solved by PETSc; with the
   // background at the geometry's resolution that takes a face far larger than its neighbours, or
-  // --field-divisions 0 on a large one.
-  linalg::PetscLane lane;
+  // --field-divisions 0 on a large one. Above SolverOptions::distributed_threshold
+  // (--distributed-threshold) all ranks solve the face's systems together.
+  linalg::SolverLane lane;
   parallel::PipelineResult result =
       parallel::run_pipeline(s.comm, s.model, options, *s.tasks, s.log, &lane);
   for (const auto& [stage, sec] : result.times.entries()) s.times.add(stage, sec);

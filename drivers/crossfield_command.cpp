@@ -65,10 +65,12 @@ int run_crossfield(const Arguments& args) {
   Session s(args, "crossfield");
   check_request(args, s);
   s.announce(args, "crossfield");
-  linalg::PetscLane lane;
+  linalg::SolverLane lane;
   parallel::PipelineOptions options;
   options.background.sizes.size = s.size;
   options.background.sizes.field_divisions = field_divisions(args);
+  if (args.distributed_threshold)
+    options.crossfield.solver.distributed_threshold = *args.distributed_threshold;
   options.cross_fields = true;
   const parallel::PipelineResult result =
       parallel::run_pipeline(s.comm, s.model, options, *s.tasks, s.log, &lane);

@@ -80,10 +80,12 @@ int run_sizemap(const Arguments& args) {
   check_output_files(args);
 
   Session s(args, "sizemap");
-  linalg::PetscLane lane;
+  linalg::SolverLane lane;
   parallel::PipelineOptions options;
   options.background.sizes.size = s.size;
   options.background.sizes.field_divisions = field_divisions(args);
+  if (args.distributed_threshold)
+    options.crossfield.solver.distributed_threshold = *args.distributed_threshold;
   options.size_map = true;
   check_request(args, s);
   apply_size_options(args, s, options);

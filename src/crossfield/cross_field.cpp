@@ -6,7 +6,8 @@
 namespace qsmesh::crossfield {
 
 FaceCrossField compute_face_cross_field(const mesh::FaceMesh& background,
-                                        const CrossFieldOptions& options, linalg::PetscLane* lane) {
+                                        const CrossFieldOptions& options,
+                                        linalg::SolverLane* lane) {
   const auto start = std::chrono::steady_clock::now();
   FaceCrossField cf;
   cf.face = background.face;

@@ -84,7 +84,7 @@ Vec2 project(const Vec2& x, const Vec2& fallback) {
 /// the solution of the CR Laplace equation on that one-triangle layer with the boundary crosses as
 /// data.
 void extend_boundary_conditions(FaceCrossField& cf, const Geometry& g,
-                                const CrossFieldOptions& options, linalg::PetscLane* lane,
+                                const CrossFieldOptions& options, linalg::SolverLane* lane,
                                 const std::vector<double>& mass) {
   const std::size_t nt = cf.triangles.size(), ne = cf.edges.size();
   std::vector<std::uint8_t> layer(nt, 0);
@@ -129,7 +129,7 @@ void extend_boundary_conditions(FaceCrossField& cf, const Geometry& g,
 }  // namespace
 
 void diffuse(FaceCrossField& cf, const Geometry& g, const CrossFieldOptions& options,
-             linalg::PetscLane* lane) {
+             linalg::SolverLane* lane) {
   QSMESH_CHECK(options.levels >= 1, "crossfield: levels must be >= 1");
   const std::size_t ne = cf.edges.size(), nt = cf.triangles.size();
   cf.u.assign(ne, Vec2{1, 0});

@@ -45,7 +45,7 @@ inline double angle_in_triangle(const FaceCrossField& cf, const Geometry& g, LO 
 
 /// Sec. 3.1: boundary-condition extension and Algorithm 1. Fills fixed_edge, u, u_norm, stats.
 void diffuse(FaceCrossField& cf, const Geometry& g, const CrossFieldOptions& options,
-             linalg::PetscLane* lane);
+             linalg::SolverLane* lane);
 
 /// Branches of the cross at each triangle barycentre. Fills directions.
 void compute_directions(FaceCrossField& cf, const Geometry& g);
@@ -55,6 +55,6 @@ void find_singularities(FaceCrossField& cf, const Geometry& g, const CrossFieldO
 
 /// Sec. 3.3: fills H and h.
 void compute_scaling(FaceCrossField& cf, const Geometry& g, const CrossFieldOptions& options,
-                     linalg::PetscLane* lane);
+                     linalg::SolverLane* lane);
 
 }  // namespace qsmesh::crossfield::detail

@@ -41,7 +41,7 @@ void clamp_to_quantiles(std::vector<double>& H, const std::vector<double>& weigh
 }  // namespace
 
 void compute_scaling(FaceCrossField& cf, const Geometry& g, const CrossFieldOptions& options,
-                     linalg::PetscLane* lane) {
+                     linalg::SolverLane* lane) {
   const LO nv = static_cast<LO>(cf.points.size()), nt = static_cast<LO>(cf.triangles.size());
   cf.H.assign(static_cast<std::size_t>(nv), 0.0);
   cf.h.assign(static_cast<std::size_t>(nv), 1.0);

@@ -37,7 +37,7 @@ void for_cotangent_weights(const mesh::FaceMesh& tri, F&& visit) {
 
 std::unique_ptr<linalg::LinearSolver> factorized(const linalg::SparseMatrix& A,
                                                  const linalg::SolverOptions& options,
-                                                 linalg::PetscLane* lane) {
+                                                 linalg::SolverLane* lane) {
   auto solver = linalg::make_solver(A.size(), options, lane);
   solver->analyze(A);
   solver->factorize(A);
@@ -47,7 +47,7 @@ std::unique_ptr<linalg::LinearSolver> factorized(const linalg::SparseMatrix& A,
 }  // namespace
 
 Frame face_frame(const mesh::FaceMesh& tri, const cad::FaceGeometry& surface,
-                 linalg::PetscLane* lane) {
+                 linalg::SolverLane* lane) {
   const LO n = tri.num_vertices();
   QSMESH_CHECK(n > 0, "face " << tri.face << ": empty triangulation");
   Frame frame;
@@ -387,7 +387,7 @@ Compatibility compatibility(const Loops& L, std::span<const double> theta) {
 std::vector<double> align_field(const mesh::FaceMesh& tri, const Loops& L,
                                 std::span<const double> theta, const Compatibility& compat,
                                 const linalg::SolverOptions& solver_options,
-                                linalg::PetscLane* lane) {
+                                linalg::SolverLane* lane) {
   const LO n = tri.num_vertices();
   std::vector<double> out(theta.begin(), theta.end());
   // Eqs. 18-20: psi = sum over holes of k arg(z - c), built as Eq. 2 around a point of each hole,

@@ -324,7 +324,7 @@ std::vector<double> field_from_samples(const mesh::FaceMesh& tri, const Frame& f
 mesh::FaceMesh mesh_face_by_method(const cad::CadModel& model, LO f,
                                    std::span<const mesh::CurveMesh> curves, FaceMethod method,
                                    const GivenFaceField* given, const FieldSamples* own,
-                                   const FieldMeshOptions& options, linalg::PetscLane* lane,
+                                   const FieldMeshOptions& options, linalg::SolverLane* lane,
                                    FieldMeshReport* report) {
   FieldMeshReport local;
   FieldMeshReport& rep = report != nullptr ? *report : local;

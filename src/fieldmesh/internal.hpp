@@ -122,6 +122,6 @@ namespace qsmesh::fieldmesh::detail {
                                               std::span<const double> theta,
                                               const Compatibility& compat,
                                               const linalg::SolverOptions& solver,
-                                              linalg::PetscLane* lane);
+                                              linalg::SolverLane* lane);
 
 }  // namespace qsmesh::fieldmesh::detail

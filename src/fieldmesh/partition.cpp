@@ -814,7 +814,7 @@ mesh::FaceMesh mesh_face_from_field(const cad::CadModel& model, LO f,
                                     const mesh::FaceMesh& tri, const Frame& frame,
                                     std::span<const double> theta,
                                     std::span<const SingularPoint> given,
-                                    const FieldMeshOptions& options, linalg::PetscLane* lane,
+                                    const FieldMeshOptions& options, linalg::SolverLane* lane,
                                     FieldMeshReport* report) {
   FieldMeshReport local;
   FieldMeshReport& rep = report != nullptr ? *report : local;

@@ -291,7 +291,7 @@ double period(const PolyAnnulus& s, const std::vector<double>& form,
 }  // namespace
 
 HolomorphicBasis holomorphic_basis(const PolyAnnulus& s, const BasisOptions& options,
-                                   linalg::PetscLane* lane) {
+                                   linalg::SolverLane* lane) {
   QSMESH_CHECK(s.ok, "holomorphic_basis on a surface that is not a poly-annulus: " << s.reason);
   const Stopwatch clock;
   HolomorphicBasis B;

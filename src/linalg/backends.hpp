@@ -38,12 +38,17 @@ std::unique_ptr<LinearSolver> make_eigen_solver();
 
 /// PETSc SeqAIJ on PETSC_COMM_SELF factorized by MUMPS (Cholesky; LU, then PETSc's own
 /// factorization, as fallbacks). Every PETSc call is made while holding lane.mutex().
-std::unique_ptr<LinearSolver> make_petsc_solver(PetscLane& lane);
+std::unique_ptr<LinearSolver> make_petsc_solver(SolverLane& lane);
 
 /// PETSc SeqAIJ on PETSC_COMM_SELF solved by CG with GAMG to relative residual `rtol`: analyze
 /// builds the matrix and the Krylov solver, factorize sets the values up the multigrid hierarchy,
 /// solve iterates (throws when CG does not converge). `block_size` unknowns per node (>= 1).
-std::unique_ptr<LinearSolver> make_petsc_multigrid_solver(PetscLane& lane, double rtol,
+std::unique_ptr<LinearSolver> make_petsc_multigrid_solver(SolverLane& lane, double rtol,
                                                           int block_size);
+
+/// MUMPS Cholesky (LU as fallback) of a system split over the ranks of `lane`'s group: an MPIAIJ
+/// matrix of which each rank sets its contiguous block of rows, the solution gathered on every
+/// rank and refined to the correctly rounded one. Collective over the group (see SolverLane).
+std::unique_ptr<LinearSolver> make_petsc_distributed_solver(SolverLane& lane);
 
 }  // namespace qsmesh::linalg::detail

@@ -2,20 +2,25 @@
 
 namespace qsmesh::linalg {
 
-std::unique_ptr<LinearSolver> make_solver(LO n, const SolverOptions& options, PetscLane* lane) {
+std::unique_ptr<LinearSolver> make_solver(LO n, const SolverOptions& options, SolverLane* lane) {
   QSMESH_CHECK(n >= 0, "make_solver: negative system size " << n);
+  // A group lane splits its large systems over the group's ranks (every rank makes this call).
+  const bool distributed =
+      lane != nullptr && lane->group() != nullptr && n >= options.distributed_threshold;
   switch (options.backend) {
     case Backend::Eigen:
       return detail::make_eigen_solver();
     case Backend::Petsc:
       QSMESH_CHECK(lane != nullptr,
-                   "make_solver: Backend::Petsc needs a PetscLane, and none was given");
+                   "make_solver: Backend::Petsc needs a SolverLane, and none was given");
+      if (distributed) return detail::make_petsc_distributed_solver(*lane);
       return detail::make_petsc_solver(*lane);
     case Backend::PetscMultigrid:
       QSMESH_CHECK(lane != nullptr,
-                   "make_solver: Backend::PetscMultigrid needs a PetscLane, and none was given");
+                   "make_solver: Backend::PetscMultigrid needs a SolverLane, and none was given");
       return detail::make_petsc_multigrid_solver(*lane, options.multigrid_rtol, options.block_size);
     case Backend::Automatic:
+      if (distributed) return detail::make_petsc_distributed_solver(*lane);
       if (lane != nullptr && n >= options.petsc_threshold) return detail::make_petsc_solver(*lane);
       return detail::make_eigen_solver();
   }

@@ -1,6 +1,6 @@
 // PETSc backend: MUMPS sparse Cholesky on a SeqAIJ matrix (PETSC_COMM_SELF), for the large
 // per-face systems where a multifrontal factorization (BLAS-3 on supernodes) beats Eigen's
-// simplicial one. Also home of PetscLane.
+// simplicial one. Also home of SolverLane.
 //
 // The factor matrix is driven directly (MatGetFactor / MatCholeskyFactorSymbolic / ...Numeric /
 // MatSolve) rather than through KSPPREONLY + PCCHOLESKY: that is exactly what the PC does
@@ -18,6 +18,7 @@
 #include <sstream>
 
 #include "backends.hpp"
+#include "petsc_common.hpp"
 
 namespace qsmesh::linalg {
 namespace {
@@ -49,13 +50,14 @@ PetscErrorCode record_petsc_error(MPI_Comm /*comm*/, int line, const char* fun, 
 
 }  // namespace
 
-PetscLane::PetscLane() {
-  std::lock_guard lock(mutex_);
+SolverLane::SolverLane() {
+  std::lock_guard lock(own_mutex_);
   PetscBool petsc_up = PETSC_FALSE;
-  QSMESH_CHECK(PetscInitialized(&petsc_up) == 0 && petsc_up == PETSC_FALSE,
-               "PetscLane: PETSc is already initialised in this process (only one lane at a time)");
+  QSMESH_CHECK(
+      PetscInitialized(&petsc_up) == 0 && petsc_up == PETSC_FALSE,
+      "SolverLane: PETSc is already initialised in this process (only one lane at a time)");
   int mpi_up = 0;
-  QSMESH_CHECK(MPI_Initialized(&mpi_up) == MPI_SUCCESS, "PetscLane: MPI_Initialized failed");
+  QSMESH_CHECK(MPI_Initialized(&mpi_up) == MPI_SUCCESS, "SolverLane: MPI_Initialized failed");
   if (mpi_up == 0) PETSC_MPI_THREAD_REQUIRED = MPI_THREAD_SERIALIZED;
   // No options files: results must not depend on a user's ~/.petscrc. No signal handler either.
   static char arg0[] = "qsmesh";
@@ -63,27 +65,33 @@ PetscLane::PetscLane() {
   static char arg2[] = "-no_signal_handler";
   std::array<char*, 4> argv{arg0, arg1, arg2, nullptr};
   const PetscErrorCode init = PetscInitializeNoPointers(3, argv.data(), nullptr, nullptr);
-  QSMESH_CHECK(init == 0, "PetscLane: PetscInitialize failed with PETSc error code " << init);
+  QSMESH_CHECK(init == 0, "SolverLane: PetscInitialize failed with PETSc error code " << init);
   const PetscErrorCode pop = PetscPopSignalHandler();
-  const PetscErrorCode push = PetscPushErrorHandler(record_petsc_error, &last_error_);
+  const PetscErrorCode push = PetscPushErrorHandler(record_petsc_error, &own_error_);
   if (pop != 0 || push != 0) {
     PetscFinalize();
-    QSMESH_CHECK(false, "PetscLane: could not set PETSc's signal/error handlers (error codes "
+    QSMESH_CHECK(false, "SolverLane: could not set PETSc's signal/error handlers (error codes "
                             << pop << ", " << push << ")");
   }
 }
 
-PetscLane::~PetscLane() {
-  std::lock_guard lock(mutex_);
+SolverLane::SolverLane(SolverLane& rank_lane, const SolverGroup& group)
+    : owns_petsc_(false),
+      mutex_(&rank_lane.mutex()),
+      last_error_(&rank_lane.last_error()),
+      group_(&group) {}
+
+SolverLane::~SolverLane() {
+  if (!owns_petsc_) return;
+  std::lock_guard lock(own_mutex_);
   // Destructors cannot throw; a failing finalisation at exit has nothing left to protect.
   PetscPopErrorHandler();
   PetscFinalize();
 }
 
 namespace detail {
-namespace {
 
-[[noreturn]] void petsc_failed(PetscLane& lane, PetscErrorCode code, const char* call,
+[[noreturn]] void petsc_failed(SolverLane& lane, PetscErrorCode code, const char* call,
                                const char* file, int line) {
   std::ostringstream os;
   os << "petsc: " << call << " failed with error " << code;
@@ -93,14 +101,6 @@ namespace {
   throw Error(os.str());
 }
 
-// Checks the return code of a PETSc call; must be used while holding lane_->mutex().
-#define QSMESH_PETSC_CALL(call)                                            \
-  do {                                                                     \
-    const PetscErrorCode qsmesh_petsc_code_ = (call);                      \
-    if (qsmesh_petsc_code_ != 0) [[unlikely]]                              \
-      petsc_failed(*lane_, qsmesh_petsc_code_, #call, __FILE__, __LINE__); \
-  } while (false)
-
 PetscInt to_petsc_int(std::int64_t value, const char* what) {
   QSMESH_CHECK(value >= 0 && value <= std::numeric_limits<PetscInt>::max(),
                "petsc: " << what << " " << value << " does not fit PETSc's " << 8 * sizeof(PetscInt)
@@ -108,10 +108,12 @@ PetscInt to_petsc_int(std::int64_t value, const char* what) {
   return static_cast<PetscInt>(value);
 }
 
+namespace {
+
 // The SeqAIJ matrix of one pattern (PETSC_COMM_SELF) and its right-hand side and solution
 // vectors, as both PETSc backends hold them. Every method runs under the lane's lock.
 struct SeqSystem {
-  PetscLane* lane_;
+  SolverLane* lane_;
   Mat matrix = nullptr;
   Vec b = nullptr;
   Vec x = nullptr;
@@ -170,7 +172,7 @@ struct SeqSystem {
 
 class PetscSolver final : public LinearSolver {
  public:
-  explicit PetscSolver(PetscLane& lane) : lane_(&lane), sys_{&lane} {}
+  explicit PetscSolver(SolverLane& lane) : lane_(&lane), sys_{&lane} {}
   ~PetscSolver() override {
     std::lock_guard lock(lane_->mutex());
     destroy_all();
@@ -313,7 +315,7 @@ class PetscSolver final : public LinearSolver {
     lane_->last_error().clear();
   }
 
-  PetscLane* lane_;
+  SolverLane* lane_;
   SeqSystem sys_;
   Pattern pattern_;
   bool factorized_ = false;
@@ -329,7 +331,7 @@ class PetscSolver final : public LinearSolver {
 // CG + GAMG: the iterative alternative measured against the factorizations.
 class PetscMultigridSolver final : public LinearSolver {
  public:
-  PetscMultigridSolver(PetscLane& lane, double rtol, int block_size)
+  PetscMultigridSolver(SolverLane& lane, double rtol, int block_size)
       : lane_(&lane), rtol_(rtol), block_size_(block_size), sys_{&lane} {
     QSMESH_CHECK(block_size >= 1, "petsc multigrid: block size " << block_size << " is below 1");
     QSMESH_CHECK(rtol > 0 && rtol < 1,
@@ -417,7 +419,7 @@ class PetscMultigridSolver final : public LinearSolver {
     lane_->last_error().clear();
   }
 
-  PetscLane* lane_;
+  SolverLane* lane_;
   double rtol_;
   int block_size_;
   SeqSystem sys_;
@@ -426,15 +428,13 @@ class PetscMultigridSolver final : public LinearSolver {
   KSP ksp_ = nullptr;
 };
 
-#undef QSMESH_PETSC_CALL
-
 }  // namespace
 
-std::unique_ptr<LinearSolver> make_petsc_solver(PetscLane& lane) {
+std::unique_ptr<LinearSolver> make_petsc_solver(SolverLane& lane) {
   return std::make_unique<PetscSolver>(lane);
 }
 
-std::unique_ptr<LinearSolver> make_petsc_multigrid_solver(PetscLane& lane, double rtol,
+std::unique_ptr<LinearSolver> make_petsc_multigrid_solver(SolverLane& lane, double rtol,
                                                           int block_size) {
   return std::make_unique<PetscMultigridSolver>(lane, rtol, block_size);
 }

@@ -73,6 +73,10 @@ int Comm::size() const {
   return s;
 }
 
+std::unique_ptr<linalg::SolverGroup> Comm::solver_group() const {
+  return std::make_unique<linalg::SolverGroup>(&impl_->comm, rank(), size());
+}
+
 int Comm::local_size() const {
   MPI_Comm node = MPI_COMM_NULL;
   check_mpi(MPI_Comm_split_type(impl_->comm, MPI_COMM_TYPE_SHARED, 0, MPI_INFO_NULL, &node),

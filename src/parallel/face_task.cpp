@@ -33,6 +33,7 @@ CrossFieldOutput summarize(const crossfield::FaceCrossField& cf) {
   out.factorizations = cf.stats.factorizations;
   out.solves = cf.stats.solves;
   out.seconds = cf.stats.seconds;
+  out.solver = cf.stats.solver;
   return out;
 }
 
@@ -44,7 +45,7 @@ void mesh_background(FaceTask& task, const cad::CadModel& model,
 }
 
 void compute_cross_field(FaceTask& task, const crossfield::CrossFieldOptions& options,
-                         bool summarize_field, bool keep, linalg::PetscLane* lane) {
+                         bool summarize_field, bool keep, linalg::SolverLane* lane) {
   try {
     auto cf = std::make_unique<crossfield::FaceCrossField>(
         crossfield::compute_face_cross_field(task.background, options, lane));

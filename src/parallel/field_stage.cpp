@@ -6,7 +6,7 @@ namespace qsmesh::parallel {
 
 FieldFace mesh_task_by_field(const FaceTask& task, const cad::CadModel& model,
                              std::span<const mesh::CurveMesh> curves,
-                             const PipelineOptions& options, linalg::PetscLane* lane) {
+                             const PipelineOptions& options, linalg::SolverLane* lane) {
   FieldFace out;
   out.method = fieldmesh::face_method(task.face, options.given_fields, options.separatrix_method);
   if (out.method == fieldmesh::FaceMethod::Default) return out;

@@ -24,7 +24,8 @@ struct FieldFace {
 /// (`curves`), from the task's cross field for Separatrix (read while the task still holds it).
 [[nodiscard]] FieldFace mesh_task_by_field(const FaceTask& task, const cad::CadModel& model,
                                            std::span<const mesh::CurveMesh> curves,
-                                           const PipelineOptions& options, linalg::PetscLane* lane);
+                                           const PipelineOptions& options,
+                                           linalg::SolverLane* lane);
 
 /// Serial, on one face: a valid result becomes the task's mesh (QuasiReport::by_field); a failed
 /// one leaves the mesh and records the stage and reason (QuasiReport::field_refusal).

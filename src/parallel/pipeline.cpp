@@ -102,6 +102,71 @@ void each_face(const Context& cx, std::vector<FaceTask>& faces, const char* stag
   });
 }
 
+// An upper bound of the unknowns of a face's largest field system: two per edge of its background
+// triangulation (the cross field's heat systems; gluing seams only removes edges, and the
+// conformal scaling has one unknown per vertex).
+std::int64_t field_unknowns_bound(const mesh::FaceMesh& m) {
+  std::vector<std::uint64_t> keys;
+  keys.reserve(3 * m.triangles.size());
+  for (const auto& t : m.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const auto a = static_cast<std::uint32_t>(std::min(t[k], t[(k + 1) % 3]));
+      const auto b = static_cast<std::uint32_t>(std::max(t[k], t[(k + 1) % 3]));
+      keys.push_back(std::uint64_t{a} << 32 | b);
+    }
+  std::sort(keys.begin(), keys.end());
+  return 2 * static_cast<std::int64_t>(std::unique(keys.begin(), keys.end()) - keys.begin());
+}
+
+// The faces whose field systems may reach SolverOptions::distributed_threshold (every rank, in
+// face order): their fields are computed by all ranks together (shared_cross_fields). Collective.
+std::vector<LO> shared_field_faces(const Context& cx, const std::vector<FaceTask>& faces) {
+  std::vector<std::int64_t> bound(static_cast<std::size_t>(cx.model.num_faces()), 0);
+  for (const FaceTask& t : faces) bound[t.face] = field_unknowns_bound(t.background);
+  cx.comm.allreduce_sum(bound);
+  std::vector<LO> shared;
+  for (LO f = 0; f < cx.model.num_faces(); ++f)
+    if (bound[f] >= cx.options.crossfield.solver.distributed_threshold) shared.push_back(f);
+  return shared;
+}
+
+// The cross fields of the shared faces, one face after the other, each by every rank of the
+// communicator: a rank that does not own the face triangulates its background again (the
+// background is deterministic), every rank builds the face's systems, and those above the
+// distributed threshold are solved by the ranks together through a group lane (linalg splits
+// the rows and gives every rank the whole, correctly rounded, solution), so every rank ends with
+// the same field; the owner keeps it. Collective, on the calling thread.
+void shared_cross_fields(const Context& cx, std::span<const mesh::CurveMesh> curves,
+                         std::vector<FaceTask>& faces, const std::vector<LO>& shared, bool keep,
+                         linalg::SolverLane& lane) {
+  const std::unique_ptr<linalg::SolverGroup> group = cx.comm.solver_group();
+  for (const LO f : shared) {
+    const Stopwatch face_clock;
+    FaceTask other;
+    auto mine =
+        std::find_if(faces.begin(), faces.end(), [f](const FaceTask& t) { return t.face == f; });
+    FaceTask& t = mine != faces.end() ? *mine : other;
+    if (mine == faces.end()) {
+      other.face = f;
+      mesh_background(other, cx.model, curves, cx.options.background);
+    }
+    linalg::SolverLane group_lane(lane, *group);
+    compute_cross_field(t, cx.options.crossfield, cx.options.cross_fields, keep, &group_lane);
+    const linalg::DistributedReport& report = group_lane.report();
+    if (cx.options.cross_fields) {
+      t.field_summary.solver_ranks = report.ranks;
+      t.field_summary.rows_per_rank = report.rows_per_rank;
+    }
+    t.times.crossfield = face_clock.seconds();
+    std::string rows;
+    for (const LO r : report.rows_per_rank) rows += cat(" ", r);
+    cx.log.info(cat("crossfield: face ", f, ": ", report.systems, " systems split over ",
+                    report.ranks, " ranks (largest ", report.unknowns, " unknowns, rows per rank",
+                    rows, "), ", report.solves, " solves + ", report.refinement_steps,
+                    " refinement solves, ", face_clock.seconds(), " s"));
+  }
+}
+
 // Size map (paper 000 Sec. 4.1-4.2): curve sizes known to every rank, face fields on the faces'
 // ranks, their union on shared curves by an MPI min-reduction, then the faces again. Returns the
 // united curve sizes (every rank); fills each task's sizes.
@@ -966,7 +1031,7 @@ GroupsForOutput apply_smooth_groups(const cad::CadModel& model, std::vector<Grou
 
 PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
                             const PipelineOptions& options, const TaskArena& tasks, Logger& log,
-                            linalg::PetscLane* lane) {
+                            linalg::SolverLane* lane) {
   PipelineResult result;
   const Context cx{comm, model, options, tasks, log};
   const int rank = comm.rank();
@@ -1031,11 +1096,16 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
 
   if (options.cross_fields || keep_fields) {
     clock.start();
+    // Faces too large for one rank: computed below by all ranks together.
+    const std::vector<LO> shared =
+        lane != nullptr ? shared_field_faces(cx, faces) : std::vector<LO>{};
     each_face(cx, faces, "crossfield", [&](FaceTask& t) {
+      if (std::binary_search(shared.begin(), shared.end(), t.face)) return;
       const Stopwatch face_clock;
       compute_cross_field(t, options.crossfield, options.cross_fields, keep_fields, lane);
       t.times.crossfield = face_clock.seconds();
     });
+    if (!shared.empty()) shared_cross_fields(cx, curves, faces, shared, keep_fields, *lane);
     clock.end("crossfield", true);
   }
 

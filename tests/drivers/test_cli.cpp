@@ -42,6 +42,22 @@ TEST(Cli, MeshOptions) {
   EXPECT_NE(help("mesh").find("--face-time-budget"), std::string::npos);
 }
 
+TEST(Cli, DistributedThreshold) {
+  EXPECT_FALSE(p({"mesh", "m.step", "-o", "o.vtu"}).distributed_threshold.has_value());
+  EXPECT_EQ(
+      *p({"mesh", "m.step", "-o", "o.vtu", "--distributed-threshold", "300"}).distributed_threshold,
+      300);
+  EXPECT_EQ(*p({"crossfield", "m.step", "--check", "--distributed-threshold", "1e6"})
+                 .distributed_threshold,
+            1000000);
+  for (const char* bad : {"0", "-5", "2.5", "x", "3e9"})
+    EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--distributed-threshold", bad})
+                  .find("--distributed-threshold"),
+              std::string::npos)
+        << bad;
+  EXPECT_NE(help("mesh").find("--distributed-threshold"), std::string::npos);
+}
+
 TEST(Cli, CrossFieldAndSeparatrixMethod) {
   const Arguments a =
       p({"mesh", "m.step", "-o", "o.vtu", "--cross-field", "f.txt", "--method", "separatrix"});

@@ -24,19 +24,19 @@ namespace {
 // and MPI cannot be initialised twice in a process.
 class LaneEnvironment : public ::testing::Environment {
  public:
-  void SetUp() override { lane_ = std::make_unique<PetscLane>(); }
+  void SetUp() override { lane_ = std::make_unique<SolverLane>(); }
   void TearDown() override { lane_.reset(); }
-  static PetscLane* lane() { return lane_.get(); }
+  static SolverLane* lane() { return lane_.get(); }
 
  private:
-  static inline std::unique_ptr<PetscLane> lane_;
+  static inline std::unique_ptr<SolverLane> lane_;
 };
 [[maybe_unused]] auto* const kLaneEnvironment =
     ::testing::AddGlobalTestEnvironment(new LaneEnvironment);
 
-PetscLane& lane() {
-  PetscLane* l = LaneEnvironment::lane();
-  if (l == nullptr) throw Error("test: no PetscLane");
+SolverLane& lane() {
+  SolverLane* l = LaneEnvironment::lane();
+  if (l == nullptr) throw Error("test: no SolverLane");
   return *l;
 }
 
@@ -265,7 +265,7 @@ TEST(Solvers, MultigridSolvesToItsToleranceAndAgreesWithTheFactorization) {
       Error);
 }
 
-TEST(Solvers, SecondLaneIsRejected) { EXPECT_THROW(PetscLane second, Error); }
+TEST(Solvers, SecondLaneIsRejected) { EXPECT_THROW(SolverLane second, Error); }
 
 TEST(Solvers, EmptySystem) {
   const SparseMatrix A(0, std::span<const SparseMatrix::Triplet>{});

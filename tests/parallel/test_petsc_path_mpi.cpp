@@ -35,7 +35,7 @@ TEST(PetscPath, FaceAboveTheThresholdIsSolvedByPetscAlikeOnEveryRankCount) {
   options.until = Stage::Unstructured;
   std::ostringstream sink;
   Logger log(sink, LogLevel::Quiet);
-  linalg::PetscLane lane;  // one per process, as the drivers make it
+  linalg::SolverLane lane;  // one per process, as the drivers make it
   const PipelineResult dist = run_pipeline(comm, model, options, TaskArena(2), log, &lane);
   if (comm.rank() != 0) return;
 

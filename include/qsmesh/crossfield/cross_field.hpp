@@ -101,7 +101,7 @@ struct FaceCrossField {
 /// or a solver failure; the caller logs the face and falls back.
 [[nodiscard]] FaceCrossField compute_face_cross_field(const mesh::FaceMesh& background,
                                                       const CrossFieldOptions& options,
-                                                      linalg::PetscLane* lane);
+                                                      linalg::SolverLane* lane);
 
 /// The constant C of Sec. 3.3 giving about n_quads quads: C = -1/2 ln(N / ∫ e^{-2H}), the integral
 /// over the glued triangulation (per triangle, the mean of e^{-2H} at its vertices times its area).

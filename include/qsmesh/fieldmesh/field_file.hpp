@@ -75,6 +75,6 @@ enum class FaceMethod {
                                                  FaceMethod method, const GivenFaceField* given,
                                                  const FieldSamples* own,
                                                  const FieldMeshOptions& options,
-                                                 linalg::PetscLane* lane, FieldMeshReport* report);
+                                                 linalg::SolverLane* lane, FieldMeshReport* report);
 
 }  // namespace qsmesh::fieldmesh

@@ -44,7 +44,7 @@ struct Frame {
 /// t = (bounding-box diagonal)^2, and normalised at every vertex. Solved through linalg (`lane`
 /// may be null). Throws qsmesh::Error at a pole or where the diffused vector vanishes.
 [[nodiscard]] Frame face_frame(const mesh::FaceMesh& tri, const cad::FaceGeometry& surface,
-                               linalg::PetscLane* lane);
+                               linalg::SolverLane* lane);
 
 /// Angle (radians, modulo pi/2) of the cross of Eq. 2 at every vertex of `tri`, measured from
 /// frame.ref: sum_i d_i / 4 arg(z - a_i), z and a_i the parameter-plane images (a_i projected on
@@ -142,13 +142,11 @@ struct FieldMeshReport {
 /// dim 2 on f); on failure an empty mesh and report->ok false with the stage and the reason. An
 /// incompatible field (Eq. 11 or 16) fails at stage "compatibility"; never throws for a face-level
 /// failure.
-[[nodiscard]] mesh::FaceMesh mesh_face_from_field(const cad::CadModel& model, LO f,
-                                                  std::span<const mesh::CurveMesh> curves,
-                                                  const mesh::FaceMesh& tri, const Frame& frame,
-                                                  std::span<const double> theta,
-                                                  std::span<const SingularPoint> given,
-                                                  const FieldMeshOptions& options,
-                                                  linalg::PetscLane* lane, FieldMeshReport* report);
+[[nodiscard]] mesh::FaceMesh mesh_face_from_field(
+    const cad::CadModel& model, LO f, std::span<const mesh::CurveMesh> curves,
+    const mesh::FaceMesh& tri, const Frame& frame, std::span<const double> theta,
+    std::span<const SingularPoint> given, const FieldMeshOptions& options, linalg::SolverLane* lane,
+    FieldMeshReport* report);
 
 /// Compatibility of `theta` with face f (the loops of `tri`'s boundary, corner indices from the
 /// corner angles by Table 1: I = (2 - round(angle / 90 deg)) / 4, or d / 4 at the boundary points

@@ -86,7 +86,7 @@ struct HolomorphicBasis {
 /// or the conjugate system is singular (a degenerate triangulation). `lane` may be null (Eigen).
 [[nodiscard]] HolomorphicBasis holomorphic_basis(const PolyAnnulus& surface,
                                                  const BasisOptions& options,
-                                                 linalg::PetscLane* lane);
+                                                 linalg::SolverLane* lane);
 
 /// The real combination sum_k lambda[k] phi_k, per edge.
 [[nodiscard]] std::vector<std::complex<double>> combine(const HolomorphicBasis& basis,

@@ -50,12 +50,48 @@ class SparseMatrix {
   std::vector<double> values_;
 };
 
-/// PETSc in Debian is not thread-safe: every PETSc call of a rank goes through its one lane, which
-/// serialises them. Created once per process by the driver, after MPI and before any solve, and
-/// passed down; it initialises PETSc on construction and finalises it on destruction.
+/// Ranks that solve one system together: a communicator made by src/parallel
+/// (parallel::Comm::solver_group) and handed to linalg opaque, so that neither MPI nor PETSc
+/// reaches a kernel's signature. The communicator must outlive the group.
+class SolverGroup {
+ public:
+  /// `mpi_comm` points at an MPI_Comm (src/parallel only); `rank` and `size` are this rank's place
+  /// in it and its size.
+  SolverGroup(const void* mpi_comm, int rank, int size);
+  ~SolverGroup();
+  SolverGroup(const SolverGroup&) = delete;
+  SolverGroup& operator=(const SolverGroup&) = delete;
+  [[nodiscard]] int rank() const { return rank_; }
+  [[nodiscard]] int size() const { return size_; }
+  /// The MPI_Comm, for src/linalg.
+  [[nodiscard]] const void* native() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  int rank_ = 0, size_ = 1;
+};
+
+/// What the distributed solves made with a group lane did (SolverLane's second constructor), for
+/// reports and for tests that check the solve really was split.
+struct DistributedReport {
+  int ranks = 0;                  ///< size of the group (0: no system was solved distributed)
+  int systems = 0;                ///< systems analysed distributed
+  LO unknowns = 0;                ///< the largest of them
+  std::vector<LO> rows_per_rank;  ///< of the largest: the rows each rank of the group assembled
+  int solves = 0;                 ///< right-hand sides solved distributed
+  int refinement_steps = 0;       ///< iterative-refinement solves on top of them (all solves)
+};
+
+/// Where a rank's solves run. PETSc in Debian is not thread-safe: every PETSc call of a rank goes
+/// through its one lane, which serialises them. Kernels take a lane pointer and pass it to
+/// make_solver; they see neither PETSc nor MPI.
 ///
-/// - At most one lane exists at a time in a process (the constructor throws qsmesh::Error when
-///   PETSc is already initialised). Every solver made with a lane must be destroyed before it.
+/// The rank's lane (first constructor) is created once per process by the driver, after MPI and
+/// before any solve, and passed down; it initialises PETSc on construction and finalises it on
+/// destruction. Its systems are solved on the rank alone (PETSC_COMM_SELF).
+/// - At most one rank lane exists at a time in a process (the constructor throws qsmesh::Error
+///   when PETSc is already initialised). Every solver made with a lane must be destroyed before it.
 /// - MPI: when MPI is already initialised (by the driver), PETSc uses it and the lane leaves it
 ///   running; the driver should ask for MPI_THREAD_SERIALIZED, since solver calls come from worker
 ///   threads (one at a time). When MPI is not initialised, PETSc initialises it (asking for
@@ -64,21 +100,46 @@ class SparseMatrix {
 /// - No options file is read (~/.petscrc, ./.petscrc); the PETSC_OPTIONS environment variable
 ///   still applies (debugging aid). PETSc's signal handler is removed so crashes are not hijacked,
 ///   and PETSc's error printing is replaced by qsmesh::Error exceptions carrying its message.
-class PetscLane {
+///
+/// A group lane (second constructor) is for a collective phase: it shares the rank lane's PETSc
+/// and lock, and a system of at least SolverOptions::distributed_threshold unknowns made with it
+/// is solved by all ranks of the group together (MUMPS on a distributed matrix, each rank
+/// assembling its contiguous block of rows). Every rank of the group must then make the same
+/// solver calls, in the same order, with the same matrices and right-hand sides (each rank builds
+/// the whole system: the callers are deterministic), and gets the whole solution. Solutions are
+/// refined until they no longer change (residuals in twice the working precision), so that they
+/// are the correctly rounded solution whatever the group's size: the same bits at 1, 2 or 4 ranks
+/// (except, with a probability of about cond(A) 1e-16 per unknown, one last bit where the exact
+/// solution lies halfway between two doubles).
+class SolverLane {
  public:
-  PetscLane();
-  ~PetscLane();
-  PetscLane(const PetscLane&) = delete;
-  PetscLane& operator=(const PetscLane&) = delete;
-  [[nodiscard]] std::mutex& mutex() { return mutex_; }
+  SolverLane();
+  SolverLane(SolverLane& rank_lane, const SolverGroup& group);
+  ~SolverLane();
+  SolverLane(const SolverLane&) = delete;
+  SolverLane& operator=(const SolverLane&) = delete;
+  [[nodiscard]] std::mutex& mutex() { return *mutex_; }
   /// Message of the last PETSc error raised under this lane (for src/linalg's error reports).
   /// Read and written only while holding mutex().
-  [[nodiscard]] std::string& last_error() { return last_error_; }
+  [[nodiscard]] std::string& last_error() { return *last_error_; }
+  /// The group of a group lane; null for the rank's lane.
+  [[nodiscard]] const SolverGroup* group() const { return group_; }
+  /// The distributed solves made so far with this lane (group lanes only).
+  [[nodiscard]] const DistributedReport& report() const { return report_; }
+  [[nodiscard]] DistributedReport& report() { return report_; }
 
  private:
-  std::mutex mutex_;
-  std::string last_error_;
+  bool owns_petsc_ = true;
+  std::mutex own_mutex_;
+  std::string own_error_;
+  std::mutex* mutex_ = &own_mutex_;
+  std::string* last_error_ = &own_error_;
+  const SolverGroup* group_ = nullptr;
+  DistributedReport report_;
 };
+
+/// The former name of SolverLane.
+using PetscLane = SolverLane;
 
 /// Eigen: sparse LDLT. Petsc: MUMPS Cholesky. PetscMultigrid: conjugate gradients preconditioned
 /// by PETSc's algebraic multigrid (GAMG), to SolverOptions::multigrid_rtol: its cost per solve
@@ -98,6 +159,11 @@ struct SolverOptions {
   /// Backend::PetscMultigrid: unknowns per node (the cross field's 2 per edge), so that GAMG
   /// aggregates nodes rather than separate components. The system size must be a multiple of it.
   int block_size = 1;
+  /// A group lane (SolverLane's second constructor): systems with at least this many unknowns are
+  /// solved by the group's ranks together, smaller ones as by the rank's lane. A system must be
+  /// large for the split to pay: the ranks exchange the factors' fronts, and every rank still
+  /// assembles the whole system (docs/benchmarks.md, "A face's system split over ranks").
+  LO distributed_threshold = 2000000;
 };
 
 /// A direct solver for symmetric positive definite systems.
@@ -115,8 +181,10 @@ class LinearSolver {
 };
 
 /// A solver for an n x n system. `lane` may be null: then Eigen is used whatever the size (and
-/// Backend::Petsc throws). Safe to call from many threads; each solver object is used by one.
+/// Backend::Petsc throws). A group lane and n >= options.distributed_threshold (Automatic or
+/// Petsc): MUMPS Cholesky over the group's ranks, a collective object (see SolverLane). Safe to
+/// call from many threads; each solver object is used by one.
 [[nodiscard]] std::unique_ptr<LinearSolver> make_solver(LO n, const SolverOptions& options,
-                                                        PetscLane* lane);
+                                                        SolverLane* lane);
 
 }  // namespace qsmesh::linalg

@@ -8,10 +8,12 @@
 #include <string>
 #include <vector>
 
+#include "qsmesh/linalg/solver.hpp"
+
 namespace qsmesh::parallel {
 
 /// Initialises MPI (thread level SERIALIZED: MPI is called from the main thread, except PETSc
-/// solves, which run on worker threads one at a time through linalg::PetscLane, and SharedCounter
+/// solves, which run on worker threads one at a time through linalg::SolverLane, and SharedCounter
 /// and SharedBytes, whose calls are serialised by their communicator's lock in stages without
 /// PETSc) and finalises it on
 /// destruction. Exactly one per process, created by the driver's main().
@@ -40,6 +42,9 @@ class Comm {
   [[nodiscard]] int size() const;
   /// Number of ranks of this communicator running on this rank's node (shared memory).
   [[nodiscard]] int local_size() const;
+  /// These ranks as a linalg::SolverGroup (the communicator opaque to linalg), for a group lane
+  /// whose large systems are split over them. Valid while this Comm (or a copy) lives.
+  [[nodiscard]] std::unique_ptr<linalg::SolverGroup> solver_group() const;
   void barrier() const;
 
   /// Element-wise sum over ranks, result on every rank.

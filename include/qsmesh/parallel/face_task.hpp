@@ -169,6 +169,11 @@ struct CrossFieldOutput {
   crossfield::EulerCheck euler;
   int levels = 0, factorizations = 0, solves = 0;
   double seconds = 0;
+  std::string solver;  ///< the heat systems' solver (crossfield::CrossFieldStats::solver)
+  /// A face whose systems were split over ranks (PipelineOptions: SolverOptions::
+  /// distributed_threshold): the ranks, and the rows each assembled of the largest system.
+  int solver_ranks = 0;
+  std::vector<LO> rows_per_rank;
   /// Every field, once (visit(name, member)): what the ranks exchange (parallel/record.hpp).
   template <class S, class V>
   static void fields(S& self, V&& visit) {
@@ -183,6 +188,9 @@ struct CrossFieldOutput {
     visit("factorizations", self.factorizations);
     visit("solves", self.solves);
     visit("seconds", self.seconds);
+    visit("solver", self.solver);
+    visit("solver_ranks", self.solver_ranks);
+    visit("rows_per_rank", self.rows_per_rank);
   }
 };
 
@@ -299,7 +307,7 @@ void mesh_background(FaceTask& task, const cad::CadModel& model,
 /// task.cross_field (shrunk to what they read when not summarized). A face whose field throws
 /// gets field_summary.error (with stage and face id) and no field: later stages fall back.
 void compute_cross_field(FaceTask& task, const crossfield::CrossFieldOptions& options,
-                         bool summarize, bool keep, linalg::PetscLane* lane);
+                         bool summarize, bool keep, linalg::SolverLane* lane);
 
 /// The gathered view of a face: what rank 0 assembles and reports. Every field is exchanged
 /// (fields()); parts of stages that did not run stay empty.

@@ -238,7 +238,7 @@ struct PipelineResult {
 /// this rank's PETSc solves (null: Eigen only).
 [[nodiscard]] PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
                                           const PipelineOptions& options, const TaskArena& tasks,
-                                          Logger& log, linalg::PetscLane* lane = nullptr);
+                                          Logger& log, linalg::SolverLane* lane = nullptr);
 
 /// Estimated cost of meshing each face (area / size^2), the METIS vertex weights.
 [[nodiscard]] std::vector<double> estimate_face_costs(const cad::CadModel& model, double size);
