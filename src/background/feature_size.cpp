@@ -213,7 +213,8 @@ void limit_by_feature_distance(const cad::CadModel& model,
 
 void limit_by_face_width(const cad::CadModel& model, std::span<const std::vector<Vec3>> polylines,
                          std::vector<std::vector<double>>& sizes, double touching,
-                         double wedge_touching, double sliver, const TaskArena& tasks) {
+                         double wedge_touching, double sliver, const TaskArena& tasks,
+                         bool shared_wedges_only) {
   // The faces of each curve, sorted: two curves are sides of one face when the lists intersect.
   const std::vector<std::vector<LO>> faces = faces_of_curves(model, polylines.size());
   const auto share_face = [&](LO a, LO b) {
@@ -269,9 +270,11 @@ void limit_by_face_width(const cad::CadModel& model, std::span<const std::vector
         if (std::isfinite(r)) {
           // The tip, where the sides are closer than wedge_touching, is one edge
           // (sharp_wedge_tips): the tail's grading stops there.
-          if (!(d < sharp * r) || !(d > wedge_touching) || !own_wedge_sides(faces, c, other))
-            return 0;
-          scale = 0.75;
+          if (!(d < sharp * r) || !(d > wedge_touching)) return 0;
+          if (own_wedge_sides(faces, c, other) == shared_wedges_only) return 0;
+          scale = shared_wedges_only ? 1.0 : 0.75;
+        } else if (shared_wedges_only) {
+          return 0;
         }
         for (const LO a : model.curves()[c].corners)
           for (const LO b : model.curves()[other].corners) {

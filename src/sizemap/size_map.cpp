@@ -44,6 +44,12 @@ constexpr double kThinTouching = 0.01;
 /// them to 0.2 and above (76 -> 84 quads; docs/benchmarks.md, issue 29).
 constexpr double kThinGradation = 0.5;
 
+/// The cap past the tips of extruded sharp wedges, as a fraction of thin_aspect (see
+/// initial_curve_sizes): the 5-degree prism's quads just past the tips at 0.75 0.192, at 0.6
+/// above 0.2. Applied to wedges whose sides bound other faces everywhere, it took t20_data from
+/// 72 to 132 interior irregular vertices (docs/benchmarks.md, issue 29).
+constexpr double kSharedWedgeAspect = 0.6;
+
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 [[noreturn]] void input_error(const std::string& what) { throw InputError("sizemap: " + what); }
@@ -275,13 +281,52 @@ CurveSizes initial_curve_sizes(const cad::CadModel& model, std::span<const mesh:
       const double touching = 0.1 * floor;
       // The thin-face widths are searched within half the size before (ii): wider faces are not
       // thin. Taken from the same densified polylines, before h is lowered by (ii).
-      std::vector<std::vector<double>> width;
+      std::vector<std::vector<double>> width, shared_width;
+      std::vector<char> shared_ok;
       if (options.thin_aspect > 0) {
         width = h;
         for (auto& w : width)
           for (double& x : w) x *= 0.5;
         background::limit_by_face_width(model, dense, width, kThinTouching * floor, touching, floor,
                                         tasks);
+        // The tails of sharp wedges whose sides also bound other faces are left to the tips
+        // above, except where each such side's other faces are four-sided and carry the counts
+        // to an opposite side that is such a tail too (an extruded wedge: the 5-degree prism of
+        // tests/drivers/test_thin_regions.cpp, whose quads just past the tips were at SICN 0.171):
+        // there the stretch past the tip narrower than a quarter of the size is capped at
+        // kSharedWedgeAspect x K x its width.
+        {
+          shared_width = h;
+          for (auto& w : shared_width)
+            for (double& x : w) x *= 0.5;
+          background::limit_by_face_width(model, dense, shared_width, kThinTouching * floor,
+                                          touching, floor, tasks, true);
+          std::vector<char> has(static_cast<std::size_t>(nc), 0);
+          for (LO c = 0; c < nc; ++c)
+            for (std::size_t k = 0; k < shared_width[c].size(); ++k)
+              if (shared_width[c][k] < 0.5 * h[c][k] * (1 - 1e-12)) has[c] = 1;
+          shared_ok.assign(static_cast<std::size_t>(nc), 0);
+          for (LO c = 0; c < nc; ++c) {
+            if (has[c] == 0) continue;
+            // Besides the wedge's own face, every face of the side carries its counts across
+            // to an opposite side that is such a tail too (an extruded wedge); elsewhere those
+            // counts need transitions (t20_data's chamfer slivers beside five- and six-sided
+            // faces).
+            int others = 0;
+            for (const LO f : model.curve2faces()[c]) {
+              const auto& face = model.faces()[f];
+              bool carried = false;
+              if (face.loops.size() == 1 && face.loops[0].uses.size() == 4) {
+                const auto& uses = face.loops[0].uses;
+                for (std::size_t k = 0; k < 4; ++k)
+                  if (uses[k].curve == c && has[uses[(k + 2) % 4].curve] != 0) carried = true;
+              }
+              if (!carried) ++others;
+            }
+            const bool ok = others <= 1;
+            shared_ok[c] = ok ? 1 : 0;
+          }
+        }
         // The tip of a sharp wedge is one edge. Where the tail behind it is graded (its sides
         // bound that face alone), the tip is where the sides are closer than `touching`, never
         // longer than the size: graded with the width down to the corner, the tail's quads would
@@ -313,6 +358,19 @@ CurveSizes initial_curve_sizes(const cad::CadModel& model, std::span<const mesh:
             if (w < 0.5 * before && options.thin_aspect * w <= s) {
               s = options.thin_aspect * w;
               thin[c][i] = 1;
+            }
+            if (!shared_width.empty() && shared_ok[c] != 0) {
+              const double sc = kSharedWedgeAspect;
+              const double ws = shared_width[c][original[c][i]];
+              bool in_tip = false;
+              for (const auto& tip : out.tips)
+                if (tip.curve == c &&
+                    distance(curves[c].points[i],
+                             tip.end == 0 ? curves[c].points.front() : curves[c].points.back()) <
+                        tip.length * 1.0000001)
+                  in_tip = true;
+              if (!in_tip && options.thin_aspect * ws < before && sc * options.thin_aspect * ws < s)
+                s = sc * options.thin_aspect * ws;
             }
           }
         }

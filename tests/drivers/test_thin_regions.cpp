@@ -287,12 +287,12 @@ TEST(ThinRegions, FiveDegreeCornerQuadsAwayFromItStayAboveSicnPointTwo) {
 }
 
 // The 5-degree wedge's polygon extruded by 2: the sides of each end face at the sharp corner also
-// bound the prism's side faces, so the tail keeps their sizes (graded, its counts would reach
-// them) and the tip quad takes the part of the tail thinner than 0.18 x the size: a quad past
-// it, half the width across and the size along, has SICN about 0.18. The bar for such
-// models is 0.1 away from the sharp corners; without the tips 0.102, with them 0.171 (0.155 with
-// tips of a sixth of the size).
-TEST(ThinRegions, PrismOfTheFiveDegreeCornerQuadsAwayFromItStayAbovePointOneFive) {
+// bound the prism's side faces, so the tail is left to the tip (graded, its counts would reach
+// them), which takes the part of the tail thinner than 0.18 x the size. The quads just past it,
+// half the width across and the size along, were at SICN 0.171. Each side face is four-sided and
+// carries the counts to the other end's tail, which asks the same: there the stretch past the tip
+// is capped at 0.6 K x its width, and those quads reach 0.2 (without the tips 0.102).
+TEST(ThinRegions, PrismOfTheFiveDegreeCornerQuadsAwayFromItStayAboveSicnPointTwo) {
   const double y = 6 * std::tan(5 * std::numbers::pi / 180);
   BRepBuilderAPI_MakePolygon polygon;
   for (const auto& [px, py] :
@@ -312,7 +312,7 @@ TEST(ThinRegions, PrismOfTheFiveDegreeCornerQuadsAwayFromItStayAbovePointOneFive
       on.sicn_min_away, on.quads, off.sicn_min_away, off.quads);
   EXPECT_EQ(on.quads_at_sharp_corner, (std::vector<int>{1, 1}));  // one per end face
   EXPECT_LT(off.sicn_min_away, 0.15);
-  EXPECT_GE(on.sicn_min_away, 0.15) << on.quads << " quads";
+  EXPECT_GE(on.sicn_min_away, 0.2) << on.quads << " quads";
 }
 
 }  // namespace

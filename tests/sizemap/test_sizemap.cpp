@@ -605,9 +605,13 @@ std::vector<std::pair<double, double>> wedge(double corner_deg) {
 TEST(SizeMap, ThinAspectLeavesWideFacesAndSidesMeetingAtACornerAlone) {
   // A 10 x 0.6 rectangle at size 1: 0.6 apart is more than half the size, not thin. A prism on a
   // triangle with a 3-degree corner: the long sides of its end faces are close near the corner and
-  // share it (a cusp's tail), but each also bounds a side face of the prism, which would take the
-  // tail's graded counts (see background::limit_by_face_width): the tail keeps its sizes, and the
-  // tip is where it is thinner than 0.18 x the size, x < 0.18 / sin(3 degrees) = 3.44.
+  // share it (a cusp's tail), but each also bounds a side face of the prism, which takes the
+  // tail's counts (see background::limit_by_face_width): the tail is not graded down to the
+  // corner, and the tip is where it is thinner than 0.18 x the size, x < 0.18 / sin(3 degrees)
+  // = 3.44. The side faces are four-sided and carry the counts to the other end's tail, which
+  // asks the same (an extruded wedge): past the tip, where the width is under a quarter of the
+  // size (x < 4.78), the sizes are capped at 0.6 K x the width, and the gradation takes them
+  // back to the tail's own sizes within (1 - 0.6 K w) / 0.2 of there.
   SizeMapOptions o;
   o.method = Method::Features;
   o.size_max = 1.0;
@@ -644,7 +648,18 @@ TEST(SizeMap, ThinAspectLeavesWideFacesAndSidesMeetingAtACornerAlone) {
         if (distance(pts[i], corner) < tip.length) {
           EXPECT_DOUBLE_EQ(on.at[tip.curve][i], tip.length);
         } else {
-          EXPECT_DOUBLE_EQ(on.at[tip.curve][i], off.at[tip.curve][i]);  // no graded tail
+          // Capped past the tip, never below 0.6 K x the tip's width (at least 0.8 x 0.18, as
+          // its length above); the rest as without K.
+          const double x = distance(pts[i], corner);
+          const double w = x * std::sin(3 * std::numbers::pi / 180);
+          EXPECT_LE(on.at[tip.curve][i], off.at[tip.curve][i] + 1e-12);
+          EXPECT_GE(on.at[tip.curve][i], 0.6 * 4 * 0.8 * 0.18);
+          if (w < 0.25 * 0.95) {
+            EXPECT_LE(on.at[tip.curve][i], 0.6 * 4 * w * (1 + 1e-6));
+          }
+          if (x > 4.78 + 2.5) {
+            EXPECT_DOUBLE_EQ(on.at[tip.curve][i], off.at[tip.curve][i]);
+          }
         }
       }
     }

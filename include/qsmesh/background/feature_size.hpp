@@ -36,10 +36,14 @@ void limit_by_feature_distance(const cad::CadModel& model,
 /// (the end of a strip, or the blunted tip of a wedge) count only where d is at most twice that
 /// curve's length (a strip as wide as its end) or less than sin(10 degrees) x the distance from the
 /// vertex to the joint (a wedge sharper than that). The distance is taken in space, so it is at
-/// most the width inside the face. Same inputs and determinism as limit_by_feature_distance.
+/// most the width inside the face. Sides sharing a corner count (at 3/4 of d) only where both
+/// bound that one face and no other; with `shared_wedges_only`, only the other sharp wedges'
+/// sides count (at d), and nothing else (sizemap: the tails of extruded wedges). Same inputs and
+/// determinism as limit_by_feature_distance.
 void limit_by_face_width(const cad::CadModel& model, std::span<const std::vector<Vec3>> polylines,
                          std::vector<std::vector<double>>& sizes, double touching,
-                         double wedge_touching, double sliver, const TaskArena& tasks);
+                         double wedge_touching, double sliver, const TaskArena& tasks,
+                         bool shared_wedges_only = false);
 
 /// Resolution inside sharp wedges (a cusp's tail): lowers sizes[c][k] to twice the distance d from
 /// polyline vertex k of curve c to another side of one of its faces that shares a corner with c,
