@@ -161,6 +161,10 @@ int run_crossfield(const Arguments& args) {
           .value("factorizations", cf.factorizations)
           .value("solves", cf.solves)
           .value("seconds", cf.seconds)
+          .value("solver", cf.solver)
+          .value("solver_ranks", cf.solver_ranks)  // split over ranks: --distributed-threshold
+          .value("rows_per_rank",
+                 std::vector<double>(cf.rows_per_rank.begin(), cf.rows_per_rank.end()))
           .end_object();
     }
     j.end_array();
