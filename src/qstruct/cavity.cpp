@@ -5,7 +5,6 @@
 #include <cmath>
 #include <limits>
 #include <optional>
-#include <set>
 #include <string>
 #include <tuple>
 #include <unordered_map>
@@ -265,15 +264,23 @@ class Grower {
         interior_.push_back(v);
         if (val != 4) ++irregular_inside_;
       }
-      if (!t_.on_boundary(v) && val - n_in_[v] == 1)
-        concave_.insert(v);
-      else
-        concave_.erase(v);
+      set_concave(v, !t_.on_boundary(v) && val - n_in_[v] == 1);
     }
     for (int k = 0; k < 4; ++k) {
       const LO nb = t_.neighbour(q, k);
       if (nb != kNoIndex && !in_[nb] && !frontier_flag_[nb]) push_frontier(nb);
     }
+  }
+
+  // concave_ is a sorted vector (a handful of vertices): a std::set allocated a node on every
+  // insertion, and add() and remove_last() update it for every vertex of every quad.
+  void set_concave(LO v, bool concave) {
+    const auto it = std::lower_bound(concave_.begin(), concave_.end(), v);
+    const bool held = it != concave_.end() && *it == v;
+    if (concave && !held)
+      concave_.insert(it, v);
+    else if (!concave && held)
+      concave_.erase(it);
   }
 
   // Centroids do not move during a growth: each quad's distance to the seed is computed once.
@@ -312,10 +319,7 @@ class Grower {
       if (n_in_[v] == 1) --corners_;
       --n_in_[v];
       if (n_in_[v] == 1) ++corners_;
-      if (!t_.on_boundary(v) && n_in_[v] > 0 && val - n_in_[v] == 1)
-        concave_.insert(v);
-      else
-        concave_.erase(v);
+      set_concave(v, !t_.on_boundary(v) && n_in_[v] > 0 && val - n_in_[v] == 1);
     }
   }
 
@@ -328,7 +332,8 @@ class Grower {
       ++res.no_pattern;
       return false;
     }
-    std::vector<LO> starts;
+    std::vector<LO>& starts = starts_;
+    starts.clear();
     bool simple = true;
     for (const LO q : quads_)
       for (int k = 0; k < 4; ++k) {
@@ -339,7 +344,8 @@ class Grower {
         next_[a] = b;
         starts.push_back(a);
       }
-    std::vector<LO> cycle;
+    std::vector<LO>& cycle = cycle_;
+    cycle.clear();
     if (simple && !starts.empty()) {
       LO v0 = kNoIndex;
       for (const LO v : starts)
@@ -442,11 +448,12 @@ class Grower {
   Vec3 seed_point_;
   std::vector<char> in_, frontier_flag_, forbidden_;
   std::vector<LO> n_in_, next_, quads_, frontier_, interior_;
+  std::vector<LO> starts_, cycle_;  // evaluate()'s boundary walk, kept for their capacity
   std::vector<double> frontier_d_;  // distance from each frontier_ quad's centroid to the seed
   LO corners_ = 0;                  // vertices in exactly one cavity quad
   static constexpr LO kMaxSides = 16;
   std::array<char, kMaxSides + 1> has_sides_{};  // a pattern has that many sides (last: or more)
-  std::set<LO> concave_;
+  std::vector<LO> concave_;                      // sorted: the concave vertices, smallest first
   int irregular_inside_ = 0, checked_irregular_ = 0;
 };
 

@@ -14,18 +14,7 @@
 namespace qsmesh::smooth {
 
 double quad_orientation(const mesh::FaceMesh& m, const cad::FaceGeometry& surface) {
-  double votes = 0;
-  for (const auto& q : m.quads) {
-    Vec3 s{};
-    for (int k = 0; k < 4; ++k)
-      s += cross(m.points[q[k]] - m.points[q[(k + 3) % 4]],
-                 m.points[q[(k + 1) % 4]] - m.points[q[k]]);
-    // The centroid uv of a quad along a seam may be meaningless; a vertex uv is not.
-    const Vec3 n = surface.normal(m.uv[q[0]]);
-    const double d = dot(s, n);
-    votes += d > 0 ? 1 : (d < 0 ? -1 : 0);
-  }
-  return votes >= 0 ? 1.0 : -1.0;
+  return detail::quad_orientation_with(m, [&](LO v) { return surface.normal(m.uv[v]); });
 }
 
 double oriented_sicn(const std::array<Vec3, 4>& x, const Vec3& normal, double sign) {

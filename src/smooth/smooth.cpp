@@ -173,6 +173,25 @@ class Smoother {
     quality_.resize(m_.quads.size());
   }
 
+  // The orientation of the quads against the surface normal (quad_orientation); set before the
+  // first quality is asked for (the cached qualities use it).
+  void set_sign(double sign) { sign_ = sign; }
+  [[nodiscard]] Vec3 normal_at(LO v) const { return vertex_normal(v); }
+
+  // forget_geometry() for the vertices with moved[v] alone: their normals, the qualities of their
+  // quads and every settled mark. A normal is a function of its (u, v) and a quality of its four
+  // corners and that normal, so what the others had is what recomputing would give, bit for bit
+  // (after the uv Laplacian, most of a cavity candidate's vertices are locked: recomputing their
+  // normals was a tenth of the smoothing).
+  void forget_moved(const std::vector<char>& moved) {
+    settled_.assign(m_.points.size(), 0);
+    for (LO v = 0; v < static_cast<LO>(moved.size()); ++v) {
+      if (!moved[v]) continue;
+      normal_ok_[v] = 0;
+      for (const LO q : t_.v2q[v]) quality_ok_[q] = 0;
+    }
+  }
+
   // Kernel targets go to the surface through the approximate surface when there is one, unless
   // `exact` (then by Gauss-Newton on the CAD surface from the current uv).
   void set_exact(bool exact) {
@@ -526,7 +545,10 @@ mesh::FaceMesh smooth_face(const mesh::FaceMesh& input, const cad::FaceGeometry&
         options.approximate_projection
             ? std::optional<ApproxSurface>(ApproxSurface::from_mesh(input))
             : std::nullopt;
-    Smoother sm(m, surface, topo, quad_orientation(m, surface), approx ? &*approx : nullptr);
+    // The orientation reads the normal at the first corner of each quad: the smoother's cache
+    // computes them once for both.
+    Smoother sm(m, surface, topo, 1.0, approx ? &*approx : nullptr);
+    sm.set_sign(detail::quad_orientation_with(m, [&](LO v) { return sm.normal_at(v); }));
     const LO nq = static_cast<LO>(m.quads.size());
 
     if (options.laplacian_uv) {
@@ -537,16 +559,24 @@ mesh::FaceMesh smooth_face(const mesh::FaceMesh& input, const cad::FaceGeometry&
         const std::vector<Vec2> uv0 = m.uv;
         const std::vector<Vec3> p0 = m.points;
         bool kept = laplacian_uv(m, topo, cache);
+        std::vector<char> moved;
         if (kept) {
+          moved.assign(m.points.size(), 0);
           for (LO v = 0; v < m.num_vertices(); ++v)
-            if (!(m.uv[v] == uv0[v])) m.points[v] = surface.eval(m.uv[v]).p;
-          sm.forget_geometry();
+            if (!(m.uv[v] == uv0[v])) {
+              m.points[v] = surface.eval(m.uv[v]).p;
+              moved[v] = 1;
+            }
+          sm.forget_moved(moved);
           kept = min_quality_all(sm, nq) >= q0;
         }
         if (!kept) {
           m.uv = uv0;
           m.points = p0;
-          sm.forget_geometry();
+          if (moved.empty())
+            sm.forget_geometry();
+          else
+            sm.forget_moved(moved);
         }
         st.method = kept ? "uv_laplacian" : "uv_laplacian(rejected)";
       }
