@@ -60,6 +60,9 @@ FaceOutput full_output() {
   o.cross_field.factorizations = 2;
   o.cross_field.solves = 9;
   o.cross_field.seconds = 0.125;
+  o.cross_field.solver = "petsc/mumps-cholesky-mpi2";
+  o.cross_field.solver_ranks = 2;
+  o.cross_field.rows_per_rank = {407, 408};
   o.sizes.s = {1, 2, 3};
   o.sizes.s_min = {0.5, 2, 3};
   o.sizes.s_cf = {4};
@@ -108,9 +111,9 @@ FaceOutput full_output() {
 TEST(Pack, EveryFieldOfAFaceOutputRoundTrips) {
   const FaceOutput a = full_output();
   // 12 parts; the counts of their fields: mesh 1 (packed whole), background report 5, cross field
-  // 11, sizes 3, unstructured 7, quasi 11 + improvement 8, stats 7, seconds 1, times 16, field
+  // 14, sizes 3, unstructured 7, quasi 11 + improvement 8, stats 7, seconds 1, times 16, field
   // grids 1 (a vector of records), a smooth group's quad faces 1 and first face 1.
-  ASSERT_EQ(count_fields(a), 1 + 5 + 11 + 3 + 7 + 19 + 7 + 1 + 16 + 1 + 2)
+  ASSERT_EQ(count_fields(a), 1 + 5 + 14 + 3 + 7 + 19 + 7 + 1 + 16 + 1 + 2)
       << "a field was added to a report: set it in full_output() and check it here";
   std::vector<char> buf;
   write_record(buf, a);
@@ -138,6 +141,9 @@ TEST(Pack, EveryFieldOfAFaceOutputRoundTrips) {
   ASSERT_EQ(b.cross_field.directions.size(), 1U);
   EXPECT_EQ(b.cross_field.directions[0][1].y, 1.0);
   EXPECT_EQ(b.cross_field.u_norm, a.cross_field.u_norm);
+  EXPECT_EQ(b.cross_field.solver, a.cross_field.solver);
+  EXPECT_EQ(b.cross_field.solver_ranks, 2);
+  EXPECT_EQ(b.cross_field.rows_per_rank, a.cross_field.rows_per_rank);
   EXPECT_EQ(b.cross_field.H, a.cross_field.H);
   ASSERT_EQ(b.cross_field.singularities.size(), 1U);
   EXPECT_EQ(b.cross_field.singularities[0].index, -1);
