@@ -2,6 +2,7 @@
 #pragma once
 
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "qsmesh/core/error.hpp"
@@ -25,6 +26,17 @@ class Pattern {
         backend << ": factorize() on a matrix whose pattern differs from the analysed one ("
                 << A.size() << " unknowns, " << A.nonzeros() << " nonzeros; analysed " << n_ << ", "
                 << cols_.size() << ")");
+  }
+  /// The checks before a solve: a successful factorization (`ready`), and b and x of the analysed
+  /// size. Returns that size.
+  std::size_t check_solve(bool ready, std::span<const double> b, std::span<const double> x,
+                          const char* backend) const {
+    QSMESH_CHECK(ready, backend << ": solve() without a successful factorize()");
+    const auto n = static_cast<std::size_t>(n_);
+    QSMESH_CHECK(b.size() == n && x.size() == n, backend << ": solve() with vectors of " << b.size()
+                                                         << " and " << x.size()
+                                                         << " entries for a system of size " << n);
+    return n;
   }
 
  private:

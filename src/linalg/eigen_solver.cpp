@@ -107,11 +107,7 @@ class EigenSolver final : public LinearSolver {
   }
 
   void solve(std::span<const double> b, std::span<double> x) override {
-    QSMESH_CHECK(factorized_, "eigen: solve() without a successful factorize()");
-    const auto n = static_cast<std::size_t>(pattern_.size());
-    QSMESH_CHECK(b.size() == n && x.size() == n, "eigen: solve() with vectors of "
-                                                     << b.size() << " and " << x.size()
-                                                     << " entries for a system of size " << n);
+    const std::size_t n = pattern_.check_solve(factorized_, b, x, "eigen");
     const Eigen::Map<const Eigen::VectorXd> bm(b.data(), static_cast<Eigen::Index>(n));
     Eigen::Map<Eigen::VectorXd> xm(x.data(), static_cast<Eigen::Index>(n));
     // SimplicialLDLT's solve with its permutation: P b, the triangular and diagonal solves, P^-1.

@@ -1,9 +1,11 @@
 // Private to src/linalg: what the PETSc backends share (error checking, index conversion).
 #pragma once
 
+#include <petscmat.h>
 #include <petscsys.h>
 
 #include <cstdint>
+#include <string>
 
 #include "qsmesh/linalg/solver.hpp"
 
@@ -15,6 +17,18 @@ namespace qsmesh::linalg::detail {
 
 /// `value` as a PETSc index; throws when it does not fit.
 PetscInt to_petsc_int(std::int64_t value, const char* what);
+
+/// Marks `matrix` symmetric positive definite for good (the field systems are), so that the
+/// factorizations take their SPD paths. Under the lane's lock.
+void set_spd_options(SolverLane& lane, Mat matrix);
+
+/// Throws unless `factor`'s numeric factorization succeeded: PETSc reports a failure through the
+/// factor, not the return code (MatSetErrorIfFailure is off), and MUMPS's SPD path accepts
+/// negative pivots, so a Cholesky factor with any is refused too. `mumps`: the factor is MUMPS's
+/// (its INFOG(1) and INFOG(12) are read); `who` and `name` open and name the messages; `n` is the
+/// system's size. Under the lane's lock.
+void check_factorization(SolverLane& lane, Mat factor, bool mumps, MatFactorType type,
+                         const std::string& name, LO n, const char* who);
 
 }  // namespace qsmesh::linalg::detail
 

@@ -146,11 +146,7 @@ class PetscDistributedSolver final : public LinearSolver {
   }
 
   void solve(std::span<const double> b, std::span<double> x) override {
-    QSMESH_CHECK(factorized_, "petsc distributed: solve() without a successful factorize()");
-    const auto n = static_cast<std::size_t>(pattern_.size());
-    QSMESH_CHECK(b.size() == n && x.size() == n, "petsc distributed: solve() with vectors of "
-                                                     << b.size() << " and " << x.size()
-                                                     << " entries for a system of size " << n);
+    const std::size_t n = pattern_.check_solve(factorized_, b, x, "petsc distributed");
     if (n == 0) return;
     std::lock_guard lock(lane_->mutex());
     solve_gathered(b, x);
@@ -204,10 +200,7 @@ class PetscDistributedSolver final : public LinearSolver {
     QSMESH_PETSC_CALL(MatMPIAIJSetPreallocationCSR(matrix_, ia.data(), ja.data(),
                                                    A.values().data() + offsets[row0_]));
     QSMESH_PETSC_CALL(MatSetOption(matrix_, MAT_NEW_NONZERO_LOCATION_ERR, PETSC_TRUE));
-    QSMESH_PETSC_CALL(MatSetOption(matrix_, MAT_SYMMETRIC, PETSC_TRUE));
-    QSMESH_PETSC_CALL(MatSetOption(matrix_, MAT_SYMMETRY_ETERNAL, PETSC_TRUE));
-    QSMESH_PETSC_CALL(MatSetOption(matrix_, MAT_SPD, PETSC_TRUE));
-    QSMESH_PETSC_CALL(MatSetOption(matrix_, MAT_SPD_ETERNAL, PETSC_TRUE));
+    set_spd_options(*lane_, matrix_);
     QSMESH_PETSC_CALL(MatCreateVecs(matrix_, &x_, &b_));
     QSMESH_PETSC_CALL(VecScatterCreateToAll(x_, &to_all_, &x_all_));
 
@@ -281,20 +274,7 @@ class PetscDistributedSolver final : public LinearSolver {
   }
 
   void check_factor(LO n) {
-    MatFactorError error = MAT_FACTOR_NOERROR;
-    QSMESH_PETSC_CALL(MatFactorGetError(factor_, &error));
-    PetscInt infog1 = 0, negative_pivots = 0;
-    QSMESH_PETSC_CALL(MatMumpsGetInfog(factor_, 1, &infog1));
-    QSMESH_PETSC_CALL(MatMumpsGetInfog(factor_, 12, &negative_pivots));
-    QSMESH_CHECK(error == MAT_FACTOR_NOERROR && infog1 >= 0,
-                 "petsc distributed: numeric factorization ("
-                     << name_ << ") failed for a matrix of size " << n
-                     << ": the matrix is singular or not positive definite (PETSc factor error "
-                     << static_cast<int>(error) << ", MUMPS INFOG(1) " << infog1 << ")");
-    QSMESH_CHECK(type_ != MAT_FACTOR_CHOLESKY || negative_pivots == 0,
-                 "petsc distributed: the matrix of size "
-                     << n << " is not positive definite (" << negative_pivots
-                     << " negative pivots in " << name_ << ")");
+    check_factorization(*lane_, factor_, true, type_, name_, n, "petsc distributed");
   }
 
   void destroy_all() noexcept {

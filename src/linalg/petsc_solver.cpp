@@ -108,6 +108,35 @@ PetscInt to_petsc_int(std::int64_t value, const char* what) {
   return static_cast<PetscInt>(value);
 }
 
+void set_spd_options(SolverLane& lane, Mat matrix) {
+  SolverLane* const lane_ = &lane;  // QSMESH_PETSC_CALL's lane
+  QSMESH_PETSC_CALL(MatSetOption(matrix, MAT_SYMMETRIC, PETSC_TRUE));
+  QSMESH_PETSC_CALL(MatSetOption(matrix, MAT_SYMMETRY_ETERNAL, PETSC_TRUE));
+  QSMESH_PETSC_CALL(MatSetOption(matrix, MAT_SPD, PETSC_TRUE));
+  QSMESH_PETSC_CALL(MatSetOption(matrix, MAT_SPD_ETERNAL, PETSC_TRUE));
+}
+
+void check_factorization(SolverLane& lane, Mat factor, bool mumps, MatFactorType type,
+                         const std::string& name, LO n, const char* who) {
+  SolverLane* const lane_ = &lane;  // QSMESH_PETSC_CALL's lane
+  MatFactorError error = MAT_FACTOR_NOERROR;
+  QSMESH_PETSC_CALL(MatFactorGetError(factor, &error));
+  PetscInt infog1 = 0;
+  PetscInt negative_pivots = 0;
+  if (mumps) {
+    QSMESH_PETSC_CALL(MatMumpsGetInfog(factor, 1, &infog1));
+    QSMESH_PETSC_CALL(MatMumpsGetInfog(factor, 12, &negative_pivots));
+  }
+  QSMESH_CHECK(error == MAT_FACTOR_NOERROR && infog1 >= 0,
+               who << ": numeric factorization (" << name << ") failed for a matrix of size " << n
+                   << ": the matrix is singular or not positive definite (PETSc factor error "
+                   << static_cast<int>(error) << (mumps ? ", MUMPS INFOG(1) " : "")
+                   << (mumps ? std::to_string(infog1) : std::string()) << ")");
+  QSMESH_CHECK(type != MAT_FACTOR_CHOLESKY || negative_pivots == 0,
+               who << ": the matrix of size " << n << " is not positive definite ("
+                   << negative_pivots << " negative pivots in " << name << ")");
+}
+
 namespace {
 
 // The SeqAIJ matrix of one pattern (PETSC_COMM_SELF) and its right-hand side and solution
@@ -133,10 +162,7 @@ struct SeqSystem {
     QSMESH_PETSC_CALL(
         MatSeqAIJSetPreallocationCSR(matrix, ia.data(), ja.data(), A.values().data()));
     QSMESH_PETSC_CALL(MatSetOption(matrix, MAT_NEW_NONZERO_LOCATION_ERR, PETSC_TRUE));
-    QSMESH_PETSC_CALL(MatSetOption(matrix, MAT_SYMMETRIC, PETSC_TRUE));
-    QSMESH_PETSC_CALL(MatSetOption(matrix, MAT_SYMMETRY_ETERNAL, PETSC_TRUE));
-    QSMESH_PETSC_CALL(MatSetOption(matrix, MAT_SPD, PETSC_TRUE));
-    QSMESH_PETSC_CALL(MatSetOption(matrix, MAT_SPD_ETERNAL, PETSC_TRUE));
+    set_spd_options(*lane_, matrix);
     QSMESH_PETSC_CALL(MatCreateVecs(matrix, &x, &b));
   }
 
@@ -253,11 +279,7 @@ class PetscSolver final : public LinearSolver {
   }
 
   void solve(std::span<const double> b, std::span<double> x) override {
-    QSMESH_CHECK(factorized_, "petsc: solve() without a successful factorize()");
-    const auto n = static_cast<std::size_t>(pattern_.size());
-    QSMESH_CHECK(b.size() == n && x.size() == n, "petsc: solve() with vectors of "
-                                                     << b.size() << " and " << x.size()
-                                                     << " entries for a system of size " << n);
+    const std::size_t n = pattern_.check_solve(factorized_, b, x, "petsc");
     if (n == 0) return;
     std::lock_guard lock(lane_->mutex());
     sys_.load(b);
@@ -282,28 +304,9 @@ class PetscSolver final : public LinearSolver {
       QSMESH_PETSC_CALL(MatLUFactorSymbolic(factor_, sys_.matrix, row_order_, col_order_, &info_));
   }
 
-  // Under the lock: PETSc reports a failed numeric factorization through the factor, not the
-  // return code (MatSetErrorIfFailure is off), and MUMPS's SPD path accepts negative pivots.
   void check_factor(LO n) {
-    MatFactorError error = MAT_FACTOR_NOERROR;
-    QSMESH_PETSC_CALL(MatFactorGetError(factor_, &error));
-    PetscInt infog1 = 0;
-    PetscInt negative_pivots = 0;
-    const bool mumps = package_ == std::string(MATSOLVERMUMPS);
-    if (mumps) {
-      QSMESH_PETSC_CALL(MatMumpsGetInfog(factor_, 1, &infog1));
-      QSMESH_PETSC_CALL(MatMumpsGetInfog(factor_, 12, &negative_pivots));
-    }
-    QSMESH_CHECK(error == MAT_FACTOR_NOERROR && infog1 >= 0,
-                 "petsc: numeric factorization ("
-                     << name_ << ") failed for a matrix of size " << n
-                     << ": the matrix is singular or not positive definite (PETSc factor error "
-                     << static_cast<int>(error) << (mumps ? ", MUMPS INFOG(1) " : "")
-                     << (mumps ? std::to_string(infog1) : std::string()) << ")");
-    QSMESH_CHECK(type_ != MAT_FACTOR_CHOLESKY || negative_pivots == 0,
-                 "petsc: the matrix of size " << n << " is not positive definite ("
-                                              << negative_pivots << " negative pivots in " << name_
-                                              << ")");
+    check_factorization(*lane_, factor_, package_ == std::string(MATSOLVERMUMPS), type_, name_, n,
+                        "petsc");
   }
 
   // Under the lock. Never throws (runs in the destructor); a failing destroy leaks at worst.
@@ -374,11 +377,7 @@ class PetscMultigridSolver final : public LinearSolver {
   }
 
   void solve(std::span<const double> b, std::span<double> x) override {
-    QSMESH_CHECK(ready_, "petsc multigrid: solve() without a successful factorize()");
-    const auto n = static_cast<std::size_t>(pattern_.size());
-    QSMESH_CHECK(b.size() == n && x.size() == n, "petsc multigrid: solve() with vectors of "
-                                                     << b.size() << " and " << x.size()
-                                                     << " entries for a system of size " << n);
+    const std::size_t n = pattern_.check_solve(ready_, b, x, "petsc multigrid");
     if (n == 0) return;
     std::lock_guard lock(lane_->mutex());
     sys_.load(b);
