@@ -104,8 +104,11 @@ void each_face(const Context& cx, std::vector<FaceTask>& faces, const char* stag
 
 // An upper bound of the unknowns of a face's largest field system: two per edge of its background
 // triangulation (the cross field's heat systems; gluing seams only removes edges, and the
-// conformal scaling has one unknown per vertex).
-std::int64_t field_unknowns_bound(const mesh::FaceMesh& m) {
+// conformal scaling has one unknown per vertex). Below `threshold` the cruder bound of two per
+// triangle side answers without counting the edges, which is every face but a giant one.
+std::int64_t field_unknowns_bound(const mesh::FaceMesh& m, std::int64_t threshold) {
+  const auto sides = 6 * static_cast<std::int64_t>(m.triangles.size());
+  if (sides < threshold) return sides;
   std::vector<std::uint64_t> keys;
   keys.reserve(3 * m.triangles.size());
   for (const auto& t : m.triangles)
@@ -122,7 +125,9 @@ std::int64_t field_unknowns_bound(const mesh::FaceMesh& m) {
 // face order): their fields are computed by all ranks together (shared_cross_fields). Collective.
 std::vector<LO> shared_field_faces(const Context& cx, const std::vector<FaceTask>& faces) {
   std::vector<std::int64_t> bound(static_cast<std::size_t>(cx.model.num_faces()), 0);
-  for (const FaceTask& t : faces) bound[t.face] = field_unknowns_bound(t.background);
+  for (const FaceTask& t : faces)
+    bound[t.face] =
+        field_unknowns_bound(t.background, cx.options.crossfield.solver.distributed_threshold);
   cx.comm.allreduce_sum(bound);
   std::vector<LO> shared;
   for (LO f = 0; f < cx.model.num_faces(); ++f)
