@@ -111,6 +111,12 @@ void append(std::vector<T>& to, const std::vector<T>& from) {
   to.insert(to.end(), from.begin(), from.end());
 }
 
+std::string example_list() {
+  std::string list;
+  for (const auto& name : cad::example_names()) list += (list.empty() ? "" : ", ") + name;
+  return list;
+}
+
 }  // namespace
 
 std::optional<cad::ExampleFormat> example_format(const std::string& path) {
@@ -383,10 +389,12 @@ Arguments parse(const std::vector<std::string>& args) {
 
   if (a.command == Command::Example) {
     if (positional.size() != 1)
-      throw InputError("example: give one example name (available: wing-body)");
+      throw InputError("example: give one example name (available: " + example_list() + ")");
     a.example_name = positional[0];
-    if (a.example_name != "wing-body")
-      throw InputError("example: unknown example '" + a.example_name + "' (available: wing-body)");
+    const auto names = cad::example_names();
+    if (std::find(names.begin(), names.end(), a.example_name) == names.end())
+      throw InputError("example: unknown example '" + a.example_name +
+                       "' (available: " + example_list() + ")");
     if (a.output.empty()) throw InputError("example: missing -o FILE.step");
     if (!example_format(a.output))
       throw InputError(
@@ -704,11 +712,15 @@ std::string help(const std::string& topic) {
           "  --size H, --size-factor F, --threads T, --stats FILE.json, --max-quads N,\n"
           "  --field-divisions N, --distributed-threshold N, --sew, -q, -v: as for mesh\n";
   } else if (topic == "example") {
-    os << "usage: qsmesh example wing-body -o FILE\n\n"
+    os << "usage: qsmesh example NAME -o FILE\n\n"
           "Writes a built-in CAD model built with OpenCASCADE, as STEP (FILE.step, .stp) or BREP\n"
-          "(FILE.brep, .brp):\n"
-          "  wing-body   a fuselage of revolution fused with a wing lofted from NACA 4-digit "
-          "sections\n";
+          "(FILE.brep, .brp). Millimetres.\n"
+          "  wing-body         a fuselage of revolution fused with a wing lofted from NACA\n"
+          "                    4-digit sections (10 m long)\n"
+          "  far-field         the wing-body cut out of a 50 x 50 x 30 m box: an external flow\n"
+          "                    domain with six huge planar faces\n"
+          "  perforated-plate  a 2000 x 1000 x 20 plate with 72 holes of radius 30, 45 and 60:\n"
+          "                    two faces with 73 loops each\n";
   } else {
     os << "qsmesh - quasi-structured quadrilateral surface meshes of CAD models, distributed with "
           "MPI\n\n"
@@ -720,7 +732,8 @@ std::string help(const std::string& topic) {
           "                        cross fields, singularities and scaling of every face\n"
           "  sizemap MODEL -o OUT.vtu\n"
           "                        size map and curve quantization\n"
-          "  example NAME -o FILE  write a built-in CAD model (wing-body) as STEP or BREP\n\n"
+          "  example NAME -o FILE  write a built-in CAD model (wing-body, far-field,\n"
+          "                        perforated-plate) as STEP or BREP\n\n"
           "Run 'qsmesh COMMAND --help' for the options of a command.\n"
           "Quick start:\n"
           "  qsmesh example wing-body -o wing_body.step\n"

@@ -247,7 +247,7 @@ int run_example(const Arguments& args) {
   const auto format = example_format(args.output);
   QSMESH_CHECK(format, "example: no CAD format for " << args.output << " (parse refuses it)");
   io::AtomicFile file(args.output);
-  cad::write_wing_body_example(file.temp_path(), *format);
+  cad::write_example(args.example_name, file.temp_path(), *format);
   file.commit();
   std::cout << "wrote " << args.output << " (example " << args.example_name << ")\n";
   return 0;

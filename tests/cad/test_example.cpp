@@ -1,4 +1,4 @@
-// The built-in wing-body example.
+// The built-in examples: wing-body, far-field, perforated-plate.
 #include <gtest/gtest.h>
 
 #include <BRepCheck_Analyzer.hxx>
@@ -17,7 +17,7 @@ namespace {
 
 TEST(CadExample, WingBodyWritesAndReloads) {
   const std::string path = test::tmp_path("wing_body.step");
-  write_wing_body_example(path);
+  write_example("wing-body", path);
   const CadModel m = load_cad(path);
   EXPECT_GE(m.num_faces(), 1);
   EXPECT_LE(m.num_faces(), 40);
@@ -59,8 +59,48 @@ TEST(CadExample, WingBodyWritesAndReloads) {
   EXPECT_TRUE(BRepCheck_Analyzer(shape).IsValid());
 }
 
-TEST(CadExample, UnwritablePathIsInputError) {
-  EXPECT_THROW(write_wing_body_example("/nonexistent_dir_qsmesh/x/wing.step"), InputError);
+// The far-field domain: the aircraft's skin as an inner shell of the box, whose six walls are
+// planar faces far larger than any skin face (what the background's bound must keep cheap).
+TEST(CadExample, FarFieldIsTheWingBodyInsideABox) {
+  const std::string wing = test::tmp_path("ff_wing_body.brep"), far = test::tmp_path("ff.brep");
+  write_example("wing-body", wing, ExampleFormat::Brep);
+  write_example("far-field", far, ExampleFormat::Brep);
+  const CadModel body = load_cad(wing), m = load_cad(far);
+  test::expect_closed_loops(m);
+  EXPECT_EQ(m.num_faces(), body.num_faces() + 6);
+  EXPECT_GT(m.diagonal(), 5 * body.diagonal());
+  double largest_skin = 0;
+  for (LO f = 0; f < body.num_faces(); ++f)
+    largest_skin = std::max(largest_skin, body.faces()[f].area);
+  int planar_walls = 0;
+  for (LO f = 0; f < m.num_faces(); ++f)
+    if (m.faces()[f].type == SurfaceType::Plane && m.faces()[f].area > 50 * largest_skin)
+      ++planar_walls;
+  EXPECT_EQ(planar_walls, 6);
+}
+
+// The perforated plate: two faces with one outer loop and 72 holes each, one cylinder per hole.
+TEST(CadExample, PerforatedPlateHasTwoFacesWithManyHoles) {
+  const std::string path = test::tmp_path("plate.brep");
+  write_example("perforated-plate", path, ExampleFormat::Brep);
+  const CadModel m = load_cad(path);
+  test::expect_closed_loops(m);
+  int many_loops = 0, cylinders = 0;
+  for (LO f = 0; f < m.num_faces(); ++f) {
+    if (m.faces()[f].loops.size() == 73) ++many_loops;
+    if (m.faces()[f].type == SurfaceType::Cylinder) ++cylinders;
+  }
+  EXPECT_EQ(many_loops, 2);
+  EXPECT_EQ(cylinders, 72);
+  EXPECT_EQ(m.num_faces(), 2 + 4 + 72);
+}
+
+TEST(CadExample, UnknownNameAndUnwritablePathAreInputErrors) {
+  EXPECT_THROW(write_example("wing-body", "/nonexistent_dir_qsmesh/x/wing.step"), InputError);
+  EXPECT_THROW(write_example("rocket", test::tmp_path("rocket.step")), InputError);
+  const auto names = example_names();
+  EXPECT_EQ(names.front(), "wing-body");
+  EXPECT_EQ(names.size(), 3u);
 }
 
 }  // namespace

@@ -1,6 +1,7 @@
 // Fuzz target of the command-line parser (drivers/cli.hpp). parse() may only return or throw
 // qsmesh::InputError; any other exception, a crash or a sanitizer report is a bug. What it
 // returns must keep the promises of cli.hpp, checked below.
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -46,7 +47,11 @@ void check(const qsmesh::cli::Arguments& a) {
   for (const auto* list : {&a.face_quads, &a.corner_sizes, &a.curve_sizes, &a.face_sizes})
     for (const auto& [id, v] : *list) require(id >= 0 && std::isfinite(v) && v > 0);
   if (a.command == Command::Mesh || a.command == Command::SizeMap) require(!a.output.empty());
-  if (a.command == Command::Example) require(a.example_name == "wing-body" && !a.output.empty());
+  if (a.command == Command::Example) {
+    const auto names = qsmesh::cad::example_names();
+    require(std::find(names.begin(), names.end(), a.example_name) != names.end() &&
+            !a.output.empty());
+  }
   // The help of whatever topic was asked must print.
   if (a.command == Command::Help) require(!qsmesh::cli::help(a.help_topic).empty());
 }

@@ -164,10 +164,18 @@ void set_kernel_messages(bool quiet);
 /// The CAD formats the built-in examples are written in.
 enum class ExampleFormat { Step, Brep };
 
-/// Writes the built-in wing-body example (fuselage of revolution fused with a wing lofted from
-/// NACA 4-digit sections) to `path` as `format`, whatever its extension (the driver picks the
-/// format by the name the user gave and writes a temporary). Throws InputError when the file
-/// cannot be written.
-void write_wing_body_example(const std::string& path, ExampleFormat format = ExampleFormat::Step);
+/// The names of the built-in examples, in the order `qsmesh example --help` lists them:
+/// "wing-body" (a fuselage of revolution fused with a wing lofted from NACA 4-digit sections,
+/// millimetres), "far-field" (the wing-body cut out of a box 5 fuselage lengths long: an external
+/// flow domain with six huge planar faces) and "perforated-plate" (a 2000 x 1000 x 20 mm plate
+/// with 72 holes: two faces of 73 loops each). Each is one valid solid.
+std::vector<std::string> example_names();
+
+/// Builds the built-in example `name` with OpenCASCADE and writes it to `path` as `format`,
+/// whatever its extension (the driver picks the format by the name the user gave and writes a
+/// temporary). Throws InputError for a name not in example_names() or when the file cannot be
+/// written, Error when OpenCASCADE fails to build the model.
+void write_example(const std::string& name, const std::string& path,
+                   ExampleFormat format = ExampleFormat::Step);
 
 }  // namespace qsmesh::cad

@@ -1,11 +1,21 @@
-// The built-in demo model: a fuselage of revolution fused with a swept, tapered wing lofted from
-// NACA 4-digit sections. Millimetres; fuselage 10 m long along +x, span along y, up along z.
+// The built-in models of `qsmesh example`:
+// - wing-body: a fuselage of revolution fused with a swept, tapered wing lofted from NACA 4-digit
+//   sections. Millimetres; fuselage 10 m long along +x, span along y, up along z.
+// - far-field: the wing-body cut out of a box 5 fuselage lengths long, the domain of an external
+//   flow. Its six walls are planar faces 80 to 140 times the area of the largest skin face.
+// - perforated-plate: a plate with a grid of holes of several radii, so its two large faces have
+//   many inner loops each.
+// They exercise what the shared models lack (huge planar faces, faces with many holes) in tests
+// and benchmarks that must run without ../shared.
+#include <BRepAlgoAPI_Cut.hxx>
 #include <BRepAlgoAPI_Fuse.hxx>
 #include <BRepBuilderAPI_MakeEdge.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepBuilderAPI_MakeWire.hxx>
 #include <BRepCheck_Analyzer.hxx>
 #include <BRepOffsetAPI_ThruSections.hxx>
+#include <BRepPrimAPI_MakeBox.hxx>
+#include <BRepPrimAPI_MakeCylinder.hxx>
 #include <BRepPrimAPI_MakeRevol.hxx>
 #include <BRepTools.hxx>
 #include <GC_MakeArcOfEllipse.hxx>
@@ -19,6 +29,7 @@
 #include <TColgp_Array1OfPnt.hxx>
 #include <TColgp_HArray1OfPnt.hxx>
 #include <TopExp_Explorer.hxx>
+#include <TopTools_ListOfShape.hxx>
 #include <TopoDS.hxx>
 #include <cmath>
 #include <gp_Ax1.hxx>
@@ -136,31 +147,79 @@ TopoDS_Shape fuse(const TopoDS_Shape& a, const TopoDS_Shape& b) {
   return op.Shape();
 }
 
+TopoDS_Shape make_wing_body() { return fuse(fuse(make_fuselage(), make_wing(+1)), make_wing(-1)); }
+
+// The flow domain around the wing-body: a box from 2 lengths ahead of the nose to 3 behind it,
+// 2.5 lengths to each side, 1.5 up and down, with the aircraft cut out (one solid, two shells).
+TopoDS_Shape make_far_field() {
+  const TopoDS_Shape box = BRepPrimAPI_MakeBox(gp_Pnt(-2 * kLength, -2.5 * kLength, -1.5 * kLength),
+                                               gp_Pnt(3 * kLength, 2.5 * kLength, 1.5 * kLength))
+                               .Shape();
+  BRepAlgoAPI_Cut op(box, make_wing_body());
+  op.Build();
+  QSMESH_CHECK(op.IsDone() && !op.HasErrors(), "far-field example: boolean cut failed");
+  op.SimplifyResult();
+  return op.Shape();
+}
+
+// A 2000 x 1000 x 20 plate with 12 x 6 through holes whose radii cycle over 30, 45 and 60: its
+// top and bottom faces have 73 loops each. All holes are cut in one operation.
+TopoDS_Shape make_perforated_plate() {
+  constexpr double kPlateX = 2000, kPlateY = 1000, kThickness = 20;
+  constexpr int kHolesX = 12, kHolesY = 6;
+  const TopoDS_Shape plate = BRepPrimAPI_MakeBox(kPlateX, kPlateY, kThickness).Shape();
+  TopTools_ListOfShape holes;
+  for (int i = 0; i < kHolesX; ++i)
+    for (int j = 0; j < kHolesY; ++j) {
+      const double r = 30 + 15 * ((i + 2 * j) % 3);
+      const gp_Pnt c((i + 0.5) * kPlateX / kHolesX, (j + 0.5) * kPlateY / kHolesY, -kThickness);
+      holes.Append(BRepPrimAPI_MakeCylinder(gp_Ax2(c, gp::DZ()), r, 3 * kThickness).Shape());
+    }
+  TopTools_ListOfShape arguments;
+  arguments.Append(plate);
+  BRepAlgoAPI_Cut op;
+  op.SetArguments(arguments);
+  op.SetTools(holes);
+  op.Build();
+  QSMESH_CHECK(op.IsDone() && !op.HasErrors(), "perforated-plate example: boolean cut failed");
+  op.SimplifyResult();
+  return op.Shape();
+}
+
 }  // namespace
 
-void write_wing_body_example(const std::string& path, ExampleFormat format) {
+std::vector<std::string> example_names() { return {"wing-body", "far-field", "perforated-plate"}; }
+
+void write_example(const std::string& name, const std::string& path, ExampleFormat format) {
   TopoDS_Shape shape;
   try {
-    shape = fuse(fuse(make_fuselage(), make_wing(+1)), make_wing(-1));
+    if (name == "wing-body")
+      shape = make_wing_body();
+    else if (name == "far-field")
+      shape = make_far_field();
+    else if (name == "perforated-plate")
+      shape = make_perforated_plate();
+    else
+      throw InputError("unknown example '" + name + "'");
   } catch (const Standard_Failure& e) {
-    throw Error(std::string("wing-body example: OpenCASCADE failed: ") + e.GetMessageString());
+    throw Error(name + " example: OpenCASCADE failed: " + e.GetMessageString());
   }
   int solids = 0;
   for (TopExp_Explorer ex(shape, TopAbs_SOLID); ex.More(); ex.Next()) ++solids;
-  QSMESH_CHECK(solids == 1, "wing-body example: fuse gave " << solids << " solids");
+  QSMESH_CHECK(solids == 1, name << " example: the model has " << solids << " solids");
   BRepCheck_Analyzer check(shape);
-  QSMESH_CHECK(check.IsValid(), "wing-body example: the fused solid is not valid");
+  QSMESH_CHECK(check.IsValid(), name << " example: the solid is not valid");
 
   if (format == ExampleFormat::Brep) {
     if (!BRepTools::Write(shape, path.c_str()))
-      throw InputError("cannot write the wing-body example to '" + path + "'");
+      throw InputError("cannot write the " + name + " example to '" + path + "'");
     return;
   }
   STEPControl_Writer writer;
   if (writer.Transfer(shape, STEPControl_AsIs) != IFSelect_RetDone)
-    throw Error("wing-body example: STEP transfer failed");
+    throw Error(name + " example: STEP transfer failed");
   if (writer.Write(path.c_str()) != IFSelect_RetDone)
-    throw InputError("cannot write the wing-body example to '" + path + "'");
+    throw InputError("cannot write the " + name + " example to '" + path + "'");
 }
 
 }  // namespace qsmesh::cad
