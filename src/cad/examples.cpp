@@ -188,8 +188,6 @@ TopoDS_Shape make_perforated_plate() {
 
 }  // namespace
 
-std::vector<std::string> example_names() { return {"wing-body", "far-field", "perforated-plate"}; }
-
 void write_example(const std::string& name, const std::string& path, ExampleFormat format) {
   TopoDS_Shape shape;
   try {
