@@ -13,10 +13,17 @@ FaceCrossField compute_face_cross_field(const mesh::FaceMesh& background,
   cf.face = background.face;
   glue_triangulation(background, cf);
   const detail::Geometry g = detail::compute_geometry(cf);
-  detail::diffuse(cf, g, options, lane);
+  const bool uniform = options.exact_uniform && detail::set_exact_uniform_field(cf, g);
+  if (!uniform) detail::diffuse(cf, g, options, lane);
   detail::compute_directions(cf, g);
   detail::find_singularities(cf, g, options);
-  detail::compute_scaling(cf, g, options, lane);
+  if (uniform) {
+    // A constant cross on a plane does not rotate: the right-hand side of Eq. 9 is zero.
+    cf.H.assign(cf.points.size(), 0.0);
+    cf.h.assign(cf.points.size(), 1.0);
+  } else {
+    detail::compute_scaling(cf, g, options, lane);
+  }
   cf.stats.seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return cf;

@@ -232,6 +232,61 @@ void diffuse(FaceCrossField& cf, const Geometry& g, const CrossFieldOptions& opt
     }
 }
 
+bool set_exact_uniform_field(FaceCrossField& cf, const Geometry& g) {
+  const std::size_t ne = cf.edges.size(), nt = cf.triangles.size();
+  if (nt == 0 || !(g.diagonal > 0)) return false;
+  // The face normal: the area-weighted mean of the triangle normals (triangles are oriented along
+  // the face normal). Planar: every vertex within 1e-10 of the diagonal from the mean plane, so
+  // the field's holonomy is zero to rounding.
+  Vec3 n{0, 0, 0};
+  for (std::size_t t = 0; t < nt; ++t) n += g.normal[t] * g.area[t];
+  if (!(norm(n) > 0)) return false;
+  n = normalized(n);
+  const Vec3 origin = cf.points[cf.triangles[0][0]];
+  const double flat = 1e-10 * g.diagonal;
+  for (const auto& p : cf.points)
+    if (std::abs(dot(p - origin, n)) > flat) return false;
+  for (std::size_t t = 0; t < nt; ++t)
+    if (g.area[t] > 0 && dot(g.normal[t], n) <= 0) return false;
+  // A global frame of the plane and the angle of each edge in it.
+  const Vec3 x = g.xaxis[0] - n * dot(g.xaxis[0], n);
+  if (!(norm(x) > 0)) return false;
+  const Vec3 ex = normalized(x), ey = cross(n, ex);
+  const auto edge_angle = [&](std::size_t e) {
+    const Vec3 d = cf.points[cf.edges[e][1]] - cf.points[cf.edges[e][0]];
+    return std::atan2(dot(d, ey), dot(d, ex));
+  };
+  // Boundary crosses are aligned with their edges (θ = 0): 4 × the edge angle must agree mod 2π.
+  // 1e-6 rad on 4ψ is 2.5e-7 rad on the edge: straight CAD lines sampled exactly pass, any real
+  // turn of the boundary does not.
+  bool has_boundary = false;
+  double ref = 0;
+  for (std::size_t e = 0; e < ne; ++e) {
+    if (!cf.boundary_edge[e]) continue;
+    const double a = 4 * edge_angle(e);
+    if (!has_boundary) {
+      ref = a, has_boundary = true;
+    } else if (std::abs(wrap_angle(a - ref)) > 1e-6) {
+      return false;
+    }
+  }
+  if (!has_boundary) return false;
+  cf.u.resize(ne);
+  cf.u_norm.assign(ne, 1.0);
+  cf.fixed_edge.assign(ne, 0);
+  for (std::size_t e = 0; e < ne; ++e) {
+    if (cf.boundary_edge[e]) {
+      cf.u[e] = {1, 0};  // exactly as the Dirichlet data of diffuse()
+      cf.fixed_edge[e] = 1;
+    } else {
+      const double b = ref - 4 * edge_angle(e);
+      cf.u[e] = {std::cos(b), std::sin(b)};
+    }
+  }
+  cf.stats.solver = "exact uniform";
+  return true;
+}
+
 void compute_directions(FaceCrossField& cf, const Geometry& g) {
   cf.directions.resize(cf.triangles.size());
   for (std::size_t t = 0; t < cf.triangles.size(); ++t) {

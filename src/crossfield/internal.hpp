@@ -47,6 +47,12 @@ inline double angle_in_triangle(const FaceCrossField& cf, const Geometry& g, LO 
 void diffuse(FaceCrossField& cf, const Geometry& g, const CrossFieldOptions& options,
              linalg::SolverLane* lane);
 
+/// CrossFieldOptions::exact_uniform: when the glued triangulation is planar and every boundary
+/// edge lies along one common cross, fills u (that cross in every edge frame), u_norm, fixed_edge
+/// and stats as diffuse() would, and returns true; otherwise leaves cf untouched and returns
+/// false. A face without boundary never qualifies.
+bool set_exact_uniform_field(FaceCrossField& cf, const Geometry& g);
+
 /// Branches of the cross at each triangle barycentre. Fills directions.
 void compute_directions(FaceCrossField& cf, const Geometry& g);
 

@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <gp_Circ.hxx>
 #include <gp_Pln.hxx>
+#include <gp_Trsf.hxx>
 #include <numbers>
 #include <stdexcept>
 
@@ -89,7 +90,9 @@ double cross_deviation_deg(const std::array<Vec3, 2>& d, const Vec3& a, const Ve
 TEST(CrossField, UnitSquareIsAlignedWithItsSides) {
   const TopoDS_Face face = BRepBuilderAPI_MakeFace(gp_Pln(gp::XOY()), 0.0, 1.0, 0.0, 1.0).Face();
   const auto model = test::load_shape(face, "cf_square.brep");
-  const auto r = run(model, 0, 0.03, "square");
+  CrossFieldOptions solved;  // the diffusion itself, not the exact uniform field
+  solved.exact_uniform = false;
+  const auto r = run(model, 0, 0.03, "square", solved);
   const auto& cf = r.cf;
   EXPECT_GT(cf.triangles.size(), 1000u);
   expect_stats(cf);
@@ -218,7 +221,9 @@ TEST(CrossField, LShapeWithReflexCorner) {
   poly.Close();
   const auto model =
       test::load_shape(BRepBuilderAPI_MakeFace(poly.Wire()).Face(), "cf_lshape.brep");
-  const auto r = run(model, 0, 0.06, "L-shape");
+  CrossFieldOptions solved;  // the diffusion itself, not the exact uniform field
+  solved.exact_uniform = false;
+  const auto r = run(model, 0, 0.06, "L-shape", solved);
   const auto& cf = r.cf;
   expect_stats(cf);
   EXPECT_EQ(cf.euler.corner_term,
@@ -230,6 +235,81 @@ TEST(CrossField, LShapeWithReflexCorner) {
   for (const auto& d : cf.directions)
     worst = std::max(worst, cross_deviation_deg(d, {1, 0, 0}, {0, 1, 0}));
   EXPECT_LT(worst, 1.0);
+}
+
+// A planar face whose straight sides all lie along one cross: the constant field is set without
+// a solve and equals the solved one to the diffusion's tolerance; anything else is solved.
+TEST(CrossField, UniformShortcutEqualsTheSolvedField) {
+  // A rectangle with a rectangular hole, turned by 30 degrees in its plane.
+  const gp_Trsf turn = [] {
+    gp_Trsf t;
+    t.SetRotation(gp::OZ(), kPi / 6);
+    return t;
+  }();
+  const auto polygon = [&](std::initializer_list<gp_Pnt> points) {
+    BRepBuilderAPI_MakePolygon poly;
+    for (const auto& p : points) poly.Add(p.Transformed(turn));
+    poly.Close();
+    return poly.Wire();
+  };
+  BRepBuilderAPI_MakeFace mk(
+      polygon({gp_Pnt(0, 0, 0), gp_Pnt(3, 0, 0), gp_Pnt(3, 2, 0), gp_Pnt(0, 2, 0)}));
+  mk.Add(TopoDS::Wire(
+      polygon({gp_Pnt(1, 0.5, 0), gp_Pnt(2, 0.5, 0), gp_Pnt(2, 1.2, 0), gp_Pnt(1, 1.2, 0)})
+          .Reversed()));
+  const auto model = test::load_shape(mk.Face(), "cf_frame.brep");
+  CrossFieldOptions solved;
+  solved.exact_uniform = false;
+  const auto fast = run(model, 0, 0.08, "frame", {});
+  const auto slow = run(model, 0, 0.08, "frame-solved", solved);
+  EXPECT_EQ(fast.cf.stats.solver, "exact uniform");
+  EXPECT_EQ(fast.cf.stats.factorizations, 0);
+  EXPECT_EQ(fast.cf.stats.extension_solves, 0);
+  EXPECT_NE(slow.cf.stats.solver, "exact uniform");
+  ASSERT_EQ(fast.cf.directions.size(), slow.cf.directions.size());
+  const Vec3 a{std::cos(kPi / 6), std::sin(kPi / 6), 0}, b{-a.y, a.x, 0};
+  double worst_fast = 0, worst_apart = 0;
+  for (std::size_t t = 0; t < fast.cf.directions.size(); ++t) {
+    worst_fast = std::max(worst_fast, cross_deviation_deg(fast.cf.directions[t], a, b));
+    worst_apart =
+        std::max(worst_apart, cross_deviation_deg(fast.cf.directions[t], slow.cf.directions[t][0],
+                                                  slow.cf.directions[t][1]));
+  }
+  std::printf(
+      "[crossfield] frame: shortcut off the sides by %.2e deg, off the solved field by "
+      "%.2e deg\n",
+      worst_fast, worst_apart);
+  EXPECT_LT(worst_fast, 1e-9);
+  EXPECT_LT(worst_apart, 0.5);  // the diffusion stops at a 1e-3 change
+  EXPECT_TRUE(fast.cf.singularities.empty());
+  EXPECT_TRUE(slow.cf.singularities.empty());
+  EXPECT_TRUE(fast.cf.euler.consistent);
+  EXPECT_EQ(fast.cf.euler.found, slow.cf.euler.found);
+  ASSERT_EQ(fast.cf.H.size(), slow.cf.H.size());
+  for (std::size_t v = 0; v < fast.cf.H.size(); ++v) {
+    EXPECT_EQ(fast.cf.H[v], 0.0);
+    EXPECT_NEAR(slow.cf.H[v], 0.0, 1e-3);
+  }
+
+  // Not uniform: a circular hole, a non-rectangular polygon (a 60 degree corner), a cylinder.
+  BRepBuilderAPI_MakeFace holed(
+      polygon({gp_Pnt(0, 0, 0), gp_Pnt(3, 0, 0), gp_Pnt(3, 2, 0), gp_Pnt(0, 2, 0)}));
+  const gp_Circ hole(gp_Ax2(gp_Pnt(1.5, 1, 0).Transformed(turn), gp_Dir(0, 0, 1)), 0.3);
+  holed.Add(TopoDS::Wire(
+      BRepBuilderAPI_MakeWire(BRepBuilderAPI_MakeEdge(hole).Edge()).Wire().Reversed()));
+  const auto holed_model = test::load_shape(holed.Face(), "cf_holed.brep");
+  EXPECT_NE(run(holed_model, 0, 0.1, "holed").cf.stats.solver, "exact uniform");
+  BRepBuilderAPI_MakePolygon slanted;
+  for (const auto& p : {gp_Pnt(0, 0, 0), gp_Pnt(2, 0, 0), gp_Pnt(1, std::sqrt(3.0), 0)})
+    slanted.Add(p);
+  slanted.Close();
+  const auto slanted_model =
+      test::load_shape(BRepBuilderAPI_MakeFace(slanted.Wire()).Face(), "cf_slanted.brep");
+  EXPECT_NE(run(slanted_model, 0, 0.1, "equilateral").cf.stats.solver, "exact uniform");
+  const auto cylinder = cad::load_cad(test::write_cylinder(tmp("cf_cylinder_u.brep")));
+  EXPECT_NE(run(cylinder, face_of_type(cylinder, cad::SurfaceType::Cylinder), 0.25, "cylinder-u")
+                .cf.stats.solver,
+            "exact uniform");
 }
 
 TEST(CrossField, CylinderSeamIsNotABoundary) {

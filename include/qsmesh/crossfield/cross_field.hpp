@@ -30,6 +30,13 @@ struct CrossFieldOptions {
   /// corner tangentially) gets a uniform scaling, H = 0: at a cusp H has a singularity the
   /// quantile clamp does not tame. 0: never.
   double cusp_angle_deg = 2;
+  /// A planar face whose boundary edges all lie along one cross (a rectilinear polygon in any
+  /// rotation, holes and slits included: box walls, machined pockets and steps) has the constant
+  /// cross as the exact solution of the boundary extension and of every diffusion level, no
+  /// singularity, and H = 0 exactly (its rotation vanishes). Such a face gets that field without a
+  /// solve (stats.solver "exact uniform", no level); the solved field differs from it by rounding
+  /// only (test CrossField.UniformShortcutEqualsTheSolvedField). false: always solve.
+  bool exact_uniform = true;
   linalg::SolverOptions solver;
 };
 
