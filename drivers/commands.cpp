@@ -483,6 +483,17 @@ std::string stats_json(const Arguments& args, const Session& session,
     for (double m : checks.rank_peak_mb) j.value("", m);
     j.end_array();
   }
+  // The curves stage's rounds split by curve over the ranks (parallel::CurveRound, documented
+  // there; scripts/simulate_scaling.py deals and replays them).
+  j.begin_array("curve_rounds");
+  for (const parallel::CurveRound& round : r.curve_rounds)
+    j.begin_object()
+        .value("seconds", round.seconds)
+        .value("bytes", round.bytes)
+        .value("weights", round.weights)
+        .value("curve_seconds", round.curve_seconds)
+        .end_object();
+  j.end_array();
   if (!r.quasi_reports.empty()) {
     // The improvement stage runs its three steps face by face; their time summed over the faces.
     j.begin_object("improvement_face_seconds")

@@ -3,7 +3,14 @@
 rank, by replaying its measured per-face, per-stage times through the pipeline's scheduling rules
 (docs/architecture.md, "Parallel model"):
 
-- replicated stages (load, curves, partition, quantize): every rank does the same work; as measured.
+- replicated stages (load, partition, quantize): every rank does the same work; as measured.
+- curves: split by curve in rounds (--stats curve_rounds: the sampling, then the feature sizes);
+  each round deals the curves over the P ranks by its weights, greedy longest first
+  (greedy_partition, the pipeline's deal_by_weight), each rank runs its curves in curve order on
+  T threads (list scheduling), then every curve's record is all-gathered (gathered on rank 0, one
+  message per rank, and broadcast: the round's bytes three times at the bandwidth). The rest of
+  the stage (the rounds' setup done by every rank, the last step on every curve) as measured.
+  A run without curve_rounds keeps the stage replicated.
 - partitioned stages (background, crossfield, sizemap, unstructured, pattern_compare, distance,
   pack):
   each rank
@@ -119,6 +126,7 @@ class Run:
             raise InputError(f"{name}: no per-face stage times (face_stats[].stage_seconds): a "
                              "quad-stage run of a qsmesh built with them is needed")
         self.threads = int(stats.get("threads", 1))
+        self.ranks = int(stats.get("ranks", 1))
         self.seconds = {k: v for k, v in stats["seconds"].items() if k != "total"}
         self.total = stats["seconds"].get("total", sum(self.seconds.values()))
         self.faces = sorted(faces, key=lambda f: f["face"])
@@ -144,6 +152,12 @@ class Run:
             self.t["pack"] = [x + rest * b / total_bytes for x, b in zip(self.t["pack"],
                                                                           self.bytes)]
         self.face_rank = [f.get("rank", 0) for f in self.faces]
+        # The curves stage's rounds split by curve (parallel::CurveRound).
+        self.curve_rounds = stats.get("curve_rounds", [])
+        for k, r in enumerate(self.curve_rounds):
+            if len(r.get("weights", [])) != len(r.get("curve_seconds", [])):
+                raise InputError(f"{name}: curve round {k + 1} has {len(r.get('weights', []))} "
+                                 f"weights for {len(r.get('curve_seconds', []))} curve times")
 
 
 class Simulator:
@@ -179,6 +193,33 @@ class Simulator:
 
     def allreduce(self, p):
         return self.comm["allreduce_s"] * levels(p)
+
+    def curve_round(self, r, p, t):
+        """One curves round's split part on p ranks x t threads: the curves dealt by weight, each
+        rank's in curve order on its t threads; the slowest rank."""
+        part = greedy_partition(r["weights"], p) if p > 1 else [0] * len(r["weights"])
+        per_rank = [[] for _ in range(p)]
+        for c, sec in enumerate(r["curve_seconds"]):
+            per_rank[part[c]].append(sec)
+        return max(list_schedule(mine, t)[0] for mine in per_rank)
+
+    def curve_gather(self, r, p):
+        """A curves round's all-gather on p ranks: gathered on rank 0 (the sizes, then one message
+        per rank) and broadcast to all; its bytes three times at the bandwidth."""
+        if p == 1:
+            return 0.0
+        return (3 * r["bytes"] / self.comm["bandwidth_bytes_per_s"]
+                + self.comm["allreduce_s"] * (p - 1) + 2 * self.allreduce(p))
+
+    def curves(self, p, t):
+        """The curves stage on p ranks x t threads: the measured stage with each round's split
+        part and all-gather (as the measured run did them) replaced by those on p x t."""
+        run = self.run
+        v = run.seconds["curves"]
+        for r in run.curve_rounds:
+            v += (self.curve_round(r, p, t) + self.curve_gather(r, p)
+                  - self.curve_round(r, run.ranks, run.threads) - self.curve_gather(r, run.ranks))
+        return max(0.0, v)
 
     def get_cost(self, nbytes):
         # A face read from its owner: one lock/get/unlock round, its bytes at the bandwidth.
@@ -312,6 +353,8 @@ class Simulator:
             elif s in GATHER:
                 away = sum(b for f, b in enumerate(run.bytes) if part[f] != 0)
                 v = measured + away / bw + self.allreduce(p) * 2 + self.comm["allreduce_s"] * (p - 1)
+            elif s == "curves" and run.curve_rounds:
+                v = self.curves(p, t) + self.allreduce(p)
             elif s in REPLICATED:
                 v = measured + self.allreduce(p)
             else:
@@ -358,6 +401,11 @@ class Simulator:
                       + max(owner_work.values()) + self.residual[s])
             elif s in PARTITIONED or s in DEALT:
                 v += max(run.t[s]) + self.residual[s]
+            elif s == "curves" and run.curve_rounds:
+                # Each round's largest curve, the rest as measured (no messages counted).
+                v += measured + sum(max(r["curve_seconds"], default=0.0)
+                                    - self.curve_round(r, run.ranks, run.threads)
+                                    for r in run.curve_rounds)
             else:
                 v += measured
         return v
@@ -416,7 +464,8 @@ def main(argv):
     base = (1, run.threads)
     stages = list(run.seconds)
     preds = {c: sim.predict(*c) for c in configs}
-    kind = {s: ("replicated" if s in REPLICATED else "METIS partition" if s in PARTITIONED
+    kind = {s: ("split by curve" if s == "curves" and run.curve_rounds
+                else "replicated" if s in REPLICATED else "METIS partition" if s in PARTITIONED
                 else "dealt" if s in DEALT else "gather on rank 0" if s in GATHER else "rank 0")
             for s in stages}
     labels = [f"{p}x{t}" for p, t in configs]

@@ -41,14 +41,6 @@ std::vector<std::vector<CurveUseRef>> curve_uses(const cad::CadModel& model) {
 
 namespace {
 
-/// A curve sampled finely enough to resolve its size field: parameters, points, arc length, and
-/// the size at each sample (reduced by the feature and gradation passes).
-struct CurveSamples {
-  std::vector<double> t, s, h;
-  std::vector<Vec3> p;
-  [[nodiscard]] double length() const { return s.empty() ? 0.0 : s.back(); }
-};
-
 CurveSamples sample_curve(const CurveCurvatureSize& sizer, const cad::Curve& curve, double cap) {
   // A coarse pass estimates the edge count from the curvature sizes; the samples then resolve the
   // size field at ~8 per edge and are never further apart than cap / 4 (for the feature search).
@@ -94,7 +86,7 @@ void grade_along(CurveSamples& cs, double h_start, double h_end, double g) {
 }
 
 /// Places round(integral of ds / h) edges (at least min_edges) at equal steps of that integral.
-mesh::CurveMesh place_vertices(const CurveSamples& cs, const CurveCurvatureSize& sizer, LO c,
+mesh::CurveMesh place_vertices(const CurveSamples& cs, const cad::CurveGeometry& geometry, LO c,
                                const Vec3& p0, const Vec3& p1, int min_edges) {
   const std::size_t n = cs.t.size();
   std::vector<double> cumulative(n, 0.0);
@@ -118,7 +110,7 @@ mesh::CurveMesh place_vertices(const CurveSamples& cs, const CurveCurvatureSize&
     const double c0 = cumulative[i - 1], c1 = cumulative[i];
     const double w = c1 > c0 ? std::clamp((target - c0) / (c1 - c0), 0.0, 1.0) : 0.0;
     out.t[k] = cs.t[i - 1] + w * (cs.t[i] - cs.t[i - 1]);
-    out.points[k] = sizer.geometry().point(out.t[k]);
+    out.points[k] = geometry.point(out.t[k]);
   }
   // End points are the corners themselves, so that every curve ending there shares them exactly.
   out.points.front() = p0;
@@ -126,68 +118,86 @@ mesh::CurveMesh place_vertices(const CurveSamples& cs, const CurveCurvatureSize&
   return out;
 }
 
+template <class Body>
+void with_context(LO c, const Body& body) {
+  try {
+    body();
+  } catch (const Error& e) {
+    throw e.with_context({"curves", 1, c});
+  }
+}
+
 }  // namespace
 
-std::vector<mesh::CurveMesh> mesh_curves(const cad::CadModel& model, const SizeOptions& sizes,
-                                         const TaskArena& tasks) {
+CurveMeshing::CurveMeshing(const cad::CadModel& model, const SizeOptions& sizes)
+    : model_(model), sizes_(sizes), uses_(curve_uses(model)) {
   QSMESH_CHECK(sizes.size > 0, "mesh size must be positive, got " << sizes.size);
   const LO n = model.num_curves();
-  const auto uses = curve_uses(model);
-  auto with_context = [](LO c, auto&& body) {
-    try {
-      body();
-    } catch (const Error& e) {
-      throw e.with_context({"curves", 1, c});
-    }
-  };
-
-  // 0. The largest size of each curve: the smallest background cap of the faces using it (the
-  //    target size, or the geometry's resolution with SizeOptions::field_divisions).
-  std::vector<double> cap(static_cast<std::size_t>(n), sizes.size);
+  // The largest size of each curve: the smallest background cap of the faces using it (the
+  // target size, or the geometry's resolution with SizeOptions::field_divisions).
+  cap_.assign(static_cast<std::size_t>(n), sizes.size);
   for (LO c = 0; c < n; ++c) {
-    if (uses[c].empty()) continue;
+    if (uses_[c].empty()) continue;
     double v = std::numeric_limits<double>::infinity();
-    for (const CurveUseRef& u : uses[c])
+    for (const CurveUseRef& u : uses_[c])
       v = std::min(v, sizes.field_cap(model.faces()[u.face].box.diagonal()));
-    cap[c] = v;
+    cap_[c] = v;
   }
-  const double largest = n > 0 ? *std::max_element(cap.begin(), cap.end()) : sizes.size;
+  largest_ = n > 0 ? *std::max_element(cap_.begin(), cap_.end()) : sizes.size;
+}
 
-  // 1. Sample every curve with its curvature sizes.
-  std::vector<std::unique_ptr<CurveCurvatureSize>> sizers(static_cast<std::size_t>(n));
-  std::vector<CurveSamples> samples(static_cast<std::size_t>(n));
-  tasks.parallel_for(n, [&](std::int64_t i) {
-    const auto c = static_cast<LO>(i);
-    if (model.curves()[c].degenerate) return;
+CurveSamples CurveMeshing::sample(LO c) const {
+  CurveSamples out;
+  if (!model_.curves()[c].degenerate)
     with_context(c, [&] {
-      sizers[c] = std::make_unique<CurveCurvatureSize>(model, c, uses[c], sizes.capped(cap[c]));
-      samples[c] = sample_curve(*sizers[c], model.curves()[c], cap[c]);
+      const CurveCurvatureSize sizer(model_, c, uses_[c], sizes_.capped(cap_[c]));
+      out = sample_curve(sizer, model_.curves()[c], cap_[c]);
     });
-  });
+  out.curve = c;
+  return out;
+}
 
-  // 2. Small features: no size larger than the distance to a curve sharing no corner with this one.
-  if (sizes.feature_size) {
-    std::vector<std::vector<Vec3>> polylines(samples.size());
-    std::vector<std::vector<double>> h(samples.size());
-    for (std::size_t c = 0; c < samples.size(); ++c) {
-      polylines[c] = samples[c].p;
-      h[c] = samples[c].h;
-    }
+double CurveMeshing::sampling_cost(LO c) const {
+  const cad::Curve& curve = model_.curves()[c];
+  if (curve.degenerate) return 0;
+  // sample_curve: 16 coarse evaluations, then at least 8 per edge of the cap (32 to 16384), each
+  // of the curve's curvature and of every face using it.
+  const double samples = std::clamp(8 * curve.length / cap_[c], 32.0, 16384.0);
+  return (17 + samples) * (1 + static_cast<double>(uses_[c].size()));
+}
+
+CurveFeatureSearch CurveMeshing::feature_search(std::span<const CurveSamples> samples) const {
+  QSMESH_CHECK(static_cast<LO>(samples.size()) == model_.num_curves(),
+               "samples of " << samples.size() << " curves for " << model_.num_curves());
+  std::vector<std::vector<Vec3>> polylines(samples.size());
+  for (std::size_t c = 0; c < samples.size(); ++c) polylines[c] = samples[c].p;
+  return {model_, std::move(polylines)};
+}
+
+void CurveMeshing::limit_sizes(const CurveFeatureSearch& search, CurveSamples& s) const {
+  if (!sizes_.feature_size || s.p.empty()) return;
+  with_context(s.curve, [&] {
     // Gaps narrower than a tenth of the smallest size are curves touching or lying on top of each
     // other (unsewn volumes, sloppy models), not features the mesh could resolve.
-    limit_by_feature_distance(model, polylines, h, 0.1 * sizes.effective_min_size(),
-                              sizes.effective_min_size(), tasks);
-    // Inside sharp wedges the sides share a corner, so (ii) does not see them; the thin-face cap
-    // of the size map grades the sizes along such a tail with its width, and needs vertices there.
-    limit_in_sharp_wedges(model, polylines, h, 0.1 * sizes.effective_min_size(), 10, tasks);
-    for (std::size_t c = 0; c < samples.size(); ++c) samples[c].h = std::move(h[c]);
-  }
+    const double touching = 0.1 * sizes_.effective_min_size();
+    search.limit_by_feature_distance(s.curve, s.h, touching, sizes_.effective_min_size());
+    // Inside sharp wedges the sides share a corner, so the search above does not see them; the
+    // thin-face cap of the size map grades the sizes along such a tail with its width, and needs
+    // vertices there.
+    search.limit_in_sharp_wedges(s.curve, s.h, touching, 10);
+  });
+}
 
-  // 3. Corners take the smallest size of the curves ending there (a curve never asks for more than
-  //    its length); then sizes grade along each curve from its two corners.
-  std::vector<double> corner_size(static_cast<std::size_t>(model.num_corners()), largest);
+std::vector<mesh::CurveMesh> CurveMeshing::place(std::vector<CurveSamples> samples,
+                                                 const TaskArena& tasks) const {
+  const LO n = model_.num_curves();
+  QSMESH_CHECK(static_cast<LO>(samples.size()) == n,
+               "samples of " << samples.size() << " curves for " << n);
+  // Corners take the smallest size of the curves ending there (a curve never asks for more than
+  // its length); then sizes grade along each curve from its two corners.
+  std::vector<double> corner_size(static_cast<std::size_t>(model_.num_corners()), largest_);
   for (LO c = 0; c < n; ++c) {
-    const auto& cc = model.curves()[c];
+    const auto& cc = model_.curves()[c];
     if (cc.degenerate || samples[c].p.empty()) continue;
     const double len = samples[c].length();
     corner_size[cc.corners[0]] = std::min({corner_size[cc.corners[0]], samples[c].h.front(), len});
@@ -196,18 +206,18 @@ std::vector<mesh::CurveMesh> mesh_curves(const cad::CadModel& model, const SizeO
 
   // Curves joining the same corner pair would coincide if both were single straight edges.
   std::map<std::pair<LO, LO>, int> pair_count;
-  for (const cad::Curve& c : model.curves()) {
+  for (const cad::Curve& c : model_.curves()) {
     if (c.degenerate) continue;
     ++pair_count[std::minmax(c.corners[0], c.corners[1])];
   }
 
-  // 4. Vertices at equal steps of the integral of 1/h.
+  // Vertices at equal steps of the integral of 1/h.
   std::vector<mesh::CurveMesh> meshes(static_cast<std::size_t>(n));
   tasks.parallel_for(n, [&](std::int64_t i) {
     const auto c = static_cast<LO>(i);
-    const cad::Curve& curve = model.curves()[c];
-    const Vec3 p0 = model.corners()[curve.corners[0]].point;
-    const Vec3 p1 = model.corners()[curve.corners[1]].point;
+    const cad::Curve& curve = model_.curves()[c];
+    const Vec3 p0 = model_.corners()[curve.corners[0]].point;
+    const Vec3 p1 = model_.corners()[curve.corners[1]].point;
     if (curve.degenerate) {
       meshes[c].curve = c;
       meshes[c].t = {curve.t0, curve.t1};
@@ -221,11 +231,24 @@ std::vector<mesh::CurveMesh> mesh_curves(const cad::CadModel& model, const SizeO
       min_edges = 2;
     with_context(c, [&] {
       grade_along(samples[c], corner_size[curve.corners[0]], corner_size[curve.corners[1]],
-                  sizes.gradation);
-      meshes[c] = place_vertices(samples[c], *sizers[c], c, p0, p1, min_edges);
+                  sizes_.gradation);
+      meshes[c] = place_vertices(samples[c], *model_.curve_geometry(c), c, p0, p1, min_edges);
     });
   });
   return meshes;
+}
+
+std::vector<mesh::CurveMesh> mesh_curves(const cad::CadModel& model, const SizeOptions& sizes,
+                                         const TaskArena& tasks) {
+  const CurveMeshing meshing(model, sizes);
+  const LO n = model.num_curves();
+  std::vector<CurveSamples> samples(static_cast<std::size_t>(n));
+  tasks.parallel_for(n, [&](std::int64_t i) { samples[i] = meshing.sample(static_cast<LO>(i)); });
+  if (meshing.limits_sizes()) {
+    const CurveFeatureSearch search = meshing.feature_search(samples);
+    tasks.parallel_for(n, [&](std::int64_t i) { meshing.limit_sizes(search, samples[i]); });
+  }
+  return meshing.place(std::move(samples), tasks);
 }
 
 }  // namespace qsmesh::background

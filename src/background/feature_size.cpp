@@ -4,8 +4,11 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <memory>
 #include <numbers>
 #include <vector>
+
+#include "qsmesh/core/error.hpp"
 
 namespace qsmesh::background {
 
@@ -131,6 +134,27 @@ namespace {
 /// Lowers sizes[c][k] to the distance d to the nearest curve `eligible(c, other)` admits where
 /// `accept(c, other, point, d)`, within the current size; distances up to `touching` ignored,
 /// never below `floor` from a feature.
+/// limit_by_distance on curve c alone, its sizes h, with the tree of all polylines: a curve's
+/// result depends on no other curve's sizes (CurveFeatureSearch splits the curves by it).
+template <class Eligible, class Accept>
+void limit_curve_by_distance(const PointTree& tree, std::span<const std::vector<Vec3>> polylines,
+                             LO c, std::vector<double>& h, double touching, double floor,
+                             const Eligible& eligible, const Accept& accept) {
+  const auto& line = polylines[c];
+  for (std::size_t k = 0; k < line.size(); ++k) {
+    for (const auto& [o, j] :
+         tree.candidates(line[k], h[k], [&](LO x) { return eligible(c, x); })) {
+      // The other curve near its nearest vertex is the polyline through the vertices around it:
+      // exact enough for dense polylines, and far cheaper than a CAD projection.
+      const double d = distance_to_polyline(polylines[o], j, line[k]);
+      // The floor bounds what a feature may ask for, never a size already smaller.
+      // accept gives the factor the distance counts with (false / 0: not at all).
+      const double scale = d > touching ? static_cast<double>(accept(c, o, line[k], d)) : 0.0;
+      if (scale > 0) h[k] = std::min(h[k], std::max(floor, scale * d));
+    }
+  }
+}
+
 template <class Eligible, class Accept>
 void limit_by_distance(std::span<const std::vector<Vec3>> polylines,
                        std::vector<std::vector<double>>& sizes, double touching, double floor,
@@ -138,20 +162,7 @@ void limit_by_distance(std::span<const std::vector<Vec3>> polylines,
   const PointTree tree(polylines);
   tasks.parallel_for(static_cast<std::int64_t>(polylines.size()), [&](std::int64_t i) {
     const auto c = static_cast<LO>(i);
-    const auto& line = polylines[c];
-    auto& h = sizes[c];
-    for (std::size_t k = 0; k < line.size(); ++k) {
-      for (const auto& [o, j] :
-           tree.candidates(line[k], h[k], [&](LO x) { return eligible(c, x); })) {
-        // The other curve near its nearest vertex is the polyline through the vertices around it:
-        // exact enough for dense polylines, and far cheaper than a CAD projection.
-        const double d = distance_to_polyline(polylines[o], j, line[k]);
-        // The floor bounds what a feature may ask for, never a size already smaller.
-        // accept gives the factor the distance counts with (false / 0: not at all).
-        const double scale = d > touching ? static_cast<double>(accept(c, o, line[k], d)) : 0.0;
-        if (scale > 0) h[k] = std::min(h[k], std::max(floor, scale * d));
-      }
-    }
+    limit_curve_by_distance(tree, polylines, c, sizes[c], touching, floor, eligible, accept);
   });
 }
 
@@ -196,19 +207,37 @@ bool own_wedge_sides(const std::vector<std::vector<LO>>& faces, LO a, LO b) {
   return faces[a].size() == 1 && faces[b].size() == 1 && faces[a][0] == faces[b][0];
 }
 
+// The curves limit_by_feature_distance counts, as limit_by_distance's `eligible` and `accept`.
+struct FeatureRule {
+  const cad::CadModel& model;
+  // Curves sharing a corner are not features of each other (paper 000 Sec. 4.1: the nearest
+  // non-adjacent curve). Counting them inside sharp wedges was tried and made things worse:
+  // the boundary sizes then vary too fast near the corner.
+  bool operator()(LO c, LO other) const { return !share_corner(model, c, other); }
+  bool operator()(LO, LO, const Vec3&, double) const { return true; }
+};
+
+// The curves limit_in_sharp_wedges counts: the other side of a wedge of c's own face, where it is
+// sharper than sin(sharp) (the sizes are halved before and doubled after).
+struct WedgeRule {
+  const cad::CadModel& model;
+  const std::vector<std::vector<LO>>& faces;
+  double sharp;
+  bool operator()(LO c, LO other) const { return other != c && own_wedge_sides(faces, c, other); }
+  bool operator()(LO c, LO other, const Vec3& p, double d) const {
+    const double r = shared_corner_distance(model, c, other, p);
+    return std::isfinite(r) && d < sharp * r;
+  }
+};
+
 }  // namespace
 
 void limit_by_feature_distance(const cad::CadModel& model,
                                std::span<const std::vector<Vec3>> polylines,
                                std::vector<std::vector<double>>& sizes, double touching,
                                double floor, const TaskArena& tasks) {
-  // Curves sharing a corner are not features of each other (paper 000 Sec. 4.1: the nearest
-  // non-adjacent curve). Counting them inside sharp wedges was tried and made things worse:
-  // the boundary sizes then vary too fast near the corner.
-  limit_by_distance(
-      polylines, sizes, touching, floor, tasks,
-      [&](LO c, LO other) { return !share_corner(model, c, other); },
-      [](LO, LO, const Vec3&, double) { return true; });
+  limit_by_distance(polylines, sizes, touching, floor, tasks, FeatureRule{model},
+                    FeatureRule{model});
 }
 
 void limit_by_face_width(const cad::CadModel& model, std::span<const std::vector<Vec3>> polylines,
@@ -302,15 +331,49 @@ void limit_in_sharp_wedges(const cad::CadModel& model, std::span<const std::vect
   // Searched within half the size, lowered to the width, then doubled: at most twice the width.
   for (auto& h : sizes)
     for (double& x : h) x *= 0.5;
-  limit_by_distance(
-      polylines, sizes, touching, 0.0, tasks,
-      [&](LO c, LO other) { return other != c && own_wedge_sides(faces, c, other); },
-      [&](LO c, LO other, const Vec3& p, double d) {
-        const double r = shared_corner_distance(model, c, other, p);
-        return std::isfinite(r) && d < sharp * r;
-      });
+  const WedgeRule rule{model, faces, sharp};
+  limit_by_distance(polylines, sizes, touching, 0.0, tasks, rule, rule);
   for (auto& h : sizes)
     for (double& x : h) x *= 2;
+}
+
+struct CurveFeatureSearch::Impl {
+  Impl(const cad::CadModel& m, std::vector<std::vector<Vec3>> lines)
+      : model(m),
+        polylines(std::move(lines)),
+        faces(faces_of_curves(m, polylines.size())),
+        tree(polylines) {}
+  const cad::CadModel& model;
+  std::vector<std::vector<Vec3>> polylines;
+  std::vector<std::vector<LO>> faces;
+  PointTree tree;
+};
+
+CurveFeatureSearch::CurveFeatureSearch(const cad::CadModel& model,
+                                       std::vector<std::vector<Vec3>> polylines)
+    : impl_(std::make_unique<Impl>(model, std::move(polylines))) {}
+CurveFeatureSearch::~CurveFeatureSearch() = default;
+CurveFeatureSearch::CurveFeatureSearch(CurveFeatureSearch&&) noexcept = default;
+CurveFeatureSearch& CurveFeatureSearch::operator=(CurveFeatureSearch&&) noexcept = default;
+
+void CurveFeatureSearch::limit_by_feature_distance(LO c, std::vector<double>& h, double touching,
+                                                   double floor) const {
+  QSMESH_CHECK(h.size() == impl_->polylines[c].size(),
+               "curve " << c << ": " << h.size() << " sizes for " << impl_->polylines[c].size()
+                        << " points");
+  const FeatureRule rule{impl_->model};
+  limit_curve_by_distance(impl_->tree, impl_->polylines, c, h, touching, floor, rule, rule);
+}
+
+void CurveFeatureSearch::limit_in_sharp_wedges(LO c, std::vector<double>& h, double touching,
+                                               double sharp_deg) const {
+  QSMESH_CHECK(h.size() == impl_->polylines[c].size(),
+               "curve " << c << ": " << h.size() << " sizes for " << impl_->polylines[c].size()
+                        << " points");
+  const WedgeRule rule{impl_->model, impl_->faces, std::sin(sharp_deg * std::numbers::pi / 180)};
+  for (double& x : h) x *= 0.5;
+  limit_curve_by_distance(impl_->tree, impl_->polylines, c, h, touching, 0.0, rule, rule);
+  for (double& x : h) x *= 2;
 }
 
 std::vector<SharpTip> sharp_wedge_tips(const cad::CadModel& model,

@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
 
 #include "qsmesh/core/error.hpp"
 
@@ -40,6 +41,23 @@ std::vector<int> partition_faces(const Adjacency& face2faces, std::span<const do
                           &nparts, nullptr, nullptr, options, &objval, result.data());
   QSMESH_CHECK(status == METIS_OK, "METIS_PartGraphKway failed with status " << status);
   for (LO i = 0; i < n; ++i) part[i] = static_cast<int>(result[i]);
+  return part;
+}
+
+std::vector<int> deal_by_weight(std::span<const double> weights, int parts) {
+  QSMESH_CHECK(parts >= 1, "number of parts must be positive");
+  std::vector<std::size_t> order(weights.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::stable_sort(order.begin(), order.end(),
+                   [&](std::size_t a, std::size_t b) { return weights[a] > weights[b]; });
+  std::vector<int> part(weights.size(), 0);
+  std::vector<double> load(static_cast<std::size_t>(parts), 0.0);
+  for (const std::size_t i : order) {
+    const auto r =
+        static_cast<std::size_t>(std::min_element(load.begin(), load.end()) - load.begin());
+    load[r] += weights[i];
+    part[i] = static_cast<int>(r);
+  }
   return part;
 }
 

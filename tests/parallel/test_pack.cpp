@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "qsmesh/background/curve_mesh.hpp"
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/parallel/face_task.hpp"
 #include "qsmesh/parallel/record.hpp"
@@ -281,6 +282,42 @@ TEST(Pack, PatternFillRoundTrips) {
   EXPECT_EQ(b.report.refused_mesh.quads, a.report.refused_mesh.quads);
   EXPECT_EQ(b.mesh.points, a.mesh.points);
   EXPECT_EQ(b.seconds, 0.75);
+}
+
+// record_bytes counts what write_record writes, for every kind of field: records nested in
+// records, vectors of records, strings, bools, meshes, arrays, and a curve's samples (the curves
+// stage's records).
+TEST(Pack, RecordBytesCountsWhatIsWritten) {
+  const auto written = [](const auto& v) {
+    std::vector<char> buf;
+    write_record(buf, v);
+    return static_cast<std::int64_t>(buf.size());
+  };
+  const FaceOutput full = full_output();
+  EXPECT_EQ(record_bytes(full), written(full));
+  EXPECT_EQ(record_bytes(FaceOutput{}), written(FaceOutput{}));
+  PatternFill fill;
+  fill.report.reason = "a reason";
+  fill.report.refused_mesh = small_mesh(2);
+  EXPECT_EQ(record_bytes(fill), written(fill));
+  background::CurveSamples samples;
+  samples.curve = 7;
+  samples.t = {0, 0.5, 1};
+  samples.s = {0, 1, 2};
+  samples.h = {0.25, 0.25, 0.5};
+  samples.p = {{0, 0, 0}, {1, 0, 0}, {2, 0, 0}};
+  EXPECT_EQ(record_bytes(samples), written(samples));
+  EXPECT_EQ(record_bytes(samples), static_cast<std::int64_t>(sizeof(LO) + 4 * 8 + 9 * 8 + 3 * 24));
+  std::vector<char> buf;
+  write_record(buf, samples);
+  std::size_t pos = 0;
+  background::CurveSamples back;
+  read_record(buf, pos, back);
+  EXPECT_EQ(back.curve, 7);
+  EXPECT_EQ(back.t, samples.t);
+  EXPECT_EQ(back.s, samples.s);
+  EXPECT_EQ(back.h, samples.h);
+  EXPECT_EQ(back.p, samples.p);
 }
 
 TEST(Pack, TruncatedRecordsAreErrors) {

@@ -53,5 +53,17 @@ TEST(Partition, MorePartsThanFaces) {
   EXPECT_EQ(p, (std::vector<int>{0, 1}));
 }
 
+// The greedy longest-first rule, worked by hand: the largest weight first, each to the rank with
+// the least so far, ties to the lower index and the lower rank.
+TEST(Partition, DealByWeightIsGreedyLongestFirst) {
+  const std::vector<double> w{1, 5, 3, 3, 2};
+  // 5 -> 0 (5); 3 (item 2) -> 1 (3); 3 (item 3) -> 1 (6); 2 -> 0 (7); 1 -> 1 (7).
+  EXPECT_EQ(deal_by_weight(w, 2), (std::vector<int>{1, 0, 1, 1, 0}));
+  EXPECT_EQ(deal_by_weight(w, 1), (std::vector<int>(5, 0)));
+  // More ranks than items: one each, largest to rank 0; ties by index.
+  EXPECT_EQ(deal_by_weight(w, 8), (std::vector<int>{4, 0, 1, 2, 3}));
+  EXPECT_TRUE(deal_by_weight({}, 3).empty());
+}
+
 }  // namespace
 }  // namespace qsmesh::parallel

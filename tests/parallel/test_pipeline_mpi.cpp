@@ -16,6 +16,7 @@
 #include "qsmesh/mesh/validate.hpp"
 #include "qsmesh/parallel/comm.hpp"
 #include "qsmesh/parallel/pipeline.hpp"
+#include "qsmesh/parallel/record.hpp"
 #include "qsmesh/quantize/quantize.hpp"
 #include "qsmesh/sizemap/size_map.hpp"
 #include "shapes.hpp"
@@ -191,6 +192,37 @@ TEST(Pipeline, DistributedEqualsSerial) {
   }
   EXPECT_EQ(*std::max_element(result.rank_busy_seconds.begin(), result.rank_busy_seconds.end()),
             result.times.get("background"));
+
+  // The curves stage in two rounds split by curve over the ranks (sampling, then feature sizes):
+  // every rank knows every curve's weight and time, and the bytes the all-gather moves are those
+  // of every curve's record, at any rank count.
+  const LO ncurves = model.num_curves();
+  ASSERT_EQ(result.curve_rounds.size(), 2U);
+  const background::CurveMeshing meshing(model, options.background.sizes);
+  std::vector<std::int64_t> record_sizes(2, 0);
+  for (LO c = 0; c < ncurves; ++c) {
+    const background::CurveSamples samples = meshing.sample(c);
+    const auto head = static_cast<std::int64_t>(sizeof(LO) + sizeof(double));
+    record_sizes[0] += head + record_bytes(samples);
+    record_sizes[1] += head + record_bytes(samples.h);
+  }
+  for (std::size_t k = 0; k < 2; ++k) {
+    const CurveRound& round = result.curve_rounds[k];
+    ASSERT_EQ(static_cast<LO>(round.weights.size()), ncurves);
+    ASSERT_EQ(static_cast<LO>(round.curve_seconds.size()), ncurves);
+    EXPECT_EQ(round.bytes, record_sizes[k]) << "round " << k + 1;
+    EXPECT_GT(round.seconds, 0.0);
+    double work = 0;
+    for (LO c = 0; c < ncurves; ++c) {
+      EXPECT_GE(round.curve_seconds[c], 0.0);
+      work += round.curve_seconds[c];
+    }
+    EXPECT_GT(work, 0.0) << "round " << k + 1;
+  }
+  EXPECT_EQ(result.curve_rounds[0].weights[0], meshing.sampling_cost(0));
+  // The rounds' times are in the stage's.
+  EXPECT_LE(result.curve_rounds[0].seconds + result.curve_rounds[1].seconds,
+            result.times.get("curves"));
 
   if (comm.rank() != 0) return;
   // The serial reference: the same stage functions, no MPI, one thread.

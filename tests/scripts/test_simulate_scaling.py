@@ -180,6 +180,35 @@ class Pieces(unittest.TestCase):
         self.assertAlmostEqual(s.bound(), 5.0, places=6)
 
 
+class Curves(unittest.TestCase):
+    def test_curves_split_by_curve(self):
+        # One round: weights 1, 5, 3, 3, 2 (the deal of C++ test
+        # Partition.DealByWeightIsGreedyLongestFirst: ranks 1, 0, 1, 1, 0), curves 0.1, 0.5, 0.3,
+        # 0.3, 0.2 s; the stage 2 s, 0.6 s of it outside the round's curves.
+        st = stats([(1, 0, 0, 0, 1, 0)], {"load": 1.0, "curves": 2.0, "background": 1.0})
+        st["curve_rounds"] = [{"seconds": 1.5, "bytes": 1000, "weights": [1, 5, 3, 3, 2],
+                               "curve_seconds": [0.1, 0.5, 0.3, 0.3, 0.2]}]
+        self.assertEqual(sim.greedy_partition([1, 5, 3, 3, 2], 2), [1, 0, 1, 1, 0])
+        s = sim.Simulator(sim.Run(st), comm=NO_COMM)
+        self.assertAlmostEqual(s.predict(1, 1)["curves"], 2.0, places=6)
+        # 2x1: ranks 0.5 + 0.2 | 0.1 + 0.3 + 0.3 -> 0.7; 1x2: 0.1, 0.5 | 0.3 -> 0.4, 0.3 -> 0.7
+        # (0.4 < 0.5), 0.2 -> 0.7.
+        self.assertAlmostEqual(s.predict(2, 1)["curves"], 1.3, places=6)
+        self.assertAlmostEqual(s.predict(1, 2)["curves"], 1.3, places=6)
+        # Five or more ranks: the largest curve.
+        self.assertAlmostEqual(s.predict(64, 1)["curves"], 1.1, places=6)
+        # The all-gather: the bytes three times at the bandwidth.
+        slow = sim.Simulator(sim.Run(st), comm=dict(NO_COMM, bandwidth_bytes_per_s=1e4))
+        self.assertAlmostEqual(slow.predict(2, 1)["curves"], 1.3 + 0.3, places=6)
+        self.assertAlmostEqual(slow.predict(1, 1)["curves"], 2.0, places=6)
+        # Unlimited ranks: the curves stage takes its largest curve.
+        self.assertAlmostEqual(s.bound(), 1.0 + 1.1 + 1.0, places=6)
+        # A run without rounds keeps the stage replicated.
+        del st["curve_rounds"]
+        self.assertAlmostEqual(sim.Simulator(sim.Run(st), comm=NO_COMM).predict(64, 1)["curves"],
+                               2.0, places=6)
+
+
 class CommandLine(unittest.TestCase):
     def test_refusals_and_output(self):
         script = os.path.join(SCRIPTS, "simulate_scaling.py")

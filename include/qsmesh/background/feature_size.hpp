@@ -3,6 +3,7 @@
 // meshing and by the small-feature size field s_min of the size map.
 #pragma once
 
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -54,6 +55,28 @@ void limit_by_face_width(const cad::CadModel& model, std::span<const std::vector
 void limit_in_sharp_wedges(const cad::CadModel& model, std::span<const std::vector<Vec3>> polylines,
                            std::vector<std::vector<double>>& sizes, double touching,
                            double sharp_deg, const TaskArena& tasks);
+
+/// limit_by_feature_distance and limit_in_sharp_wedges one curve at a time, over polylines given
+/// once (their k-d tree built once), for callers that split the curves over ranks or tasks: a
+/// curve's result is exactly what the functions over all curves give it, whichever curves are done
+/// with it and in whatever order. Thread-safe (const). Holds a reference to `model`.
+class CurveFeatureSearch {
+ public:
+  /// polylines: as limit_by_feature_distance's, indexed by curve id.
+  CurveFeatureSearch(const cad::CadModel& model, std::vector<std::vector<Vec3>> polylines);
+  ~CurveFeatureSearch();
+  CurveFeatureSearch(CurveFeatureSearch&&) noexcept;
+  CurveFeatureSearch& operator=(CurveFeatureSearch&&) noexcept;
+  /// limit_by_feature_distance on curve c: h, one size per vertex of polyline c (checked), lowered
+  /// in place.
+  void limit_by_feature_distance(LO c, std::vector<double>& h, double touching, double floor) const;
+  /// limit_in_sharp_wedges on curve c, as above.
+  void limit_in_sharp_wedges(LO c, std::vector<double>& h, double touching, double sharp_deg) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
 
 /// The tip of a sharp wedge: where curve `curve` leaves its corner at end `end` (0: its first
 /// corner, 1: its last) inside a wedge sharper than the given angle with another side of one of its

@@ -15,4 +15,10 @@ namespace qsmesh::parallel {
 [[nodiscard]] std::vector<int> partition_faces(const Adjacency& face2faces,
                                                std::span<const double> weights, int parts);
 
+/// Deals items over `parts` ranks, largest weight first (ties: the lower index), each to the rank
+/// whose weights so far sum least (ties: the lower rank): the greedy longest-first rule,
+/// the same on every rank (scripts/simulate_scaling.py's greedy_partition replays it). Returns the
+/// rank of each item. Precondition: parts >= 1.
+[[nodiscard]] std::vector<int> deal_by_weight(std::span<const double> weights, int parts);
+
 }  // namespace qsmesh::parallel

@@ -135,6 +135,44 @@ void write_record(std::vector<char>& out, const T& v) {
   }
 }
 
+/// The number of bytes write_record(out, v) appends, counted without writing them (what an
+/// exchange of `v` moves, for --stats and the scaling simulation on runs that send nothing).
+template <class T>
+std::int64_t record_bytes(const T& v) {
+  if constexpr (HasFields<T>) {
+    std::int64_t n = 0;
+    T::fields(v, [&](const char*, const auto& field) { n += record_bytes(field); });
+    return n;
+  } else if constexpr (std::is_same_v<T, bool>) {
+    return sizeof(std::uint8_t);
+  } else if constexpr (std::is_same_v<T, std::string>) {
+    return sizeof(std::int64_t) + static_cast<std::int64_t>(v.size());
+  } else if constexpr (std::is_same_v<T, mesh::FaceMesh>) {
+    auto vec = [](const auto& x) {
+      return sizeof(std::int64_t) +
+             x.size() * sizeof(typename std::decay_t<decltype(x)>::value_type);
+    };
+    return static_cast<std::int64_t>(sizeof(LO) + vec(v.points) + vec(v.uv) + vec(v.vclass) +
+                                     vec(v.triangles) + vec(v.quads));
+  } else if constexpr (detail::IsVector<T>::value) {
+    using E = typename T::value_type;
+    if constexpr (std::is_trivially_copyable_v<E> && !std::is_same_v<E, bool>) {
+      return static_cast<std::int64_t>(sizeof(std::int64_t) + v.size() * sizeof(E));
+    } else {
+      std::int64_t n = sizeof(std::int64_t);
+      for (const auto& e : v) n += record_bytes(e);
+      return n;
+    }
+  } else if constexpr (IsStdArray<T>::value) {
+    std::int64_t n = 0;
+    for (const auto& e : v) n += record_bytes(e);
+    return n;
+  } else {
+    static_assert(std::is_trivially_copyable_v<T>);
+    return sizeof(T);
+  }
+}
+
 /// Reads a value written by write_record at `pos` into `v` and advances `pos`; throws
 /// qsmesh::Error on a truncated buffer.
 template <class T>
