@@ -30,8 +30,8 @@ namespace qsmesh::layout {
 namespace {
 
 constexpr LO kNever = std::numeric_limits<LO>::max();
-// Fine meshes built again with the curve sides of bad coarse quads switched to the other spacing
-// before a repair.
+// Fine meshes built again with the curve sides of bad coarse quads back at the uniform spacing,
+// before every side is uniform.
 constexpr int kMaxSpacingRounds = 3;
 constexpr int kMaxRounds = 40;
 constexpr int kMaxRepairs = 12;
@@ -1320,29 +1320,28 @@ class Builder {
   }
 
   // The fine mesh with the spacing of choose_spacing; where fine quads fold or are invalid, the
-  // curve sides of their coarse quads take the other spacing (each side once) and it is built
-  // again: a repair changes the quantization (restored input lengths, more blocks), so it comes
-  // only when no side of the bad coarse quads is left to switch.
+  // curve sides of their coarse quads go back to the uniform spacing and it is built again, and
+  // after kMaxSpacingRounds every side is uniform (the former placement). A repair changes the
+  // quantization (restored input lengths, more blocks), so it comes only after that. Switching
+  // the bad quads' uniform sides to the input spacing as well was tried: on Block it made new
+  // folds next to them and the layout failed after 11 repairs (docs/benchmarks.md).
   void fine_mesh(CoarseResult& out) {
     std::vector<char> input_like = choose_spacing();
-    std::vector<char> switched(cedges_.size(), 0);
     for (int attempt = 0;; ++attempt) {
       out.mesh = {};
       out.layout = {};
       fine_mesh_with(out, input_like);
-      if (bad_cquads_.empty() || !opt_.input_spacing_on_curves || attempt >= kMaxSpacingRounds)
-        break;
+      if (bad_cquads_.empty()) break;
       bool changed = false;
       for (std::size_t k : bad_cquads_)
-        for (GO g : cquads_[k].e) {
-          const auto e = static_cast<std::size_t>(g);
-          if (cedges_[e].curve == kNoIndex || cedges_[e].n < 2 || switched[e]) continue;
-          input_like[e] = input_like[e] != 0 ? 0 : 1;
-          switched[e] = 1;
-          changed = true;
-        }
+        for (GO e : cquads_[k].e)
+          if (input_like[static_cast<std::size_t>(e)] != 0) {
+            input_like[static_cast<std::size_t>(e)] = 0;
+            changed = true;
+          }
       if (!changed) break;
       ++out.stats.spacing_fallbacks;
+      if (attempt + 1 >= kMaxSpacingRounds) std::fill(input_like.begin(), input_like.end(), 0);
     }
     out.stats.sides_input_spacing = std::count(input_like.begin(), input_like.end(), 1);
     out.stats.sides_uniform_spacing = 0;
