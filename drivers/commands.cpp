@@ -470,6 +470,9 @@ std::string stats_json(const Arguments& args, const Session& session,
       j.value("block_mesh_quads", kept ? c->fine_quads : std::int64_t{0});
       j.value("block_mesh_sicn_min", kept ? c->sicn_min : 0.0);
       j.value("block_mesh_sicn_avg", kept ? c->sicn_avg : 0.0);
+      j.value("sides_input_spacing", kept ? c->sides_input_spacing : std::int64_t{0});
+      j.value("sides_uniform_spacing", kept ? c->sides_uniform_spacing : std::int64_t{0});
+      j.value("spacing_fallbacks", static_cast<std::int64_t>(c->spacing_fallbacks));
     }
     if (checks.blocks->plot3d) {
       const io::Plot3dReport& p = *checks.blocks->plot3d;
@@ -933,6 +936,8 @@ int run_mesh(const Arguments& args) {
       if (args.coarse_layout) {
         layout::CoarseOptions co;
         co.loop_balance = args.loop_balance;
+        co.laplacian_uv = args.fine_laplacian;
+        co.input_spacing_on_curves = args.fine_input_spacing;
         if (args.cone_angle_deg > 0) co.alpha = args.cone_angle_deg * 3.14159265358979323846 / 180;
         co.cross_smooth_curves = !args.sharp_and_smooth_walls;
         co.traces_across_smooth_curves = args.traces_cross_curves;

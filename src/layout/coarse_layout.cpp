@@ -30,6 +30,9 @@ namespace qsmesh::layout {
 namespace {
 
 constexpr LO kNever = std::numeric_limits<LO>::max();
+// Fine meshes built again with the curve sides of bad coarse quads back at the uniform spacing,
+// before every side is uniform.
+constexpr int kMaxSpacingRounds = 3;
 constexpr int kMaxRounds = 40;
 constexpr int kMaxRepairs = 12;
 
@@ -1181,7 +1184,172 @@ class Builder {
     mesh::VertexClass c;
   };
 
+  // The curve parameters t_0..t_n of the fine nodes of coarse edge ce (along a CAD curve), from
+  // its vertex a to b: uniform in the parameter, or (input_like) the input mesh's nodes on the
+  // curve between the edge's ends, their parameters interpolated at n evenly spread fractional
+  // positions (the input's grading along the side, at the coarse edge's node count).
+  std::vector<double> side_params(std::size_t e, bool input_like) {
+    const auto& ce = cedges_[e];
+    const cad::Curve& cc = model_.curves()[static_cast<std::size_t>(ce.curve)];
+    const GO cb = center_[static_cast<std::size_t>(ce.b)];
+    const double tb0 = vc(cb).dim == 1 ? vc(cb).param[0] : 0.5 * (cc.t0 + cc.t1);
+    const double ta = param_on(ce.a, ce.curve, tb0);
+    const double tb = param_on(ce.b, ce.curve, ta);
+    std::vector<double> ts(static_cast<std::size_t>(ce.n) + 1);
+    for (LO k = 0; k <= ce.n; ++k) ts[static_cast<std::size_t>(k)] = ta + (tb - ta) * k / ce.n;
+    ts.back() = tb;
+    if (!input_like || ce.n < 2) return ts;
+    const std::vector<double>& all = input_params(ce.curve);
+    const double lo = std::min(ta, tb), hi = std::max(ta, tb);
+    std::vector<double> s{ta};
+    for (auto it = std::upper_bound(all.begin(), all.end(), lo); it != all.end() && *it < hi; ++it)
+      s.push_back(*it);
+    if (ta > tb) std::reverse(s.begin() + 1, s.end());
+    s.push_back(tb);
+    const auto m = static_cast<LO>(s.size()) - 1;
+    if (m < 2) return ts;  // no input node inside: the same as uniform
+    for (LO k = 1; k < ce.n; ++k) {
+      const double x = static_cast<double>(k) * m / ce.n;
+      const auto j = std::min<LO>(static_cast<LO>(std::floor(x)), m - 1);
+      const double f = x - j;
+      ts[static_cast<std::size_t>(k)] =
+          s[static_cast<std::size_t>(j)] +
+          f * (s[static_cast<std::size_t>(j) + 1] - s[static_cast<std::size_t>(j)]);
+    }
+    return ts;
+  }
+
+  // The parameters of the input mesh's vertices inside curve c, sorted.
+  const std::vector<double>& input_params(LO c) {
+    if (curve_params_.empty()) {
+      curve_params_.resize(static_cast<std::size_t>(std::max<LO>(m_.num_cad_curves, 0)));
+      for (GO v = 0; v < nv_; ++v)
+        if (vc(v).dim == 1 && vc(v).entity >= 0 &&
+            static_cast<std::size_t>(vc(v).entity) < curve_params_.size())
+          curve_params_[static_cast<std::size_t>(vc(v).entity)].push_back(vc(v).param[0]);
+      for (auto& list : curve_params_) std::sort(list.begin(), list.end());
+    }
+    return curve_params_[static_cast<std::size_t>(c)];
+  }
+
+  // Which coarse edges on curves take the input spacing (CoarseOptions::input_spacing_on_curves):
+  // each coarse quad with a side on a curve is scored (SICN of its fine quads by transfinite
+  // interpolation, not projected nor smoothed) with all its curve sides uniform and all at the
+  // input spacing; an edge takes the input spacing when choose_side_spacing prefers it for every
+  // coarse quad it bounds.
+  std::vector<char> choose_spacing() {
+    std::vector<char> input_like(cedges_.size(), 0);
+    if (!opt_.input_spacing_on_curves) return input_like;
+    std::vector<char> vote(cedges_.size(), 0);
+    for (std::size_t e = 0; e < cedges_.size(); ++e)
+      if (cedges_[e].curve != kNoIndex && cedges_[e].n >= 2) vote[e] = 1;
+    // Side points of an edge walked from `from`, under one spacing.
+    auto side_points = [&](GO e, GO from, bool input) {
+      const CEdge& ce = cedges_[static_cast<std::size_t>(e)];
+      const GO ca = center_[static_cast<std::size_t>(ce.a)];
+      const GO cb = center_[static_cast<std::size_t>(ce.b)];
+      const Vec3 pa = m_.points[static_cast<std::size_t>(ca)];
+      const Vec3 pb = m_.points[static_cast<std::size_t>(cb)];
+      std::vector<Vec3> pts(static_cast<std::size_t>(ce.n) + 1);
+      if (ce.curve != kNoIndex) {
+        const std::vector<double> ts = side_params(static_cast<std::size_t>(e), input);
+        for (LO k = 1; k < ce.n; ++k)
+          pts[static_cast<std::size_t>(k)] =
+              curve_geom(ce.curve).point(ts[static_cast<std::size_t>(k)]);
+      } else {
+        for (LO k = 1; k < ce.n; ++k)
+          pts[static_cast<std::size_t>(k)] = pa + (pb - pa) * (static_cast<double>(k) / ce.n);
+      }
+      pts.front() = pa;
+      pts.back() = pb;
+      if (from != ce.a) std::reverse(pts.begin(), pts.end());
+      return pts;
+    };
+    auto score = [&](const CQuad& q, bool input) {
+      const LO n0 = cedges_[static_cast<std::size_t>(q.e[0])].n;
+      const LO n1 = cedges_[static_cast<std::size_t>(q.e[1])].n;
+      const auto s0 = side_points(q.e[0], q.v[0], input), s1 = side_points(q.e[1], q.v[1], input);
+      const auto s2 = side_points(q.e[2], q.v[2], input), s3 = side_points(q.e[3], q.v[3], input);
+      auto P = [&](LO i, LO j) -> Vec3 {
+        if (j == 0) return s0[static_cast<std::size_t>(i)];
+        if (i == n0) return s1[static_cast<std::size_t>(j)];
+        if (j == n1) return s2[static_cast<std::size_t>(n0 - i)];
+        return s3[static_cast<std::size_t>(n1 - j)];
+      };
+      std::vector<Vec3> g(static_cast<std::size_t>(n0 + 1) * static_cast<std::size_t>(n1 + 1));
+      auto at = [&](LO i, LO j) -> Vec3& {
+        return g[static_cast<std::size_t>(j) * static_cast<std::size_t>(n0 + 1) +
+                 static_cast<std::size_t>(i)];
+      };
+      for (LO j = 0; j <= n1; ++j)
+        for (LO i = 0; i <= n0; ++i) {
+          if (i == 0 || j == 0 || i == n0 || j == n1) {
+            at(i, j) = P(i, j);
+            continue;
+          }
+          const double s = static_cast<double>(i) / n0, t = static_cast<double>(j) / n1;
+          at(i, j) = (1 - t) * P(i, 0) + t * P(i, n1) + (1 - s) * P(0, j) + s * P(n0, j) -
+                     ((1 - s) * (1 - t) * P(0, 0) + s * (1 - t) * P(n0, 0) +
+                      (1 - s) * t * P(0, n1) + s * t * P(n0, n1));
+        }
+      SideScore sc{2, 0};
+      for (LO j = 0; j < n1; ++j)
+        for (LO i = 0; i < n0; ++i) {
+          const double v =
+              mesh::quad_sicn({at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)});
+          sc.sicn_min = std::min(sc.sicn_min, v);
+          sc.sicn_avg += v;
+        }
+      sc.sicn_avg /= static_cast<double>(n0) * static_cast<double>(n1);
+      return sc;
+    };
+    for (const CQuad& q : cquads_) {
+      bool any = false;
+      for (GO e : q.e) any = any || vote[static_cast<std::size_t>(e)] != 0;
+      if (!any) continue;
+      if (cedges_[static_cast<std::size_t>(q.e[2])].n !=
+              cedges_[static_cast<std::size_t>(q.e[0])].n ||
+          cedges_[static_cast<std::size_t>(q.e[3])].n !=
+              cedges_[static_cast<std::size_t>(q.e[1])].n)
+        continue;  // fine_mesh refuses it
+      if (!choose_side_spacing(score(q, false), score(q, true)))
+        for (GO e : q.e) vote[static_cast<std::size_t>(e)] = 0;
+    }
+    for (std::size_t e = 0; e < cedges_.size(); ++e) input_like[e] = vote[e];
+    return input_like;
+  }
+
+  // The fine mesh with the spacing of choose_spacing; where fine quads fold or are invalid, the
+  // curve sides of their coarse quads go back to the uniform spacing and it is built again, and
+  // after kMaxSpacingRounds every side is uniform (the former placement). A repair changes the
+  // quantization (restored input lengths, more blocks), so it comes only after that. Switching
+  // the bad quads' uniform sides to the input spacing as well was tried: on Block it made new
+  // folds next to them and the layout failed after 11 repairs (docs/benchmarks.md).
   void fine_mesh(CoarseResult& out) {
+    std::vector<char> input_like = choose_spacing();
+    for (int attempt = 0;; ++attempt) {
+      out.mesh = {};
+      out.layout = {};
+      fine_mesh_with(out, input_like);
+      if (bad_cquads_.empty()) break;
+      bool changed = false;
+      for (std::size_t k : bad_cquads_)
+        for (GO e : cquads_[k].e)
+          if (input_like[static_cast<std::size_t>(e)] != 0) {
+            input_like[static_cast<std::size_t>(e)] = 0;
+            changed = true;
+          }
+      if (!changed) break;
+      ++out.stats.spacing_fallbacks;
+      if (attempt + 1 >= kMaxSpacingRounds) std::fill(input_like.begin(), input_like.end(), 0);
+    }
+    out.stats.sides_input_spacing = std::count(input_like.begin(), input_like.end(), 1);
+    out.stats.sides_uniform_spacing = 0;
+    for (std::size_t e = 0; e < cedges_.size(); ++e)
+      if (cedges_[e].curve != kNoIndex && input_like[e] == 0) ++out.stats.sides_uniform_spacing;
+  }
+
+  void fine_mesh_with(CoarseResult& out, const std::vector<char>& input_like) {
     std::vector<FineNode> nodes;
     // Coarse vertices.
     std::vector<GO> vnode(static_cast<std::size_t>(ng_), -1);
@@ -1201,14 +1369,9 @@ class Builder {
       const Vec3 pa = nodes[static_cast<std::size_t>(vnode[static_cast<std::size_t>(ce.a)])].p;
       const Vec3 pb = nodes[static_cast<std::size_t>(vnode[static_cast<std::size_t>(ce.b)])].p;
       if (ce.curve != kNoIndex) {
-        const double tb0 = vc(center_[static_cast<std::size_t>(ce.b)]).dim == 1
-                               ? vc(center_[static_cast<std::size_t>(ce.b)]).param[0]
-                               : 0.5 * (model_.curves()[static_cast<std::size_t>(ce.curve)].t0 +
-                                        model_.curves()[static_cast<std::size_t>(ce.curve)].t1);
-        const double ta = param_on(ce.a, ce.curve, tb0);
-        const double tb = param_on(ce.b, ce.curve, ta);
+        const std::vector<double> ts = side_params(e, input_like[e] != 0);
         for (LO k = 1; k < ce.n; ++k) {
-          const double t = ta + (tb - ta) * k / ce.n;
+          const double t = ts[static_cast<std::size_t>(k)];
           nodes.push_back({curve_geom(ce.curve).point(t), {1, ce.curve, kNoIndex, {t, 0}}});
         }
       } else {
@@ -1703,6 +1866,10 @@ class Builder {
     for (const auto& [f, list] : by_face) {
       mesh::FaceMesh fm;
       fm.face = f;
+      const cad::Face& face = model_.faces()[static_cast<std::size_t>(f)];
+      auto seam = [&](LO c) {
+        return std::find(face.seams.begin(), face.seams.end(), c) != face.seams.end();
+      };
       std::vector<GO> global;
       std::vector<Vec2> gs_uv;
       for (std::size_t i : list) {
@@ -1727,6 +1894,12 @@ class Builder {
         const FineNode& n = nodes[static_cast<std::size_t>(global[l])];
         fm.points[l] = n.p;
         fm.vclass[l] = n.c;
+        // Each curve node its own index: the smoother reads a (dim, entity, index) met twice with
+        // two uv as a seam and skips its uv Laplacian. With the index left kNoIndex every curve
+        // node of a curve shared that key, so every face looked like a seam. Nodes on the face's
+        // own seam curves keep the shared key: there the face is periodic and one node stands for
+        // two uv, which the Laplacian must not see.
+        if (n.c.dim == 1 && !seam(n.c.entity)) fm.vclass[l].index = static_cast<LO>(global[l]);
         if (n.c.dim == 2) {
           fm.uv[l] = {n.c.param[0], n.c.param[1]};
           has[l] = 1;
@@ -1756,7 +1929,9 @@ class Builder {
         }
       smooth::SmoothOptions so;
       so.iterations = opt_.smoothing_iterations;
-      so.laplacian_uv = false;
+      // The uv Laplacian first (a direct solve, kept only when the face's minimum SICN does not
+      // drop), not on faces with a seam, where a node on the seam has one uv for two sides.
+      so.laplacian_uv = opt_.laplacian_uv && face.seams.empty();
       mesh::FaceMesh sm =
           opt_.smoothing_iterations > 0 ? smooth::smooth_face(fm, face_geom(f), so) : fm;
       // Concave corners may leave folded quads (paper 002 Sec. IV.E): local untangling there.
@@ -1835,6 +2010,7 @@ class Builder {
   std::map<LO, std::unique_ptr<cad::FaceGeometry>> face_geom_;
   std::map<LO, std::unique_ptr<cad::CurveGeometry>> curve_geom_;
   std::vector<char> bad_fine_cquad_;
+  std::vector<std::vector<double>> curve_params_;  // input_params, per CAD curve
   std::vector<int> repair_level_;
   std::vector<std::size_t> bad_cquads_;
   std::int64_t bad_quads_ = 0;
@@ -1848,6 +2024,13 @@ class Builder {
 };
 
 }  // namespace
+
+bool choose_side_spacing(const SideScore& uniform, const SideScore& input_like, double avg_slack) {
+  if (input_like.sicn_min <= 0) return false;
+  if (uniform.sicn_min <= 0) return true;
+  return input_like.sicn_avg >= uniform.sicn_avg - avg_slack &&
+         input_like.sicn_min >= 0.9 * uniform.sicn_min;
+}
 
 CoarseResult build_coarse_layout(const mesh::SurfaceMesh& input, const cad::CadModel& model,
                                  const CoarseOptions& options) {

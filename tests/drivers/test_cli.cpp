@@ -147,6 +147,21 @@ TEST(Cli, ConeAngleInDegreesBetweenZeroAndNinety) {
         << bad;
 }
 
+TEST(Cli, FinePlacementChoosesTheCoarseMeshsPlacementChanges) {
+  const auto both = p({"mesh", "m.step", "-o", "o.xyz", "--layout", "coarse"});
+  EXPECT_TRUE(both.fine_laplacian && both.fine_input_spacing);
+  const auto former =
+      p({"mesh", "m.step", "-o", "o.xyz", "--layout", "coarse", "--fine-placement", "former"});
+  EXPECT_FALSE(former.fine_laplacian || former.fine_input_spacing);
+  const auto spacing =
+      p({"mesh", "m.step", "-o", "o.xyz", "--layout", "coarse", "--fine-placement", "spacing"});
+  EXPECT_TRUE(!spacing.fine_laplacian && spacing.fine_input_spacing);
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.xyz", "--layout", "coarse", "--fine-placement",
+                      "uniform"})
+                .find("--fine-placement"),
+            std::string::npos);
+}
+
 TEST(Cli, BlockStructuredNeedsCgnsAndQuads) {
   EXPECT_TRUE(p({"mesh", "m.step", "-o", "o.cgns", "--block-structured"}).block_structured);
   EXPECT_FALSE(p({"mesh", "m.step", "-o", "o.cgns"}).block_structured);

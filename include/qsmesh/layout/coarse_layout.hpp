@@ -44,7 +44,30 @@ struct CoarseOptions {
   bool traces_across_smooth_curves = false;
   /// Passes of the smoother (smooth::smooth_face, Winslow kernels) on each face of the new mesh.
   int smoothing_iterations = 10;
+  /// Before the kernels, the smoother's Laplacian in the parameter plane (a direct solve, kept
+  /// only when the face's minimum SICN does not drop); not on faces with a seam or periodic.
+  bool laplacian_uv = true;
+  /// Fine nodes on coarse edges along CAD curves spread like the input mesh's nodes between the
+  /// edge's two ends (their curve parameters interpolated), instead of uniformly in the curve
+  /// parameter. Each such edge keeps the spacing choose_side_spacing prefers for the coarse
+  /// quads on its sides, and falls back to the uniform one where fine quads fold.
+  bool input_spacing_on_curves = true;
 };
+
+/// Quality of the fine quads of one coarse quad (SICN, before smoothing), for one placement of
+/// the fine nodes on its sides.
+struct SideScore {
+  double sicn_min = 0;
+  double sicn_avg = 0;
+};
+
+/// The policy between the two placements of a coarse quad's side nodes on CAD curves: true keeps
+/// the input mesh's spacing (`input_like`), false the uniform parameter spacing (`uniform`).
+/// The input spacing is kept when it leaves no inverted quad and neither lowers the average by
+/// more than `avg_slack` nor the minimum below 0.9 of the uniform's (a lower minimum with a
+/// higher average is how a stretched corner quad shows up, and corner quads are what folds).
+[[nodiscard]] bool choose_side_spacing(const SideScore& uniform, const SideScore& input_like,
+                                       double avg_slack = 0.0);
 
 struct CoarseStats {
   std::int64_t tmesh_nodes = 0, tmesh_arcs = 0, tmesh_patches = 0, traces = 0;
@@ -76,6 +99,11 @@ struct CoarseStats {
                chords_open_elsewhere = 0;
   std::int64_t coarse_quads = 0;  ///< blocks
   std::int64_t fine_quads = 0;
+  /// Coarse edges on CAD curves whose fine nodes follow the input spacing, and those kept at the
+  /// uniform spacing (by choose_side_spacing, or after a fold).
+  std::int64_t sides_input_spacing = 0, sides_uniform_spacing = 0;
+  /// Fine meshes built again with some sides back at the uniform spacing, after folds.
+  int spacing_fallbacks = 0;
   double sicn_min = 0, sicn_avg = 0;  ///< of the new mesh (after smoothing)
   double seconds = 0;                 ///< the whole stage
 };
