@@ -50,6 +50,20 @@ constexpr double kThinGradation = 0.5;
 /// 72 to 132 interior irregular vertices (docs/benchmarks.md, issue 29).
 constexpr double kSharedWedgeAspect = 0.6;
 
+/// Rule (i'): the end corners of a curve shorter than the floor are no larger than this many times
+/// its length. The floor keeps such a curve's size (and its corners') at the floor while the
+/// quantization gives it 2 edges, so the quads against it went from half its length to the floor
+/// in one row: beside a step 0.003 x the size high (floor 0.17) SICN 0.015, 0.188 graded from 5 x
+/// the length (ThinRegions.StepShorterThanTheFloorGetsItsCornersGraded). Block at size factor 0.02
+/// (steps 0.01 long at reflex corners, 4 faces) 20 -> 11 quads below SICN 0.1, A319 9 -> 0, the
+/// reference meshes unchanged (docs/benchmarks.md, issue 29). Not at corners that a four-sided face
+/// without the curve touches: its grid fill takes the curve's neighbourhood as it is, and finer
+/// sizes at its corner carry finer counts through the grids. Capped there too, wing_fuselage's
+/// wing-root slivers took it at its reference factor from 17926 to 19014 vertices and SICN avg
+/// 0.927 to 0.915 (below its criterion, 0.918), at size factor 0.01 from 72 to 97 interior
+/// irregular vertices; with the exception its meshes are unchanged.
+constexpr double kSliverCornerRatio = 5;
+
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 [[noreturn]] void input_error(const std::string& what) { throw InputError("sizemap: " + what); }
@@ -155,6 +169,20 @@ void check_shape(const CurveSizes& sizes, std::span<const mesh::CurveMesh> curve
       "sizemap: " << sizes.corner.size() << " corner sizes for " << num_corners << " corners");
 }
 
+/// Whether a four-sided face (one loop of four curve uses) that does not use curve `c` touches
+/// corner `k`: rule (i') leaves such corners alone (kSliverCornerRatio).
+bool grid_face_without_curve_at(const cad::CadModel& model, LO k, LO c) {
+  for (const LO d : model.corner2curves()[k])
+    for (const LO f : model.curve2faces()[d]) {
+      const auto& loops = model.faces()[f].loops;
+      if (loops.size() != 1 || loops[0].uses.size() != 4) continue;
+      bool uses_c = false;
+      for (const auto& use : loops[0].uses) uses_c = uses_c || use.curve == c;
+      if (!uses_c) return true;
+    }
+  return false;
+}
+
 }  // namespace
 
 double effective_size_min(const SizeMapOptions& options) {
@@ -240,7 +268,7 @@ CurveSizes initial_curve_sizes(const cad::CadModel& model, std::span<const mesh:
   //     curve gets at least one edge, and the faces around a very short curve grade out from it.
   //     A floor the user gave is a statement about the smallest elements wanted, so it holds here
   //     too: a sliver edge of the CAD still gets its edges (the quantization's minimum), and its
-  //     surroundings stay at the floor.
+  //     surroundings stay at the floor, but for its corners (rule (i') below).
   const double length_floor = options.size_min > 0 ? floor : 0.0;
   for (LO c = 0; c < nc; ++c) {
     const auto& cc = model.curves()[c];
@@ -392,6 +420,18 @@ CurveSizes initial_curve_sizes(const cad::CadModel& model, std::span<const mesh:
             at[i] = std::min(at[i], at[i + 1] + g * distance(p[i], p[i + 1]));
       }
     }
+  }
+
+  // (i') The corners of a curve shorter than the floor: at most kSliverCornerRatio x its length,
+  //      so that the sizes grade toward it instead of dropping from the floor to its edges in one
+  //      row (except where a grid face beside it takes the corner as it is).
+  for (LO c = 0; c < nc; ++c) {
+    const auto& cc = model.curves()[c];
+    if (cc.degenerate || !(cc.length < floor)) continue;
+    const double cap = kSliverCornerRatio * cc.length;
+    for (const LO k : cc.corners)
+      if (k >= 0 && cap < out.corner[k] && !grid_face_without_curve_at(model, k, c))
+        out.corner[k] = cap;
   }
 
   for (const auto& [k, v] : options.corner_sizes) out.corner[k] = std::min(out.corner[k], v);

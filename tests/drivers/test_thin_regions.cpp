@@ -315,4 +315,41 @@ TEST(ThinRegions, PrismOfTheFiveDegreeCornerQuadsAwayFromItStayAboveSicnPointTwo
   EXPECT_GE(on.sicn_min_away, 0.2) << on.quads << " quads";
 }
 
+/// The smallest SICN over the quads of `m` with a vertex within `radius` of `centre`, and how many
+/// such quads there are.
+std::pair<double, std::size_t> sicn_min_near(const MshQuads& m, const Vec3& centre, double radius) {
+  double smallest = 1;
+  std::size_t near = 0;
+  for (const auto& q : m.quads) {
+    bool close = false;
+    for (const std::size_t v : q) close = close || qsmesh::distance(m.points[v], centre) < radius;
+    if (!close) continue;
+    ++near;
+    smallest = std::min(smallest, qsmesh::mesh::quad_sicn({m.points[q[0]], m.points[q[1]],
+                                                           m.points[q[2]], m.points[q[3]]}));
+  }
+  return {smallest, near};
+}
+
+// A 10 x 4 plate whose top edge steps down by 0.003 at x = 5: the step is a curve 0.003 x the
+// size long, far below the floor (0.17 x the size by default) and below a tenth of it, where the
+// thin-face cap takes the sides it joins for a blunted wedge's tip and leaves them alone. The
+// floor kept the step's corners at 0.17 while the step has its 2 edges of 0.0015, so the quads
+// against it went from one to the other in one row: SICN 0.015 (0.023 for a step of 0.005, 0.115
+// for 0.01; one of 0.02, above a tenth of the floor, the thin-face cap grades: 0.238). Rule (i')
+// of the size map caps the step's corners at 5 x its length and the sizes grade toward it: 0.188.
+// --sizing paper (rule (i) below the floor) sets them at the step's length anyway.
+TEST(ThinRegions, StepShorterThanTheFloorGetsItsCornersGraded) {
+  const std::string model = qsmesh::test::write_polygon_face(
+      {{0, 0}, {10, 0}, {10, 4}, {5, 4}, {5, 3.997}, {0, 3.997}}, tmp("thin_step.brep"));
+  const std::string out = tmp("thin_step.msh"), err = tmp("thin_step.err");
+  const std::string cmd = std::string(QSMESH_EXE) + " mesh " + model + " -o " + out +
+                          " --size 1 --threads 2 -q 2>" + err;
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd << ": " << qsmesh::test::slurp(err);
+  const auto [sicn, near] = sicn_min_near(read_msh(out), Vec3{5, 3.9985, 0}, 1.0);
+  std::printf("step 0.003 high: SICN min %.3f over the %zu quads within 1 of it\n", sicn, near);
+  ASSERT_GT(near, 0u);
+  EXPECT_GE(sicn, 0.15);
+}
+
 }  // namespace

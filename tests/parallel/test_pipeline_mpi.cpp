@@ -665,10 +665,28 @@ TEST(Pipeline, SizeMapOnSharedModels) {
     // chains have equal counts, and (rule (i) of Sec. 4.1) the size never exceeds the length of its
     // curve where that length is above the floor (degenerate curves, poles, have no length: their
     // vertices carry the pole corner's size); with the clamp no size is below the floor, so a
-    // curve shorter than it keeps the floor. Every rank holds the same curve data, so every rank
-    // checks.
+    // curve shorter than it keeps the floor, except that its corners are at 5 x its length and
+    // the sizes grow from them at the gradation (rule (i'), sizemap's kSliverCornerRatio): no
+    // size below min(floor, 5 L + g d) for the distance d to such a corner. Every rank holds the
+    // same curve data, so every rank checks.
     PipelineResult r;
     check_size_map(comm, model, size, &r, ratio);
+    background::SizeOptions sizes;
+    sizes.size = size;
+    const auto curves = background::mesh_curves(model, sizes, TaskArena(1));
+    std::vector<std::pair<Vec3, double>> sliver_corners;  // (point, 5 x the curve's length)
+    for (const cad::Curve& curve : model.curves())
+      if (!curve.degenerate && curve.length < floor)
+        for (const LO k : curve.corners)
+          if (k >= 0) sliver_corners.emplace_back(model.corners()[k].point, 5 * curve.length);
+    const double gradation = sizemap::SizeMapOptions{}.gradation;
+    auto lowest = [&](const Vec3& p) {
+      double s = floor;
+      for (const auto& [corner, cap] : sliver_corners)
+        s = std::min(s, cap + gradation * distance(p, corner));
+      return s;
+    };
+    int graded = 0;  // vertices below the floor, graded toward a sliver's corner
     const auto& q = r.quantization;
     int pairs = 0, unequal = 0, too_large = 0, below_floor = 0;
     for (const auto& face : model.faces()) {
@@ -684,16 +702,18 @@ TEST(Pipeline, SizeMapOnSharedModels) {
     for (LO c = 0; c < model.num_curves(); ++c) {
       const cad::Curve& curve = model.curves()[c];
       if (!curve.degenerate && curve.length < floor) ++clamped_curves;
-      for (double s : r.curve_sizes.at[c]) {
+      for (std::size_t i = 0; i < r.curve_sizes.at[c].size(); ++i) {
+        const double s = r.curve_sizes.at[c][i];
         if (!curve.degenerate && curve.length >= floor && s > curve.length * (1 + 1e-12)) {
           ++too_large;
           ADD_FAILURE() << name << ": curve " << c << " of length " << curve.length << " has size "
                         << s;
         }
-        if (s < floor * (1 - 1e-12)) {
+        if (s < floor * (1 - 1e-12)) ++graded;
+        if (s < lowest(curves[c].points[i]) * (1 - 1e-12)) {
           ++below_floor;
           ADD_FAILURE() << name << ": curve " << c << " has size " << s << " below the floor "
-                        << floor;
+                        << floor << " and below the growth from the slivers' corners";
         }
       }
     }
@@ -703,7 +723,8 @@ TEST(Pipeline, SizeMapOnSharedModels) {
     EXPECT_EQ(below_floor, 0) << name;
     if (comm.rank() == 0)
       std::cout << name << " (floor " << floor << "): " << q.num_chords << " chords, " << pairs
-                << " opposite pairs in chords\n";
+                << " opposite pairs in chords, " << graded
+                << " curve-mesh vertices graded below the floor toward sliver corners\n";
   }
   EXPECT_GT(clamped_curves, 0);  // the clamp was put to the test
 }

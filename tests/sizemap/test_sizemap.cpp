@@ -214,7 +214,9 @@ TEST(SizeMap, FeatureRatioBoundsHowFarTheSlotRefinesItsSides) {
 TEST(SizeMap, GivenFloorStopsSliverCurvesFromRefining) {
   // A 10 x 10 square with one corner cut by a sliver edge 0.005 long. Rule (i) sizes the sliver
   // by its length, below the default floor (size cap / 100); a floor the user gives holds there
-  // too, and everywhere else.
+  // too, and everywhere else but around the sliver's corners, which rule (i') sets at 5 x its
+  // length (the quantization gives the sliver 2 edges whatever its size, and the sizes grade
+  // toward them instead of dropping from the floor in one row).
   const Model m = prepare(
       polygon_face({{0, 0}, {10, 0}, {10, 10}, {0.003, 10}, {0, 9.996}}, "sliver_corner.brep"), 1.0,
       false);
@@ -231,9 +233,28 @@ TEST(SizeMap, GivenFloorStopsSliverCurvesFromRefining) {
   for (const double s : paper.at[sliver]) EXPECT_LE(s, length + 1e-12);
   o.size_min = 0.2;
   const CurveSizes floored = initial_curve_sizes(m.cad, m.curves, o, TaskArena(1));
+  // No size below the floor or below the growth from the sliver's corners, whichever is less.
+  const auto& ends = m.cad.curves()[sliver].corners;
+  auto lower_bound = [&](const Vec3& p) {
+    double d = std::numeric_limits<double>::infinity();
+    for (const LO k : ends) d = std::min(d, distance(p, m.cad.corners()[k].point));
+    return std::min(0.2, 5 * length + o.gradation * d);
+  };
+  int below_floor = 0;
   for (LO c = 0; c < m.cad.num_curves(); ++c)
-    for (const double s : floored.at[c]) EXPECT_GE(s, 0.2 - 1e-12) << "curve " << c;
-  for (const double s : floored.corner) EXPECT_GE(s, 0.2 - 1e-12);
+    for (std::size_t i = 0; i < floored.at[c].size(); ++i) {
+      EXPECT_GE(floored.at[c][i], lower_bound(m.curves[c].points[i]) * (1 - 1e-12))
+          << "curve " << c;
+      below_floor += floored.at[c][i] < 0.2 - 1e-12 ? 1 : 0;
+    }
+  EXPECT_GT(below_floor, 0);  // the sliver's neighbourhood is graded
+  for (LO k = 0; k < m.cad.num_corners(); ++k) {
+    const bool end = k == ends[0] || k == ends[1];
+    if (end)
+      EXPECT_NEAR(floored.corner[k], 5 * length, 1e-12);
+    else
+      EXPECT_GE(floored.corner[k], 0.2 - 1e-12);
+  }
   EXPECT_LE(curve_gradation_excess(m, floored, o.gradation), 1e-9);
   // A user size below the floor still wins (the floor drops to it).
   o.curve_sizes = {{sliver, 0.05}};

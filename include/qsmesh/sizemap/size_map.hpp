@@ -40,9 +40,12 @@ struct SizeMapOptions {
   /// honoured (the floor is then lowered to the smallest user size, see effective_size_min).
   /// Given (> 0, --size-min), it also bounds rule (i) of Sec. 4.1: a curve shorter than the floor
   /// (a sliver edge of the CAD) keeps its 2 edges but no longer makes the sizes around it finer
-  /// than the floor. With 0, rule (i) goes below the default floor as the paper has it (no size
-  /// above its curve's length): wing_fuselage's two 0.036-long curves at the wing root then
-  /// grade every face around them from 0.036 where the size cap is about 6.
+  /// than the floor, except at its two corners, which are at most 5 x its length (rule (i'),
+  /// unless a four-sided face without the curve touches the corner) so that the sizes grade
+  /// toward its edges instead of dropping to them in one row of quads. With 0, rule (i) goes below
+  /// the default floor as the paper has it (no size above its curve's length): wing_fuselage's two
+  /// 0.036-long curves at the wing root then grade every face around them from 0.036 where the size
+  /// cap is about 6.
   double size_min = 0;
   /// g_max of Eq. 10: largest growth of the size per unit distance (0.2: progression ratio 1.2).
   double gradation = 0.2;
@@ -121,11 +124,12 @@ struct CurveSizes {
 /// (background::limit_by_feature_distance on the curve-mesh polylines, densified so that a segment
 /// is no longer than half the local size), (ii) lowering a size to no less than feature_ratio x
 /// its value before (ii); floored by effective_size_min (so (i) and (ii) hold for
-/// features larger than the floor; (i) also below the floor unless size_min was given); then user
-/// corner sizes, the thin-face cap (thin_aspect), and grade_curves (corners = min over their
-/// curves, Eq. 10 along the curve edges and through corners). `curves` indexed by curve id, as
-/// background::mesh_curves returns them. Deterministic whatever the thread count of `tasks`. Throws
-/// InputError for bad options (sizes <= 0, ids out of range).
+/// features larger than the floor; (i) also below the floor unless size_min was given); the
+/// corners of curves shorter than the floor at most 5 x their length (i'); then user corner sizes,
+/// the thin-face cap (thin_aspect), and grade_curves (corners = min over their curves, Eq. 10 along
+/// the curve edges and through corners). `curves` indexed by curve id, as background::mesh_curves
+/// returns them. Deterministic whatever the thread count of `tasks`. Throws InputError for bad
+/// options (sizes <= 0, ids out of range).
 [[nodiscard]] CurveSizes initial_curve_sizes(const cad::CadModel& model,
                                              std::span<const mesh::CurveMesh> curves,
                                              const SizeMapOptions& options, const TaskArena& tasks);
