@@ -131,9 +131,6 @@ class PointTree {
 
 namespace {
 
-/// Lowers sizes[c][k] to the distance d to the nearest curve `eligible(c, other)` admits where
-/// `accept(c, other, point, d)`, within the current size; distances up to `touching` ignored,
-/// never below `floor` from a feature.
 /// limit_by_distance on curve c alone, its sizes h, with the tree of all polylines: a curve's
 /// result depends on no other curve's sizes (CurveFeatureSearch splits the curves by it).
 template <class Eligible, class Accept>
@@ -155,6 +152,9 @@ void limit_curve_by_distance(const PointTree& tree, std::span<const std::vector<
   }
 }
 
+/// Lowers sizes[c][k] to the distance d to the nearest curve `eligible(c, other)` admits where
+/// `accept(c, other, point, d)`, within the current size; distances up to `touching` ignored,
+/// never below `floor` from a feature.
 template <class Eligible, class Accept>
 void limit_by_distance(std::span<const std::vector<Vec3>> polylines,
                        std::vector<std::vector<double>>& sizes, double touching, double floor,
@@ -323,26 +323,14 @@ void limit_by_face_width(const cad::CadModel& model, std::span<const std::vector
       });
 }
 
-void limit_in_sharp_wedges(const cad::CadModel& model, std::span<const std::vector<Vec3>> polylines,
-                           std::vector<std::vector<double>>& sizes, double touching,
-                           double sharp_deg, const TaskArena& tasks) {
-  const auto faces = faces_of_curves(model, polylines.size());
-  const double sharp = std::sin(sharp_deg * std::numbers::pi / 180);
-  // Searched within half the size, lowered to the width, then doubled: at most twice the width.
-  for (auto& h : sizes)
-    for (double& x : h) x *= 0.5;
-  const WedgeRule rule{model, faces, sharp};
-  limit_by_distance(polylines, sizes, touching, 0.0, tasks, rule, rule);
-  for (auto& h : sizes)
-    for (double& x : h) x *= 2;
-}
-
 struct CurveFeatureSearch::Impl {
   Impl(const cad::CadModel& m, std::vector<std::vector<Vec3>> lines)
       : model(m),
         polylines(std::move(lines)),
         faces(faces_of_curves(m, polylines.size())),
         tree(polylines) {}
+  /// QSMESH_CHECK that h has one size per vertex of polyline c.
+  void check_sizes(LO c, const std::vector<double>& h) const;
   const cad::CadModel& model;
   std::vector<std::vector<Vec3>> polylines;
   std::vector<std::vector<LO>> faces;
@@ -356,20 +344,22 @@ CurveFeatureSearch::~CurveFeatureSearch() = default;
 CurveFeatureSearch::CurveFeatureSearch(CurveFeatureSearch&&) noexcept = default;
 CurveFeatureSearch& CurveFeatureSearch::operator=(CurveFeatureSearch&&) noexcept = default;
 
+void CurveFeatureSearch::Impl::check_sizes(LO c, const std::vector<double>& h) const {
+  QSMESH_CHECK(h.size() == polylines[c].size(), "curve " << c << ": " << h.size() << " sizes for "
+                                                         << polylines[c].size() << " points");
+}
+
 void CurveFeatureSearch::limit_by_feature_distance(LO c, std::vector<double>& h, double touching,
                                                    double floor) const {
-  QSMESH_CHECK(h.size() == impl_->polylines[c].size(),
-               "curve " << c << ": " << h.size() << " sizes for " << impl_->polylines[c].size()
-                        << " points");
+  impl_->check_sizes(c, h);
   const FeatureRule rule{impl_->model};
   limit_curve_by_distance(impl_->tree, impl_->polylines, c, h, touching, floor, rule, rule);
 }
 
 void CurveFeatureSearch::limit_in_sharp_wedges(LO c, std::vector<double>& h, double touching,
                                                double sharp_deg) const {
-  QSMESH_CHECK(h.size() == impl_->polylines[c].size(),
-               "curve " << c << ": " << h.size() << " sizes for " << impl_->polylines[c].size()
-                        << " points");
+  impl_->check_sizes(c, h);
+  // Searched within half the size, lowered to the width, then doubled: at most twice the width.
   const WedgeRule rule{impl_->model, impl_->faces, std::sin(sharp_deg * std::numbers::pi / 180)};
   for (double& x : h) x *= 0.5;
   limit_curve_by_distance(impl_->tree, impl_->polylines, c, h, touching, 0.0, rule, rule);

@@ -36,6 +36,16 @@ constexpr int kMaxSpacingRounds = 3;
 constexpr int kMaxRounds = 40;
 constexpr int kMaxRepairs = 12;
 
+// Transfinite (Coons) interpolation at grid node (i, j) of an n0 x n1 grid from its boundary
+// nodes P(i, 0), P(n0, j), P(i, n1), P(0, j).
+template <class Boundary>
+Vec3 coons_point(const Boundary& P, LO i, LO j, LO n0, LO n1) {
+  const double s = static_cast<double>(i) / n0, t = static_cast<double>(j) / n1;
+  return (1 - t) * P(i, 0) + t * P(i, n1) + (1 - s) * P(0, j) + s * P(n0, j) -
+         ((1 - s) * (1 - t) * P(0, 0) + s * (1 - t) * P(n0, 0) + (1 - s) * t * P(0, n1) +
+          s * t * P(n0, n1));
+}
+
 // Thrown inside the stage when the result cannot be built; turned into CoarseResult::failure.
 struct Reject {
   std::string why;
@@ -1283,14 +1293,8 @@ class Builder {
       };
       for (LO j = 0; j <= n1; ++j)
         for (LO i = 0; i <= n0; ++i) {
-          if (i == 0 || j == 0 || i == n0 || j == n1) {
-            at(i, j) = P(i, j);
-            continue;
-          }
-          const double s = static_cast<double>(i) / n0, t = static_cast<double>(j) / n1;
-          at(i, j) = (1 - t) * P(i, 0) + t * P(i, n1) + (1 - s) * P(0, j) + s * P(n0, j) -
-                     ((1 - s) * (1 - t) * P(0, 0) + s * (1 - t) * P(n0, 0) +
-                      (1 - s) * t * P(0, n1) + s * t * P(n0, n1));
+          const bool side = i == 0 || j == 0 || i == n0 || j == n1;
+          at(i, j) = side ? P(i, j) : coons_point(P, i, j, n0, n1);
         }
       SideScore sc{2, 0};
       for (LO j = 0; j < n1; ++j)
@@ -1428,10 +1432,7 @@ class Builder {
       auto P = [&](LO i, LO j) { return nodes[static_cast<std::size_t>(at(i, j))].p; };
       for (LO j = 1; j < n1; ++j)
         for (LO i = 1; i < n0; ++i) {
-          const double s = static_cast<double>(i) / n0, t = static_cast<double>(j) / n1;
-          const Vec3 target = (1 - t) * P(i, 0) + t * P(i, n1) + (1 - s) * P(0, j) + s * P(n0, j) -
-                              ((1 - s) * (1 - t) * P(0, 0) + s * (1 - t) * P(n0, 0) +
-                               (1 - s) * t * P(0, n1) + s * t * P(n0, n1));
+          const Vec3 target = coons_point(P, i, j, n0, n1);
           Vec3 foot{};
           const Vec2 uv = face_geom(q.face).project(target, nearest_guess(gs, target), &foot);
           at(i, j) = static_cast<GO>(nodes.size());

@@ -46,20 +46,11 @@ void limit_by_face_width(const cad::CadModel& model, std::span<const std::vector
                          double wedge_touching, double sliver, const TaskArena& tasks,
                          bool shared_wedges_only = false);
 
-/// Resolution inside sharp wedges (a cusp's tail): lowers sizes[c][k] to twice the distance d from
-/// polyline vertex k of curve c to another side of one of its faces that shares a corner with c,
-/// where d is below sin(sharp_deg) x the distance to that corner, searching within half the
-/// current size; distances up to `touching` are ignored. The background curve meshes need it so
-/// that the sizes graded along such a tail (sizemap::SizeMapOptions::thin_aspect) have vertices
-/// to live on. Deterministic, whatever the thread count of `tasks`.
-void limit_in_sharp_wedges(const cad::CadModel& model, std::span<const std::vector<Vec3>> polylines,
-                           std::vector<std::vector<double>>& sizes, double touching,
-                           double sharp_deg, const TaskArena& tasks);
-
-/// limit_by_feature_distance and limit_in_sharp_wedges one curve at a time, over polylines given
-/// once (their k-d tree built once), for callers that split the curves over ranks or tasks: a
-/// curve's result is exactly what the functions over all curves give it, whichever curves are done
-/// with it and in whatever order. Thread-safe (const). Holds a reference to `model`.
+/// limit_by_feature_distance, and the resolution inside sharp wedges, one curve at a time over
+/// polylines given once (their k-d tree built once), for callers that split the curves over ranks
+/// or tasks: a curve's result is exactly what limit_by_feature_distance over all curves gives it,
+/// whichever curves are done with it and in whatever order. Thread-safe (const). Holds a reference
+/// to `model`.
 class CurveFeatureSearch {
  public:
   /// polylines: as limit_by_feature_distance's, indexed by curve id.
@@ -70,7 +61,12 @@ class CurveFeatureSearch {
   /// limit_by_feature_distance on curve c: h, one size per vertex of polyline c (checked), lowered
   /// in place.
   void limit_by_feature_distance(LO c, std::vector<double>& h, double touching, double floor) const;
-  /// limit_in_sharp_wedges on curve c, as above.
+  /// Resolution inside sharp wedges (a cusp's tail): lowers h[k] to twice the distance d from
+  /// vertex k of curve c to another side of one of its faces that shares a corner with c, where d
+  /// is below sin(sharp_deg) x the distance to that corner, searching within half the current
+  /// size; distances up to `touching` are ignored. The background curve meshes need it so that the
+  /// sizes graded along such a tail (sizemap::SizeMapOptions::thin_aspect) have vertices to live
+  /// on. h: one size per vertex of polyline c (checked).
   void limit_in_sharp_wedges(LO c, std::vector<double>& h, double touching, double sharp_deg) const;
 
  private:
