@@ -148,11 +148,11 @@ TEST(Cli, ConeAngleInDegreesBetweenZeroAndNinety) {
 }
 
 TEST(Cli, FinePlacementChoosesTheCoarseMeshsPlacementChanges) {
-  const auto patch = p({"mesh", "m.step", "-o", "o.xyz", "--layout", "coarse"});
-  EXPECT_TRUE(patch.fine_laplacian && patch.fine_input_spacing && patch.fine_patch);
-  const auto both =
-      p({"mesh", "m.step", "-o", "o.xyz", "--layout", "coarse", "--fine-placement", "both"});
+  const auto both = p({"mesh", "m.step", "-o", "o.xyz", "--layout", "coarse"});
   EXPECT_TRUE(both.fine_laplacian && both.fine_input_spacing && !both.fine_patch);
+  const auto patch =
+      p({"mesh", "m.step", "-o", "o.xyz", "--layout", "coarse", "--fine-placement", "patch"});
+  EXPECT_TRUE(patch.fine_laplacian && patch.fine_input_spacing && patch.fine_patch);
   const auto former =
       p({"mesh", "m.step", "-o", "o.xyz", "--layout", "coarse", "--fine-placement", "former"});
   EXPECT_FALSE(former.fine_laplacian || former.fine_input_spacing || former.fine_patch);

@@ -60,8 +60,11 @@ struct CoarseOptions {
   /// interpolation. The fine rows then follow the input's rows and grading; with n0 x n1 equal
   /// to the input counts the input is reproduced. Coarse edges off the curves follow the input
   /// grid line between their ends the same way. false: the sides' transfinite interpolation
-  /// alone, with coarse edges off the curves straight chords projected on the face.
-  bool patch_placement = true;
+  /// alone, with coarse edges off the curves straight chords projected on the face. Off by
+  /// default: it places better (before smoothing) but the smoothed meshes of the shared models
+  /// are no better, as the uv Laplacian's direct solve forgets the placement and the gap comes
+  /// from the quad-loop widths (docs/benchmarks.md, branch coarse7).
+  bool patch_placement = false;
 };
 
 /// Quality of the fine quads of one coarse quad (SICN, before smoothing), for one placement of
