@@ -1250,10 +1250,10 @@ class Builder {
                                  Vec2& guess) const {
     const Grid& g =
         grids_[static_cast<std::size_t>(cells_[static_cast<std::size_t>(cquads_[k].cell)].patch)];
-    const double gi = (1 - s) * (1 - t) * C[0].u + s * (1 - t) * C[1].u + s * t * C[2].u +
-                      (1 - s) * t * C[3].u;
-    const double gj = (1 - s) * (1 - t) * C[0].v + s * (1 - t) * C[1].v + s * t * C[2].v +
-                      (1 - s) * t * C[3].v;
+    const double gi =
+        (1 - s) * (1 - t) * C[0].u + s * (1 - t) * C[1].u + s * t * C[2].u + (1 - s) * t * C[3].u;
+    const double gj =
+        (1 - s) * (1 - t) * C[0].v + s * (1 - t) * C[1].v + s * t * C[2].v + (1 - s) * t * C[3].v;
     const LO i0 = std::clamp<LO>(static_cast<LO>(std::floor(gi)), 0, std::max<LO>(g.ni - 1, 0));
     const LO j0 = std::clamp<LO>(static_cast<LO>(std::floor(gj)), 0, std::max<LO>(g.nj - 1, 0));
     const LO i1 = std::min(i0 + 1, g.ni), j1 = std::min(j0 + 1, g.nj);
@@ -1265,7 +1265,8 @@ class Builder {
     for (int c = 0; c < 4; ++c) {
       const GO x = v[static_cast<std::size_t>(c)];
       out += w[static_cast<std::size_t>(c)] * m_.points[static_cast<std::size_t>(x)];
-      if (vc(x).dim == 2 && vc(x).entity == cquads_[k].face && w[static_cast<std::size_t>(c)] > best) {
+      if (vc(x).dim == 2 && vc(x).entity == cquads_[k].face &&
+          w[static_cast<std::size_t>(c)] > best) {
         best = w[static_cast<std::size_t>(c)];
         guess = {vc(x).param[0], vc(x).param[1]};
       }
@@ -1554,8 +1555,8 @@ class Builder {
             const auto l = static_cast<std::size_t>(j) * static_cast<std::size_t>(n0 + 1) +
                            static_cast<std::size_t>(i);
             Xuv[l] = {std::numeric_limits<double>::quiet_NaN(), 0};
-            X[l] = patch_point(k, C, static_cast<double>(i) / n0, static_cast<double>(j) / n1,
-                               Xuv[l]);
+            X[l] =
+                patch_point(k, C, static_cast<double>(i) / n0, static_cast<double>(j) / n1, Xuv[l]);
           }
       }
       auto gap = [&](LO i, LO j) {
