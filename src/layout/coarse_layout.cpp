@@ -1471,8 +1471,8 @@ class Builder {
           nodes.push_back({curve_geom(ce.curve).point(t), {1, ce.curve, kNoIndex, {t, 0}}});
         }
       } else {
-        const auto [kq, side] = ce.uses.front();
-        const auto k = static_cast<std::size_t>(kq);
+        const auto k = static_cast<std::size_t>(ce.uses.front().first);
+        const int side = ce.uses.front().second;
         const LO f = cquads_[k].face;
         const auto gs = guesses(k);
         // With patch_placement, the input grid line of the first coarse quad on the edge, its
