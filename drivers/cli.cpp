@@ -235,10 +235,12 @@ Arguments parse(const std::vector<std::string>& args) {
       a.loop_balance = *b;
     } else if (opt == "--fine-placement" && a.command == Command::Mesh) {
       const std::string& v = value();
-      if (v != "former" && v != "laplacian" && v != "spacing" && v != "both")
-        throw InputError("--fine-placement: '" + v + "' is not former, laplacian, spacing or both");
-      a.fine_laplacian = v == "laplacian" || v == "both";
-      a.fine_input_spacing = v == "spacing" || v == "both";
+      if (v != "former" && v != "laplacian" && v != "spacing" && v != "both" && v != "patch")
+        throw InputError("--fine-placement: '" + v +
+                         "' is not former, laplacian, spacing, both or patch");
+      a.fine_laplacian = v == "laplacian" || v == "both" || v == "patch";
+      a.fine_input_spacing = v == "spacing" || v == "both" || v == "patch";
+      a.fine_patch = v == "patch";
     } else if (opt == "--cone-angle" && a.command == Command::Mesh) {
       const std::string& v = value();
       const auto d = parse_double(v);
@@ -565,9 +567,10 @@ std::string help(const std::string& topic) {
           "  --loop-balance B      with --layout coarse: quad-loop widths blended with weight B\n"
           "                        (0..1) towards square fine quads in each coarse quad\n"
           "                        (default 0: the input mesh's lengths alone)\n"
-          "  --fine-placement P    with --layout coarse: former, laplacian, spacing or both\n"
-          "                        (default): the uv Laplacian before the kernels, and fine\n"
-          "                        nodes on CAD curves spaced like the input mesh's\n"
+          "  --fine-placement P    with --layout coarse: former, laplacian, spacing, both\n"
+          "                        (default) or patch: the uv Laplacian before the kernels, fine\n"
+          "                        nodes on CAD curves spaced like the input mesh's (both), and\n"
+          "                        fine nodes inside faces placed from the input patch's grid\n"
           "  --cone-angle DEG      with --layout coarse: half-angle of the T-mesh traces' cone\n"
           "                        (stopping rule and geometric consistency; default 45, the\n"
           "                        paper's): larger gives fewer, more distorted blocks\n"

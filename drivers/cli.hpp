@@ -52,10 +52,11 @@ struct Arguments {
   bool coarse_layout = false;
   /// --loop-balance B (with --layout coarse): layout::CoarseOptions::loop_balance, in [0, 1].
   double loop_balance = 0;
-  /// --fine-placement former|laplacian|spacing|both (with --layout coarse): which of the fine
-  /// mesh's placement changes are on (layout::CoarseOptions::laplacian_uv and
-  /// input_spacing_on_curves); default both. For measurements.
-  bool fine_laplacian = true, fine_input_spacing = true;
+  /// --fine-placement former|laplacian|spacing|both|patch (with --layout coarse): which of the
+  /// fine mesh's placement changes are on (layout::CoarseOptions::laplacian_uv,
+  /// input_spacing_on_curves and patch_placement); default both, patch is both with
+  /// patch_placement. For measurements.
+  bool fine_laplacian = true, fine_input_spacing = true, fine_patch = false;
   /// --cone-angle DEG (with --layout coarse): layout::CoarseOptions::alpha in degrees, in
   /// (0, 90); 0: the option's default (the paper's 45 degrees).
   double cone_angle_deg = 0;

@@ -938,6 +938,7 @@ int run_mesh(const Arguments& args) {
         co.loop_balance = args.loop_balance;
         co.laplacian_uv = args.fine_laplacian;
         co.input_spacing_on_curves = args.fine_input_spacing;
+        co.patch_placement = args.fine_patch;
         if (args.cone_angle_deg > 0) co.alpha = args.cone_angle_deg * 3.14159265358979323846 / 180;
         co.cross_smooth_curves = !args.sharp_and_smooth_walls;
         co.traces_across_smooth_curves = args.traces_cross_curves;

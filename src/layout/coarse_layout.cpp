@@ -866,12 +866,34 @@ class Builder {
     }
     for (GO g = 0; g < ng_; ++g) {
       if (!flat[static_cast<std::size_t>(g)]) continue;
+      // Only curve vertices in the group and the input has the same flat corner there (a quad
+      // of the face whose two edges at one of them lie on curves: wing_fuselage has one): no row
+      // can separate it and it is the input's own. Kept; the fold check of the fine mesh still
+      // stands behind it.
+      if (inner[static_cast<std::size_t>(g)] < 0 && on_curve[static_cast<std::size_t>(g)] >= 0 &&
+          input_flat_corner(g))
+        continue;
       if (inner[static_cast<std::size_t>(g)] < 0 || on_curve[static_cast<std::size_t>(g)] < 0)
         throw Reject{"a coarse quad has a flat corner on a CAD curve"};
       rows.push_back(
           separation(inner[static_cast<std::size_t>(g)], on_curve[static_cast<std::size_t>(g)]));
     }
     return rows;
+  }
+
+  // Whether a member of group g is a curve vertex where an input quad has both its edges at it
+  // on CAD curves (a flat corner of the input mesh).
+  [[nodiscard]] bool input_flat_corner(GO g) const {
+    for (std::size_t x = 0; x < rep_.size(); ++x) {
+      if (group_[x] != g) continue;
+      const GO v = rep_[x];
+      if (vc(v).dim != 1) continue;
+      for (GO q : v2q_[v]) {
+        const auto nb = neighbours_in_quad(q, v);
+        if (edge(v, nb[0]).curve != kNoIndex && edge(v, nb[1]).curve != kNoIndex) return true;
+      }
+    }
+    return false;
   }
 
   void split_and_merge() {
@@ -1182,6 +1204,76 @@ class Builder {
     return out;
   }
 
+  // Input edges from the start of side s of patch p to its lattice point k: where side_points
+  // took that point's input vertex (arc_point, split_and_merge).
+  [[nodiscard]] double side_offset(std::size_t p, int s, LO k) const {
+    if (k == 0) return 0;
+    LO done = 0, off = 0;
+    for (const SideArc& x : sides_[p][static_cast<std::size_t>(s)]) {
+      const auto q = static_cast<LO>(q_[static_cast<std::size_t>(x.arc)]);
+      const LO l = arcs_[static_cast<std::size_t>(x.arc)].length();
+      if (q > 0 && k <= done + q) {
+        const LO t = k - done;
+        const auto at = [&](LO u) {
+          return static_cast<LO>(std::lround(static_cast<double>(u) * l / static_cast<double>(q)));
+        };
+        return off + (x.forward ? at(t) : l - at(q - t));
+      }
+      done += q;
+      off += l;
+    }
+    return off;
+  }
+
+  // Grid coordinates (i, j) in its patch's input grid of the four corners of coarse quad k's
+  // cell, counter-clockwise as the coarse quad's corners.
+  [[nodiscard]] std::array<Vec2, 4> cell_grid_corners(std::size_t k) const {
+    const Cell& c = cells_[static_cast<std::size_t>(cquads_[k].cell)];
+    const auto p = static_cast<std::size_t>(c.patch);
+    const Grid& g = grids_[p];
+    auto at = [&](LO X, LO Y) -> Vec2 {
+      const auto ni = static_cast<double>(g.ni), nj = static_cast<double>(g.nj);
+      if (Y == 0) return {side_offset(p, 0, X), 0};
+      if (X == c.a) return {ni, side_offset(p, 1, Y)};
+      if (Y == c.b) return {ni - side_offset(p, 2, c.a - X), nj};
+      if (X == 0) return {0, nj - side_offset(p, 3, c.b - Y)};
+      return {static_cast<double>(std::lround(X * ni / c.a)),
+              static_cast<double>(std::lround(Y * nj / c.b))};
+    };
+    return {at(c.x, c.y), at(c.x + 1, c.y), at(c.x + 1, c.y + 1), at(c.x, c.y + 1)};
+  }
+
+  // The input patch of coarse quad k at fractional position (s, t) of the coarse quad: its grid
+  // coordinates bilinear between the cell's corners, the point bilinear in the input quad there.
+  // `guess` gets the uv of a face vertex of that input quad (left as is when it has none).
+  [[nodiscard]] Vec3 patch_point(std::size_t k, const std::array<Vec2, 4>& C, double s, double t,
+                                 Vec2& guess) const {
+    const Grid& g =
+        grids_[static_cast<std::size_t>(cells_[static_cast<std::size_t>(cquads_[k].cell)].patch)];
+    const double gi =
+        (1 - s) * (1 - t) * C[0].u + s * (1 - t) * C[1].u + s * t * C[2].u + (1 - s) * t * C[3].u;
+    const double gj =
+        (1 - s) * (1 - t) * C[0].v + s * (1 - t) * C[1].v + s * t * C[2].v + (1 - s) * t * C[3].v;
+    const LO i0 = std::clamp<LO>(static_cast<LO>(std::floor(gi)), 0, std::max<LO>(g.ni - 1, 0));
+    const LO j0 = std::clamp<LO>(static_cast<LO>(std::floor(gj)), 0, std::max<LO>(g.nj - 1, 0));
+    const LO i1 = std::min(i0 + 1, g.ni), j1 = std::min(j0 + 1, g.nj);
+    const double fi = std::clamp(gi - i0, 0.0, 1.0), fj = std::clamp(gj - j0, 0.0, 1.0);
+    const std::array<GO, 4> v{g.at(i0, j0), g.at(i1, j0), g.at(i1, j1), g.at(i0, j1)};
+    const std::array<double, 4> w{(1 - fi) * (1 - fj), fi * (1 - fj), fi * fj, (1 - fi) * fj};
+    Vec3 out{0, 0, 0};
+    double best = -1;
+    for (int c = 0; c < 4; ++c) {
+      const GO x = v[static_cast<std::size_t>(c)];
+      out += w[static_cast<std::size_t>(c)] * m_.points[static_cast<std::size_t>(x)];
+      if (vc(x).dim == 2 && vc(x).entity == cquads_[k].face &&
+          w[static_cast<std::size_t>(c)] > best) {
+        best = w[static_cast<std::size_t>(c)];
+        guess = {vc(x).param[0], vc(x).param[1]};
+      }
+    }
+    return out;
+  }
+
   static Vec2 nearest_guess(const std::vector<std::pair<Vec3, Vec2>>& gs, const Vec3& p) {
     std::size_t best = 0;
     for (std::size_t i = 1; i < gs.size(); ++i)
@@ -1379,13 +1471,33 @@ class Builder {
           nodes.push_back({curve_geom(ce.curve).point(t), {1, ce.curve, kNoIndex, {t, 0}}});
         }
       } else {
-        const std::size_t k = static_cast<std::size_t>(ce.uses.front().first);
+        const auto k = static_cast<std::size_t>(ce.uses.front().first);
+        const int side = ce.uses.front().second;
         const LO f = cquads_[k].face;
         const auto gs = guesses(k);
+        // With patch_placement, the input grid line of the first coarse quad on the edge, its
+        // ends moved onto the edge's ends; else the straight chord.
+        const std::array<Vec2, 4> C =
+            opt_.patch_placement ? cell_grid_corners(k) : std::array<Vec2, 4>{};
+        const bool from_a = cquads_[k].v[static_cast<std::size_t>(side)] == ce.a;
+        auto on_side = [&](double r, Vec2& guess) {
+          // Position r in [0, 1] along side `side` of coarse quad k, walked counter-clockwise.
+          static constexpr std::array<std::array<double, 4>, 4> st{
+              {{0, 0, 1, 0}, {1, 0, 0, 1}, {1, 1, -1, 0}, {0, 1, 0, -1}}};
+          const auto& m = st[static_cast<std::size_t>(side)];
+          return patch_point(k, C, m[0] + m[2] * r, m[1] + m[3] * r, guess);
+        };
+        Vec2 g0 = nearest_guess(gs, pa);
+        const Vec3 xa = opt_.patch_placement ? on_side(from_a ? 0.0 : 1.0, g0) : pa;
+        const Vec3 xb = opt_.patch_placement ? on_side(from_a ? 1.0 : 0.0, g0) : pb;
         for (LO i = 1; i < ce.n; ++i) {
-          const Vec3 target = pa + (pb - pa) * (static_cast<double>(i) / ce.n);
+          const double r = static_cast<double>(i) / ce.n;
+          Vec3 target = pa + (pb - pa) * r;
+          Vec2 guess = nearest_guess(gs, target);
+          if (opt_.patch_placement)
+            target = on_side(from_a ? r : 1 - r, guess) + (1 - r) * (pa - xa) + r * (pb - xb);
           Vec3 foot{};
-          const Vec2 uv = face_geom(f).project(target, nearest_guess(gs, target), &foot);
+          const Vec2 uv = face_geom(f).project(target, guess, &foot);
           nodes.push_back({foot, {2, f, kNoIndex, {uv.u, uv.v}}});
         }
       }
@@ -1430,11 +1542,42 @@ class Builder {
       }
       const auto gs = (n0 > 1 && n1 > 1) ? guesses(k) : std::vector<std::pair<Vec3, Vec2>>{};
       auto P = [&](LO i, LO j) { return nodes[static_cast<std::size_t>(at(i, j))].p; };
+      // patch_placement: the input patch's map X at every node, and the sides' gap to it (P - X)
+      // spread inside by transfinite interpolation.
+      std::vector<Vec3> X;
+      std::vector<Vec2> Xuv;
+      if (opt_.patch_placement && n0 > 1 && n1 > 1) {
+        const std::array<Vec2, 4> C = cell_grid_corners(k);
+        X.resize(G.size());
+        Xuv.resize(G.size());
+        for (LO j = 0; j <= n1; ++j)
+          for (LO i = 0; i <= n0; ++i) {
+            const auto l = static_cast<std::size_t>(j) * static_cast<std::size_t>(n0 + 1) +
+                           static_cast<std::size_t>(i);
+            Xuv[l] = {std::numeric_limits<double>::quiet_NaN(), 0};
+            X[l] =
+                patch_point(k, C, static_cast<double>(i) / n0, static_cast<double>(j) / n1, Xuv[l]);
+          }
+      }
+      auto gap = [&](LO i, LO j) {
+        return P(i, j) - X[static_cast<std::size_t>(j) * static_cast<std::size_t>(n0 + 1) +
+                           static_cast<std::size_t>(i)];
+      };
       for (LO j = 1; j < n1; ++j)
         for (LO i = 1; i < n0; ++i) {
-          const Vec3 target = coons_point(P, i, j, n0, n1);
+          Vec3 target{};
+          Vec2 guess{};
+          if (X.empty()) {
+            target = coons_point(P, i, j, n0, n1);
+            guess = nearest_guess(gs, target);
+          } else {
+            const auto l = static_cast<std::size_t>(j) * static_cast<std::size_t>(n0 + 1) +
+                           static_cast<std::size_t>(i);
+            target = X[l] + coons_point(gap, i, j, n0, n1);
+            guess = std::isnan(Xuv[l].u) ? nearest_guess(gs, target) : Xuv[l];
+          }
           Vec3 foot{};
-          const Vec2 uv = face_geom(q.face).project(target, nearest_guess(gs, target), &foot);
+          const Vec2 uv = face_geom(q.face).project(target, guess, &foot);
           at(i, j) = static_cast<GO>(nodes.size());
           nodes.push_back({foot, {2, q.face, kNoIndex, {uv.u, uv.v}}});
         }

@@ -149,10 +149,13 @@ TEST(Cli, ConeAngleInDegreesBetweenZeroAndNinety) {
 
 TEST(Cli, FinePlacementChoosesTheCoarseMeshsPlacementChanges) {
   const auto both = p({"mesh", "m.step", "-o", "o.xyz", "--layout", "coarse"});
-  EXPECT_TRUE(both.fine_laplacian && both.fine_input_spacing);
+  EXPECT_TRUE(both.fine_laplacian && both.fine_input_spacing && !both.fine_patch);
+  const auto patch =
+      p({"mesh", "m.step", "-o", "o.xyz", "--layout", "coarse", "--fine-placement", "patch"});
+  EXPECT_TRUE(patch.fine_laplacian && patch.fine_input_spacing && patch.fine_patch);
   const auto former =
       p({"mesh", "m.step", "-o", "o.xyz", "--layout", "coarse", "--fine-placement", "former"});
-  EXPECT_FALSE(former.fine_laplacian || former.fine_input_spacing);
+  EXPECT_FALSE(former.fine_laplacian || former.fine_input_spacing || former.fine_patch);
   const auto spacing =
       p({"mesh", "m.step", "-o", "o.xyz", "--layout", "coarse", "--fine-placement", "spacing"});
   EXPECT_TRUE(!spacing.fine_laplacian && spacing.fine_input_spacing);

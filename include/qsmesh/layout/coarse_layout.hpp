@@ -52,6 +52,19 @@ struct CoarseOptions {
   /// parameter. Each such edge keeps the spacing choose_side_spacing prefers for the coarse
   /// quads on its sides, and falls back to the uniform one where fine quads fold.
   bool input_spacing_on_curves = true;
+  /// Fine nodes inside faces placed from the input patch each coarse quad was cut from (its cell
+  /// of the patch's lattice covers a part of the patch's ni x nj grid of input quads): node
+  /// (i, j) of the coarse quad's n0 x n1 grid goes where the input grid is at the same fractional
+  /// grid coordinates (bilinear in the input quad there, projected on the face), and the gap
+  /// between that map and the coarse quad's actual side nodes is spread inside by transfinite
+  /// interpolation. The fine rows then follow the input's rows and grading; with n0 x n1 equal
+  /// to the input counts the input is reproduced. Coarse edges off the curves follow the input
+  /// grid line between their ends the same way. false: the sides' transfinite interpolation
+  /// alone, with coarse edges off the curves straight chords projected on the face. Off by
+  /// default: it places better (before smoothing) but the smoothed meshes of the shared models
+  /// are no better, as the uv Laplacian's direct solve forgets the placement and the gap comes
+  /// from the quad-loop widths (docs/benchmarks.md, branch coarse7).
+  bool patch_placement = false;
 };
 
 /// Quality of the fine quads of one coarse quad (SICN, before smoothing), for one placement of
