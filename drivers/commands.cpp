@@ -429,6 +429,7 @@ std::string stats_json(const Arguments& args, const Session& session,
     j.value("high_order_curve_nodes", checks.high_order->curve_nodes);
     j.value("high_order_face_nodes", checks.high_order->face_nodes);
     j.value("high_order_unprojected_nodes", checks.high_order->unprojected);
+    j.value("high_order_reshaped_quads", checks.high_order->reshaped);
     j.value("high_order_straightened_quads", checks.high_order->straightened);
     j.value("high_order_curve_straightened_quads", checks.high_order->curve_straightened);
     j.value("high_order_invalid_quads", checks.high_order->invalid);
@@ -626,8 +627,8 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
     os << "  high-order nodes (order " << q.order << "): " << q.curve_nodes << " on curves, "
        << q.face_nodes << " in faces (" << q.unprojected
        << " off the CAD: no CAD point near, or put back straight); quads whose face nodes went "
-          "back "
-       << "straight to stay valid " << q.straightened << ", made entirely straight "
+          "along the face's parameter lines to stay valid "
+       << q.reshaped << ", went back straight " << q.straightened << ", made entirely straight "
        << q.curve_straightened << ", still invalid " << q.invalid
        << "; curved elements' largest distance to the CAD / diagonal " << checks.high_order_distance
        << "\n";

@@ -332,6 +332,35 @@ TEST(MakeHighOrder, EdgeNodesEvenlyApartOnACoarseCurvedMesh) {
   }
 }
 
+// The box with a cylindrical hole meshed coarsely (h = 2 and 2.5): at order 3 one quad on the
+// hole's side folds with its face nodes projected from the 3D Coons patch (the side turns
+// strongly across its edges), and is valid with them along the face's parameter lines. Before the
+// reshaping it was straightened, its nodes off the CAD; now every node is on the CAD.
+TEST(MakeHighOrder, FoldedQuadKeepsItsNodesOnTheCadAlongTheParameterLines) {
+  const cad::CadModel model =
+      cad::load_cad(test::write_box_with_hole(test::tmp("ho_box_hole.brep")));
+  const TaskArena tasks(2);
+  for (double h : {2.0, 2.5}) {
+    const mesh::SurfaceMesh lin = quad_mesh(model, h);
+    mesh::SurfaceMesh m = lin;
+    const HighOrderReport r = make_high_order(m, model, 3, tasks);
+    EXPECT_GE(r.reshaped, 1) << "h " << h;
+    EXPECT_EQ(r.straightened, 0) << "h " << h;
+    EXPECT_EQ(r.invalid, 0) << "h " << h;
+    EXPECT_EQ(r.unprojected, 0) << "h " << h;
+    expect_nodes_on_cad_and_shared(m, lin.num_vertices(), model);
+    for (std::size_t q = 0; q < m.quads.size(); ++q) {
+      Vec3 nrm{};
+      for (std::size_t k = 0; k < 4; ++k) {
+        const Vec3& c = m.points[static_cast<std::size_t>(m.quads[q][k])];
+        nrm += cross(m.points[static_cast<std::size_t>(m.quads[q][(k + 1) % 4])] - c,
+                     m.points[static_cast<std::size_t>(m.quads[q][(k + 3) % 4])] - c);
+      }
+      EXPECT_TRUE(lagrange_quad_valid(3, element(m, q), nrm)) << "h " << h << " quad " << q;
+    }
+  }
+}
+
 TEST(MakeHighOrder, SameResultWhateverTheThreads) {
   const cad::CadModel model =
       cad::load_cad(test::write_sphere(test::tmp("ho_sphere_threads.brep")));
@@ -339,6 +368,7 @@ TEST(MakeHighOrder, SameResultWhateverTheThreads) {
   mesh::SurfaceMesh one = lin, three = lin;
   const HighOrderReport a = make_high_order(one, model, 4, TaskArena(1));
   const HighOrderReport b = make_high_order(three, model, 4, TaskArena(3));
+  EXPECT_EQ(a.reshaped, b.reshaped);
   EXPECT_EQ(a.straightened, b.straightened);
   EXPECT_EQ(a.unprojected, b.unprojected);
   EXPECT_EQ(one.quad_nodes, three.quad_nodes);
