@@ -214,6 +214,8 @@ Arguments parse(const std::vector<std::string>& args) {
       a.distributed_threshold = static_cast<LO>(*n);
     } else if (opt == "--block-structured" && a.command == Command::Mesh)
       a.block_structured = true;
+    else if (opt == "--block-patches" && a.command == Command::Mesh)
+      a.block_patches = true;
     else if (opt == "--plot3d-stream" && a.command == Command::Mesh)
       a.plot3d_stream = true;
     else if (opt == "--plot3d-single" && a.command == Command::Mesh)
@@ -438,8 +440,26 @@ Arguments parse(const std::vector<std::string>& args) {
       throw InputError(
           "--smooth-groups: a group's quads cross its faces' curves, which the blocks of "
           "--block-structured follow; not together");
-    if (layout_given && !a.block_structured)
-      throw InputError("--layout: only with --block-structured (or -o FILE.xyz)");
+    if (a.block_patches) {
+      if (a.order < 2)
+        throw InputError(
+            "--block-patches: give --order N (2..5), the order of the Lagrange quad of each block");
+      if (plot3d || a.block_structured)
+        throw InputError(
+            "--block-patches writes each block as one high-order quad (-o FILE.vtu, .msh, .h5 or "
+            ".cgns); not with --block-structured or PLOT3D, which write each block as a grid");
+      if (a.until == "background")
+        throw InputError("--block-patches needs a quad mesh: not with --until background");
+      if (a.smooth_groups)
+        throw InputError(
+            "--smooth-groups: a group's quads cross its faces' curves, which the blocks of "
+            "--block-patches follow; not together");
+      // A patch per block is worth having when the blocks are few and large: the coarse layout.
+      if (!layout_given) a.coarse_layout = true;
+    }
+    if (layout_given && !a.block_structured && !a.block_patches)
+      throw InputError(
+          "--layout: only with --block-structured or --block-patches (or -o FILE.xyz)");
     if (a.block_structured) {
       if (io::output_format(a.output) != io::Format::kCgns && !plot3d)
         throw InputError(
@@ -449,7 +469,8 @@ Arguments parse(const std::vector<std::string>& args) {
         throw InputError("--block-structured needs a quad mesh: not with --until background");
       if (a.order > 1)
         throw InputError("--block-structured with --order " + std::to_string(a.order) +
-                         ": blocks of high-order quads are not written yet");
+                         ": the blocks' grids are of linear quads; for one high-order quad per "
+                         "block give --block-patches instead of --block-structured");
     }
     if (a.order > 1 && a.until == "background")
       throw InputError("--order " + std::to_string(a.order) +
@@ -544,13 +565,18 @@ std::string help(const std::string& topic) {
           "                        curves and each goes to the face holding its centre; the outer\n"
           "                        loops' counts come from the form (not with --block-structured)\n"
           "  --order N             high-order elements, N = 2..5: Lagrange quads of (N+1)^2 nodes\n"
-          "                        and bars of N+1 nodes, the new nodes on the CAD, quads that\n"
-          "                        would fold straightened (CGNS QUAD_9/16/25 and BAR_3/4/5, so\n"
+          "                        and bars of N+1 nodes, the new nodes on the CAD; a quad that\n"
+          "                        would fold gets its face nodes along the face's parameter\n"
+          "                        lines, else straightened (CGNS QUAD_9/16/25 and BAR_3/4/5, so\n"
           "                        N <= 4 there; VTU Lagrange cells; MSH; in .h5 the datasets\n"
           "                        quadM and barN+1, and the .xdmf shows order 2 curved, higher\n"
           "                        orders as the linear quads of their corners)\n"
           "  --block-structured    write the .cgns file as structured zones, one per block,\n"
           "                        joined by 1-to-1 connectivity (see --layout)\n"
+          "  --block-patches       with --order N: each block of the layout (coarse unless\n"
+          "                        --layout dense) written as one Lagrange quad of order N on\n"
+          "                        the CAD, a light model of the surface (paper 002 Sec. IV.F;\n"
+          "                        .vtu, .msh, .h5 or .cgns)\n"
           "  --layout dense|coarse the blocks of --block-structured (and of .xyz). dense "
           "(default):\n"
           "                        the layout of the quad mesh as it is (traces from irregular\n"

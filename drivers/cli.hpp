@@ -34,6 +34,10 @@ struct Arguments {
   /// (layout::extract_quad_layout, io::write_cgns_blocks) instead of one unstructured zone.
   /// Implied by a PLOT3D output (-o FILE.xyz / .p3d: io::write_plot3d).
   bool block_structured = false;
+  /// --block-patches (with --order N): each block of the layout (coarse unless --layout dense)
+  /// written as one Lagrange quad of order N on the CAD (highorder::make_block_patches), in any
+  /// mesh format but PLOT3D.
+  bool block_patches = false;
   /// --plot3d-stream: PLOT3D without Fortran record lengths (C stream; WriteOptions).
   bool plot3d_stream = false;
   /// --plot3d-single: PLOT3D coordinates in single precision.

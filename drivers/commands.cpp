@@ -21,6 +21,7 @@
 #include "qsmesh/core/log.hpp"
 #include "qsmesh/core/tasks.hpp"
 #include "qsmesh/core/timer.hpp"
+#include "qsmesh/highorder/block_patches.hpp"
 #include "qsmesh/highorder/high_order.hpp"
 #include "qsmesh/holomorphic/holomorphic.hpp"
 #include "qsmesh/io/atomic_file.hpp"
@@ -270,6 +271,10 @@ struct Checks {
     LO partition_faces = 0;
     /// PLOT3D output: what it could not hold (the unblocked faces with elements).
     std::optional<io::Plot3dReport> plot3d;
+    /// --block-patches: the patches' report and their largest distance to the fine mesh over
+    /// the model's diagonal.
+    std::optional<highorder::BlockPatchReport> patches;
+    double patch_deviation = 0;
     /// --layout coarse: its statistics; fallback: it failed and the dense layout was written.
     std::optional<layout::CoarseStats> coarse;
     bool fallback = false;
@@ -429,6 +434,7 @@ std::string stats_json(const Arguments& args, const Session& session,
     j.value("high_order_curve_nodes", checks.high_order->curve_nodes);
     j.value("high_order_face_nodes", checks.high_order->face_nodes);
     j.value("high_order_unprojected_nodes", checks.high_order->unprojected);
+    j.value("high_order_reshaped_quads", checks.high_order->reshaped);
     j.value("high_order_straightened_quads", checks.high_order->straightened);
     j.value("high_order_curve_straightened_quads", checks.high_order->curve_straightened);
     j.value("high_order_invalid_quads", checks.high_order->invalid);
@@ -473,6 +479,15 @@ std::string stats_json(const Arguments& args, const Session& session,
       j.value("sides_input_spacing", kept ? c->sides_input_spacing : std::int64_t{0});
       j.value("sides_uniform_spacing", kept ? c->sides_uniform_spacing : std::int64_t{0});
       j.value("spacing_fallbacks", static_cast<std::int64_t>(c->spacing_fallbacks));
+    }
+    if (const auto& p = checks.blocks->patches) {
+      j.value("block_patch_order", p->order);
+      j.value("block_patches", p->patches);
+      j.value("block_patch_curve_bars", p->curve_bars);
+      j.value("block_patch_nodes", p->nodes);
+      j.value("block_patch_nodes_off_cad", p->unprojected);
+      j.value("block_patches_invalid", p->invalid);
+      j.value("block_patch_max_deviation", checks.blocks->patch_deviation);
     }
     if (checks.blocks->plot3d) {
       const io::Plot3dReport& p = *checks.blocks->plot3d;
@@ -626,8 +641,8 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
     os << "  high-order nodes (order " << q.order << "): " << q.curve_nodes << " on curves, "
        << q.face_nodes << " in faces (" << q.unprojected
        << " off the CAD: no CAD point near, or put back straight); quads whose face nodes went "
-          "back "
-       << "straight to stay valid " << q.straightened << ", made entirely straight "
+          "along the face's parameter lines to stay valid "
+       << q.reshaped << ", went back straight " << q.straightened << ", made entirely straight "
        << q.curve_straightened << ", still invalid " << q.invalid
        << "; curved elements' largest distance to the CAD / diagonal " << checks.high_order_distance
        << "\n";
@@ -648,6 +663,12 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
          << b.coarse->seconds << " s; " << b.coarse->fine_quads << " quads, SICN min "
          << b.coarse->sicn_min << " avg " << b.coarse->sicn_avg << "\n";
     if (b.fallback) os << "  coarse layout failed: the dense layout was written\n";
+    if (b.patches)
+      os << "  block patches (order " << b.patches->order << "): " << b.patches->patches
+         << " Lagrange quads, " << b.patches->curve_bars << " bars on CAD curves, "
+         << b.patches->nodes << " nodes (" << b.patches->unprojected << " off the CAD), "
+         << b.patches->invalid << " folded; largest distance to the fine mesh / diagonal "
+         << b.patch_deviation << "\n";
   }
   if (!checks.rank_peak_mb.empty()) {
     const std::vector<double>& mb = checks.rank_peak_mb;
@@ -920,7 +941,7 @@ int run_mesh(const Arguments& args) {
     checks.max_distance_to_cad = result.max_distance_to_cad / s.model.diagonal();
     s.times.add("statistics", clock.seconds());
     clock.reset();
-    if (args.order > 1) {
+    if (args.order > 1 && !args.block_patches) {
       checks.high_order = highorder::make_high_order(result.mesh, s.model, args.order, *s.tasks);
       s.times.add("high_order", clock.seconds());
       clock.reset();
@@ -930,7 +951,7 @@ int run_mesh(const Arguments& args) {
       s.times.add("high_order_check", clock.seconds());
       clock.reset();
     }
-    if (args.block_structured) {
+    if (args.block_structured || args.block_patches) {
       Checks::Blocks b;
       std::optional<layout::CoarseResult> coarse;
       if (args.coarse_layout) {
@@ -971,7 +992,22 @@ int run_mesh(const Arguments& args) {
       b.partition_faces = lay.faces_with_given_blocks;
       s.times.add("layout", clock.seconds());
       clock.reset();
-      if (io::output_format(args.output) == io::Format::kPlot3d) {
+      if (args.block_patches) {
+        mesh::SurfaceMesh patches;
+        b.patches = highorder::make_block_patches(written, lay, s.model, args.order, patches);
+        b.patch_deviation = b.patches->max_deviation / s.model.diagonal();
+        s.times.add("patches", clock.seconds());
+        clock.reset();
+        if (b.unblocked_faces > 0)
+          s.log.warn(cat(b.unblocked_faces, " faces do not split into blocks and are not in ",
+                         args.output, " (--layout coarse covers every face where it succeeds)"));
+        if (b.patches->invalid > 0)
+          s.log.warn(cat(b.patches->invalid, " of ", b.patches->patches,
+                         " block patches fold at order ", args.order,
+                         " (a block bends too much for one polynomial): a lower --order, or "
+                         "--block-structured for the blocks' grids"));
+        io::write_mesh(patches, args.output);
+      } else if (io::output_format(args.output) == io::Format::kPlot3d) {
         io::WriteOptions wo;
         wo.plot3d_fortran_records = !args.plot3d_stream;
         wo.plot3d_single_precision = args.plot3d_single;

@@ -18,8 +18,8 @@ if [ $# -gt 0 ]; then
 fi
 out=$(mktemp -d)
 trap 'rm -rf "$out"' EXIT
-echo "| model | size factor | order | quads | straightened (curve nodes too) | invalid | off the CAD | element distance / diagonal | high_order s | check s | write .vtu s |"
-echo "|---|---|---|---|---|---|---|---|---|---|---|"
+echo "| model | size factor | order | quads | reshaped | straightened (curve nodes too) | invalid | off the CAD | element distance / diagonal | high_order s | check s | write .vtu s |"
+echo "|---|---|---|---|---|---|---|---|---|---|---|---|"
 for m in "${models[@]}"; do
   [ -f "../shared/cad/$m" ] || continue
   for n in $orders; do
@@ -30,7 +30,8 @@ import json, sys
 m, f, n, path = sys.argv[1:]
 s = json.load(open(path))
 t = s["seconds"]
-print(f"| {m} | {f} | {n} | {s['quads']} | {s['high_order_straightened_quads']} "
+print(f"| {m} | {f} | {n} | {s['quads']} | {s['high_order_reshaped_quads']} | "
+      f"{s['high_order_straightened_quads']} "
       f"({s['high_order_curve_straightened_quads']}) | {s['high_order_invalid_quads']} | "
       f"{s['high_order_unprojected_nodes']} | {s['high_order_max_element_distance_to_cad']:.2e} | "
       f"{t['high_order']:.2f} | {t['high_order_check']:.2f} | {t.get('write', float('nan')):.2f} |")

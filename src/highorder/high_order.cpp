@@ -9,6 +9,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "lagrange.hpp"
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/mesh/edges.hpp"
 #include "qsmesh/mesh/high_order_nodes.hpp"
@@ -24,116 +25,11 @@ struct Edge {
   GO quad = -1;         // first quad using it
 };
 
-// The (u, v) images of vertex v in face f: its own (u, v) inside the face; on a curve or at a
-// corner, the pcurve images of every use of the curve(s) in the face's loops (a seam has two).
-std::vector<Vec2> uv_images(const cad::CadModel& model, const cad::FaceGeometry& face, LO f,
-                            const mesh::VertexClass& c) {
-  if (c.dim == 2) return {Vec2{c.param[0], c.param[1]}};
-  std::vector<Vec2> out;
-  const auto& loops = model.faces()[static_cast<std::size_t>(f)].loops;
-  for (std::size_t l = 0; l < loops.size(); ++l)
-    for (std::size_t u = 0; u < loops[l].uses.size(); ++u) {
-      const LO curve = loops[l].uses[u].curve;
-      const cad::Curve& cc = model.curves()[static_cast<std::size_t>(curve)];
-      if (c.dim == 1 && curve == c.entity) {
-        out.push_back(face.boundary_uv(static_cast<LO>(l), static_cast<LO>(u), c.param[0]));
-      } else if (c.dim == 0) {
-        if (cc.corners[0] == c.entity)
-          out.push_back(face.boundary_uv(static_cast<LO>(l), static_cast<LO>(u), cc.t0));
-        if (cc.corners[1] == c.entity)
-          out.push_back(face.boundary_uv(static_cast<LO>(l), static_cast<LO>(u), cc.t1));
-      }
-    }
-  return out;
-}
-
-Vec2 nearest(const std::vector<Vec2>& images, const Vec2& ref) {
-  Vec2 best = images.front();
-  double d = std::numeric_limits<double>::max();
-  for (const Vec2& x : images) {
-    const double e = (x.u - ref.u) * (x.u - ref.u) + (x.v - ref.v) * (x.v - ref.v);
-    if (e < d) {
-      d = e;
-      best = x;
-    }
-  }
-  return best;
-}
-
-// The 1D Lagrange basis of degree n on the equispaced nodes a / n of [0, 1], and its derivative,
-// at s.
-void lagrange_1d(int n, double s, double* l, double* dl) {
-  for (int a = 0; a <= n; ++a) {
-    const double xa = static_cast<double>(a) / n;
-    double value = 1, derivative = 0;
-    for (int b = 0; b <= n; ++b) {
-      if (b == a) continue;
-      const double xb = static_cast<double>(b) / n;
-      derivative = derivative * (s - xb) / (xa - xb) + value / (xa - xb);
-      value *= (s - xb) / (xa - xb);
-    }
-    l[a] = value;
-    if (dl != nullptr) dl[a] = derivative;
-  }
-}
-
-constexpr int kMaxNodes = (kMaxOrder + 1) * (kMaxOrder + 1);
-constexpr int kMaxSamples = 2 * kMaxOrder + 1;
-
-// The Jacobian check of Lagrange quads of one order, its tables made once: the basis and its
-// derivative at the samples m / (2 n), and where each stored node sits on the grid.
-class QuadChecker {
- public:
-  explicit QuadChecker(int order) : n_(order), positions_(mesh::quad_grid_positions(order)) {
-    QSMESH_CHECK(order >= 1 && order <= kMaxOrder,
-                 "Lagrange quad: order " << order << " out of [1, " << kMaxOrder << "]");
-    for (int m = 0; m < samples(); ++m)
-      lagrange_1d(n_, static_cast<double>(m) / (2 * n_), l_[static_cast<std::size_t>(m)].data(),
-                  dl_[static_cast<std::size_t>(m)].data());
-  }
-  [[nodiscard]] int order() const { return n_; }
-  [[nodiscard]] int samples() const { return 2 * n_ + 1; }
-  [[nodiscard]] const std::vector<std::array<int, 2>>& positions() const { return positions_; }
-  // Grid index (i + (n + 1) j) of stored node k.
-  [[nodiscard]] std::size_t grid(std::size_t k) const {
-    return static_cast<std::size_t>(positions_[k][0] + (n_ + 1) * positions_[k][1]);
-  }
-  // `g`: the nodes on the grid (i + (n + 1) j).
-  [[nodiscard]] bool valid(const std::array<Vec3, kMaxNodes>& g, const Vec3& normal) const {
-    const int np = n_ + 1;
-    std::array<Vec3, kMaxOrder + 1> along{}, across{};
-    for (int m2 = 0; m2 < samples(); ++m2) {
-      const auto& l2 = l_[static_cast<std::size_t>(m2)];
-      const auto& d2 = dl_[static_cast<std::size_t>(m2)];
-      for (int a = 0; a < np; ++a) {
-        Vec3 x{}, y{};
-        for (int b = 0; b < np; ++b) {
-          const Vec3& p = g[static_cast<std::size_t>(a + np * b)];
-          x += p * l2[static_cast<std::size_t>(b)];
-          y += p * d2[static_cast<std::size_t>(b)];
-        }
-        along[static_cast<std::size_t>(a)] = x;
-        across[static_cast<std::size_t>(a)] = y;
-      }
-      for (int m1 = 0; m1 < samples(); ++m1) {
-        const auto& l1 = l_[static_cast<std::size_t>(m1)];
-        const auto& d1 = dl_[static_cast<std::size_t>(m1)];
-        Vec3 ds{}, dt{};
-        for (int a = 0; a < np; ++a) {
-          ds += along[static_cast<std::size_t>(a)] * d1[static_cast<std::size_t>(a)];
-          dt += across[static_cast<std::size_t>(a)] * l1[static_cast<std::size_t>(a)];
-        }
-        if (!(dot(cross(ds, dt), normal) > 0)) return false;
-      }
-    }
-    return true;
-  }
-
- private:
-  int n_;
-  std::vector<std::array<int, 2>> positions_;
-  std::array<std::array<double, kMaxOrder + 1>, kMaxSamples> l_{}, dl_{};
-};
+using detail::kMaxNodes;
+using detail::lagrange_1d;
+using detail::nearest;
+using detail::QuadChecker;
+using detail::uv_images;
 
 }  // namespace
 
@@ -533,6 +429,90 @@ HighOrderReport make_high_order(mesh::SurfaceMesh& m, const cad::CadModel& model
         projected[node] = 0;
       }
   };
+  // Puts the face nodes of quad q back on its face along the parameter lines instead of straight:
+  // the nodes of its edges inside the face at the images of evenly spaced (u, v) between the
+  // edge's ends, its interior nodes at the image of the Coons patch of its four sides' (u, v)
+  // (curve nodes stay where they are, their pcurve images are the patch's sides). The element is
+  // then S o phi with phi the quad's parameter patch: on a regular surface it folds only where
+  // phi does, whereas the projected 3D positions fold where the surface turns strongly across a
+  // long edge. Returns false, changing nothing, where the images are not known (a node already
+  // off the CAD, a vertex with no image in the face).
+  std::vector<Vec2> patch(static_cast<std::size_t>((n + 1) * (n + 1)));
+  auto reshape = [&](GO q) {
+    const auto& quad = m.quads[static_cast<std::size_t>(q)];
+    const LO f = m.quad_face[static_cast<std::size_t>(q)];
+    const auto geom = model.face_geometry(f);
+    const int np = n + 1;
+    auto uv = [&](int i, int j) -> Vec2& { return patch[static_cast<std::size_t>(i + np * j)]; };
+    Vec2 ref{};
+    bool have_ref = false;
+    for (GO v : quad)
+      if (!have_ref && m.vclass[static_cast<std::size_t>(v)].dim == 2) {
+        ref = {m.vclass[static_cast<std::size_t>(v)].param[0],
+               m.vclass[static_cast<std::size_t>(v)].param[1]};
+        have_ref = true;
+      }
+    std::array<Vec2, 4> corner{};
+    for (std::size_t k = 0; k < 4; ++k) {
+      const auto images = uv_images(model, *geom, f, m.vclass[static_cast<std::size_t>(quad[k])]);
+      if (images.empty()) return false;
+      if (!have_ref) {
+        ref = images.front();
+        have_ref = true;
+      }
+      corner[k] = nearest(images, ref);
+    }
+    uv(0, 0) = corner[0];
+    uv(n, 0) = corner[1];
+    uv(n, n) = corner[2];
+    uv(0, n) = corner[3];
+    const GO* ho = m.quad_nodes.data() + q * per_quad;
+    const std::array<std::array<int, 4>, 4> walk{
+        {{0, 0, 1, 0}, {n, 0, 0, 1}, {n, n, -1, 0}, {0, n, 0, -1}}};  // start (i, j), step (di, dj)
+    for (std::size_t k = 0; k < 4; ++k) {
+      const Edge& x =
+          edges[static_cast<std::size_t>(quad_sides[static_cast<std::size_t>(q)][k] / 2)];
+      const Vec2 a = corner[k], b = corner[(k + 1) % 4];
+      for (int s = 1; s < n; ++s) {
+        const Vec2 straight = a + (static_cast<double>(s) / n) * (b - a);
+        Vec2 at = straight;
+        if (x.curve != kNoIndex) {
+          const auto node = static_cast<std::size_t>(ho[k * per_edge + s - 1] - nv);
+          if (projected[node] == 0) return false;
+          const auto images = uv_images(model, *geom, f, vclass[node]);
+          if (images.empty()) return false;
+          at = nearest(images, straight);
+        }
+        uv(walk[k][0] + s * walk[k][2], walk[k][1] + s * walk[k][3]) = at;
+      }
+    }
+    for (int j = 1; j < n; ++j)
+      for (int i = 1; i < n; ++i) {
+        const double r = static_cast<double>(i) / n, t = static_cast<double>(j) / n;
+        uv(i, j) = (1 - t) * uv(i, 0) + t * uv(i, n) + (1 - r) * uv(0, j) + r * uv(n, j) -
+                   ((1 - r) * (1 - t) * uv(0, 0) + r * (1 - t) * uv(n, 0) + r * t * uv(n, n) +
+                    (1 - r) * t * uv(0, n));
+      }
+    auto set = [&](std::size_t node, const Vec2& at) {
+      points[node] = geom->eval(at).p;
+      vclass[node] = {2, f, kNoIndex, {at.u, at.v}};
+      projected[node] = 1;
+    };
+    for (std::size_t k = 0; k < 4; ++k) {
+      if (edges[static_cast<std::size_t>(quad_sides[static_cast<std::size_t>(q)][k] / 2)].curve !=
+          kNoIndex)
+        continue;
+      for (int s = 1; s < n; ++s)
+        set(static_cast<std::size_t>(ho[k * per_edge + s - 1] - nv),
+            uv(walk[k][0] + s * walk[k][2], walk[k][1] + s * walk[k][3]));
+    }
+    for (int j = 1; j < n; ++j)
+      for (int i = 1; i < n; ++i)
+        set(static_cast<std::size_t>(first_interior + q * per_interior + (i - 1) +
+                                     per_edge * (j - 1)),
+            uv(i, j));
+    return true;
+  };
   // Quads sharing an edge (and so edge nodes) with q; interior nodes are q's own.
   std::vector<GO> edge_quad_offsets(static_cast<std::size_t>(ne) + 1, 0), edge_quads;
   for (const auto& sides : quad_sides)
@@ -555,9 +535,10 @@ HighOrderReport make_high_order(mesh::SurfaceMesh& m, const cad::CadModel& model
       if (ok[static_cast<std::size_t>(q)] == 0) bad.push_back(q);
     return bad;
   };
-  // Straightens the quads of `work` that are not valid, then those their straightened nodes
-  // fold, round after round in quad order (deterministic); each quad once at most.
-  auto straighten_all = [&](std::vector<GO> work, bool curve_nodes_too) {
+  // Applies `fix` to the quads of `work` that are not valid, then to those the fixed nodes fold,
+  // round after round in quad order (deterministic); each quad once at most. `fix` returns
+  // whether it changed the quad.
+  auto fix_all = [&](std::vector<GO> work, auto&& fix) {
     std::vector<char> done(static_cast<std::size_t>(nq), 0);
     std::int64_t count = 0;
     while (!work.empty()) {
@@ -565,8 +546,8 @@ HighOrderReport make_high_order(mesh::SurfaceMesh& m, const cad::CadModel& model
       for (GO q : work) {
         if (done[static_cast<std::size_t>(q)] != 0 || valid(q)) continue;
         done[static_cast<std::size_t>(q)] = 1;
+        if (!fix(q)) continue;
         ++count;
-        straighten(q, curve_nodes_too);
         for (GO side : quad_sides[static_cast<std::size_t>(q)]) {
           const auto e = static_cast<std::size_t>(side / 2);
           for (GO k = edge_quad_offsets[e]; k < edge_quad_offsets[e + 1]; ++k) {
@@ -581,11 +562,20 @@ HighOrderReport make_high_order(mesh::SurfaceMesh& m, const cad::CadModel& model
     }
     return count;
   };
-  report.straightened = straighten_all(check_all(), false);
+  // Folded quads first get their face nodes along the parameter lines (still on the CAD); those
+  // still folded get them straight, off the CAD.
+  report.reshaped = fix_all(check_all(), reshape);
+  report.straightened = fix_all(check_all(), [&](GO q) {
+    straighten(q, false);
+    return true;
+  });
   // A quad still folded by its curve nodes (at a sharp CAD corner the curve bends across the
   // element) gets those straight too: its edge then leaves the curve between its ends.
   if (report.straightened > 0) {
-    report.curve_straightened = straighten_all(check_all(), true);
+    report.curve_straightened = fix_all(check_all(), [&](GO q) {
+      straighten(q, true);
+      return true;
+    });
     report.invalid = static_cast<std::int64_t>(check_all().size());
   }
 

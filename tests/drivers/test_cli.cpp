@@ -115,7 +115,29 @@ TEST(Cli, SecondOrder) {
                 .find("quad mesh"),
             std::string::npos);
   EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.cgns", "--order", "2", "--block-structured"})
-                .find("not written yet"),
+                .find("--block-patches"),
+            std::string::npos);
+}
+
+TEST(Cli, BlockPatchesTakeAnOrderAndTheCoarseLayout) {
+  const Arguments a = p({"mesh", "m.step", "-o", "o.vtu", "--block-patches", "--order", "3"});
+  EXPECT_TRUE(a.block_patches);
+  EXPECT_FALSE(a.block_structured);
+  EXPECT_TRUE(a.coarse_layout);
+  EXPECT_FALSE(
+      p({"mesh", "m.step", "-o", "o.msh", "--block-patches", "--order", "2", "--layout", "dense"})
+          .coarse_layout);
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--block-patches"}).find("--order"),
+            std::string::npos);
+  EXPECT_NE(
+      error_of({"mesh", "m.step", "-o", "o.xyz", "--block-patches", "--order", "2"}).find("PLOT3D"),
+      std::string::npos);
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.cgns", "--block-patches", "--order", "2",
+                      "--block-structured"})
+                .find("not with --block-structured"),
+            std::string::npos);
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.cgns", "--block-patches", "--order", "5"})
+                .find("order 5"),
             std::string::npos);
 }
 

@@ -325,6 +325,29 @@ TEST_F(Qsmesh, BlockStructuredCgnsJoinsItsBlocks) {
   }
 }
 
+TEST_F(Qsmesh, BlockPatchesAreOneHighOrderQuadPerBlockOnTheCad) {
+  // --block-patches: the wing-body example's blocks, each written as one order-3 Lagrange quad,
+  // every node on the CAD.
+  const std::string step = tmp("e2e_wing_body_patches.step");
+  ASSERT_EQ(run("example wing-body -o " + step).code, 0);
+  const std::string out = tmp("e2e_wing_body_patches.vtu");
+  const std::string stats = tmp("e2e_wing_body_patches.json");
+  const ExeResult r =
+      run("mesh " + step + " -o " + out +
+          " --block-patches --order 3 --size-factor 0.1 --threads 1 -q --stats " + stats);
+  ASSERT_EQ(r.code, 0) << r.err;
+  const std::string json = slurp(stats);
+  EXPECT_GT(json_number(json, "blocks"), 4);
+  EXPECT_EQ(json_number(json, "block_patches"), json_number(json, "blocks"));
+  EXPECT_EQ(json_number(json, "block_patch_order"), 3);
+  EXPECT_GT(json_number(json, "block_patch_nodes"), 0);
+  EXPECT_EQ(json_number(json, "block_patch_nodes_off_cad"), 0);
+  const std::string vtu = slurp(out);
+  const std::string cells =
+      "NumberOfCells=\"" + std::to_string(static_cast<long>(json_number(json, "blocks"))) + "\"";
+  EXPECT_NE(vtu.find(cells), std::string::npos) << cells;
+}
+
 TEST_F(Qsmesh, BlockSidesAlongBothBanksOfASeamAreJoined) {
   // On the wing-body example at a coarse size, a block of the fuselage (a surface of revolution)
   // runs along its seam on both banks: the same mesh edges at two places of one side. They are an

@@ -26,6 +26,10 @@ struct HighOrderReport {
   /// say), or put back there to keep a quad valid (straightened, below). Their classification
   /// keeps the curve or face they belong to, with parameters NaN.
   std::int64_t unprojected = 0;
+  /// Quads whose curved element was not valid and whose face nodes were put again on the face
+  /// along its parameter lines (the images of the Coons patch of the quad's sides in (u, v)),
+  /// still on the CAD; counted whether or not that made them valid.
+  std::int64_t reshaped = 0;
   /// Quads whose curved element was not valid (lagrange_quad_valid) and whose face nodes (the
   /// nodes of their edges inside the face and their interior nodes) were put back on their
   /// straight positions.
@@ -56,8 +60,10 @@ struct HighOrderReport {
 /// again from the element's corners.
 /// Each is classified on its entity (dim 1 with the curve parameter, dim 2 with (u, v); index
 /// kNoIndex; parameters NaN for the nodes left off the CAD, see unprojected). Quads whose curved
-/// form is not valid get their face nodes back on the straight (bilinear) positions, and then
-/// their curve nodes if still not valid. Deterministic whatever the thread count of `tasks`.
+/// form is not valid first get their face nodes along the face's parameter lines (the surface's
+/// images of the Coons patch of the quad's sides in (u, v): still on the CAD, see reshaped); those
+/// still not valid get their face nodes back on the straight (bilinear) positions, and then
+/// their curve nodes. Deterministic whatever the thread count of `tasks`.
 /// Throws qsmesh::Error when the mesh has triangles or is already of higher order, and when
 /// `order` is out of range.
 HighOrderReport make_high_order(mesh::SurfaceMesh& mesh, const cad::CadModel& model, int order,
