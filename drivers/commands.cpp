@@ -887,6 +887,7 @@ int run_mesh(const Arguments& args) {
   if (until >= parallel::Stage::Unstructured) note_sliver_curves(s, options.sizemap);
   options.cavities.time_budget_s = args.face_time_budget;
   if (args.task_quads >= 0) options.task_quads = args.task_quads;
+  if (args.second_pass_task >= 0) options.second_pass_task_irregular = args.second_pass_task;
   if (args.second_pass_quads == 0) options.second_pass_sicn_per_irregular = 0;  // off
   if (args.second_pass_quads > 0) options.second_pass_max_quads = args.second_pass_quads;
   // Paper 003: read before any work, so that a bad file is one InputError line up front.
