@@ -544,6 +544,20 @@ std::string stats_json(const Arguments& args, const Session& session,
                                     [&](const char* name, const auto& v) { j.value(name, v); });
         j.end_object();
       }
+      // The face's topological improvement (parallel::ImprovementReport::fields, documented
+      // there): what its cost follows (the unstructured mesh's irregular vertices) and did.
+      if (f < r.quasi_reports.size() && r.face_times.size() > f &&
+          r.face_times[f].improvement_quads > 0) {
+        j.begin_object("improvement");
+        parallel::ImprovementReport::fields(
+            r.quasi_reports[f].improvement, [&](const char* name, const auto& v) {
+              if constexpr (std::is_same_v<std::decay_t<decltype(v)>, std::array<std::int64_t, 4>>)
+                j.value(name, std::vector<double>(v.begin(), v.end()));
+              else
+                j.value(name, v);
+            });
+        j.end_object();
+      }
       j.end_object();
     }
     j.end_array();

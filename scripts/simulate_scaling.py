@@ -27,8 +27,8 @@ rank, by replaying its measured per-face, per-stage times through the pipeline's
   (each piece keyed by the face's quads / pieces); its cutting and merging (its improvement time
   less its pieces') runs on its owner between and after the rounds. A face whose two passes ran
   as two tasks (--second-pass-task; face_stats' stage_seconds.improvement_passes) is two tasks of
-  the first round; the choice between them (its improvement time less the passes') runs on its
-  owner after it.
+  the first round, the second passes dealt after every other task; the choice between them (its
+  improvement time less the passes') runs on its owner after it.
 - assemble: rank 0 unpacks and assembles every face (as measured) after receiving the other ranks'
   faces (bytes / bandwidth); the driver's later stages (statistics, write, ...) on rank 0 as
   measured.
@@ -335,9 +335,14 @@ class Simulator:
             tasks = run.improve_tasks[f]
             passes = run.improve_passes[f]
             if not tasks and passes:
-                # Both passes in the first round, each with the face's input (its bytes).
-                for i, sec in enumerate(passes):
-                    first.append((f, q, i, sec, run.bytes[f]))
+                # Both passes in the first round, each with the face's input (its bytes); the
+                # second passes dealt after every other task, largest first among themselves. A
+                # second pass the run skipped (0 s: its first, done before on its rank, did not
+                # want it) stays 0 s: where the run would start it before its first ended, its
+                # work is missed.
+                first.append((f, q, 0, passes[0], run.bytes[f]))
+                if len(passes) > 1:
+                    first.append((f, q - 1e15, 1, passes[1], run.bytes[f]))
                 owner_work[f] = max(0.0, run.t["improvement"][f] - sum(passes))
                 continue
             if not tasks:

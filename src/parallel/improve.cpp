@@ -77,12 +77,15 @@ struct Result {
   std::array<double, 3> steps{};  // not exchanged: summed over all tasks by a reduction
   // A first pass's result asks for the second pass (second_pass_applies).
   bool second_wanted = false;
+  // A second pass not run: its first, ended on the same rank before it, did not want it.
+  bool skipped = false;
   template <class S, class V>
   static void fields(S& self, V&& visit) {
     visit("mesh", self.mesh);
     visit("report", self.report);
     visit("seconds", self.seconds);
     visit("second_wanted", self.second_wanted);
+    visit("skipped", self.skipped);
   }
 };
 
@@ -274,22 +277,39 @@ std::vector<Result> deal_round(const Comm& comm, const cad::CadModel& model,
     std::vector<char>().swap(buffer);  // the window holds the copy now
   }
 
-  // Largest first, so that the last tasks dealt out are short.
+  // Largest first, so that the last tasks dealt out are short; the second passes dealt as tasks
+  // of their own after all others, so that a thread that takes one after its first pass ended
+  // on this rank knows whether the face wants it.
   std::vector<std::size_t> order(work.size());
   std::iota(order.begin(), order.end(), std::size_t{0});
   std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
     const Work& x = work[a];
     const Work& y = work[b];
+    if ((x.pass == kSecondPass) != (y.pass == kSecondPass)) return y.pass == kSecondPass;
     if (x.quads != y.quads) return x.quads > y.quads;
     if (x.face != y.face) return x.face < y.face;
     return x.piece != y.piece ? x.piece < y.piece : x.pass < y.pass;
   });
   const auto n = static_cast<std::int64_t>(work.size());
   std::vector<Result> results(work.size());
+  // Per task, once a first pass (kFirstPass) ended on this rank: 1 when its result asks for the
+  // second pass, 2 when not. A second pass whose first is known not to want it is skipped; one
+  // whose first ran elsewhere or has not ended runs (and may be dropped by the owner). Which
+  // runs depends on timing, the mesh does not: a skipped pass is never wanted.
+  std::vector<std::atomic<int>> first_ended(work.size());
   DealProgress progress(stage, n, comm, log);
   deal_out(comm, n, tasks, [&](std::int64_t k) {
     const std::size_t w_at = order[static_cast<std::size_t>(k)];
     const Work& w = work[w_at];
+    // Its first pass is the task before it (the same owner's next-to-last).
+    if (w.pass == kSecondPass && w_at > 0 && work[w_at - 1].pass == kFirstPass &&
+        work[w_at - 1].face == w.face &&
+        first_ended[w_at - 1].load(std::memory_order_acquire) == 2) {
+      results[w_at].done = true;
+      results[w_at].skipped = true;
+      progress.done();
+      return;
+    }
     if (w.owner == rank) {
       Task& t = mine[w.local];
       results[w_at] = improve_one(model, w.face, std::move(t.input.mesh), t.input.singularities,
@@ -305,6 +325,8 @@ std::vector<Result> deal_round(const Comm& comm, const cad::CadModel& model,
       results[w_at] =
           improve_one(model, w.face, std::move(in.mesh), in.singularities, settings, log, w.pass);
     }
+    if (w.pass == kFirstPass)
+      first_ended[w_at].store(results[w_at].second_wanted ? 1 : 2, std::memory_order_release);
     progress.done();
   });
   shared.reset();  // collective: every rank is past its last read
@@ -509,6 +531,8 @@ std::array<double, 3> improve_faces(const Comm& comm, const cad::CadModel& model
       f.pass_seconds->push_back(results[k].seconds);
       f.pass_seconds->push_back(results[k2].seconds);
     }
+    QSMESH_CHECK(!results[k].second_wanted || !results[k2].skipped,
+                 "improvement: face " << f.face << " wants the second pass it skipped");
     Result r = results[k].second_wanted
                    ? choose_pass(std::move(results[k]), std::move(results[k2]), settings)
                    : std::move(results[k]);

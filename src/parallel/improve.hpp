@@ -85,9 +85,11 @@ struct ImproveSettings {
   /// 28): a face's cavity remeshing costs with its irregular vertices, not its quads, and the
   /// two passes in a row were the longest task of the stage (A319 at 16x: face 18, 2949 quads,
   /// 3.2 s). The second pass starts from the same input either way and the memo the first
-  /// pass leaves it only spares work (qstruct::CavityMemo), so the mesh is the same; it runs
-  /// whether or not the first's result asks for it (second_pass_applies), and is dropped when
-  /// it does not. Not with a time budget (the first pass's may stop it).
+  /// pass leaves it only spares work (qstruct::CavityMemo), so the mesh is the same. The second
+  /// passes are dealt after every other task: one whose first pass ended on the same rank
+  /// without asking for it (second_pass_applies) is skipped; else it runs, and the owner drops
+  /// it where the first's result does not ask for it. Not with a time budget (the first pass's
+  /// may stop it).
   std::int64_t second_pass_task_irregular = 0;
 };
 

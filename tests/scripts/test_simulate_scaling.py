@@ -186,8 +186,11 @@ class Pieces(unittest.TestCase):
                    {"background": 2.0, "improvement": 6.5})
         st["face_stats"][0]["stage_seconds"]["improvement_passes"] = [3, 2]
         s = sim.Simulator(sim.Run(st), comm=NO_COMM)
-        # Two workers: 3 | 2+1 -> 3, then 0.5 on the owner.
+        # Two workers: the first pass (3) | face 1 (1) then the second pass (2, dealt last) -> 3,
+        # then 0.5 on the owner.
         self.assertAlmostEqual(s.predict(2, 1)["improvement"], 3.5, places=6)
+        # Three workers: 3 | 1 | 2.
+        self.assertAlmostEqual(s.predict(3, 1)["improvement"], 3.5, places=6)
         self.assertAlmostEqual(s.predict(1, 1)["improvement"], 6.5, places=6)
         big = s.largest_faces()
         self.assertAlmostEqual(big["improvement task"][1], 3.0)

@@ -236,9 +236,9 @@ struct FaceTimes {
   /// Their sum and the cutting and merging make `improvement`. Empty: one task.
   std::vector<double> improvement_tasks;
   /// A whole face whose two improvement passes were dealt as two tasks at once (ImproveSettings::
-  /// second_pass_task_irregular): the seconds of its first pass, then of its second (run whether
-  /// or not the first's result asks for it). Their sum and the choice between them make
-  /// `improvement`. Empty: one task.
+  /// second_pass_task_irregular): the seconds of its first pass, then of its second (0 where it
+  /// was skipped: its first, ended before on the same rank, did not ask for it). Their sum and
+  /// the choice between them make `improvement`. Empty: one task.
   std::vector<double> improvement_passes;
   /// The pattern fill's move search (qstruct::PatternFaceReport: layouts, batches,
   /// search_seconds): the part of `patterns` that its batches split over the threads.
