@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <exception>
 #include <limits>
+#include <memory>
 #include <numeric>
 #include <optional>
 #include <string>
@@ -175,7 +176,8 @@ Result choose_pass(Result first, Result second, const ImproveSettings& settings)
 // Improves one task: its mesh through both passes (kBothPasses), or one of them.
 Result improve_one(const cad::CadModel& model, LO face, mesh::FaceMesh mesh,
                    std::span<const crossfield::Singularity> singularities,
-                   const ImproveSettings& settings, Logger& log, LO pass) {
+                   const ImproveSettings& settings, Logger& log, LO pass,
+                   qstruct::CavityMemo* shared_memo = nullptr) {
   const Stopwatch total;
   std::unique_ptr<cad::FaceGeometry> surface;
   try {
@@ -188,8 +190,10 @@ Result improve_one(const cad::CadModel& model, LO face, mesh::FaceMesh mesh,
   const bool second_pass = settings.second_pass_sicn_per_irregular > 0 && !piece &&
                            surface != nullptr && !mesh.quads.empty() && mesh.triangles.empty();
   // The candidates the first pass refused are refused by the second too when its bounds still
-  // refuse them: it starts from the same mesh (qstruct::CavityMemo). One memo per task.
-  qstruct::CavityMemo memo;
+  // refuse them: it starts from the same mesh (qstruct::CavityMemo). One memo per task, or the
+  // one a first pass leaves its second where both run on this rank in turn (`shared_memo`).
+  qstruct::CavityMemo own_memo;
+  qstruct::CavityMemo& memo = shared_memo != nullptr ? *shared_memo : own_memo;
   if (pass == kSecondPass) {
     // The second pass alone, from the face's input, while the first runs as another task.
     Result r;
@@ -297,23 +301,35 @@ std::vector<Result> deal_round(const Comm& comm, const cad::CadModel& model,
   // whose first ran elsewhere or has not ended runs (and may be dropped by the owner). Which
   // runs depends on timing, the mesh does not: a skipped pass is never wanted.
   std::vector<std::atomic<int>> first_ended(work.size());
+  // The memo of each first pass run on this rank whose result asks for the second, for the
+  // second where it starts after (the same result with less work).
+  std::vector<std::unique_ptr<qstruct::CavityMemo>> memos(work.size());
   DealProgress progress(stage, n, comm, log);
   deal_out(comm, n, tasks, [&](std::int64_t k) {
     const std::size_t w_at = order[static_cast<std::size_t>(k)];
     const Work& w = work[w_at];
-    // Its first pass is the task before it (the same owner's next-to-last).
+    // A second pass's first is the task before it (the same owner's).
+    qstruct::CavityMemo* memo = nullptr;
     if (w.pass == kSecondPass && w_at > 0 && work[w_at - 1].pass == kFirstPass &&
-        work[w_at - 1].face == w.face &&
-        first_ended[w_at - 1].load(std::memory_order_acquire) == 2) {
-      results[w_at].done = true;
-      results[w_at].skipped = true;
-      progress.done();
-      return;
+        work[w_at - 1].face == w.face) {
+      const int first = first_ended[w_at - 1].load(std::memory_order_acquire);
+      if (first == 2) {
+        results[w_at].done = true;
+        results[w_at].skipped = true;
+        progress.done();
+        return;
+      }
+      if (first == 1) memo = memos[w_at - 1].get();
+    }
+    std::unique_ptr<qstruct::CavityMemo> first_memo;
+    if (w.pass == kFirstPass) {
+      first_memo = std::make_unique<qstruct::CavityMemo>();
+      memo = first_memo.get();
     }
     if (w.owner == rank) {
       Task& t = mine[w.local];
       results[w_at] = improve_one(model, w.face, std::move(t.input.mesh), t.input.singularities,
-                                  settings, log, w.pass);
+                                  settings, log, w.pass, memo);
     } else {
       const std::vector<char> bytes = shared->read(w.owner, w.offset, w.length);
       std::size_t pos = 0;
@@ -322,11 +338,14 @@ std::vector<Result> deal_round(const Comm& comm, const cad::CadModel& model,
       QSMESH_CHECK(in.mesh.face == w.face, "improvement: rank " << w.owner << " sent face "
                                                                 << in.mesh.face << " for face "
                                                                 << w.face);
-      results[w_at] =
-          improve_one(model, w.face, std::move(in.mesh), in.singularities, settings, log, w.pass);
+      results[w_at] = improve_one(model, w.face, std::move(in.mesh), in.singularities, settings,
+                                  log, w.pass, memo);
     }
-    if (w.pass == kFirstPass)
+    if (w.pass == kSecondPass && memo != nullptr) memos[w_at - 1].reset();
+    if (w.pass == kFirstPass) {
+      if (results[w_at].second_wanted) memos[w_at] = std::move(first_memo);
       first_ended[w_at].store(results[w_at].second_wanted ? 1 : 2, std::memory_order_release);
+    }
     progress.done();
   });
   shared.reset();  // collective: every rank is past its last read
