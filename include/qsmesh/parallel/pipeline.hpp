@@ -48,9 +48,9 @@ inline constexpr std::int64_t kDefaultTaskQuads = 20000;
 
 /// Default PipelineOptions::second_pass_task_irregular. On A319 at 16 times its reference vertex
 /// count it splits the three faces whose improvement takes over 0.9 s (25-41 irregular vertices
-/// before it) and none of the ten others (at most 10); it costs one rank no measurable time,
-/// the second pass taking the first's memo there (docs/benchmarks.md, issue 28, branch
-/// `scale7`). The mesh does not depend on it.
+/// before it) and none of the nine others of at most second_pass_max_quads quads (at most 10
+/// each); it costs one rank no measurable time, the second pass taking the first's memo there
+/// (docs/benchmarks.md, issue 28, branch `scale7`). The mesh does not depend on it.
 inline constexpr std::int64_t kDefaultSecondPassTaskIrregular = 16;
 
 /// The cavity options of the second pass (PipelineOptions::second_pass_cavities): the defaults
