@@ -328,6 +328,13 @@ Arguments parse(const std::vector<std::string>& args) {
       if (!n || !std::isfinite(*n) || *n < 0 || *n > 1e15 || *n != std::floor(*n))
         throw InputError(opt + ": '" + v + "' is not a whole number of quads (0: never cut)");
       a.task_quads = static_cast<std::int64_t>(*n);
+    } else if (opt == "--second-pass-task" && a.command == Command::Mesh) {
+      const std::string& v = value();
+      const auto n = parse_double(v);
+      if (!n || !std::isfinite(*n) || *n < 0 || *n > 1e15 || *n != std::floor(*n))
+        throw InputError(opt + ": '" + v +
+                         "' is not a whole number of irregular vertices (0: never)");
+      a.second_pass_task = static_cast<std::int64_t>(*n);
     } else if (opt == "--second-pass-quads" && a.command == Command::Mesh) {
       const std::string& v = value();
       const auto n = parse_double(v);
@@ -657,6 +664,11 @@ std::string help(const std::string& topic) {
           "                        second time with looser cavity bounds, and keep that mesh\n"
           "                        when it has fewer irregular vertices at a small SICN cost\n"
           "                        (docs/architecture.md); 0: no second pass (faster)\n"
+          "  --second-pass-task N  a face with at least N irregular vertices (default "
+       << parallel::kDefaultSecondPassTaskIrregular
+       << ")\n"
+          "                        before its improvement runs its second pass as a task of its\n"
+          "                        own, beside the first; 0: never. The mesh is the same\n"
           "  --max-quads N         refuse, before any work, a run whose estimated quad count is\n"
           "                        above N (default "
        << kDefaultMaxQuads

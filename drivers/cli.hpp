@@ -118,6 +118,10 @@ struct Arguments {
   /// --second-pass-quads N: the largest face given a second improvement pass
   /// (parallel::PipelineOptions::second_pass_max_quads; 0: no second pass); -1: the default.
   std::int64_t second_pass_quads = -1;
+  /// --second-pass-task N: a face with at least N interior irregular vertices before its
+  /// improvement runs its second pass as a task of its own
+  /// (parallel::PipelineOptions::second_pass_task_irregular; 0: never); -1: the default.
+  std::int64_t second_pass_task = -1;
   /// --field-divisions N: the background (where the fields are computed) at the geometry's
   /// resolution, each face's edges at most its bounding-box diagonal / N (and at most the target
   /// size's resolution); 0: the background follows the target size. See kDefaultFieldDivisions.

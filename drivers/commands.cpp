@@ -559,6 +559,20 @@ std::string stats_json(const Arguments& args, const Session& session,
                                     [&](const char* name, const auto& v) { j.value(name, v); });
         j.end_object();
       }
+      // The face's topological improvement (parallel::ImprovementReport::fields, documented
+      // there): what its cost follows (the unstructured mesh's irregular vertices) and did.
+      if (f < r.quasi_reports.size() && r.face_times.size() > f &&
+          r.face_times[f].improvement_quads > 0) {
+        j.begin_object("improvement");
+        parallel::ImprovementReport::fields(
+            r.quasi_reports[f].improvement, [&](const char* name, const auto& v) {
+              if constexpr (std::is_same_v<std::decay_t<decltype(v)>, std::array<std::int64_t, 4>>)
+                j.value(name, std::vector<double>(v.begin(), v.end()));
+              else
+                j.value(name, v);
+            });
+        j.end_object();
+      }
       j.end_object();
     }
     j.end_array();
@@ -908,6 +922,7 @@ int run_mesh(const Arguments& args) {
   if (until >= parallel::Stage::Unstructured) note_sliver_curves(s, options.sizemap);
   options.cavities.time_budget_s = args.face_time_budget;
   if (args.task_quads >= 0) options.task_quads = args.task_quads;
+  if (args.second_pass_task >= 0) options.second_pass_task_irregular = args.second_pass_task;
   if (args.second_pass_quads == 0) options.second_pass_sicn_per_irregular = 0;  // off
   if (args.second_pass_quads > 0) options.second_pass_max_quads = args.second_pass_quads;
   // Paper 003: read before any work, so that a bad file is one InputError line up front.

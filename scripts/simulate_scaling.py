@@ -25,7 +25,10 @@ rank, by replaying its measured per-face, per-stage times through the pipeline's
   pieces (--task-quads; face_stats' stage_seconds.improvement_tasks: 2k + 1 piece times) is k
   tasks in the first round, dealt with the whole faces, and k + 1 in a second round after it
   (each piece keyed by the face's quads / pieces); its cutting and merging (its improvement time
-  less its pieces') runs on its owner between and after the rounds.
+  less its pieces') runs on its owner between and after the rounds. A face whose two passes ran
+  as two tasks (--second-pass-task; face_stats' stage_seconds.improvement_passes) is two tasks of
+  the first round, the second passes dealt after every other task; the choice between them (its
+  improvement time less the passes') runs on its owner after it.
 - assemble: rank 0 unpacks and assembles every face (as measured) after receiving the other ranks'
   faces (bytes / bandwidth); the driver's later stages (statistics, write, ...) on rank 0 as
   measured.
@@ -136,6 +139,8 @@ class Run:
         self.expected = [f["stage_seconds"].get("expected_quads", 0.0) for f in self.faces]
         self.improve_quads = [f["stage_seconds"].get("improvement_quads", 0) for f in self.faces]
         self.improve_tasks = [f["stage_seconds"].get("improvement_tasks", []) for f in self.faces]
+        # A whole face's two improvement passes dealt as two tasks (--second-pass-task).
+        self.improve_passes = [f["stage_seconds"].get("improvement_passes", []) for f in self.faces]
         self.bytes = [f["stage_seconds"].get("bytes", 0) for f in self.faces]
         # The pattern fill's move search: layouts read, the batches they come in, its seconds.
         self.pattern_layouts = [f["stage_seconds"].get("pattern_layouts", 0) for f in self.faces]
@@ -291,13 +296,14 @@ class Simulator:
                     mine = max(sum(i[4] for i in items if part[i[0]] == r) for r in range(p))
                     move += self.allreduce(p) + RECORD_BYTES * len(items) / bw + mine / bw + 2 * self.allreduce(p)
                 extra[s] += move
-            if s == "improvement" and len(improvement) > 1 and improvement[1]:
-                # Cutting and merging on the owners, between and after the rounds.
+            if s == "improvement" and owner_work:
+                # Cutting and merging, or choosing between a face's two passes, on the owners,
+                # between and after the rounds.
                 per_rank = [0.0] * p
                 for f, sec in owner_work.items():
                     per_rank[part[f]] += sec
                 times[s] += max(per_rank)
-                if messages and p > 1:
+                if messages and p > 1 and improvement[1]:
                     extra[s] += self.allreduce(p)  # whether any face was cut
             if not messages:
                 for r in range(p):
@@ -318,7 +324,8 @@ class Simulator:
 
     def improvement_rounds(self):
         """The improvement's tasks, [first round, second round], each task (face, order key,
-        piece, seconds, bytes), and the seconds of each cut face's cutting and merging."""
+        piece, seconds, bytes), and the seconds of each cut face's cutting and merging (or of the
+        choice between a face's two passes dealt as two tasks)."""
         run = self.run
         first, second, owner_work = [], [], {}
         for f in range(run.n):
@@ -326,6 +333,18 @@ class Simulator:
             if q <= 0:
                 continue
             tasks = run.improve_tasks[f]
+            passes = run.improve_passes[f]
+            if not tasks and passes:
+                # Both passes in the first round, each with the face's input (its bytes); the
+                # second passes dealt after every other task, largest first among themselves. A
+                # second pass the run skipped (0 s: its first, done before on its rank, did not
+                # want it) stays 0 s: where the run would start it before its first ended, its
+                # work is missed.
+                first.append((f, q, 0, passes[0], run.bytes[f]))
+                if len(passes) > 1:
+                    first.append((f, q - 1e15, 1, passes[1], run.bytes[f]))
+                owner_work[f] = max(0.0, run.t["improvement"][f] - sum(passes))
+                continue
             if not tasks:
                 first.append((f, q, -1, run.t["improvement"][f], run.bytes[f]))
                 continue
@@ -395,10 +414,12 @@ class Simulator:
         v = 0.0
         rounds, owner_work = self.improvement_rounds()
         for s, measured in run.seconds.items():
-            if s == "improvement" and rounds[1]:
-                # Faces cut into pieces: each round's largest task, and the cutting and merging.
-                v += (max(i[3] for i in rounds[0]) + max(i[3] for i in rounds[1])
-                      + max(owner_work.values()) + self.residual[s])
+            if s == "improvement" and (rounds[1] or owner_work):
+                # Faces cut into pieces or with their passes as two tasks: each round's largest
+                # task, and the cutting and merging or the choice between the passes.
+                v += (max((i[3] for i in rounds[0]), default=0.0)
+                      + max((i[3] for i in rounds[1]), default=0.0)
+                      + max(owner_work.values(), default=0.0) + self.residual[s])
             elif s in PARTITIONED or s in DEALT:
                 v += max(run.t[s]) + self.residual[s]
             elif s == "curves" and run.curve_rounds:

@@ -190,6 +190,13 @@ bool second_pass_wins(const mesh::FaceQuadStats& first, const mesh::FaceQuadStat
              sum_per_irregular * static_cast<double>(removed);
 }
 
+bool second_pass_applies(const mesh::FaceQuadStats& first, std::int64_t flagged_kept,
+                         bool time_budget_hit, std::int64_t min_unnecessary,
+                         std::int64_t max_quads) {
+  if (time_budget_hit || first.irregular_interior - flagged_kept < min_unnecessary) return false;
+  return max_quads <= 0 || first.quads <= max_quads;
+}
+
 bool wants_unstructured(const FaceTask& task) { return !task.quasi.by_pattern; }
 
 bool wants_improvement(const FaceTask& task) {

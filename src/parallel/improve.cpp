@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <exception>
 #include <limits>
+#include <memory>
 #include <numeric>
 #include <optional>
 #include <string>
@@ -26,6 +27,7 @@ namespace {
 struct Work {
   LO face = kNoIndex;
   LO piece = kNoIndex;      // kNoIndex: the whole face
+  LO pass = 0;              // Pass: both passes, or one of a face's two pass tasks
   int owner = 0;            // not exchanged: the sender
   std::size_t local = 0;    // index in the owner's tasks; not exchanged: the order received
   std::int64_t offset = 0;  // the task's bytes in the owner's SharedBytes (several ranks)
@@ -36,6 +38,7 @@ struct Work {
   static void fields(S& self, V&& visit) {
     visit("face", self.face);
     visit("piece", self.piece);
+    visit("pass", self.pass);
     visit("quads", self.quads);
     visit("offset", self.offset);
     visit("length", self.length);
@@ -53,10 +56,16 @@ struct Input {
   }
 };
 
+// Which passes of the improvement a task runs: both in a row (the first, then the second where
+// second_pass_applies), or one of them, the face's other pass being a task of its own
+// (ImproveSettings::second_pass_task_irregular).
+enum Pass : LO { kBothPasses = 0, kFirstPass = 1, kSecondPass = 2 };
+
 // A task of this rank.
 struct Task {
   LO face = kNoIndex;
   LO piece = kNoIndex;
+  LO pass = kBothPasses;
   Input input;
 };
 
@@ -67,11 +76,17 @@ struct Result {
   ImprovementReport report;
   double seconds = 0;
   std::array<double, 3> steps{};  // not exchanged: summed over all tasks by a reduction
+  // A first pass's result asks for the second pass (second_pass_applies).
+  bool second_wanted = false;
+  // A second pass not run: its first, ended on the same rank before it, did not want it.
+  bool skipped = false;
   template <class S, class V>
   static void fields(S& self, V&& visit) {
     visit("mesh", self.mesh);
     visit("report", self.report);
     visit("seconds", self.seconds);
+    visit("second_wanted", self.second_wanted);
+    visit("skipped", self.skipped);
   }
 };
 
@@ -140,9 +155,29 @@ Result improve_pass(LO face, mesh::FaceMesh mesh, const cad::FaceGeometry* surfa
   return r;
 }
 
+// The face's result of its two passes: the second's where it wins (second_pass_wins), else the
+// first's; the steps' times of both.
+Result choose_pass(Result first, Result second, const ImproveSettings& settings) {
+  std::array<double, 3> steps{};
+  for (std::size_t k = 0; k < steps.size(); ++k) steps[k] = first.steps[k] + second.steps[k];
+  const bool keep =
+      !second.report.time_budget_hit &&
+      second_pass_wins(
+          mesh::face_quad_stats(first.mesh), mesh::face_quad_stats(second.mesh),
+          settings.second_pass_sicn_per_irregular, settings.second_pass_sicn_sum_per_irregular,
+          settings.second_pass_cavities.good_sicn, settings.second_pass_cavities.keep_ratio);
+  Result r = keep ? std::move(second) : std::move(first);
+  if (keep) r.report.second_pass_kept = true;
+  r.steps = steps;
+  r.second_wanted = true;
+  return r;
+}
+
+// Improves one task: its mesh through both passes (kBothPasses), or one of them.
 Result improve_one(const cad::CadModel& model, LO face, mesh::FaceMesh mesh,
                    std::span<const crossfield::Singularity> singularities,
-                   const ImproveSettings& settings, Logger& log) {
+                   const ImproveSettings& settings, Logger& log, LO pass,
+                   qstruct::CavityMemo* shared_memo = nullptr) {
   const Stopwatch total;
   std::unique_ptr<cad::FaceGeometry> surface;
   try {
@@ -154,33 +189,39 @@ Result improve_one(const cad::CadModel& model, LO face, mesh::FaceMesh mesh,
                                  [](const mesh::VertexClass& c) { return mesh::is_cut_vertex(c); });
   const bool second_pass = settings.second_pass_sicn_per_irregular > 0 && !piece &&
                            surface != nullptr && !mesh.quads.empty() && mesh.triangles.empty();
-  std::optional<mesh::FaceMesh> input;
-  if (second_pass) input = mesh;
-  std::int64_t flagged = 0;
   // The candidates the first pass refused are refused by the second too when its bounds still
-  // refuse them: it starts from the same mesh (qstruct::CavityMemo). One memo per task.
-  qstruct::CavityMemo memo;
+  // refuse them: it starts from the same mesh (qstruct::CavityMemo). One memo per task, or the
+  // one a first pass leaves its second where both run on this rank in turn (`shared_memo`).
+  qstruct::CavityMemo own_memo;
+  qstruct::CavityMemo& memo = shared_memo != nullptr ? *shared_memo : own_memo;
+  if (pass == kSecondPass) {
+    // The second pass alone, from the face's input, while the first runs as another task.
+    Result r;
+    if (second_pass) {
+      std::int64_t flagged = 0;
+      r = improve_pass(face, std::move(mesh), surface.get(), singularities, settings,
+                       settings.second_pass_cavities, memo, log, flagged);
+    } else {
+      r.done = true;
+      r.mesh = std::move(mesh);
+    }
+    r.seconds = total.seconds();
+    return r;
+  }
+  std::optional<mesh::FaceMesh> input;
+  if (second_pass && pass == kBothPasses) input = mesh;
+  std::int64_t flagged = 0;
   Result r = improve_pass(face, std::move(mesh), surface.get(), singularities, settings,
                           settings.cavities, memo, log, flagged);
-  if (second_pass && !r.report.time_budget_hit) {
-    const mesh::FaceQuadStats first = mesh::face_quad_stats(r.mesh);
-    if (first.irregular_interior - flagged >= settings.second_pass_min_unnecessary &&
-        (settings.second_pass_max_quads <= 0 || first.quads <= settings.second_pass_max_quads)) {
-      std::int64_t flagged2 = 0;
-      Result again = improve_pass(face, std::move(*input), surface.get(), singularities, settings,
-                                  settings.second_pass_cavities, memo, log, flagged2);
-      for (std::size_t k = 0; k < r.steps.size(); ++k) again.steps[k] += r.steps[k];
-      if (!again.report.time_budget_hit &&
-          second_pass_wins(
-              first, mesh::face_quad_stats(again.mesh), settings.second_pass_sicn_per_irregular,
-              settings.second_pass_sicn_sum_per_irregular, settings.second_pass_cavities.good_sicn,
-              settings.second_pass_cavities.keep_ratio)) {
-        again.report.second_pass_kept = true;
-        r = std::move(again);
-      } else {
-        r.steps = again.steps;
-      }
-    }
+  r.second_wanted =
+      second_pass &&
+      second_pass_applies(mesh::face_quad_stats(r.mesh), flagged, r.report.time_budget_hit,
+                          settings.second_pass_min_unnecessary, settings.second_pass_max_quads);
+  if (r.second_wanted && pass == kBothPasses) {
+    std::int64_t flagged2 = 0;
+    Result again = improve_pass(face, std::move(*input), surface.get(), singularities, settings,
+                                settings.second_pass_cavities, memo, log, flagged2);
+    r = choose_pass(std::move(r), std::move(again), settings);
   }
   r.seconds = total.seconds();
   return r;
@@ -203,6 +244,7 @@ std::vector<Result> deal_round(const Comm& comm, const cad::CadModel& model,
   for (std::size_t i = 0; i < mine.size(); ++i) {
     Work w{mine[i].face,
            mine[i].piece,
+           mine[i].pass,
            rank,
            i,
            0,
@@ -229,9 +271,9 @@ std::vector<Result> deal_round(const Comm& comm, const cad::CadModel& model,
         w.owner = r;
         w.local = i;
         read_record(bytes, pos, w);
-        QSMESH_CHECK(
-            r != rank || (i < mine.size() && mine[i].face == w.face && mine[i].piece == w.piece),
-            "improvement: task record " << w.face << "/" << w.piece << " out of order");
+        QSMESH_CHECK(r != rank || (i < mine.size() && mine[i].face == w.face &&
+                                   mine[i].piece == w.piece && mine[i].pass == w.pass),
+                     "improvement: task record " << w.face << "/" << w.piece << " out of order");
         work.push_back(w);
       }
     }
@@ -239,25 +281,55 @@ std::vector<Result> deal_round(const Comm& comm, const cad::CadModel& model,
     std::vector<char>().swap(buffer);  // the window holds the copy now
   }
 
-  // Largest first, so that the last tasks dealt out are short.
+  // Largest first, so that the last tasks dealt out are short; the second passes dealt as tasks
+  // of their own after all others, so that a thread that takes one after its first pass ended
+  // on this rank knows whether the face wants it.
   std::vector<std::size_t> order(work.size());
   std::iota(order.begin(), order.end(), std::size_t{0});
   std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
     const Work& x = work[a];
     const Work& y = work[b];
+    if ((x.pass == kSecondPass) != (y.pass == kSecondPass)) return y.pass == kSecondPass;
     if (x.quads != y.quads) return x.quads > y.quads;
-    return x.face != y.face ? x.face < y.face : x.piece < y.piece;
+    if (x.face != y.face) return x.face < y.face;
+    return x.piece != y.piece ? x.piece < y.piece : x.pass < y.pass;
   });
   const auto n = static_cast<std::int64_t>(work.size());
   std::vector<Result> results(work.size());
+  // Per task, once a first pass (kFirstPass) ended on this rank: 1 when its result asks for the
+  // second pass, 2 when not. A second pass whose first is known not to want it is skipped; one
+  // whose first ran elsewhere or has not ended runs (and may be dropped by the owner). Which
+  // runs depends on timing, the mesh does not: a skipped pass is never wanted.
+  std::vector<std::atomic<int>> first_ended(work.size());
+  // The memo of each first pass run on this rank whose result asks for the second, for the
+  // second where it starts after (the same result with less work).
+  std::vector<std::unique_ptr<qstruct::CavityMemo>> memos(work.size());
   DealProgress progress(stage, n, comm, log);
   deal_out(comm, n, tasks, [&](std::int64_t k) {
     const std::size_t w_at = order[static_cast<std::size_t>(k)];
     const Work& w = work[w_at];
+    // A second pass's first is the task before it (the same owner's).
+    qstruct::CavityMemo* memo = nullptr;
+    if (w.pass == kSecondPass && w_at > 0 && work[w_at - 1].pass == kFirstPass &&
+        work[w_at - 1].face == w.face) {
+      const int first = first_ended[w_at - 1].load(std::memory_order_acquire);
+      if (first == 2) {
+        results[w_at].done = true;
+        results[w_at].skipped = true;
+        progress.done();
+        return;
+      }
+      if (first == 1) memo = memos[w_at - 1].get();
+    }
+    std::unique_ptr<qstruct::CavityMemo> first_memo;
+    if (w.pass == kFirstPass) {
+      first_memo = std::make_unique<qstruct::CavityMemo>();
+      memo = first_memo.get();
+    }
     if (w.owner == rank) {
       Task& t = mine[w.local];
-      results[w_at] =
-          improve_one(model, w.face, std::move(t.input.mesh), t.input.singularities, settings, log);
+      results[w_at] = improve_one(model, w.face, std::move(t.input.mesh), t.input.singularities,
+                                  settings, log, w.pass, memo);
     } else {
       const std::vector<char> bytes = shared->read(w.owner, w.offset, w.length);
       std::size_t pos = 0;
@@ -266,8 +338,13 @@ std::vector<Result> deal_round(const Comm& comm, const cad::CadModel& model,
       QSMESH_CHECK(in.mesh.face == w.face, "improvement: rank " << w.owner << " sent face "
                                                                 << in.mesh.face << " for face "
                                                                 << w.face);
-      results[w_at] =
-          improve_one(model, w.face, std::move(in.mesh), in.singularities, settings, log);
+      results[w_at] = improve_one(model, w.face, std::move(in.mesh), in.singularities, settings,
+                                  log, w.pass, memo);
+    }
+    if (w.pass == kSecondPass && memo != nullptr) memos[w_at - 1].reset();
+    if (w.pass == kFirstPass) {
+      if (results[w_at].second_wanted) memos[w_at] = std::move(first_memo);
+      first_ended[w_at].store(results[w_at].second_wanted ? 1 : 2, std::memory_order_release);
     }
     progress.done();
   });
@@ -414,7 +491,10 @@ std::array<double, 3> improve_faces(const Comm& comm, const cad::CadModel& model
   // Round 1: the whole faces, and the pieces of the first cut of the faces above
   // settings.task_quads.
   std::vector<Task> round;
-  std::vector<std::array<std::size_t, 2>> whole;  // each whole face: index in `mine`, task
+  // Each whole face: index in `mine`, its task (or first pass), its second pass's task (npos:
+  // none of its own).
+  constexpr std::size_t kNone = std::numeric_limits<std::size_t>::max();
+  std::vector<std::array<std::size_t, 3>> whole;
   std::vector<Split> splits;
   for (std::size_t i = 0; i < mine.size(); ++i) {
     const ImproveFace& f = mine[i];
@@ -433,17 +513,52 @@ std::array<double, 3> improve_faces(const Comm& comm, const cad::CadModel& model
       splits.push_back(std::move(s));
       *f.seconds += clock.seconds();
     } else {
+      const bool two_tasks =
+          settings.second_pass_task_irregular > 0 && settings.second_pass_sicn_per_irregular > 0 &&
+          settings.cavities.time_budget_s <= 0 && !f.mesh->quads.empty() &&
+          f.mesh->triangles.empty() &&
+          (settings.second_pass_max_quads <= 0 || quads <= settings.second_pass_max_quads) &&
+          qstruct::count_irregular(*f.mesh) >= settings.second_pass_task_irregular;
       Task t;
       t.face = f.face;
+      t.pass = two_tasks ? kFirstPass : kBothPasses;
       t.input.mesh = std::move(*f.mesh);
       t.input.singularities.assign(f.singularities.begin(), f.singularities.end());
-      whole.push_back({i, round.size()});
-      round.push_back(std::move(t));
+      whole.push_back({i, round.size(), two_tasks ? round.size() + 1 : kNone});
+      if (two_tasks) {
+        Task second = t;
+        second.pass = kSecondPass;
+        round.push_back(std::move(t));
+        round.push_back(std::move(second));
+      } else {
+        round.push_back(std::move(t));
+      }
     }
   }
   std::vector<Result> results =
       deal_round(comm, model, round, settings, tasks, log, "improvement", steps);
-  for (const auto& [i, k] : whole) apply(std::move(results[k]), mine[i]);
+  for (const auto& [i, k, k2] : whole) {
+    if (k2 == kNone) {
+      apply(std::move(results[k]), mine[i]);
+      continue;
+    }
+    // The two passes' tasks: the second's result where the first's asks for it and it wins.
+    ImproveFace& f = mine[i];
+    const Stopwatch clock;  // the choice is part of the face's time
+    const double passes = results[k].seconds + results[k2].seconds;
+    if (f.pass_seconds != nullptr) {
+      f.pass_seconds->push_back(results[k].seconds);
+      f.pass_seconds->push_back(results[k2].seconds);
+    }
+    QSMESH_CHECK(!results[k].second_wanted || !results[k2].skipped,
+                 "improvement: face " << f.face << " wants the second pass it skipped");
+    Result r = results[k].second_wanted
+                   ? choose_pass(std::move(results[k]), std::move(results[k2]), settings)
+                   : std::move(results[k]);
+    r.seconds = passes;
+    apply(std::move(r), f);
+    *f.seconds += clock.seconds();
+  }
 
   // Round 2, where any face was cut: the merged faces cut again halfway between the first cuts
   // (bisect_quads shifted), so that the cavity and disk passes run across the first cuts and

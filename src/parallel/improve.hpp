@@ -54,6 +54,9 @@ struct ImproveFace {
   /// out (optional): the seconds of each piece task of a face cut into pieces (the first cut's
   /// pieces, then the second's; ImproveSettings::task_quads), appended.
   std::vector<double>* task_seconds = nullptr;
+  /// out (optional): the seconds of its first and second pass where they ran as two tasks
+  /// (ImproveSettings::second_pass_task_irregular), appended.
+  std::vector<double>* pass_seconds = nullptr;
 };
 
 /// What the steps take.
@@ -77,6 +80,17 @@ struct ImproveSettings {
   double second_pass_sicn_sum_per_irregular = 0;
   std::int64_t second_pass_min_unnecessary = 2;
   std::int64_t second_pass_max_quads = 0;  ///< 0: no bound
+  /// A whole face whose unstructured mesh has at least this many interior irregular vertices
+  /// gets its second pass as a task of its own, dealt beside its first pass (0: never; issue
+  /// 28): a face's cavity remeshing costs with its irregular vertices, not its quads, and the
+  /// two passes in a row were the longest task of the stage (A319 at 16x: face 18, 2949 quads,
+  /// 3.2 s). The second pass starts from the same input either way and the memo the first
+  /// pass leaves it only spares work (qstruct::CavityMemo), so the mesh is the same. The second
+  /// passes are dealt after every other task: one whose first pass ended on the same rank
+  /// without asking for it (second_pass_applies) is skipped; else it runs, and the owner drops
+  /// it where the first's result does not ask for it. Not with a time budget (the first pass's
+  /// may stop it).
+  std::int64_t second_pass_task_irregular = 0;
 };
 
 /// Per face, in order: cavity remeshing (Sec. 6.2), disk remeshing of the defects (Sec. 6.3), the

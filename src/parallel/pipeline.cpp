@@ -682,6 +682,7 @@ std::array<double, 3> improvement_stage(const Context& cx, std::vector<FaceTask>
     f.report = &t.quasi.improvement;
     f.seconds = &t.seconds;
     f.task_seconds = &t.times.improvement_tasks;
+    f.pass_seconds = &t.times.improvement_passes;
     to_improve.push_back(f);
   }
   const remesh::DiskQuadTable table = remesh::DiskQuadTable::builtin();
@@ -698,6 +699,7 @@ std::array<double, 3> improvement_stage(const Context& cx, std::vector<FaceTask>
   settings.second_pass_sicn_sum_per_irregular = cx.options.second_pass_sicn_sum_per_irregular;
   settings.second_pass_min_unnecessary = cx.options.second_pass_min_unnecessary;
   settings.second_pass_max_quads = cx.options.second_pass_max_quads;
+  settings.second_pass_task_irregular = cx.options.second_pass_task_irregular;
   const std::array<double, 3> steps =
       improve_faces(cx.comm, cx.model, to_improve, settings, cx.tasks, cx.log);
   for (std::size_t i = 0; i < faces.size(); ++i)

@@ -273,5 +273,21 @@ TEST(FacePolicy, SecondPassKeptOnlyWhenItsIrregularVerticesAreCheap) {
   EXPECT_FALSE(second_pass_wins(first, stats(600, 2, 0.62, 0.95), 0, sum, good, keep));
 }
 
+TEST(FacePolicy, SecondPassRunsOnlyWhereTheFirstLeftUnnecessaryIrregularVertices) {
+  mesh::FaceQuadStats first;
+  first.quads = 3000;
+  first.irregular_interior = 5;
+  // 5 irregular, 3 of them asked for by singularities: 2 unnecessary, enough at min 2, not at 3.
+  EXPECT_TRUE(second_pass_applies(first, 3, false, 2, 4000));
+  EXPECT_FALSE(second_pass_applies(first, 4, false, 2, 4000));
+  EXPECT_FALSE(second_pass_applies(first, 3, false, 3, 4000));
+  // The quad bound: the first pass's count, inclusive; 0 is no bound.
+  EXPECT_TRUE(second_pass_applies(first, 0, false, 2, 3000));
+  EXPECT_FALSE(second_pass_applies(first, 0, false, 2, 2999));
+  EXPECT_TRUE(second_pass_applies(first, 0, false, 2, 0));
+  // A first pass stopped by its time budget: never.
+  EXPECT_FALSE(second_pass_applies(first, 0, true, 2, 0));
+}
+
 }  // namespace
 }  // namespace qsmesh::parallel

@@ -102,5 +102,41 @@ TEST(SubFace, SeamAndPolesInPieces) {
   EXPECT_GT(dist.face_stats[0].sicn_min, 0);
 }
 
+// A face's second improvement pass dealt as a task of its own, beside its first
+// (PipelineOptions::second_pass_task_irregular): the same mesh as the two passes in a row, at
+// every rank count. The plate coarse enough (a few thousand quads) for its second pass.
+TEST(SubFace, SecondPassAsATaskGivesTheSameMesh) {
+  const Comm comm = Comm::world();
+  const std::string path = tmp("second_pass_plate_np" + std::to_string(comm.size()) + ".brep");
+  if (comm.rank() == 0) test::write_long_plate(100, 20, path);
+  comm.barrier();
+  const cad::CadModel model = cad::load_cad(path);
+  std::ostringstream sink;
+  Logger log(sink, LogLevel::Quiet);
+  PipelineOptions options = plate_options(0);
+  options.background.sizes.size = 1.0;
+  options.sizemap.size_max = 1.0;
+  options.second_pass_task_irregular = 1;
+  const PipelineResult dist = run_pipeline(comm, model, options, TaskArena(2), log);
+  if (comm.rank() != 0) return;
+  options.second_pass_task_irregular = 0;
+  const PipelineResult in_a_row = run_pipeline(Comm::self(), model, options, TaskArena(1), log);
+  ASSERT_EQ(dist.face_times.size(), 1U);
+  const std::int64_t quads = dist.face_times[0].improvement_quads;
+  ASSERT_GT(quads, 0);
+  ASSERT_LE(quads, options.second_pass_max_quads);
+  EXPECT_EQ(dist.face_times[0].improvement_passes.size(), 2U);
+  EXPECT_TRUE(in_a_row.face_times[0].improvement_passes.empty());
+  EXPECT_EQ(dist.mesh.points, in_a_row.mesh.points);
+  EXPECT_EQ(dist.mesh.quads, in_a_row.mesh.quads);
+  // The plate keeps its second pass (1981 quads, 29 interior irregular vertices after it): the
+  // choice between the two tasks is exercised, not only the drop.
+  EXPECT_TRUE(dist.quasi_reports[0].improvement.second_pass_kept);
+  EXPECT_TRUE(in_a_row.quasi_reports[0].improvement.second_pass_kept);
+  std::cout << "plate: " << quads << " quads, interior irregular "
+            << dist.face_stats[0].irregular_interior << ", second pass kept "
+            << dist.quasi_reports[0].improvement.second_pass_kept << "\n";
+}
+
 }  // namespace
 }  // namespace qsmesh::parallel

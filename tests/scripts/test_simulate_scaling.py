@@ -179,6 +179,24 @@ class Pieces(unittest.TestCase):
         # Unlimited ranks: background 1 + improvement 2 + 1 + 1.
         self.assertAlmostEqual(s.bound(), 5.0, places=6)
 
+    def test_two_passes_are_two_tasks_of_the_first_round(self):
+        # Face 0 (3000 quads): its passes as two tasks of 3 s and 2 s, 0.5 s of choosing on its
+        # owner (5.5 - 5); face 1 (500 quads) whole, 1 s.
+        st = stats([(1, 0, 0, 5.5, 1, 3000), (1, 0, 0, 1, 1, 500)],
+                   {"background": 2.0, "improvement": 6.5})
+        st["face_stats"][0]["stage_seconds"]["improvement_passes"] = [3, 2]
+        s = sim.Simulator(sim.Run(st), comm=NO_COMM)
+        # Two workers: the first pass (3) | face 1 (1) then the second pass (2, dealt last) -> 3,
+        # then 0.5 on the owner.
+        self.assertAlmostEqual(s.predict(2, 1)["improvement"], 3.5, places=6)
+        # Three workers: 3 | 1 | 2.
+        self.assertAlmostEqual(s.predict(3, 1)["improvement"], 3.5, places=6)
+        self.assertAlmostEqual(s.predict(1, 1)["improvement"], 6.5, places=6)
+        big = s.largest_faces()
+        self.assertAlmostEqual(big["improvement task"][1], 3.0)
+        # Unlimited ranks: background 1 + improvement 3 + 0.5.
+        self.assertAlmostEqual(s.bound(), 4.5, places=6)
+
 
 class Curves(unittest.TestCase):
     def test_curves_split_by_curve(self):

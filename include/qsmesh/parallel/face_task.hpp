@@ -107,6 +107,16 @@ struct ImprovementReport {
                                     const mesh::FaceQuadStats& second, double avg_per_irregular,
                                     double sum_per_irregular, double good_sicn, double keep_ratio);
 
+/// Whether a face's second pass of the topological improvement runs after its first
+/// (PipelineOptions::second_pass_cavities): the first pass's result (`first`) still has at least
+/// `min_unnecessary` interior irregular vertices beyond the `flagged_kept` that singularities ask
+/// for, at most `max_quads` quads (0: no bound), and the first pass did not stop at its time
+/// budget. Decided on the first pass's result alone, so the second pass may run beside it as its
+/// own task and be dropped when this says no (issue 28). Serial, pure.
+[[nodiscard]] bool second_pass_applies(const mesh::FaceQuadStats& first, std::int64_t flagged_kept,
+                                       bool time_budget_hit, std::int64_t min_unnecessary,
+                                       std::int64_t max_quads);
+
 /// How the quasi-structured stage treated one face. Its fields are declared once, in fields(), the
 /// countable ones named by their total over the faces in the drivers' --stats (as
 /// ImprovementReport).
@@ -225,6 +235,11 @@ struct FaceTimes {
   /// first cut's pieces (dealt with the whole faces) then the second cut's (dealt after them).
   /// Their sum and the cutting and merging make `improvement`. Empty: one task.
   std::vector<double> improvement_tasks;
+  /// A whole face whose two improvement passes were dealt as two tasks at once (ImproveSettings::
+  /// second_pass_task_irregular): the seconds of its first pass, then of its second (0 where it
+  /// was skipped: its first, ended before on the same rank, did not ask for it). Their sum and
+  /// the choice between them make `improvement`. Empty: one task.
+  std::vector<double> improvement_passes;
   /// The pattern fill's move search (qstruct::PatternFaceReport: layouts, batches,
   /// search_seconds): the part of `patterns` that its batches split over the threads.
   std::int64_t pattern_layouts = 0;
@@ -245,6 +260,7 @@ struct FaceTimes {
     visit("improvement_quads", self.improvement_quads);
     visit("bytes", self.bytes);
     visit("improvement_tasks", self.improvement_tasks);
+    visit("improvement_passes", self.improvement_passes);
     visit("pattern_layouts", self.pattern_layouts);
     visit("pattern_batches", self.pattern_batches);
     visit("pattern_search", self.pattern_search);

@@ -46,6 +46,13 @@ enum class Stage { Background, Unstructured, QuasiStructured };
 /// (docs/benchmarks.md, issue 28).
 inline constexpr std::int64_t kDefaultTaskQuads = 20000;
 
+/// Default PipelineOptions::second_pass_task_irregular. On A319 at 16 times its reference vertex
+/// count it splits the three faces whose improvement takes over 0.9 s (25-41 irregular vertices
+/// before it) and none of the nine others of at most second_pass_max_quads quads (at most 10
+/// each); it costs one rank no measurable time, the second pass taking the first's memo there
+/// (docs/benchmarks.md, issue 28, branch `scale7`). The mesh does not depend on it.
+inline constexpr std::int64_t kDefaultSecondPassTaskIrregular = 16;
+
 /// The cavity options of the second pass (PipelineOptions::second_pass_cavities): the defaults
 /// with keep_avg_ratio 0.94 (0.97), max_candidates 4 (2) and max_backtracks 16 (8). Each alone,
 /// for every face, on wing_fuselage's window (eight factors 0.0058-0.0063) left 3, 7 and 3 of the
@@ -157,6 +164,11 @@ struct PipelineOptions {
   /// in pieces, each a task of its own (ImproveSettings::task_quads; 0: never). A fixed count,
   /// not a share of the ranks' work, so that the mesh does not depend on the rank count.
   std::int64_t task_quads = kDefaultTaskQuads;
+  /// Stage::QuasiStructured: a whole face of at most second_pass_max_quads quads whose
+  /// unstructured mesh has at least this many interior irregular vertices has its second pass
+  /// dealt as a task of its own, beside its first (ImproveSettings::second_pass_task_irregular;
+  /// 0: never). The mesh is the same either way.
+  std::int64_t second_pass_task_irregular = kDefaultSecondPassTaskIrregular;
   /// Quad stages: the per-face method (`--method`). Holomorphic and Auto also mesh each face whose
   /// background triangulation is a topological annulus from its holomorphic 1-form (paper 004,
   /// holomorphic::mesh_annulus) and choose between that and the default mesh with
