@@ -17,6 +17,7 @@
 #include "qsmesh/qstruct/cavity.hpp"
 #include "qsmesh/remesh/disk_remesh.hpp"
 #include "qsmesh/smooth/smooth.hpp"
+#include "qsmesh/smooth/untangle.hpp"
 
 namespace qsmesh::parallel {
 
@@ -134,7 +135,10 @@ Result improve_pass(LO face, mesh::FaceMesh mesh, const cad::FaceGeometry* surfa
   });
   if (settings.final_smoothing)
     step(2, "final smoothing", [&](const cad::FaceGeometry& s) {
-      return smooth::smooth_face(mesh, s, settings.final_smooth);
+      mesh::FaceMesh out = smooth::smooth_face(mesh, s, settings.final_smooth);
+      // The smoother keeps the quads that split a curve vertex's angle very unevenly (issue 29).
+      if (settings.lift.target > 0) out = smooth::lift_poor_quads(out, s, settings.lift);
+      return out;
     });
   r.mesh = std::move(mesh);
   return r;

@@ -336,4 +336,108 @@ mesh::FaceMesh untangle_face(const mesh::FaceMesh& input, const cad::FaceGeometr
   return m;
 }
 
+mesh::FaceMesh lift_poor_quads(const mesh::FaceMesh& input, const cad::FaceGeometry& surface,
+                               const LiftOptions& options, LiftStats* stats) {
+  QSMESH_CHECK(options.rings >= 1, "lift_poor_quads: rings must be >= 1");
+  LiftStats st;
+  st.before = measure(input);
+  st.after = st.before;
+  mesh::FaceMesh m = input;
+  const LO nv = m.num_vertices();
+  const auto nq = static_cast<LO>(m.quads.size());
+  if (nq == 0 || !(options.target > 0) || !(st.before.sicn_min < options.target)) {
+    if (stats) *stats = st;
+    return m;
+  }
+  const std::vector<std::vector<LO>> v2q = detail::vertex_quads(m);
+  std::vector<char> movable(static_cast<std::size_t>(nv), 0);
+  for (LO v = 0; v < nv; ++v) movable[v] = m.vclass[v].dim == 2 ? 1 : 0;
+  for (const auto& t : m.triangles)
+    for (const LO v : t) movable[v] = 0;
+  const auto sicn = [&](LO q) {
+    const auto& qd = m.quads[q];
+    return mesh::quad_sicn({m.points[qd[0]], m.points[qd[1]], m.points[qd[2]], m.points[qd[3]]});
+  };
+
+  std::vector<char> in_patch(static_cast<std::size_t>(nq), 0), seen(static_cast<std::size_t>(nv), 0);
+  std::vector<LO> local(static_cast<std::size_t>(nv), kNoIndex);
+  for (LO seed = 0; seed < nq; ++seed) {
+    if (!(sicn(seed) < options.target)) continue;
+    ++st.seeds;
+    // The patch: the seed grown ring by ring through the vertices' quads.
+    std::vector<LO> quads{seed}, verts;
+    in_patch[seed] = 1;
+    std::vector<LO> front(m.quads[seed].begin(), m.quads[seed].end());
+    for (const LO v : front) seen[v] = 1;
+    verts = front;
+    for (int r = 0; r < options.rings; ++r) {
+      std::vector<LO> next;
+      for (const LO v : front)
+        for (const LO q : v2q[v]) {
+          if (in_patch[q]) continue;
+          in_patch[q] = 1;
+          quads.push_back(q);
+          for (const LO w : m.quads[q])
+            if (!seen[w]) {
+              seen[w] = 1;
+              next.push_back(w);
+              verts.push_back(w);
+            }
+        }
+      front = std::move(next);
+    }
+    std::sort(quads.begin(), quads.end());
+    std::sort(verts.begin(), verts.end());
+    // The patch as a mesh of its own: a vertex with a quad outside stays, held by a degenerate
+    // triangle (untangle_face never moves triangle vertices).
+    mesh::FaceMesh sub;
+    sub.face = m.face;
+    for (const LO v : verts) {
+      local[v] = sub.num_vertices();
+      sub.points.push_back(m.points[v]);
+      sub.uv.push_back(m.uv[v]);
+      sub.vclass.push_back(m.vclass[v]);
+    }
+    for (const LO q : quads) {
+      std::array<LO, 4> lq{};
+      for (int k = 0; k < 4; ++k) lq[k] = local[m.quads[q][k]];
+      sub.quads.push_back(lq);
+    }
+    std::vector<LO> moving;
+    for (const LO v : verts) {
+      bool inside = movable[v] != 0;
+      for (const LO q : v2q[v]) inside = inside && in_patch[q];
+      if (inside)
+        moving.push_back(v);
+      else
+        sub.triangles.push_back({local[v], local[v], local[v]});
+    }
+    for (const LO q : quads) in_patch[q] = 0;
+    for (const LO v : verts) seen[v] = 0;
+    if (moving.empty()) {
+      for (const LO v : verts) local[v] = kNoIndex;
+      continue;
+    }
+    UntangleOptions uo;
+    uo.target = options.target;
+    uo.rings = 2 * options.rings + 2;  // the whole patch at once
+    uo.max_rings = uo.rings;
+    UntangleStats us;
+    const mesh::FaceMesh out = untangle_face(sub, surface, uo, &us);
+    if (!us.rolled_back) {
+      ++st.lifted;
+      for (const LO v : moving) {
+        const LO l = local[v];
+        m.points[v] = out.points[l];
+        m.uv[v] = out.uv[l];
+        m.vclass[v].param = out.vclass[l].param;
+      }
+    }
+    for (const LO v : verts) local[v] = kNoIndex;
+  }
+  st.after = measure(m);
+  if (stats) *stats = st;
+  return m;
+}
+
 }  // namespace qsmesh::smooth

@@ -69,4 +69,38 @@ struct UntangleStats {
                                            const UntangleOptions& options,
                                            UntangleStats* stats = nullptr);
 
+struct LiftOptions {
+  /// Quads whose SICN is below this seed a lift (0: none).
+  double target = 0.1;
+  /// The quads within this many rings (vertex adjacency) of a seed form its patch; the free
+  /// vertices all of whose quads lie in the patch move, the others stay.
+  int rings = 3;
+};
+
+struct LiftStats {
+  QualityReport before, after;
+  std::int64_t seeds = 0;   ///< patches tried (seed quads still below the target when reached)
+  std::int64_t lifted = 0;  ///< patches kept
+};
+
+/// Lifts the poor quads of one face mesh (SICN below options.target) one patch at a time, each
+/// kept on its own: the shape the smoother leaves is a quad with one angle near 180 degrees at a
+/// curve vertex whose face angle it splits very unevenly with its neighbour (a 225-degree hole arc
+/// vertex held as 179 / 46), and its opposite corner near 0. The smoothing kernels move the
+/// interior vertex towards the middle of its neighbours and never look at the angle at the curve;
+/// the untangler's max-min search does, but it judges a whole face by its minimum, so one quad the
+/// CAD forces (a cusp) would make it refuse every other lift of the face.
+///
+/// Takes and returns a FaceMesh as untangle_face does (same topology; dim < 2 vertices and
+/// triangle vertices bit-identical). For each quad in order still below the target: its patch (the
+/// quads within options.rings rings) is untangled alone (untangle_face with the target, the
+/// patch's outer vertices fixed) and kept when the patch's minimum SICN rose and it has no more
+/// invalid quads; the quads outside the patch do not change. Every kept patch raises the
+/// minimum of the quads it touches, so the face's minimum never drops.
+/// Deterministic: fixed order, no threads.
+[[nodiscard]] mesh::FaceMesh lift_poor_quads(const mesh::FaceMesh& mesh,
+                                             const cad::FaceGeometry& surface,
+                                             const LiftOptions& options,
+                                             LiftStats* stats = nullptr);
+
 }  // namespace qsmesh::smooth
