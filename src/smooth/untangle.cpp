@@ -359,7 +359,8 @@ mesh::FaceMesh lift_poor_quads(const mesh::FaceMesh& input, const cad::FaceGeome
     return mesh::quad_sicn({m.points[qd[0]], m.points[qd[1]], m.points[qd[2]], m.points[qd[3]]});
   };
 
-  std::vector<char> in_patch(static_cast<std::size_t>(nq), 0), seen(static_cast<std::size_t>(nv), 0);
+  std::vector<char> in_patch(static_cast<std::size_t>(nq), 0),
+      seen(static_cast<std::size_t>(nv), 0);
   std::vector<LO> local(static_cast<std::size_t>(nv), kNoIndex);
   for (LO seed = 0; seed < nq; ++seed) {
     if (!(sicn(seed) < options.target)) continue;
@@ -398,19 +399,29 @@ mesh::FaceMesh lift_poor_quads(const mesh::FaceMesh& input, const cad::FaceGeome
       sub.uv.push_back(m.uv[v]);
       sub.vclass.push_back(m.vclass[v]);
     }
-    for (const LO q : quads) {
-      std::array<LO, 4> lq{};
-      for (int k = 0; k < 4; ++k) lq[k] = local[m.quads[q][k]];
-      sub.quads.push_back(lq);
-    }
     std::vector<LO> moving;
-    for (const LO v : verts) {
+    std::vector<char> moves(verts.size(), 0);
+    for (std::size_t i = 0; i < verts.size(); ++i) {
+      const LO v = verts[i];
       bool inside = movable[v] != 0;
       for (const LO q : v2q[v]) inside = inside && in_patch[q];
-      if (inside)
+      if (inside) {
         moving.push_back(v);
-      else
+        moves[i] = 1;
+      } else {
         sub.triangles.push_back({local[v], local[v], local[v]});
+      }
+    }
+    // Only the quads that can change are measured: a poor quad of fixed vertices (a cusp's, or
+    // one held between curves) must not make the patch's minimum unreachable.
+    for (const LO q : quads) {
+      std::array<LO, 4> lq{};
+      bool changes = false;
+      for (int k = 0; k < 4; ++k) {
+        lq[k] = local[m.quads[q][k]];
+        changes = changes || moves[static_cast<std::size_t>(lq[k])] != 0;
+      }
+      if (changes) sub.quads.push_back(lq);
     }
     for (const LO q : quads) in_patch[q] = 0;
     for (const LO v : verts) seen[v] = 0;
