@@ -281,10 +281,10 @@ mesh::FaceMesh untangle_face(const mesh::FaceMesh& input, const cad::FaceGeometr
     int valid_sweeps = 0;
     double last_worst = -std::numeric_limits<double>::infinity();
     std::vector<LO> pq;  // quads of the patch
-    {
-      for (const LO v : patch) pq.insert(pq.end(), v2q[v].begin(), v2q[v].end());
-      std::sort(pq.begin(), pq.end());
-      pq.erase(std::unique(pq.begin(), pq.end()), pq.end());
+    for (const LO v : patch) pq.insert(pq.end(), v2q[v].begin(), v2q[v].end());
+    std::sort(pq.begin(), pq.end());
+    pq.erase(std::unique(pq.begin(), pq.end()), pq.end());
+    if (options.laplacian_start) {
       const auto worst = [&] {
         double w = std::numeric_limits<double>::infinity();
         for (const LO q : pq) w = std::min(w, un.quad_quality(q));
@@ -338,7 +338,8 @@ mesh::FaceMesh untangle_face(const mesh::FaceMesh& input, const cad::FaceGeometr
 
 mesh::FaceMesh lift_poor_quads(const mesh::FaceMesh& input, const cad::FaceGeometry& surface,
                                const LiftOptions& options, LiftStats* stats) {
-  QSMESH_CHECK(options.rings >= 1, "lift_poor_quads: rings must be >= 1");
+  QSMESH_CHECK(options.rings >= 1 && options.max_rings >= options.rings,
+               "lift_poor_quads: rings must be >= 1 and max_rings >= rings");
   LiftStats st;
   st.before = measure(input);
   st.after = st.before;
@@ -362,16 +363,16 @@ mesh::FaceMesh lift_poor_quads(const mesh::FaceMesh& input, const cad::FaceGeome
   std::vector<char> in_patch(static_cast<std::size_t>(nq), 0),
       seen(static_cast<std::size_t>(nv), 0);
   std::vector<LO> local(static_cast<std::size_t>(nv), kNoIndex);
-  for (LO seed = 0; seed < nq; ++seed) {
-    if (!(sicn(seed) < options.target)) continue;
-    ++st.seeds;
+  // One patch of `rings` rings around `seed`; true when it was kept and reached the target.
+  const auto lift = [&](LO seed, int rings) {
+    bool kept = false;
     // The patch: the seed grown ring by ring through the vertices' quads.
     std::vector<LO> quads{seed}, verts;
     in_patch[seed] = 1;
     std::vector<LO> front(m.quads[seed].begin(), m.quads[seed].end());
     for (const LO v : front) seen[v] = 1;
     verts = front;
-    for (int r = 0; r < options.rings; ++r) {
+    for (int r = 0; r < rings; ++r) {
       std::vector<LO> next;
       for (const LO v : front)
         for (const LO q : v2q[v]) {
@@ -427,16 +428,24 @@ mesh::FaceMesh lift_poor_quads(const mesh::FaceMesh& input, const cad::FaceGeome
     for (const LO v : verts) seen[v] = 0;
     if (moving.empty()) {
       for (const LO v : verts) local[v] = kNoIndex;
-      continue;
+      return false;
     }
     UntangleOptions uo;
     uo.target = options.target;
-    uo.rings = 2 * options.rings + 2;  // the whole patch at once
+    uo.rings = 2 * rings + 2;  // the whole patch at once
     uo.max_rings = uo.rings;
+    uo.polish_sweeps = options.polish_sweeps;
+    uo.laplacian_start = options.laplacian_start;
     UntangleStats us;
     const mesh::FaceMesh out = untangle_face(sub, surface, uo, &us);
-    if (!us.rolled_back) {
+    // A lift that leaves the patch below the target is worth keeping only when it costs the
+    // patch nothing on average: a quad held by a short curve edge (a sliver's) rises by a few
+    // thousandths while the search reshapes its neighbours for them.
+    const bool reached = us.after.sicn_min >= options.target;
+    const bool free_gain = us.after.sicn_avg >= us.before.sicn_avg || !options.partial_only_free;
+    if (!us.rolled_back && (reached || free_gain)) {
       ++st.lifted;
+      kept = true;
       for (const LO v : moving) {
         const LO l = local[v];
         m.points[v] = out.points[l];
@@ -445,6 +454,14 @@ mesh::FaceMesh lift_poor_quads(const mesh::FaceMesh& input, const cad::FaceGeome
       }
     }
     for (const LO v : verts) local[v] = kNoIndex;
+    return reached && kept;
+  };
+  for (LO seed = 0; seed < nq; ++seed) {
+    if (!(sicn(seed) < options.target)) continue;
+    ++st.seeds;
+    // A larger patch only where the smaller one could not reach the target: more room, more cost.
+    for (int rings = options.rings; rings <= options.max_rings; rings += options.rings)
+      if (lift(seed, rings)) break;
   }
   st.after = measure(m);
   if (stats) *stats = st;

@@ -24,6 +24,9 @@ struct UntangleOptions {
   int sweeps = 60;
   /// Sweeps done after every quad of the patch is above `target` (lifting its minimum further).
   int polish_sweeps = 5;
+  /// Start each patch from its tangent-plane Laplacian (step 1 below), kept when the patch's worst
+  /// quad gets better.
+  bool laplacian_start = true;
   /// Wall-clock bound on the whole call (0: none). When it stops a run early the result depends
   /// on timing; leave 0 where reproducibility matters (the iteration bounds always apply).
   double time_budget_s = 0;
@@ -75,6 +78,14 @@ struct LiftOptions {
   /// The quads within this many rings (vertex adjacency) of a seed form its patch; the free
   /// vertices all of whose quads lie in the patch move, the others stay.
   int rings = 3;
+  /// A patch that does not reach the target is tried again with `rings` more rings, up to this.
+  int max_rings = 6;
+  /// UntangleOptions::polish_sweeps and laplacian_start of each patch.
+  int polish_sweeps = 0;
+  bool laplacian_start = true;
+  /// A patch whose minimum rose but stays below the target is kept only when its mean SICN did
+  /// not drop (false: kept whenever its minimum rose).
+  bool partial_only_free = true;
 };
 
 struct LiftStats {
