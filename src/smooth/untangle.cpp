@@ -363,9 +363,8 @@ mesh::FaceMesh lift_poor_quads(const mesh::FaceMesh& input, const cad::FaceGeome
   std::vector<char> in_patch(static_cast<std::size_t>(nq), 0),
       seen(static_cast<std::size_t>(nv), 0);
   std::vector<LO> local(static_cast<std::size_t>(nv), kNoIndex);
-  // One patch of `rings` rings around `seed`; true when it was kept and reached the target.
+  // One patch of `rings` rings around `seed`; true when no larger patch is worth trying.
   const auto lift = [&](LO seed, int rings) {
-    bool kept = false;
     // The patch: the seed grown ring by ring through the vertices' quads.
     std::vector<LO> quads{seed}, verts;
     in_patch[seed] = 1;
@@ -445,7 +444,6 @@ mesh::FaceMesh lift_poor_quads(const mesh::FaceMesh& input, const cad::FaceGeome
     const bool free_gain = us.after.sicn_avg >= us.before.sicn_avg || !options.partial_only_free;
     if (!us.rolled_back && (reached || free_gain)) {
       ++st.lifted;
-      kept = true;
       for (const LO v : moving) {
         const LO l = local[v];
         m.points[v] = out.points[l];
@@ -454,12 +452,16 @@ mesh::FaceMesh lift_poor_quads(const mesh::FaceMesh& input, const cad::FaceGeome
       }
     }
     for (const LO v : verts) local[v] = kNoIndex;
-    return reached && kept;
+    // Worth a larger patch only when this one got a tenth of the way: one that barely moves is
+    // held by its fixed vertices (a sliver's short curve edge), not short of room.
+    const double before = us.before.sicn_min;
+    return reached || us.after.sicn_min - before < 0.1 * (options.target - before);
   };
   for (LO seed = 0; seed < nq; ++seed) {
     if (!(sicn(seed) < options.target)) continue;
     ++st.seeds;
-    // A larger patch only where the smaller one could not reach the target: more room, more cost.
+    // A larger patch only where the smaller one made some way toward the target: more room, more
+    // cost.
     for (int rings = options.rings; rings <= options.max_rings; rings += options.rings)
       if (lift(seed, rings)) break;
   }
