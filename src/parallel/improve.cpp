@@ -18,6 +18,7 @@
 #include "qsmesh/qstruct/cavity.hpp"
 #include "qsmesh/remesh/disk_remesh.hpp"
 #include "qsmesh/smooth/smooth.hpp"
+#include "qsmesh/smooth/untangle.hpp"
 
 namespace qsmesh::parallel {
 
@@ -149,7 +150,22 @@ Result improve_pass(LO face, mesh::FaceMesh mesh, const cad::FaceGeometry* surfa
   });
   if (settings.final_smoothing)
     step(2, "final smoothing", [&](const cad::FaceGeometry& s) {
-      return smooth::smooth_face(mesh, s, settings.final_smooth);
+      mesh::FaceMesh out = smooth::smooth_face(mesh, s, settings.final_smooth);
+      // The smoother keeps the quads that split a curve vertex's angle very unevenly (issue 29).
+      // The lift judges a patch by its minimum; the kernels after it (each move kept only when
+      // the minimum of its quads does not drop, so they cannot undo it) give back most of the
+      // mean it cost. Not the uv Laplacian: a global step, it would put the lifted vertices back
+      // wherever the face's minimum is elsewhere.
+      if (settings.lift.target > 0) {
+        smooth::LiftStats ls;
+        out = smooth::lift_poor_quads(out, s, settings.lift, &ls);
+        if (ls.lifted > 0) {
+          smooth::SmoothOptions kernels = settings.final_smooth;
+          kernels.laplacian_uv = false;
+          out = smooth::smooth_face(out, s, kernels);
+        }
+      }
+      return out;
     });
   r.mesh = std::move(mesh);
   return r;

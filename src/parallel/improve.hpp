@@ -17,6 +17,7 @@
 #include "qsmesh/parallel/pipeline.hpp"
 #include "qsmesh/qstruct/patterns.hpp"
 #include "qsmesh/remesh/disk_table.hpp"
+#include "qsmesh/smooth/untangle.hpp"
 
 namespace qsmesh::parallel {
 
@@ -67,6 +68,8 @@ struct ImproveSettings {
   remesh::DiskRemeshOptions disk;
   bool final_smoothing = true;
   smooth::SmoothOptions final_smooth;
+  /// After the final smoothing (when on): PipelineOptions::lift.
+  smooth::LiftOptions lift;
   /// A face of more quads than this is improved in pieces (0: never; issue 28): cut into k =
   /// ceil(quads / task_quads) pieces by mesh::bisect_quads, each piece a task with its cut
   /// vertices fixed, merged, then cut again halfway between the first cuts (k + 1 pieces, the

@@ -693,6 +693,7 @@ std::array<double, 3> improvement_stage(const Context& cx, std::vector<FaceTask>
   settings.disk = cx.options.disk;
   settings.final_smoothing = cx.options.final_smoothing;
   settings.final_smooth = cx.options.final_smooth;
+  settings.lift = cx.options.lift;
   settings.task_quads = cx.options.task_quads;
   settings.second_pass_cavities = cx.options.second_pass_cavities;
   settings.second_pass_sicn_per_irregular = cx.options.second_pass_sicn_per_irregular;

@@ -281,10 +281,10 @@ mesh::FaceMesh untangle_face(const mesh::FaceMesh& input, const cad::FaceGeometr
     int valid_sweeps = 0;
     double last_worst = -std::numeric_limits<double>::infinity();
     std::vector<LO> pq;  // quads of the patch
-    {
-      for (const LO v : patch) pq.insert(pq.end(), v2q[v].begin(), v2q[v].end());
-      std::sort(pq.begin(), pq.end());
-      pq.erase(std::unique(pq.begin(), pq.end()), pq.end());
+    for (const LO v : patch) pq.insert(pq.end(), v2q[v].begin(), v2q[v].end());
+    std::sort(pq.begin(), pq.end());
+    pq.erase(std::unique(pq.begin(), pq.end()), pq.end());
+    if (options.laplacian_start) {
       const auto worst = [&] {
         double w = std::numeric_limits<double>::infinity();
         for (const LO q : pq) w = std::min(w, un.quad_quality(q));
@@ -332,6 +332,140 @@ mesh::FaceMesh untangle_face(const mesh::FaceMesh& input, const cad::FaceGeometr
 
   detail::sync_interior_params(m);
   st.rolled_back = detail::keep_or_roll_back(m, input, st.before, detail::Accept::kGain, st.after);
+  if (stats) *stats = st;
+  return m;
+}
+
+mesh::FaceMesh lift_poor_quads(const mesh::FaceMesh& input, const cad::FaceGeometry& surface,
+                               const LiftOptions& options, LiftStats* stats) {
+  QSMESH_CHECK(options.rings >= 1 && options.max_rings >= options.rings,
+               "lift_poor_quads: rings must be >= 1 and max_rings >= rings");
+  LiftStats st;
+  st.before = measure(input);
+  st.after = st.before;
+  mesh::FaceMesh m = input;
+  const LO nv = m.num_vertices();
+  const auto nq = static_cast<LO>(m.quads.size());
+  if (nq == 0 || !(options.target > 0) || !(st.before.sicn_min < options.target)) {
+    if (stats) *stats = st;
+    return m;
+  }
+  const std::vector<std::vector<LO>> v2q = detail::vertex_quads(m);
+  std::vector<char> movable(static_cast<std::size_t>(nv), 0);
+  for (LO v = 0; v < nv; ++v) movable[v] = m.vclass[v].dim == 2 ? 1 : 0;
+  for (const auto& t : m.triangles)
+    for (const LO v : t) movable[v] = 0;
+  const auto sicn = [&](LO q) {
+    const auto& qd = m.quads[q];
+    return mesh::quad_sicn({m.points[qd[0]], m.points[qd[1]], m.points[qd[2]], m.points[qd[3]]});
+  };
+
+  std::vector<char> in_patch(static_cast<std::size_t>(nq), 0),
+      seen(static_cast<std::size_t>(nv), 0);
+  std::vector<LO> local(static_cast<std::size_t>(nv), kNoIndex);
+  // One patch of `rings` rings around `seed`; true when no larger patch is worth trying.
+  const auto lift = [&](LO seed, int rings) {
+    // The patch: the seed grown ring by ring through the vertices' quads.
+    std::vector<LO> quads{seed}, verts;
+    in_patch[seed] = 1;
+    std::vector<LO> front(m.quads[seed].begin(), m.quads[seed].end());
+    for (const LO v : front) seen[v] = 1;
+    verts = front;
+    for (int r = 0; r < rings; ++r) {
+      std::vector<LO> next;
+      for (const LO v : front)
+        for (const LO q : v2q[v]) {
+          if (in_patch[q]) continue;
+          in_patch[q] = 1;
+          quads.push_back(q);
+          for (const LO w : m.quads[q])
+            if (!seen[w]) {
+              seen[w] = 1;
+              next.push_back(w);
+              verts.push_back(w);
+            }
+        }
+      front = std::move(next);
+    }
+    std::sort(quads.begin(), quads.end());
+    std::sort(verts.begin(), verts.end());
+    // The patch as a mesh of its own: a vertex with a quad outside stays, held by a degenerate
+    // triangle (untangle_face never moves triangle vertices).
+    mesh::FaceMesh sub;
+    sub.face = m.face;
+    for (const LO v : verts) {
+      local[v] = sub.num_vertices();
+      sub.points.push_back(m.points[v]);
+      sub.uv.push_back(m.uv[v]);
+      sub.vclass.push_back(m.vclass[v]);
+    }
+    std::vector<LO> moving;
+    std::vector<char> moves(verts.size(), 0);
+    for (std::size_t i = 0; i < verts.size(); ++i) {
+      const LO v = verts[i];
+      bool inside = movable[v] != 0;
+      for (const LO q : v2q[v]) inside = inside && in_patch[q];
+      if (inside) {
+        moving.push_back(v);
+        moves[i] = 1;
+      } else {
+        sub.triangles.push_back({local[v], local[v], local[v]});
+      }
+    }
+    // Only the quads that can change are measured: a poor quad of fixed vertices (a cusp's, or
+    // one held between curves) must not make the patch's minimum unreachable.
+    for (const LO q : quads) {
+      std::array<LO, 4> lq{};
+      bool changes = false;
+      for (int k = 0; k < 4; ++k) {
+        lq[k] = local[m.quads[q][k]];
+        changes = changes || moves[static_cast<std::size_t>(lq[k])] != 0;
+      }
+      if (changes) sub.quads.push_back(lq);
+    }
+    for (const LO q : quads) in_patch[q] = 0;
+    for (const LO v : verts) seen[v] = 0;
+    if (moving.empty()) {
+      for (const LO v : verts) local[v] = kNoIndex;
+      return false;
+    }
+    UntangleOptions uo;
+    uo.target = options.target;
+    uo.rings = 2 * rings + 2;  // the whole patch at once
+    uo.max_rings = uo.rings;
+    uo.polish_sweeps = options.polish_sweeps;
+    uo.laplacian_start = options.laplacian_start;
+    UntangleStats us;
+    const mesh::FaceMesh out = untangle_face(sub, surface, uo, &us);
+    // A lift that leaves the patch below the target is worth keeping only when it costs the
+    // patch nothing on average: a quad held by a short curve edge (a sliver's) rises by a few
+    // thousandths while the search reshapes its neighbours for them.
+    const bool reached = us.after.sicn_min >= options.target;
+    const bool free_gain = us.after.sicn_avg >= us.before.sicn_avg || !options.partial_only_free;
+    if (!us.rolled_back && (reached || free_gain)) {
+      ++st.lifted;
+      for (const LO v : moving) {
+        const LO l = local[v];
+        m.points[v] = out.points[l];
+        m.uv[v] = out.uv[l];
+        m.vclass[v].param = out.vclass[l].param;
+      }
+    }
+    for (const LO v : verts) local[v] = kNoIndex;
+    // Worth a larger patch only when this one got a tenth of the way: one that barely moves is
+    // held by its fixed vertices (a sliver's short curve edge), not short of room.
+    const double before = us.before.sicn_min;
+    return reached || us.after.sicn_min - before < 0.1 * (options.target - before);
+  };
+  for (LO seed = 0; seed < nq; ++seed) {
+    if (!(sicn(seed) < options.target)) continue;
+    ++st.seeds;
+    // A larger patch only where the smaller one made some way toward the target: more room, more
+    // cost.
+    for (int rings = options.rings; rings <= options.max_rings; rings += options.rings)
+      if (lift(seed, rings)) break;
+  }
+  st.after = measure(m);
   if (stats) *stats = st;
   return m;
 }

@@ -162,5 +162,65 @@ TEST(Untangle, Deterministic) {
   }
 }
 
+// Issue 29: the poor quads the smoother leaves are lifted patch by patch. The face has two: a
+// short edge made by a free vertex pushed next to its neighbour (SICN just under 0.1, valid), and
+// a quad held by a corner whose neighbour is a fixed (curve) vertex pushed beside it (SICN about
+// 0.01, which no free vertex can change). The untangler, judging the whole face by its minimum,
+// keeps neither; the lift keeps the first and leaves the second as it is.
+TEST(LiftPoorQuads, LiftsAFreeQuadBesideAForcedOne) {
+  const Case c = load_face(
+      BRepBuilderAPI_MakeFace(gp_Pln(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), 0.0, 12.0, 0.0, 12.0)
+          .Face(),
+      "lift_plate.brep");
+  const Box2 box = c.model.faces()[0].uv_box;
+  const int n = 12;
+  auto in = grid(*c.geometry, box, n);
+  const auto id = [&](int i, int j) { return static_cast<LO>(j * (n + 1) + i); };
+  // Free vertex (8, 8) pushed 0.95 cells toward (9, 8): its quads on that side get a 0.05 edge.
+  fold(in, *c.geometry, box, n, 8, 8, {0.95, 0.0});
+  // Vertex (1, 1) made a fixed curve vertex and put beside corner (1, 0).
+  fold(in, *c.geometry, box, n, 1, 1, {-0.02, -0.97});
+  in.vclass[id(1, 1)].dim = 1;
+  in.vclass[id(1, 1)].entity = 0;
+  in.vclass[id(1, 1)].index = id(1, 1);
+  const auto sicn = [](const mesh::FaceMesh& m, LO q) {
+    const auto& qd = m.quads[q];
+    return mesh::quad_sicn({m.points[qd[0]], m.points[qd[1]], m.points[qd[2]], m.points[qd[3]]});
+  };
+  const LO free_quad = 7 * n + 8, forced_quad = 0;  // cells (8, 7) and (0, 0)
+  ASSERT_GT(sicn(in, free_quad), 0.0);
+  ASSERT_LT(sicn(in, free_quad), 0.1);
+  ASSERT_GT(sicn(in, forced_quad), 0.0);
+  ASSERT_LT(sicn(in, forced_quad), sicn(in, free_quad));
+
+  UntangleOptions uo;
+  uo.target = 0.1;
+  UntangleStats us;
+  const auto whole = untangle_face(in, *c.geometry, uo, &us);
+  EXPECT_TRUE(us.rolled_back);
+  EXPECT_LT(sicn(whole, free_quad), 0.1);
+
+  LiftStats st;
+  const auto out = lift_poor_quads(in, *c.geometry, LiftOptions{}, &st);
+  std::printf("lift: free quad %.4f -> %.4f, forced %.4f -> %.4f, %lld seeds, %lld lifted\n",
+              sicn(in, free_quad), sicn(out, free_quad), sicn(in, forced_quad),
+              sicn(out, forced_quad), static_cast<long long>(st.seeds),
+              static_cast<long long>(st.lifted));
+  EXPECT_GT(sicn(out, free_quad), 0.3);
+  EXPECT_EQ(sicn(out, forced_quad), sicn(in, forced_quad));
+  EXPECT_GE(st.lifted, 1);
+  EXPECT_GE(st.after.sicn_min, st.before.sicn_min);
+  EXPECT_EQ(st.after.invalid, 0);
+  expect_locked_and_on_surface(in, out, *c.geometry, c.model.diagonal());
+  // Far from both, nothing moves.
+  EXPECT_TRUE(out.points[id(4, 10)] == in.points[id(4, 10)]);
+  // A mesh above the target comes back as it is.
+  const auto good = grid(*c.geometry, box, n);
+  const auto same = lift_poor_quads(good, *c.geometry, LiftOptions{}, &st);
+  EXPECT_EQ(st.seeds, 0);
+  for (std::size_t v = 0; v < good.points.size(); ++v)
+    EXPECT_TRUE(good.points[v] == same.points[v]);
+}
+
 }  // namespace
 }  // namespace qsmesh::smooth

@@ -28,6 +28,7 @@
 #include "qsmesh/quantize/quantize.hpp"
 #include "qsmesh/remesh/disk_remesh.hpp"
 #include "qsmesh/sizemap/size_map.hpp"
+#include "qsmesh/smooth/untangle.hpp"
 
 namespace qsmesh::parallel {
 
@@ -160,6 +161,10 @@ struct PipelineOptions {
   /// 0.884 -> 0.885 (min 0.093 -> 0.099) for 0.06-0.5 s; 30 iterations instead of 10 add nothing.
   bool final_smoothing = true;
   smooth::SmoothOptions final_smooth;
+  /// Stage::QuasiStructured, after the final smoothing: the quads still below lift.target are
+  /// lifted one patch at a time (smooth::lift_poor_quads; target 0: off). The poor quads the
+  /// smoother leaves have one angle near 180 degrees at a curve vertex (issue 29).
+  smooth::LiftOptions lift;
   /// Stage::QuasiStructured: a face whose unstructured mesh has more quads than this is improved
   /// in pieces, each a task of its own (ImproveSettings::task_quads; 0: never). A fixed count,
   /// not a share of the ranks' work, so that the mesh does not depend on the rank count.
