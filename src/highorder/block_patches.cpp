@@ -96,8 +96,7 @@ BlockPatchReport make_block_patches(const mesh::SurfaceMesh& fine, const layout:
       }
       uv[k] = detail::nearest(images, ref);
     }
-    const Vec2 guess = (1 - fx) * (1 - fy) * uv[0] + fx * (1 - fy) * uv[1] + fx * fy * uv[2] +
-                       (1 - fx) * fy * uv[3];
+    const Vec2 guess = detail::bilinear(uv, fx, fy);
     Vec3 foot{};
     const Vec2 at = geom.project(p, guess, &foot);
     if (!(distance(foot, p) <= reach)) return Sample{p, {2, f, kNoIndex, {kNaN, kNaN}}, false};
@@ -129,6 +128,16 @@ BlockPatchReport make_block_patches(const mesh::SurfaceMesh& fine, const layout:
     return std::array<GO, 4>{grid(k, i, j), grid(k, i + 1, j), grid(k, i + 1, j + 1),
                              grid(k, i, j + 1)};
   };
+  auto corners_of = [&](const std::array<GO, 4>& c) {
+    return std::array<Vec3, 4>{point(c[0]), point(c[1]), point(c[2]), point(c[3])};
+  };
+  // The fine cell's normal (the sum of its corners' cross products, as the SICN's).
+  auto cell_normal = [&](const std::array<GO, 4>& c) {
+    Vec3 nrm{};
+    for (std::size_t q = 0; q < 4; ++q)
+      nrm += cross(point(c[(q + 1) % 4]) - point(c[q]), point(c[(q + 3) % 4]) - point(c[q]));
+    return nrm;
+  };
   // Node (a, b) of block k's patch: grid position (a ni / n, b nj / n), exact in integers.
   auto sample = [&](const layout::Block& k, int a, int b) {
     const std::int64_t xi = static_cast<std::int64_t>(a) * k.ni,
@@ -153,19 +162,12 @@ BlockPatchReport make_block_patches(const mesh::SurfaceMesh& fine, const layout:
     }
     const auto c = cell(k, ix, iy);
     const double fx = static_cast<double>(rx) / n, fy = static_cast<double>(ry) / n;
-    const Vec3 p = (1 - fx) * (1 - fy) * point(c[0]) + fx * (1 - fy) * point(c[1]) +
-                   fx * fy * point(c[2]) + (1 - fx) * fy * point(c[3]);
-    return on_face(face_of_cell(k, ix, iy), p, c, fx, fy);
+    return on_face(face_of_cell(k, ix, iy), detail::bilinear(corners_of(c), fx, fy), c, fx, fy);
   };
 
   patches = mesh::SurfaceMesh{};
   patches.order = n;
-  patches.num_cad_faces = fine.num_cad_faces;
-  patches.num_cad_curves = fine.num_cad_curves;
-  patches.num_cad_corners = fine.num_cad_corners;
-  patches.curve_corners = fine.curve_corners;
-  patches.face2curves = fine.face2curves;
-  patches.length_unit = fine.length_unit;
+  mesh::copy_cad_topology(fine, patches);
   BlockPatchReport report;
   report.order = n;
 
@@ -203,8 +205,7 @@ BlockPatchReport make_block_patches(const mesh::SurfaceMesh& fine, const layout:
   // A side's nodes, made once: keyed by its end vertices and the middle of its fine path (two
   // sides may join the same two corners), stored from the smaller end.
   std::map<std::array<GO, 3>, GO> side_nodes;
-  const std::array<std::array<int, 4>, 4> walk{
-      {{0, 0, 1, 0}, {n, 0, 0, 1}, {n, n, -1, 0}, {0, n, 0, -1}}};  // start (a, b), step
+  const auto walk = detail::side_walk(n);
   patches.quad_nodes.resize(patches.quads.size() * static_cast<std::size_t>(per_quad));
   for (std::size_t kb = 0; kb < layout.blocks.size(); ++kb) {
     const layout::Block& k = layout.blocks[kb];
@@ -256,15 +257,16 @@ BlockPatchReport make_block_patches(const mesh::SurfaceMesh& fine, const layout:
 
   // Validity along the fine cells' normals, and the distance to the fine mesh.
   const detail::QuadChecker checker(n);
-  std::vector<double> l(static_cast<std::size_t>(np)), lt(static_cast<std::size_t>(np));
+  std::vector<Vec3> nodes(static_cast<std::size_t>(np * np));
   for (std::size_t kb = 0; kb < layout.blocks.size(); ++kb) {
     const layout::Block& k = layout.blocks[kb];
     std::array<Vec3, detail::kMaxNodes> g{};
     const GO* ho = patches.quad_nodes.data() + kb * static_cast<std::size_t>(per_quad);
-    for (std::size_t c = 0; c < 4; ++c)
-      g[checker.grid(c)] = patches.points[static_cast<std::size_t>(patches.quads[kb][c])];
-    for (std::size_t c = 0; c < static_cast<std::size_t>(per_quad); ++c)
-      g[checker.grid(4 + c)] = patches.points[static_cast<std::size_t>(ho[c])];
+    for (std::size_t c = 0; c < nodes.size(); ++c) {
+      const GO id = c < 4 ? patches.quads[kb][c] : ho[c - 4];
+      nodes[c] = patches.points[static_cast<std::size_t>(id)];
+      g[checker.grid(c)] = nodes[c];
+    }
     // The fine cell at reference position (s, t) of the block, and the position inside it.
     auto locate = [&](double s, double t, double& fx, double& fy) {
       const double x = s * k.ni, y = t * k.nj;
@@ -276,33 +278,20 @@ BlockPatchReport make_block_patches(const mesh::SurfaceMesh& fine, const layout:
     };
     const bool ok = checker.valid_along(g, [&](int m1, int m2) {
       double fx = 0, fy = 0;
-      const auto c =
-          locate(static_cast<double>(m1) / (2 * n), static_cast<double>(m2) / (2 * n), fx, fy);
-      Vec3 nrm{};
-      for (std::size_t q = 0; q < 4; ++q)
-        nrm += cross(point(c[(q + 1) % 4]) - point(c[q]), point(c[(q + 3) % 4]) - point(c[q]));
-      return nrm;
+      return cell_normal(
+          locate(static_cast<double>(m1) / (2 * n), static_cast<double>(m2) / (2 * n), fx, fy));
     });
     if (!ok) ++report.invalid;
     for (int b = 0; b < n; ++b)
       for (int a = 0; a < n; ++a) {
         const double s = (a + 0.5) / n, t = (b + 0.5) / n;
-        detail::lagrange_1d(n, s, l.data(), nullptr);
-        detail::lagrange_1d(n, t, lt.data(), nullptr);
-        Vec3 x{};
-        for (int j = 0; j < np; ++j)
-          for (int i = 0; i < np; ++i)
-            x += g[static_cast<std::size_t>(i + np * j)] *
-                 (l[static_cast<std::size_t>(i)] * lt[static_cast<std::size_t>(j)]);
+        const Vec3 x = lagrange_quad_point(n, nodes, s, t);
         double fx = 0, fy = 0;
         const auto c = locate(s, t, fx, fy);
-        const Vec3 y = (1 - fx) * (1 - fy) * point(c[0]) + fx * (1 - fy) * point(c[1]) +
-                       fx * fy * point(c[2]) + (1 - fx) * fy * point(c[3]);
+        const Vec3 y = detail::bilinear(corners_of(c), fx, fy);
         // Across the fine surface only: the patch's parametrization is not the fine grid's, so the
         // two points at one reference position also differ along the surface.
-        Vec3 nrm{};
-        for (std::size_t q = 0; q < 4; ++q)
-          nrm += cross(point(c[(q + 1) % 4]) - point(c[q]), point(c[(q + 3) % 4]) - point(c[q]));
+        const Vec3 nrm = cell_normal(c);
         const double len = norm(nrm);
         const double d = len > 0 ? std::abs(dot(x - y, nrm)) / len : distance(x, y);
         report.max_deviation = std::max(report.max_deviation, d);

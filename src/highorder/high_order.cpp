@@ -25,10 +25,13 @@ struct Edge {
   GO quad = -1;         // first quad using it
 };
 
+using detail::bilinear;
+using detail::coons;
 using detail::kMaxNodes;
 using detail::lagrange_1d;
 using detail::nearest;
 using detail::QuadChecker;
+using detail::side_walk;
 using detail::uv_images;
 
 }  // namespace
@@ -357,14 +360,9 @@ HighOrderReport make_high_order(mesh::SurfaceMesh& m, const cad::CadModel& model
         for (int j = 1; j < n; ++j)
           for (int i = 1; i < n; ++i) {
             const double r = static_cast<double>(i) / n, t = static_cast<double>(j) / n;
-            const Vec3 x = (1 - t) * at(i, 0) + t * at(i, n) + (1 - r) * at(0, j) + r * at(n, j) -
-                           ((1 - r) * (1 - t) * at(0, 0) + r * (1 - t) * at(n, 0) +
-                            r * t * at(n, n) + (1 - r) * t * at(0, n));
-            const Vec2 guess = (1 - r) * (1 - t) * uv[0] + r * (1 - t) * uv[1] + r * t * uv[2] +
-                               (1 - r) * t * uv[3];
             place(static_cast<std::size_t>(first_interior + q * per_interior + (i - 1) +
                                            per_edge * (j - 1)),
-                  x, guess, reach, uv);
+                  coons(at, n, i, j), bilinear(uv, r, t), reach, uv);
           }
       }
     });
@@ -424,8 +422,7 @@ HighOrderReport make_high_order(mesh::SurfaceMesh& m, const cad::CadModel& model
         const double r = static_cast<double>(i) / n, t = static_cast<double>(j) / n;
         const auto node = static_cast<std::size_t>(first_interior + q * per_interior + (i - 1) +
                                                    per_edge * (j - 1));
-        points[node] =
-            (1 - r) * (1 - t) * c[0] + r * (1 - t) * c[1] + r * t * c[2] + (1 - r) * t * c[3];
+        points[node] = bilinear(c, r, t);
         projected[node] = 0;
       }
   };
@@ -467,8 +464,7 @@ HighOrderReport make_high_order(mesh::SurfaceMesh& m, const cad::CadModel& model
     uv(n, n) = corner[2];
     uv(0, n) = corner[3];
     const GO* ho = m.quad_nodes.data() + q * per_quad;
-    const std::array<std::array<int, 4>, 4> walk{
-        {{0, 0, 1, 0}, {n, 0, 0, 1}, {n, n, -1, 0}, {0, n, 0, -1}}};  // start (i, j), step (di, dj)
+    const auto walk = side_walk(n);
     for (std::size_t k = 0; k < 4; ++k) {
       const Edge& x =
           edges[static_cast<std::size_t>(quad_sides[static_cast<std::size_t>(q)][k] / 2)];
@@ -488,10 +484,7 @@ HighOrderReport make_high_order(mesh::SurfaceMesh& m, const cad::CadModel& model
     }
     for (int j = 1; j < n; ++j)
       for (int i = 1; i < n; ++i) {
-        const double r = static_cast<double>(i) / n, t = static_cast<double>(j) / n;
-        uv(i, j) = (1 - t) * uv(i, 0) + t * uv(i, n) + (1 - r) * uv(0, j) + r * uv(n, j) -
-                   ((1 - r) * (1 - t) * uv(0, 0) + r * (1 - t) * uv(n, 0) + r * t * uv(n, n) +
-                    (1 - r) * t * uv(0, n));
+        uv(i, j) = coons(uv, n, i, j);
       }
     auto set = [&](std::size_t node, const Vec2& at) {
       points[node] = geom->eval(at).p;

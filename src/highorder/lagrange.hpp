@@ -39,6 +39,29 @@ inline std::vector<Vec2> uv_images(const cad::CadModel& model, const cad::FaceGe
   return out;
 }
 
+// The bilinear interpolation at (r, t) of the values at a quad's corners 0 (0, 0), 1 (1, 0),
+// 2 (1, 1) and 3 (0, 1).
+template <class T>
+T bilinear(const std::array<T, 4>& c, double r, double t) {
+  return (1 - r) * (1 - t) * c[0] + r * (1 - t) * c[1] + r * t * c[2] + (1 - r) * t * c[3];
+}
+
+// Point (i, j), 0 < i, j < n, of the transfinite (Coons) interpolation of the boundary rows of an
+// (n + 1) x (n + 1) grid `at(i, j)`.
+template <class At>
+auto coons(const At& at, int n, int i, int j) {
+  const double r = static_cast<double>(i) / n, t = static_cast<double>(j) / n;
+  return (1 - t) * at(i, 0) + t * at(i, n) + (1 - r) * at(0, j) + r * at(n, j) -
+         ((1 - r) * (1 - t) * at(0, 0) + r * (1 - t) * at(n, 0) + r * t * at(n, n) +
+          (1 - r) * t * at(0, n));
+}
+
+// The sides of an n x n node grid in a quad's node order: side k starts at (walk[k][0],
+// walk[k][1]) and its node s is s steps of (walk[k][2], walk[k][3]) on.
+inline std::array<std::array<int, 4>, 4> side_walk(int n) {
+  return {{{0, 0, 1, 0}, {n, 0, 0, 1}, {n, n, -1, 0}, {0, n, 0, -1}}};
+}
+
 inline Vec2 nearest(const std::vector<Vec2>& images, const Vec2& ref) {
   Vec2 best = images.front();
   double d = std::numeric_limits<double>::max();

@@ -1668,12 +1668,7 @@ class Builder {
       sm.bars.push_back({b.a, b.b});
       sm.bar_curve.push_back(b.curve);
     }
-    sm.num_cad_faces = m_.num_cad_faces;
-    sm.num_cad_curves = m_.num_cad_curves;
-    sm.num_cad_corners = m_.num_cad_corners;
-    sm.curve_corners = m_.curve_corners;
-    sm.face2curves = m_.face2curves;
-    sm.length_unit = m_.length_unit;
+    mesh::copy_cad_topology(m_, sm);
     // Validity: no quad folded against the face (normal at its corners) and SICN > 0.
     double smin = 2, ssum = 0;
     for (std::size_t i = 0; i < sm.quads.size(); ++i) {

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <limits>
 #include <numbers>
+#include <span>
 #include <vector>
 
 #include "internal.hpp"
@@ -191,6 +192,48 @@ class Untangler {
   mutable std::vector<double> corner_;
 };
 
+// The quads and vertices within `rings` rings of quads around the quads `seeds`: the seeds and
+// their vertices, then ring by ring every quad of a vertex reached last, and its vertices. Both
+// lists sorted. `vertex_mark` (one per vertex) and `quad_mark` (one per quad) are all 0 on entry
+// and are left so.
+void grow_patch(const mesh::FaceMesh& m, const std::vector<std::vector<LO>>& v2q,
+                std::span<const LO> seeds, int rings, std::vector<char>& vertex_mark,
+                std::vector<char>& quad_mark, std::vector<LO>& quads, std::vector<LO>& verts) {
+  quads.clear();
+  verts.clear();
+  for (const LO q : seeds) {
+    if (quad_mark[q]) continue;
+    quad_mark[q] = 1;
+    quads.push_back(q);
+    for (const LO v : m.quads[q])
+      if (!vertex_mark[v]) {
+        vertex_mark[v] = 1;
+        verts.push_back(v);
+      }
+  }
+  std::vector<LO> front = verts;
+  for (int r = 0; r < rings; ++r) {
+    std::vector<LO> next;
+    for (const LO v : front)
+      for (const LO q : v2q[v]) {
+        if (quad_mark[q]) continue;
+        quad_mark[q] = 1;
+        quads.push_back(q);
+        for (const LO w : m.quads[q])
+          if (!vertex_mark[w]) {
+            vertex_mark[w] = 1;
+            next.push_back(w);
+            verts.push_back(w);
+          }
+      }
+    front = std::move(next);
+  }
+  for (const LO q : quads) quad_mark[q] = 0;
+  for (const LO v : verts) vertex_mark[v] = 0;
+  std::sort(quads.begin(), quads.end());
+  std::sort(verts.begin(), verts.end());
+}
+
 }  // namespace
 
 mesh::FaceMesh untangle_face(const mesh::FaceMesh& input, const cad::FaceGeometry& surface,
@@ -244,34 +287,16 @@ mesh::FaceMesh untangle_face(const mesh::FaceMesh& input, const cad::FaceGeometr
     }
   }
 
+  std::vector<char> vertex_mark(static_cast<std::size_t>(nv), 0),
+      quad_mark(static_cast<std::size_t>(nq), 0);
+  std::vector<LO> patch_quads, patch_verts;
   for (int rings = options.rings; !seed.empty() && !st.timed_out;
        rings += std::max(options.rings, 1)) {
     // Patch: vertices of the seeds grown by `rings` rings of quads.
-    std::vector<char> in_patch(static_cast<std::size_t>(nv), 0), quad_seen(nq, 0);
-    std::vector<LO> front;
-    for (const LO q : seed)
-      for (const LO v : m.quads[q])
-        if (!in_patch[v]) {
-          in_patch[v] = 1;
-          front.push_back(v);
-        }
-    for (int r = 0; r < rings; ++r) {
-      std::vector<LO> next;
-      for (const LO v : front)
-        for (const LO q : v2q[v]) {
-          if (quad_seen[q]) continue;
-          quad_seen[q] = 1;
-          for (const LO w : m.quads[q])
-            if (!in_patch[w]) {
-              in_patch[w] = 1;
-              next.push_back(w);
-            }
-        }
-      front = std::move(next);
-    }
+    grow_patch(m, v2q, seed, rings, vertex_mark, quad_mark, patch_quads, patch_verts);
     std::vector<LO> patch;
-    for (LO v = 0; v < nv; ++v)
-      if (in_patch[v] && free[v] && step0[v] > 0) patch.push_back(v);
+    for (const LO v : patch_verts)
+      if (free[v] && step0[v] > 0) patch.push_back(v);
     // A vertex stuck at its smallest step in a smaller patch may move again with new neighbours.
     std::vector<double> step = step0;
     st.rings = rings;
@@ -362,33 +387,13 @@ mesh::FaceMesh lift_poor_quads(const mesh::FaceMesh& input, const cad::FaceGeome
 
   std::vector<char> in_patch(static_cast<std::size_t>(nq), 0),
       seen(static_cast<std::size_t>(nv), 0);
-  std::vector<LO> local(static_cast<std::size_t>(nv), kNoIndex);
+  std::vector<LO> local(static_cast<std::size_t>(nv), kNoIndex), quads, verts;
   // One patch of `rings` rings around `seed`; true when no larger patch is worth trying.
   const auto lift = [&](LO seed, int rings) {
     // The patch: the seed grown ring by ring through the vertices' quads.
-    std::vector<LO> quads{seed}, verts;
-    in_patch[seed] = 1;
-    std::vector<LO> front(m.quads[seed].begin(), m.quads[seed].end());
-    for (const LO v : front) seen[v] = 1;
-    verts = front;
-    for (int r = 0; r < rings; ++r) {
-      std::vector<LO> next;
-      for (const LO v : front)
-        for (const LO q : v2q[v]) {
-          if (in_patch[q]) continue;
-          in_patch[q] = 1;
-          quads.push_back(q);
-          for (const LO w : m.quads[q])
-            if (!seen[w]) {
-              seen[w] = 1;
-              next.push_back(w);
-              verts.push_back(w);
-            }
-        }
-      front = std::move(next);
-    }
-    std::sort(quads.begin(), quads.end());
-    std::sort(verts.begin(), verts.end());
+    const std::array<LO, 1> seeds{seed};
+    grow_patch(m, v2q, seeds, rings, seen, in_patch, quads, verts);
+    for (const LO q : quads) in_patch[q] = 1;
     // The patch as a mesh of its own: a vertex with a quad outside stays, held by a degenerate
     // triangle (untangle_face never moves triangle vertices).
     mesh::FaceMesh sub;
@@ -424,7 +429,6 @@ mesh::FaceMesh lift_poor_quads(const mesh::FaceMesh& input, const cad::FaceGeome
       if (changes) sub.quads.push_back(lq);
     }
     for (const LO q : quads) in_patch[q] = 0;
-    for (const LO v : verts) seen[v] = 0;
     if (moving.empty()) {
       for (const LO v : verts) local[v] = kNoIndex;
       return false;

@@ -79,4 +79,16 @@ struct SurfaceMesh {
   [[nodiscard]] GO num_vertices() const { return static_cast<GO>(points.size()); }
 };
 
+/// Sets `to`'s CAD entity counts, curve_corners, face2curves and length_unit to `from`'s: what a
+/// mesh made from another on the same model (a coarse layout's, the blocks' patches) shares with
+/// it.
+inline void copy_cad_topology(const SurfaceMesh& from, SurfaceMesh& to) {
+  to.num_cad_faces = from.num_cad_faces;
+  to.num_cad_curves = from.num_cad_curves;
+  to.num_cad_corners = from.num_cad_corners;
+  to.curve_corners = from.curve_corners;
+  to.face2curves = from.face2curves;
+  to.length_unit = from.length_unit;
+}
+
 }  // namespace qsmesh::mesh
