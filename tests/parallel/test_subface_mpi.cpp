@@ -17,6 +17,16 @@ namespace {
 
 std::string tmp(const std::string& name) { return std::string(QSMESH_TEST_TMP_DIR) + "/" + name; }
 
+// The model `write(path)` makes, written once by rank 0 (one file per rank count: the ctest runs
+// at 1, 2 and 4 ranks may overlap) and loaded by every rank.
+template <class Write>
+cad::CadModel load_written_by_rank0(const Comm& comm, const std::string& name, const Write& write) {
+  const std::string path = tmp(name + "_np" + std::to_string(comm.size()) + ".brep");
+  if (comm.rank() == 0) write(path);
+  comm.barrier();
+  return cad::load_cad(path);
+}
+
 PipelineOptions plate_options(std::int64_t task_quads) {
   PipelineOptions options;
   options.background.sizes.size = 0.5;
@@ -28,10 +38,9 @@ PipelineOptions plate_options(std::int64_t task_quads) {
 
 TEST(SubFace, PiecesGiveTheSameMeshAtEveryRankCountAndKeepTheQuality) {
   const Comm comm = Comm::world();
-  const std::string path = tmp("subface_plate_np" + std::to_string(comm.size()) + ".brep");
-  if (comm.rank() == 0) test::write_long_plate(100, 20, path);
-  comm.barrier();
-  const cad::CadModel model = cad::load_cad(path);
+  const cad::CadModel model =
+      load_written_by_rank0(comm, "subface_plate",
+                            [](const std::string& path) { test::write_long_plate(100, 20, path); });
   ASSERT_EQ(model.num_faces(), 1);
   std::ostringstream sink;
   Logger log(sink, LogLevel::Quiet);
@@ -80,10 +89,8 @@ TEST(SubFace, PiecesGiveTheSameMeshAtEveryRankCountAndKeepTheQuality) {
 // the same at every rank count.
 TEST(SubFace, SeamAndPolesInPieces) {
   const Comm comm = Comm::world();
-  const std::string path = tmp("subface_sphere_np" + std::to_string(comm.size()) + ".brep");
-  if (comm.rank() == 0) test::write_sphere(path);
-  comm.barrier();
-  const cad::CadModel model = cad::load_cad(path);
+  const cad::CadModel model = load_written_by_rank0(
+      comm, "subface_sphere", [](const std::string& path) { test::write_sphere(path); });
   std::ostringstream sink;
   Logger log(sink, LogLevel::Quiet);
   PipelineOptions options = plate_options(150);
@@ -107,10 +114,9 @@ TEST(SubFace, SeamAndPolesInPieces) {
 // every rank count. The plate coarse enough (a few thousand quads) for its second pass.
 TEST(SubFace, SecondPassAsATaskGivesTheSameMesh) {
   const Comm comm = Comm::world();
-  const std::string path = tmp("second_pass_plate_np" + std::to_string(comm.size()) + ".brep");
-  if (comm.rank() == 0) test::write_long_plate(100, 20, path);
-  comm.barrier();
-  const cad::CadModel model = cad::load_cad(path);
+  const cad::CadModel model =
+      load_written_by_rank0(comm, "second_pass_plate",
+                            [](const std::string& path) { test::write_long_plate(100, 20, path); });
   std::ostringstream sink;
   Logger log(sink, LogLevel::Quiet);
   PipelineOptions options = plate_options(0);
