@@ -9,8 +9,8 @@
 #include "qsmesh/core/tasks.hpp"
 #include "qsmesh/core/timer.hpp"
 #include "qsmesh/parallel/comm.hpp"
-#include "qsmesh/parallel/split.hpp"
 #include "qsmesh/parallel/pipeline.hpp"
+#include "qsmesh/parallel/split.hpp"
 
 namespace qsmesh::cli {
 

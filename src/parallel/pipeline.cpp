@@ -14,7 +14,6 @@
 #include "exchange.hpp"
 #include "field_stage.hpp"
 #include "improve.hpp"
-#include "split_round.hpp"
 #include "qsmesh/background/curve_mesh.hpp"
 #include "qsmesh/background/face_mesh.hpp"
 #include "qsmesh/core/error.hpp"
@@ -24,6 +23,7 @@
 #include "qsmesh/parallel/face_task.hpp"
 #include "qsmesh/parallel/partition.hpp"
 #include "qsmesh/parallel/record.hpp"
+#include "split_round.hpp"
 
 namespace qsmesh::parallel {
 
@@ -1061,7 +1061,8 @@ std::vector<mesh::CurveMesh> curves_stage(const Context& cx, std::vector<SplitRo
     weights.assign(static_cast<std::size_t>(n), 0.0);
     for (LO c = 0; c < n; ++c) weights[c] = static_cast<double>(samples[c].p.size());
     SplitRound round = split_round(
-        cx.comm, cx.tasks, std::move(weights), [&](LO c) { meshing.limit_sizes(search, samples[c]); },
+        cx.comm, cx.tasks, std::move(weights),
+        [&](LO c) { meshing.limit_sizes(search, samples[c]); },
         [&](LO c) { return record_bytes(samples[c].h); },
         [&](LO c, std::vector<char>& out) { write_record(out, samples[c].h); },
         [&](LO c, const std::vector<char>& in, std::size_t& pos) {

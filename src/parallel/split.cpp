@@ -11,7 +11,9 @@ std::vector<double> measure_split(const Comm& comm, const TaskArena& tasks, LO c
       comm, tasks, std::vector<double>(static_cast<std::size_t>(count), 1.0),
       [&](LO i) { values[i] = measure(i); }, [](LO) { return std::int64_t{sizeof(double)}; },
       [&](LO i, std::vector<char>& out) { put<double>(out, values[i]); },
-      [&](LO i, const std::vector<char>& in, std::size_t& pos) { values[i] = get<double>(in, pos); });
+      [&](LO i, const std::vector<char>& in, std::size_t& pos) {
+        values[i] = get<double>(in, pos);
+      });
   if (round != nullptr) *round = std::move(r);
   return values;
 }

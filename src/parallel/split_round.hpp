@@ -45,8 +45,7 @@ struct ItemError {
 // of the lowest item whose work failed on any rank.
 template <class Work, class Bytes, class Write, class Read>
 SplitRound split_round(const Comm& comm, const TaskArena& tasks, std::vector<double> weights,
-                       const Work& work, const Bytes& bytes, const Write& write,
-                       const Read& read) {
+                       const Work& work, const Bytes& bytes, const Write& write, const Read& read) {
   const Stopwatch clock;
   const int nranks = comm.size();
   const int rank = comm.rank();
