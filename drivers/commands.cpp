@@ -120,7 +120,7 @@ std::int64_t trimmed_curves(const cad::CadModel& model) {
 }  // namespace
 
 int run_info(const Arguments& args) {
-  const cad::CadModel model = cad::load_cad(args.model, cad::LoadOptions{args.sew, 0});
+  const cad::CadModel model = cad::load_cad(args.model, cad::LoadOptions{args.sew, 0, {}});
   // --partition: the faces over P ranks as run_pipeline partitions them (same weights, same METIS
   // call), at the size a mesh run with the same --size / --size-factor has.
   const double size =
