@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <iomanip>
 #include <iostream>
 #include <optional>
@@ -119,7 +120,7 @@ std::int64_t trimmed_curves(const cad::CadModel& model) {
 }  // namespace
 
 int run_info(const Arguments& args) {
-  const cad::CadModel model = cad::load_cad(args.model, cad::LoadOptions{args.sew, 0});
+  const cad::CadModel model = cad::load_cad(args.model, cad::LoadOptions{args.sew, 0, {}});
   // --partition: the faces over P ranks as run_pipeline partitions them (same weights, same METIS
   // call), at the size a mesh run with the same --size / --size-factor has.
   const double size =
@@ -343,6 +344,16 @@ bool time_budget_hit(const parallel::PipelineResult& r, std::size_t f) {
 }
 
 // Largest over mean of the ranks' busy times (1 when balanced or on one rank).
+// One round split over the ranks: its seconds, bytes, and by item its weight and seconds.
+void write_split_round(JsonWriter& j, const parallel::SplitRound& round) {
+  j.begin_object()
+      .value("seconds", round.seconds)
+      .value("bytes", round.bytes)
+      .value("weights", round.weights)
+      .value("item_seconds", round.item_seconds)
+      .end_object();
+}
+
 double load_imbalance(const std::vector<double>& busy) {
   if (busy.empty()) return 1.0;
   double sum = 0, most = 0;
@@ -501,16 +512,14 @@ std::string stats_json(const Arguments& args, const Session& session,
     for (double m : checks.rank_peak_mb) j.value("", m);
     j.end_array();
   }
-  // The curves stage's rounds split by curve over the ranks (parallel::CurveRound, documented
-  // there; scripts/simulate_scaling.py deals and replays them).
+  // The rounds split over the ranks (parallel::SplitRound, documented there;
+  // scripts/simulate_scaling.py deals and replays them): the curves stage's, by curve, and the
+  // load's face measurements, by face.
   j.begin_array("curve_rounds");
-  for (const parallel::CurveRound& round : r.curve_rounds)
-    j.begin_object()
-        .value("seconds", round.seconds)
-        .value("bytes", round.bytes)
-        .value("weights", round.weights)
-        .value("curve_seconds", round.curve_seconds)
-        .end_object();
+  for (const parallel::SplitRound& round : r.curve_rounds) write_split_round(j, round);
+  j.end_array();
+  j.begin_array("load_rounds");
+  if (!session.load_round.weights.empty()) write_split_round(j, session.load_round);
   j.end_array();
   if (!r.quasi_reports.empty()) {
     // The improvement stage runs its three steps face by face; their time summed over the faces.
@@ -748,12 +757,6 @@ Session::Session(const Arguments& args, const char* command)
               ? (args.quiet ? LogLevel::Warning : (args.verbose ? LogLevel::Debug : LogLevel::Info))
               : LogLevel::Warning,
           ranks > 1 ? cat("[rank ", rank, "] ") : "") {
-  Stopwatch clock;
-  model = cad::load_cad(args.model, cad::LoadOptions{args.sew, 0});
-  times.add("load", comm.allreduce_max(clock.seconds()));
-  size = args.size ? *args.size : model.diagonal() * args.size_factor.value_or(kDefaultSizeFactor);
-  if (!(size > 0))
-    throw InputError("size: the model '" + args.model + "' has an empty bounding box");
   threads = args.threads;
   if (threads <= 0)
     threads =
@@ -763,6 +766,18 @@ Session::Session(const Arguments& args, const char* command)
     log.warn(cat("--threads ", args.threads, ": this process may run on ", tasks->threads(),
                  " core(s); using ", tasks->threads(), " thread(s)"));
   threads = tasks->threads();
+  Stopwatch clock;
+  cad::LoadOptions load{args.sew, 0, {}};
+  // Every rank reads the file (the topology's ids must be the same everywhere), but the faces'
+  // area integrals, most of the rest on B-spline models, are split over the ranks and threads.
+  load.measure_faces = [this](LO n, const std::function<double(LO)>& area) {
+    return parallel::measure_split(comm, *tasks, n, area, &load_round);
+  };
+  model = cad::load_cad(args.model, load);
+  times.add("load", comm.allreduce_max(clock.seconds()));
+  size = args.size ? *args.size : model.diagonal() * args.size_factor.value_or(kDefaultSizeFactor);
+  if (!(size > 0))
+    throw InputError("size: the model '" + args.model + "' has an empty bounding box");
 }
 
 void Session::announce(const Arguments& args, const char* command) {

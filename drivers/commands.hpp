@@ -10,6 +10,7 @@
 #include "qsmesh/core/timer.hpp"
 #include "qsmesh/parallel/comm.hpp"
 #include "qsmesh/parallel/pipeline.hpp"
+#include "qsmesh/parallel/split.hpp"
 
 namespace qsmesh::cli {
 
@@ -29,6 +30,8 @@ struct Session {
   int threads = 1;
   std::unique_ptr<TaskArena> tasks;
   StageTimes times;
+  /// The load's face measurements, split over the ranks and threads (cad::LoadOptions).
+  parallel::SplitRound load_round;
 };
 
 class JsonWriter;

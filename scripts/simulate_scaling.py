@@ -11,6 +11,9 @@ rank, by replaying its measured per-face, per-stage times through the pipeline's
   message per rank, and broadcast: the round's bytes three times at the bandwidth). The rest of
   the stage (the rounds' setup done by every rank, the last step on every curve) as measured.
   A run without curve_rounds keeps the stage replicated.
+- load: replicated (every rank reads the file), except the faces' area integrals, split by face
+  over the ranks (--stats load_rounds: dealt evenly by face id, all-gathered), replayed as a
+  curves round is. A run without load_rounds keeps the whole stage replicated.
 - partitioned stages (background, crossfield, sizemap, unstructured, pattern_compare, distance,
   pack):
   each rank
@@ -118,6 +121,20 @@ def levels(p):
     return math.ceil(math.log2(p)) if p > 1 else 0
 
 
+def split_rounds(stats, key, name):
+    """The rounds of --stats `key` (parallel::SplitRound), each with its items' times under
+    "item_seconds"."""
+    rounds = []
+    for k, r in enumerate(stats.get(key, [])):
+        r = dict(r)
+        r.setdefault("item_seconds", r.get("curve_seconds", []))
+        if len(r.get("weights", [])) != len(r["item_seconds"]):
+            raise InputError(f"{name}: {key} round {k + 1} has {len(r.get('weights', []))} "
+                             f"weights for {len(r['item_seconds'])} item times")
+        rounds.append(r)
+    return rounds
+
+
 class Run:
     """What the simulation reads of one --stats JSON."""
 
@@ -157,12 +174,11 @@ class Run:
             self.t["pack"] = [x + rest * b / total_bytes for x, b in zip(self.t["pack"],
                                                                           self.bytes)]
         self.face_rank = [f.get("rank", 0) for f in self.faces]
-        # The curves stage's rounds split by curve (parallel::CurveRound).
-        self.curve_rounds = stats.get("curve_rounds", [])
-        for k, r in enumerate(self.curve_rounds):
-            if len(r.get("weights", [])) != len(r.get("curve_seconds", [])):
-                raise InputError(f"{name}: curve round {k + 1} has {len(r.get('weights', []))} "
-                                 f"weights for {len(r.get('curve_seconds', []))} curve times")
+        # The rounds split by item over the ranks (parallel::SplitRound): the curves stage's, by
+        # curve, and the load's face measurements, by face. Older runs name the items' times
+        # curve_seconds.
+        self.curve_rounds = split_rounds(stats, "curve_rounds", name)
+        self.load_rounds = split_rounds(stats, "load_rounds", name)
 
 
 class Simulator:
@@ -204,7 +220,7 @@ class Simulator:
         rank's in curve order on its t threads; the slowest rank."""
         part = greedy_partition(r["weights"], p) if p > 1 else [0] * len(r["weights"])
         per_rank = [[] for _ in range(p)]
-        for c, sec in enumerate(r["curve_seconds"]):
+        for c, sec in enumerate(r["item_seconds"]):
             per_rank[part[c]].append(sec)
         return max(list_schedule(mine, t)[0] for mine in per_rank)
 
@@ -216,15 +232,19 @@ class Simulator:
         return (3 * r["bytes"] / self.comm["bandwidth_bytes_per_s"]
                 + self.comm["allreduce_s"] * (p - 1) + 2 * self.allreduce(p))
 
-    def curves(self, p, t):
-        """The curves stage on p ranks x t threads: the measured stage with each round's split
-        part and all-gather (as the measured run did them) replaced by those on p x t."""
+    def replay_rounds(self, stage, rounds, p, t):
+        """A stage with rounds split by item (the curves, the load) on p ranks x t threads: the
+        measured stage with each round's split part and all-gather (as the measured run did them)
+        replaced by those on p x t."""
         run = self.run
-        v = run.seconds["curves"]
-        for r in run.curve_rounds:
+        v = run.seconds[stage]
+        for r in rounds:
             v += (self.curve_round(r, p, t) + self.curve_gather(r, p)
                   - self.curve_round(r, run.ranks, run.threads) - self.curve_gather(r, run.ranks))
         return max(0.0, v)
+
+    def curves(self, p, t):
+        return self.replay_rounds("curves", self.run.curve_rounds, p, t)
 
     def get_cost(self, nbytes):
         # A face read from its owner: one lock/get/unlock round, its bytes at the bandwidth.
@@ -374,6 +394,8 @@ class Simulator:
                 v = measured + away / bw + self.allreduce(p) * 2 + self.comm["allreduce_s"] * (p - 1)
             elif s == "curves" and run.curve_rounds:
                 v = self.curves(p, t) + self.allreduce(p)
+            elif s == "load" and run.load_rounds:
+                v = self.replay_rounds("load", run.load_rounds, p, t) + self.allreduce(p)
             elif s in REPLICATED:
                 v = measured + self.allreduce(p)
             else:
@@ -424,9 +446,13 @@ class Simulator:
                 v += max(run.t[s]) + self.residual[s]
             elif s == "curves" and run.curve_rounds:
                 # Each round's largest curve, the rest as measured (no messages counted).
-                v += measured + sum(max(r["curve_seconds"], default=0.0)
+                v += measured + sum(max(r["item_seconds"], default=0.0)
                                     - self.curve_round(r, run.ranks, run.threads)
                                     for r in run.curve_rounds)
+            elif s == "load" and run.load_rounds:
+                v += measured + sum(max(r["item_seconds"], default=0.0)
+                                    - self.curve_round(r, run.ranks, run.threads)
+                                    for r in run.load_rounds)
             else:
                 v += measured
         return v
@@ -486,6 +512,7 @@ def main(argv):
     stages = list(run.seconds)
     preds = {c: sim.predict(*c) for c in configs}
     kind = {s: ("split by curve" if s == "curves" and run.curve_rounds
+                else "areas split by face" if s == "load" and run.load_rounds
                 else "replicated" if s in REPLICATED else "METIS partition" if s in PARTITIONED
                 else "dealt" if s in DEALT else "gather on rank 0" if s in GATHER else "rank 0")
             for s in stages}

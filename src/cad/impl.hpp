@@ -26,7 +26,8 @@ struct CadModel::Impl {
 /// Builds the topology of a shape (friend of CadModel).
 class ModelBuilder {
  public:
-  static CadModel build(const TopoDS_Shape& shape, std::string source);
+  static CadModel build(const TopoDS_Shape& shape, std::string source,
+                        const MeasureItems& measure_faces);
 };
 
 std::unique_ptr<CurveGeometry> make_curve_geometry(const CadModel::Impl& impl, const Curve& curve,

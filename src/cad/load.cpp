@@ -106,7 +106,7 @@ CadModel load_cad(const std::string& path, const LoadOptions& options) {
       fail(path, std::string("sewing failed: ") + e.GetMessageString());
     }
   }
-  return ModelBuilder::build(shape, path);
+  return ModelBuilder::build(shape, path, options.measure_faces);
 }
 
 }  // namespace qsmesh::cad

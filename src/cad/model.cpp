@@ -219,7 +219,8 @@ Box3 to_box(const Bnd_Box& b) {
 
 }  // namespace
 
-CadModel ModelBuilder::build(const TopoDS_Shape& shape, std::string source) {
+CadModel ModelBuilder::build(const TopoDS_Shape& shape, std::string source,
+                             const MeasureItems& measure_faces) {
   CadModel m;
   CadModel::Impl& im = *m.impl_;
   im.shape = shape;
@@ -333,13 +334,6 @@ CadModel ModelBuilder::build(const TopoDS_Shape& shape, std::string source) {
       f.type = SurfaceType::Other;
     }
     try {
-      GProp_GProps props;
-      BRepGProp::SurfaceProperties(ff, props);
-      f.area = props.Mass();
-    } catch (const Standard_Failure&) {
-      f.area = 0;
-    }
-    try {
       Bnd_Box b;
       BRepBndLib::Add(ff, b, false);
       f.box = to_box(b);
@@ -352,6 +346,24 @@ CadModel ModelBuilder::build(const TopoDS_Shape& shape, std::string source) {
       f.uv_box.add(Vec2{u1, v1});
     } catch (const Standard_Failure&) {
     }
+  }
+
+  const auto area = [&im](LO f) {
+    try {
+      GProp_GProps props;
+      BRepGProp::SurfaceProperties(im.faces[static_cast<std::size_t>(f)], props);
+      return props.Mass();
+    } catch (const Standard_Failure&) {
+      return 0.0;
+    }
+  };
+  if (measure_faces) {
+    const std::vector<double> areas = measure_faces(nf, area);
+    QSMESH_CHECK(static_cast<LO>(areas.size()) == nf,
+                 "load: " << areas.size() << " face areas measured for " << nf << " faces");
+    for (LO f = 0; f < nf; ++f) m.faces_[f].area = areas[static_cast<std::size_t>(f)];
+  } else {
+    for (LO f = 0; f < nf; ++f) m.faces_[f].area = area(f);
   }
 
   const Adjacency face2curves = Adjacency::from_pairs(nf, face_curve);

@@ -23,6 +23,7 @@
 #include "qsmesh/parallel/face_task.hpp"
 #include "qsmesh/parallel/partition.hpp"
 #include "qsmesh/parallel/record.hpp"
+#include "split_round.hpp"
 
 namespace qsmesh::parallel {
 
@@ -1035,106 +1036,19 @@ GroupsForOutput apply_smooth_groups(const cad::CadModel& model, std::vector<Grou
   return out;
 }
 
-// The first error a rank met in a round of the curves stage, sent with its curves so that every
-// rank throws the same one: that of the lowest curve id over all ranks.
-struct CurveError {
-  LO curve = kNoIndex;  // kNoIndex: none
-  std::string message, stage;
-  int dim = -1;
-  std::int64_t id = -1;
-  template <class S, class V>
-  static void fields(S& self, V&& visit) {
-    visit("curve", self.curve);
-    visit("message", self.message);
-    visit("stage", self.stage);
-    visit("dim", self.dim);
-    visit("id", self.id);
-  }
-};
-
-// One round of the curves stage: the curves dealt over the ranks by `weights` (deal_by_weight: by
-// curve id, the same on every rank), work(c) on this rank's curves as tasks, then every curve's
-// result on every rank: each rank writes, per curve of its own, the curve id, its seconds and
-// write(c, bytes), all of which are all-gathered and read back with read(c, bytes, pos). Each
-// curve's result is computed by one rank and copied byte for byte to the others, so the results
-// are those of one rank doing every curve. bytes(c): what write(c, ...) appends (record_bytes).
-// Collective. Throws on every rank the error of the lowest curve whose work failed on any rank.
-template <class Work, class Bytes, class Write, class Read>
-CurveRound curve_round(const Context& cx, std::vector<double> weights, const Work& work,
-                       const Bytes& bytes, const Write& write, const Read& read) {
-  const Stopwatch clock;
-  const int nranks = cx.comm.size();
-  const int rank = cx.comm.rank();
-  const auto n = static_cast<LO>(weights.size());
-  const std::vector<int> owner = deal_by_weight(weights, nranks);
-  std::vector<LO> mine;
-  for (LO c = 0; c < n; ++c)
-    if (owner[c] == rank) mine.push_back(c);
-  CurveRound round;
-  round.curve_seconds.assign(weights.size(), 0.0);
-  std::vector<std::optional<Error>> errors(mine.size());
-  cx.tasks.parallel_for(static_cast<std::int64_t>(mine.size()), [&](std::int64_t i) {
-    const Stopwatch curve_clock;
-    try {
-      work(mine[i]);
-    } catch (const Error& e) {
-      errors[i] = e;
-    }
-    round.curve_seconds[mine[i]] = curve_clock.seconds();
-  });
-  CurveError first;
-  for (std::size_t i = 0; i < mine.size() && first.curve == kNoIndex; ++i)
-    if (errors[i])
-      first = {mine[i], errors[i]->message(), errors[i]->context().stage,
-               errors[i]->context().entity_dim, errors[i]->context().entity_id};
-  if (nranks > 1) {
-    std::vector<char> out;
-    write_record(out, first);
-    for (const LO c : mine) {
-      put<LO>(out, c);
-      put<double>(out, round.curve_seconds[c]);
-      write(c, out);
-    }
-    const std::vector<std::vector<char>> all = cx.comm.allgather_bytes(out);
-    for (int r = 0; r < nranks; ++r) {
-      if (r == rank) continue;
-      const std::vector<char>& in = all[r];
-      std::size_t pos = 0;
-      CurveError theirs;
-      read_record(in, pos, theirs);
-      if (theirs.curve != kNoIndex && (first.curve == kNoIndex || theirs.curve < first.curve))
-        first = std::move(theirs);
-      while (pos < in.size()) {
-        const LO c = get<LO>(in, pos);
-        QSMESH_CHECK(c >= 0 && c < n && owner[c] == r,
-                     "curves: rank " << r << " sent curve " << c << ", not one of its own");
-        round.curve_seconds[c] = get<double>(in, pos);
-        read(c, in, pos);
-      }
-    }
-  }
-  if (first.curve != kNoIndex)
-    throw Error(first.message, ErrorContext{first.stage, first.dim, first.id});
-  for (LO c = 0; c < n; ++c)
-    round.bytes += static_cast<std::int64_t>(sizeof(LO) + sizeof(double)) + bytes(c);
-  round.weights = std::move(weights);
-  round.seconds = clock.seconds();
-  return round;
-}
-
 // The curves stage (background::CurveMeshing), its first two steps split by curve over the ranks
 // in two rounds (curve_round): the sampling, then the feature and wedge sizes, which need every
 // curve's samples. The last step (gradation from the corners and the vertices) needs every
 // curve's sizes and is cheap: every rank does it on every curve. The meshes are those of
 // background::mesh_curves, at any rank count. Collective.
-std::vector<mesh::CurveMesh> curves_stage(const Context& cx, std::vector<CurveRound>& rounds) {
+std::vector<mesh::CurveMesh> curves_stage(const Context& cx, std::vector<SplitRound>& rounds) {
   const background::CurveMeshing meshing(cx.model, cx.options.background.sizes);
   const LO n = meshing.num_curves();
   std::vector<background::CurveSamples> samples(static_cast<std::size_t>(n));
   std::vector<double> weights(static_cast<std::size_t>(n));
   for (LO c = 0; c < n; ++c) weights[c] = meshing.sampling_cost(c);
-  rounds.push_back(curve_round(
-      cx, std::move(weights), [&](LO c) { samples[c] = meshing.sample(c); },
+  rounds.push_back(split_round(
+      cx.comm, cx.tasks, std::move(weights), [&](LO c) { samples[c] = meshing.sample(c); },
       [&](LO c) { return record_bytes(samples[c]); },
       [&](LO c, std::vector<char>& out) { write_record(out, samples[c]); },
       [&](LO c, const std::vector<char>& in, std::size_t& pos) {
@@ -1146,8 +1060,9 @@ std::vector<mesh::CurveMesh> curves_stage(const Context& cx, std::vector<CurveRo
     // A curve's search costs about one query per sample.
     weights.assign(static_cast<std::size_t>(n), 0.0);
     for (LO c = 0; c < n; ++c) weights[c] = static_cast<double>(samples[c].p.size());
-    CurveRound round = curve_round(
-        cx, std::move(weights), [&](LO c) { meshing.limit_sizes(search, samples[c]); },
+    SplitRound round = split_round(
+        cx.comm, cx.tasks, std::move(weights),
+        [&](LO c) { meshing.limit_sizes(search, samples[c]); },
         [&](LO c) { return record_bytes(samples[c].h); },
         [&](LO c, std::vector<char>& out) { write_record(out, samples[c].h); },
         [&](LO c, const std::vector<char>& in, std::size_t& pos) {
@@ -1185,7 +1100,7 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
   for (const auto& c : curves) curve_edges += c.num_edges();
   clock.end("curves", false);
   std::string rounds;
-  for (const CurveRound& r : result.curve_rounds)
+  for (const SplitRound& r : result.curve_rounds)
     rounds += cat(rounds.empty() ? "" : ", ", r.seconds);
   log.info(cat("curves: ", model.num_curves(), " curves meshed, ", curve_edges, " edges (",
                result.times.get("curves"), " s; rounds split by curve ", rounds, " s)"));

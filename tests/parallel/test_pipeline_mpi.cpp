@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <atomic>
 #include <filesystem>
+#include <functional>
 #include <numeric>
 #include <sstream>
 
@@ -32,6 +33,45 @@ cad::CadModel shared_model(const Comm& comm, const std::string& name) {
   if (comm.rank() == 0) test::write_filleted_box(path);
   comm.barrier();
   return cad::load_cad(path);
+}
+
+TEST(MeasureSplit, FaceAreasSplitOverRanksAndThreadsAreTheSerialOnes) {
+  const Comm comm = Comm::world();
+  const std::string path = tmp("measured_box_np" + std::to_string(comm.size()) + ".step");
+  if (comm.rank() == 0) test::write_filleted_box(path);
+  comm.barrier();
+  const cad::CadModel serial = cad::load_cad(path);
+  const TaskArena two(2);
+  SplitRound round;
+  std::atomic<int> measured{0};
+  cad::LoadOptions options;
+  options.measure_faces = [&](LO n, const std::function<double(LO)>& area) {
+    return measure_split(
+        comm, two, n,
+        [&](LO f) {
+          ++measured;
+          return area(f);
+        },
+        &round);
+  };
+  const cad::CadModel split = cad::load_cad(path, options);
+  const LO nf = serial.num_faces();
+  ASSERT_EQ(split.num_faces(), nf);
+  for (LO f = 0; f < nf; ++f) {
+    EXPECT_GT(serial.faces()[f].area, 0.0) << "face " << f;
+    // Computed once, on one rank, and copied bit for bit.
+    EXPECT_EQ(split.faces()[f].area, serial.faces()[f].area) << "face " << f;
+  }
+  // Each face measured once over all ranks, dealt evenly: this rank did its share.
+  std::vector<std::int64_t> count{measured.load()};
+  comm.allreduce_sum(count);
+  EXPECT_EQ(count[0], nf);
+  EXPECT_LE(measured.load(), (nf + comm.size() - 1) / comm.size());
+  ASSERT_EQ(static_cast<LO>(round.item_seconds.size()), nf);
+  EXPECT_EQ(round.weights, std::vector<double>(static_cast<std::size_t>(nf), 1.0));
+  EXPECT_EQ(round.bytes, static_cast<std::int64_t>(nf) *
+                             static_cast<std::int64_t>(sizeof(LO) + 2 * sizeof(double)));
+  for (LO f = 0; f < nf; ++f) EXPECT_GE(round.item_seconds[f], 0.0);
 }
 
 TEST(Comm, ReductionsAndGather) {
@@ -207,15 +247,15 @@ TEST(Pipeline, DistributedEqualsSerial) {
     record_sizes[1] += head + record_bytes(samples.h);
   }
   for (std::size_t k = 0; k < 2; ++k) {
-    const CurveRound& round = result.curve_rounds[k];
+    const SplitRound& round = result.curve_rounds[k];
     ASSERT_EQ(static_cast<LO>(round.weights.size()), ncurves);
-    ASSERT_EQ(static_cast<LO>(round.curve_seconds.size()), ncurves);
+    ASSERT_EQ(static_cast<LO>(round.item_seconds.size()), ncurves);
     EXPECT_EQ(round.bytes, record_sizes[k]) << "round " << k + 1;
     EXPECT_GT(round.seconds, 0.0);
     double work = 0;
     for (LO c = 0; c < ncurves; ++c) {
-      EXPECT_GE(round.curve_seconds[c], 0.0);
-      work += round.curve_seconds[c];
+      EXPECT_GE(round.item_seconds[c], 0.0);
+      work += round.item_seconds[c];
     }
     EXPECT_GT(work, 0.0) << "round " << k + 1;
   }

@@ -227,6 +227,25 @@ class Curves(unittest.TestCase):
                                2.0, places=6)
 
 
+class Load(unittest.TestCase):
+    def test_face_areas_split_by_face(self):
+        # The load's round: four faces of equal weight (dealt 0, 1, 0, 1 over 2 ranks), areas
+        # 0.2, 0.2, 0.1, 0.1 s; the stage 1 s, 0.4 s of it the file's reading on every rank.
+        st = stats([(1, 0, 0, 0, 1, 0)], {"load": 1.0, "background": 1.0})
+        st["load_rounds"] = [{"seconds": 0.6, "bytes": 64, "weights": [1, 1, 1, 1],
+                              "item_seconds": [0.2, 0.2, 0.1, 0.1]}]
+        self.assertEqual(sim.greedy_partition([1, 1, 1, 1], 2), [0, 1, 0, 1])
+        s = sim.Simulator(sim.Run(st), comm=NO_COMM)
+        self.assertAlmostEqual(s.predict(1, 1)["load"], 1.0, places=6)
+        self.assertAlmostEqual(s.predict(2, 1)["load"], 0.7, places=6)
+        self.assertAlmostEqual(s.predict(1, 2)["load"], 0.7, places=6)
+        self.assertAlmostEqual(s.predict(64, 1)["load"], 0.6, places=6)
+        # A run without load rounds keeps the load replicated.
+        del st["load_rounds"]
+        self.assertAlmostEqual(sim.Simulator(sim.Run(st), comm=NO_COMM).predict(64, 1)["load"],
+                               1.0, places=6)
+
+
 class CommandLine(unittest.TestCase):
     def test_refusals_and_output(self):
         script = os.path.join(SCRIPTS, "simulate_scaling.py")

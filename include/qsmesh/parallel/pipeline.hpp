@@ -21,6 +21,7 @@
 #include "qsmesh/mesh/surface_mesh.hpp"
 #include "qsmesh/parallel/comm.hpp"
 #include "qsmesh/parallel/face_task.hpp"
+#include "qsmesh/parallel/split.hpp"
 #include "qsmesh/qstruct/balance.hpp"
 #include "qsmesh/qstruct/cavity.hpp"
 #include "qsmesh/qstruct/face_pattern.hpp"
@@ -208,21 +209,6 @@ struct PipelineOptions {
   bool distance_to_cad = false;
 };
 
-/// One round of the curves stage, split by curve over the ranks (run_pipeline; round 1 samples
-/// the curves, round 2 lowers their sizes to the small features and sharp wedges: the first two
-/// steps of background::CurveMeshing): for --stats and scripts/simulate_scaling.py, which deals
-/// the curves by `weights` as the pipeline does (deal_by_weight) and replays `curve_seconds`.
-struct CurveRound {
-  /// Wall time of the round on this rank, seconds: its share of the curves, the round's setup
-  /// done by every rank (round 2: the search over all curves' samples), and the all-gather.
-  double seconds = 0;
-  /// The records of all curves that the all-gather moves, all ranks together (record_bytes;
-  /// counted on one rank too, where nothing is sent).
-  std::int64_t bytes = 0;
-  std::vector<double> weights;        ///< by curve: its weight in the dealing
-  std::vector<double> curve_seconds;  ///< by curve: its time on the rank that did it, seconds
-};
-
 struct PipelineResult {
   mesh::SurfaceMesh mesh;                       ///< assembled mesh (rank 0 only)
   std::vector<background::FaceReport> reports;  ///< one per face, by face id (rank 0 only)
@@ -248,9 +234,10 @@ struct PipelineResult {
   /// empty for the other faces. Their blocks in block-structured output.
   std::vector<std::vector<fieldmesh::RegionGrid>> field_grids;
   std::vector<int> face_rank;  ///< rank that meshed each face (every rank)
-  /// The curves stage's rounds split by curve over the ranks, in order (every rank): the
-  /// sampling, then (with SizeOptions::feature_size) the feature and wedge sizes.
-  std::vector<CurveRound> curve_rounds;
+  /// The curves stage's rounds split by curve over the ranks, in order (every rank): round 1
+  /// samples the curves, round 2 (with SizeOptions::feature_size) lowers their sizes to the small
+  /// features and sharp wedges: the first two steps of background::CurveMeshing.
+  std::vector<SplitRound> curve_rounds;
   /// With smooth_groups: the first face of each face's group (itself when alone; every rank),
   /// for mesh::check_conformity. Empty otherwise.
   std::vector<LO> face_group;
