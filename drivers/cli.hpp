@@ -128,6 +128,8 @@ struct Arguments {
   std::optional<double> field_divisions;
   /// --distributed-threshold (linalg::SolverOptions::distributed_threshold); unset: its default.
   std::optional<LO> distributed_threshold;
+  /// --field-change max|rms (crossfield::CrossFieldOptions::level_change); empty: its default.
+  std::string field_change;
   bool sew = false;
   bool quiet = false;
   bool verbose = false;

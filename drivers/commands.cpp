@@ -913,6 +913,9 @@ int run_mesh(const Arguments& args) {
   options.background.sizes.field_divisions = field_divisions(args);
   if (args.distributed_threshold)
     options.crossfield.solver.distributed_threshold = *args.distributed_threshold;
+  if (!args.field_change.empty())
+    options.crossfield.level_change =
+        args.field_change == "rms" ? crossfield::LevelChange::Rms : crossfield::LevelChange::Max;
   check_request(args, s);
   if (until >= parallel::Stage::Unstructured) apply_size_options(args, s, options);
   s.announce(args, "mesh");
