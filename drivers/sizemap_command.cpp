@@ -89,6 +89,7 @@ int run_sizemap(const Arguments& args) {
   if (!args.field_change.empty())
     options.crossfield.level_change =
         args.field_change == "rms" ? crossfield::LevelChange::Rms : crossfield::LevelChange::Max;
+  if (args.field_iterations) options.crossfield.max_iterations_per_level = *args.field_iterations;
   options.size_map = true;
   check_request(args, s);
   apply_size_options(args, s, options);
