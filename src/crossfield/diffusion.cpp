@@ -197,20 +197,22 @@ void diffuse(FaceCrossField& cf, const Geometry& g, const CrossFieldOptions& opt
       U[i] = has_boundary ? 0.0 : cf.u[e].u;
       U[i + 1] = has_boundary ? 0.0 : cf.u[e].v;
     }
-  std::vector<double> previous(U.size()), pair_mass(U.size() / 2);
+  std::vector<double> previous(U.size()), pair_mass(U.size() / 2), m_alpha(U.size());
   for (std::size_t k = 0; k < pair_mass.size(); ++k) pair_mass[k] = mfree[2 * k];
   linalg::SparseMatrix A = K;
   for (int level = 0; level < options.levels; ++level) {
     const double alpha =
         options.levels == 1 ? a1 : a0 + (a1 - a0) * double(level) / double(options.levels - 1);
     A.values() = K.values();
-    for (LO i = 0; i < n; ++i) A.values()[diag[i]] += mfree[i] / alpha;
+    // M / α once a level: the same quotients the loops below would divide out every iteration.
+    for (LO i = 0; i < n; ++i) m_alpha[i] = mfree[i] / alpha;
+    for (LO i = 0; i < n; ++i) A.values()[diag[i]] += m_alpha[i];
     solver->factorize(A);
     ++cf.stats.factorizations;
     int it = 0;
     double change = 1e300;
     while (change >= options.tolerance && it < options.max_iterations_per_level) {
-      for (LO i = 0; i < n; ++i) rhs[i] = mfree[i] / alpha * U[i] + coupling[i];
+      for (LO i = 0; i < n; ++i) rhs[i] = m_alpha[i] * U[i] + coupling[i];
       solver->solve(rhs, X);
       ++cf.stats.solves;
       ++it;
