@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "qsmesh/core/error.hpp"
+#include "qsmesh/crossfield/cross_field.hpp"
 #include "qsmesh/io/writer.hpp"
 #include "qsmesh/parallel/pipeline.hpp"
 
@@ -212,6 +213,16 @@ Arguments parse(const std::vector<std::string>& args) {
       if (!n || !std::isfinite(*n) || *n < 1 || *n > 2e9 || *n != std::floor(*n))
         throw InputError(opt + ": '" + v + "' is not a number of unknowns in [1, 2e9]");
       a.distributed_threshold = static_cast<LO>(*n);
+    } else if (opt == "--field-change" && meshing) {
+      const std::string& v = value();
+      if (v != "max" && v != "rms") throw InputError(opt + ": '" + v + "' is not max or rms");
+      a.field_change = v;
+    } else if (opt == "--field-iterations" && meshing) {
+      const std::string& v = value();
+      const auto n = parse_double(v);
+      if (!n || !std::isfinite(*n) || *n < 1 || *n > 1000 || *n != std::floor(*n))
+        throw InputError(opt + ": '" + v + "' is not a number of iterations in [1, 1000]");
+      a.field_iterations = static_cast<int>(*n);
     } else if (opt == "--block-structured" && a.command == Command::Mesh)
       a.block_structured = true;
     else if (opt == "--block-patches" && a.command == Command::Mesh)
@@ -646,6 +657,13 @@ std::string help(const std::string& topic) {
        << linalg::SolverOptions{}.distributed_threshold
        << ");\n"
           "                        the mesh is the same at any rank count\n"
+          "  --field-change M      how a cross-field diffusion level measures its convergence:\n"
+          "                        max (default: the largest change of any edge's cross) or rms\n"
+          "                        (the area-weighted root mean square; fewer solves, another\n"
+          "                        mesh: docs/benchmarks.md, issue 27, branch field2)\n"
+          "  --field-iterations N  at most N iterations per cross-field diffusion level (default "
+       << crossfield::CrossFieldOptions{}.max_iterations_per_level
+       << ")\n"
           "  --face-time-budget S  at most S seconds of cavity remeshing (paper 000 Sec. 6.2) per\n"
           "                        face; a face that reaches it keeps the mesh it has (valid) and "
           "is\n"
@@ -702,7 +720,8 @@ std::string help(const std::string& topic) {
           "end\n"
           "                        with the line 'euler-consistent: K/N'\n"
           "  --size H, --size-factor F, --threads T, --stats FILE.json, --max-quads N,\n"
-          "  --field-divisions N, --distributed-threshold N, --sew, -q, -v: as for mesh\n";
+          "  --field-divisions N, --distributed-threshold N, --field-change M,\n"
+          "  --field-iterations N, --sew, -q, -v: as for mesh\n";
   } else if (topic == "sizemap") {
     os << "usage: [mpirun -np P] qsmesh sizemap MODEL -o OUT.vtu [options]\n\n"
           "Computes the size map (paper 000 Sec. 4.1-4.2) and the curve quantization (Sec. 4.3):\n"
@@ -760,7 +779,8 @@ std::string help(const std::string& topic) {
           "  --corner-size K:H,.., --curve-size C:H,.., --face-size F:H,..\n"
           "                        size constraints at corners, on curves, on faces (model units)\n"
           "  --size H, --size-factor F, --threads T, --stats FILE.json, --max-quads N,\n"
-          "  --field-divisions N, --distributed-threshold N, --sew, -q, -v: as for mesh\n";
+          "  --field-divisions N, --distributed-threshold N, --field-change M,\n"
+          "  --field-iterations N, --sew, -q, -v: as for mesh\n";
   } else if (topic == "example") {
     os << "usage: qsmesh example NAME -o FILE\n\n"
           "Writes a built-in CAD model built with OpenCASCADE, as STEP (FILE.step, .stp) or BREP\n"

@@ -128,6 +128,11 @@ struct Arguments {
   std::optional<double> field_divisions;
   /// --distributed-threshold (linalg::SolverOptions::distributed_threshold); unset: its default.
   std::optional<LO> distributed_threshold;
+  /// --field-change max|rms (crossfield::CrossFieldOptions::level_change); empty: its default.
+  std::string field_change;
+  /// --field-iterations N (crossfield::CrossFieldOptions::max_iterations_per_level); unset: its
+  /// default.
+  std::optional<int> field_iterations;
   bool sew = false;
   bool quiet = false;
   bool verbose = false;

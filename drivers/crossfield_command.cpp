@@ -71,6 +71,10 @@ int run_crossfield(const Arguments& args) {
   options.background.sizes.field_divisions = field_divisions(args);
   if (args.distributed_threshold)
     options.crossfield.solver.distributed_threshold = *args.distributed_threshold;
+  if (!args.field_change.empty())
+    options.crossfield.level_change =
+        args.field_change == "rms" ? crossfield::LevelChange::Rms : crossfield::LevelChange::Max;
+  if (args.field_iterations) options.crossfield.max_iterations_per_level = *args.field_iterations;
   options.cross_fields = true;
   const parallel::PipelineResult result =
       parallel::run_pipeline(s.comm, s.model, options, *s.tasks, s.log, &lane);

@@ -197,28 +197,32 @@ void diffuse(FaceCrossField& cf, const Geometry& g, const CrossFieldOptions& opt
       U[i] = has_boundary ? 0.0 : cf.u[e].u;
       U[i + 1] = has_boundary ? 0.0 : cf.u[e].v;
     }
+  std::vector<double> previous(U.size()), pair_mass(U.size() / 2), m_alpha(U.size());
+  for (std::size_t k = 0; k < pair_mass.size(); ++k) pair_mass[k] = mfree[2 * k];
   linalg::SparseMatrix A = K;
   for (int level = 0; level < options.levels; ++level) {
     const double alpha =
         options.levels == 1 ? a1 : a0 + (a1 - a0) * double(level) / double(options.levels - 1);
     A.values() = K.values();
-    for (LO i = 0; i < n; ++i) A.values()[diag[i]] += mfree[i] / alpha;
+    // M / α once a level: the same quotients the loops below would divide out every iteration.
+    for (LO i = 0; i < n; ++i) m_alpha[i] = mfree[i] / alpha;
+    for (LO i = 0; i < n; ++i) A.values()[diag[i]] += m_alpha[i];
     solver->factorize(A);
     ++cf.stats.factorizations;
     int it = 0;
     double change = 1e300;
     while (change >= options.tolerance && it < options.max_iterations_per_level) {
-      for (LO i = 0; i < n; ++i) rhs[i] = mfree[i] / alpha * U[i] + coupling[i];
+      for (LO i = 0; i < n; ++i) rhs[i] = m_alpha[i] * U[i] + coupling[i];
       solver->solve(rhs, X);
       ++cf.stats.solves;
       ++it;
-      change = 0;
+      previous = U;
       for (LO i = 0; i < n; i += 2) {
         const Vec2 p = project({X[i], X[i + 1]}, Vec2{U[i], U[i + 1]});
-        change = std::max({change, std::abs(p.u - U[i]), std::abs(p.v - U[i + 1])});
         U[i] = p.u;
         U[i + 1] = p.v;
       }
+      change = level_change(previous, U, pair_mass, options.level_change);
     }
     cf.stats.iterations_per_level.push_back(it);
     ++cf.stats.levels;
@@ -231,6 +235,33 @@ void diffuse(FaceCrossField& cf, const Geometry& g, const CrossFieldOptions& opt
                    "crossfield: face " << cf.face << ": non-finite cross at edge " << e);
     }
 }
+
+}  // namespace qsmesh::crossfield::detail
+
+namespace qsmesh::crossfield {
+
+double level_change(std::span<const double> before, std::span<const double> after,
+                    std::span<const double> mass, LevelChange how) {
+  QSMESH_CHECK(before.size() == after.size() && before.size() == 2 * mass.size(),
+               "crossfield: level_change needs two pairs of values per mass");
+  if (how == LevelChange::Max) {
+    double change = 0;
+    for (std::size_t i = 0; i < before.size(); ++i)
+      change = std::max(change, std::abs(after[i] - before[i]));
+    return change;
+  }
+  double sum = 0, total = 0;
+  for (std::size_t k = 0; k < mass.size(); ++k) {
+    const double du = after[2 * k] - before[2 * k], dv = after[2 * k + 1] - before[2 * k + 1];
+    sum += mass[k] * (du * du + dv * dv);
+    total += mass[k];
+  }
+  return total > 0 ? std::sqrt(sum / total) : 0.0;
+}
+
+}  // namespace qsmesh::crossfield
+
+namespace qsmesh::crossfield::detail {
 
 bool set_exact_uniform_field(FaceCrossField& cf, const Geometry& g) {
   const std::size_t ne = cf.edges.size(), nt = cf.triangles.size();

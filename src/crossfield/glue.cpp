@@ -43,7 +43,17 @@ void glue_triangulation(const mesh::FaceMesh& background, FaceCrossField& cf) {
   }
   QSMESH_CHECK(!cf.triangles.empty(), "crossfield: every triangle collapsed by gluing");
 
-  std::map<std::pair<LO, LO>, LO> key2edge;
+  // Edges numbered in the order of their first appearance in the triangle list. The edges (a, b),
+  // a < b, of each vertex a sit in a slot of a flat array sized by the half-edges leaving a: a
+  // short linear scan finds an edge again (the balanced tree this replaces cost as much as the
+  // rest of the stage on the large planar walls of a far-field box).
+  const std::size_t nv_glued = cf.points.size();
+  std::vector<LO> first(nv_glued + 1, 0);
+  for (const auto& tri : cf.triangles)
+    for (int k = 0; k < 3; ++k) ++first[std::min(tri[k], tri[(k + 1) % 3]) + 1];
+  for (std::size_t v = 0; v < nv_glued; ++v) first[v + 1] += first[v];
+  std::vector<LO> filled(nv_glued, 0);
+  std::vector<LO> slot_edge(static_cast<std::size_t>(first[nv_glued]));
   cf.edges.clear();
   cf.tri2edges.assign(cf.triangles.size(), {kNoIndex, kNoIndex, kNoIndex});
   std::vector<int> count;
@@ -51,14 +61,20 @@ void glue_triangulation(const mesh::FaceMesh& background, FaceCrossField& cf) {
     for (int k = 0; k < 3; ++k) {
       LO a = cf.triangles[t][k], b = cf.triangles[t][(k + 1) % 3];
       if (a > b) std::swap(a, b);
-      const auto [it, inserted] =
-          key2edge.emplace(std::make_pair(a, b), static_cast<LO>(cf.edges.size()));
-      if (inserted) {
+      const LO* begin = slot_edge.data() + first[a];
+      const LO* end = begin + filled[a];
+      const LO* it = std::find_if(begin, end, [&](LO e) { return cf.edges[e][1] == b; });
+      LO e = 0;
+      if (it != end) {
+        e = *it;
+      } else {
+        e = static_cast<LO>(cf.edges.size());
+        slot_edge[first[a] + filled[a]++] = e;
         cf.edges.push_back({a, b});
         count.push_back(0);
       }
-      cf.tri2edges[t][k] = it->second;
-      ++count[it->second];
+      cf.tri2edges[t][k] = e;
+      ++count[e];
     }
   }
   cf.boundary_edge.assign(cf.edges.size(), 0);

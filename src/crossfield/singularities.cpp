@@ -23,10 +23,11 @@ void find_singularities(FaceCrossField& cf, const Geometry& g, const CrossFieldO
   std::vector<int> tri_index(static_cast<std::size_t>(nt), 0);
   for (LO t = 0; t < nt; ++t) {
     double sum = 0;
+    const double angle[3] = {angle_in_triangle(cf, g, t, 0), angle_in_triangle(cf, g, t, 1),
+                             angle_in_triangle(cf, g, t, 2)};
     for (int m = 0; m < 3; ++m) {
       // At vertex m, counterclockwise around the normal: from edge (m, m+1) to edge (m+2, m).
-      const double d =
-          wrap_angle(angle_in_triangle(cf, g, t, (m + 2) % 3) - angle_in_triangle(cf, g, t, m));
+      const double d = wrap_angle(angle[(m + 2) % 3] - angle[m]);
       S[cf.triangles[t][m]] += d;
       sum += d;
     }
@@ -47,13 +48,19 @@ void find_singularities(FaceCrossField& cf, const Geometry& g, const CrossFieldO
 
   // Group singular cells touching each other (vertex-vertex by an edge, vertex-triangle by
   // incidence, triangle-triangle by an edge); a group whose indices sum to ±1 is one singularity.
-  std::vector<std::vector<LO>> v2t(static_cast<std::size_t>(nv));
-  for (LO t = 0; t < nt; ++t)
-    for (LO v : cf.triangles[t]) v2t[v].push_back(t);
+  // The triangles around each vertex, built only when some cell is singular (most faces of a CAD
+  // model have no singularity at all).
+  const bool any_singular =
+      std::any_of(vert_index.begin(), vert_index.end(), [](int k) { return k != 0; }) ||
+      std::any_of(tri_index.begin(), tri_index.end(), [](int k) { return k != 0; });
+  std::vector<std::vector<LO>> v2t(any_singular ? static_cast<std::size_t>(nv) : 0);
+  if (any_singular)
+    for (LO t = 0; t < nt; ++t)
+      for (LO v : cf.triangles[t]) v2t[v].push_back(t);
   const auto cell_index = [&](LO c) { return c < nv ? vert_index[c] : tri_index[c - nv]; };
-  std::vector<std::uint8_t> seen(static_cast<std::size_t>(nv + nt), 0);
+  std::vector<std::uint8_t> seen(any_singular ? static_cast<std::size_t>(nv + nt) : 0, 0);
   cf.singularities.clear();
-  for (LO c0 = 0; c0 < nv + nt; ++c0) {
+  for (LO c0 = 0; any_singular && c0 < nv + nt; ++c0) {
     if (seen[c0] || cell_index(c0) == 0) continue;
     std::vector<LO> group{c0};
     seen[c0] = 1;

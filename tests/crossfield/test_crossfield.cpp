@@ -21,6 +21,7 @@
 #include "load_shape.hpp"
 #include "qsmesh/background/curve_mesh.hpp"
 #include "qsmesh/background/face_mesh.hpp"
+#include "qsmesh/core/error.hpp"
 #include "qsmesh/crossfield/cross_field.hpp"
 #include "shapes.hpp"
 #include "tmp_dir.hpp"
@@ -471,6 +472,64 @@ TEST(CrossField, ScalingConstantGivesTheQuadCount) {
   // Constant H = 0 on a plane with aligned crosses: h = e^C, and area / h^2 = N.
   const double C = scaling_constant(r.cf, 200);
   EXPECT_NEAR(2.0 / std::exp(2 * C), 200, 1e-6 * 200);
+}
+
+TEST(CrossField, LevelChangeRmsWeighsEdgesByMass) {
+  // Three edges; the third, of a hundredth of the others' mass, turns its cross by a right angle
+  // (4θ by π: (1, 0) -> (-1, 0)), as the edges next to a moving singularity do.
+  const std::vector<double> before{1, 0, 0, 1, 1, 0}, mass{1, 1, 0.01};
+  std::vector<double> after = before;
+  after[4] = -1;
+  EXPECT_DOUBLE_EQ(level_change(before, after, mass, LevelChange::Max), 2.0);
+  const double rms = level_change(before, after, mass, LevelChange::Rms);
+  EXPECT_NEAR(rms, std::sqrt(0.01 * 4 / 2.01), 1e-15);
+  EXPECT_LT(rms, 0.15);
+  // A change spread evenly over the face reads the same either way (per component for Max, per
+  // pair for Rms: a change of d in one component of every pair).
+  std::vector<double> even = before;
+  for (std::size_t k = 0; k < 3; ++k) even[2 * k + 1] += 1e-3;
+  EXPECT_NEAR(level_change(before, even, mass, LevelChange::Max), 1e-3, 1e-15);
+  EXPECT_NEAR(level_change(before, even, mass, LevelChange::Rms), 1e-3, 1e-15);
+  EXPECT_EQ(level_change(before, before, mass, LevelChange::Rms), 0.0);
+  EXPECT_THROW((void)level_change(before, after, std::vector<double>{1, 1}, LevelChange::Rms),
+               Error);
+}
+
+TEST(CrossField, RmsLevelChangeSolvesLessForTheSameSingularities) {
+  // A plate with holes of several radii: around each hole four -1 singularities settle as the
+  // finest levels creep them cell by cell; the largest change stays large while the rest of the
+  // face has converged.
+  BRepBuilderAPI_MakeFace mk(gp_Pln(gp::XOY()), 0.0, 6.0, 0.0, 3.0);
+  const double radius[3] = {0.25, 0.35, 0.45};
+  for (int i = 0; i < 3; ++i)
+    for (int j = 0; j < 2; ++j) {
+      const gp_Circ c(gp_Ax2(gp_Pnt(1.0 + 2.0 * i, 0.8 + 1.4 * j, 0), gp_Dir(0, 0, 1)),
+                      radius[(i + j) % 3]);
+      mk.Add(TopoDS::Wire(
+          BRepBuilderAPI_MakeWire(BRepBuilderAPI_MakeEdge(c).Edge()).Wire().Reversed()));
+    }
+  const auto model = test::load_shape(mk.Face(), "cf_holes.brep");
+  CrossFieldOptions max_change, rms_change;
+  rms_change.level_change = LevelChange::Rms;
+  const auto a = run(model, 0, 0.06, "holes-max", max_change);
+  const auto b = run(model, 0, 0.06, "holes-rms", rms_change);
+  EXPECT_TRUE(a.cf.euler.consistent);
+  EXPECT_TRUE(b.cf.euler.consistent);
+  EXPECT_EQ(a.cf.singularities.size(), b.cf.singularities.size());
+  EXPECT_EQ(a.cf.stats.levels, b.cf.stats.levels);
+  EXPECT_LT(b.cf.stats.solves, a.cf.stats.solves);
+  for (std::size_t l = 0; l < a.cf.stats.iterations_per_level.size(); ++l)
+    EXPECT_LE(b.cf.stats.iterations_per_level[l], a.cf.stats.iterations_per_level[l]);
+  // The two fields agree away from the singularities: the directions of most triangles within a
+  // degree.
+  ASSERT_EQ(a.cf.directions.size(), b.cf.directions.size());
+  std::size_t close = 0;
+  for (std::size_t t = 0; t < a.cf.directions.size(); ++t)
+    if (cross_deviation_deg(b.cf.directions[t], a.cf.directions[t][0], a.cf.directions[t][1]) < 1)
+      ++close;
+  std::printf("[crossfield] holes: %zu of %zu triangles within 1 deg\n", close,
+              a.cf.directions.size());
+  EXPECT_GT(double(close), 0.9 * double(a.cf.directions.size()));
 }
 
 }  // namespace

@@ -58,6 +58,25 @@ TEST(Cli, DistributedThreshold) {
   EXPECT_NE(help("mesh").find("--distributed-threshold"), std::string::npos);
 }
 
+TEST(Cli, FieldChangeAndIterations) {
+  const Arguments plain = p({"mesh", "m.step", "-o", "o.vtu"});
+  EXPECT_TRUE(plain.field_change.empty());
+  EXPECT_FALSE(plain.field_iterations.has_value());
+  EXPECT_EQ(p({"mesh", "m.step", "-o", "o.vtu", "--field-change", "rms"}).field_change, "rms");
+  EXPECT_EQ(p({"crossfield", "m.step", "--check", "--field-change", "max"}).field_change, "max");
+  EXPECT_EQ(*p({"mesh", "m.step", "-o", "o.vtu", "--field-iterations", "20"}).field_iterations, 20);
+  EXPECT_NE(
+      error_of({"mesh", "m.step", "-o", "o.vtu", "--field-change", "l2"}).find("--field-change"),
+      std::string::npos);
+  for (const char* bad : {"0", "-1", "2.5", "x", "1001"})
+    EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--field-iterations", bad})
+                  .find("--field-iterations"),
+              std::string::npos)
+        << bad;
+  EXPECT_NE(help("mesh").find("--field-change"), std::string::npos);
+  EXPECT_NE(help("mesh").find("--field-iterations"), std::string::npos);
+}
+
 TEST(Cli, CrossFieldAndSeparatrixMethod) {
   const Arguments a =
       p({"mesh", "m.step", "-o", "o.vtu", "--cross-field", "f.txt", "--method", "separatrix"});
