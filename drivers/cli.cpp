@@ -395,8 +395,7 @@ Arguments parse(const std::vector<std::string>& args) {
       sizing_rules_given || a.sizemap != "crossfield" || a.quads > 0 || a.curvature_edges ||
       a.face_curvature || a.feature_ratio || a.thin_aspect || a.size_min || a.size_min_ratio ||
       !a.curve_edges.empty() || !a.face_quads.empty() || !a.corner_sizes.empty() ||
-      !a.curve_sizes.empty() || !a.face_sizes.empty() || a.odd_slivers ||
-      a.one_edge_slivers;
+      !a.curve_sizes.empty() || !a.face_sizes.empty() || a.odd_slivers || a.one_edge_slivers;
   if (a.command == Command::Mesh && sizing_given && a.until == "background")
     throw InputError(
         "size-map options act on the quad mesh: with --until background only --size or "

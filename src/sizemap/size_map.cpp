@@ -446,8 +446,7 @@ CurveSizes initial_curve_sizes(const cad::CadModel& model, std::span<const mesh:
     const bool one_edge = cc.length < sliver;
     const double cap = (one_edge ? kOneEdgeSliverCornerRatio : kSliverCornerRatio) * cc.length;
     for (const LO k : cc.corners)
-      if (k >= 0 && cap < out.corner[k] &&
-          (one_edge || !grid_face_without_curve_at(model, k, c)))
+      if (k >= 0 && cap < out.corner[k] && (one_edge || !grid_face_without_curve_at(model, k, c)))
         out.corner[k] = cap;
   }
 
