@@ -283,6 +283,8 @@ Arguments parse(const std::vector<std::string>& args) {
       a.face_curvature = true;
     } else if (opt == "--odd-slivers" && sizing) {
       a.odd_slivers = true;
+    } else if (opt == "--one-edge-slivers" && sizing) {
+      a.one_edge_slivers = true;
     } else if (opt == "--feature-ratio" && sizing) {
       const std::string& v = value();
       const auto r = parse_double(v);
@@ -404,7 +406,7 @@ Arguments parse(const std::vector<std::string>& args) {
       sizing_rules_given || a.sizemap != "crossfield" || a.quads > 0 || a.curvature_edges ||
       a.face_curvature || a.feature_ratio || a.thin_aspect || a.size_min || a.size_min_ratio ||
       !a.curve_edges.empty() || !a.face_quads.empty() || !a.corner_sizes.empty() ||
-      !a.curve_sizes.empty() || !a.face_sizes.empty() || a.odd_slivers;
+      !a.curve_sizes.empty() || !a.face_sizes.empty() || a.odd_slivers || a.one_edge_slivers;
   if (a.command == Command::Mesh && sizing_given && a.until == "background")
     throw InputError(
         "size-map options act on the quad mesh: with --until background only --size or "
@@ -636,6 +638,7 @@ std::string help(const std::string& topic) {
           "K,\n"
           "  --size-min H, --size-min-ratio R, --sizing RULES, --curve-edges C:N,.., "
           "--odd-slivers,\n"
+          "  --one-edge-slivers,\n"
           "  --face-quads F:N,.., --corner-size K:H,.., --curve-size C:H,.., --face-size F:H,..,\n"
           "  --sizemap METHOD\n"
           "                        size-map controls, as for sizemap (see qsmesh sizemap --help);\n"
@@ -775,6 +778,9 @@ std::string help(const std::string& topic) {
           "  --odd-slivers         a curve nearer 1 edge than 2 (its size map's count below\n"
           "                        sqrt 2) takes 1 edge, the loops kept even by other curves;\n"
           "                        off by default (measured: docs/benchmarks.md)\n"
+          "  --one-edge-slivers    a curve shorter than a tenth of the size floor takes 1 edge,\n"
+          "                        its corners at most 10 x its length even beside four-sided\n"
+          "                        faces; off by default (measured: docs/benchmarks.md)\n"
           "  --face-quads F:N,..   prescribe the number of quads of faces\n"
           "  --corner-size K:H,.., --curve-size C:H,.., --face-size F:H,..\n"
           "                        size constraints at corners, on curves, on faces (model units)\n"

@@ -93,6 +93,9 @@ struct Arguments {
   bool face_curvature = false;
   /// --odd-slivers: curves nearer 1 edge than 2 take 1 (quantize::QuantizeOptions::odd_slivers).
   bool odd_slivers = false;
+  /// --one-edge-slivers: curves shorter than a tenth of the floor take 1 edge, their corners graded
+  /// (sizemap::SizeMapOptions::one_edge_slivers).
+  bool one_edge_slivers = false;
   /// --feature-ratio R: how far small features refine (sizemap::SizeMapOptions::feature_ratio;
   /// unset: its default).
   std::optional<double> feature_ratio;

@@ -865,6 +865,8 @@ void apply_size_options(const Arguments& args, const Session& s,
   for (const auto& [id, v] : args.face_sizes) so.face_sizes.emplace_back(id, v);
   for (const auto& [id, n] : args.curve_edges) options.quantize.prescribed.emplace_back(id, n);
   options.quantize.odd_slivers = args.odd_slivers;
+  so.one_edge_slivers = args.one_edge_slivers;
+  options.quantize.sliver_length = sizemap::sliver_length(so);
   // Odd counts are fine as long as every face loop can stay even (midpoint subdivision): what
   // no choice of the other curves allows is refused now, naming the loop, not after the sizes.
   quantize::check_prescription_parity(s.model, options.quantize.prescribed);

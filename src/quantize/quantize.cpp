@@ -674,7 +674,11 @@ Quantization quantize_level(const cad::CadModel& model, std::span<const double> 
       };
       // A sliver (options.odd_slivers): 1 edge rather than 2 when the ideal count is nearer 1
       // (in ratio: below sqrt 2), so that a strip is one quad across.
-      if (options.odd_slivers && other == 1 && mean < std::numbers::sqrt2) {
+      // A curve shorter than options.sliver_length likewise, whatever its ideal count.
+      bool sliver = options.sliver_length > 0 && now == 2;
+      for (const LO m : mem)
+        sliver = sliver && fixed[m] == 0 && model.curves()[m].length < options.sliver_length;
+      if ((options.odd_slivers && other == 1 && mean < std::numbers::sqrt2) || sliver) {
         for (const LO m : mem) q.edges[m] = 1;
         alternative[v] = now;
       } else {

@@ -64,6 +64,15 @@ constexpr double kSharedWedgeAspect = 0.6;
 /// irregular vertices; with the exception its meshes are unchanged.
 constexpr double kSliverCornerRatio = 5;
 
+/// Rule (i') for a sliver that takes one edge (SizeMapOptions::one_edge_slivers): its corners are
+/// at most this many times its length, at every corner. Ten edge lengths, as kSliverCornerRatio
+/// gives a 2-edge sliver: the quads against the edge then have SICN about 2 / 10 at the corner.
+constexpr double kOneEdgeSliverCornerRatio = 10;
+
+/// Sliver curves that take one edge are shorter than this fraction of the floor (sliver_length):
+/// a tenth, as rule (ii) ignores gaps narrower than a tenth of the floor.
+constexpr double kSliverFraction = 0.1;
+
 constexpr double kInf = std::numeric_limits<double>::infinity();
 
 [[noreturn]] void input_error(const std::string& what) { throw InputError("sizemap: " + what); }
@@ -195,6 +204,10 @@ double effective_size_min(const SizeMapOptions& options) {
     for (const auto& [id, v] : *list)
       if (v > 0) floor = std::min(floor, v);
   return floor;
+}
+
+double sliver_length(const SizeMapOptions& options) {
+  return options.one_edge_slivers ? kSliverFraction * effective_size_min(options) : 0.0;
 }
 
 std::vector<double> CurveSizes::pack() const {
@@ -424,13 +437,16 @@ CurveSizes initial_curve_sizes(const cad::CadModel& model, std::span<const mesh:
 
   // (i') The corners of a curve shorter than the floor: at most kSliverCornerRatio x its length,
   //      so that the sizes grade toward it instead of dropping from the floor to its edges in one
-  //      row (except where a grid face beside it takes the corner as it is).
+  //      row (except where a grid face beside it takes the corner as it is, unless the curve takes
+  //      one edge: one_edge_slivers).
+  const double sliver = sliver_length(options);
   for (LO c = 0; c < nc; ++c) {
     const auto& cc = model.curves()[c];
     if (cc.degenerate || !(cc.length < floor)) continue;
-    const double cap = kSliverCornerRatio * cc.length;
+    const bool one_edge = cc.length < sliver;
+    const double cap = (one_edge ? kOneEdgeSliverCornerRatio : kSliverCornerRatio) * cc.length;
     for (const LO k : cc.corners)
-      if (k >= 0 && cap < out.corner[k] && !grid_face_without_curve_at(model, k, c))
+      if (k >= 0 && cap < out.corner[k] && (one_edge || !grid_face_without_curve_at(model, k, c)))
         out.corner[k] = cap;
   }
 

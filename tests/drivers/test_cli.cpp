@@ -353,6 +353,8 @@ TEST(Cli, SizeMapOptions) {
   EXPECT_TRUE(p({"sizemap", "m.step", "-o", "s.vtu", "--face-curvature"}).face_curvature);
   EXPECT_TRUE(p({"mesh", "m.step", "-o", "o.msh", "--odd-slivers"}).odd_slivers);
   EXPECT_FALSE(p({"mesh", "m.step", "-o", "o.msh"}).odd_slivers);
+  EXPECT_TRUE(p({"mesh", "m.step", "-o", "o.msh", "--one-edge-slivers"}).one_edge_slivers);
+  EXPECT_FALSE(p({"mesh", "m.step", "-o", "o.msh"}).one_edge_slivers);
   EXPECT_FALSE(p({"mesh", "m.step", "-o", "o.vtu"}).feature_ratio.has_value());
   EXPECT_DOUBLE_EQ(*p({"mesh", "m.step", "-o", "o.vtu", "--feature-ratio", "0"}).feature_ratio,
                    0.0);

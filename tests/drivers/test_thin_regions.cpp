@@ -8,13 +8,16 @@
 #include <BRepBuilderAPI_MakeEdge.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepBuilderAPI_MakePolygon.hxx>
+#include <BRepBuilderAPI_MakeVertex.hxx>
 #include <BRepBuilderAPI_MakeWire.hxx>
 #include <BRepPrimAPI_MakePrism.hxx>
 #include <BRepTools.hxx>
+#include <BRep_Builder.hxx>
 #include <GC_MakeArcOfCircle.hxx>
 #include <TopoDS.hxx>
 #include <TopoDS_Face.hxx>
 #include <TopoDS_Shape.hxx>
+#include <TopoDS_Shell.hxx>
 #include <TopoDS_Wire.hxx>
 #include <array>
 #include <cmath>
@@ -352,6 +355,72 @@ TEST(ThinRegions, StepShorterThanTheFloorGetsItsCornersGraded) {
   std::printf("step 0.003 high: SICN min %.3f over the %zu quads within 1 of it\n", sicn, near);
   ASSERT_GT(near, 0u);
   EXPECT_GE(sicn, 0.15);
+}
+
+// A sliver between two faces, as at wing_fuselage's wing roots: four coplanar faces sharing their
+// edges around the curve x = 0, 0 <= y <= s (s = 0.005 at --size 1, below a tenth of the floor,
+// 0.17). A = [0, 10] x [0, 4] and B = [-4, 0] x [-4, s] both hold it, each with a straight
+// (180-degree) corner at one of its ends; the four-sided C = [0, 10] x [-4, 0] and D = [-4, 0] x
+// [s, 4] touch its corners without it. Rule (i') leaves corners that a four-sided face touches at
+// the floor, and the quads against the sliver's two edges of s / 2 were 0.28 long at the straight
+// corner: SICN 0.016 (about 2 (s / 2) / L), which no vertex move lifts. With one edge on the
+// sliver and its corners at most 10 x s at every corner (--one-edge-slivers,
+// SizeMapOptions::one_edge_slivers) the lift after the smoothing takes them to 0.1 (0.101; s =
+// 0.003: 0.009 -> 0.114, s = 0.01: 0.085 -> 0.136).
+std::string write_sliver_between_grids(double s, const std::string& path) {
+  const auto v = [](double x, double y) {
+    return BRepBuilderAPI_MakeVertex(gp_Pnt(x, y, 0)).Vertex();
+  };
+  const TopoDS_Vertex p6 = v(0, 0), p7 = v(0, s), a = v(0, 4), b = v(10, 4), c = v(10, 0),
+                      d = v(10, -4), e = v(0, -4), f = v(-4, -4), g = v(-4, s), h = v(-4, 4);
+  const auto edge = [](const TopoDS_Vertex& p, const TopoDS_Vertex& q) {
+    return BRepBuilderAPI_MakeEdge(p, q).Edge();
+  };
+  const TopoDS_Edge sliver = edge(p6, p7), p7a = edge(p7, a), ab = edge(a, b), bc = edge(b, c),
+                    cp6 = edge(c, p6), cd = edge(c, d), de = edge(d, e), ep6 = edge(e, p6),
+                    ef = edge(e, f), fg = edge(f, g), gp7 = edge(g, p7), gh = edge(g, h),
+                    ha = edge(h, a);
+  TopoDS_Shell shell;
+  BRep_Builder builder;
+  builder.MakeShell(shell);
+  for (const std::vector<TopoDS_Edge>& loop :
+       {std::vector<TopoDS_Edge>{sliver, p7a, ab, bc, cp6},
+        std::vector<TopoDS_Edge>{ep6, sliver, gp7, fg, ef},
+        std::vector<TopoDS_Edge>{cp6, cd, de, ep6}, std::vector<TopoDS_Edge>{p7a, ha, gh, gp7}}) {
+    BRepBuilderAPI_MakeWire wire;
+    for (const TopoDS_Edge& x : loop) wire.Add(x);
+    if (!wire.IsDone()) throw std::runtime_error("sliver wire construction failed");
+    BRepBuilderAPI_MakeFace face(wire.Wire(), /*OnlyPlane=*/true);
+    if (!face.IsDone()) throw std::runtime_error("sliver face construction failed");
+    builder.Add(shell, face.Face());
+  }
+  if (!BRepTools::Write(shell, path.c_str())) throw std::runtime_error("cannot write " + path);
+  return path;
+}
+
+TEST(ThinRegions, SliverBetweenGridFacesTakesOneEdgeAndGradedCorners) {
+  const double s = 0.005;
+  const std::string model = write_sliver_between_grids(s, tmp("thin_sliver_grids.brep"));
+  const auto run = [&](const std::string& options, const std::string& name) {
+    const std::string out = tmp(name + ".msh"), err = tmp(name + ".err");
+    const std::string cmd = std::string(QSMESH_EXE) + " mesh " + model + " -o " + out +
+                            " --size 1 " + options + " --threads 2 -q 2>" + err;
+    if (std::system(cmd.c_str()) != 0)
+      throw std::runtime_error(cmd + " failed: " + qsmesh::test::slurp(err));
+    return read_msh(out);
+  };
+  const MshQuads off = run("", "thin_sliver_grids_off");
+  const MshQuads on = run("--one-edge-slivers", "thin_sliver_grids");
+  const auto [sicn_off, near_off] = sicn_min_near(off, Vec3{0, s / 2, 0}, 1.0);
+  const auto [sicn, near] = sicn_min_near(on, Vec3{0, s / 2, 0}, 1.0);
+  std::printf(
+      "sliver %.3f between grid faces: SICN min within 1 of it %.3f (%zu quads), %.3f without "
+      "--one-edge-slivers (%zu quads)\n",
+      s, sicn, near, sicn_off, near_off);
+  ASSERT_GT(near, 0u);
+  EXPECT_LT(sicn_off, 0.1);  // the shape this test is about
+  EXPECT_GE(sicn, 0.1);
+  EXPECT_TRUE(check(on).quads_at_sharp_corner.empty());
 }
 
 // A 10 x 4 plate with two round holes (radius 1 and 0.7, one closed curve each) meshed coarsely:

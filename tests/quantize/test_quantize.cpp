@@ -409,6 +409,35 @@ TEST(Quantize, SliversTakeOneEdgeWithTheOption) {
   expect_even_loops(model, q, "pentagon with a sliver");
 }
 
+TEST(Quantize, CurvesShorterThanTheSliverLengthTakeOneEdge) {
+  // The strip 10 x 0.3 with ends sized as 2 edges each (ideal 2: no sliver by count): the ends
+  // take 1 edge when shorter than sliver_length, 2 otherwise.
+  const auto strip = polygon_face({{0, 0}, {10, 0}, {10, 0.3}, {0, 0.3}}, "q_strip_len.brep");
+  const auto ideal = ideal_by_use(strip, {10.0, 2.0, 10.0, 2.0});
+  QuantizeOptions options;
+  options.odd_slivers = true;  // the count rule alone keeps them at 2
+  EXPECT_EQ(edges_by_use(strip, quantize_curves(strip, ideal, options)),
+            (std::vector<int>{10, 2, 10, 2}));
+  options.odd_slivers = false;
+  options.sliver_length = 0.5;
+  const Quantization q = quantize_curves(strip, ideal, options);
+  EXPECT_EQ(edges_by_use(strip, q), (std::vector<int>{10, 1, 10, 1}));
+  expect_even_loops(strip, q, "strip with short ends");
+  options.sliver_length = 0.2;
+  EXPECT_EQ(edges_by_use(strip, quantize_curves(strip, ideal, options)),
+            (std::vector<int>{10, 2, 10, 2}));
+  // A prescription wins over the length rule.
+  options.sliver_length = 0.5;
+  LO end = kNoIndex;
+  for (LO c = 0; c < strip.num_curves(); ++c)
+    if (strip.curves()[c].length < 1) end = c;
+  ASSERT_NE(end, kNoIndex);
+  options.prescribed = {{end, 2}};
+  const Quantization p = quantize_curves(strip, ideal, options);
+  EXPECT_EQ(p.edges[end], 2);
+  expect_even_loops(strip, p, "strip with a prescribed end");
+}
+
 TEST(Quantize, RefinementKeepsEachCountsParity) {
   Quantization q;
   q.edges = {7, 4, 1};

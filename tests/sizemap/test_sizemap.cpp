@@ -211,6 +211,35 @@ TEST(SizeMap, FeatureRatioBoundsHowFarTheSlotRefinesItsSides) {
   EXPECT_THROW((void)initial_curve_sizes(m.cad, m.curves, o, TaskArena(1)), InputError);
 }
 
+TEST(SizeMap, OneEdgeSliverCornersAreTenTimesItsLength) {
+  // The square of GivenFloorStopsSliverCurvesFromRefining: its sliver (0.005) is below a tenth of
+  // the floor (0.2), so with one_edge_slivers it takes one edge and its corners are at most
+  // 10 x its length (twice rule (i')'s 5 x for two edges: the same edge-to-neighbour ratio).
+  const Model m = prepare(
+      polygon_face({{0, 0}, {10, 0}, {10, 10}, {0.003, 10}, {0, 9.996}}, "sliver_one_edge.brep"),
+      1.0, false);
+  LO sliver = kNoIndex;
+  for (LO c = 0; c < m.cad.num_curves(); ++c)
+    if (m.cad.curves()[c].length < 0.1) sliver = c;
+  ASSERT_NE(sliver, kNoIndex);
+  const double length = m.cad.curves()[sliver].length;
+  SizeMapOptions o;
+  o.method = Method::Features;
+  o.size_max = 1.0;
+  o.size_min = 0.2;
+  EXPECT_EQ(sliver_length(o), 0.0);  // off
+  o.one_edge_slivers = true;
+  EXPECT_NEAR(sliver_length(o), 0.02, 1e-15);
+  const CurveSizes cs = initial_curve_sizes(m.cad, m.curves, o, TaskArena(1));
+  for (const LO k : m.cad.curves()[sliver].corners) EXPECT_NEAR(cs.corner[k], 10 * length, 1e-12);
+  EXPECT_LE(curve_gradation_excess(m, cs, o.gradation), 1e-9);
+  // A curve above a tenth of the floor is no one-edge sliver: rule (i') as before (5 x).
+  o.size_min = 0.04;
+  EXPECT_GT(length, sliver_length(o));
+  const CurveSizes two = initial_curve_sizes(m.cad, m.curves, o, TaskArena(1));
+  for (const LO k : m.cad.curves()[sliver].corners) EXPECT_NEAR(two.corner[k], 5 * length, 1e-12);
+}
+
 TEST(SizeMap, GivenFloorStopsSliverCurvesFromRefining) {
   // A 10 x 10 square with one corner cut by a sliver edge 0.005 long. Rule (i) sizes the sliver
   // by its length, below the default floor (size cap / 100); a floor the user gives holds there

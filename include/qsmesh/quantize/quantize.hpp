@@ -40,6 +40,10 @@ struct QuantizeOptions {
   /// 2 in ratio) takes 1 edge, and the loops it makes odd get a neighbouring curve odd too. A
   /// strip between two such curves is then one quad across (a grid fill).
   bool odd_slivers = false;
+  /// With `even`: a free curve (or chord, every member) shorter than this (CAD length, model
+  /// units; 0: off) takes 1 edge, like odd_slivers, whatever its ideal count. Set from
+  /// sizemap::sliver_length, whose rule (i') grades the sizes toward that one edge.
+  double sliver_length = 0;
   /// When `even`, also make the halved meshes (place_vertices with halved = true) valid boundaries:
   /// closed curves at least 6 (3 before subdivision) and curves joining the same two corners at
   /// least 4 (2 before subdivision, so the two halved curves never coincide). Off by default: the

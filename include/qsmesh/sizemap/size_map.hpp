@@ -82,6 +82,13 @@ struct SizeMapOptions {
   /// both sides bound that face alone, the tail behind it is capped at 3/4 K x its width
   /// (background::limit_by_face_width, background::sharp_wedge_tips).
   double thin_aspect = 0;
+  /// One edge on sliver curves: a curve shorter than a tenth of the floor (sliver_length) takes 1
+  /// edge in the quantization (quantize::QuantizeOptions::sliver_length) and rule (i') grades its
+  /// corners from kOneEdgeSliverCornerRatio x its length at every corner, grid faces' included. A
+  /// quad with an edge l beside an edge L has SICN at most about 2 l / L: the two half-length
+  /// edges of a 2-edge sliver need neighbours twice as short, and grading a corner that a grid
+  /// face touches carries the finer counts through the grid (see size_min).
+  bool one_edge_slivers = false;
   /// N, the target number of quads of the whole model; 0: total area / size_max^2.
   double target_quads = 0;
   /// (face id, quad count) fixed by the user: that face gets this N_i instead of its area share.
@@ -94,6 +101,11 @@ struct SizeMapOptions {
 /// The floor actually applied: size_min (or size_max / 100) lowered to the smallest user size.
 /// Throws InputError when size_max <= 0, size_min < 0 or size_min > size_max.
 [[nodiscard]] double effective_size_min(const SizeMapOptions& options);
+
+/// The length below which a curve is a sliver that takes one edge (one_edge_slivers): a tenth of
+/// effective_size_min, the gap below which rule (ii) ignores a feature; 0 when one_edge_slivers is
+/// off.
+[[nodiscard]] double sliver_length(const SizeMapOptions& options);
 
 /// Size values (model units) at the vertices of the curve meshes.
 struct CurveSizes {
