@@ -746,13 +746,17 @@ HighOrderReport make_high_order(mesh::SurfaceMesh& m, const cad::CadModel& model
       }
     return kept;
   };
-  std::vector<char> ok(static_cast<std::size_t>(nq), 1);
+  // Each quad's smallest scaled Jacobian, positive where the quad is valid (the same test as
+  // valid's: the Jacobian over positive lengths), as of the last check_all.
+  std::vector<double> lowest(static_cast<std::size_t>(nq), 1.0);
   auto check_all = [&] {
-    tasks.parallel_for(nq,
-                       [&](std::int64_t q) { ok[static_cast<std::size_t>(q)] = valid(q) ? 1 : 0; });
+    tasks.parallel_for(nq, [&](std::int64_t q) {
+      lowest[static_cast<std::size_t>(q)] =
+          checker.min_scaled_jacobian(element(q), linear_normal(q), nullptr);
+    });
     std::vector<GO> bad;
     for (GO q = 0; q < nq; ++q)
-      if (ok[static_cast<std::size_t>(q)] == 0) bad.push_back(q);
+      if (!(lowest[static_cast<std::size_t>(q)] > 0)) bad.push_back(q);
     return bad;
   };
   // Applies `fix` to the quads of `work` that are not valid, then to those the fixed nodes fold,
@@ -784,10 +788,14 @@ HighOrderReport make_high_order(mesh::SurfaceMesh& m, const cad::CadModel& model
   };
   // Folded quads first get their face nodes along the parameter lines (still on the CAD); those
   // still folded get them straight, off the CAD.
-  report.reshaped = fix_all(check_all(), reshape);
+  // (A check that found nothing folded is not repeated: nothing changed since.)
+  std::vector<GO> bad = check_all();
+  report.reshaped = fix_all(bad, reshape);
   // Those still folded are untangled in parameter space (still on the CAD).
-  report.untangled = fix_all(check_all(), untangle);
-  report.straightened = fix_all(check_all(), [&](GO q) {
+  if (!bad.empty()) bad = check_all();
+  report.untangled = fix_all(bad, untangle);
+  if (!bad.empty()) bad = check_all();
+  report.straightened = fix_all(bad, [&](GO q) {
     straighten(q, false);
     return true;
   });
@@ -800,20 +808,14 @@ HighOrderReport make_high_order(mesh::SurfaceMesh& m, const cad::CadModel& model
     });
     report.invalid = static_cast<std::int64_t>(check_all().size());
   }
-
-  {
-    std::vector<double> lowest(static_cast<std::size_t>(nq), 1.0);
-    tasks.parallel_for(nq, [&](std::int64_t q) {
-      lowest[static_cast<std::size_t>(q)] =
-          checker.min_scaled_jacobian(element(q), linear_normal(q), nullptr);
-    });
-    report.min_scaled_jacobian =
-        lowest.empty() ? 1.0 : *std::min_element(lowest.begin(), lowest.end());
-    for (GO q = 0; q < nq; ++q)
-      if (untangled[static_cast<std::size_t>(q)] != 0)
-        report.untangled_min_scaled_jacobian =
-            std::min(report.untangled_min_scaled_jacobian, lowest[static_cast<std::size_t>(q)]);
-  }
+  // `lowest` is the final elements': the last check_all found nothing to straighten (so nothing
+  // changed since), or came after the straightening.
+  report.min_scaled_jacobian =
+      lowest.empty() ? 1.0 : *std::min_element(lowest.begin(), lowest.end());
+  for (GO q = 0; q < nq; ++q)
+    if (untangled[static_cast<std::size_t>(q)] != 0)
+      report.untangled_min_scaled_jacobian =
+          std::min(report.untangled_min_scaled_jacobian, lowest[static_cast<std::size_t>(q)]);
 
   // A node off its entity keeps the entity it belongs to (dim, id) but no parameters: a reader
   // that evaluated them would put it back on the CAD, curving the quad that had to go straight.

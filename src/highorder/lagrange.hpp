@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <limits>
 #include <vector>
 
@@ -136,7 +137,7 @@ class QuadChecker {
     const Vec3 unit = len > 0 ? normal * (1 / len) : normal;
     double worst = 1;
     (void)for_each_sample(g, [&](int, int, const Vec3& ds, const Vec3& dt) {
-      const double scale = norm(ds) * norm(dt);
+      const double scale = std::sqrt(dot(ds, ds) * dot(dt, dt));
       const double j = scale > 0 ? dot(cross(ds, dt), unit) / scale : 0.0;
       worst = std::min(worst, j);
       if (folded != nullptr && j < 0) *folded += j;
