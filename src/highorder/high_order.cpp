@@ -534,8 +534,9 @@ HighOrderReport make_high_order(mesh::SurfaceMesh& m, const cad::CadModel& model
   // grows with that (on a cylinder's side next to a cap quad with two sides on the circle, order
   // 3: 2.6e-3 with small steps and this stop, 5e-3 with steps of a quarter, 9e-3 maximising;
   // the linear mesh's 3.3e-2). Kept only when q comes out valid and no quad that was valid
-  // folds; else every node goes back. Returns whether it was kept. Serial, so deterministic.
-  constexpr int kUntangleBudget = 3000;  // objective evaluations per quad at most
+  // folds; else the search starts once more from the curve nodes at equal parameter steps, and
+  // failing that every node goes back. Returns whether it was kept. Serial, so deterministic.
+  constexpr int kUntangleBudget = 3000;  // objective evaluations per search at most
   constexpr int kUntangleHalvings = 8;
   constexpr double kUntangleEnough = 0.1;
   constexpr double kUntangleStep = 1.0 / 16;  // first step, of the node spacing
@@ -698,46 +699,74 @@ HighOrderReport make_high_order(mesh::SurfaceMesh& m, const cad::CadModel& model
     auto better = [](const std::array<double, 2>& a, const std::array<double, 2>& b) {
       return a[0] > b[0] || (a[0] == b[0] && a[1] > b[1]);
     };
-    auto best = total();
+    std::array<double, 2> best{};
     std::vector<double> step(coords.size());
-    for (std::size_t k = 0; k < coords.size(); ++k) step[k] = coords[k].step;
-    int evaluations = 0;
-    for (int halvings = 0; halvings <= kUntangleHalvings && evaluations < kUntangleBudget &&
-                           !(best[0] == 0 && best[1] >= kUntangleEnough);) {
-      bool improved = false;
-      for (std::size_t k = 0; k < coords.size() && evaluations < kUntangleBudget &&
-                              !(best[0] == 0 && best[1] >= kUntangleEnough);
-           ++k)
-        for (const double sign : {1.0, -1.0}) {
-          const auto before = std::make_pair(points[coords[k].node], vclass[coords[k].node]);
-          if (!move(k, sign * step[k])) continue;
-          ++evaluations;
-          std::vector<std::array<double, 2>> old;
-          for (std::size_t h : coords[k].quads) {
-            old.push_back({folded[h], worst[h]});
-            measure(h);
+    auto search = [&] {
+      best = total();
+      for (std::size_t k = 0; k < coords.size(); ++k) step[k] = coords[k].step;
+      int evaluations = 0;
+      for (int halvings = 0; halvings <= kUntangleHalvings && evaluations < kUntangleBudget &&
+                             !(best[0] == 0 && best[1] >= kUntangleEnough);) {
+        bool improved = false;
+        for (std::size_t k = 0; k < coords.size() && evaluations < kUntangleBudget &&
+                                !(best[0] == 0 && best[1] >= kUntangleEnough);
+             ++k)
+          for (const double sign : {1.0, -1.0}) {
+            const auto before = std::make_pair(points[coords[k].node], vclass[coords[k].node]);
+            if (!move(k, sign * step[k])) continue;
+            ++evaluations;
+            std::vector<std::array<double, 2>> old;
+            for (std::size_t h : coords[k].quads) {
+              old.push_back({folded[h], worst[h]});
+              measure(h);
+            }
+            const auto now = total();
+            if (better(now, best)) {
+              best = now;
+              improved = true;
+              break;
+            }
+            points[coords[k].node] = before.first;
+            vclass[coords[k].node] = before.second;
+            for (std::size_t i = 0; i < coords[k].quads.size(); ++i) {
+              folded[coords[k].quads[i]] = old[i][0];
+              worst[coords[k].quads[i]] = old[i][1];
+            }
           }
-          const auto now = total();
-          if (better(now, best)) {
-            best = now;
-            improved = true;
-            break;
-          }
-          points[coords[k].node] = before.first;
-          vclass[coords[k].node] = before.second;
-          for (std::size_t i = 0; i < coords[k].quads.size(); ++i) {
-            folded[coords[k].quads[i]] = old[i][0];
-            worst[coords[k].quads[i]] = old[i][1];
-          }
+        if (!improved) {
+          for (double& x : step) x *= 0.5;
+          ++halvings;
         }
-      if (!improved) {
-        for (double& x : step) x *= 0.5;
-        ++halvings;
+      }
+    };
+    auto acceptable = [&] {
+      bool ok = valid(q);
+      for (std::size_t k = 0; k < near.size() && ok; ++k) ok = was_valid[k] == 0 || valid(near[k]);
+      return ok;
+    };
+    search();
+    bool kept = acceptable();
+    // A search that ended folded (a local optimum) starts again once from the curve nodes at
+    // equal parameter steps between their edge's ends, the face nodes where they were.
+    if (!kept) {
+      bool relaxed = false;
+      for (std::size_t k = 0; k < coords.size(); ++k) {
+        points[coords[k].node] = saved[k].first;
+        vclass[coords[k].node] = saved[k].second;
+        if (coords[k].which != 0) continue;
+        const double t =
+            coords[k].lo_end + static_cast<double>(coords[k].node - coords[k].first + 1) / n *
+                                   (coords[k].hi_end - coords[k].lo_end);
+        vclass[coords[k].node].param[0] = t;
+        points[coords[k].node] = curves[coords[k].curve]->point(t);
+        relaxed = true;
+      }
+      if (relaxed) {
+        for (std::size_t k = 0; k < near.size(); ++k) measure(k);
+        search();
+        kept = acceptable();
       }
     }
-    bool kept = valid(q);
-    for (std::size_t k = 0; k < near.size() && kept; ++k)
-      kept = was_valid[k] == 0 || valid(near[k]);
     untangled[static_cast<std::size_t>(q)] = kept ? 1 : 0;
     if (!kept)
       for (std::size_t k = 0; k < coords.size(); ++k) {
