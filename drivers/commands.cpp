@@ -446,9 +446,13 @@ std::string stats_json(const Arguments& args, const Session& session,
     j.value("high_order_face_nodes", checks.high_order->face_nodes);
     j.value("high_order_unprojected_nodes", checks.high_order->unprojected);
     j.value("high_order_reshaped_quads", checks.high_order->reshaped);
+    j.value("high_order_untangled_quads", checks.high_order->untangled);
     j.value("high_order_straightened_quads", checks.high_order->straightened);
     j.value("high_order_curve_straightened_quads", checks.high_order->curve_straightened);
     j.value("high_order_invalid_quads", checks.high_order->invalid);
+    j.value("high_order_min_scaled_jacobian", checks.high_order->min_scaled_jacobian);
+    j.value("high_order_untangled_min_scaled_jacobian",
+            checks.high_order->untangled_min_scaled_jacobian);
     j.value("high_order_max_element_distance_to_cad", checks.high_order_distance);
   }
   if (checks.blocks) {
@@ -665,10 +669,11 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
        << q.face_nodes << " in faces (" << q.unprojected
        << " off the CAD: no CAD point near, or put back straight); quads whose face nodes went "
           "along the face's parameter lines to stay valid "
-       << q.reshaped << ", went back straight " << q.straightened << ", made entirely straight "
-       << q.curve_straightened << ", still invalid " << q.invalid
-       << "; curved elements' largest distance to the CAD / diagonal " << checks.high_order_distance
-       << "\n";
+       << q.reshaped << ", untangled along the curves and in (u, v) " << q.untangled
+       << ", went back straight " << q.straightened << ", made entirely straight "
+       << q.curve_straightened << ", still invalid " << q.invalid << "; smallest scaled Jacobian "
+       << q.min_scaled_jacobian << "; curved elements' largest distance to the CAD / diagonal "
+       << checks.high_order_distance << "\n";
   }
   if (checks.blocks) {
     const Checks::Blocks& b = *checks.blocks;

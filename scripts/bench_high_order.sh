@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # High-order quads (`--order N`, N = 2..5) on each shared model at its reference size factor
 # (docs/benchmarks.md, "High order"): quads, quads reshaped along the parameter lines, quads
-# straightened (face nodes; curve nodes too), quads still invalid, nodes left off the CAD, the
+# untangled in parameter space, quads straightened (face nodes; curve nodes too), quads still
+# invalid, nodes left off the CAD, the smallest scaled Jacobian, the
 # curved elements' largest distance to the CAD over the model's diagonal
 # (highorder::max_element_distance_to_cad), the time of the high-order stage and of writing the
 # .vtu (Lagrange cells). With --block-patches: the blocks of the coarse layout as single patches
@@ -31,8 +32,8 @@ if [ $patches = 1 ]; then
   echo "|---|---|---|---|---|---|---|---|---|---|"
   extra=--block-patches
 else
-  echo "| model | size factor | order | quads | reshaped | straightened (curve nodes too) | invalid | off the CAD | element distance / diagonal | high_order s | check s | write .vtu s |"
-  echo "|---|---|---|---|---|---|---|---|---|---|---|---|"
+  echo "| model | size factor | order | quads | reshaped | untangled | straightened (curve nodes too) | invalid | off the CAD | min scaled Jacobian | element distance / diagonal | high_order s | check s | write .vtu s |"
+  echo "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
   extra=
 fi
 for m in "${models[@]}"; do
@@ -51,9 +52,10 @@ if patches == "1":
           f"{t['layout']:.2f} | {t['patches']:.2f} |")
 else:
     print(f"| {m} | {f} | {n} | {s['quads']} | {s['high_order_reshaped_quads']} | "
-          f"{s['high_order_straightened_quads']} "
+          f"{s['high_order_untangled_quads']} | {s['high_order_straightened_quads']} "
           f"({s['high_order_curve_straightened_quads']}) | {s['high_order_invalid_quads']} | "
-          f"{s['high_order_unprojected_nodes']} | {s['high_order_max_element_distance_to_cad']:.2e} | "
+          f"{s['high_order_unprojected_nodes']} | {s['high_order_min_scaled_jacobian']:.3f} | "
+          f"{s['high_order_max_element_distance_to_cad']:.2e} | "
           f"{t['high_order']:.2f} | {t['high_order_check']:.2f} | {t.get('write', float('nan')):.2f} |")
 PY
     rm -f "$out/m.vtu"

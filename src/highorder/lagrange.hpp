@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <limits>
 #include <vector>
 
@@ -122,6 +123,34 @@ class QuadChecker {
   template <class NormalAt>
   [[nodiscard]] bool valid_along(const std::array<Vec3, kMaxNodes>& g,
                                  const NormalAt& normal_at) const {
+    return for_each_sample(g, [&](int m1, int m2, const Vec3& ds, const Vec3& dt) {
+      return dot(cross(ds, dt), normal_at(m1, m2)) > 0;
+    });
+  }
+  // The scaled Jacobian of the quad along `normal` at each sample: the Jacobian over the product
+  // of the lengths of its two columns, in [-1, 1] (0 where a column vanishes). Returns the
+  // smallest, and adds the negative ones to `*folded` (how deep the element folds, summed over
+  // the samples: a smooth measure to untangle by, where the smallest alone moves with one node).
+  [[nodiscard]] double min_scaled_jacobian(const std::array<Vec3, kMaxNodes>& g, const Vec3& normal,
+                                           double* folded) const {
+    const double len = norm(normal);
+    const Vec3 unit = len > 0 ? normal * (1 / len) : normal;
+    double worst = 1;
+    (void)for_each_sample(g, [&](int, int, const Vec3& ds, const Vec3& dt) {
+      const double scale = std::sqrt(dot(ds, ds) * dot(dt, dt));
+      const double j = scale > 0 ? dot(cross(ds, dt), unit) / scale : 0.0;
+      worst = std::min(worst, j);
+      if (folded != nullptr && j < 0) *folded += j;
+      return true;
+    });
+    return worst;
+  }
+
+ private:
+  // Calls visit(m1, m2, ds, dt) with the two derivatives of the Lagrange map at each sample
+  // (m1, m2) / (2 n) until it returns false; returns whether it never did.
+  template <class Visit>
+  bool for_each_sample(const std::array<Vec3, kMaxNodes>& g, const Visit& visit) const {
     const int np = n_ + 1;
     std::array<Vec3, kMaxOrder + 1> along{}, across{};
     for (int m2 = 0; m2 < samples(); ++m2) {
@@ -145,13 +174,12 @@ class QuadChecker {
           ds += along[static_cast<std::size_t>(a)] * d1[static_cast<std::size_t>(a)];
           dt += across[static_cast<std::size_t>(a)] * l1[static_cast<std::size_t>(a)];
         }
-        if (!(dot(cross(ds, dt), normal_at(m1, m2)) > 0)) return false;
+        if (!visit(m1, m2, ds, dt)) return false;
       }
     }
     return true;
   }
 
- private:
   int n_;
   std::vector<std::array<int, 2>> positions_;
   std::array<std::array<double, kMaxOrder + 1>, kMaxSamples> l_{}, dl_{};

@@ -30,6 +30,11 @@ struct HighOrderReport {
   /// along its parameter lines (the images of the Coons patch of the quad's sides in (u, v)),
   /// still on the CAD; counted whether or not that made them valid.
   std::int64_t reshaped = 0;
+  /// Quads still not valid after that, untangled in parameter space and kept on the CAD: their
+  /// curve nodes moved along their curves (between their edge's ends, in order), their face
+  /// nodes in (u, v), to raise the smallest scaled Jacobian of the quad and of the quads sharing
+  /// an edge with it; counted when it came out valid without folding a neighbour.
+  std::int64_t untangled = 0;
   /// Quads whose curved element was not valid (lagrange_quad_valid) and whose face nodes (the
   /// nodes of their edges inside the face and their interior nodes) were put back on their
   /// straight positions.
@@ -40,6 +45,12 @@ struct HighOrderReport {
   std::int64_t curve_straightened = 0;
   /// Quads not valid even with every node straight (their linear quad is not valid).
   std::int64_t invalid = 0;
+  /// The smallest scaled Jacobian of the final elements (the Jacobian along the linear quad's
+  /// normal over the product of its columns' lengths, at the (2N + 1)^2 samples of the validity
+  /// check), in [-1, 1].
+  double min_scaled_jacobian = 1;
+  /// The same over the untangled quads only (1 when there is none).
+  double untangled_min_scaled_jacobian = 1;
 };
 
 /// Makes `mesh` (an assembled all-quad SurfaceMesh: no triangles, order 1) a mesh of order `order`
@@ -62,10 +73,11 @@ struct HighOrderReport {
 /// kNoIndex; parameters NaN for the nodes left off the CAD, see unprojected). Quads whose curved
 /// form is not valid first get their face nodes along the face's parameter lines (the surface's
 /// images of the Coons patch of the quad's sides in (u, v): still on the CAD, see reshaped); those
-/// still not valid get their face nodes back on the straight (bilinear) positions, and then
-/// their curve nodes. Deterministic whatever the thread count of `tasks`.
-/// Throws qsmesh::Error when the mesh has triangles or is already of higher order, and when
-/// `order` is out of range.
+/// still not valid are untangled in parameter space (curve nodes along their curves, face nodes
+/// in (u, v): still on the CAD, see untangled); those still not valid get their face nodes back on
+/// the straight (bilinear) positions, and then their curve nodes. Deterministic whatever the thread
+/// count of `tasks`. Throws qsmesh::Error when the mesh has triangles or is already of higher
+/// order, and when `order` is out of range.
 HighOrderReport make_high_order(mesh::SurfaceMesh& mesh, const cad::CadModel& model, int order,
                                 const TaskArena& tasks);
 
