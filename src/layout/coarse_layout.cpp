@@ -1,3 +1,5 @@
+#include <cstdio>
+#include <cstdlib>
 #include "qsmesh/layout/coarse_layout.hpp"
 
 #include <algorithm>
@@ -198,6 +200,17 @@ class Builder {
         out.layout = {};
         fine_mesh(out);
         if (bad_cquads_.empty()) break;
+        if (std::getenv("QSM_DBG")) {  // DEBUG
+          for (std::size_t k : bad_cquads_) {
+            const CQuad& q = cquads_[k];
+            const Cell& c = cells_[static_cast<std::size_t>(q.cell)];
+            const Grid& g = grids_[static_cast<std::size_t>(c.patch)];
+            std::fprintf(stderr, "DBG repair %d bad cq %zu face %d patch %d (%dx%d input %dx%d lvl %d) cell %d,%d n %d x %d; v", repair, k, q.face, c.patch, c.a, c.b, g.ni, g.nj, c.patch < (LO)repair_level_.size() ? repair_level_[c.patch] : 0, c.x, c.y, cedges_[q.e[0]].n, cedges_[q.e[1]].n);
+            for (GO v : q.v) { const GO cv = center_[v]; std::fprintf(stderr, " %lld(d%d e%d val%d)", (long long)cv, vc(cv).dim, vc(cv).entity, valence(cv)); }
+            for (GO e : q.e) std::fprintf(stderr, " e[c%d n%d]", cedges_[e].curve, cedges_[e].n);
+            std::fprintf(stderr, "\n");
+          }
+        }
         if (repair + 1 >= kMaxRepairs)
           throw Reject{
               cat(bad_quads_, " fine quads invalid or folded after ", kMaxRepairs, " repairs")};
@@ -1116,7 +1129,36 @@ class Builder {
       const auto r = static_cast<std::size_t>(loops.find(static_cast<GO>(e)));
       cedges_[e].n = std::max<LO>(1, static_cast<LO>(std::lround(lsum[r] / lcnt[r])));
     }
+    if (opt_.fit_loop_widths) fit_loops(loops);
     if (opt_.loop_balance > 0) balance_loops(loops);
+  }
+
+  // CoarseOptions::fit_loop_widths: each loop's width fitted to the extents of its cells in
+  // their input patch grids (fit_loop_width).
+  void fit_loops(Dsu& loops) {
+    std::vector<std::vector<LoopCrossing>> cross(cedges_.size());
+    for (std::size_t k = 0; k < cquads_.size(); ++k) {
+      const std::array<Vec2, 4> C = cell_grid_corners(k);
+      const double e0 = 0.5 * (std::abs(C[1].u - C[0].u) + std::abs(C[2].u - C[3].u));
+      const double e1 = 0.5 * (std::abs(C[3].v - C[0].v) + std::abs(C[2].v - C[1].v));
+      const double area = std::getenv("QSM_W1") ? 1.0 : std::max(e0, 0.5) * std::max(e1, 0.5);
+      const CQuad& q = cquads_[k];
+      cross[static_cast<std::size_t>(loops.find(q.e[0]))].push_back({e0, area});
+      cross[static_cast<std::size_t>(loops.find(q.e[1]))].push_back({e1, area});
+    }
+    std::vector<LO> width(cedges_.size(), 0);
+    for (std::size_t e = 0; e < cedges_.size(); ++e) {
+      const auto r = static_cast<std::size_t>(loops.find(static_cast<GO>(e)));
+      if (width[r] == 0) {
+        width[r] = fit_loop_width(cross[r]);
+        if (std::getenv("QSM_DBG2") && e % 50 == 0) {  // DEBUG
+          std::fprintf(stderr, "DBG2 loop %zu mean %d fit %d:", e, cedges_[e].n, width[r]);
+          for (auto& c : cross[r]) std::fprintf(stderr, " %.2f/%.1f", c.extent, c.weight);
+          std::fprintf(stderr, "\n");
+        }
+      }
+      cedges_[e].n = width[r];
+    }
   }
 
   // CoarseOptions::loop_balance: each edge's target blended with the width that would make the
@@ -1691,6 +1733,12 @@ class Builder {
             sm.points[static_cast<std::size_t>(sm.quads[i][static_cast<std::size_t>(c)])];
       const std::size_t k = cq_of_fine[i];
       if (mesh::quad_sicn(p) <= 0 || bad_fine_cquad_[k]) {
+        if (std::getenv("QSM_DBG")) {  // DEBUG
+          const auto& fc = model_.faces()[static_cast<std::size_t>(sm.quad_face[i])];
+          std::fprintf(stderr, "DBGQ cq %zu fine %zu sicn %.4f flag %d face %d type %d seams %zu per %d%d:", k, i, mesh::quad_sicn(p), (int)bad_fine_cquad_[k], sm.quad_face[i], (int)fc.type, fc.seams.size(), (int)fc.u_periodic, (int)fc.v_periodic);
+          for (int c = 0; c < 4; ++c) { const auto& vv = sm.vclass[sm.quads[i][c]]; std::fprintf(stderr, " [%.5g %.5g %.5g d%d e%d uv %.5g %.5g]", p[c].x, p[c].y, p[c].z, vv.dim, vv.entity, vv.param[0], vv.param[1]); }
+          std::fprintf(stderr, "\n");
+        }
         bad_cquads_.push_back(k);
         ++bad_quads_;
       }
@@ -2074,8 +2122,11 @@ class Builder {
       mesh::FaceMesh sm =
           opt_.smoothing_iterations > 0 ? smooth::smooth_face(fm, face_geom(f), so) : fm;
       // Concave corners may leave folded quads (paper 002 Sec. IV.E): local untangling there.
+      const std::int64_t dbg0 = folded(fm, f), dbg0i = smooth::measure(fm).invalid, dbg1 = folded(sm, f), dbg1i = smooth::measure(sm).invalid;
       if (smooth::measure(sm).invalid > 0 || folded(sm, f) > 0)
         sm = smooth::untangle_face(sm, face_geom(f), smooth::UntangleOptions{});
+      if (std::getenv("QSM_DBG") && (dbg1 > 0 || dbg1i > 0))  // DEBUG
+        std::fprintf(stderr, "DBGF face %d placed folded %lld invalid %lld; smoothed %lld %lld; untangled %lld %lld\n", f, (long long)dbg0, (long long)dbg0i, (long long)dbg1, (long long)dbg1i, (long long)folded(sm, f), (long long)smooth::measure(sm).invalid);
       for (std::size_t l = 0; l < global.size(); ++l) {
         FineNode& n = nodes[static_cast<std::size_t>(global[l])];
         if (n.c.dim == 2) {
@@ -2163,6 +2214,28 @@ class Builder {
 };
 
 }  // namespace
+
+int fit_loop_width(const std::vector<LoopCrossing>& crossings) {
+  if (crossings.empty()) return 1;
+  // The cost is convex in ln w, so its integer minimum lies at the floor or the ceiling of the
+  // weighted median of the extents, searched here over every integer up to the largest extent
+  // (loops are short: a few cells, extents of a few input quads).
+  double top = 1;
+  for (const LoopCrossing& c : crossings) top = std::max(top, c.extent);
+  const int wmax = static_cast<int>(std::ceil(top));
+  int best = 1;
+  double best_cost = std::numeric_limits<double>::infinity();
+  for (int w = 1; w <= wmax; ++w) {
+    double cost = 0;
+    for (const LoopCrossing& c : crossings)
+      cost += std::getenv("QSM_L2") ? std::max(c.weight, 0.0) * std::pow(std::log(w / std::max(c.extent, 0.5)), 2) : std::getenv("QSM_LIN") ? std::max(c.weight, 0.0) * std::abs(w - std::max(c.extent, 0.5)) : std::max(c.weight, 0.0) * std::abs(std::log(w / std::max(c.extent, 0.5)));
+    if (w == 1 || cost < best_cost - 1e-12 * std::max(1.0, best_cost)) {
+      best_cost = cost;
+      best = w;
+    }
+  }
+  return best;
+}
 
 bool choose_side_spacing(const SideScore& uniform, const SideScore& input_like, double avg_slack) {
   if (input_like.sicn_min <= 0) return false;
