@@ -237,7 +237,8 @@ Arguments parse(const std::vector<std::string>& args) {
       a.loop_balance = *b;
     } else if (opt == "--loop-widths" && a.command == Command::Mesh) {
       const std::string& v = value();
-      if (v != "mean" && v != "fit") throw InputError("--loop-widths: '" + v + "' is not mean or fit");
+      if (v != "mean" && v != "fit")
+        throw InputError("--loop-widths: '" + v + "' is not mean or fit");
       a.fit_loop_widths = v == "fit";
     } else if (opt == "--fine-placement" && a.command == Command::Mesh) {
       const std::string& v = value();

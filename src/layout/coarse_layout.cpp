@@ -1,5 +1,3 @@
-#include <cstdio>
-#include <cstdlib>
 #include "qsmesh/layout/coarse_layout.hpp"
 
 #include <algorithm>
@@ -200,23 +198,20 @@ class Builder {
         out.layout = {};
         fine_mesh(out);
         if (bad_cquads_.empty()) break;
-        if (std::getenv("QSM_DBG")) {  // DEBUG
-          for (std::size_t k : bad_cquads_) {
-            const CQuad& q = cquads_[k];
-            const Cell& c = cells_[static_cast<std::size_t>(q.cell)];
-            const Grid& g = grids_[static_cast<std::size_t>(c.patch)];
-            std::fprintf(stderr, "DBG repair %d bad cq %zu face %d patch %d (%dx%d input %dx%d lvl %d) cell %d,%d n %d x %d; v", repair, k, q.face, c.patch, c.a, c.b, g.ni, g.nj, c.patch < (LO)repair_level_.size() ? repair_level_[c.patch] : 0, c.x, c.y, cedges_[q.e[0]].n, cedges_[q.e[1]].n);
-            for (GO v : q.v) { const GO cv = center_[v]; std::fprintf(stderr, " %lld(d%d e%d val%d)", (long long)cv, vc(cv).dim, vc(cv).entity, valence(cv)); }
-            for (GO e : q.e) std::fprintf(stderr, " e[c%d n%d]", cedges_[e].curve, cedges_[e].n);
-            std::fprintf(stderr, "\n");
-          }
-        }
+        // Where the fine mesh is invalid, the patches that made those coarse quads keep their
+        // input lengths (the input layout is valid), and all is solved again. When every such
+        // row is already there (those patches are at their input lengths), solving again would
+        // give the same layout and the same folds (Block: repairs 5 to 11 were such, see
+        // docs/benchmarks.md), so the layout fails there. Restoring one to three rings of
+        // patches around them as well was tried on Block: other folds, failure after 12 repairs.
+        const std::vector<IntegerProgram::Row> rows = restore_rows();
+        if (!new_rows(ilp, rows))
+          throw Reject{cat(bad_quads_, " fine quads invalid or folded on patches already at ",
+                           "their input lengths")};
         if (repair + 1 >= kMaxRepairs)
           throw Reject{
               cat(bad_quads_, " fine quads invalid or folded after ", kMaxRepairs, " repairs")};
-        // Where the fine mesh is invalid, the patches that made those coarse quads keep their
-        // input lengths (the input layout is valid), and all is solved again.
-        for (const auto& r : restore_rows()) ilp.rows.push_back(r);
+        for (const auto& r : rows) ilp.rows.push_back(r);
         out.stats.repairs = repair + 1;
       }
       out.stats.coarse_quads = static_cast<std::int64_t>(out.layout.blocks.size());
@@ -854,6 +849,24 @@ class Builder {
     return rows;
   }
 
+  // Whether a row of `rows` (single-arc lower bounds, restore_rows) is not yet in the program:
+  // no row of the program on the same arc with a bound as high.
+  [[nodiscard]] static bool new_rows(const IntegerProgram& ilp,
+                                     const std::vector<IntegerProgram::Row>& rows) {
+    std::map<LO, double> have;
+    for (const auto& r : ilp.rows)
+      if (r.terms.size() == 1 && r.terms.front().second == 1.0 &&
+          r.hi == std::numeric_limits<double>::infinity()) {
+        auto [it, fresh] = have.emplace(r.terms.front().first, r.lo);
+        if (!fresh) it->second = std::max(it->second, r.lo);
+      }
+    for (const auto& r : rows) {
+      const auto it = have.find(r.terms.front().first);
+      if (it == have.end() || it->second < r.lo) return true;
+    }
+    return false;
+  }
+
   // A coarse quad corner between two edges on CAD curves away from a CAD corner is flat (an
   // interior node merged onto the curve made it): the row separating them.
   [[nodiscard]] std::vector<IntegerProgram::Row> flat_corners() {
@@ -1141,7 +1154,7 @@ class Builder {
       const std::array<Vec2, 4> C = cell_grid_corners(k);
       const double e0 = 0.5 * (std::abs(C[1].u - C[0].u) + std::abs(C[2].u - C[3].u));
       const double e1 = 0.5 * (std::abs(C[3].v - C[0].v) + std::abs(C[2].v - C[1].v));
-      const double area = std::getenv("QSM_W1") ? 1.0 : std::max(e0, 0.5) * std::max(e1, 0.5);
+      const double area = std::max(e0, 0.5) * std::max(e1, 0.5);
       const CQuad& q = cquads_[k];
       cross[static_cast<std::size_t>(loops.find(q.e[0]))].push_back({e0, area});
       cross[static_cast<std::size_t>(loops.find(q.e[1]))].push_back({e1, area});
@@ -1149,14 +1162,7 @@ class Builder {
     std::vector<LO> width(cedges_.size(), 0);
     for (std::size_t e = 0; e < cedges_.size(); ++e) {
       const auto r = static_cast<std::size_t>(loops.find(static_cast<GO>(e)));
-      if (width[r] == 0) {
-        width[r] = fit_loop_width(cross[r]);
-        if (std::getenv("QSM_DBG2") && e % 50 == 0) {  // DEBUG
-          std::fprintf(stderr, "DBG2 loop %zu mean %d fit %d:", e, cedges_[e].n, width[r]);
-          for (auto& c : cross[r]) std::fprintf(stderr, " %.2f/%.1f", c.extent, c.weight);
-          std::fprintf(stderr, "\n");
-        }
-      }
+      if (width[r] == 0) width[r] = fit_loop_width(cross[r]);
       cedges_[e].n = width[r];
     }
   }
@@ -1733,12 +1739,6 @@ class Builder {
             sm.points[static_cast<std::size_t>(sm.quads[i][static_cast<std::size_t>(c)])];
       const std::size_t k = cq_of_fine[i];
       if (mesh::quad_sicn(p) <= 0 || bad_fine_cquad_[k]) {
-        if (std::getenv("QSM_DBG")) {  // DEBUG
-          const auto& fc = model_.faces()[static_cast<std::size_t>(sm.quad_face[i])];
-          std::fprintf(stderr, "DBGQ cq %zu fine %zu sicn %.4f flag %d face %d type %d seams %zu per %d%d:", k, i, mesh::quad_sicn(p), (int)bad_fine_cquad_[k], sm.quad_face[i], (int)fc.type, fc.seams.size(), (int)fc.u_periodic, (int)fc.v_periodic);
-          for (int c = 0; c < 4; ++c) { const auto& vv = sm.vclass[sm.quads[i][c]]; std::fprintf(stderr, " [%.5g %.5g %.5g d%d e%d uv %.5g %.5g]", p[c].x, p[c].y, p[c].z, vv.dim, vv.entity, vv.param[0], vv.param[1]); }
-          std::fprintf(stderr, "\n");
-        }
         bad_cquads_.push_back(k);
         ++bad_quads_;
       }
@@ -2122,11 +2122,8 @@ class Builder {
       mesh::FaceMesh sm =
           opt_.smoothing_iterations > 0 ? smooth::smooth_face(fm, face_geom(f), so) : fm;
       // Concave corners may leave folded quads (paper 002 Sec. IV.E): local untangling there.
-      const std::int64_t dbg0 = folded(fm, f), dbg0i = smooth::measure(fm).invalid, dbg1 = folded(sm, f), dbg1i = smooth::measure(sm).invalid;
       if (smooth::measure(sm).invalid > 0 || folded(sm, f) > 0)
         sm = smooth::untangle_face(sm, face_geom(f), smooth::UntangleOptions{});
-      if (std::getenv("QSM_DBG") && (dbg1 > 0 || dbg1i > 0))  // DEBUG
-        std::fprintf(stderr, "DBGF face %d placed folded %lld invalid %lld; smoothed %lld %lld; untangled %lld %lld\n", f, (long long)dbg0, (long long)dbg0i, (long long)dbg1, (long long)dbg1i, (long long)folded(sm, f), (long long)smooth::measure(sm).invalid);
       for (std::size_t l = 0; l < global.size(); ++l) {
         FineNode& n = nodes[static_cast<std::size_t>(global[l])];
         if (n.c.dim == 2) {
@@ -2202,6 +2199,7 @@ class Builder {
   std::vector<char> bad_fine_cquad_;
   std::vector<std::vector<double>> curve_params_;  // input_params, per CAD curve
   std::vector<int> repair_level_;
+
   std::vector<std::size_t> bad_cquads_;
   std::int64_t bad_quads_ = 0;
   std::vector<std::vector<LO>> point_patches_;
@@ -2228,7 +2226,7 @@ int fit_loop_width(const std::vector<LoopCrossing>& crossings) {
   for (int w = 1; w <= wmax; ++w) {
     double cost = 0;
     for (const LoopCrossing& c : crossings)
-      cost += std::getenv("QSM_L2") ? std::max(c.weight, 0.0) * std::pow(std::log(w / std::max(c.extent, 0.5)), 2) : std::getenv("QSM_LIN") ? std::max(c.weight, 0.0) * std::abs(w - std::max(c.extent, 0.5)) : std::max(c.weight, 0.0) * std::abs(std::log(w / std::max(c.extent, 0.5)));
+      cost += std::max(c.weight, 0.0) * std::abs(std::log(w / std::max(c.extent, 0.5)));
     if (w == 1 || cost < best_cost - 1e-12 * std::max(1.0, best_cost)) {
       best_cost = cost;
       best = w;
