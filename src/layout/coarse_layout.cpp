@@ -34,7 +34,12 @@ constexpr LO kNever = std::numeric_limits<LO>::max();
 // before every side is uniform.
 constexpr int kMaxSpacingRounds = 3;
 constexpr int kMaxRounds = 40;
-constexpr int kMaxRepairs = 12;
+// Block at its reference factor needs 12 (docs/benchmarks.md, branch coarse8); a bound against a
+// loop that keeps finding new folds, each repair restoring more of the input's split lines.
+constexpr int kMaxRepairs = 16;
+// Rings of patches around the bad coarse quads' own that a repair may restore once those are at
+// their input lengths (restore_rows).
+constexpr int kMaxRings = 3;
 
 // Transfinite (Coons) interpolation at grid node (i, j) of an n0 x n1 grid from its boundary
 // nodes P(i, 0), P(n0, j), P(i, n1), P(0, j).
@@ -201,13 +206,21 @@ class Builder {
         // Where the fine mesh is invalid, the patches that made those coarse quads keep their
         // input lengths (the input layout is valid), and all is solved again. When every such
         // row is already there (those patches are at their input lengths), solving again would
-        // give the same layout and the same folds (Block: repairs 5 to 11 were such, see
-        // docs/benchmarks.md), so the layout fails there. Restoring one to three rings of
-        // patches around them as well was tried on Block: other folds, failure after 12 repairs.
-        const std::vector<IntegerProgram::Row> rows = restore_rows();
-        if (!new_rows(ilp, rows))
+        // give the same layout and the same folds (Block: a reflex CAD corner whose cells were
+        // single input quads and still folded, docs/benchmarks.md): the rows then reach one
+        // ring of patches further out (every patch touching a corner group of a coarse quad cut
+        // from the restored ones, whose collapsed arcs move those groups' centres), up to
+        // kMaxRings rings, before the layout fails.
+        std::vector<IntegerProgram::Row> rows = restore_rows(0);
+        bool fresh = new_rows(ilp, rows);
+        for (int ring = 1; !fresh && ring <= kMaxRings; ++ring) {
+          rows = restore_rows(ring);
+          fresh = new_rows(ilp, rows);
+        }
+        if (!fresh)
           throw Reject{cat(bad_quads_, " fine quads invalid or folded on patches already at ",
-                           "their input lengths")};
+                           "their input lengths, and ", kMaxRings,
+                           " rings of patches around them")};
         if (repair + 1 >= kMaxRepairs)
           throw Reject{
               cat(bad_quads_, " fine quads invalid or folded after ", kMaxRepairs, " repairs")};
@@ -813,8 +826,9 @@ class Builder {
   }
 
   // Rows q_a >= l_a for the side arcs of every patch touching a corner group of a bad coarse
-  // quad, and of the patch it was cut from.
-  [[nodiscard]] std::vector<IntegerProgram::Row> restore_rows() {
+  // quad, and of the patch it was cut from; `rings` times more, also every patch touching a
+  // corner group of a coarse quad cut from those patches.
+  [[nodiscard]] std::vector<IntegerProgram::Row> restore_rows(int rings) {
     std::vector<char> bad_group(static_cast<std::size_t>(ng_), 0);
     std::vector<LO> patches;
     for (std::size_t k : bad_cquads_) {
@@ -826,6 +840,18 @@ class Builder {
         patches.insert(patches.end(), point_patches_[x].begin(), point_patches_[x].end());
     std::sort(patches.begin(), patches.end());
     patches.erase(std::unique(patches.begin(), patches.end()), patches.end());
+    for (int ring = 0; ring < rings; ++ring) {
+      std::vector<char> in(grids_.size(), 0);
+      for (LO p : patches) in[static_cast<std::size_t>(p)] = 1;
+      for (const CQuad& q : cquads_)
+        if (in[static_cast<std::size_t>(cells_[static_cast<std::size_t>(q.cell)].patch)])
+          for (GO g : q.v) bad_group[static_cast<std::size_t>(g)] = 1;
+      for (std::size_t x = 0; x < rep_.size(); ++x)
+        if (bad_group[static_cast<std::size_t>(group_[x])])
+          patches.insert(patches.end(), point_patches_[x].begin(), point_patches_[x].end());
+      std::sort(patches.begin(), patches.end());
+      patches.erase(std::unique(patches.begin(), patches.end()), patches.end());
+    }
     // A patch's first repair only forbids its arcs to collapse; its next ones restore the input
     // lengths (which keeps more of the input's split lines, hence more blocks).
     repair_level_.resize(grids_.size(), 0);

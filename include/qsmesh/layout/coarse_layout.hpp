@@ -112,7 +112,7 @@ struct CoarseStats {
   /// Solves, each after rows forbidding the CAD merges of the last one (at most 40 per repair).
   int ilp_rounds = 0;
   /// Solves again after an invalid fine mesh, the patches that made the bad coarse quads kept from
-  /// collapsing, then at their input lengths (at most 12).
+  /// collapsing, then at their input lengths, then rings of patches around them (at most 16).
   int repairs = 0;
   std::string ilp_status;
   std::int64_t smooth_curves = 0;  ///< CAD curves crossed (CoarseOptions::cross_smooth_curves)
