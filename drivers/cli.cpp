@@ -246,6 +246,11 @@ Arguments parse(const std::vector<std::string>& args) {
       if (!b || !(*b >= 0 && *b <= 1))
         throw InputError("--loop-balance: '" + v + "' is not a number in [0, 1]");
       a.loop_balance = *b;
+    } else if (opt == "--loop-widths" && a.command == Command::Mesh) {
+      const std::string& v = value();
+      if (v != "mean" && v != "fit")
+        throw InputError("--loop-widths: '" + v + "' is not mean or fit");
+      a.fit_loop_widths = v == "fit";
     } else if (opt == "--fine-placement" && a.command == Command::Mesh) {
       const std::string& v = value();
       if (v != "former" && v != "laplacian" && v != "spacing" && v != "both" && v != "patch")
@@ -613,6 +618,9 @@ std::string help(const std::string& topic) {
           "  --loop-balance B      with --layout coarse: quad-loop widths blended with weight B\n"
           "                        (0..1) towards square fine quads in each coarse quad\n"
           "                        (default 0: the input mesh's lengths alone)\n"
+          "  --loop-widths W       with --layout coarse: mean (default: each quad loop's width\n"
+          "                        the rounded mean of its input lengths) or fit (the width\n"
+          "                        nearest in ratio to the input extent of every cell it crosses)\n"
           "  --fine-placement P    with --layout coarse: former, laplacian, spacing, both\n"
           "                        (default) or patch: the uv Laplacian before the kernels, fine\n"
           "                        nodes on CAD curves spaced like the input mesh's (both), and\n"

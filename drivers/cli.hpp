@@ -56,6 +56,8 @@ struct Arguments {
   bool coarse_layout = false;
   /// --loop-balance B (with --layout coarse): layout::CoarseOptions::loop_balance, in [0, 1].
   double loop_balance = 0;
+  /// --loop-widths mean|fit (with --layout coarse): layout::CoarseOptions::fit_loop_widths.
+  bool fit_loop_widths = false;
   /// --fine-placement former|laplacian|spacing|both|patch (with --layout coarse): which of the
   /// fine mesh's placement changes are on (layout::CoarseOptions::laplacian_uv,
   /// input_spacing_on_curves and patch_placement); default both, patch is both with

@@ -34,7 +34,12 @@ constexpr LO kNever = std::numeric_limits<LO>::max();
 // before every side is uniform.
 constexpr int kMaxSpacingRounds = 3;
 constexpr int kMaxRounds = 40;
-constexpr int kMaxRepairs = 12;
+// Block at its reference factor needs 12 (docs/benchmarks.md, branch coarse8); a bound against a
+// loop that keeps finding new folds, each repair restoring more of the input's split lines.
+constexpr int kMaxRepairs = 16;
+// Rings of patches around the bad coarse quads' own that a repair may restore once those are at
+// their input lengths (restore_rows).
+constexpr int kMaxRings = 3;
 
 // Transfinite (Coons) interpolation at grid node (i, j) of an n0 x n1 grid from its boundary
 // nodes P(i, 0), P(n0, j), P(i, n1), P(0, j).
@@ -198,12 +203,28 @@ class Builder {
         out.layout = {};
         fine_mesh(out);
         if (bad_cquads_.empty()) break;
+        // Where the fine mesh is invalid, the patches that made those coarse quads keep their
+        // input lengths (the input layout is valid), and all is solved again. When every such
+        // row is already there (those patches are at their input lengths), solving again would
+        // give the same layout and the same folds (Block: a reflex CAD corner whose cells were
+        // single input quads and still folded, docs/benchmarks.md): the rows then reach one
+        // ring of patches further out (every patch touching a corner group of a coarse quad cut
+        // from the restored ones, whose collapsed arcs move those groups' centres), up to
+        // kMaxRings rings, before the layout fails.
+        std::vector<IntegerProgram::Row> rows = restore_rows(0);
+        bool fresh = new_rows(ilp, rows);
+        for (int ring = 1; !fresh && ring <= kMaxRings; ++ring) {
+          rows = restore_rows(ring);
+          fresh = new_rows(ilp, rows);
+        }
+        if (!fresh)
+          throw Reject{cat(bad_quads_, " fine quads invalid or folded on patches already at ",
+                           "their input lengths, and ", kMaxRings,
+                           " rings of patches around them")};
         if (repair + 1 >= kMaxRepairs)
           throw Reject{
               cat(bad_quads_, " fine quads invalid or folded after ", kMaxRepairs, " repairs")};
-        // Where the fine mesh is invalid, the patches that made those coarse quads keep their
-        // input lengths (the input layout is valid), and all is solved again.
-        for (const auto& r : restore_rows()) ilp.rows.push_back(r);
+        for (const auto& r : rows) ilp.rows.push_back(r);
         out.stats.repairs = repair + 1;
       }
       out.stats.coarse_quads = static_cast<std::int64_t>(out.layout.blocks.size());
@@ -805,8 +826,9 @@ class Builder {
   }
 
   // Rows q_a >= l_a for the side arcs of every patch touching a corner group of a bad coarse
-  // quad, and of the patch it was cut from.
-  [[nodiscard]] std::vector<IntegerProgram::Row> restore_rows() {
+  // quad, and of the patch it was cut from; `rings` times more, also every patch touching a
+  // corner group of a coarse quad cut from those patches.
+  [[nodiscard]] std::vector<IntegerProgram::Row> restore_rows(int rings) {
     std::vector<char> bad_group(static_cast<std::size_t>(ng_), 0);
     std::vector<LO> patches;
     for (std::size_t k : bad_cquads_) {
@@ -818,6 +840,18 @@ class Builder {
         patches.insert(patches.end(), point_patches_[x].begin(), point_patches_[x].end());
     std::sort(patches.begin(), patches.end());
     patches.erase(std::unique(patches.begin(), patches.end()), patches.end());
+    for (int ring = 0; ring < rings; ++ring) {
+      std::vector<char> in(grids_.size(), 0);
+      for (LO p : patches) in[static_cast<std::size_t>(p)] = 1;
+      for (const CQuad& q : cquads_)
+        if (in[static_cast<std::size_t>(cells_[static_cast<std::size_t>(q.cell)].patch)])
+          for (GO g : q.v) bad_group[static_cast<std::size_t>(g)] = 1;
+      for (std::size_t x = 0; x < rep_.size(); ++x)
+        if (bad_group[static_cast<std::size_t>(group_[x])])
+          patches.insert(patches.end(), point_patches_[x].begin(), point_patches_[x].end());
+      std::sort(patches.begin(), patches.end());
+      patches.erase(std::unique(patches.begin(), patches.end()), patches.end());
+    }
     // A patch's first repair only forbids its arcs to collapse; its next ones restore the input
     // lengths (which keeps more of the input's split lines, hence more blocks).
     repair_level_.resize(grids_.size(), 0);
@@ -839,6 +873,24 @@ class Builder {
       rows.push_back(std::move(r));
     }
     return rows;
+  }
+
+  // Whether a row of `rows` (single-arc lower bounds, restore_rows) is not yet in the program:
+  // no row of the program on the same arc with a bound as high.
+  [[nodiscard]] static bool new_rows(const IntegerProgram& ilp,
+                                     const std::vector<IntegerProgram::Row>& rows) {
+    std::map<LO, double> have;
+    for (const auto& r : ilp.rows)
+      if (r.terms.size() == 1 && r.terms.front().second == 1.0 &&
+          r.hi == std::numeric_limits<double>::infinity()) {
+        auto [it, fresh] = have.emplace(r.terms.front().first, r.lo);
+        if (!fresh) it->second = std::max(it->second, r.lo);
+      }
+    for (const auto& r : rows) {
+      const auto it = have.find(r.terms.front().first);
+      if (it == have.end() || it->second < r.lo) return true;
+    }
+    return false;
   }
 
   // A coarse quad corner between two edges on CAD curves away from a CAD corner is flat (an
@@ -1116,7 +1168,29 @@ class Builder {
       const auto r = static_cast<std::size_t>(loops.find(static_cast<GO>(e)));
       cedges_[e].n = std::max<LO>(1, static_cast<LO>(std::lround(lsum[r] / lcnt[r])));
     }
+    if (opt_.fit_loop_widths) fit_loops(loops);
     if (opt_.loop_balance > 0) balance_loops(loops);
+  }
+
+  // CoarseOptions::fit_loop_widths: each loop's width fitted to the extents of its cells in
+  // their input patch grids (fit_loop_width).
+  void fit_loops(Dsu& loops) {
+    std::vector<std::vector<LoopCrossing>> cross(cedges_.size());
+    for (std::size_t k = 0; k < cquads_.size(); ++k) {
+      const std::array<Vec2, 4> C = cell_grid_corners(k);
+      const double e0 = 0.5 * (std::abs(C[1].u - C[0].u) + std::abs(C[2].u - C[3].u));
+      const double e1 = 0.5 * (std::abs(C[3].v - C[0].v) + std::abs(C[2].v - C[1].v));
+      const double area = std::max(e0, 0.5) * std::max(e1, 0.5);
+      const CQuad& q = cquads_[k];
+      cross[static_cast<std::size_t>(loops.find(q.e[0]))].push_back({e0, area});
+      cross[static_cast<std::size_t>(loops.find(q.e[1]))].push_back({e1, area});
+    }
+    std::vector<LO> width(cedges_.size(), 0);
+    for (std::size_t e = 0; e < cedges_.size(); ++e) {
+      const auto r = static_cast<std::size_t>(loops.find(static_cast<GO>(e)));
+      if (width[r] == 0) width[r] = fit_loop_width(cross[r]);
+      cedges_[e].n = width[r];
+    }
   }
 
   // CoarseOptions::loop_balance: each edge's target blended with the width that would make the
@@ -2151,6 +2225,7 @@ class Builder {
   std::vector<char> bad_fine_cquad_;
   std::vector<std::vector<double>> curve_params_;  // input_params, per CAD curve
   std::vector<int> repair_level_;
+
   std::vector<std::size_t> bad_cquads_;
   std::int64_t bad_quads_ = 0;
   std::vector<std::vector<LO>> point_patches_;
@@ -2163,6 +2238,28 @@ class Builder {
 };
 
 }  // namespace
+
+int fit_loop_width(const std::vector<LoopCrossing>& crossings) {
+  if (crossings.empty()) return 1;
+  // The cost is convex in ln w, so its integer minimum lies at the floor or the ceiling of the
+  // weighted median of the extents, searched here over every integer up to the largest extent
+  // (loops are short: a few cells, extents of a few input quads).
+  double top = 1;
+  for (const LoopCrossing& c : crossings) top = std::max(top, c.extent);
+  const int wmax = static_cast<int>(std::ceil(top));
+  int best = 1;
+  double best_cost = std::numeric_limits<double>::infinity();
+  for (int w = 1; w <= wmax; ++w) {
+    double cost = 0;
+    for (const LoopCrossing& c : crossings)
+      cost += std::max(c.weight, 0.0) * std::abs(std::log(w / std::max(c.extent, 0.5)));
+    if (w == 1 || cost < best_cost - 1e-12 * std::max(1.0, best_cost)) {
+      best_cost = cost;
+      best = w;
+    }
+  }
+  return best;
+}
 
 bool choose_side_spacing(const SideScore& uniform, const SideScore& input_like, double avg_slack) {
   if (input_like.sicn_min <= 0) return false;

@@ -200,6 +200,38 @@ TEST(CoarseLayout, LoopWidthsBalancedAgainstTheCoarseQuadsShapes) {
   EXPECT_NE(balanced.mesh.quads.size(), plain.mesh.quads.size());
 }
 
+TEST(CoarseLayout, LoopWidthFitFollowsTheCellsThatHoldMostInputQuads) {
+  // Three cells one input quad across (one quad each) and one eight across (eight quads): the
+  // loop's mean of targets would give 3, wrong for all four; the fit gives the large cell its
+  // extent, as it holds most of the input quads.
+  EXPECT_EQ(fit_loop_width({{1, 1}, {1, 1}, {1, 1}, {8, 8}}), 8);
+  // Many small cells outweigh one large one.
+  EXPECT_EQ(fit_loop_width({{1, 4}, {1, 4}, {1, 4}, {8, 8}}), 1);
+  // One cell: its extent, rounded in ratio (2.6 is nearer 3 than 2 in ratio).
+  EXPECT_EQ(fit_loop_width({{11, 1}}), 11);
+  EXPECT_EQ(fit_loop_width({{2.6, 1}}), 3);
+  // A tie between 2 and 4 (every width between costs the same): the smallest.
+  EXPECT_EQ(fit_loop_width({{2, 1}, {4, 1}}), 2);
+  // Cells spanning no input quad still get one fine quad; no cell: width 1.
+  EXPECT_EQ(fit_loop_width({{0, 1}, {0.2, 3}}), 1);
+  EXPECT_EQ(fit_loop_width({}), 1);
+}
+
+TEST(CoarseLayout, FittedLoopWidthsKeepTheLayoutConforming) {
+  // The fitted widths change the fine counts (and, where fine quads fold, the repairs and so the
+  // blocks); the layout stays conforming and valid on the box with a hole.
+  const std::string path = test::write_box_with_hole(test::tmp("coarse_fit.brep"));
+  const Meshed in = mesh_model(path, 0.35);
+  const CoarseResult plain = build_coarse_layout(in.mesh, in.model);
+  CoarseOptions o;
+  o.fit_loop_widths = true;
+  const CoarseResult fit = build_coarse_layout(in.mesh, in.model, o);
+  expect_conforming_blocks(plain, in.model);
+  expect_conforming_blocks(fit, in.model);
+  EXPECT_NE(fit.mesh.quads.size(), plain.mesh.quads.size());
+  EXPECT_GT(fit.stats.sicn_min, 0.0);
+}
+
 TEST(CoarseLayout, BlocksCrossSmoothCurvesNotSharpOnes) {
   // A filleted box: the fillets meet the box's faces and each other along smooth curves, which
   // blocks may cross; fewer blocks than with every curve a wall, still conforming.

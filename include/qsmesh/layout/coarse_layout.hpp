@@ -65,7 +65,30 @@ struct CoarseOptions {
   /// are no better, as the uv Laplacian's direct solve forgets the placement and the gap comes
   /// from the quad-loop widths (docs/benchmarks.md, branch coarse7).
   bool patch_placement = false;
+  /// Quad-loop widths fitted to the cells each loop crosses (fit_loop_width: the integer width
+  /// nearest, in ratio and weighted by the input quads each cell covers, to the extent of every
+  /// cell of the loop in its input patch grid) instead of the rounded mean of the loop's targets.
+  bool fit_loop_widths = false;
 };
+
+/// One coarse quad a quad loop crosses: how many input quads its cell spans across the loop (in
+/// its input patch's grid, fractional where the cell's sides run between grid lines) and its
+/// weight in the fit (the input quads the cell covers).
+struct LoopCrossing {
+  double extent = 1;
+  double weight = 1;
+};
+
+/// The width of a quad loop fitted to the coarse quads it crosses: the integer w >= 1 that
+/// minimises sum weight * |ln w - ln extent| (extents below 1/2 count as 1/2: a cell spanning
+/// no input quad still gets one fine quad), the smallest such w on a tie; 1 for no crossing.
+/// A fine quad in a cell meshed w times across an extent e is stretched by w / e against the
+/// input quads it replaces; the loop's rounded mean of targets lets large cells pay for small
+/// ones, this weighted median in ratio lets the cells that hold most input quads decide.
+/// The integer program "widths minimising the weighted mismatch over every cell" separates by
+/// loop (each cell's two terms each hold one loop's width, no row couples loops), so this is
+/// its exact solution, loop by loop.
+[[nodiscard]] int fit_loop_width(const std::vector<LoopCrossing>& crossings);
 
 /// Quality of the fine quads of one coarse quad (SICN, before smoothing), for one placement of
 /// the fine nodes on its sides.
@@ -89,7 +112,7 @@ struct CoarseStats {
   /// Solves, each after rows forbidding the CAD merges of the last one (at most 40 per repair).
   int ilp_rounds = 0;
   /// Solves again after an invalid fine mesh, the patches that made the bad coarse quads kept from
-  /// collapsing, then at their input lengths (at most 12).
+  /// collapsing, then at their input lengths, then rings of patches around them (at most 16).
   int repairs = 0;
   std::string ilp_status;
   std::int64_t smooth_curves = 0;  ///< CAD curves crossed (CoarseOptions::cross_smooth_curves)
