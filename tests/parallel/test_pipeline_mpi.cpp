@@ -27,19 +27,22 @@ namespace {
 
 std::string tmp(const std::string& name) { return std::string(QSMESH_TEST_TMP_DIR) + "/" + name; }
 
-/// Rank 0 writes the model, everybody reads it (every rank reads the CAD file itself).
-cad::CadModel shared_model(const Comm& comm, const std::string& name) {
+/// The path of a filleted box that rank 0 writes, once every rank may read it.
+std::string written_box(const Comm& comm, const std::string& name) {
   const std::string path = tmp(name + "_np" + std::to_string(comm.size()) + ".step");
   if (comm.rank() == 0) test::write_filleted_box(path);
   comm.barrier();
-  return cad::load_cad(path);
+  return path;
+}
+
+/// Rank 0 writes the model, everybody reads it (every rank reads the CAD file itself).
+cad::CadModel shared_model(const Comm& comm, const std::string& name) {
+  return cad::load_cad(written_box(comm, name));
 }
 
 TEST(MeasureSplit, FaceAreasSplitOverRanksAndThreadsAreTheSerialOnes) {
   const Comm comm = Comm::world();
-  const std::string path = tmp("measured_box_np" + std::to_string(comm.size()) + ".step");
-  if (comm.rank() == 0) test::write_filleted_box(path);
-  comm.barrier();
+  const std::string path = written_box(comm, "measured_box");
   const cad::CadModel serial = cad::load_cad(path);
   const TaskArena two(2);
   SplitRound round;
