@@ -223,6 +223,21 @@ Arguments parse(const std::vector<std::string>& args) {
       if (!n || !std::isfinite(*n) || *n < 1 || *n > 1000 || *n != std::floor(*n))
         throw InputError(opt + ": '" + v + "' is not a number of iterations in [1, 1000]");
       a.field_iterations = static_cast<int>(*n);
+    } else if (opt == "--field-stall" && meshing) {
+      // K or K:R.
+      const std::string& v = value();
+      const auto colon = v.find(':');
+      const auto n = parse_double(v.substr(0, colon));
+      if (!n || !std::isfinite(*n) || *n < 0 || *n > 1000 || *n != std::floor(*n))
+        throw InputError(opt + ": '" + v +
+                         "' does not start with 0 (off) or a number of iterations in [1, 1000]");
+      a.field_stall = static_cast<int>(*n);
+      if (colon != std::string::npos) {
+        const auto r = parse_double(v.substr(colon + 1));
+        if (!r || !std::isfinite(*r) || *r <= 0 || *r >= 1)
+          throw InputError(opt + ": '" + v + "': the ratio after ':' is not in (0, 1)");
+        a.field_stall_ratio = *r;
+      }
     } else if (opt == "--block-structured" && a.command == Command::Mesh)
       a.block_structured = true;
     else if (opt == "--block-patches" && a.command == Command::Mesh)
@@ -675,6 +690,13 @@ std::string help(const std::string& topic) {
           "  --field-iterations N  at most N iterations per cross-field diffusion level (default "
        << crossfield::CrossFieldOptions{}.max_iterations_per_level
        << ")\n"
+          "  --field-stall K[:R]   a cross-field diffusion level also ends when its RMS change\n"
+          "                        has not fallen below R times its value K iterations earlier\n"
+          "                        (a stalled level: singularities creeping a cell at a time);\n"
+          "                        0: off (default "
+       << crossfield::CrossFieldOptions{}.stall_window << "; R default "
+       << crossfield::CrossFieldOptions{}.stall_ratio
+       << ")\n"
           "  --face-time-budget S  at most S seconds of cavity remeshing (paper 000 Sec. 6.2) per\n"
           "                        face; a face that reaches it keeps the mesh it has (valid) and "
           "is\n"
@@ -732,7 +754,7 @@ std::string help(const std::string& topic) {
           "                        with the line 'euler-consistent: K/N'\n"
           "  --size H, --size-factor F, --threads T, --stats FILE.json, --max-quads N,\n"
           "  --field-divisions N, --distributed-threshold N, --field-change M,\n"
-          "  --field-iterations N, --sew, -q, -v: as for mesh\n";
+          "  --field-iterations N, --field-stall K[:R], --sew, -q, -v: as for mesh\n";
   } else if (topic == "sizemap") {
     os << "usage: [mpirun -np P] qsmesh sizemap MODEL -o OUT.vtu [options]\n\n"
           "Computes the size map (paper 000 Sec. 4.1-4.2) and the curve quantization (Sec. 4.3):\n"
@@ -794,7 +816,7 @@ std::string help(const std::string& topic) {
           "                        size constraints at corners, on curves, on faces (model units)\n"
           "  --size H, --size-factor F, --threads T, --stats FILE.json, --max-quads N,\n"
           "  --field-divisions N, --distributed-threshold N, --field-change M,\n"
-          "  --field-iterations N, --sew, -q, -v: as for mesh\n";
+          "  --field-iterations N, --field-stall K[:R], --sew, -q, -v: as for mesh\n";
   } else if (topic == "example") {
     os << "usage: qsmesh example NAME -o FILE\n\n"
           "Writes a built-in CAD model built with OpenCASCADE, as STEP (FILE.step, .stp) or BREP\n"

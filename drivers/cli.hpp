@@ -138,6 +138,10 @@ struct Arguments {
   /// --field-iterations N (crossfield::CrossFieldOptions::max_iterations_per_level); unset: its
   /// default.
   std::optional<int> field_iterations;
+  /// --field-stall K (crossfield::CrossFieldOptions::stall_window); unset: its default.
+  std::optional<int> field_stall;
+  /// the R of --field-stall K:R (crossfield::CrossFieldOptions::stall_ratio); unset: its default.
+  std::optional<double> field_stall_ratio;
   bool sew = false;
   bool quiet = false;
   bool verbose = false;

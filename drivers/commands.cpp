@@ -939,6 +939,8 @@ int run_mesh(const Arguments& args) {
     options.crossfield.level_change =
         args.field_change == "rms" ? crossfield::LevelChange::Rms : crossfield::LevelChange::Max;
   if (args.field_iterations) options.crossfield.max_iterations_per_level = *args.field_iterations;
+  if (args.field_stall) options.crossfield.stall_window = *args.field_stall;
+  if (args.field_stall_ratio) options.crossfield.stall_ratio = *args.field_stall_ratio;
   check_request(args, s);
   if (until >= parallel::Stage::Unstructured) apply_size_options(args, s, options);
   s.announce(args, "mesh");

@@ -75,6 +75,8 @@ int run_crossfield(const Arguments& args) {
     options.crossfield.level_change =
         args.field_change == "rms" ? crossfield::LevelChange::Rms : crossfield::LevelChange::Max;
   if (args.field_iterations) options.crossfield.max_iterations_per_level = *args.field_iterations;
+  if (args.field_stall) options.crossfield.stall_window = *args.field_stall;
+  if (args.field_stall_ratio) options.crossfield.stall_ratio = *args.field_stall_ratio;
   options.cross_fields = true;
   const parallel::PipelineResult result =
       parallel::run_pipeline(s.comm, s.model, options, *s.tasks, s.log, &lane);

@@ -90,6 +90,8 @@ int run_sizemap(const Arguments& args) {
     options.crossfield.level_change =
         args.field_change == "rms" ? crossfield::LevelChange::Rms : crossfield::LevelChange::Max;
   if (args.field_iterations) options.crossfield.max_iterations_per_level = *args.field_iterations;
+  if (args.field_stall) options.crossfield.stall_window = *args.field_stall;
+  if (args.field_stall_ratio) options.crossfield.stall_ratio = *args.field_stall_ratio;
   options.size_map = true;
   check_request(args, s);
   apply_size_options(args, s, options);

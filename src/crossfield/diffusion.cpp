@@ -198,6 +198,7 @@ void diffuse(FaceCrossField& cf, const Geometry& g, const CrossFieldOptions& opt
       U[i + 1] = has_boundary ? 0.0 : cf.u[e].v;
     }
   std::vector<double> previous(U.size()), pair_mass(U.size() / 2), m_alpha(U.size());
+  std::vector<double> rms;  // the level's RMS changes, for the stall rule
   for (std::size_t k = 0; k < pair_mass.size(); ++k) pair_mass[k] = mfree[2 * k];
   linalg::SparseMatrix A = K;
   for (int level = 0; level < options.levels; ++level) {
@@ -211,6 +212,7 @@ void diffuse(FaceCrossField& cf, const Geometry& g, const CrossFieldOptions& opt
     ++cf.stats.factorizations;
     int it = 0;
     double change = 1e300;
+    rms.clear();
     while (change >= options.tolerance && it < options.max_iterations_per_level) {
       for (LO i = 0; i < n; ++i) rhs[i] = m_alpha[i] * U[i] + coupling[i];
       solver->solve(rhs, X);
@@ -223,6 +225,16 @@ void diffuse(FaceCrossField& cf, const Geometry& g, const CrossFieldOptions& opt
         U[i + 1] = p.v;
       }
       change = level_change(previous, U, pair_mass, options.level_change);
+      if (options.stall_window > 0) {
+        rms.push_back(options.level_change == LevelChange::Rms
+                          ? change
+                          : level_change(previous, U, pair_mass, LevelChange::Rms));
+        if (change >= options.tolerance &&
+            level_stalled(rms, options.stall_window, options.stall_ratio)) {
+          ++cf.stats.stalled_levels;
+          break;
+        }
+      }
     }
     cf.stats.iterations_per_level.push_back(it);
     ++cf.stats.levels;
@@ -239,6 +251,11 @@ void diffuse(FaceCrossField& cf, const Geometry& g, const CrossFieldOptions& opt
 }  // namespace qsmesh::crossfield::detail
 
 namespace qsmesh::crossfield {
+
+bool level_stalled(std::span<const double> rms, int window, double ratio) {
+  if (window <= 0 || rms.size() <= static_cast<std::size_t>(window)) return false;
+  return rms.back() > ratio * rms[rms.size() - 1 - static_cast<std::size_t>(window)];
+}
 
 double level_change(std::span<const double> before, std::span<const double> after,
                     std::span<const double> mass, LevelChange how) {

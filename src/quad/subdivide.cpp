@@ -215,7 +215,43 @@ bool has_corner_mids(const background::HalvedBoundary& boundary) {
   return false;
 }
 
+// Below this SICN a sub-quad at a pole is worth a second centre placement (see subdivide).
+constexpr double kPoleCentreSicn = 0.1;
+// A parameter line is degenerate when its image moves less than this fraction of what a step
+// across it moves: CAD poles (coincident control points) are points only to the model's
+// tolerance, and the placement only needs to know which way the element lies.
+constexpr double kDegenerateRatio = 1e-3;
+
 }  // namespace
+
+std::vector<PoleLine> degenerate_lines(const cad::FaceGeometry& surface,
+                                       std::span<const Vec2> poles, double reach) {
+  std::vector<PoleLine> out;
+  if (!(reach > 0)) return out;
+  for (const Vec2& p : poles) {
+    const cad::SurfaceEval e = surface.eval(p);
+    // The surface does not move along the degenerate direction: du vanishes on a line v = const.
+    const int fixed = norm(e.du) <= norm(e.dv) ? 1 : 0;
+    const Vec2 along = fixed == 1 ? Vec2{reach, 0} : Vec2{0, reach};
+    const Vec2 across = fixed == 1 ? Vec2{0, reach} : Vec2{reach, 0};
+    double moved_along = 0;
+    for (const double s : {-1.0, -0.5, 0.5, 1.0})
+      moved_along = std::max(moved_along, distance(surface.eval(p + s * along).p, e.p));
+    const double moved_across = std::max(distance(surface.eval(p + across).p, e.p),
+                                         distance(surface.eval(p - across).p, e.p));
+    if (!(moved_across > 0) || moved_along > kDegenerateRatio * moved_across) continue;
+    const double value = fixed == 1 ? p.v : p.u;
+    bool seen = false;
+    for (const PoleLine& l : out)
+      seen = seen || (l.fixed == fixed && std::abs(l.value - value) <= 1e-12 * reach);
+    if (!seen) out.push_back({fixed, value, e.p});
+  }
+  return out;
+}
+
+Vec2 pole_image(const PoleLine& line, const Vec2& toward) {
+  return line.fixed == 0 ? Vec2{line.value, toward.v} : Vec2{toward.u, line.value};
+}
 
 std::map<std::pair<LO, LO>, Vec3> corner_midpoints(const mesh::FaceMesh& mesh,
                                                    const background::HalvedBoundary& boundary) {
@@ -384,7 +420,43 @@ mesh::FaceMesh subdivide(const mesh::FaceMesh& mesh, const cad::FaceGeometry& su
         guess += mesh.uv[elems[e][k]];
         ++regular;
       }
-    if (regular > 0 && regular < n) uv = surface.project(g, guess / regular, nullptr);
+    if (regular > 0 && regular < n) {
+      const Vec2 toward = guess / regular;
+      uv = surface.project(g, toward, nullptr);
+      const auto worst_sub_quad = [&](const Vec2& at) {
+        const Vec3 pc = surface.eval(at).p;
+        double s = std::numeric_limits<double>::infinity();
+        for (int k = 0; k < n; ++k)
+          s = std::min(s, mesh::quad_sicn({out.points[elems[e][k]], out.points[elem_mid[e][k]], pc,
+                                           out.points[elem_mid[e][(k + n - 1) % n]]}));
+        return s;
+      };
+      const double projected = worst_sub_quad(uv);
+      if (projected < kPoleCentreSicn) {
+        // The 3D centroid can lie off the surface's side the element is on (on the axis of a
+        // half of revolution), and its projection then lands on the boundary: place the centre
+        // in (u, v) instead, each pole at the point of its degenerate line facing the element.
+        double reach = 0;
+        for (int k = 0; k < n; ++k) reach = std::max(reach, norm(mesh.uv[elems[e][k]] - toward));
+        Vec2 alt{0, 0};
+        bool placed = true;
+        for (int k = 0; k < n && placed; ++k) {
+          const LO v = elems[e][k];
+          if (pole[v] == 0) {
+            alt += mesh.uv[v];
+            continue;
+          }
+          const std::vector<PoleLine> lines =
+              degenerate_lines(surface, std::span<const Vec2>(&mesh.uv[v], 1), reach);
+          placed = !lines.empty();
+          if (placed) alt += pole_image(lines.front(), toward);
+        }
+        if (placed) {
+          alt = alt / n;
+          if (worst_sub_quad(alt) > projected) uv = alt;
+        }
+      }
+    }
     const LO c = out.num_vertices();
     mesh::VertexClass vc;
     vc.dim = 2;

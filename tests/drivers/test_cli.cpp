@@ -77,6 +77,25 @@ TEST(Cli, FieldChangeAndIterations) {
   EXPECT_NE(help("mesh").find("--field-iterations"), std::string::npos);
 }
 
+TEST(Cli, FieldStall) {
+  const Arguments plain = p({"mesh", "m.step", "-o", "o.vtu"});
+  EXPECT_FALSE(plain.field_stall.has_value());
+  EXPECT_FALSE(plain.field_stall_ratio.has_value());
+  const Arguments k = p({"mesh", "m.step", "-o", "o.vtu", "--field-stall", "5"});
+  EXPECT_EQ(*k.field_stall, 5);
+  EXPECT_FALSE(k.field_stall_ratio.has_value());
+  const Arguments kr = p({"crossfield", "m.step", "--check", "--field-stall", "8:0.75"});
+  EXPECT_EQ(*kr.field_stall, 8);
+  EXPECT_DOUBLE_EQ(*kr.field_stall_ratio, 0.75);
+  EXPECT_EQ(*p({"mesh", "m.step", "-o", "o.vtu", "--field-stall", "0"}).field_stall, 0);
+  for (const char* bad : {"-1", "2.5", "x", "1001", "5:", "5:0", "5:1", "5:x", ":0.5"})
+    EXPECT_NE(
+        error_of({"mesh", "m.step", "-o", "o.vtu", "--field-stall", bad}).find("--field-stall"),
+        std::string::npos)
+        << bad;
+  EXPECT_NE(help("mesh").find("--field-stall"), std::string::npos);
+}
+
 TEST(Cli, CrossFieldAndSeparatrixMethod) {
   const Arguments a =
       p({"mesh", "m.step", "-o", "o.vtu", "--cross-field", "f.txt", "--method", "separatrix"});

@@ -5,6 +5,7 @@
 #include <map>
 #include <span>
 #include <utility>
+#include <vector>
 
 #include "qsmesh/background/face_mesh.hpp"
 #include "qsmesh/cad/geometry.hpp"
@@ -24,6 +25,28 @@ struct SubdivideStats {
 /// counts even). Throws what subdivide throws on an edge it cannot match.
 [[nodiscard]] std::map<std::pair<LO, LO>, Vec3> corner_midpoints(
     const mesh::FaceMesh& mesh, const background::HalvedBoundary& boundary);
+
+/// A parameter line of a surface whose 3D image is a single point: a pole of the
+/// parametrization (the apex of a cone, a pole of a sphere, the tip of a surface of revolution
+/// whose profile ends on its axis). A pole vertex has an arbitrary uv on its line.
+struct PoleLine {
+  int fixed = 0;     ///< 0: the line u = value (v runs along it); 1: the line v = value
+  double value = 0;  ///< the fixed parameter
+  Vec3 point;        ///< the line's 3D image
+};
+
+/// The degenerate parameter lines through the parameter points `poles` (the uv of pole vertices,
+/// where surface.normal is zero), one per distinct line. At a pole the derivative along the
+/// degenerate direction vanishes; the line is kept only when steps of up to +-reach along it
+/// move the point by at most 1e-3 of what a step of reach across it moves (reach: a length in
+/// (u, v), > 0, such as the extent of the elements at the pole). A pole where neither
+/// derivative vanishes (du parallel to dv) has no such line and is left out; none for reach <= 0.
+[[nodiscard]] std::vector<PoleLine> degenerate_lines(const cad::FaceGeometry& surface,
+                                                     std::span<const Vec2> poles, double reach);
+
+/// The point of `line` that faces an element whose other (regular) corners have the uv centroid
+/// `toward`: `toward` moved along the fixed parameter onto the line.
+[[nodiscard]] Vec2 pole_image(const PoleLine& line, const Vec2& toward);
 
 /// Midpoint subdivision (paper 000 Sec. 5.2): each quad into 4 quads, each triangle into 3.
 /// New vertices are the edge midpoints and the element centres.
@@ -51,6 +74,12 @@ struct SubdivideStats {
 ///    evaluated with surface.eval; when such a point leaves an adjacent quad with SICN <= 0, it is
 ///    moved to the 3D midpoint / centroid projected with surface.project if that is better, and
 ///    counted in stats->snaps_reverted.
+///  - The centre of an element touching a pole is the 3D centroid projected from the uv centroid
+///    of its regular corners (a pole's uv says nothing about where the element is). Where that
+///    leaves one of its sub-quads below SICN 0.1 (the projection can land on the boundary: the
+///    3D centroid of an element spanning a half of revolution lies on the axis), the uv centroid
+///    with each pole corner replaced by its pole_image (toward the regular corners) is tried too,
+///    and the better of the two minimum sub-quad SICNs kept.
 /// Returns an all-quad FaceMesh oriented like the input: the old vertices first (same order), then
 /// the edge midpoints, then the centres. Throws qsmesh::Error when a boundary edge matches no
 /// segment of `boundary` or a curve vertex lies outside full_curves (inconsistent inputs).
