@@ -610,23 +610,26 @@ std::vector<std::int64_t> pattern_stage(const Context& cx, std::vector<FaceTask>
     ranks.emplace(cx.comm);
     helpers.emplace(*ranks, cx.model, result.quantized_curves, patterns, options.patterns);
   }
-  deal_out(cx.comm, nfaces, cx.tasks, [&](std::int64_t k) {
-    const auto f = static_cast<std::size_t>(order[static_cast<std::size_t>(k)]);
-    qstruct::PatternFaceOptions po = options.patterns;
-    po.size_map_quads = expected[f];
-    po.tasks = &cx.tasks;  // one face's move search split over this rank's threads
-    if (lend) po.helpers = &*helpers;
-    if (!options.move_layouts_over_ranks) po.move_lend_layouts = 0;
-    fills[f] = mesh_face_fill(cx.model, static_cast<LO>(f), result.quantized_curves, patterns, po,
-                              fill_bound[f], options.pattern_compare_tolerance >= 0);
-    filled[f] = 1;
-    progress.done();
-  });
-  if (lend) {
-    helpers->serve_until_all_done();
-    cx.log.debug(cat("patterns: rank ", cx.comm.rank(), " laid out ", helpers->served(),
-                     " move layouts for other ranks"));
-  }
+  deal_out(
+      cx.comm, nfaces, cx.tasks,
+      [&](std::int64_t k) {
+        const auto f = static_cast<std::size_t>(order[static_cast<std::size_t>(k)]);
+        qstruct::PatternFaceOptions po = options.patterns;
+        po.size_map_quads = expected[f];
+        po.tasks = &cx.tasks;  // one face's move search split over this rank's threads
+        if (lend) po.helpers = &*helpers;
+        if (!options.move_layouts_over_ranks) po.move_lend_layouts = 0;
+        fills[f] = mesh_face_fill(cx.model, static_cast<LO>(f), result.quantized_curves, patterns,
+                                  po, fill_bound[f], options.pattern_compare_tolerance >= 0);
+        filled[f] = 1;
+        progress.done();
+      },
+      [&] {
+        if (!lend) return;
+        helpers->serve_until_all_done();
+        cx.log.debug(cat("patterns: rank ", cx.comm.rank(), " laid out ", helpers->served(),
+                         " move layouts for other ranks"));
+      });
   // Fills to their owners.
   std::vector<std::int64_t> local_of(static_cast<std::size_t>(nfaces), -1);
   for (std::size_t i = 0; i < faces.size(); ++i)
