@@ -6,6 +6,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
@@ -14,6 +15,7 @@
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/parallel/comm.hpp"
 #include "qsmesh/parallel/pattern_helpers.hpp"
+#include "qsmesh/parallel/pipeline.hpp"
 #include "qsmesh/qstruct/face_pattern.hpp"
 #include "shapes.hpp"
 
@@ -113,6 +115,40 @@ TEST(PatternHelpers, SearchDealtOverRanksGivesTheSerialFill) {
   } else {
     EXPECT_EQ(lent, 0);
   }
+}
+
+// The pipeline (PipelineOptions::move_layouts_over_ranks, on by default): one face, one thread per
+// rank, so every other rank is free while its search runs. The mesh is the one-rank mesh, and the
+// search had helpers (the ranks wait for the pattern stage's end in the helper loop, not in the
+// shared counter's collective end).
+TEST(PatternHelpers, PipelineLendsTheSearchOfItsOneFace) {
+  const Comm comm = Comm::world();
+  const XY xy = {{0, 0}, {4, 0}, {4, 16}, {5.456, 20}, {0, 20}};
+  const std::string path = tmp("helpers_pipeline_np" + std::to_string(comm.size()) + ".brep");
+  if (comm.rank() == 0) test::write_polygon_face(xy, path);
+  comm.barrier();
+  const cad::CadModel model = cad::load_cad(path);
+  PipelineOptions options;
+  options.background.sizes.size = 0.4;
+  options.sizemap.size_max = 0.4;
+  options.until = Stage::QuasiStructured;
+  std::ostringstream sink;
+  Logger log(sink, LogLevel::Quiet);
+  const PipelineResult dist = run_pipeline(comm, model, options, TaskArena(1), log);
+  if (comm.rank() != 0) return;
+  const PipelineResult serial = run_pipeline(Comm::self(), model, options, TaskArena(1), log);
+  ASSERT_EQ(dist.face_times.size(), 1U);
+  const FaceTimes& t = dist.face_times[0];
+  EXPECT_GT(t.pattern_layouts, 0) << "the face must be searched";
+  EXPECT_EQ(t.pattern_vector_lendable, 1);
+  EXPECT_EQ(t.pattern_layouts, serial.face_times[0].pattern_layouts);
+  if (comm.size() > 1) {
+    EXPECT_GT(t.pattern_layout_lend_ranks, 0);
+  } else {
+    EXPECT_EQ(t.pattern_layout_lend_ranks, 0);
+  }
+  EXPECT_EQ(dist.mesh.points, serial.mesh.points);
+  EXPECT_EQ(dist.mesh.quads, serial.mesh.quads);
 }
 
 }  // namespace
