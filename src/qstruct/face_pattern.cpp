@@ -482,7 +482,9 @@ mesh::FaceMesh move_irregular_vertices(const cad::CadModel& model, LO f, const c
     for (const LO t : offsets) planned.insert(t);
     ++rep.layout_batches;
     rep.layout_vectors += static_cast<int>(offsets.size());
-    if (options.helpers == nullptr) return;
+    // No helper free: the rules lay out what they read, as the serial search does (laying out
+    // -step before knowing whether +step wins would cost this worker a layout).
+    if (options.helpers == nullptr || workers < 2) return;
     rep.lend_ranks = std::max(rep.lend_ranks, workers - 1);
     std::vector<MoveLayoutRequest> requests;
     std::vector<Candidate> cands;
