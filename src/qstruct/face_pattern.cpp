@@ -402,9 +402,10 @@ mesh::FaceMesh move_irregular_vertices(const cad::CadModel& model, LO f, const c
   // rules may read in the next levels of halving steps from where the search stands (a level:
   // every position the previous levels may have moved to, +step and -step each), up to
   // move_lend_layouts of them, and has them laid out over the free helpers and this worker at
-  // once. The rules then read them in their order, as they read the threads' batches. Without a
-  // free helper the batches are only counted (as if move_lend_layouts helpers were free): what
-  // the scaling simulation replays.
+  // once. The rules then read them in their order, as they read the threads' batches. Without
+  // helpers (options.helpers null: one rank) the batches are only counted, as if move_lend_layouts
+  // workers were free: what the scaling simulation replays; with helpers but none free, each
+  // batch is the first level, and the rules lay out what they read.
   const bool lending = options.move_lend_layouts > 0;
   // Whether moved(origin, v, t) gives a candidate, without refining it: every chord at least 1
   // and the refined quads (per coarse quad, the product of its two chords) within max_quads.
