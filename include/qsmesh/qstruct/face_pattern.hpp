@@ -210,9 +210,9 @@ struct PatternFaceReport {
   /// Lending the search's layouts (PatternFaceOptions::helpers, move_lend_layouts): the seconds
   /// this worker spent laying out the layouts the rules read (layout_seconds / layouts is one
   /// layout), the lent batches along the search's path (counted as if move_lend_layouts workers
-  /// were free when there are no helpers), the layouts those batches plan (speculative ones included: the
-  /// work lending deals out), the most helpers one batch had, and whether the search could be
-  /// lent at all (1: it ran its rules over planned batches).
+  /// were free when there are no helpers), the layouts those batches plan (speculative ones
+  /// included: the work lending deals out), the most helpers one batch had, and whether the search
+  /// could be lent at all (1: it ran its rules over planned batches).
   double layout_seconds = 0;
   int layout_batches = 0;
   int layout_vectors = 0;
