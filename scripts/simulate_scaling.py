@@ -24,7 +24,9 @@ rank, by replaying its measured per-face, per-stage times through the pipeline's
   quads), i.e. list scheduling in that order over P x T workers; a face taken away from its owner
   is read from it first (MPI_Get), and each result goes back to its owner. A face's pattern fill
   splits its move search's batches over its rank's threads (batched_schedule; face_stats'
-  pattern_layouts, pattern_batches, pattern_search). A face improved in
+  pattern_layouts, pattern_batches, pattern_search); with one thread per rank its search's lent
+  batches go over the ranks done with their faces instead (helped_schedule; pattern_layout_*,
+  pattern_vector_lendable). A face improved in
   pieces (--task-quads; face_stats' stage_seconds.improvement_tasks: 2k + 1 piece times) is k
   tasks in the first round, dealt with the whole faces, and k + 1 in a second round after it
   (each piece keyed by the face's quads / pieces); its cutting and merging (its improvement time
@@ -106,6 +108,34 @@ def batched_schedule(seconds, search, layouts, batches, threads):
     return min(seconds, seconds - search + per * batches * math.ceil(layouts / batches / threads))
 
 
+def lent_batch_seconds(per, steps, per_step, planned, workers):
+    """One lent batch of a move search (PatternFaceOptions::helpers) over `workers` (the owner and
+    its helpers): it covers `steps` single steps of the rules reading `per_step` layouts each and
+    plans `planned` layouts. With a worker for each it costs one layout; with fewer the deeper
+    levels are left out and each step costs ceil(per_step / workers); never more than the serial
+    steps."""
+    serial = steps * per_step
+    cost = min(serial, steps * math.ceil(per_step / workers))
+    if workers >= planned:
+        cost = min(cost, 1)
+    return per * cost
+
+
+def helped_schedule(seconds, layout_seconds, layouts, batches, lent_batches, lent_layouts,
+                    helpers):
+    """A face's pattern time when its move search's layouts are lent to `helpers` free ranks
+    throughout (face_stats' pattern_layout_*): the layouts the rules read take `layout_seconds`
+    of its `seconds`, one layout layout_seconds / layouts; the rest stays serial; each of the
+    `lent_batches` costs lent_batch_seconds. Never more than the serial time."""
+    if helpers <= 0 or layouts <= 0 or layout_seconds <= 0 or lent_batches <= 0 or batches <= 0:
+        return seconds
+    layout_seconds = min(layout_seconds, seconds)
+    per = layout_seconds / layouts
+    one = lent_batch_seconds(per, batches / lent_batches, layouts / batches,
+                             lent_layouts / lent_batches, helpers + 1)
+    return min(seconds, seconds - layout_seconds + lent_batches * one)
+
+
 def greedy_partition(weights, parts):
     """Longest-first greedy partition (the stand-in for METIS without --partitions): each face, by
     decreasing weight, to the part with the least weight so far."""
@@ -163,6 +193,13 @@ class Run:
         self.pattern_layouts = [f["stage_seconds"].get("pattern_layouts", 0) for f in self.faces]
         self.pattern_batches = [f["stage_seconds"].get("pattern_batches", 0) for f in self.faces]
         self.pattern_search = [f["stage_seconds"].get("pattern_search", 0.0) for f in self.faces]
+        # ... and what lending it to free ranks would make of it (a run on one rank counts the
+        # lent batches as if enough ranks were free).
+        ss = [f["stage_seconds"] for f in self.faces]
+        self.layout_seconds = [x.get("pattern_layout_seconds", 0.0) for x in ss]
+        self.layout_batches = [x.get("pattern_layout_batches", 0) for x in ss]
+        self.layout_vectors = [x.get("pattern_layout_vectors", 0) for x in ss]
+        self.lendable = [x.get("pattern_vector_lendable", 0) > 0 for x in ss]
         self.by_pattern = [f.get("method", "").startswith("pattern") for f in self.faces]
         # pack: a face's stage_seconds.pack is its output and statistics; writing its record comes
         # after (and cannot time itself into it). On one rank and one thread the stage's rest is
@@ -274,8 +311,8 @@ class Simulator:
         bw = self.comm["bandwidth_bytes_per_s"]
         fetch = self.comm["fetch_and_add_s"] if (messages and p > 1) else 0.0
         times, extra = {}, {}
-        patterns = [[(f, run.expected[f], 0, self.pattern_seconds(f, t), run.bytes[f])
-                     for f in range(run.n)]]
+        patterns = [[(f, run.expected[f], 0, sec, run.bytes[f])
+                     for f, sec in enumerate(self.helped_pattern_seconds(p, t, fetch))]]
         improvement, owner_work = self.improvement_rounds()
         for s, rounds in (("patterns", patterns), ("improvement", improvement)):
             times[s] = 0.0
@@ -341,6 +378,56 @@ class Simulator:
             return self.run.t["patterns"][f]
         return batched_schedule(self.run.t["patterns"][f], self.run.pattern_search[f],
                                 self.run.pattern_layouts[f], self.run.pattern_batches[f], t)
+
+    def helped_pattern_seconds(self, p, t, fetch=0.0):
+        """Each face's pattern time on p ranks x t threads. With one thread per rank the move
+        searches are lent to the ranks done with their faces (PipelineOptions::
+        move_layouts_over_ranks): a rank is free once the shared counter has dealt every face and
+        its own are done. The faces are dealt as the pipeline deals them (largest first, list
+        scheduling); a lendable face's search starts halfway through its serial part, and each
+        of its lent batches (lent_batch_seconds) gets the ranks free when it starts, shared
+        evenly with the other searches running then. Three rounds of that (the helped times
+        change the schedule). A run measured on several ranks or threads already holds its help."""
+        run = self.run
+        sec = [self.pattern_seconds(f, t) for f in range(run.n)]
+        lendable = [f for f in range(run.n) if run.lendable[f] and run.layout_batches[f] > 0
+                    and run.layout_seconds[f] > 0 and run.pattern_layouts[f] > 0
+                    and run.pattern_batches[f] > 0]
+        if t != 1 or p == 1 or run.ranks != 1 or run.threads != 1 or not lendable:
+            return sec
+        order = sorted(range(run.n), key=lambda f: (-run.expected[f], f))
+        cur = list(sec)
+        for _ in range(3):
+            free = [(0.0, w) for w in range(p)]
+            heapq.heapify(free)
+            start, end_of = {}, [0.0] * p
+            for f in order:
+                at, w = heapq.heappop(free)
+                start[f] = at
+                end_of[w] = at + cur[f] + fetch
+                heapq.heappush(free, (end_of[w], w))
+            last_dealt = max(start.values(), default=0.0)
+            pre = {f: max(0.0, sec[f] - min(run.layout_seconds[f], sec[f])) / 2 for f in lendable}
+            window = {f: (start[f] + pre[f], start[f] + cur[f] - pre[f]) for f in lendable}
+            new = list(sec)
+            for f in lendable:
+                layout = min(run.layout_seconds[f], sec[f])
+                per = layout / run.pattern_layouts[f]
+                nb = run.layout_batches[f]
+                steps = run.pattern_batches[f] / nb
+                per_step = run.pattern_layouts[f] / run.pattern_batches[f]
+                planned = run.layout_vectors[f] / nb
+                now = window[f][0]
+                for _ in range(nb):
+                    helpers = 0
+                    if now >= last_dealt:
+                        idle = sum(1 for w in range(p) if end_of[w] <= now)
+                        searching = sum(1 for g in lendable if window[g][0] <= now < window[g][1])
+                        helpers = idle // max(1, searching)
+                    now += lent_batch_seconds(per, steps, per_step, planned, helpers + 1)
+                new[f] = min(sec[f], sec[f] - layout + (now - window[f][0]))
+            cur = new
+        return cur
 
     def improvement_rounds(self):
         """The improvement's tasks, [first round, second round], each task (face, order key,

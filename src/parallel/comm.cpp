@@ -4,9 +4,11 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cstring>
 #include <limits>
 #include <mutex>
+#include <thread>
 
 #include "qsmesh/core/error.hpp"
 
@@ -370,6 +372,142 @@ std::vector<char> SharedBytes::read(int owner, std::int64_t offset, std::int64_t
   }
   check_mpi(MPI_Win_unlock(owner, impl_->win), "MPI_Win_unlock");
   return out;
+}
+
+// RankHelpers: slot r of rank 0's window holds rank r's state, slot size() the ranks done.
+namespace {
+constexpr std::int64_t kBusy = 0, kFree = 1, kClaimed = 2;
+constexpr int kTagShare = 1, kTagAnswer = 2;
+}  // namespace
+
+struct RankHelpers::Impl {
+  MPI_Comm comm = MPI_COMM_NULL;  // a duplicate: the shares' tags meet no other message
+  int rank = 0, size = 1;
+  MPI_Win win = MPI_WIN_NULL;
+  std::vector<MPI_Request> sends;
+
+  std::int64_t fetch(std::int64_t value, int slot, MPI_Op op) {
+    std::int64_t old = 0;
+    check_mpi(MPI_Win_lock(MPI_LOCK_SHARED, 0, 0, win), "MPI_Win_lock");
+    check_mpi(MPI_Fetch_and_op(&value, &old, MPI_INT64_T, 0, slot, op, win), "MPI_Fetch_and_op");
+    check_mpi(MPI_Win_unlock(0, win), "MPI_Win_unlock");
+    return old;
+  }
+};
+
+RankHelpers::RankHelpers(const Comm& comm) : impl_(std::make_unique<Impl>()) {
+  impl_->rank = comm.rank();
+  impl_->size = comm.size();
+  if (impl_->size == 1) return;
+  check_mpi(MPI_Comm_dup(comm.impl_->comm, &impl_->comm), "MPI_Comm_dup");
+  check_mpi(MPI_Comm_set_errhandler(impl_->comm, MPI_ERRORS_RETURN), "MPI_Comm_set_errhandler");
+  const bool owner = impl_->rank == 0;
+  const auto slots = static_cast<MPI_Aint>(impl_->size + 1);
+  std::int64_t* base = nullptr;
+  // Memory allocated by MPI, as SharedCounter's (shared memory on one node).
+  check_mpi(MPI_Win_allocate(owner ? slots * static_cast<MPI_Aint>(sizeof(std::int64_t)) : 0,
+                             static_cast<int>(sizeof(std::int64_t)), MPI_INFO_NULL, impl_->comm,
+                             &base, &impl_->win),
+            "MPI_Win_allocate");
+  check_mpi(MPI_Win_set_errhandler(impl_->win, MPI_ERRORS_RETURN), "MPI_Win_set_errhandler");
+  if (owner) {
+    check_mpi(MPI_Win_lock(MPI_LOCK_EXCLUSIVE, 0, 0, impl_->win), "MPI_Win_lock");
+    for (MPI_Aint i = 0; i < slots; ++i) base[i] = kBusy;  // and no rank done
+    check_mpi(MPI_Win_unlock(0, impl_->win), "MPI_Win_unlock");
+  }
+  check_mpi(MPI_Barrier(impl_->comm), "MPI_Barrier");
+}
+
+RankHelpers::~RankHelpers() {
+  // Collective; every rank left serve_until_all_done, so no share is in flight.
+  if (impl_->win != MPI_WIN_NULL) MPI_Win_free(&impl_->win);
+  if (impl_->comm != MPI_COMM_NULL) MPI_Comm_free(&impl_->comm);
+}
+
+int RankHelpers::rank() const { return impl_->rank; }
+int RankHelpers::size() const { return impl_->size; }
+
+std::vector<int> RankHelpers::claim(int wanted) {
+  std::vector<int> got;
+  if (impl_->size == 1) return got;
+  // From the next rank on, so that owners do not all ask rank 0 first.
+  for (int k = 1; k < impl_->size && static_cast<int>(got.size()) < wanted; ++k) {
+    const int r = (impl_->rank + k) % impl_->size;
+    if (impl_->fetch(kClaimed, r, MPI_REPLACE) == kFree) got.push_back(r);
+  }
+  return got;
+}
+
+void RankHelpers::send(int helper, const std::vector<char>& bytes) {
+  QSMESH_CHECK(bytes.size() <= static_cast<std::size_t>(std::numeric_limits<int>::max()),
+               "helper share of " << bytes.size() << " bytes");
+  MPI_Request request = MPI_REQUEST_NULL;
+  check_mpi(MPI_Isend(bytes.data(), static_cast<int>(bytes.size()), MPI_BYTE, helper, kTagShare,
+                      impl_->comm, &request),
+            "MPI_Isend");
+  impl_->sends.push_back(request);
+}
+
+void RankHelpers::wait_sent() {
+  if (impl_->sends.empty()) return;
+  check_mpi(
+      MPI_Waitall(static_cast<int>(impl_->sends.size()), impl_->sends.data(), MPI_STATUSES_IGNORE),
+      "MPI_Waitall");
+  impl_->sends.clear();
+}
+
+namespace {
+std::vector<char> receive_bytes(MPI_Comm comm, int from, int tag) {
+  MPI_Status status;
+  check_mpi(MPI_Probe(from, tag, comm, &status), "MPI_Probe");
+  int count = 0;
+  check_mpi(MPI_Get_count(&status, MPI_BYTE, &count), "MPI_Get_count");
+  std::vector<char> bytes(static_cast<std::size_t>(count));
+  check_mpi(
+      MPI_Recv(bytes.data(), count, MPI_BYTE, status.MPI_SOURCE, tag, comm, MPI_STATUS_IGNORE),
+      "MPI_Recv");
+  return bytes;
+}
+}  // namespace
+
+std::vector<char> RankHelpers::receive(int helper) {
+  return receive_bytes(impl_->comm, helper, kTagAnswer);
+}
+
+void RankHelpers::serve_until_all_done(
+    const std::function<std::vector<char>(const std::vector<char>&)>& serve) {
+  if (impl_->size == 1) return;
+  wait_sent();
+  impl_->fetch(kFree, impl_->rank, MPI_REPLACE);
+  impl_->fetch(1, impl_->size, MPI_SUM);
+  // Polled, with a pause growing to 1 ms while nothing comes: a free rank should not take a core
+  // from the ranks still working when ranks share cores.
+  int idle = 0;
+  for (;;) {
+    int flag = 0;
+    MPI_Status status;
+    check_mpi(MPI_Iprobe(MPI_ANY_SOURCE, kTagShare, impl_->comm, &flag, &status), "MPI_Iprobe");
+    if (flag != 0) {
+      idle = 0;
+      const int from = status.MPI_SOURCE;
+      const std::vector<char> share = receive_bytes(impl_->comm, from, kTagShare);
+      std::vector<char> answer;
+      if (!share.empty()) answer = serve(share);
+      // Free again before answering, so that the owner's next claim can find this rank.
+      impl_->fetch(kFree, impl_->rank, MPI_REPLACE);
+      QSMESH_CHECK(answer.size() <= static_cast<std::size_t>(std::numeric_limits<int>::max()),
+                   "helper answer of " << answer.size() << " bytes");
+      check_mpi(MPI_Send(answer.data(), static_cast<int>(answer.size()), MPI_BYTE, from, kTagAnswer,
+                         impl_->comm),
+                "MPI_Send");
+      continue;
+    }
+    // Every rank done: no share can come any more (an owner counts itself done only after the
+    // answers to all it sent).
+    if (impl_->fetch(0, impl_->size, MPI_NO_OP) == impl_->size) break;
+    std::this_thread::sleep_for(std::chrono::microseconds(std::min(1000, 20 << std::min(idle, 6))));
+    ++idle;
+  }
 }
 
 }  // namespace qsmesh::parallel

@@ -491,11 +491,13 @@ void DealProgress::done() {
 }
 
 void deal_out(const Comm& comm, std::int64_t n, const TaskArena& tasks,
-              const std::function<void(std::int64_t)>& body) {
+              const std::function<void(std::int64_t)>& body, const std::function<void()>& then) {
   SharedCounter counter(comm);
   tasks.parallel_for(tasks.threads(), [&](std::int64_t) {
     for (std::int64_t k = counter.next(); k < n; k = counter.next()) body(k);
   });
+  // The counter's destruction is collective: a rank that waits there cannot help the others.
+  if (then) then();
 }
 
 std::array<double, 3> improve_faces(const Comm& comm, const cad::CadModel& model,

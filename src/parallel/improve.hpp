@@ -24,9 +24,12 @@ namespace qsmesh::parallel {
 /// Calls body(k) once for each k in [0, n), over the threads of every rank together: each free
 /// thread takes the next k from a SharedCounter (collective; body may call MPI only through
 /// objects that take `comm`'s lock, such as SharedBytes::read). Which rank runs which k depends on
-/// timing; the caller keeps results keyed by k and sends them where they belong.
+/// timing; the caller keeps results keyed by k and sends them where they belong. `then` (when
+/// set) runs once on this rank after its threads found no k left and before the collective end:
+/// while other ranks are still in their body (RankLayoutHelpers::serve_until_all_done).
 void deal_out(const Comm& comm, std::int64_t n, const TaskArena& tasks,
-              const std::function<void(std::int64_t)>& body);
+              const std::function<void(std::int64_t)>& body,
+              const std::function<void()>& then = nullptr);
 
 /// Progress of a dealt-out stage as this rank sees it: done() after each item it finished logs
 /// "STAGE: d/n faces" on one rank, "STAGE: d faces on rank r (n on all ranks)" on several, at

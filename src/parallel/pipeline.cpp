@@ -22,6 +22,7 @@
 #include "qsmesh/mesh/validate.hpp"
 #include "qsmesh/parallel/face_task.hpp"
 #include "qsmesh/parallel/partition.hpp"
+#include "qsmesh/parallel/pattern_helpers.hpp"
 #include "qsmesh/parallel/record.hpp"
 #include "split_round.hpp"
 
@@ -559,6 +560,11 @@ void set_pattern_times(FaceTimes& times, const PatternFill& fill) {
   times.pattern_layouts = fill.report.layouts;
   times.pattern_batches = fill.report.batches;
   times.pattern_search = fill.report.search_seconds;
+  times.pattern_layout_seconds = fill.report.layout_seconds;
+  times.pattern_layout_batches = fill.report.layout_batches;
+  times.pattern_layout_vectors = fill.report.layout_vectors;
+  times.pattern_layout_lend_ranks = fill.report.lend_ranks;
+  times.pattern_vector_lendable = fill.report.vector_lendable;
 }
 
 // Simple CAD faces meshed directly by a pattern (paper 000 Sec. 6.1.2, pipeline step 4); the
@@ -593,16 +599,37 @@ std::vector<std::int64_t> pattern_stage(const Context& cx, std::vector<FaceTask>
   std::vector<PatternFill> fills(static_cast<std::size_t>(nfaces));
   std::vector<char> filled(static_cast<std::size_t>(nfaces), 0);  // by this rank
   DealProgress progress("patterns", nfaces, cx.comm, cx.log);
-  deal_out(cx.comm, nfaces, cx.tasks, [&](std::int64_t k) {
-    const auto f = static_cast<std::size_t>(order[static_cast<std::size_t>(k)]);
-    qstruct::PatternFaceOptions po = options.patterns;
-    po.size_map_quads = expected[f];
-    po.tasks = &cx.tasks;  // one face's move search split over this rank's threads
-    fills[f] = mesh_face_fill(cx.model, static_cast<LO>(f), result.quantized_curves, patterns, po,
-                              fill_bound[f], options.pattern_compare_tolerance >= 0);
-    filled[f] = 1;
-    progress.done();
-  });
+  // Ranks done with their faces lay out the move searches of the others
+  // (PipelineOptions::move_layouts_over_ranks): with one thread per rank only, since RankHelpers
+  // is used by one thread (with more, the rank's threads split its own searches).
+  const bool lend = cx.comm.size() > 1 && cx.comm.allreduce_and(options.move_layouts_over_ranks &&
+                                                                cx.tasks.threads() == 1);
+  std::optional<RankHelpers> ranks;
+  std::optional<RankLayoutHelpers> helpers;
+  if (lend) {
+    ranks.emplace(cx.comm);
+    helpers.emplace(*ranks, cx.model, result.quantized_curves, patterns, options.patterns);
+  }
+  deal_out(
+      cx.comm, nfaces, cx.tasks,
+      [&](std::int64_t k) {
+        const auto f = static_cast<std::size_t>(order[static_cast<std::size_t>(k)]);
+        qstruct::PatternFaceOptions po = options.patterns;
+        po.size_map_quads = expected[f];
+        po.tasks = &cx.tasks;  // one face's move search split over this rank's threads
+        if (lend) po.helpers = &*helpers;
+        if (!options.move_layouts_over_ranks) po.move_lend_layouts = 0;
+        fills[f] = mesh_face_fill(cx.model, static_cast<LO>(f), result.quantized_curves, patterns,
+                                  po, fill_bound[f], options.pattern_compare_tolerance >= 0);
+        filled[f] = 1;
+        progress.done();
+      },
+      [&] {
+        if (!lend) return;
+        helpers->serve_until_all_done();
+        cx.log.debug(cat("patterns: rank ", cx.comm.rank(), " laid out ", helpers->served(),
+                         " move layouts for other ranks"));
+      });
   // Fills to their owners.
   std::vector<std::int64_t> local_of(static_cast<std::size_t>(nfaces), -1);
   for (std::size_t i = 0; i < faces.size(); ++i)

@@ -8,6 +8,7 @@
 #include <memory>
 #include <numbers>
 #include <optional>
+#include <set>
 #include <sstream>
 #include <utility>
 
@@ -154,6 +155,38 @@ mesh::FaceMesh build_mesh(LO f, const cad::Face& face, const cad::FaceGeometry& 
   return m;
 }
 
+// The move search's counts and times of `from` added to (or set in) `to`: a face's report covers
+// every search it ran.
+void add_search_counts(PatternFaceReport& to, const PatternFaceReport& from) {
+  to.layouts += from.layouts;
+  to.batches += from.batches;
+  to.search_seconds += from.search_seconds;
+  to.layout_seconds += from.layout_seconds;
+  to.layout_batches += from.layout_batches;
+  to.layout_vectors += from.layout_vectors;
+  to.lend_ranks = std::max(to.lend_ranks, from.lend_ranks);
+  to.vector_lendable = std::max(to.vector_lendable, from.vector_lendable);
+}
+
+void set_search_counts(PatternFaceReport& to, const PatternFaceReport& from) {
+  to.layouts = from.layouts;
+  to.batches = from.batches;
+  to.search_seconds = from.search_seconds;
+  to.layout_seconds = from.layout_seconds;
+  to.layout_batches = from.layout_batches;
+  to.layout_vectors = from.layout_vectors;
+  to.lend_ranks = from.lend_ranks;
+  to.vector_lendable = from.vector_lendable;
+}
+
+// One layout of a candidate: built (Laplace in (u, v)) and smoothed with `smooth`.
+mesh::FaceMesh lay_out_candidate(LO f, const cad::Face& face, const cad::FaceGeometry& surface,
+                                 const FaceSides& fs, const Candidate& c,
+                                 const smooth::SmoothOptions& smooth, linalg::SolverCache* cache) {
+  return smooth::smooth_face(build_mesh(f, face, surface, fs, c, cache), surface, smooth, nullptr,
+                             cache);
+}
+
 // Whether the quads at or below min_sicn are few enough for the untangler to be worth a try
 // (PatternFaceOptions::lift_max_poor_fraction).
 bool few_poor_quads(const mesh::FaceMesh& m, const PatternFaceOptions& options, double min_sicn) {
@@ -296,7 +329,7 @@ mesh::FaceMesh move_irregular_vertices(const cad::CadModel& model, LO f, const c
   // single-thread, and it gives the same bits as a fresh factorization.
   const auto lay_out = [&](Candidate c, const cad::FaceGeometry& on, linalg::SolverCache* with) {
     Layout l;
-    l.mesh = smooth::smooth_face(build_mesh(f, face, on, fs, c, with), on, search, nullptr, with);
+    l.mesh = lay_out_candidate(f, face, on, fs, c, search, with);
     l.q = smooth::measure(l.mesh);
     l.c = std::move(c);
     return l;
@@ -342,7 +375,9 @@ mesh::FaceMesh move_irregular_vertices(const cad::CadModel& model, LO f, const c
     if (it == laid.end()) {
       std::optional<Candidate> c = moved(origin, v, t);
       if (!c) return false;
+      const Stopwatch layout_clock;
       it = laid.emplace(t, lay_out(std::move(*c), surface, cache)).first;
+      rep.layout_seconds += layout_clock.seconds();
     }
     // Counted by the batches the rules read from, whether or not they were laid out at once, so
     // that a run on one thread tells what the batches would be on several.
@@ -363,6 +398,143 @@ mesh::FaceMesh move_irregular_vertices(const cad::CadModel& model, LO f, const c
     ++rep.moves;
     return true;
   };
+  // Lending (PatternFaceOptions::helpers, move_lend_layouts). A lent batch plans the offsets the
+  // rules may read in the next levels of halving steps from where the search stands (a level:
+  // every position the previous levels may have moved to, +step and -step each), up to
+  // move_lend_layouts of them, and has them laid out over the free helpers and this worker at
+  // once. The rules then read them in their order, as they read the threads' batches. Without
+  // helpers (options.helpers null: one rank) the batches are only counted, as if move_lend_layouts
+  // workers were free: what the scaling simulation replays; with helpers but none free, each
+  // batch is the first level, and the rules lay out what they read.
+  const bool lending = options.move_lend_layouts > 0;
+  // Whether moved(origin, v, t) gives a candidate, without refining it: every chord at least 1
+  // and the refined quads (per coarse quad, the product of its two chords) within max_quads.
+  const auto feasible = [&](const std::vector<LO>& v, LO t) {
+    if (v.empty())
+      return options.max_quads <= 0 ||
+             static_cast<std::int64_t>(origin.refined.quads.size()) <= options.max_quads;
+    std::vector<LO> chords = origin.match.chords;
+    for (std::size_t j = 0; j < v.size(); ++j) {
+      chords[j] += t * v[j];
+      if (chords[j] < 1) return false;
+    }
+    if (options.max_quads <= 0) return true;
+    std::int64_t quads = 0;
+    for (const auto& qe : pattern.quad_edges)
+      quads += static_cast<std::int64_t>(chords[pattern.edge_chord[qe[0]]]) *
+               chords[pattern.edge_chord[qe[1]]];
+    return quads <= options.max_quads;
+  };
+  if (lending) rep.vector_lendable = 1;
+  std::set<LO> planned;  // offsets from origin planned by the current vector's batches
+  // The levels of halving steps from `step` down (each the new offsets it may read, in the order
+  // the rules read them: +step before -step, positions in increasing order), while they add up
+  // to at most move_lend_layouts (the first level always). Offsets no move reaches (a chord below
+  // 1, a fill above max_quads) are left out, and so are the positions they would lead to.
+  const auto halving_levels = [&](const std::vector<LO>& v, LO step) {
+    std::vector<std::vector<LO>> levels;
+    std::set<LO> positions{at}, seen;
+    std::size_t total = 0;
+    for (LO s = step; s >= 1; s /= 2) {
+      std::vector<LO> level;
+      std::set<LO> reached = positions;
+      for (const LO p : positions)
+        for (const LO t : {p + s, p - s}) {
+          if (!feasible(v, t)) continue;
+          reached.insert(t);
+          if (seen.insert(t).second) level.push_back(t);
+        }
+      if (!levels.empty() &&
+          total + level.size() > static_cast<std::size_t>(options.move_lend_layouts))
+        break;
+      total += level.size();
+      levels.push_back(std::move(level));
+      positions = std::move(reached);
+    }
+    return levels;
+  };
+  // Plans a lent batch when the first level holds an offset not planned yet: counts it, and lays
+  // out as many of its levels as the helpers claimed can take at once (each worker one layout,
+  // one level at least) over them and this worker.
+  const auto plan_batch = [&](const std::vector<LO>& v, std::vector<std::vector<LO>> levels) {
+    if (levels.empty() || evaluations >= max_evaluations) return;  // the rules read no more
+    bool fresh = false;
+    for (const LO t : levels.front())
+      fresh = fresh || (t != at && planned.count(t) == 0 && laid.count(t) == 0 && feasible(v, t));
+    if (!fresh) return;
+    std::size_t total = 0;
+    for (const auto& level : levels) total += level.size();
+    int workers = options.move_lend_layouts;  // counted only, no helper free
+    if (options.helpers != nullptr) {
+      const int want = static_cast<int>(std::min<std::size_t>(
+                           total, static_cast<std::size_t>(options.move_lend_layouts))) -
+                       1;
+      workers = 1 + (want > 0 ? options.helpers->claim(want) : 0);
+    }
+    // The deepest levels that give each worker one layout, the first level at least.
+    std::vector<LO> offsets;
+    for (std::size_t l = 0; l < levels.size(); ++l) {
+      if (l > 0 && offsets.size() + levels[l].size() > static_cast<std::size_t>(workers)) break;
+      for (const LO t : levels[l])
+        if ((l > 0 || t != at) && planned.count(t) == 0 && laid.count(t) == 0 &&
+            std::find(offsets.begin(), offsets.end(), t) == offsets.end() && feasible(v, t))
+          offsets.push_back(t);
+    }
+    for (const LO t : offsets) planned.insert(t);
+    ++rep.layout_batches;
+    rep.layout_vectors += static_cast<int>(offsets.size());
+    // No helper free: the rules lay out what they read, as the serial search does (laying out
+    // -step before knowing whether +step wins would cost this worker a layout).
+    if (options.helpers == nullptr || workers < 2) return;
+    rep.lend_ranks = std::max(rep.lend_ranks, workers - 1);
+    std::vector<MoveLayoutRequest> requests;
+    std::vector<Candidate> cands;
+    std::vector<LO> at_offset;
+    for (const LO t : offsets) {
+      std::optional<Candidate> c = moved(origin, v, t);
+      if (!c) continue;
+      at_offset.push_back(t);
+      MoveLayoutRequest r;
+      r.face = f;
+      r.pattern = c->match.pattern;
+      r.reversed = c->match.reversed;
+      r.chords = c->match.chords;
+      r.seq = c->seq;
+      r.smooth_iterations = search.iterations;
+      requests.push_back(std::move(r));
+      cands.push_back(std::move(*c));
+    }
+    // Released even when this worker keeps every layout (lay_out hands each claimed one a share).
+    std::vector<MoveLayoutResult> results =
+        options.helpers->lay_out(requests, [&](const MoveLayoutRequest& r) {
+          const Stopwatch layout_clock;
+          MoveLayoutResult out;
+          const auto u = static_cast<std::size_t>(&r - requests.data());
+          try {
+            out.mesh = lay_out_candidate(f, face, surface, fs, cands[u], search, cache);
+            out.quality = smooth::measure(out.mesh);
+          } catch (const Error& e) {
+            out.error = e.message();
+          } catch (const std::exception& e) {
+            out.error = e.what();
+          }
+          rep.layout_seconds += layout_clock.seconds();
+          return out;
+        });
+    QSMESH_CHECK(results.size() == requests.size(),
+                 "move layouts: " << results.size() << " results for " << requests.size());
+    for (std::size_t u = 0; u < results.size(); ++u) {
+      Layout l;
+      l.c = std::move(cands[u]);
+      if (!results[u].error.empty()) {
+        l.error = std::make_exception_ptr(Error(results[u].error));
+      } else {
+        l.mesh = std::move(results[u].mesh);
+        l.q = results[u].quality;
+      }
+      laid.emplace(at_offset[u], std::move(l));
+    }
+  };
   for (const auto& v : moves) {
     // Feasible range [lo, hi] of t (every chord stays >= 1).
     LO lo = std::numeric_limits<LO>::min(), hi = std::numeric_limits<LO>::max();
@@ -381,15 +553,20 @@ mesh::FaceMesh move_irregular_vertices(const cad::CadModel& model, LO f, const c
     if (lo == std::numeric_limits<LO>::min() || hi - lo < 1) continue;
     origin = best;
     laid.clear();
+    planned.clear();
     at = 0;
     // Coarse: four points spread over the range; then halving steps around the best.
     const LO span = std::max<LO>(1, (hi - lo) / 5);
     std::vector<LO> coarse;
     for (int k = 1; k <= 4; ++k) coarse.push_back(lo + k * (hi - lo) / 5);
-    lay_out_batch(v, coarse);
+    used_batch = false;  // a step: the rules' batch (counted whether or not laid out at once)
+    if (lending) plan_batch(v, {coarse});
+    if (!lending || options.helpers == nullptr) lay_out_batch(v, coarse);
     for (const LO t : coarse) try_move(v, t);
     for (LO step = std::max<LO>(1, span / 2); step >= 1; step /= 2) {
-      lay_out_batch(v, {at + step, at - step});
+      used_batch = false;
+      if (lending) plan_batch(v, halving_levels(v, step));
+      if (!lending || options.helpers == nullptr) lay_out_batch(v, {at + step, at - step});
       if (!try_move(v, at + step)) try_move(v, at - step);
     }
   }
@@ -634,9 +811,7 @@ mesh::FaceMesh try_sides(const cad::CadModel& model, LO f, const cad::Face& face
       mesh = move_irregular_vertices(model, f, face, surface, fs, patterns[c.match.pattern], c,
                                      std::move(mesh), q, min_sicn, options, trial, cache);
       rep.moves += trial.moves;
-      rep.layouts += trial.layouts;
-      rep.batches += trial.batches;
-      rep.search_seconds += trial.search_seconds;
+      add_search_counts(rep, trial);
       q.sicn_min = trial.sicn_min;
       q.sicn_avg = trial.sicn_avg;
       chords = trial.chords;
@@ -692,6 +867,38 @@ mesh::FaceMesh try_sides(const cad::CadModel& model, LO f, const cad::Face& face
 }
 
 }  // namespace
+
+MoveLayoutResult lay_out_move(const cad::CadModel& model, const FaceSides& fs,
+                              std::span<const Pattern> patterns,
+                              const smooth::SmoothOptions& smooth,
+                              const MoveLayoutRequest& request) {
+  MoveLayoutResult out;
+  try {
+    QSMESH_CHECK(request.face >= 0 && request.face < model.num_faces() && request.pattern >= 0 &&
+                     request.pattern < static_cast<LO>(patterns.size()) &&
+                     request.seq.size() == fs.points.size(),
+                 "move layout request of face " << request.face << " does not fit its sides");
+    Candidate c;
+    c.match.pattern = request.pattern;
+    c.match.reversed = request.reversed;
+    c.match.chords = request.chords;
+    c.refined = refine_pattern(patterns[request.pattern], request.chords);
+    c.seq = request.seq;
+    smooth::SmoothOptions so = smooth;
+    so.iterations = request.smooth_iterations;
+    const auto surface = model.face_geometry(request.face);
+    out.mesh =
+        lay_out_candidate(request.face, model.faces()[request.face], *surface, fs, c, so, nullptr);
+    out.quality = smooth::measure(out.mesh);
+  } catch (const Error& e) {
+    out = MoveLayoutResult{};
+    out.error = e.message();
+  } catch (const std::exception& e) {
+    out = MoveLayoutResult{};
+    out.error = e.what();
+  }
+  return out;
+}
 
 double boundary_held_sicn(const Vec3& a, const Vec3& b) {
   const double denom = norm2(a) + norm2(b);
@@ -855,15 +1062,11 @@ mesh::FaceMesh mesh_face_pattern(const cad::CadModel& model, LO f,
          !second.refused_mesh.quads.empty() &&
          (rep.refused_mesh.quads.empty() || second.sicn_min > rep.sicn_min));
     // The search's counts and time cover both attempts (the pattern stage's batched schedule).
-    second.layouts += rep.layouts;
-    second.batches += rep.batches;
-    second.search_seconds += rep.search_seconds;
+    add_search_counts(second, rep);
     if (second_better) {
       rep = std::move(second);
     } else {
-      rep.layouts = second.layouts;
-      rep.batches = second.batches;
-      rep.search_seconds = second.search_seconds;
+      set_search_counts(rep, second);
     }
     return out;
   } catch (const Error& e) {

@@ -9,6 +9,7 @@
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/parallel/face_task.hpp"
 #include "qsmesh/parallel/record.hpp"
+#include "qsmesh/qstruct/face_pattern.hpp"
 
 namespace qsmesh::parallel {
 namespace {
@@ -101,8 +102,8 @@ FaceOutput full_output() {
   o.stats.sicn_min = 0.75;
   o.stats.sicn_avg = 0.875;
   o.seconds = 2.5;
-  o.times = {0.5,  1.5, 2.5,  3.5,          4.5,          5.5, 6.5, 7.5,  8.25,
-             77.5, 42,  1001, {0.25, 0.75}, {1.25, 1.75}, 9,   3,   0.125};
+  o.times = {0.5,  1.5,          2.5,          3.5, 4.5, 5.5,   6.5,   7.5, 8.25, 77.5, 42,
+             1001, {0.25, 0.75}, {1.25, 1.75}, 9,   3,   0.125, 0.375, 4,   21,   7,    1};
   o.field_grids = {fieldmesh::RegionGrid{1, 1, {0, 1, 2, 3}}, fieldmesh::RegionGrid{2, 1, {}}};
   o.group_quad_face = {4, 5, 4};
   o.group_first = 4;
@@ -112,9 +113,9 @@ FaceOutput full_output() {
 TEST(Pack, EveryFieldOfAFaceOutputRoundTrips) {
   const FaceOutput a = full_output();
   // 12 parts; the counts of their fields: mesh 1 (packed whole), background report 5, cross field
-  // 14, sizes 3, unstructured 7, quasi 11 + improvement 8, stats 7, seconds 1, times 17, field
+  // 14, sizes 3, unstructured 7, quasi 11 + improvement 8, stats 7, seconds 1, times 22, field
   // grids 1 (a vector of records), a smooth group's quad faces 1 and first face 1.
-  ASSERT_EQ(count_fields(a), 1 + 5 + 14 + 3 + 7 + 19 + 7 + 1 + 17 + 1 + 2)
+  ASSERT_EQ(count_fields(a), 1 + 5 + 14 + 3 + 7 + 19 + 7 + 1 + 22 + 1 + 2)
       << "a field was added to a report: set it in full_output() and check it here";
   std::vector<char> buf;
   write_record(buf, a);
@@ -205,6 +206,11 @@ TEST(Pack, EveryFieldOfAFaceOutputRoundTrips) {
   EXPECT_EQ(b.times.pattern_layouts, 9);
   EXPECT_EQ(b.times.pattern_batches, 3);
   EXPECT_EQ(b.times.pattern_search, 0.125);
+  EXPECT_EQ(b.times.pattern_layout_seconds, 0.375);
+  EXPECT_EQ(b.times.pattern_layout_batches, 4);
+  EXPECT_EQ(b.times.pattern_layout_vectors, 21);
+  EXPECT_EQ(b.times.pattern_layout_lend_ranks, 7);
+  EXPECT_EQ(b.times.pattern_vector_lendable, 1);
   EXPECT_EQ(b.times.expected_quads, 77.5);
   EXPECT_EQ(b.times.improvement_tasks, (std::vector<double>{0.25, 0.75}));
   EXPECT_EQ(b.times.improvement_quads, 42);
@@ -245,6 +251,11 @@ TEST(Pack, PatternFillRoundTrips) {
   a.report.layouts = 20;
   a.report.batches = 8;
   a.report.search_seconds = 0.5;
+  a.report.layout_seconds = 0.25;
+  a.report.layout_batches = 3;
+  a.report.layout_vectors = 17;
+  a.report.lend_ranks = 5;
+  a.report.vector_lendable = 1;
   a.report.sicn_min = 0.2;
   a.report.sicn_avg = 0.7;
   a.report.min_sicn = 0.3;
@@ -252,7 +263,7 @@ TEST(Pack, PatternFillRoundTrips) {
   a.report.refused_mesh = small_mesh(5);
   a.mesh = small_mesh(5);
   a.seconds = 0.75;
-  ASSERT_EQ(count_fields(a), 20 + 1 + 1)
+  ASSERT_EQ(count_fields(a), 25 + 1 + 1)
       << "a field was added to PatternFaceReport: set it here and check it below";
   std::vector<char> buf;
   write_record(buf, a);
@@ -275,6 +286,11 @@ TEST(Pack, PatternFillRoundTrips) {
   EXPECT_EQ(b.report.layouts, 20);
   EXPECT_EQ(b.report.batches, 8);
   EXPECT_EQ(b.report.search_seconds, 0.5);
+  EXPECT_EQ(b.report.layout_seconds, 0.25);
+  EXPECT_EQ(b.report.layout_batches, 3);
+  EXPECT_EQ(b.report.layout_vectors, 17);
+  EXPECT_EQ(b.report.lend_ranks, 5);
+  EXPECT_EQ(b.report.vector_lendable, 1);
   EXPECT_EQ(b.report.sicn_min, 0.2);
   EXPECT_EQ(b.report.sicn_avg, 0.7);
   EXPECT_EQ(b.report.min_sicn, 0.3);
@@ -282,6 +298,59 @@ TEST(Pack, PatternFillRoundTrips) {
   EXPECT_EQ(b.report.refused_mesh.quads, a.report.refused_mesh.quads);
   EXPECT_EQ(b.mesh.points, a.mesh.points);
   EXPECT_EQ(b.seconds, 0.75);
+}
+
+// A lent move layout (qstruct::MoveLayoutRequest) and its answer (MoveLayoutResult) travel as
+// vectors of records, every field declared once.
+TEST(Pack, MoveLayoutRequestAndResultRoundTrip) {
+  qstruct::MoveLayoutRequest r;
+  r.face = 7;
+  r.pattern = 2;
+  r.reversed = true;
+  r.chords = {3, 1, 4};
+  r.seq = {5, 6, 7, 0, 1, 2, 3, 4};
+  r.smooth_iterations = 3;
+  ASSERT_EQ(count_fields(r), 6) << "a field was added to MoveLayoutRequest: check it here";
+  qstruct::MoveLayoutResult ok, failed;
+  ok.mesh = small_mesh(7);
+  ok.quality = {0.25, 0.75, 1, 9};
+  failed.error = "the Laplace layout is not finite";
+  ASSERT_EQ(count_fields(ok), 3) << "a field was added to MoveLayoutResult: check it here";
+  std::vector<char> buf;
+  write_record(buf, std::vector<qstruct::MoveLayoutRequest>{r, qstruct::MoveLayoutRequest{}});
+  write_record(buf, std::vector<qstruct::MoveLayoutResult>{ok, failed});
+  std::size_t pos = 0;
+  std::vector<qstruct::MoveLayoutRequest> rs;
+  std::vector<qstruct::MoveLayoutResult> results;
+  read_record(buf, pos, rs);
+  read_record(buf, pos, results);
+  EXPECT_EQ(pos, buf.size());
+  ASSERT_EQ(rs.size(), 2U);
+  EXPECT_EQ(rs[0].face, 7);
+  EXPECT_EQ(rs[0].pattern, 2);
+  EXPECT_TRUE(rs[0].reversed);
+  EXPECT_EQ(rs[0].chords, r.chords);
+  EXPECT_EQ(rs[0].seq, r.seq);
+  EXPECT_EQ(rs[0].smooth_iterations, 3);
+  EXPECT_EQ(rs[1].face, kNoIndex);
+  EXPECT_FALSE(rs[1].reversed);
+  EXPECT_TRUE(rs[1].seq.empty());
+  ASSERT_EQ(results.size(), 2U);
+  EXPECT_EQ(results[0].mesh.points, ok.mesh.points);
+  EXPECT_EQ(results[0].mesh.quads, ok.mesh.quads);
+  EXPECT_EQ(results[0].mesh.vclass[1].index, 4);
+  EXPECT_EQ(results[0].quality.sicn_min, 0.25);
+  EXPECT_EQ(results[0].quality.sicn_avg, 0.75);
+  EXPECT_EQ(results[0].quality.invalid, 1);
+  EXPECT_EQ(results[0].quality.quads, 9);
+  EXPECT_TRUE(results[0].error.empty());
+  EXPECT_TRUE(results[1].mesh.quads.empty());
+  EXPECT_EQ(results[1].error, failed.error);
+  // A share cut short is an error, not a short answer.
+  buf.resize(buf.size() - 3);
+  pos = 0;
+  read_record(buf, pos, rs);
+  EXPECT_THROW(read_record(buf, pos, results), Error);
 }
 
 // record_bytes counts what write_record writes, for every kind of field: records nested in

@@ -421,6 +421,114 @@ TEST(FacePattern, MoveSearchInBatchesGivesTheSameFill) {
   EXPECT_EQ(searched, 4);  // the test must exercise searches
 }
 
+// PatternFaceOptions::helpers: a fake set of helpers in this process, laying out each lent
+// layout with lay_out_move on sides of its own (as a helper rank does) and offering `free_now`
+// workers per claim. The search planned over them must read the same layouts in the same order:
+// the same fill point for point, the same moves, layouts and (single-step) batches; with helpers,
+// fewer lent batches than batches along the search's path.
+namespace {
+class FakeHelpers final : public MoveLayoutHelpers {
+ public:
+  FakeHelpers(const cad::CadModel& model, std::span<const mesh::CurveMesh> curves,
+              std::span<const Pattern> patterns, const PatternFaceOptions& options, int free_now)
+      : model_(model), curves_(curves), patterns_(patterns), options_(options), free_(free_now) {}
+  int claim(int wanted) override {
+    claimed_ = std::min(wanted, free_);
+    return claimed_;
+  }
+  std::vector<MoveLayoutResult> lay_out(
+      const std::vector<MoveLayoutRequest>& requests,
+      const std::function<MoveLayoutResult(const MoveLayoutRequest&)>& here) override {
+    const std::size_t workers = static_cast<std::size_t>(claimed_) + 1;
+    claimed_ = 0;
+    std::vector<MoveLayoutResult> out(requests.size());
+    for (std::size_t u = 0; u < requests.size(); ++u) {
+      if (u % workers == 0) {
+        out[u] = here(requests[u]);
+        continue;
+      }
+      const auto surface = model_.face_geometry(requests[u].face);
+      const FaceSides fs = face_sides(model_, requests[u].face, *surface, curves_, options_);
+      out[u] = lay_out_move(model_, fs, patterns_, options_.smooth, requests[u]);
+      ++lent;
+    }
+    ++calls;
+    return out;
+  }
+  int lent = 0, calls = 0;
+
+ private:
+  const cad::CadModel& model_;
+  std::span<const mesh::CurveMesh> curves_;
+  std::span<const Pattern> patterns_;
+  const PatternFaceOptions& options_;
+  int free_ = 0, claimed_ = 0;
+};
+}  // namespace
+
+TEST(FacePattern, MoveSearchWithHelpersGivesTheSameFill) {
+  const auto patterns = builtin_patterns();
+  std::vector<std::pair<std::vector<std::pair<double, double>>, std::vector<LO>>> shapes = {
+      {{{0, 0}, {4, 0}, {4, 16}, {5.456, 20}, {0, 20}}, {8, 32, 8, 12, 40}}};
+  std::vector<std::pair<double, double>> ellipse;
+  for (int k = 0; k < 32; ++k) {
+    const double a = 2 * std::numbers::pi * k / 32;
+    ellipse.emplace_back(2 * std::cos(a), std::sin(a));
+  }
+  shapes.emplace_back(ellipse, std::vector<LO>(32, 2));
+  int lent = 0;
+  for (std::size_t k = 0; k < shapes.size(); ++k) {
+    const auto pc =
+        polygon(shapes[k].first, shapes[k].second, "qs_helpers" + std::to_string(k) + ".brep");
+    for (const int evaluations : {40, 7}) {
+      PatternFaceOptions o;
+      o.move_evaluations = evaluations;  // 7: the search cut short inside its steps
+      o.move_min_layouts_per_vector = 0;
+      PatternFaceReport serial;
+      const auto m0 = mesh_face_pattern(pc.model, 0, pc.curves, patterns, o, &serial);
+      EXPECT_EQ(serial.lend_ranks, 0);
+      for (const int free_now : {0, 1, 3, 31}) {
+        FakeHelpers helpers(pc.model, pc.curves, patterns, o, free_now);
+        PatternFaceOptions oh = o;
+        oh.helpers = &helpers;
+        PatternFaceReport helped;
+        const auto m1 = mesh_face_pattern(pc.model, 0, pc.curves, patterns, oh, &helped);
+        EXPECT_EQ(helped.ok, serial.ok) << k;
+        EXPECT_EQ(helped.chords, serial.chords) << k;
+        EXPECT_EQ(helped.moves, serial.moves) << k;
+        EXPECT_EQ(helped.layouts, serial.layouts) << k;
+        EXPECT_EQ(helped.batches, serial.batches) << k;
+        EXPECT_EQ(helped.sicn_avg, serial.sicn_avg) << k;
+        EXPECT_EQ(m1.quads, m0.quads) << k;
+        ASSERT_EQ(m1.points.size(), m0.points.size()) << k;
+        for (std::size_t i = 0; i < m0.points.size(); ++i)
+          ASSERT_EQ(distance(m1.points[i], m0.points[i]), 0.0) << k << " point " << i;
+        EXPECT_LE(helped.lend_ranks, free_now);
+        if (free_now == 0) {
+          EXPECT_EQ(helpers.lent, 0);
+        }
+        if (free_now == 31 && serial.layouts > 0) {
+          // Planned as deep as the counting of a run without helpers: the same lent batches.
+          EXPECT_EQ(helped.layout_batches, serial.layout_batches) << k;
+          EXPECT_GT(helpers.lent, 0) << k;
+          lent += helpers.lent;
+        }
+      }
+      std::cout << "case " << k << ", " << evaluations << " layouts at most: " << serial.layouts
+                << " layouts read in " << serial.batches << " batches, " << serial.layout_batches
+                << " lent batches planning " << serial.layout_vectors << " layouts\n";
+      EXPECT_EQ(serial.vector_lendable, serial.layouts > 0 ? 1 : serial.vector_lendable);
+      // Several levels per lent batch: never more lent batches than single steps.
+      EXPECT_LE(serial.layout_batches, serial.batches) << k;
+      if (evaluations == 40 && serial.batches > 2) {
+        EXPECT_LT(serial.layout_batches, serial.batches);
+      }
+      EXPECT_GE(serial.layout_vectors, serial.layouts > 0 ? serial.layout_batches : 0);
+    }
+  }
+  EXPECT_GT(lent, 0);  // the test must lend layouts
+}
+
 // ... and a fill whose balanced subdivisions need more quads than max_quads may still fit the
 // bound once moved: the same strip with the bound one quad below the balanced fill's count.
 TEST(FacePattern, MovedFillsMayFitTheQuadBound) {

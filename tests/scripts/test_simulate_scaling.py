@@ -161,6 +161,48 @@ class Batches(unittest.TestCase):
         self.assertAlmostEqual(s2.predict(1, 2)["patterns"], 6.0, places=6)
 
 
+class Helped(unittest.TestCase):
+    def test_helped_schedule(self):
+        # 10 s of which 8 s laying out 8 layouts (1 s each), read in 4 single steps of 2, planned
+        # in 2 lent batches of 8. No helper: serial; one: 2 + 4 (a layout per worker per step);
+        # seven or more: 2 + 2 (one layout per lent batch); never above the serial time.
+        self.assertAlmostEqual(sim.helped_schedule(10, 8, 8, 4, 2, 16, 0), 10)
+        self.assertAlmostEqual(sim.helped_schedule(10, 8, 8, 4, 2, 16, 1), 6)
+        self.assertAlmostEqual(sim.helped_schedule(10, 8, 8, 4, 2, 16, 7), 4)
+        self.assertAlmostEqual(sim.helped_schedule(10, 8, 8, 4, 2, 16, 100), 4)
+        self.assertAlmostEqual(sim.helped_schedule(10, 8, 8, 8, 8, 8, 7), 10)  # one layout a step
+        self.assertAlmostEqual(sim.helped_schedule(10, 0, 0, 0, 0, 0, 7), 10)  # no search
+
+    def test_pattern_stage_lends_to_free_ranks(self):
+        # Face 0: patterns 10 s, 8 of them its 8 layouts (4 steps of 2, 2 lent batches of 8);
+        # eight faces of 0.1 s. 9x1: the eight others free by the search (at 1 s): 2 + 2 x 1 = 4 s.
+        # 4x1 or 2x1 (one to three ranks free): a layout per step, 2 + 4 = 6 s. Not lendable: 10 s.
+        faces = [(0, 10, 0, 0, 50, 0)] + [(0, 0.1, 0, 0, 9 - i, 0) for i in range(8)]
+        st = stats(faces, {"patterns": 10.8})
+        st["face_stats"][0]["stage_seconds"].update(
+            pattern_layouts=8, pattern_batches=4, pattern_search=8.5, pattern_layout_seconds=8.0,
+            pattern_layout_batches=2, pattern_layout_vectors=16, pattern_vector_lendable=1)
+        s = sim.Simulator(sim.Run(st), comm=NO_COMM)
+        self.assertAlmostEqual(s.predict(1, 1)["patterns"], 10.8, places=6)
+        self.assertAlmostEqual(s.predict(9, 1)["patterns"], 4.0, places=6)
+        self.assertAlmostEqual(s.predict(4, 1)["patterns"], 6.0, places=6)
+        self.assertAlmostEqual(s.predict(2, 1)["patterns"], 6.0, places=6)
+        st["face_stats"][0]["stage_seconds"]["pattern_vector_lendable"] = 0
+        s0 = sim.Simulator(sim.Run(st), comm=NO_COMM)
+        self.assertAlmostEqual(s0.predict(4, 1)["patterns"], 10.0, places=6)
+
+    def test_no_rank_is_free_while_faces_are_dealt(self):
+        # Two ranks, the lendable face first and nine faces of 1 s: the other rank takes faces
+        # until 9 s, after the search's midpoint (1 s): no help, 10 s.
+        faces = [(0, 10, 0, 0, 50, 0)] + [(0, 1.0, 0, 0, 10 - i, 0) for i in range(9)]
+        st = stats(faces, {"patterns": 19.0})
+        st["face_stats"][0]["stage_seconds"].update(
+            pattern_layouts=8, pattern_batches=4, pattern_search=8.5, pattern_layout_seconds=8.0,
+            pattern_layout_batches=2, pattern_layout_vectors=16, pattern_vector_lendable=1)
+        s = sim.Simulator(sim.Run(st), comm=NO_COMM)
+        self.assertAlmostEqual(s.predict(2, 1)["patterns"], 10.0, places=6)
+
+
 class Pieces(unittest.TestCase):
     def test_pieces_are_tasks_in_two_rounds(self):
         # Face 0 (3000 quads) improved in pieces: 3 of 2 s in the first round, 4 of 1 s in the

@@ -83,6 +83,7 @@ class Comm {
   std::shared_ptr<Impl> impl_;
   friend class SharedCounter;
   friend class SharedBytes;
+  friend class RankHelpers;
 };
 
 /// A counter shared by every rank and thread of a communicator, for dealing out work dynamically:
@@ -125,6 +126,50 @@ class SharedBytes {
   /// Bytes [offset, offset + length) of rank `owner`'s buffer. Precondition: the range lies in
   /// that buffer (checked against its size; throws qsmesh::Error otherwise).
   [[nodiscard]] std::vector<char> read(int owner, std::int64_t offset, std::int64_t length) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// Ranks lending themselves to other ranks' work once their own is done (issue 28: one face's
+/// move search dealt over the ranks that have finished theirs). A rank whose own work has ended
+/// calls serve_until_all_done: it declares itself free and answers requests until every rank has
+/// called it. A rank with lendable work claims free ranks (claim), sends each claimed one a
+/// message (send: every claimed rank gets exactly one, possibly empty) and receives its answer
+/// (receive: every message is answered, an empty one with an empty answer), after which that
+/// rank is free again.
+/// Several ranks: each rank's state (busy, free, claimed) in an MPI window on rank 0, with a count
+/// of the ranks done. A claim swaps "claimed" into a rank's slot with MPI_Fetch_and_op and
+/// MPI_REPLACE and has that rank when the old value was "free"; swapping "claimed" over "busy" or
+/// "claimed" changes nothing that matters (a busy rank writes "free" itself when it ends, and only
+/// a free rank is ever sent a message). MPI_Compare_and_swap is avoided: it crashed in Open MPI
+/// 4's shared-memory windows. The messages travel on a duplicate of the communicator. One rank:
+/// nothing to claim, serve_until_all_done returns at once.
+/// Construction and destruction are collective. Not thread-safe: one thread of the rank uses it
+/// (the pipeline lends only with one thread per rank).
+class RankHelpers {
+ public:
+  explicit RankHelpers(const Comm& comm);
+  ~RankHelpers();
+  RankHelpers(const RankHelpers&) = delete;
+  RankHelpers& operator=(const RankHelpers&) = delete;
+  [[nodiscard]] int rank() const;
+  [[nodiscard]] int size() const;
+  /// Claims up to `wanted` ranks that are free now (never this one); their ranks, possibly none.
+  [[nodiscard]] std::vector<int> claim(int wanted);
+  /// Sends a claimed rank its share (empty: released with nothing to do). Non-blocking: the bytes
+  /// must stay alive until wait_sent().
+  void send(int helper, const std::vector<char>& bytes);
+  /// Waits for every send() since the last call.
+  void wait_sent();
+  /// The answer of a claimed rank that was sent a share.
+  [[nodiscard]] std::vector<char> receive(int helper);
+  /// This rank has no work of its own left: declares itself free, answers each share with
+  /// serve(share) (an empty share with an empty answer, without calling serve) and returns when
+  /// every rank has called this. Every rank calls it once, after its own work.
+  void serve_until_all_done(
+      const std::function<std::vector<char>(const std::vector<char>&)>& serve);
 
  private:
   struct Impl;

@@ -245,6 +245,14 @@ struct FaceTimes {
   std::int64_t pattern_layouts = 0;
   std::int64_t pattern_batches = 0;
   double pattern_search = 0;
+  /// Lending the search to free ranks (qstruct::PatternFaceReport: layout_seconds,
+  /// layout_batches, layout_vectors, lend_ranks, vector_lendable): what the scaling simulation's
+  /// helped schedule replays.
+  double pattern_layout_seconds = 0;
+  std::int64_t pattern_layout_batches = 0;
+  std::int64_t pattern_layout_vectors = 0;
+  std::int64_t pattern_layout_lend_ranks = 0;
+  std::int64_t pattern_vector_lendable = 0;
   template <class S, class V>
   static void fields(S& self, V&& visit) {
     visit("background", self.background);
@@ -264,6 +272,11 @@ struct FaceTimes {
     visit("pattern_layouts", self.pattern_layouts);
     visit("pattern_batches", self.pattern_batches);
     visit("pattern_search", self.pattern_search);
+    visit("pattern_layout_seconds", self.pattern_layout_seconds);
+    visit("pattern_layout_batches", self.pattern_layout_batches);
+    visit("pattern_layout_vectors", self.pattern_layout_vectors);
+    visit("pattern_layout_lend_ranks", self.pattern_layout_lend_ranks);
+    visit("pattern_vector_lendable", self.pattern_vector_lendable);
   }
 };
 

@@ -95,6 +95,12 @@ struct PipelineOptions {
   int boundary_repair_rounds = 4;
   /// Stage::QuasiStructured: pattern meshing of simple CAD faces (Sec. 6.1.2).
   qstruct::PatternFaceOptions patterns;
+  /// With one thread per rank, the ranks that have finished their share of the pattern stage
+  /// lay out the move-search layouts of the faces still being filled (issue 28:
+  /// parallel::RankLayoutHelpers, qstruct::PatternFaceOptions::helpers and move_lend_layouts).
+  /// The fills are those of one rank. Off: patterns.move_lend_layouts is set to 0 (no lending, no
+  /// counting).
+  bool move_layouts_over_ranks = true;
   /// A pattern mesh of a face may have at most this many times the quads the size map asks for
   /// (the sum over the background triangles of area / s^2); patterns.max_quads is set from it per
   /// face. 0 (the default): no bound, as in paper 000 Sec. 6.1.2 and Gmsh, which keep a fill on

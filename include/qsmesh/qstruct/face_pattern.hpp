@@ -7,6 +7,7 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <string>
 #include <vector>
@@ -20,6 +21,8 @@
 #include "qsmesh/smooth/smooth.hpp"
 
 namespace qsmesh::qstruct {
+
+class MoveLayoutHelpers;
 
 struct PatternFaceOptions {
   /// A CAD corner whose interior angle in the face (3D, degrees) is below this splits the
@@ -153,6 +156,17 @@ struct PatternFaceOptions {
   /// the face (issue 28). The fill is the same as the serial search's at any thread count; a
   /// layout the serial search would not have read is wasted work.
   const TaskArena* tasks = nullptr;
+  /// Other workers (ranks, in the pipeline: parallel::RankLayoutHelpers) that lay out layouts of
+  /// the move search for this face while they have nothing else to do (null: none; issue 28).
+  /// Where some are free, the layouts the search may read in its next halving levels (or a
+  /// vector's four coarse points) are planned at once, at most move_lend_layouts of them, and
+  /// dealt over the caller and the helpers; the serial rules then read them in their order, so
+  /// the fill is the serial search's. Takes precedence over `tasks` for the search.
+  MoveLayoutHelpers* helpers = nullptr;
+  /// Most layouts one lent batch plans (the levels of halving steps it covers: 2, then 2 + 6,
+  /// then 2 + 6 + 18 offsets); also what the batches are counted against when no helper is free,
+  /// so that a run on one rank tells the scaling simulation what lending would be.
+  int move_lend_layouts = 32;
 };
 
 /// Why a face was not meshed by a pattern.
@@ -193,6 +207,17 @@ struct PatternFaceReport {
   int layouts = 0;
   int batches = 0;
   double search_seconds = 0;
+  /// Lending the search's layouts (PatternFaceOptions::helpers, move_lend_layouts): the seconds
+  /// this worker spent laying out the layouts the rules read (layout_seconds / layouts is one
+  /// layout), the lent batches along the search's path (counted as if move_lend_layouts workers
+  /// were free when there are no helpers), the layouts those batches plan (speculative ones
+  /// included: the work lending deals out), the most helpers one batch had, and whether the search
+  /// could be lent at all (1: it ran its rules over planned batches).
+  double layout_seconds = 0;
+  int layout_batches = 0;
+  int layout_vectors = 0;
+  int lend_ranks = 0;
+  int vector_lendable = 0;
   double sicn_min = 0, sicn_avg = 0;  ///< of the mesh kept (or of the best refused one)
   /// The min threshold applied (options.min_sicn, lowered at sharp corners: corner_sicn_factor).
   double min_sicn = 0;
@@ -219,6 +244,11 @@ struct PatternFaceReport {
     visit("layouts", self.layouts);
     visit("batches", self.batches);
     visit("search_seconds", self.search_seconds);
+    visit("layout_seconds", self.layout_seconds);
+    visit("layout_batches", self.layout_batches);
+    visit("layout_vectors", self.layout_vectors);
+    visit("lend_ranks", self.lend_ranks);
+    visit("vector_lendable", self.vector_lendable);
     visit("sicn_min", self.sicn_min);
     visit("sicn_avg", self.sicn_avg);
     visit("min_sicn", self.min_sicn);
@@ -328,5 +358,66 @@ struct FaceSides {
 [[nodiscard]] bool fill_wins(const mesh::FaceQuadStats& fill,
                              const mesh::FaceQuadStats& unstructured, bool kept, double tolerance,
                              const PatternFaceOptions& options);
+
+/// One layout of the move search (move_irregular_vertices) that another worker can make: the
+/// pattern `pattern` (index in the pattern list) with chord subdivisions `chords`, mirrored or
+/// not, its refined boundary position p on face loop point seq[p] (FaceSides::points), laid out
+/// and smoothed with `smooth_iterations` passes. Plain data: what the ranks exchange.
+struct MoveLayoutRequest {
+  LO face = kNoIndex;
+  LO pattern = kNoIndex;
+  bool reversed = false;
+  std::vector<LO> chords;
+  std::vector<LO> seq;
+  int smooth_iterations = 0;
+  template <class S, class V>
+  static void fields(S& self, V&& visit) {
+    visit("face", self.face);
+    visit("pattern", self.pattern);
+    visit("reversed", self.reversed);
+    visit("chords", self.chords);
+    visit("seq", self.seq);
+    visit("smooth_iterations", self.smooth_iterations);
+  }
+};
+
+/// The smoothed layout of a MoveLayoutRequest and its quality, or the error laying it out threw
+/// (non-empty `error`: the owner throws it when its rules read the layout).
+struct MoveLayoutResult {
+  mesh::FaceMesh mesh;
+  smooth::QualityReport quality;
+  std::string error;
+  template <class S, class V>
+  static void fields(S& self, V&& visit) {
+    visit("mesh", self.mesh);
+    visit("quality", self.quality);
+    visit("error", self.error);
+  }
+};
+
+/// Lays out one move of the search: what the owner of a face and a helper both run, so that a
+/// lent layout is bit for bit the owner's own. `fs`: face_sides of request.face (its points, poles
+/// and loop area; the corners do not matter); `smooth`: PatternFaceOptions::smooth (its iterations
+/// replaced by the request's). Never throws: an error goes into the result.
+[[nodiscard]] MoveLayoutResult lay_out_move(const cad::CadModel& model, const FaceSides& fs,
+                                            std::span<const Pattern> patterns,
+                                            const smooth::SmoothOptions& smooth,
+                                            const MoveLayoutRequest& request);
+
+/// Workers that lay out moves for a face's search (PatternFaceOptions::helpers). Implemented over
+/// ranks by parallel::RankLayoutHelpers; qstruct sees only this interface. Used by one thread at a
+/// time.
+class MoveLayoutHelpers {
+ public:
+  virtual ~MoveLayoutHelpers() = default;
+  /// Claims up to `wanted` workers free now; returns how many (0: none). Every claimed worker is
+  /// handed a share, possibly empty, by the next lay_out, which releases it.
+  virtual int claim(int wanted) = 0;
+  /// Lays out `requests` over the claimed workers and the caller (`here` runs the caller's share);
+  /// the results in request order.
+  virtual std::vector<MoveLayoutResult> lay_out(
+      const std::vector<MoveLayoutRequest>& requests,
+      const std::function<MoveLayoutResult(const MoveLayoutRequest&)>& here) = 0;
+};
 
 }  // namespace qsmesh::qstruct
