@@ -2211,16 +2211,32 @@ class Builder {
           Vec3 foot{};
           fm.uv[l] = face_geom(f).project(fm.points[l], Vec2{0, 0}, &foot);
         }
-      smooth::SmoothOptions so;
-      so.iterations = opt_.smoothing_iterations;
-      // The uv Laplacian first (a direct solve, kept only when the face's minimum SICN does not
-      // drop), not on faces with a seam, where a node on the seam has one uv for two sides.
-      so.laplacian_uv = opt_.laplacian_uv && face.seams.empty();
-      mesh::FaceMesh sm =
-          opt_.smoothing_iterations > 0 ? smooth::smooth_face(fm, face_geom(f), so) : fm;
-      // Concave corners may leave folded quads (paper 002 Sec. IV.E): local untangling there.
-      if (smooth::measure(sm).invalid > 0 || folded(sm, f) > 0)
-        sm = smooth::untangle_face(sm, face_geom(f), smooth::UntangleOptions{});
+      // A repair changes a few patches; every other face gets the same face mesh as in the last
+      // fine mesh, and smoothing it again would give the same result (the smoother and the
+      // untangler are deterministic and read the curve nodes' indices only as a pattern), so the
+      // last result is taken (Block: 32 fine meshes, most of the coarse stage's time).
+      SmoothedFace& memo = smoothed_[f];
+      std::vector<LO> pattern = curve_node_pattern(fm);
+      if (!same_face_mesh(memo, fm, pattern)) {
+        smooth::SmoothOptions so;
+        so.iterations = opt_.smoothing_iterations;
+        // The uv Laplacian first (a direct solve, kept only when the face's minimum SICN does not
+        // drop), not on faces with a seam, where a node on the seam has one uv for two sides.
+        so.laplacian_uv = opt_.laplacian_uv && face.seams.empty();
+        mesh::FaceMesh out =
+            opt_.smoothing_iterations > 0 ? smooth::smooth_face(fm, face_geom(f), so) : fm;
+        // Concave corners may leave folded quads (paper 002 Sec. IV.E): local untangling there.
+        if (smooth::measure(out).invalid > 0 || folded(out, f) > 0)
+          out = smooth::untangle_face(out, face_geom(f), smooth::UntangleOptions{});
+        memo.folded.assign(out.quads.size(), 0);
+        for (std::size_t qi = 0; qi < out.quads.size(); ++qi)
+          memo.folded[qi] = folded_quad(out, f, qi) ? 1 : 0;
+        memo.in = std::move(fm);
+        memo.pattern = std::move(pattern);
+        memo.out = std::move(out);
+        memo.valid = true;
+      }
+      const mesh::FaceMesh& sm = memo.out;
       for (std::size_t l = 0; l < global.size(); ++l) {
         FineNode& n = nodes[static_cast<std::size_t>(global[l])];
         if (n.c.dim == 2) {
@@ -2230,9 +2246,46 @@ class Builder {
         local[static_cast<std::size_t>(global[l])] = -1;
       }
       for (std::size_t qi = 0; qi < sm.quads.size(); ++qi)
-        if (folded_quad(sm, f, qi))
-          bad_fine_cquad_[static_cast<std::size_t>(fq[list[qi]].block)] = 1;
+        if (memo.folded[qi] != 0) bad_fine_cquad_[static_cast<std::size_t>(fq[list[qi]].block)] = 1;
     }
+  }
+
+  // A face's mesh before smoothing and after (smoothing and untangling), with its folded quads:
+  // the last fine mesh's, per face (smooth_nodes).
+  struct SmoothedFace {
+    bool valid = false;
+    mesh::FaceMesh in, out;
+    std::vector<LO> pattern;  // curve_node_pattern(in)
+    std::vector<char> folded;
+  };
+
+  // For each node of fm on a curve, the first node of fm with the same (curve, index) key (the
+  // smoother's seam test reads only which keys repeat); -1 for the others.
+  [[nodiscard]] static std::vector<LO> curve_node_pattern(const mesh::FaceMesh& fm) {
+    std::vector<LO> out(fm.vclass.size(), -1);
+    std::map<std::pair<LO, LO>, LO> first;
+    for (std::size_t l = 0; l < fm.vclass.size(); ++l) {
+      const mesh::VertexClass& c = fm.vclass[l];
+      if (c.dim != 1) continue;
+      out[l] = first.emplace(std::make_pair(c.entity, c.index), static_cast<LO>(l)).first->second;
+    }
+    return out;
+  }
+
+  // Whether fm is the face mesh memo was smoothed from, up to the curve nodes' index values.
+  [[nodiscard]] static bool same_face_mesh(const SmoothedFace& memo, const mesh::FaceMesh& fm,
+                                           const std::vector<LO>& pattern) {
+    if (!memo.valid || memo.in.face != fm.face || memo.in.quads != fm.quads ||
+        memo.in.triangles != fm.triangles || memo.in.points != fm.points || memo.in.uv != fm.uv ||
+        memo.pattern != pattern || memo.in.vclass.size() != fm.vclass.size())
+      return false;
+    for (std::size_t l = 0; l < fm.vclass.size(); ++l) {
+      const mesh::VertexClass &a = memo.in.vclass[l], &b = fm.vclass[l];
+      if (a.dim != b.dim || a.entity != b.entity || a.param != b.param ||
+          (a.dim != 1 && a.index != b.index))
+        return false;
+    }
+    return true;
   }
 
   // Quads of face mesh fm turning against the normal of face f (at their corners).
@@ -2296,6 +2349,7 @@ class Builder {
   std::vector<char> bad_fine_cquad_;
   std::vector<std::vector<double>> curve_params_;  // input_params, per CAD curve
   std::vector<int> repair_level_;
+  std::map<LO, SmoothedFace> smoothed_;  // per face, the last fine mesh's (smooth_nodes)
 
   std::vector<std::size_t> bad_cquads_;
   std::int64_t bad_quads_ = 0;
