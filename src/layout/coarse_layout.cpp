@@ -34,7 +34,7 @@ constexpr LO kNever = std::numeric_limits<LO>::max();
 // before every side is uniform.
 constexpr int kMaxSpacingRounds = 3;
 constexpr int kMaxRounds = 40;
-// Block at its reference factor needs 30 with local repairs (12 without; docs/benchmarks.md,
+// Block at its reference factor needs 31 with local repairs (12 without; docs/benchmarks.md,
 // branches coarse8 and coarse10); a bound against a loop that keeps finding new folds.
 constexpr int kMaxRepairs = 40;
 // Rings of patches around the bad coarse quads' own that a repair may reach (repair_patches).
