@@ -34,11 +34,10 @@ constexpr LO kNever = std::numeric_limits<LO>::max();
 // before every side is uniform.
 constexpr int kMaxSpacingRounds = 3;
 constexpr int kMaxRounds = 40;
-// Block at its reference factor needs 12 (docs/benchmarks.md, branch coarse8); a bound against a
-// loop that keeps finding new folds, each repair restoring more of the input's split lines.
-constexpr int kMaxRepairs = 16;
-// Rings of patches around the bad coarse quads' own that a repair may restore once those are at
-// their input lengths (restore_rows).
+// Block at its reference factor needs 31 with local repairs (12 without; docs/benchmarks.md,
+// branches coarse8 and coarse10); a bound against a loop that keeps finding new folds.
+constexpr int kMaxRepairs = 40;
+// Rings of patches around the bad coarse quads' own that a repair may reach (repair_patches).
 constexpr int kMaxRings = 3;
 
 // Transfinite (Coons) interpolation at grid node (i, j) of an n0 x n1 grid from its boundary
@@ -203,19 +202,31 @@ class Builder {
         out.layout = {};
         fine_mesh(out);
         if (bad_cquads_.empty()) break;
-        // Where the fine mesh is invalid, the patches that made those coarse quads keep their
-        // input lengths (the input layout is valid), and all is solved again. When every such
-        // row is already there (those patches are at their input lengths), solving again would
-        // give the same layout and the same folds (Block: a reflex CAD corner whose cells were
-        // single input quads and still folded, docs/benchmarks.md): the rows then reach one
-        // ring of patches further out (every patch touching a corner group of a coarse quad cut
-        // from the restored ones, whose collapsed arcs move those groups' centres), up to
-        // kMaxRings rings, before the layout fails.
-        std::vector<IntegerProgram::Row> rows = restore_rows(0);
-        bool fresh = new_rows(ilp, rows);
-        for (int ring = 1; !fresh && ring <= kMaxRings; ++ring) {
-          rows = restore_rows(ring);
+        // Where the fine mesh is invalid, the patches that made those coarse quads are kept from
+        // collapsing, and all is solved again (local_repairs): first those patches, then up to
+        // kMaxRings rings of patches around them (every patch touching a corner group of a coarse
+        // quad cut from the last ones), the first set whose rows the last solution does not
+        // meet; only when every ring is already kept from collapsing, the same patches are
+        // restored to their input lengths (the input layout is valid), ring by ring. Restoring
+        // input lengths first spreads along chains of patches (an arc at its input length forces
+        // its patch's opposite side, and so on), which on Block kept most of the model at its
+        // input lengths (docs/benchmarks.md, branch coarse10).
+        std::vector<IntegerProgram::Row> rows;
+        bool fresh = false;
+        if (opt_.local_repairs) {
+          rows = local_repair_rows();
+          fresh = !rows.empty();
+        } else {
+          // The former repairs: a patch's first repair keeps its arcs from collapsing, its next
+          // ones restore its input lengths; when every such row is already there, solving again
+          // would give the same layout and the same folds (Block: a reflex CAD corner whose cells
+          // were single input quads and still folded), so the rows reach rings further out.
+          rows = restore_rows(0);
           fresh = new_rows(ilp, rows);
+          for (int ring = 1; !fresh && ring <= kMaxRings; ++ring) {
+            rows = restore_rows(ring);
+            fresh = new_rows(ilp, rows);
+          }
         }
         if (!fresh)
           throw Reject{cat(bad_quads_, " fine quads invalid or folded on patches already at ",
@@ -825,10 +836,10 @@ class Builder {
     return rows;
   }
 
-  // Rows q_a >= l_a for the side arcs of every patch touching a corner group of a bad coarse
-  // quad, and of the patch it was cut from; `rings` times more, also every patch touching a
-  // corner group of a coarse quad cut from those patches.
-  [[nodiscard]] std::vector<IntegerProgram::Row> restore_rows(int rings) {
+  // The patches a repair acts on: every patch touching a corner group of a bad coarse quad, and
+  // the patch it was cut from; `rings` times more, also every patch touching a corner group of a
+  // coarse quad cut from those patches. Sorted, distinct.
+  [[nodiscard]] std::vector<LO> repair_patches(int rings) const {
     std::vector<char> bad_group(static_cast<std::size_t>(ng_), 0);
     std::vector<LO> patches;
     for (std::size_t k : bad_cquads_) {
@@ -852,18 +863,21 @@ class Builder {
       std::sort(patches.begin(), patches.end());
       patches.erase(std::unique(patches.begin(), patches.end()), patches.end());
     }
-    // A patch's first repair only forbids its arcs to collapse; its next ones restore the input
-    // lengths (which keeps more of the input's split lines, hence more blocks).
-    repair_level_.resize(grids_.size(), 0);
+    return patches;
+  }
+
+  // Single-arc rows q_a >= lo(a) for the side arcs of `patches`, one per arc, by arc.
+  template <class Lower>
+  [[nodiscard]] std::vector<IntegerProgram::Row> arc_rows(const std::vector<LO>& patches,
+                                                          Lower lower) const {
     std::map<LO, double> arcs;  // arc -> lower bound
-    for (LO p : patches) {
-      const int level = ++repair_level_[static_cast<std::size_t>(p)];
+    for (LO p : patches)
       for (int s = 0; s < 4; ++s)
         for (LO a : side_arcs(static_cast<std::size_t>(p), s)) {
-          const double lo = level == 1 ? 1.0 : arcs_[static_cast<std::size_t>(a)].length();
-          arcs[a] = std::max(arcs[a], lo);
+          const double lo = lower(p, a);
+          auto [it, fresh] = arcs.emplace(a, lo);
+          if (!fresh) it->second = std::max(it->second, lo);
         }
-    }
     std::vector<IntegerProgram::Row> rows;
     for (const auto& [a, lo] : arcs) {
       IntegerProgram::Row r;
@@ -873,6 +887,63 @@ class Builder {
       rows.push_back(std::move(r));
     }
     return rows;
+  }
+
+  // No-collapse rows q_a >= 1 for the side arcs of `patches` (CoarseOptions::local_repairs).
+  [[nodiscard]] std::vector<IntegerProgram::Row> keep_rows(const std::vector<LO>& patches) const {
+    return arc_rows(patches, [](LO, LO) { return 1.0; });
+  }
+
+  // Rows q_a >= l_a (the input lengths) for the side arcs of `patches`.
+  [[nodiscard]] std::vector<IntegerProgram::Row> bound_rows(const std::vector<LO>& patches) const {
+    return arc_rows(patches, [this](LO, LO a) {
+      return static_cast<double>(arcs_[static_cast<std::size_t>(a)].length());
+    });
+  }
+
+  // Whether the last solution meets every row of `rows`: solving again with them added would
+  // give the same layout (CBC is deterministic), so a repair made of them changes nothing.
+  [[nodiscard]] bool met(const std::vector<IntegerProgram::Row>& rows) const {
+    for (const auto& r : rows) {
+      double sum = 0;
+      for (const auto& [a, c] : r.terms)
+        sum += c * static_cast<double>(q_[static_cast<std::size_t>(a)]);
+      if (sum < r.lo || sum > r.hi) return false;
+    }
+    return true;
+  }
+
+  // The rows of the next repair (CoarseOptions::local_repairs): no-collapse rows on the bad coarse
+  // quads' patches, then on up to kMaxRings rings of patches around them, the first of those the
+  // last solution does not meet; only when all are met, the input lengths on the same patches,
+  // ring by ring. Empty when every such set of rows is met.
+  [[nodiscard]] std::vector<IntegerProgram::Row> local_repair_rows() const {
+    std::vector<std::vector<LO>> rings;
+    for (int ring = 0; ring <= kMaxRings; ++ring) rings.push_back(repair_patches(ring));
+    for (const auto& patches : rings) {
+      auto rows = keep_rows(patches);
+      if (!met(rows)) return rows;
+    }
+    for (const auto& patches : rings) {
+      auto rows = bound_rows(patches);
+      if (!met(rows)) return rows;
+    }
+    return {};
+  }
+
+  // Rows of the former repairs (local_repairs off): q_a >= 1 on a patch's first repair, q_a >= l_a
+  // on its next ones, for the patches of repair_patches(rings).
+  [[nodiscard]] std::vector<IntegerProgram::Row> restore_rows(int rings) {
+    const std::vector<LO> patches = repair_patches(rings);
+    repair_level_.resize(grids_.size(), 0);
+    std::vector<int> level(grids_.size(), 0);
+    for (LO p : patches)
+      level[static_cast<std::size_t>(p)] = ++repair_level_[static_cast<std::size_t>(p)];
+    return arc_rows(patches, [&](LO p, LO a) {
+      return level[static_cast<std::size_t>(p)] == 1
+                 ? 1.0
+                 : static_cast<double>(arcs_[static_cast<std::size_t>(a)].length());
+    });
   }
 
   // Whether a row of `rows` (single-arc lower bounds, restore_rows) is not yet in the program:
@@ -2140,16 +2211,32 @@ class Builder {
           Vec3 foot{};
           fm.uv[l] = face_geom(f).project(fm.points[l], Vec2{0, 0}, &foot);
         }
-      smooth::SmoothOptions so;
-      so.iterations = opt_.smoothing_iterations;
-      // The uv Laplacian first (a direct solve, kept only when the face's minimum SICN does not
-      // drop), not on faces with a seam, where a node on the seam has one uv for two sides.
-      so.laplacian_uv = opt_.laplacian_uv && face.seams.empty();
-      mesh::FaceMesh sm =
-          opt_.smoothing_iterations > 0 ? smooth::smooth_face(fm, face_geom(f), so) : fm;
-      // Concave corners may leave folded quads (paper 002 Sec. IV.E): local untangling there.
-      if (smooth::measure(sm).invalid > 0 || folded(sm, f) > 0)
-        sm = smooth::untangle_face(sm, face_geom(f), smooth::UntangleOptions{});
+      // A repair changes a few patches; every other face gets the same face mesh as in the last
+      // fine mesh, and smoothing it again would give the same result (the smoother and the
+      // untangler are deterministic and read the curve nodes' indices only as a pattern), so the
+      // last result is taken (Block: 32 fine meshes, most of the coarse stage's time).
+      SmoothedFace& memo = smoothed_[f];
+      std::vector<LO> pattern = curve_node_pattern(fm);
+      if (!same_face_mesh(memo, fm, pattern)) {
+        smooth::SmoothOptions so;
+        so.iterations = opt_.smoothing_iterations;
+        // The uv Laplacian first (a direct solve, kept only when the face's minimum SICN does not
+        // drop), not on faces with a seam, where a node on the seam has one uv for two sides.
+        so.laplacian_uv = opt_.laplacian_uv && face.seams.empty();
+        mesh::FaceMesh out =
+            opt_.smoothing_iterations > 0 ? smooth::smooth_face(fm, face_geom(f), so) : fm;
+        // Concave corners may leave folded quads (paper 002 Sec. IV.E): local untangling there.
+        if (smooth::measure(out).invalid > 0 || folded(out, f) > 0)
+          out = smooth::untangle_face(out, face_geom(f), smooth::UntangleOptions{});
+        memo.folded.assign(out.quads.size(), 0);
+        for (std::size_t qi = 0; qi < out.quads.size(); ++qi)
+          memo.folded[qi] = folded_quad(out, f, qi) ? 1 : 0;
+        memo.in = std::move(fm);
+        memo.pattern = std::move(pattern);
+        memo.out = std::move(out);
+        memo.valid = true;
+      }
+      const mesh::FaceMesh& sm = memo.out;
       for (std::size_t l = 0; l < global.size(); ++l) {
         FineNode& n = nodes[static_cast<std::size_t>(global[l])];
         if (n.c.dim == 2) {
@@ -2159,9 +2246,46 @@ class Builder {
         local[static_cast<std::size_t>(global[l])] = -1;
       }
       for (std::size_t qi = 0; qi < sm.quads.size(); ++qi)
-        if (folded_quad(sm, f, qi))
-          bad_fine_cquad_[static_cast<std::size_t>(fq[list[qi]].block)] = 1;
+        if (memo.folded[qi] != 0) bad_fine_cquad_[static_cast<std::size_t>(fq[list[qi]].block)] = 1;
     }
+  }
+
+  // A face's mesh before smoothing and after (smoothing and untangling), with its folded quads:
+  // the last fine mesh's, per face (smooth_nodes).
+  struct SmoothedFace {
+    bool valid = false;
+    mesh::FaceMesh in, out;
+    std::vector<LO> pattern;  // curve_node_pattern(in)
+    std::vector<char> folded;
+  };
+
+  // For each node of fm on a curve, the first node of fm with the same (curve, index) key (the
+  // smoother's seam test reads only which keys repeat); -1 for the others.
+  [[nodiscard]] static std::vector<LO> curve_node_pattern(const mesh::FaceMesh& fm) {
+    std::vector<LO> out(fm.vclass.size(), -1);
+    std::map<std::pair<LO, LO>, LO> first;
+    for (std::size_t l = 0; l < fm.vclass.size(); ++l) {
+      const mesh::VertexClass& c = fm.vclass[l];
+      if (c.dim != 1) continue;
+      out[l] = first.emplace(std::make_pair(c.entity, c.index), static_cast<LO>(l)).first->second;
+    }
+    return out;
+  }
+
+  // Whether fm is the face mesh memo was smoothed from, up to the curve nodes' index values.
+  [[nodiscard]] static bool same_face_mesh(const SmoothedFace& memo, const mesh::FaceMesh& fm,
+                                           const std::vector<LO>& pattern) {
+    if (!memo.valid || memo.in.face != fm.face || memo.in.quads != fm.quads ||
+        memo.in.triangles != fm.triangles || memo.in.points != fm.points || memo.in.uv != fm.uv ||
+        memo.pattern != pattern || memo.in.vclass.size() != fm.vclass.size())
+      return false;
+    for (std::size_t l = 0; l < fm.vclass.size(); ++l) {
+      const mesh::VertexClass &a = memo.in.vclass[l], &b = fm.vclass[l];
+      if (a.dim != b.dim || a.entity != b.entity || a.param != b.param ||
+          (a.dim != 1 && a.index != b.index))
+        return false;
+    }
+    return true;
   }
 
   // Quads of face mesh fm turning against the normal of face f (at their corners).
@@ -2225,6 +2349,7 @@ class Builder {
   std::vector<char> bad_fine_cquad_;
   std::vector<std::vector<double>> curve_params_;  // input_params, per CAD curve
   std::vector<int> repair_level_;
+  std::map<LO, SmoothedFace> smoothed_;  // per face, the last fine mesh's (smooth_nodes)
 
   std::vector<std::size_t> bad_cquads_;
   std::int64_t bad_quads_ = 0;

@@ -1,6 +1,7 @@
 #include "shapes.hpp"
 
 #include <BRepAlgoAPI_Cut.hxx>
+#include <BRepAlgoAPI_Fuse.hxx>
 #include <BRepBuilderAPI_MakeEdge.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepBuilderAPI_MakePolygon.hxx>
@@ -75,6 +76,20 @@ std::string write_box_with_hole(const std::string& path) {
   cut.Build();
   if (!cut.IsDone()) throw std::runtime_error("boolean cut failed");
   return write(cut.Shape(), path);
+}
+
+std::string write_pipe_cross(const std::string& path) {
+  const auto pipe = [](gp_Pnt origin, gp_Dir dir, double radius) {
+    return BRepPrimAPI_MakeCylinder(gp_Ax2(origin, dir), radius, 6.0).Shape();
+  };
+  BRepAlgoAPI_Fuse two(pipe(gp_Pnt(-3, 0, 0), gp_Dir(1, 0, 0), 1.0),
+                       pipe(gp_Pnt(0, -3, 0.2), gp_Dir(0, 1, 0), 0.8));
+  two.Build();
+  if (!two.IsDone()) throw std::runtime_error("boolean fuse failed");
+  BRepAlgoAPI_Fuse three(two.Shape(), pipe(gp_Pnt(0.5, 0, -3), gp_Dir(0, 0, 1), 0.6));
+  three.Build();
+  if (!three.IsDone()) throw std::runtime_error("boolean fuse failed");
+  return write(three.Shape(), path);
 }
 
 std::string write_cylinder(const std::string& path) {

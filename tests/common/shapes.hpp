@@ -51,6 +51,11 @@ std::string write_half_disk(double radius, const std::string& path);
 std::string write_l_prism(const std::string& path);
 /// Writes a box with filleted edges (radius 1), as STEP.
 std::string write_filleted_box(const std::string& path);
+/// Writes three fused pipes of different radii crossing near the origin: radius 1 along x from
+/// x = -3, 0.8 along y from y = -3 (axis at z = 0.2), 0.6 along z from z = -3 (axis at x = 0.5),
+/// each 6 long. Their intersection curves meet the cylinders' seams and each other, leaving
+/// reflex CAD corners on the cylinders (as BREP).
+std::string write_pipe_cross(const std::string& path);
 /// Writes a T of three plates meeting along one curve (non-manifold: three faces border it): the
 /// 4 x 2 rectangles [0, 4] x [0, 2] and [4, 8] x [0, 2] at z = 0 and the upright 2 x 3 one
 /// x = 4, 0 <= z <= 3, all bounded by the shared TopoDS edge x = 4, z = 0. The faces are one

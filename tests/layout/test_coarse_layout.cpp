@@ -232,6 +232,27 @@ TEST(CoarseLayout, FittedLoopWidthsKeepTheLayoutConforming) {
   EXPECT_GT(fit.stats.sicn_min, 0.0);
 }
 
+TEST(CoarseLayout, RepairsForbidCollapseBeforeRestoringInputLengths) {
+  // Three crossing pipes: fine quads fold near the reflex corners of the pipes' junctions after
+  // the first solve and again after the first repair. The former repairs then restore the input
+  // lengths of those patches, which spreads along chains of patches (an arc at its input length
+  // forces the opposite side of its patch): most of the model ends at its input lengths. Local
+  // repairs keep the patches and rings around them from collapsing first, and stay coarse.
+  const std::string path = test::write_pipe_cross(test::tmp("coarse_pipe_cross.brep"));
+  const Meshed in = mesh_model(path, 0.036);
+  const CoarseResult local = build_coarse_layout(in.mesh, in.model);
+  CoarseOptions restore_options;
+  restore_options.local_repairs = false;
+  const CoarseResult restore = build_coarse_layout(in.mesh, in.model, restore_options);
+  expect_conforming_blocks(local, in.model);
+  expect_conforming_blocks(restore, in.model);
+  EXPECT_GE(local.stats.repairs, 2);
+  EXPECT_GE(restore.stats.repairs, 2);
+  // Measured: 1,238 cells against 9,257 (78,198 input quads).
+  EXPECT_LT(local.stats.cells * 4, restore.stats.cells)
+      << local.stats.cells << " cells with local repairs, " << restore.stats.cells << " without";
+}
+
 TEST(CoarseLayout, BlocksCrossSmoothCurvesNotSharpOnes) {
   // A filleted box: the fillets meet the box's faces and each other along smooth curves, which
   // blocks may cross; fewer blocks than with every curve a wall, still conforming.

@@ -69,6 +69,15 @@ struct CoarseOptions {
   /// nearest, in ratio and weighted by the input quads each cell covers, to the extent of every
   /// cell of the loop in its input patch grid) instead of the rounded mean of the loop's targets.
   bool fit_loop_widths = false;
+  /// Repairs after an invalid fine mesh (folded or invalid fine quads) act locally: a repair
+  /// first forbids the arcs of the bad coarse quads' patches to collapse (q_a >= 1), then those
+  /// of up to 3 rings of patches around them, the first set the last solution does not meet, and
+  /// only when all are met restores the input lengths (q_a >= l_a) on the same patches, ring by
+  /// ring. false: the former repairs, where a patch's second repair restores its input lengths;
+  /// those spread along chains of patches (an arc at its input length forces the opposite side
+  /// of its patch, and so on) and on Block kept most of the model at its input lengths (70,841
+  /// blocks against 43,132, docs/benchmarks.md, branch coarse10).
+  bool local_repairs = true;
 };
 
 /// One coarse quad a quad loop crosses: how many input quads its cell spans across the loop (in
@@ -111,8 +120,9 @@ struct CoarseStats {
   double ilp_seconds = 0;  ///< all rounds
   /// Solves, each after rows forbidding the CAD merges of the last one (at most 40 per repair).
   int ilp_rounds = 0;
-  /// Solves again after an invalid fine mesh, the patches that made the bad coarse quads kept from
-  /// collapsing, then at their input lengths, then rings of patches around them (at most 16).
+  /// Solves again after an invalid fine mesh, the patches that made the bad coarse quads and rings
+  /// of patches around them kept from collapsing, then at their input lengths
+  /// (CoarseOptions::local_repairs; at most 40).
   int repairs = 0;
   std::string ilp_status;
   std::int64_t smooth_curves = 0;  ///< CAD curves crossed (CoarseOptions::cross_smooth_curves)
