@@ -11,7 +11,6 @@
 #include <GCPnts_AbscissaPoint.hxx>
 #include <GProp_GProps.hxx>
 #include <Standard_Failure.hxx>
-#include <gp_Vec.hxx>
 #include <TopExp.hxx>
 #include <TopoDS.hxx>
 #include <TopoDS_Iterator.hxx>
@@ -19,6 +18,7 @@
 #include <TopoDS_Wire.hxx>
 #include <algorithm>
 #include <cmath>
+#include <gp_Vec.hxx>
 #include <numbers>
 #include <utility>
 
