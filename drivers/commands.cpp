@@ -202,7 +202,11 @@ int run_info(const Arguments& args) {
           .value("seams", static_cast<std::int64_t>(face.seams.size()))
           .value("area", face.area)
           .value("reversed", face.reversed)
-          .end_object();
+          .value("uniform_field", cad::planar_with_right_angle_lines(model, f));
+      if (!parts.empty())  // the partition's two weights
+        j.value("estimated_cost", costs[static_cast<std::size_t>(f)])
+            .value("estimated_field_cost", field_costs[static_cast<std::size_t>(f)]);
+      j.end_object();
     }
     j.end_array();
     if (!parts.empty()) {
@@ -241,7 +245,9 @@ int run_info(const Arguments& args) {
               << (face.reversed ? "  reversed" : "") << "\n";
   }
   if (!parts.empty()) {
-    std::cout << "\nMETIS partition at size " << size << " (weights area / size^2):\n";
+    std::cout << "\nMETIS partition at size " << size
+              << " (weights area / size^2; cross field: 0 on\n"
+              << "faces of the exact-uniform shortcut, planar with lines at right angles):\n";
     for (std::size_t k = 0; k < parts.size(); ++k)
       std::cout << "  " << args.partition[k] << " ranks: " << balance(args.partition[k], parts[k])
                 << "\n";
