@@ -20,7 +20,9 @@ namespace qsmesh::parallel {
 /// the crossfield stage alone, which the faces' partition also runs and whose time is the slowest
 /// rank's). Falls back to the one-constraint partition above, the same answer, when the second
 /// column says nothing the first does not: it is empty, sums to zero, or (after METIS's integer
-/// scaling) equals the first; and when METIS refuses the two-constraint call. Deterministic.
+/// scaling) equals the first; when METIS refuses the two-constraint call; and when the
+/// one-constraint partition has the smaller sum of the two imbalances (largest part / mean, on
+/// the scaled weights; ties keep it). Deterministic.
 /// Precondition: field_weights is empty or has one entry per face.
 [[nodiscard]] std::vector<int> partition_faces(const Adjacency& face2faces,
                                                std::span<const double> weights,
