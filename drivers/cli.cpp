@@ -551,8 +551,9 @@ std::string help(const std::string& topic) {
           "  --partition P,...  also the METIS partition of the faces over P ranks that\n"
           "                   `mpirun -np P qsmesh mesh` uses at the same size (--size or "
           "--size-factor,\n"
-          "                   default 0.02): per P, faces per rank and estimated cost max / mean;\n"
-          "                   with --json each face's rank (key partitions, by P)\n";
+          "                   default 0.02): per P, faces per rank, estimated cost and\n"
+          "                   cross-field cost max / mean; with --json each face's rank (key\n"
+          "                   partitions, by P)\n";
   } else if (topic == "mesh") {
     os << "usage: [mpirun -np P] qsmesh mesh MODEL -o OUT [options]\n\n"
           "Meshes every face of a CAD model and writes the surface mesh to OUT; the extension "

@@ -126,11 +126,12 @@ int run_info(const Arguments& args) {
   const double size =
       args.size ? *args.size : model.diagonal() * args.size_factor.value_or(kDefaultSizeFactor);
   std::vector<std::vector<int>> parts;
-  std::vector<double> costs;
+  std::vector<double> costs, field_costs;
   if (!args.partition.empty()) {
     if (!(size > 0))
       throw InputError("size: the model '" + args.model + "' has an empty bounding box");
     costs = parallel::estimate_face_costs(model, size);
+    field_costs = parallel::estimate_field_costs(model, size);
     // METIS prints its complaints (more parts than a graph bisects well) on stdout, which holds
     // the JSON: they go to stderr instead.
     std::cout.flush();
@@ -138,28 +139,32 @@ int run_info(const Arguments& args) {
     const int saved = ::dup(STDOUT_FILENO);
     if (saved >= 0) ::dup2(STDERR_FILENO, STDOUT_FILENO);
     for (const int p : args.partition)
-      parts.push_back(parallel::partition_faces(model.face2faces(), costs, p));
+      parts.push_back(parallel::partition_model_faces(model, size, p));
     std::fflush(stdout);
     if (saved >= 0) {
       ::dup2(saved, STDOUT_FILENO);
       ::close(saved);
     }
   }
-  // Per part: faces and estimated cost; returns "faces min-max, cost max / mean".
+  // Per part: faces and the two estimated costs; returns "faces min-max, cost max / mean, field
+  // cost max / mean".
   const auto balance = [&](int p, const std::vector<int>& part) {
     std::vector<std::int64_t> n(static_cast<std::size_t>(p), 0);
-    std::vector<double> w(static_cast<std::size_t>(p), 0.0);
+    std::vector<double> w(static_cast<std::size_t>(p), 0.0), wf(w);
     for (std::size_t f = 0; f < part.size(); ++f) {
       ++n[static_cast<std::size_t>(part[f])];
       w[static_cast<std::size_t>(part[f])] += costs[f];
+      wf[static_cast<std::size_t>(part[f])] += field_costs[f];
     }
-    double total = 0;
-    for (const double x : w) total += x;
-    const double mean = total / p;
+    const auto max_over_mean = [p](const std::vector<double>& x) {
+      double total = 0;
+      for (const double v : x) total += v;
+      return total > 0 ? *std::max_element(x.begin(), x.end()) * p / total : 1.0;
+    };
     std::ostringstream os;
     os << *std::min_element(n.begin(), n.end()) << "-" << *std::max_element(n.begin(), n.end())
-       << " faces per rank, estimated cost max / mean "
-       << (mean > 0 ? *std::max_element(w.begin(), w.end()) / mean : 1.0);
+       << " faces per rank, estimated cost max / mean " << max_over_mean(w)
+       << ", estimated cross-field cost max / mean " << max_over_mean(wf);
     return os.str();
   };
   if (args.json) {
@@ -197,7 +202,11 @@ int run_info(const Arguments& args) {
           .value("seams", static_cast<std::int64_t>(face.seams.size()))
           .value("area", face.area)
           .value("reversed", face.reversed)
-          .end_object();
+          .value("uniform_field", cad::planar_with_right_angle_lines(model, f));
+      if (!parts.empty())  // the partition's two weights
+        j.value("estimated_cost", costs[static_cast<std::size_t>(f)])
+            .value("estimated_field_cost", field_costs[static_cast<std::size_t>(f)]);
+      j.end_object();
     }
     j.end_array();
     if (!parts.empty()) {
@@ -236,7 +245,9 @@ int run_info(const Arguments& args) {
               << (face.reversed ? "  reversed" : "") << "\n";
   }
   if (!parts.empty()) {
-    std::cout << "\nMETIS partition at size " << size << " (weights area / size^2):\n";
+    std::cout << "\nMETIS partition at size " << size
+              << " (weights area / size^2; cross field: 0 on\n"
+              << "faces of the exact-uniform shortcut, planar with lines at right angles):\n";
     for (std::size_t k = 0; k < parts.size(); ++k)
       std::cout << "  " << args.partition[k] << " ranks: " << balance(args.partition[k], parts[k])
                 << "\n";

@@ -10,18 +10,21 @@
 # against the multiple (scripts/plot_table.py).
 # Usage: scripts/bench_growth.sh [--runs "MODEL:FACTOR:MULTIPLES ..."] [--ranks P]
 #                                [--extra "qsmesh options"] [--csv FILE] [--png FILE]
+#                                [--qsmesh BINARY]
 #   MODEL is a file under ../shared/cad (or a path), FACTOR the size factor of its reference
 #   vertex count, MULTIPLES comma-separated vertex multiples (the size factor is divided by their
 #   square root). Defaults: --ranks 2, --runs "Block.stp:0.00463:1,4,16 A319.brep:0.00388426:1,16"
-#   (the factors of docs/benchmarks.md's reference-count table).
+#   (the factors of docs/benchmarks.md's reference-count table). --qsmesh: the binary to run
+#   (default build/drivers/qsmesh), e.g. a copy of main's to compare with.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-usage() { sed -n '11,16p' "$0" | sed 's/^# \{0,1\}//' >&2; exit 2; }
+usage() { sed -n '11,18p' "$0" | sed 's/^# \{0,1\}//' >&2; exit 2; }
 runs="Block.stp:0.00463:1,4,16 A319.brep:0.00388426:1,16"
 ranks=2
 extra=
 csv=
 png=
+qsmesh=build/drivers/qsmesh
 while [ $# -gt 0 ]; do
   case "$1" in
     --runs) runs=$2; shift 2 ;;
@@ -29,12 +32,12 @@ while [ $# -gt 0 ]; do
     --extra) extra=$2; shift 2 ;;
     --csv) csv=$2; shift 2 ;;
     --png) png=$2; shift 2 ;;
+    --qsmesh) qsmesh=$2; shift 2 ;;
     -h|--help) usage ;;
     *) echo "bench_growth: unknown option $1" >&2; usage ;;
   esac
 done
 [[ "$ranks" =~ ^[1-9][0-9]*$ ]] || { echo "bench_growth: --ranks must be a positive integer" >&2; exit 2; }
-qsmesh=build/drivers/qsmesh
 [ -x "$qsmesh" ] || { echo "bench_growth: $qsmesh not found: run scripts/build.sh first" >&2; exit 2; }
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 work=$(mktemp -d)

@@ -17,6 +17,9 @@
 #include <TopoDS_Vertex.hxx>
 #include <TopoDS_Wire.hxx>
 #include <algorithm>
+#include <cmath>
+#include <gp_Vec.hxx>
+#include <numbers>
 #include <utility>
 
 #include "impl.hpp"
@@ -93,6 +96,30 @@ std::unique_ptr<CurveGeometry> CadModel::curve_geometry(LO c) const {
 std::unique_ptr<FaceGeometry> CadModel::face_geometry(LO f, bool with_classifier) const {
   QSMESH_CHECK(f >= 0 && f < num_faces(), "face id " << f << " out of range");
   return make_face_geometry(*impl_, faces_[f], f, with_classifier);
+}
+
+bool planar_with_right_angle_lines(const CadModel& model, LO f) {
+  QSMESH_CHECK(f >= 0 && f < model.num_faces(), "face " << f << " out of range");
+  const Face& face = model.faces()[f];
+  if (face.type != SurfaceType::Plane) return false;
+  bool first = true;
+  gp_Vec ref;
+  for (const Loop& loop : face.loops)
+    for (const CurveUse& use : loop.uses) {
+      const Curve& curve = model.curves()[use.curve];
+      if (curve.degenerate || curve.type != CurveType::Line) return false;
+      const BRepAdaptor_Curve adaptor(model.impl().edges[use.curve]);
+      if (adaptor.GetType() != GeomAbs_Line) return false;
+      const gp_Vec d(adaptor.Line().Direction());
+      if (first) {
+        ref = d, first = false;
+        continue;
+      }
+      // The angle between the two lines, in [0, pi]; 4x it must be a multiple of 2 pi.
+      const double a = 4 * std::atan2(d.Crossed(ref).Magnitude(), d.Dot(ref));
+      if (std::abs(std::remainder(a, 2 * std::numbers::pi)) > 1e-6) return false;
+    }
+  return !first;
 }
 
 namespace {

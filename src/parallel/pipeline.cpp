@@ -55,6 +55,21 @@ std::vector<double> estimate_face_costs(const cad::CadModel& model, double size)
   return cost;
 }
 
+std::vector<double> estimate_field_costs(const cad::CadModel& model, double size,
+                                         bool exact_uniform) {
+  std::vector<double> cost = estimate_face_costs(model, size);
+  if (exact_uniform)
+    for (LO f = 0; f < model.num_faces(); ++f)
+      if (cad::planar_with_right_angle_lines(model, f)) cost[static_cast<std::size_t>(f)] = 0;
+  return cost;
+}
+
+std::vector<int> partition_model_faces(const cad::CadModel& model, double size, int nranks,
+                                       bool exact_uniform) {
+  return partition_faces(model.face2faces(), estimate_face_costs(model, size),
+                         estimate_field_costs(model, size, exact_uniform), nranks);
+}
+
 namespace {
 
 // Stage times: each stage ends with the slowest rank's time; the stages split by faces also add
@@ -1132,11 +1147,11 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
   log.info(cat("curves: ", model.num_curves(), " curves meshed, ", curve_edges, " edges (",
                result.times.get("curves"), " s; rounds split by curve ", rounds, " s)"));
 
-  // Faces: METIS partition weighted by the estimated cost. Each face of this rank is one record
-  // (FaceTask) that the stages below fill in turn.
+  // Faces: METIS partition balancing the estimated cost and the estimated cross-field cost. Each
+  // face of this rank is one record (FaceTask) that the stages below fill in turn.
   clock.start();
-  result.face_rank = partition_faces(
-      model.face2faces(), estimate_face_costs(model, options.background.sizes.size), nranks);
+  result.face_rank = partition_model_faces(model, options.background.sizes.size, nranks,
+                                           options.crossfield.exact_uniform);
   // A smooth group is meshed as one surface: its faces go to the rank of its first face (the
   // partition is the same on every rank, so is this).
   const bool by_groups =

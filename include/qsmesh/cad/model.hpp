@@ -161,6 +161,14 @@ class CadModel {
   std::unique_ptr<Impl> impl_;
 };
 
+/// Whether face f is planar and bounded only by straight lines (every loop, holes included), each
+/// parallel or perpendicular to the others: the crossfield stage's exact-uniform shortcut
+/// (CrossFieldOptions::exact_uniform) then gives the face its field without a solve, so its
+/// cross-field cost is about nothing. Tolerance: 1e-6 rad on 4x the angle between two lines, the
+/// shortcut's own test on the sampled boundary edges. A face without curves is false. Reads the
+/// lines' directions from the CAD (OpenCASCADE); thread-safe, the same answer on every rank.
+[[nodiscard]] bool planar_with_right_angle_lines(const CadModel& model, LO f);
+
 /// Reads a STEP (.step, .stp), IGES (.iges, .igs) or BREP (.brep, .brp) file and builds the
 /// topology. Entity ids follow OpenCASCADE's unique-shape maps (TopExp::MapShapes order), so they
 /// are the same on every rank and every run. Throws InputError for a missing, empty, unreadable or

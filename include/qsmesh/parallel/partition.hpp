@@ -15,6 +15,19 @@ namespace qsmesh::parallel {
 [[nodiscard]] std::vector<int> partition_faces(const Adjacency& face2faces,
                                                std::span<const double> weights, int parts);
 
+/// The same with a second balance constraint (METIS multi-constraint, ncon = 2): each part gets
+/// a fair share of `weights` (the whole cost) and of `field_weights` (>= 0 per face: the cost of
+/// the crossfield stage alone, which the faces' partition also runs and whose time is the slowest
+/// rank's). Falls back to the one-constraint partition above, the same answer, when the second
+/// column says nothing the first does not: it is empty, sums to zero, or (after METIS's integer
+/// scaling) equals the first; when METIS refuses the two-constraint call; and when the
+/// one-constraint partition has the smaller sum of the two imbalances (largest part / mean, on
+/// the scaled weights; ties keep it). Deterministic.
+/// Precondition: field_weights is empty or has one entry per face.
+[[nodiscard]] std::vector<int> partition_faces(const Adjacency& face2faces,
+                                               std::span<const double> weights,
+                                               std::span<const double> field_weights, int parts);
+
 /// Deals items over `parts` ranks, largest weight first (ties: the lower index), each to the rank
 /// whose weights so far sum least (ties: the lower rank): the greedy longest-first rule,
 /// the same on every rank (scripts/simulate_scaling.py's greedy_partition replays it). Returns the

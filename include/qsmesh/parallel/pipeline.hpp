@@ -272,4 +272,17 @@ struct PipelineResult {
 /// Estimated cost of meshing each face (area / size^2), the METIS vertex weights.
 [[nodiscard]] std::vector<double> estimate_face_costs(const cad::CadModel& model, double size);
 
+/// Estimated cost of each face's crossfield stage (cross field, singularities, scaling), the
+/// partition's second balance constraint: area / size^2 as estimate_face_costs, but about nothing
+/// (0) for a face that takes the exact-uniform shortcut (cad::planar_with_right_angle_lines) when
+/// `exact_uniform` (CrossFieldOptions::exact_uniform) is on. From the CAD model alone, so it is
+/// known before the background stage and the same on every rank.
+[[nodiscard]] std::vector<double> estimate_field_costs(const cad::CadModel& model, double size,
+                                                       bool exact_uniform = true);
+
+/// The faces over `nranks` ranks as run_pipeline partitions them: partition_faces with both
+/// estimates (also `qsmesh info --partition`, which scripts/simulate_scaling.py replays).
+[[nodiscard]] std::vector<int> partition_model_faces(const cad::CadModel& model, double size,
+                                                     int nranks, bool exact_uniform = true);
+
 }  // namespace qsmesh::parallel
