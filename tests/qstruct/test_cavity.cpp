@@ -10,7 +10,6 @@
 #include <vector>
 
 #include "analytic_surfaces.hpp"
-#include "qsmesh/cad/cached_geometry.hpp"
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/qstruct/cavity.hpp"
@@ -653,64 +652,6 @@ TEST(Cavity, MemoLeavesTheResultUnchanged) {
   }
   EXPECT_GT(memo.records(), 0);
   EXPECT_GT(memo.hits(), 0);  // the rounds meet refused candidates again
-}
-
-// CavityOptions::cache_surface: the candidates' evaluations through cad::CachedFaceGeometry give
-// the mesh of the uncached surface, bit for bit, on a curved surface where the normals and points
-// differ from vertex to vertex.
-TEST(Cavity, CachedSurfaceLeavesTheResultUnchanged) {
-  const Plane plane;
-  const test::Sphere sphere(12.0);
-  mesh::FaceMesh in = graded_grid(plane);
-  for (LO v = 0; v < in.num_vertices(); ++v) {
-    // Longitude 0 to 2 radians, latitude -0.5 to 0.5: cells near the plane's.
-    in.uv[v] = {in.uv[v].u / 12.0, in.uv[v].v / 12.0 - 0.5};
-    in.points[v] = sphere.eval(in.uv[v]).p;
-    if (in.vclass[v].dim == 2) in.vclass[v].param = {in.uv[v].u, in.uv[v].v};
-  }
-  const auto patterns = builtin_patterns();
-  CavityOptions cached, uncached;
-  cached.max_quads_maximal = uncached.max_quads_maximal = 80;
-  cached.keep_avg_ratio = uncached.keep_avg_ratio = 1.05;
-  uncached.cache_surface = false;
-  CavityReport a, b;
-  const mesh::FaceMesh with = remesh_cavities(in, sphere, {}, patterns, cached, &a);
-  const mesh::FaceMesh without = remesh_cavities(in, sphere, {}, patterns, uncached, &b);
-  ASSERT_TRUE(a.skipped.empty()) << a.skipped;
-  EXPECT_LT(a.irregular_after, a.irregular_before);
-  expect_same_mesh(with, without);
-  std::int64_t refused = 0;
-  for (int k = 0; k < 4; ++k) {
-    EXPECT_EQ(a.remeshed[k], b.remeshed[k]);
-    refused += a.diagnostics[k].refused_screened + a.diagnostics[k].refused_avg +
-               a.diagnostics[k].refused_min;
-  }
-  EXPECT_GT(refused, 0);  // candidates were smoothed and measured, not only the kept ones
-}
-
-// cad::CachedFaceGeometry answers what the wrapped surface answers, bit for bit, also when its
-// table is so small that new parameters keep taking the slots of older ones.
-TEST(Cavity, CachedFaceGeometryReturnsTheSurfacesValues) {
-  const test::Sphere sphere(2.0);
-  for (const int bits : {1, 3, 12}) {
-    const cad::CachedFaceGeometry cached(sphere, bits);
-    for (int pass = 0; pass < 3; ++pass)
-      for (int i = 0; i < 40; ++i) {
-        // Parameters that share u or v or differ in their last bits only, and a pole (a zero
-        // normal).
-        const Vec2 uv{0.1 * (i % 5) + 1e-15 * pass, i == 7 ? std::numbers::pi / 2 : 0.03 * (i / 5)};
-        const cad::SurfaceEval x = sphere.eval(uv);
-        for (int again = 0; again < 2; ++again) {
-          const cad::SurfaceEval e = cached.eval(uv);
-          EXPECT_EQ(e.p, x.p);
-          EXPECT_EQ(e.du, x.du);
-          EXPECT_EQ(e.dv, x.dv);
-          EXPECT_EQ(cached.normal(uv), sphere.normal(uv));
-        }
-      }
-    EXPECT_GT(cached.misses(), 0);
-    if (bits == 12) EXPECT_GT(cached.hits(), 0);
-  }
 }
 
 // A memo handed on to a second call on the same mesh: under the same bounds every candidate the
