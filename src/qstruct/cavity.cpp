@@ -2,9 +2,7 @@
 
 #include <algorithm>
 #include <array>
-#include <bit>
 #include <cmath>
-#include <cstdint>
 #include <limits>
 #include <optional>
 #include <string>
@@ -12,7 +10,6 @@
 #include <unordered_map>
 #include <utility>
 
-#include "qsmesh/cad/cached_geometry.hpp"
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/core/timer.hpp"
 #include "qsmesh/mesh/quality.hpp"
@@ -1030,19 +1027,7 @@ mesh::FaceMesh remesh_cavities(const mesh::FaceMesh& input, const cad::FaceGeome
       memo_impl = &memo->impl();
       memo_impl->adopt(options);
     }
-    // The candidates' layouts, smoothings and measures evaluate the surface at the same (u, v)
-    // again and again (the normals of the vertices they keep, the point each smoothing move
-    // starts from): the evaluations are kept, which gives the same values (CachedFaceGeometry).
-    std::optional<cad::CachedFaceGeometry> cached;
-    // About four slots per vertex, so that a small face does not pay for a large table.
-    if (options.cache_surface)
-      cached.emplace(
-          surface,
-          std::clamp(
-              static_cast<int>(std::bit_width(static_cast<std::uint64_t>(work.num_vertices()))) + 2,
-              8, 16));
-    const cad::FaceGeometry& eval_surface = cached ? *cached : surface;
-    Remesher remesher(work, eval_surface, options, sign, memo_impl, solvers);
+    Remesher remesher(work, surface, options, sign, memo_impl, solvers);
     // The growths match the same side counts against the same lists (grid, four, tri, pent,
     // alive for the whole call and, with a memo, for the memo's calls) again and again:
     // match_cache.

@@ -218,10 +218,6 @@ struct CavityOptions {
   /// takes up to 2.4x as long (Block 8.5 -> 16.9 s, A319 3.4 -> 8.1 s; docs/benchmarks.md).
   bool step3_transitions = true;
   int max_rounds = 10;  ///< passes of Steps 1-4 (the loop stops earlier when nothing changes)
-  /// The candidates evaluate the surface through a cad::CachedFaceGeometry: their layouts,
-  /// smoothings and measures ask for the same (u, v) again and again. Same mesh either way (the
-  /// off switch is for the tests that check it).
-  bool cache_surface = true;
   std::array<bool, 4> steps{true, true, true, true};  ///< which of Steps 1-4 run (experiments)
   /// Deterministic work bound: growths started, all steps together (0: none).
   std::int64_t max_cavities = 0;
