@@ -81,7 +81,10 @@ std::vector<int> partition_faces(const Adjacency& face2faces, std::span<const do
   }
   if (!field.empty()) {
     std::vector<idx_t> vwgt(2 * static_cast<std::size_t>(n));
-    for (LO i = 0; i < n; ++i) vwgt[2 * i] = total[i], vwgt[2 * i + 1] = field[i];
+    for (LO i = 0; i < n; ++i) {
+      const auto at = 2 * static_cast<std::size_t>(i);
+      vwgt[at] = total[i], vwgt[at + 1] = field[i];
+    }
     // A refusal (METIS_ERROR_INPUT on a graph it cannot split under both constraints) leaves the
     // one-constraint partition: the run must go on, and the same way on every rank.
     std::vector<int> two(part);
