@@ -838,6 +838,21 @@ double field_divisions(const Arguments& args) {
   return args.field_divisions.value_or(kDefaultFieldDivisions);
 }
 
+parallel::PipelineOptions field_options(const Arguments& args, const Session& s) {
+  parallel::PipelineOptions options;
+  options.background.sizes.size = s.size;
+  options.background.sizes.field_divisions = field_divisions(args);
+  if (args.distributed_threshold)
+    options.crossfield.solver.distributed_threshold = *args.distributed_threshold;
+  if (!args.field_change.empty())
+    options.crossfield.level_change =
+        args.field_change == "rms" ? crossfield::LevelChange::Rms : crossfield::LevelChange::Max;
+  if (args.field_iterations) options.crossfield.max_iterations_per_level = *args.field_iterations;
+  if (args.field_stall) options.crossfield.stall_window = *args.field_stall;
+  if (args.field_stall_ratio) options.crossfield.stall_ratio = *args.field_stall_ratio;
+  return options;
+}
+
 double curvature_edges(const Arguments& args) {
   return args.curvature_edges.value_or(sizemap::SizeMapOptions{}.edges_per_turn);
 }
@@ -941,17 +956,7 @@ int run_mesh(const Arguments& args) {
   check_output_files(args);
 
   Session s(args, "mesh");
-  parallel::PipelineOptions options;
-  options.background.sizes.size = s.size;
-  options.background.sizes.field_divisions = field_divisions(args);
-  if (args.distributed_threshold)
-    options.crossfield.solver.distributed_threshold = *args.distributed_threshold;
-  if (!args.field_change.empty())
-    options.crossfield.level_change =
-        args.field_change == "rms" ? crossfield::LevelChange::Rms : crossfield::LevelChange::Max;
-  if (args.field_iterations) options.crossfield.max_iterations_per_level = *args.field_iterations;
-  if (args.field_stall) options.crossfield.stall_window = *args.field_stall;
-  if (args.field_stall_ratio) options.crossfield.stall_ratio = *args.field_stall_ratio;
+  parallel::PipelineOptions options = field_options(args, s);
   check_request(args, s);
   if (until >= parallel::Stage::Unstructured) apply_size_options(args, s, options);
   s.announce(args, "mesh");

@@ -61,6 +61,10 @@ void apply_size_options(const Arguments& args, const Session& s,
                         parallel::PipelineOptions& options);
 /// The background's field divisions a run uses: --field-divisions, or kDefaultFieldDivisions.
 double field_divisions(const Arguments& args);
+/// The pipeline options every field-computing command shares: the session's size, the field
+/// divisions, and the cross-field options (--distributed-threshold, --field-change,
+/// --field-iterations, --field-stall); the rest at their defaults.
+parallel::PipelineOptions field_options(const Arguments& args, const Session& s);
 /// The curvature edges per turn a run uses: --curvature-edges, or the size map's default.
 double curvature_edges(const Arguments& args);
 /// The feature ratio a run uses: --feature-ratio, or the size map's default.

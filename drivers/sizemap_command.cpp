@@ -81,17 +81,7 @@ int run_sizemap(const Arguments& args) {
 
   Session s(args, "sizemap");
   linalg::SolverLane lane;
-  parallel::PipelineOptions options;
-  options.background.sizes.size = s.size;
-  options.background.sizes.field_divisions = field_divisions(args);
-  if (args.distributed_threshold)
-    options.crossfield.solver.distributed_threshold = *args.distributed_threshold;
-  if (!args.field_change.empty())
-    options.crossfield.level_change =
-        args.field_change == "rms" ? crossfield::LevelChange::Rms : crossfield::LevelChange::Max;
-  if (args.field_iterations) options.crossfield.max_iterations_per_level = *args.field_iterations;
-  if (args.field_stall) options.crossfield.stall_window = *args.field_stall;
-  if (args.field_stall_ratio) options.crossfield.stall_ratio = *args.field_stall_ratio;
+  parallel::PipelineOptions options = field_options(args, s);
   options.size_map = true;
   check_request(args, s);
   apply_size_options(args, s, options);

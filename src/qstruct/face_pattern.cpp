@@ -155,7 +155,7 @@ mesh::FaceMesh build_mesh(LO f, const cad::Face& face, const cad::FaceGeometry& 
   return m;
 }
 
-// The move search's counts and times of `from` added to (or set in) `to`: a face's report covers
+// The move search's counts and times of `from` added to `to`: a face's report covers
 // every search it ran.
 void add_search_counts(PatternFaceReport& to, const PatternFaceReport& from) {
   to.layouts += from.layouts;
@@ -166,17 +166,6 @@ void add_search_counts(PatternFaceReport& to, const PatternFaceReport& from) {
   to.layout_vectors += from.layout_vectors;
   to.lend_ranks = std::max(to.lend_ranks, from.lend_ranks);
   to.vector_lendable = std::max(to.vector_lendable, from.vector_lendable);
-}
-
-void set_search_counts(PatternFaceReport& to, const PatternFaceReport& from) {
-  to.layouts = from.layouts;
-  to.batches = from.batches;
-  to.search_seconds = from.search_seconds;
-  to.layout_seconds = from.layout_seconds;
-  to.layout_batches = from.layout_batches;
-  to.layout_vectors = from.layout_vectors;
-  to.lend_ranks = from.lend_ranks;
-  to.vector_lendable = from.vector_lendable;
 }
 
 // One layout of a candidate: built (Laplace in (u, v)) and smoothed with `smooth`.
@@ -1061,12 +1050,13 @@ mesh::FaceMesh mesh_face_pattern(const cad::CadModel& model, LO f,
         (rep.refusal == Refusal::Quality && second.refusal == Refusal::Quality &&
          !second.refused_mesh.quads.empty() &&
          (rep.refused_mesh.quads.empty() || second.sicn_min > rep.sicn_min));
-    // The search's counts and time cover both attempts (the pattern stage's batched schedule).
-    add_search_counts(second, rep);
+    // The search's counts and time cover both attempts (the pattern stage's batched schedule):
+    // the kept report takes the other's (sums and maxima, so the order does not matter).
     if (second_better) {
+      add_search_counts(second, rep);
       rep = std::move(second);
     } else {
-      set_search_counts(rep, second);
+      add_search_counts(rep, second);
     }
     return out;
   } catch (const Error& e) {

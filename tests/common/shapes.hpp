@@ -14,6 +14,12 @@ namespace qsmesh::test {
 /// exactly the curve's corners.
 mesh::CurveMesh uniform_curve_mesh(const cad::CadModel& model, LO c, LO n);
 
+/// Curve meshes of a planar polygon face (write_polygon_face): counts[k] uniform edges on the
+/// polygon edge from xy[k] to xy[k + 1]. Throws when a curve of `model` is on no polygon edge.
+std::vector<mesh::CurveMesh> polygon_curves(const cad::CadModel& model,
+                                            const std::vector<std::pair<double, double>>& xy,
+                                            const std::vector<LO>& counts);
+
 /// Writes a 10 x 6 x 4 box with a cylindrical hole (radius 1.5) through it, as BREP; returns path.
 std::string write_box_with_hole(const std::string& path);
 /// Writes a cylinder (radius 2, height 5): side face with a seam, two disks.

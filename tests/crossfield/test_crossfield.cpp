@@ -496,10 +496,8 @@ TEST(CrossField, LevelChangeRmsWeighsEdgesByMass) {
                Error);
 }
 
-TEST(CrossField, RmsLevelChangeSolvesLessForTheSameSingularities) {
-  // A plate with holes of several radii: around each hole four -1 singularities settle as the
-  // finest levels creep them cell by cell; the largest change stays large while the rest of the
-  // face has converged.
+// A 6 x 3 plate with six holes of three radii, loaded from `name`.
+cad::CadModel six_hole_plate(const std::string& name) {
   BRepBuilderAPI_MakeFace mk(gp_Pln(gp::XOY()), 0.0, 6.0, 0.0, 3.0);
   const double radius[3] = {0.25, 0.35, 0.45};
   for (int i = 0; i < 3; ++i)
@@ -509,7 +507,14 @@ TEST(CrossField, RmsLevelChangeSolvesLessForTheSameSingularities) {
       mk.Add(TopoDS::Wire(
           BRepBuilderAPI_MakeWire(BRepBuilderAPI_MakeEdge(c).Edge()).Wire().Reversed()));
     }
-  const auto model = test::load_shape(mk.Face(), "cf_holes.brep");
+  return test::load_shape(mk.Face(), name);
+}
+
+TEST(CrossField, RmsLevelChangeSolvesLessForTheSameSingularities) {
+  // A plate with holes of several radii: around each hole four -1 singularities settle as the
+  // finest levels creep them cell by cell; the largest change stays large while the rest of the
+  // face has converged.
+  const auto model = six_hole_plate("cf_holes.brep");
   CrossFieldOptions max_change, rms_change;
   rms_change.level_change = LevelChange::Rms;
   const auto a = run(model, 0, 0.06, "holes-max", max_change);
@@ -557,16 +562,7 @@ TEST(CrossField, LevelStallsWhenItsRmsChangeStopsHalving) {
 TEST(CrossField, StalledLevelsEndEarlyWithTheSameSingularities) {
   // The plate with six holes of RmsLevelChangeSolvesLessForTheSameSingularities: its finest
   // levels creep the -1 singularities around the holes and run to the iteration cap.
-  BRepBuilderAPI_MakeFace mk(gp_Pln(gp::XOY()), 0.0, 6.0, 0.0, 3.0);
-  const double radius[3] = {0.25, 0.35, 0.45};
-  for (int i = 0; i < 3; ++i)
-    for (int j = 0; j < 2; ++j) {
-      const gp_Circ c(gp_Ax2(gp_Pnt(1.0 + 2.0 * i, 0.8 + 1.4 * j, 0), gp_Dir(0, 0, 1)),
-                      radius[(i + j) % 3]);
-      mk.Add(TopoDS::Wire(
-          BRepBuilderAPI_MakeWire(BRepBuilderAPI_MakeEdge(c).Edge()).Wire().Reversed()));
-    }
-  const auto model = test::load_shape(mk.Face(), "cf_holes_stall.brep");
+  const auto model = six_hole_plate("cf_holes_stall.brep");
   CrossFieldOptions plain, stall;
   stall.stall_window = 5;
   const auto a = run(model, 0, 0.06, "holes-max", plain);

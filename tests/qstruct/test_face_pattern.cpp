@@ -25,28 +25,7 @@ using XY = std::vector<std::pair<double, double>>;
 
 std::string tmp(const std::string& name) { return qsmesh::test::tmp_dir() + "/" + name; }
 
-// Curve meshes of a polygon face: counts[k] edges on the polygon edge from xy[k] to xy[k + 1].
-std::vector<mesh::CurveMesh> polygon_curves(const cad::CadModel& model, const XY& xy,
-                                            const std::vector<LO>& counts) {
-  std::vector<mesh::CurveMesh> out;
-  const auto near = [](const Vec3& p, const std::pair<double, double>& q) {
-    return std::abs(p.x - q.first) + std::abs(p.y - q.second) < 1e-9;
-  };
-  for (LO c = 0; c < model.num_curves(); ++c) {
-    const auto& curve = model.curves()[c];
-    const Vec3 a = model.corners()[curve.corners[0]].point,
-               b = model.corners()[curve.corners[1]].point;
-    LO n = 0;
-    for (std::size_t k = 0; k < xy.size(); ++k) {
-      const auto& p = xy[k];
-      const auto& q = xy[(k + 1) % xy.size()];
-      if ((near(a, p) && near(b, q)) || (near(a, q) && near(b, p))) n = counts[k];
-    }
-    if (n == 0) throw std::runtime_error("curve not on the polygon");
-    out.push_back(test::uniform_curve_mesh(model, c, n));
-  }
-  return out;
-}
+using test::polygon_curves;
 
 struct Valences {
   std::map<int, int> interior;  // valence -> interior vertices
