@@ -223,6 +223,11 @@ Arguments parse(const std::vector<std::string>& args) {
       if (!n || !std::isfinite(*n) || *n < 1 || *n > 1000 || *n != std::floor(*n))
         throw InputError(opt + ": '" + v + "' is not a number of iterations in [1, 1000]");
       a.field_iterations = static_cast<int>(*n);
+    } else if (opt == "--field-shortcuts" && meshing) {
+      const std::string& v = value();
+      if (v != "all" && v != "uniform" && v != "none")
+        throw InputError(opt + ": '" + v + "' is not all, uniform or none");
+      a.field_shortcuts = v;
     } else if (opt == "--field-stall" && meshing) {
       // K or K:R.
       const std::string& v = value();
@@ -707,6 +712,11 @@ std::string help(const std::string& topic) {
        << crossfield::CrossFieldOptions{}.stall_window << "; R default "
        << crossfield::CrossFieldOptions{}.stall_ratio
        << ")\n"
+          "  --field-shortcuts S   faces whose cross field is known in closed form take it\n"
+          "                        without a solve: planar faces bounded by lines at right\n"
+          "                        angles, and faces of revolution (cylinders, cones, tori,\n"
+          "                        spheres) bounded by their parallels and meridians. all\n"
+          "                        (default), uniform (the planar ones only) or none\n"
           "  --face-time-budget S  at most S seconds of cavity remeshing (paper 000 Sec. 6.2) per\n"
           "                        face; a face that reaches it keeps the mesh it has (valid) and "
           "is\n"
@@ -764,7 +774,8 @@ std::string help(const std::string& topic) {
           "                        with the line 'euler-consistent: K/N'\n"
           "  --size H, --size-factor F, --threads T, --stats FILE.json, --max-quads N,\n"
           "  --field-divisions N, --distributed-threshold N, --field-change M,\n"
-          "  --field-iterations N, --field-stall K[:R], --sew, -q, -v: as for mesh\n";
+          "  --field-iterations N, --field-stall K[:R], --field-shortcuts S, --sew, -q, -v:\n"
+          "                        as for mesh\n";
   } else if (topic == "sizemap") {
     os << "usage: [mpirun -np P] qsmesh sizemap MODEL -o OUT.vtu [options]\n\n"
           "Computes the size map (paper 000 Sec. 4.1-4.2) and the curve quantization (Sec. 4.3):\n"
@@ -826,7 +837,8 @@ std::string help(const std::string& topic) {
           "                        size constraints at corners, on curves, on faces (model units)\n"
           "  --size H, --size-factor F, --threads T, --stats FILE.json, --max-quads N,\n"
           "  --field-divisions N, --distributed-threshold N, --field-change M,\n"
-          "  --field-iterations N, --field-stall K[:R], --sew, -q, -v: as for mesh\n";
+          "  --field-iterations N, --field-stall K[:R], --field-shortcuts S, --sew, -q, -v:\n"
+          "                        as for mesh\n";
   } else if (topic == "example") {
     os << "usage: qsmesh example NAME -o FILE\n\n"
           "Writes a built-in CAD model built with OpenCASCADE, as STEP (FILE.step, .stp) or BREP\n"

@@ -144,6 +144,9 @@ struct Arguments {
   std::optional<int> field_stall;
   /// the R of --field-stall K:R (crossfield::CrossFieldOptions::stall_ratio); unset: its default.
   std::optional<double> field_stall_ratio;
+  /// --field-shortcuts: "all" (default), "uniform" or "none" (crossfield::CrossFieldOptions::
+  /// exact_uniform and exact_revolution); empty: unset.
+  std::string field_shortcuts;
   bool sew = false;
   bool quiet = false;
   bool verbose = false;

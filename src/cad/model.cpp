@@ -122,6 +122,74 @@ bool planar_with_right_angle_lines(const CadModel& model, LO f) {
   return !first;
 }
 
+std::optional<RevolutionAxis> revolution_axis(const CadModel& model, LO f) {
+  QSMESH_CHECK(f >= 0 && f < model.num_faces(), "face " << f << " out of range");
+  const BRepAdaptor_Surface s(model.impl().faces[static_cast<std::size_t>(f)]);
+  gp_Ax1 axis;
+  bool cylinder = false;
+  switch (s.GetType()) {
+    case GeomAbs_Cylinder:
+      axis = s.Cylinder().Axis();
+      cylinder = true;
+      break;
+    case GeomAbs_Cone:
+      axis = s.Cone().Axis();
+      break;
+    case GeomAbs_Sphere:
+      axis = s.Sphere().Position().Axis();
+      break;
+    case GeomAbs_Torus:
+      axis = s.Torus().Axis();
+      break;
+    case GeomAbs_SurfaceOfRevolution:
+      axis = s.AxeOfRevolution();
+      break;
+    default:
+      return std::nullopt;
+  }
+  const gp_Pnt& p = axis.Location();
+  const gp_Dir& d = axis.Direction();
+  return RevolutionAxis{{p.X(), p.Y(), p.Z()}, {d.X(), d.Y(), d.Z()}, cylinder};
+}
+
+bool revolution_with_iso_lines(const CadModel& model, LO f) {
+  const auto axis = revolution_axis(model, f);
+  if (!axis) return false;
+  const Face& face = model.faces()[static_cast<std::size_t>(f)];
+  const Box3& box = face.box;
+  const double tol = 1e-6 * norm(box.hi - box.lo);
+  const Vec3 a = axis->direction;
+  bool any = false;
+  for (const Loop& loop : face.loops)
+    for (const CurveUse& use : loop.uses) {
+      const Curve& curve = model.curves()[static_cast<std::size_t>(use.curve)];
+      if (curve.degenerate) return false;
+      const BRepAdaptor_Curve c(model.impl().edges[static_cast<std::size_t>(use.curve)]);
+      std::array<Vec3, 5> q;
+      for (int k = 0; k < 5; ++k) {
+        const gp_Pnt p =
+            c.Value(c.FirstParameter() + (c.LastParameter() - c.FirstParameter()) * double(k) / 4);
+        q[static_cast<std::size_t>(k)] = Vec3{p.X(), p.Y(), p.Z()} - axis->point;
+      }
+      // A parallel: every point at the first one's height along the axis and distance from it.
+      const auto height = [&](const Vec3& v) { return dot(v, a); };
+      const auto radius = [&](const Vec3& v) { return norm(v - a * dot(v, a)); };
+      bool parallel = true, meridian = true;
+      // A meridian: every point in the plane through the axis and the first point off it.
+      const Vec3 r0 = q[0] - a * dot(q[0], a);
+      const Vec3 side = norm(r0) > tol ? normalized(cross(a, r0)) : Vec3{0, 0, 0};
+      for (const Vec3& v : q) {
+        parallel = parallel && std::abs(height(v) - height(q[0])) <= tol &&
+                   std::abs(radius(v) - radius(q[0])) <= tol;
+        meridian = meridian && norm(side) > 0 && std::abs(dot(v, side)) <= tol &&
+                   dot(v - a * dot(v, a), r0) >= 0;
+      }
+      if (!parallel && !meridian) return false;
+      any = true;
+    }
+  return any;
+}
+
 namespace {
 
 Vec3 to_vec(const gp_Pnt& p) { return {p.X(), p.Y(), p.Z()}; }

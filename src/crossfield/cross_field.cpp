@@ -6,19 +6,31 @@
 namespace qsmesh::crossfield {
 
 FaceCrossField compute_face_cross_field(const mesh::FaceMesh& background,
-                                        const CrossFieldOptions& options,
-                                        linalg::SolverLane* lane) {
+                                        const CrossFieldOptions& options, linalg::SolverLane* lane,
+                                        const std::optional<cad::RevolutionAxis>& axis) {
   const auto start = std::chrono::steady_clock::now();
   FaceCrossField cf;
   cf.face = background.face;
   glue_triangulation(background, cf);
   const detail::Geometry g = detail::compute_geometry(cf);
   const bool uniform = options.exact_uniform && detail::set_exact_uniform_field(cf, g);
-  if (!uniform) detail::diffuse(cf, g, options, lane);
+  bool revolution = !uniform && options.exact_revolution && axis.has_value() &&
+                    detail::set_revolution_field(cf, g, *axis);
+  if (!uniform && !revolution) detail::diffuse(cf, g, options, lane);
   detail::compute_directions(cf, g);
   detail::find_singularities(cf, g, options);
-  if (uniform) {
-    // A constant cross on a plane does not rotate: the right-hand side of Eq. 9 is zero.
+  if (revolution && (!cf.singularities.empty() || !cf.euler.consistent)) {
+    // The parallels' cross turns around a pole inside the face, or does not fit its corners: the
+    // shortcut does not hold, the face is solved as any other.
+    revolution = false;
+    cf.stats.solver.clear();
+    detail::diffuse(cf, g, options, lane);
+    detail::compute_directions(cf, g);
+    detail::find_singularities(cf, g, options);
+  }
+  if (uniform || (revolution && axis->cylinder)) {
+    // A constant cross on a plane, or the parallels' cross on a cylinder (developable: unrolled,
+    // it is constant), does not rotate: the right-hand side of Eq. 9 is zero.
     cf.H.assign(cf.points.size(), 0.0);
     cf.h.assign(cf.points.size(), 1.0);
   } else {

@@ -335,6 +335,46 @@ bool set_exact_uniform_field(FaceCrossField& cf, const Geometry& g) {
   return true;
 }
 
+bool set_revolution_field(FaceCrossField& cf, const Geometry& g, const cad::RevolutionAxis& axis) {
+  const std::size_t ne = cf.edges.size();
+  if (ne == 0 || !(g.diagonal > 0) || !(norm(axis.direction) > 0)) return false;
+  const Vec3 a = normalized(axis.direction);
+  // The parallel through x runs along a x (x - o); its length is x's distance from the axis.
+  const double near_axis = 1e-6 * g.diagonal;
+  std::vector<Vec2> u(ne);
+  bool has_boundary = false;
+  for (std::size_t e = 0; e < ne; ++e) {
+    const Vec3 p0 = cf.points[cf.edges[e][0]], p1 = cf.points[cf.edges[e][1]];
+    const Vec3 c = cross(a, (p0 + p1) * 0.5 - axis.point);
+    if (!(norm(c) > near_axis)) return false;
+    // The edge's tangent plane: the mean of its triangles' (the hinge between them).
+    const auto& tris = g.edge2tris[e];
+    Vec3 n = g.normal[tris[0]];
+    if (tris[1] != kNoIndex) n = n + g.normal[tris[1]];
+    if (!(norm(n) > 0)) return false;
+    n = normalized(n);
+    const Vec3 f = c - n * dot(c, n);
+    if (!(norm(f) > 0.5 * norm(c))) return false;  // the parallel leaves the surface's plane
+    const Vec3 d = normalized(p1 - p0);
+    // θ of the parallel's cross from the edge, positive around the normal (FaceCrossField::u).
+    const double theta = std::atan2(dot(cross(d, f), n), dot(d, f));
+    if (cf.boundary_edge[e]) {
+      if (std::abs(wrap_angle(4 * theta)) > 1e-4) return false;
+      u[e] = {1, 0};  // exactly as the Dirichlet data of diffuse()
+      has_boundary = true;
+    } else {
+      u[e] = {std::cos(4 * theta), std::sin(4 * theta)};
+    }
+  }
+  if (!has_boundary) return false;
+  cf.u = std::move(u);
+  cf.u_norm.assign(ne, 1.0);
+  cf.fixed_edge.assign(ne, 0);
+  for (std::size_t e = 0; e < ne; ++e) cf.fixed_edge[e] = cf.boundary_edge[e];
+  cf.stats.solver = "exact revolution";
+  return true;
+}
+
 void compute_directions(FaceCrossField& cf, const Geometry& g) {
   cf.directions.resize(cf.triangles.size());
   for (std::size_t t = 0; t < cf.triangles.size(); ++t) {

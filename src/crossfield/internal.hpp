@@ -52,6 +52,11 @@ void diffuse(FaceCrossField& cf, const Geometry& g, const CrossFieldOptions& opt
 /// and stats as diffuse() would, and returns true; otherwise leaves cf untouched and returns
 /// false. A face without boundary never qualifies.
 bool set_exact_uniform_field(FaceCrossField& cf, const Geometry& g);
+/// CrossFieldOptions::exact_revolution: when every boundary edge lies along the parallel through
+/// its midpoint or across it (within 1e-4 rad on 4x the angle) and no edge midpoint lies on the
+/// axis, fills u (the cross of the parallels, seen in every edge frame), u_norm, fixed_edge and
+/// stats as diffuse() would, and returns true; otherwise leaves cf untouched and returns false.
+bool set_revolution_field(FaceCrossField& cf, const Geometry& g, const cad::RevolutionAxis& axis);
 
 /// Branches of the cross at each triangle barycentre. Fills directions.
 void compute_directions(FaceCrossField& cf, const Geometry& g);

@@ -42,13 +42,14 @@ void mesh_background(FaceTask& task, const cad::CadModel& model,
                      const background::BackgroundOptions& options) {
   task.background =
       background::mesh_face_background(model, task.face, curves, options, &task.background_report);
+  task.axis = cad::revolution_axis(model, task.face);
 }
 
 void compute_cross_field(FaceTask& task, const crossfield::CrossFieldOptions& options,
                          bool summarize_field, bool keep, linalg::SolverLane* lane) {
   try {
     auto cf = std::make_unique<crossfield::FaceCrossField>(
-        crossfield::compute_face_cross_field(task.background, options, lane));
+        crossfield::compute_face_cross_field(task.background, options, lane, task.axis));
     if (summarize_field)
       task.field_summary = summarize(*cf);
     else

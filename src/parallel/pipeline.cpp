@@ -56,18 +56,24 @@ std::vector<double> estimate_face_costs(const cad::CadModel& model, double size)
 }
 
 std::vector<double> estimate_field_costs(const cad::CadModel& model, double size,
-                                         bool exact_uniform) {
+                                         bool exact_uniform, bool exact_revolution) {
   std::vector<double> cost = estimate_face_costs(model, size);
-  if (exact_uniform)
-    for (LO f = 0; f < model.num_faces(); ++f)
-      if (cad::planar_with_right_angle_lines(model, f)) cost[static_cast<std::size_t>(f)] = 0;
+  for (LO f = 0; f < model.num_faces(); ++f) {
+    double& c = cost[static_cast<std::size_t>(f)];
+    if (exact_uniform && cad::planar_with_right_angle_lines(model, f)) {
+      c = 0;
+    } else if (exact_revolution && cad::revolution_with_iso_lines(model, f)) {
+      c = cad::revolution_axis(model, f)->cylinder ? 0 : c / 10;
+    }
+  }
   return cost;
 }
 
 std::vector<int> partition_model_faces(const cad::CadModel& model, double size, int nranks,
-                                       bool exact_uniform) {
+                                       bool exact_uniform, bool exact_revolution) {
   return partition_faces(model.face2faces(), estimate_face_costs(model, size),
-                         estimate_field_costs(model, size, exact_uniform), nranks);
+                         estimate_field_costs(model, size, exact_uniform, exact_revolution),
+                         nranks);
 }
 
 namespace {
@@ -1150,8 +1156,9 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
   // Faces: METIS partition balancing the estimated cost and the estimated cross-field cost. Each
   // face of this rank is one record (FaceTask) that the stages below fill in turn.
   clock.start();
-  result.face_rank = partition_model_faces(model, options.background.sizes.size, nranks,
-                                           options.crossfield.exact_uniform);
+  result.face_rank =
+      partition_model_faces(model, options.background.sizes.size, nranks,
+                            options.crossfield.exact_uniform, options.crossfield.exact_revolution);
   // A smooth group is meshed as one surface: its faces go to the rank of its first face (the
   // partition is the same on every rank, so is this).
   const bool by_groups =

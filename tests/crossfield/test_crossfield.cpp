@@ -1,11 +1,16 @@
 // Cross field of single faces built with OpenCASCADE (paper 000 Sec. 3.1-3.3).
 #include <gtest/gtest.h>
 
+#include <BRepAlgoAPI_Cut.hxx>
 #include <BRepBuilderAPI_MakeEdge.hxx>
 #include <BRepBuilderAPI_MakeFace.hxx>
 #include <BRepBuilderAPI_MakePolygon.hxx>
 #include <BRepBuilderAPI_MakeWire.hxx>
+#include <BRepPrimAPI_MakeBox.hxx>
+#include <BRepPrimAPI_MakeCone.hxx>
+#include <BRepPrimAPI_MakeCylinder.hxx>
 #include <BRepPrimAPI_MakeSphere.hxx>
+#include <BRepPrimAPI_MakeTorus.hxx>
 #include <BRepTools.hxx>
 #include <GC_MakeArcOfCircle.hxx>
 #include <TopoDS.hxx>
@@ -16,6 +21,7 @@
 #include <gp_Pln.hxx>
 #include <gp_Trsf.hxx>
 #include <numbers>
+#include <optional>
 #include <span>
 #include <stdexcept>
 
@@ -45,7 +51,8 @@ struct Result {
   FaceCrossField cf;
 };
 Result run(const cad::CadModel& model, LO f, double size, const char* label,
-           const CrossFieldOptions& cf_options = {}) {
+           const CrossFieldOptions& cf_options = {},
+           const std::optional<cad::RevolutionAxis>& axis = std::nullopt) {
   background::BackgroundOptions options;
   options.sizes.size = size;
   const TaskArena tasks(1);
@@ -55,7 +62,7 @@ Result run(const cad::CadModel& model, LO f, double size, const char* label,
   r.background = background::mesh_face_background(model, f, curves, options, &report);
   EXPECT_TRUE(report.ok) << report.error;
   EXPECT_FALSE(report.fell_back) << report.error;
-  r.cf = compute_face_cross_field(r.background, cf_options, nullptr);
+  r.cf = compute_face_cross_field(r.background, cf_options, nullptr, axis);
   const auto& s = r.cf.stats;
   std::printf("[crossfield] %-10s %6zu triangles  %.3f s  levels %d  solves %d  iterations", label,
               r.cf.triangles.size(), s.seconds, s.levels, s.solves);
@@ -584,6 +591,101 @@ TEST(CrossField, StalledLevelsEndEarlyWithTheSameSingularities) {
   // Measured: 200 solves (50 at every level) against 49 (15 9 9 16, every level stalled), the
   // same 24 singularities, 8795 of 10160 triangles within 1 degree (87%).
   EXPECT_GT(double(close), 0.8 * double(a.cf.directions.size()));
+}
+
+// A face on a surface of revolution cut along its parallels and meridians takes the cross of the
+// parallels without a solve; it matches the solved field to the discretisation, and on a cylinder
+// its scaling is exactly zero. A face where that cross would not fit (a pole inside, a boundary
+// across the parallels) is solved.
+TEST(CrossField, RevolutionShortcutMatchesTheSolvedField) {
+  struct Case {
+    const char* label;
+    TopoDS_Shape shape;
+    cad::SurfaceType type;
+    double size;
+    bool solved_has_no_singularity;  // false: the diffusion adds +- pairs, so no comparison
+  };
+  const gp_Ax2 z(gp_Pnt(1, -2, 0.5), gp_Dir(0.2, 0.1, 1));
+  const Case cases[] = {
+      {"rev-cyl-part", BRepPrimAPI_MakeCylinder(z, 2, 5, 2.0).Shape(), cad::SurfaceType::Cylinder,
+       0.2, true},
+      {"rev-cyl-full", BRepPrimAPI_MakeCylinder(z, 2, 5).Shape(), cad::SurfaceType::Cylinder, 0.2,
+       true},
+      {"rev-cone", BRepPrimAPI_MakeCone(z, 3, 1, 4).Shape(), cad::SurfaceType::Cone, 0.2, true},
+      // A quarter of a torus tube: the diffusion puts 2 + and 2 - singularities on it (its
+      // levels end at the iteration cap); the parallels' cross is the structured choice.
+      {"rev-torus", BRepPrimAPI_MakeTorus(z, 4, 1.5, kPi / 2).Shape(), cad::SurfaceType::Torus, 0.2,
+       false},
+  };
+  for (const Case& c : cases) {
+    const auto model = test::load_shape(c.shape, std::string("cf_") + c.label + ".brep");
+    const LO f = face_of_type(model, c.type);
+    const auto axis = cad::revolution_axis(model, f);
+    ASSERT_TRUE(axis.has_value()) << c.label;
+    CrossFieldOptions solved;
+    solved.exact_revolution = false;
+    const auto fast = run(model, f, c.size, c.label, {}, axis);
+    const auto slow = run(model, f, c.size, c.label, solved, axis);
+    EXPECT_EQ(fast.cf.stats.solver, "exact revolution") << c.label;
+    EXPECT_EQ(fast.cf.stats.factorizations, 0) << c.label;
+    EXPECT_NE(slow.cf.stats.solver, "exact revolution") << c.label;
+    EXPECT_TRUE(fast.cf.singularities.empty()) << c.label;
+    EXPECT_EQ(slow.cf.singularities.empty(), c.solved_has_no_singularity) << c.label;
+    EXPECT_TRUE(fast.cf.euler.consistent) << c.label;
+    ASSERT_EQ(fast.cf.directions.size(), slow.cf.directions.size());
+    // The fast field against the parallels themselves, and against the solved field.
+    const Vec3 a = normalized(axis->direction);
+    double worst_parallel = 0, worst_apart = 0, mean_apart = 0;
+    for (std::size_t t = 0; t < fast.cf.directions.size(); ++t) {
+      const auto& tri = fast.cf.triangles[t];
+      const Vec3 x = (fast.cf.points[tri[0]] + fast.cf.points[tri[1]] + fast.cf.points[tri[2]]) / 3;
+      const Vec3 n = normalized(cross(fast.cf.points[tri[1]] - fast.cf.points[tri[0]],
+                                      fast.cf.points[tri[2]] - fast.cf.points[tri[0]]));
+      Vec3 p = cross(a, x - axis->point);
+      p = normalized(p - n * dot(p, n));
+      worst_parallel =
+          std::max(worst_parallel, cross_deviation_deg(fast.cf.directions[t], p, cross(n, p)));
+      const double apart = cross_deviation_deg(fast.cf.directions[t], slow.cf.directions[t][0],
+                                               slow.cf.directions[t][1]);
+      worst_apart = std::max(worst_apart, apart);
+      mean_apart += apart / static_cast<double>(fast.cf.directions.size());
+    }
+    double worst_h = 0, h_range = 0;
+    for (std::size_t v = 0; v < fast.cf.H.size(); ++v) {
+      worst_h = std::max(worst_h, std::abs(fast.cf.H[v] - slow.cf.H[v]));
+      h_range = std::max(h_range, std::abs(fast.cf.H[v] - fast.cf.H[0]));
+    }
+    std::printf(
+        "[crossfield] %s: off the parallels by %.2e deg; off the solved field by %.3f deg (mean "
+        "%.4f); H spans %.3f, apart by %.2e\n",
+        c.label, worst_parallel, worst_apart, mean_apart, h_range, worst_h);
+    EXPECT_LT(worst_parallel, 0.5) << c.label;
+    if (axis->cylinder) {
+      for (double h : fast.cf.H) EXPECT_EQ(h, 0.0) << c.label;
+    } else {
+      EXPECT_GT(h_range, 0.1) << c.label;  // the parallels shrink toward the axis
+    }
+    if (!c.solved_has_no_singularity) continue;
+    EXPECT_LT(worst_apart, 1.0) << c.label;
+    EXPECT_LT(mean_apart, 0.2) << c.label;
+    EXPECT_LT(worst_h, 0.05) << c.label;
+  }
+
+  // Solved: a sphere octant (its pole is a corner, the face needs a +1 singularity inside) and a
+  // cylinder cut by an oblique plane (an ellipse across the parallels).
+  const auto octant = cad::load_cad(test::write_sphere_octant(tmp("cf_rev_octant.brep")));
+  const LO fo = face_of_type(octant, cad::SurfaceType::Sphere);
+  const auto r = run(octant, fo, 0.2, "rev-octant", {}, cad::revolution_axis(octant, fo));
+  EXPECT_NE(r.cf.stats.solver, "exact revolution");
+  EXPECT_TRUE(r.cf.euler.consistent);
+  const TopoDS_Shape cut = BRepAlgoAPI_Cut(
+      BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), 2, 5).Shape(),
+      BRepPrimAPI_MakeBox(gp_Ax2(gp_Pnt(-5, -5, 3), gp_Dir(0.3, 0, 1)), 10, 10, 10).Shape());
+  const auto slanted = test::load_shape(cut, "cf_rev_slanted.brep");
+  const LO fs = face_of_type(slanted, cad::SurfaceType::Cylinder);
+  EXPECT_NE(
+      run(slanted, fs, 0.2, "rev-slanted", {}, cad::revolution_axis(slanted, fs)).cf.stats.solver,
+      "exact revolution");
 }
 
 }  // namespace

@@ -96,6 +96,18 @@ TEST(Cli, FieldStall) {
   EXPECT_NE(help("mesh").find("--field-stall"), std::string::npos);
 }
 
+TEST(Cli, FieldShortcuts) {
+  EXPECT_TRUE(p({"mesh", "m.step", "-o", "o.vtu"}).field_shortcuts.empty());
+  for (const char* v : {"all", "uniform", "none"})
+    EXPECT_EQ(p({"mesh", "m.step", "-o", "o.vtu", "--field-shortcuts", v}).field_shortcuts, v);
+  EXPECT_EQ(p({"crossfield", "m.step", "--check", "--field-shortcuts", "none"}).field_shortcuts,
+            "none");
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--field-shortcuts", "some"})
+                .find("--field-shortcuts"),
+            std::string::npos);
+  EXPECT_NE(help("mesh").find("--field-shortcuts"), std::string::npos);
+}
+
 TEST(Cli, CrossFieldAndSeparatrixMethod) {
   const Arguments a =
       p({"mesh", "m.step", "-o", "o.vtu", "--cross-field", "f.txt", "--method", "separatrix"});

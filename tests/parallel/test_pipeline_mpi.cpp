@@ -305,8 +305,8 @@ TEST(Pipeline, CrossFieldsDoNotDependOnRanks) {
   for (LO f = 0; f < model.num_faces(); ++f) {
     const auto face =
         background::mesh_face_background(model, f, curves, options.background, nullptr);
-    const CrossFieldOutput serial =
-        summarize(crossfield::compute_face_cross_field(face, options.crossfield, nullptr));
+    const CrossFieldOutput serial = summarize(crossfield::compute_face_cross_field(
+        face, options.crossfield, nullptr, cad::revolution_axis(model, f)));
     const CrossFieldOutput& dist = result.cross_fields[f];
     ASSERT_TRUE(dist.ok) << dist.error;
     ASSERT_EQ(dist.directions.size(), serial.directions.size());
@@ -356,7 +356,8 @@ void check_size_map(const Comm& comm, const cad::CadModel& model, double size,
   sizemap::CurveSizes united = initial;
   for (LO f = 0; f < model.num_faces(); ++f) {
     const auto bg = background::mesh_face_background(model, f, curves, options.background, nullptr);
-    const auto cf = crossfield::compute_face_cross_field(bg, options.crossfield, nullptr);
+    const auto cf = crossfield::compute_face_cross_field(bg, options.crossfield, nullptr,
+                                                         cad::revolution_axis(model, f));
     const auto fs = sizemap::face_sizes(bg, &cf, curves, initial, targets[f], options.sizemap);
     sizemap::fold_boundary_min(bg, fs.s, united);
   }

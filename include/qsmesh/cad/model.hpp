@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <functional>
 #include <memory>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
@@ -168,6 +169,29 @@ class CadModel {
 /// shortcut's own test on the sampled boundary edges. A face without curves is false. Reads the
 /// lines' directions from the CAD (OpenCASCADE); thread-safe, the same answer on every rank.
 [[nodiscard]] bool planar_with_right_angle_lines(const CadModel& model, LO f);
+
+/// The axis of a surface of revolution, in model units.
+struct RevolutionAxis {
+  Vec3 point;      ///< a point of the axis
+  Vec3 direction;  ///< unit direction of the axis
+  /// The surface is a circular cylinder: developable, and the field along its parallels is
+  /// parallel (it does not rotate), so the cross field's conformal scaling H is exactly 0.
+  bool cylinder = false;
+};
+
+/// The axis of face f when its surface is one of revolution: a circular cylinder, a cone, a sphere
+/// (the axis of its parametrisation, through its poles), a torus or a surface of revolution;
+/// nullopt otherwise (planes included: planar_with_right_angle_lines covers them). With the
+/// location of the face applied. Thread-safe, the same answer on every rank.
+[[nodiscard]] std::optional<RevolutionAxis> revolution_axis(const CadModel& model, LO f);
+
+/// Whether face f lies on a surface of revolution (revolution_axis) and every curve of its loops is
+/// a parallel (a circle about the axis) or a meridian (a curve in a plane through the axis), none
+/// degenerate: the crossfield stage's revolution shortcut (CrossFieldOptions::exact_revolution)
+/// then gives the face its field without a diffusion solve. From 5 points of each curve, each
+/// within 1e-6 of the face's diagonal of the parallel or meridian through the first. A prediction
+/// for the partition's cost estimate: the shortcut itself checks the sampled boundary.
+[[nodiscard]] bool revolution_with_iso_lines(const CadModel& model, LO f);
 
 /// Reads a STEP (.step, .stp), IGES (.iges, .igs) or BREP (.brep, .brp) file and builds the
 /// topology. Entity ids follow OpenCASCADE's unique-shape maps (TopExp::MapShapes order), so they

@@ -6,10 +6,12 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <string>
 #include <vector>
 
+#include "qsmesh/cad/model.hpp"
 #include "qsmesh/core/types.hpp"
 #include "qsmesh/linalg/solver.hpp"
 #include "qsmesh/mesh/surface_mesh.hpp"
@@ -73,6 +75,19 @@ struct CrossFieldOptions {
   /// solve (stats.solver "exact uniform", no level); the solved field differs from it by rounding
   /// only (test CrossField.UniformShortcutEqualsTheSolvedField). false: always solve.
   bool exact_uniform = true;
+  /// A face on a surface of revolution (compute_face_cross_field's `axis`) whose sampled boundary
+  /// edges all lie along the parallels or the meridians (a cylinder, cone, torus or sphere patch
+  /// cut along them, a hole's wall, a fillet) takes the cross of the parallels and meridians
+  /// without a diffusion solve (stats.solver "exact revolution"). Among the boundary-aligned
+  /// fields without singularities it is the exact continuous minimiser of the smoothness energy:
+  /// it is harmonic (the connection form of the orthogonal frame of a surface of revolution is
+  /// divergence-free), and on a cylinder it is parallel, so H = 0 there without a solve; elsewhere
+  /// the scaling is solved as usual. The face falls back to the diffusion when the field has a
+  /// singularity (a pole inside) or breaks the Euler relation. On cylinders and cones the solved
+  /// field differs from it by the discretisation only; on a torus tube the diffusion may add
+  /// +- pairs where it gets no structured grid (test
+  /// CrossField.RevolutionShortcutMatchesTheSolvedField). false: always solve.
+  bool exact_revolution = true;
   linalg::SolverOptions solver;
 };
 
@@ -142,10 +157,11 @@ struct FaceCrossField {
 /// background::mesh_face_background, triangles oriented along the face normal); `lane` may be null
 /// (Eigen). A face without boundary (closed surface, e.g. a full sphere) has no Dirichlet data and
 /// starts from a fixed direction projected on the surface. Throws qsmesh::Error on an empty mesh
-/// or a solver failure; the caller logs the face and falls back.
-[[nodiscard]] FaceCrossField compute_face_cross_field(const mesh::FaceMesh& background,
-                                                      const CrossFieldOptions& options,
-                                                      linalg::SolverLane* lane);
+/// or a solver failure; the caller logs the face and falls back. `axis`: the face's axis when it
+/// lies on a surface of revolution (cad::revolution_axis), for CrossFieldOptions::exact_revolution.
+[[nodiscard]] FaceCrossField compute_face_cross_field(
+    const mesh::FaceMesh& background, const CrossFieldOptions& options, linalg::SolverLane* lane,
+    const std::optional<cad::RevolutionAxis>& axis = std::nullopt);
 
 /// The constant C of Sec. 3.3 giving about n_quads quads: C = -1/2 ln(N / ∫ e^{-2H}), the integral
 /// over the glued triangulation (per triangle, the mean of e^{-2H} at its vertices times its area).

@@ -299,6 +299,9 @@ struct RefusedFill {
 struct FaceTask {
   LO face = kNoIndex;
   mesh::FaceMesh background;  ///< background triangulation (Sec. 3.1)
+  /// The face's axis when it lies on a surface of revolution (cad::revolution_axis), for the
+  /// cross field's revolution shortcut; set with the background.
+  std::optional<cad::RevolutionAxis> axis;
   background::FaceReport background_report;
   CrossFieldOutput field_summary;  ///< when the driver asked for cross fields, or the error met
   std::unique_ptr<crossfield::FaceCrossField> cross_field;  ///< null: none (or released)
@@ -326,7 +329,7 @@ struct FaceTask {
 };
 
 /// Background triangulation of task.face (background::mesh_face_background) into task.background
-/// and task.background_report.
+/// and task.background_report, and task.axis.
 void mesh_background(FaceTask& task, const cad::CadModel& model,
                      std::span<const mesh::CurveMesh> curves,
                      const background::BackgroundOptions& options);

@@ -275,14 +275,18 @@ struct PipelineResult {
 /// Estimated cost of each face's crossfield stage (cross field, singularities, scaling), the
 /// partition's second balance constraint: area / size^2 as estimate_face_costs, but about nothing
 /// (0) for a face that takes the exact-uniform shortcut (cad::planar_with_right_angle_lines) when
-/// `exact_uniform` (CrossFieldOptions::exact_uniform) is on. From the CAD model alone, so it is
-/// known before the background stage and the same on every rank.
+/// `exact_uniform` (CrossFieldOptions::exact_uniform) is on, or the revolution shortcut on a
+/// cylinder (cad::revolution_with_iso_lines) when `exact_revolution` is; a tenth of it on the
+/// other surfaces of revolution that take it (the scaling's one vertex-based solve is left). From
+/// the CAD model alone, so it is known before the background stage and the same on every rank.
 [[nodiscard]] std::vector<double> estimate_field_costs(const cad::CadModel& model, double size,
-                                                       bool exact_uniform = true);
+                                                       bool exact_uniform = true,
+                                                       bool exact_revolution = true);
 
 /// The faces over `nranks` ranks as run_pipeline partitions them: partition_faces with both
 /// estimates (also `qsmesh info --partition`, which scripts/simulate_scaling.py replays).
 [[nodiscard]] std::vector<int> partition_model_faces(const cad::CadModel& model, double size,
-                                                     int nranks, bool exact_uniform = true);
+                                                     int nranks, bool exact_uniform = true,
+                                                     bool exact_revolution = true);
 
 }  // namespace qsmesh::parallel
