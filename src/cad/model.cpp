@@ -18,6 +18,7 @@
 #include <TopoDS_Wire.hxx>
 #include <algorithm>
 #include <cmath>
+#include <gp_Circ.hxx>
 #include <gp_Vec.hxx>
 #include <numbers>
 #include <utility>
@@ -128,6 +129,30 @@ std::optional<RevolutionAxis> revolution_axis(const CadModel& model, LO f) {
   gp_Ax1 axis;
   bool cylinder = false;
   switch (s.GetType()) {
+    case GeomAbs_Plane: {
+      // A plane is a surface of revolution about any normal line: about the common centre of
+      // its circles, if they have one (a washer, a flange's face around a bore, an annular
+      // sector).
+      const gp_Dir normal = s.Plane().Axis().Direction();
+      const Face& face = model.faces()[static_cast<std::size_t>(f)];
+      const double tol = 1e-6 * face.box.diagonal();
+      std::optional<gp_Pnt> centre;
+      for (const Loop& loop : face.loops)
+        for (const CurveUse& use : loop.uses) {
+          const BRepAdaptor_Curve c(model.impl().edges[static_cast<std::size_t>(use.curve)]);
+          if (c.GetType() != GeomAbs_Circle) continue;
+          const gp_Circ circle = c.Circle();
+          if (!circle.Axis().Direction().IsParallel(normal, 1e-9)) return std::nullopt;
+          if (!centre) {
+            centre = circle.Location();
+          } else if (centre->Distance(circle.Location()) > tol) {
+            return std::nullopt;
+          }
+        }
+      if (!centre) return std::nullopt;
+      axis = gp_Ax1(*centre, normal);
+      break;
+    }
     case GeomAbs_Cylinder:
       axis = s.Cylinder().Axis();
       cylinder = true;

@@ -24,7 +24,7 @@ double off_axis(const RevolutionAxis& axis, const Vec3& p) {
   return norm(d - axis.direction * dot(d, axis.direction));
 }
 
-TEST(RevolutionFaces, DrilledHoleWallQualifiesAndThePlanesHaveNoAxis) {
+TEST(RevolutionFaces, DrilledHoleWallQualifiesAndThePlanesDoNot) {
   const TopoDS_Shape box = BRepPrimAPI_MakeBox(10, 10, 3).Shape();
   const TopoDS_Shape drill =
       BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(5, 5, -1), gp_Dir(0, 0, 1)), 2, 5).Shape();
@@ -33,7 +33,9 @@ TEST(RevolutionFaces, DrilledHoleWallQualifiesAndThePlanesHaveNoAxis) {
   for (LO f = 0; f < m.num_faces(); ++f) {
     const auto axis = revolution_axis(m, f);
     if (m.faces()[f].type == SurfaceType::Plane) {
-      EXPECT_FALSE(axis.has_value()) << "face " << f;
+      // The sides have no circle, so no axis; the top and bottom have the hole's, but their
+      // square sides are neither parallels nor meridians of it.
+      EXPECT_EQ(axis.has_value(), m.faces()[f].loops.size() == 2) << "face " << f;
       EXPECT_FALSE(revolution_with_iso_lines(m, f)) << "face " << f;
       continue;
     }
@@ -77,6 +79,35 @@ TEST(RevolutionFaces, ConeTorusAndSphereBeltQualify) {
     }
     EXPECT_EQ(found, 1) << c.name;
   }
+}
+
+TEST(RevolutionFaces, WasherQualifiesAboutItsCentre) {
+  // A flat ring between two concentric circles, and a disc with an off-centre hole.
+  const gp_Ax2 z(gp_Pnt(1, 2, 3), gp_Dir(0, 0, 1));
+  const TopoDS_Shape ring = BRepAlgoAPI_Cut(BRepPrimAPI_MakeCylinder(z, 4, 1).Shape(),
+                                            BRepPrimAPI_MakeCylinder(z, 2, 1).Shape())
+                                .Shape();
+  const CadModel m = test::round_trip(ring, "rev_washer");
+  int flat = 0;
+  for (LO f = 0; f < m.num_faces(); ++f) {
+    if (m.faces()[f].type != SurfaceType::Plane) continue;
+    const auto axis = revolution_axis(m, f);
+    ASSERT_TRUE(axis.has_value()) << "face " << f;
+    EXPECT_FALSE(axis->cylinder);
+    EXPECT_NEAR(off_axis(*axis, {1, 2, 0}), 0.0, 1e-9);
+    EXPECT_TRUE(revolution_with_iso_lines(m, f)) << "face " << f;
+    ++flat;
+  }
+  EXPECT_EQ(flat, 2);
+  const TopoDS_Shape holed =
+      BRepAlgoAPI_Cut(
+          BRepPrimAPI_MakeCylinder(z, 4, 1).Shape(),
+          BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(2, 2, 3), gp_Dir(0, 0, 1)), 1, 1).Shape())
+          .Shape();
+  const CadModel h = test::round_trip(holed, "rev_off_centre");
+  for (LO f = 0; f < h.num_faces(); ++f)
+    if (h.faces()[f].type == SurfaceType::Plane)
+      EXPECT_FALSE(revolution_axis(h, f).has_value()) << "face " << f;
 }
 
 TEST(RevolutionFaces, PoleOrSlantedCutDoesNot) {

@@ -612,6 +612,12 @@ TEST(CrossField, RevolutionShortcutMatchesTheSolvedField) {
       {"rev-cyl-full", BRepPrimAPI_MakeCylinder(z, 2, 5).Shape(), cad::SurfaceType::Cylinder, 0.2,
        true},
       {"rev-cone", BRepPrimAPI_MakeCone(z, 3, 1, 4).Shape(), cad::SurfaceType::Cone, 0.2, true},
+      // A flat ring: the polar grid about its centre.
+      {"rev-washer",
+       BRepAlgoAPI_Cut(BRepPrimAPI_MakeCylinder(z, 4, 1).Shape(),
+                       BRepPrimAPI_MakeCylinder(z, 2, 1).Shape())
+           .Shape(),
+       cad::SurfaceType::Plane, 0.2, true},
       // A quarter of a torus tube: the diffusion puts 2 + and 2 - singularities on it (its
       // levels end at the iteration cap); the parallels' cross is the structured choice.
       {"rev-torus", BRepPrimAPI_MakeTorus(z, 4, 1.5, kPi / 2).Shape(), cad::SurfaceType::Torus, 0.2,
@@ -666,7 +672,9 @@ TEST(CrossField, RevolutionShortcutMatchesTheSolvedField) {
       EXPECT_GT(h_range, 0.1) << c.label;  // the parallels shrink toward the axis
     }
     if (!c.solved_has_no_singularity) continue;
-    EXPECT_LT(worst_apart, 1.0) << c.label;
+    // Where the parallels turn fast (the washer's inner circle: 0.1 rad per edge) the solved
+    // field lags the exact one by up to a degree.
+    EXPECT_LT(worst_apart, 2.0) << c.label;
     EXPECT_LT(mean_apart, 0.2) << c.label;
     EXPECT_LT(worst_h, 0.05) << c.label;
   }

@@ -180,9 +180,11 @@ struct RevolutionAxis {
 };
 
 /// The axis of face f when its surface is one of revolution: a circular cylinder, a cone, a sphere
-/// (the axis of its parametrisation, through its poles), a torus or a surface of revolution;
-/// nullopt otherwise (planes included: planar_with_right_angle_lines covers them). With the
-/// location of the face applied. Thread-safe, the same answer on every rank.
+/// (the axis of its parametrisation, through its poles), a torus, a surface of revolution, or a
+/// plane with circles that share one centre (the normal through it: a washer, an annular
+/// sector); nullopt otherwise (other planes: planar_with_right_angle_lines covers the
+/// rectilinear ones). With the location of the face applied. Thread-safe, the same answer on
+/// every rank.
 [[nodiscard]] std::optional<RevolutionAxis> revolution_axis(const CadModel& model, LO f);
 
 /// Whether face f lies on a surface of revolution (revolution_axis) and every curve of its loops is
