@@ -105,9 +105,11 @@ TEST(RevolutionFaces, WasherQualifiesAboutItsCentre) {
           BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(2, 2, 3), gp_Dir(0, 0, 1)), 1, 1).Shape())
           .Shape();
   const CadModel h = test::round_trip(holed, "rev_off_centre");
-  for (LO f = 0; f < h.num_faces(); ++f)
-    if (h.faces()[f].type == SurfaceType::Plane)
+  for (LO f = 0; f < h.num_faces(); ++f) {
+    if (h.faces()[f].type == SurfaceType::Plane) {
       EXPECT_FALSE(revolution_axis(h, f).has_value()) << "face " << f;
+    }
+  }
 }
 
 TEST(RevolutionFaces, PoleOrSlantedCutDoesNot) {
