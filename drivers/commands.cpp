@@ -247,7 +247,9 @@ int run_info(const Arguments& args) {
   if (!parts.empty()) {
     std::cout << "\nMETIS partition at size " << size
               << " (weights area / size^2; cross field: 0 on\n"
-              << "faces of the exact-uniform shortcut, planar with lines at right angles):\n";
+              << "faces of the exact shortcuts, planar with lines at right angles or cylinders\n"
+              << "cut along their circles and lines, a tenth on other faces of revolution that\n"
+              << "take theirs):\n";
     for (std::size_t k = 0; k < parts.size(); ++k)
       std::cout << "  " << args.partition[k] << " ranks: " << balance(args.partition[k], parts[k])
                 << "\n";

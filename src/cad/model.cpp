@@ -177,18 +177,18 @@ std::optional<RevolutionAxis> revolution_axis(const CadModel& model, LO f) {
   return RevolutionAxis{{p.X(), p.Y(), p.Z()}, {d.X(), d.Y(), d.Z()}, cylinder};
 }
 
-bool revolution_with_iso_lines(const CadModel& model, LO f) {
+std::optional<RevolutionAxis> iso_line_revolution_axis(const CadModel& model, LO f) {
   const auto axis = revolution_axis(model, f);
-  if (!axis) return false;
+  if (!axis) return std::nullopt;
   const Face& face = model.faces()[static_cast<std::size_t>(f)];
-  const Box3& box = face.box;
-  const double tol = 1e-6 * norm(box.hi - box.lo);
+  const double tol = 1e-6 * face.box.diagonal();
   const Vec3 a = axis->direction;
+  const auto height = [&](const Vec3& v) { return dot(v, a); };
+  const auto off_axis = [&](const Vec3& v) { return v - a * dot(v, a); };
   bool any = false;
   for (const Loop& loop : face.loops)
     for (const CurveUse& use : loop.uses) {
-      const Curve& curve = model.curves()[static_cast<std::size_t>(use.curve)];
-      if (curve.degenerate) return false;
+      if (model.curves()[static_cast<std::size_t>(use.curve)].degenerate) return std::nullopt;
       const BRepAdaptor_Curve c(model.impl().edges[static_cast<std::size_t>(use.curve)]);
       std::array<Vec3, 5> q;
       for (int k = 0; k < 5; ++k) {
@@ -197,22 +197,20 @@ bool revolution_with_iso_lines(const CadModel& model, LO f) {
         q[static_cast<std::size_t>(k)] = Vec3{p.X(), p.Y(), p.Z()} - axis->point;
       }
       // A parallel: every point at the first one's height along the axis and distance from it.
-      const auto height = [&](const Vec3& v) { return dot(v, a); };
-      const auto radius = [&](const Vec3& v) { return norm(v - a * dot(v, a)); };
-      bool parallel = true, meridian = true;
-      // A meridian: every point in the plane through the axis and the first point off it.
-      const Vec3 r0 = q[0] - a * dot(q[0], a);
-      const Vec3 side = norm(r0) > tol ? normalized(cross(a, r0)) : Vec3{0, 0, 0};
+      // A meridian: every point in the half-plane through the axis and the first point.
+      const Vec3 r0 = off_axis(q[0]);
+      bool parallel = true, meridian = norm(r0) > tol;
+      const Vec3 side = meridian ? normalized(cross(a, r0)) : Vec3{0, 0, 0};
       for (const Vec3& v : q) {
         parallel = parallel && std::abs(height(v) - height(q[0])) <= tol &&
-                   std::abs(radius(v) - radius(q[0])) <= tol;
-        meridian = meridian && norm(side) > 0 && std::abs(dot(v, side)) <= tol &&
-                   dot(v - a * dot(v, a), r0) >= 0;
+                   std::abs(norm(off_axis(v)) - norm(r0)) <= tol;
+        meridian = meridian && std::abs(dot(v, side)) <= tol && dot(off_axis(v), r0) >= 0;
       }
-      if (!parallel && !meridian) return false;
+      if (!parallel && !meridian) return std::nullopt;
       any = true;
     }
-  return any;
+  if (!any) return std::nullopt;
+  return axis;
 }
 
 namespace {

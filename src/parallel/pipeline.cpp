@@ -62,8 +62,9 @@ std::vector<double> estimate_field_costs(const cad::CadModel& model, double size
     double& c = cost[static_cast<std::size_t>(f)];
     if (exact_uniform && cad::planar_with_right_angle_lines(model, f)) {
       c = 0;
-    } else if (exact_revolution && cad::revolution_with_iso_lines(model, f)) {
-      c = cad::revolution_axis(model, f)->cylinder ? 0 : c / 10;
+    } else if (const auto axis =
+                   exact_revolution ? cad::iso_line_revolution_axis(model, f) : std::nullopt) {
+      c = axis->cylinder ? 0 : c / 10;
     }
   }
   return cost;

@@ -1,4 +1,4 @@
-// cad::revolution_axis and cad::revolution_with_iso_lines: the faces the crossfield stage's
+// cad::revolution_axis and cad::iso_line_revolution_axis: the faces the crossfield stage's
 // revolution shortcut takes, known from the CAD alone (the partition's cross-field estimate).
 #include <gtest/gtest.h>
 
@@ -36,14 +36,14 @@ TEST(RevolutionFaces, DrilledHoleWallQualifiesAndThePlanesDoNot) {
       // The sides have no circle, so no axis; the top and bottom have the hole's, but their
       // square sides are neither parallels nor meridians of it.
       EXPECT_EQ(axis.has_value(), m.faces()[f].loops.size() == 2) << "face " << f;
-      EXPECT_FALSE(revolution_with_iso_lines(m, f)) << "face " << f;
+      EXPECT_FALSE(iso_line_revolution_axis(m, f).has_value()) << "face " << f;
       continue;
     }
     ASSERT_TRUE(axis.has_value()) << "face " << f;
     EXPECT_TRUE(axis->cylinder);
     EXPECT_NEAR(std::abs(axis->direction.z), 1.0, 1e-12);
     EXPECT_NEAR(off_axis(*axis, {5, 5, 0}), 0.0, 1e-9);
-    EXPECT_TRUE(revolution_with_iso_lines(m, f)) << "face " << f;
+    EXPECT_TRUE(iso_line_revolution_axis(m, f).has_value()) << "face " << f;
     ++walls;
   }
   EXPECT_GE(walls, 1);
@@ -74,7 +74,7 @@ TEST(RevolutionFaces, ConeTorusAndSphereBeltQualify) {
       EXPECT_FALSE(axis->cylinder) << c.name;
       EXPECT_NEAR(std::abs(axis->direction.y), 1.0, 1e-12) << c.name;
       EXPECT_NEAR(off_axis(*axis, {1, 7, 3}), 0.0, 1e-9) << c.name;
-      EXPECT_TRUE(revolution_with_iso_lines(m, f)) << c.name;
+      EXPECT_TRUE(iso_line_revolution_axis(m, f).has_value()) << c.name;
       ++found;
     }
     EXPECT_EQ(found, 1) << c.name;
@@ -95,7 +95,7 @@ TEST(RevolutionFaces, WasherQualifiesAboutItsCentre) {
     ASSERT_TRUE(axis.has_value()) << "face " << f;
     EXPECT_FALSE(axis->cylinder);
     EXPECT_NEAR(off_axis(*axis, {1, 2, 0}), 0.0, 1e-9);
-    EXPECT_TRUE(revolution_with_iso_lines(m, f)) << "face " << f;
+    EXPECT_TRUE(iso_line_revolution_axis(m, f).has_value()) << "face " << f;
     ++flat;
   }
   EXPECT_EQ(flat, 2);
@@ -127,7 +127,7 @@ TEST(RevolutionFaces, PoleOrSlantedCutDoesNot) {
     for (LO f = 0; f < m->num_faces(); ++f) {
       if (m->faces()[f].type == SurfaceType::Plane) continue;
       EXPECT_TRUE(revolution_axis(*m, f).has_value());
-      EXPECT_FALSE(revolution_with_iso_lines(*m, f)) << "face " << f;
+      EXPECT_FALSE(iso_line_revolution_axis(*m, f).has_value()) << "face " << f;
       ++curved;
     }
     EXPECT_EQ(curved, 1);

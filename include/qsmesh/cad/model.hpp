@@ -187,13 +187,13 @@ struct RevolutionAxis {
 /// every rank.
 [[nodiscard]] std::optional<RevolutionAxis> revolution_axis(const CadModel& model, LO f);
 
-/// Whether face f lies on a surface of revolution (revolution_axis) and every curve of its loops is
-/// a parallel (a circle about the axis) or a meridian (a curve in a plane through the axis), none
-/// degenerate: the crossfield stage's revolution shortcut (CrossFieldOptions::exact_revolution)
-/// then gives the face its field without a diffusion solve. From 5 points of each curve, each
+/// revolution_axis(model, f) when face f also has every curve of its loops a parallel (a circle
+/// about the axis) or a meridian (a curve in a plane through the axis), none degenerate: the
+/// crossfield stage's revolution shortcut (CrossFieldOptions::exact_revolution) then gives the
+/// face its field without a diffusion solve; nullopt otherwise. From 5 points of each curve, each
 /// within 1e-6 of the face's diagonal of the parallel or meridian through the first. A prediction
 /// for the partition's cost estimate: the shortcut itself checks the sampled boundary.
-[[nodiscard]] bool revolution_with_iso_lines(const CadModel& model, LO f);
+[[nodiscard]] std::optional<RevolutionAxis> iso_line_revolution_axis(const CadModel& model, LO f);
 
 /// Reads a STEP (.step, .stp), IGES (.iges, .igs) or BREP (.brep, .brp) file and builds the
 /// topology. Entity ids follow OpenCASCADE's unique-shape maps (TopExp::MapShapes order), so they

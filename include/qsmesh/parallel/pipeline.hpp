@@ -276,7 +276,7 @@ struct PipelineResult {
 /// partition's second balance constraint: area / size^2 as estimate_face_costs, but about nothing
 /// (0) for a face that takes the exact-uniform shortcut (cad::planar_with_right_angle_lines) when
 /// `exact_uniform` (CrossFieldOptions::exact_uniform) is on, or the revolution shortcut on a
-/// cylinder (cad::revolution_with_iso_lines) when `exact_revolution` is; a tenth of it on the
+/// cylinder (cad::iso_line_revolution_axis) when `exact_revolution` is; a tenth of it on the
 /// other surfaces of revolution that take it (the scaling's one vertex-based solve is left). From
 /// the CAD model alone, so it is known before the background stage and the same on every rank.
 [[nodiscard]] std::vector<double> estimate_field_costs(const cad::CadModel& model, double size,
