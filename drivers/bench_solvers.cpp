@@ -10,6 +10,9 @@
 //   poisson: 5-point Laplacian on a sqrt(N) x sqrt(N) grid + 0.01 * identity;
 //   cr:      Crouzeix-Raviart-like: 2 unknowns per edge of a triangulated grid (N/2 edges), the
 //            P1-nonconforming Laplacian coupled by a 2x2 block [1 .5; .5 1] + 0.01 * identity.
+//        qsmesh_bench_solvers --complex [N ...]: the cross field's kind of cr matrix, each pair of
+//        edges coupled by a rotation (the real form of a complex Hermitian matrix), factorized in
+//        real form and as complex (SolverOptions::complex_pairs), and by MUMPS in real form.
 #include <mpi.h>
 
 #include <algorithm>
@@ -50,7 +53,7 @@ SparseMatrix poisson(LO target) {
   return SparseMatrix(m * m, t);
 }
 
-SparseMatrix crouzeix_raviart(LO target) {
+SparseMatrix crouzeix_raviart(LO target, bool rotations = false) {
   // m x m grid vertices, each cell cut by its anti-diagonal: ~3 m^2 edges, 2 unknowns each.
   const LO m = std::max<LO>(2, static_cast<LO>(std::lround(std::sqrt(target / 6.0))) + 1);
   const LO nh = m * (m - 1), nv = (m - 1) * m;
@@ -67,9 +70,17 @@ SparseMatrix crouzeix_raviart(LO target) {
             2 * static_cast<std::size_t>(edges));
   const auto element = [&](const LO(&e)[3]) {
     for (int a = 0; a < 3; ++a)
-      for (int b = 0; b < 3; ++b)
+      for (int b = 0; b < 3; ++b) {
+        // With rotations, edge a sees edge b's frame turned by 0.3 (e[a] - e[b]) radians: a gauge
+        // of the plain Laplacian, so the matrix stays positive definite, with the cross field's
+        // [[cos, -sin], [sin, cos]] blocks.
+        const double angle = 0.3 * static_cast<double>(e[a] - e[b]);
+        const double Q[2][2] = {{std::cos(angle), -std::sin(angle)},
+                                {std::sin(angle), std::cos(angle)}};
         for (int c = 0; c < 2; ++c)
-          for (int k = 0; k < 2; ++k) t.push_back({2 * e[a] + c, 2 * e[b] + k, R[c][k] * K[a][b]});
+          for (int k = 0; k < 2; ++k)
+            t.push_back({2 * e[a] + c, 2 * e[b] + k, (rotations ? Q : R)[c][k] * K[a][b]});
+      }
   };
   for (LO i = 0; i + 1 < m; ++i)
     for (LO j = 0; j + 1 < m; ++j) {
@@ -86,9 +97,10 @@ struct Times {
 };
 
 Times run(const SparseMatrix& A, Backend backend, qsmesh::linalg::SolverLane* lane,
-          int block_size = 1, LO distributed_threshold = 2000000) {
+          int block_size = 1, LO distributed_threshold = 2000000, bool complex_pairs = false) {
   qsmesh::linalg::SolverOptions options;
   options.backend = backend;
+  options.complex_pairs = complex_pairs;
   options.block_size = block_size;
   options.distributed_threshold = distributed_threshold;
   auto solver = qsmesh::linalg::make_solver(A.size(), options, lane);
@@ -157,6 +169,31 @@ void backends_benchmark(const std::vector<LO>& sizes, qsmesh::linalg::SolverLane
   }
 }
 
+// --complex: the rotation-coupled cr matrices in real form and as complex (Eigen), and MUMPS.
+void complex_benchmark(const std::vector<LO>& sizes, qsmesh::linalg::SolverLane& lane) {
+  std::printf(
+      "| n | nonzeros | solver | analyze (s) | factorize (s) | refactorize (s) | solve (s) | rel. "
+      "residual | real / complex: factorize | solve | analyze+2 fact.+10 solves |\n");
+  std::printf("|---|---|---|---|---|---|---|---|---|---|---|\n");
+  for (const LO target : sizes) {
+    const SparseMatrix A = crouzeix_raviart(target, true);
+    const Times r = run(A, Backend::Eigen, &lane);
+    const Times c = run(A, Backend::Eigen, &lane, 1, 2000000, true);
+    const Times p = run(A, Backend::Petsc, &lane);
+    for (const Times* t : {&r, &c, &p}) {
+      std::printf("| %d | %lld | %s | %.4f | %.4f | %.4f | %.5f | %.1e |", A.size(),
+                  static_cast<long long>(A.nonzeros()), t->name.c_str(), t->analyze, t->factorize,
+                  t->refactorize, t->solve, t->residual);
+      if (t == &r)
+        std::printf(" %.2f | %.2f | %.2f |\n", r.refactorize / c.refactorize, r.solve / c.solve,
+                    total(r) / total(c));
+      else
+        std::printf("  |  |  |\n");
+    }
+    std::fflush(stdout);
+  }
+}
+
 // --split: the cr matrices split over every rank against rank 0 alone. Wall seconds (the ranks
 // start together); CPU seconds summed over the ranks that took part.
 void split_benchmark(const std::vector<LO>& sizes, qsmesh::linalg::SolverLane& lane) {
@@ -219,10 +256,12 @@ int main(int argc, char** argv) {
   int status = 0;
   try {
     std::vector<LO> sizes;
-    bool split = false;
+    bool split = false, complex = false;
     for (int i = 1; i < argc; ++i) {
       if (std::string(argv[i]) == "--split")
         split = true;
+      else if (std::string(argv[i]) == "--complex")
+        complex = true;
       else
         sizes.push_back(static_cast<LO>(std::atof(argv[i])));
     }
@@ -230,6 +269,8 @@ int main(int argc, char** argv) {
     qsmesh::linalg::SolverLane lane;
     if (split)
       split_benchmark(sizes, lane);
+    else if (complex)
+      complex_benchmark(sizes, lane);
     else
       backends_benchmark(sizes, lane);
   } catch (const std::exception& ex) {

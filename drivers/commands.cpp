@@ -984,7 +984,8 @@ int run_mesh(const Arguments& args) {
   options.separatrix_method = args.separatrix_method;
   options.smooth_groups = args.smooth_groups;
   options.distance_to_cad = true;
-  // A face whose field system is above SolverOptions::petsc_threshold is solved by PETSc; with the
+  // A face whose field system is above SolverOptions::petsc_threshold (petsc_threshold_complex for
+  // the cross field's heat systems, factorized as complex by Eigen) is solved by PETSc; with the
   // background at the geometry's resolution that takes a face far larger than its neighbours, or
   // --field-divisions 0 on a large one. Above SolverOptions::distributed_threshold
   // (--distributed-threshold) all ranks solve the face's systems together.

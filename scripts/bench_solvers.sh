@@ -2,7 +2,9 @@
 # Eigen vs PETSc/MUMPS: analyze, factorize, refactorize (same pattern, new values) and solve times
 # on 2D Poisson (5-point) and Crouzeix-Raviart-like (2 unknowns per edge) SPD matrices, one rank,
 # one thread. Prints a markdown table (ratios are Eigen time / PETSc time, measured in one run).
-# Usage: scripts/bench_solvers.sh [N ...]   (default: 1e3 1e4 1e5 5e5; run after scripts/build.sh)
+# Usage: scripts/bench_solvers.sh [--complex] [N ...]   (default: 1e3 1e4 1e5 5e5; run after
+# scripts/build.sh). --complex: the cross field's rotation-coupled matrices, real form against
+# complex (linalg::SolverOptions::complex_pairs).
 # QSMESH_BENCH_SOLVERS_EXE overrides the executable (default build/drivers/qsmesh_bench_solvers).
 set -euo pipefail
 cd "$(dirname "$0")/.."

@@ -17,6 +17,14 @@ namespace {
 
 using Triplet = linalg::SparseMatrix::Triplet;
 
+// The cross field's systems are the real form of complex Hermitian ones (each edge's two
+// unknowns are the real and imaginary parts of its representation vector, and the connection
+// couples them by rotations): factorized as complex, they cost less (linalg::SolverOptions).
+linalg::SolverOptions pair_solver(linalg::SolverOptions options) {
+  options.complex_pairs = true;
+  return options;
+}
+
 /// CR stiffness of the triangles selected by `use`, on the unknowns edge2unk (2 per edge, kNoIndex:
 /// Dirichlet). Returns the free-free triplets and adds -K_fd u_d to `coupling`.
 std::vector<Triplet> assemble_stiffness(const FaceCrossField& cf, const Geometry& g,
@@ -110,7 +118,7 @@ void extend_boundary_conditions(FaceCrossField& cf, const Geometry& g,
     if (edge2unk[e] != kNoIndex)
       for (int a = 0; a < 2; ++a) trip.push_back({edge2unk[e] + a, edge2unk[e] + a, eps * mass[e]});
   const linalg::SparseMatrix A(n, trip);
-  auto solver = linalg::make_solver(n, options.solver, lane);
+  auto solver = linalg::make_solver(n, pair_solver(options.solver), lane);
   solver->analyze(A);
   solver->factorize(A);
   std::vector<double> x(static_cast<std::size_t>(n));
@@ -186,7 +194,7 @@ void diffuse(FaceCrossField& cf, const Geometry& g, const CrossFieldOptions& opt
   // α from (0.1 d)^2 down to (3 h_min)^2, linearly (Algorithm 1).
   const double a0 = std::pow(0.1 * g.diagonal, 2);
   const double a1 = std::min(a0, std::pow(3 * g.min_edge, 2));
-  auto solver = linalg::make_solver(n, options.solver, lane);
+  auto solver = linalg::make_solver(n, pair_solver(options.solver), lane);
   cf.stats.solver = solver->name();
   solver->analyze(K);
 

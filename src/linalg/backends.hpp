@@ -48,6 +48,10 @@ class Pattern {
 /// Eigen::SimplicialLDLT (AMD ordering) on a copy of the matrix in Eigen's storage.
 std::unique_ptr<LinearSolver> make_eigen_solver();
 
+/// Eigen::SimplicialLDLT (AMD ordering) of the complex Hermitian matrix whose real form is A
+/// (SolverOptions::complex_pairs).
+std::unique_ptr<LinearSolver> make_eigen_complex_solver();
+
 /// PETSc SeqAIJ on PETSC_COMM_SELF factorized by MUMPS (Cholesky; LU, then PETSc's own
 /// factorization, as fallbacks). Every PETSc call is made while holding lane.mutex().
 std::unique_ptr<LinearSolver> make_petsc_solver(SolverLane& lane);

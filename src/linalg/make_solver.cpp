@@ -7,9 +7,15 @@ std::unique_ptr<LinearSolver> make_solver(LO n, const SolverOptions& options, So
   // A group lane splits its large systems over the group's ranks (every rank makes this call).
   const bool distributed =
       lane != nullptr && lane->group() != nullptr && n >= options.distributed_threshold;
+  QSMESH_CHECK(!options.complex_pairs || n % 2 == 0,
+               "make_solver: complex_pairs needs an even system size, not " << n);
+  const auto eigen = [&] {
+    return options.complex_pairs ? detail::make_eigen_complex_solver()
+                                 : detail::make_eigen_solver();
+  };
   switch (options.backend) {
     case Backend::Eigen:
-      return detail::make_eigen_solver();
+      return eigen();
     case Backend::Petsc:
       QSMESH_CHECK(lane != nullptr,
                    "make_solver: Backend::Petsc needs a SolverLane, and none was given");
@@ -21,8 +27,10 @@ std::unique_ptr<LinearSolver> make_solver(LO n, const SolverOptions& options, So
       return detail::make_petsc_multigrid_solver(*lane, options.multigrid_rtol, options.block_size);
     case Backend::Automatic:
       if (distributed) return detail::make_petsc_distributed_solver(*lane);
-      if (lane != nullptr && n >= options.petsc_threshold) return detail::make_petsc_solver(*lane);
-      return detail::make_eigen_solver();
+      if (lane != nullptr &&
+          n >= (options.complex_pairs ? options.petsc_threshold_complex : options.petsc_threshold))
+        return detail::make_petsc_solver(*lane);
+      return eigen();
   }
   QSMESH_CHECK(false, "make_solver: unknown backend " << static_cast<int>(options.backend));
   return nullptr;

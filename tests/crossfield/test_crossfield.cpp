@@ -84,6 +84,9 @@ void expect_stats(const FaceCrossField& cf) {
   const CrossFieldOptions defaults;
   EXPECT_EQ(cf.stats.levels, defaults.levels);
   EXPECT_EQ(cf.stats.factorizations, cf.stats.levels);
+  // The heat systems are the real form of complex Hermitian ones, factorized as such
+  // (linalg::SolverOptions::complex_pairs).
+  EXPECT_EQ(cf.stats.solver, "eigen/simplicial-ldlt-complex");
   EXPECT_GE(cf.stats.solves, cf.stats.levels);
   EXPECT_EQ(static_cast<int>(cf.stats.iterations_per_level.size()), cf.stats.levels);
   for (const auto& u : cf.u) EXPECT_NEAR(std::hypot(u.u, u.v), 1.0, 1e-9);

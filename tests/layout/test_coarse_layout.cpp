@@ -167,25 +167,30 @@ TEST(CoarseLayout, CylinderWithClosedCurves) {
   EXPECT_GT(r.stats.ilp_variables, 0);
 }
 
-// Mean over the quads of |log(aspect)|, the aspect the ratio of a quad's two mean opposite edge
-// lengths: 0 for squares.
-double mean_log_aspect(const mesh::SurfaceMesh& m) {
-  double sum = 0;
-  for (const auto& q : m.quads) {
-    auto p = [&](int c) {
-      return m.points[static_cast<std::size_t>(q[static_cast<std::size_t>(c)])];
+// Mean over the blocks, weighted by their quads, of |log(aspect)| of the fine quads each block
+// plans: its straight sides between its corners, over its counts. What loop_balance aims at
+// (CoarseOptions), before the fine nodes are placed on the CAD and smoothed.
+double block_log_aspect(const CoarseResult& r) {
+  double sum = 0, weight = 0;
+  for (const auto& b : r.layout.blocks) {
+    auto p = [&](LO i, LO j) {
+      return r.mesh.points[static_cast<std::size_t>(b.vertex(i, j, r.layout.vertices))];
     };
-    const double a = distance(p(0), p(1)) + distance(p(3), p(2));
-    const double b = distance(p(1), p(2)) + distance(p(0), p(3));
-    sum += std::abs(std::log(a / b));
+    const double li = 0.5 * (distance(p(0, 0), p(b.ni, 0)) + distance(p(0, b.nj), p(b.ni, b.nj)));
+    const double lj = 0.5 * (distance(p(0, 0), p(0, b.nj)) + distance(p(b.ni, 0), p(b.ni, b.nj)));
+    const double w = static_cast<double>(b.ni) * b.nj;
+    sum += w * std::abs(std::log((li / b.ni) / (lj / b.nj)));
+    weight += w;
   }
-  return m.quads.empty() ? 0 : sum / static_cast<double>(m.quads.size());
+  return weight > 0 ? sum / weight : 0;
 }
 
 TEST(CoarseLayout, LoopWidthsBalancedAgainstTheCoarseQuadsShapes) {
   // The widths of the quad loops come from the input mesh's lengths; balanced fully against the
-  // coarse quads' shapes (loop_balance 1), they make squarer fine quads, and the layout stays
-  // conforming and valid.
+  // coarse quads' shapes (loop_balance 1), the blocks plan squarer fine quads, and the layout
+  // stays conforming and valid. The fine quads as placed on the CAD and smoothed are not always
+  // squarer: at sizes 0.3 to 0.4 their mean |log(aspect)| drops at 4 of 7, the planned one at 6
+  // (docs/benchmarks.md, "Complex factorization").
   const std::string path = test::write_box_with_hole(test::tmp("coarse_balance.brep"));
   const Meshed in = mesh_model(path, 0.35);
   const CoarseResult plain = build_coarse_layout(in.mesh, in.model);
@@ -194,7 +199,7 @@ TEST(CoarseLayout, LoopWidthsBalancedAgainstTheCoarseQuadsShapes) {
   const CoarseResult balanced = build_coarse_layout(in.mesh, in.model, o);
   expect_conforming_blocks(plain, in.model);
   expect_conforming_blocks(balanced, in.model);
-  EXPECT_LT(mean_log_aspect(balanced.mesh), mean_log_aspect(plain.mesh));
+  EXPECT_LT(block_log_aspect(balanced), block_log_aspect(plain));
   // The same blocks, other widths.
   EXPECT_EQ(balanced.layout.blocks.size(), plain.layout.blocks.size());
   EXPECT_NE(balanced.mesh.quads.size(), plain.mesh.quads.size());

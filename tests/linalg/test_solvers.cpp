@@ -220,6 +220,14 @@ TEST(Solvers, AutomaticPicksBySize) {
   big->analyze(poisson(10, 1.0));
   EXPECT_EQ(std::string(big->name()).rfind("petsc/mumps-cholesky", 0), 0u) << big->name();
   EXPECT_EQ(std::string(make_solver(1000, options, nullptr)->name()).rfind("eigen", 0), 0u);
+  // Complex pairs have their own threshold.
+  options.complex_pairs = true;
+  options.petsc_threshold_complex = 200;
+  EXPECT_STREQ(make_solver(100, options, &lane())->name(), "eigen/simplicial-ldlt-complex");
+  auto big_complex = make_solver(200, options, &lane());
+  big_complex->analyze(poisson(10, 1.0));
+  big_complex->factorize(poisson(10, 1.0));
+  EXPECT_EQ(std::string(big_complex->name()).rfind("petsc/mumps-cholesky", 0), 0u);
 }
 
 TEST(Solvers, MultigridSolvesToItsToleranceAndAgreesWithTheFactorization) {
@@ -263,6 +271,96 @@ TEST(Solvers, MultigridSolvesToItsToleranceAndAgreesWithTheFactorization) {
         gamg->solve(rhs(indefinite.size(), 1), x);
       },
       Error);
+}
+
+// The real form of a magnetic Laplacian on an m x m grid (a discrete connection turning by
+// `twist` radians per edge, as the cross field's Crouzeix-Raviart systems do) plus shift * I:
+// complex Hermitian positive definite, unknowns (2i, 2i+1) = (Re z_i, Im z_i).
+SparseMatrix magnetic_laplacian(LO m, double shift, double twist) {
+  std::vector<SparseMatrix::Triplet> t;
+  const auto id = [m](LO i, LO j) { return i * m + j; };
+  // Complex entry a + ic at (r, s) in real form: [[a, -c], [c, a]].
+  const auto add = [&t](LO r, LO s, double a, double c) {
+    t.push_back({2 * r, 2 * s, a});
+    t.push_back({2 * r, 2 * s + 1, -c});
+    t.push_back({2 * r + 1, 2 * s, c});
+    t.push_back({2 * r + 1, 2 * s + 1, a});
+  };
+  for (LO i = 0; i < m; ++i)
+    for (LO j = 0; j < m; ++j) {
+      const LO r = id(i, j);
+      add(r, r, 4.0 + shift, 0.0);
+      // Hermitian: the entry (s, r) is the conjugate of (r, s).
+      const auto link = [&](LO s, double angle) {
+        add(r, s, -std::cos(angle), -std::sin(angle));
+        add(s, r, -std::cos(angle), std::sin(angle));
+      };
+      if (i + 1 < m) link(id(i + 1, j), twist * (1 + i + 2 * j));
+      if (j + 1 < m) link(id(i, j + 1), -twist * (3 + j));
+    }
+  return SparseMatrix(2 * m * m, t);
+}
+
+TEST(Solvers, ComplexPairsAgreeWithTheRealForm) {
+  const SparseMatrix A = magnetic_laplacian(25, 0.05, 0.3);
+  const auto b = rhs(A.size(), 2);
+  SolverOptions options;
+  options.backend = Backend::Eigen;
+  auto real = make_solver(A.size(), options, nullptr);
+  options.complex_pairs = true;
+  auto complex = make_solver(A.size(), options, nullptr);
+  EXPECT_STREQ(complex->name(), "eigen/simplicial-ldlt-complex");
+  // PETSc ignores the flag and solves the real form.
+  options.backend = Backend::Petsc;
+  auto petsc = make_solver(A.size(), options, &lane());
+  std::vector<double> xr(b.size()), xc(b.size()), xp(b.size());
+  for (auto* s : {real.get(), complex.get(), petsc.get()}) {
+    s->analyze(A);
+    s->factorize(A);
+  }
+  real->solve(b, xr);
+  complex->solve(b, xc);
+  petsc->solve(b, xp);
+  EXPECT_LT(relative_residual(A, xc, b), 1e-12);
+  std::vector<double> diff(b.size());
+  for (std::size_t i = 0; i < b.size(); ++i) diff[i] = xc[i] - xr[i];
+  EXPECT_LT(norm(diff) / norm(xr), 1e-12);
+  for (std::size_t i = 0; i < b.size(); ++i) diff[i] = xp[i] - xr[i];
+  EXPECT_LT(norm(diff) / norm(xr), 1e-12);
+  // A second factorization with other values on the same pattern (the diffusion levels).
+  SparseMatrix B = A;
+  for (LO r = 0; r < B.size(); ++r) B.values()[static_cast<std::size_t>(B.find(r, r))] += 1.0;
+  complex->factorize(B);
+  complex->solve(b, xc);
+  EXPECT_LT(relative_residual(B, xc, b), 1e-12);
+}
+
+TEST(Solvers, ComplexPairsRejectWhatIsNotAHermitianRealForm) {
+  SolverOptions options;
+  options.backend = Backend::Eigen;
+  options.complex_pairs = true;
+  EXPECT_THROW((void)make_solver(7, options, nullptr), Error);  // odd size
+  // A real Laplacian read in pairs: its 2 x 2 blocks are not whole.
+  auto solver = make_solver(100, options, nullptr);
+  EXPECT_THROW(solver->analyze(poisson(10, 1.0)), Error);
+  // Whole blocks, but one is not of the form [[a, -c], [c, a]].
+  SparseMatrix A = magnetic_laplacian(6, 0.5, 0.2);
+  auto broken = make_solver(A.size(), options, nullptr);
+  broken->analyze(A);
+  broken->factorize(A);
+  A.values()[static_cast<std::size_t>(A.find(2, 3))] += 0.25;
+  EXPECT_THROW(broken->factorize(A), Error);
+  // Not positive definite: the solver reports it, then recovers on a good matrix.
+  SparseMatrix negative = magnetic_laplacian(6, 0.5, 0.2);
+  for (double& v : negative.values()) v = -v;
+  EXPECT_THROW(broken->factorize(negative), Error);
+  std::vector<double> x(static_cast<std::size_t>(negative.size()));
+  EXPECT_THROW(broken->solve(rhs(negative.size(), 1), x), Error);
+  const SparseMatrix good = magnetic_laplacian(6, 0.5, 0.2);
+  broken->factorize(good);
+  const auto b = rhs(good.size(), 1);
+  broken->solve(b, x);
+  EXPECT_LT(relative_residual(good, x, b), 1e-12);
 }
 
 TEST(Solvers, SecondLaneIsRejected) { EXPECT_THROW(SolverLane second, Error); }

@@ -131,6 +131,7 @@ TEST(DistributedSolve, FaceAboveTheThresholdIsSplitOverTheRanksAlikeOnEveryRankC
   options.background.sizes.size = 0.2;  // the field system: about a thousand unknowns per level
   options.sizemap.size_max = 0.6;
   options.crossfield.solver.petsc_threshold = 300;
+  options.crossfield.solver.petsc_threshold_complex = 300;
   options.crossfield.solver.distributed_threshold = 300;
   options.cross_fields = true;
   options.until = Stage::Unstructured;

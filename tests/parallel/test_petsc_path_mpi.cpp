@@ -1,6 +1,6 @@
 // The mesh path solves a face's field system by PETSc when it is above the threshold
-// (SolverOptions::petsc_threshold): the same fields as Eigen's, and the same mesh at 1, 2 and 4
-// ranks.
+// (SolverOptions::petsc_threshold; petsc_threshold_complex for the cross field's heat systems):
+// the same fields as Eigen's, and the same mesh at 1, 2 and 4 ranks.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -31,6 +31,7 @@ TEST(PetscPath, FaceAboveTheThresholdIsSolvedByPetscAlikeOnEveryRankCount) {
   options.background.sizes.size = 0.2;  // the field system: about a thousand unknowns per level
   options.sizemap.size_max = 0.6;
   options.crossfield.solver.petsc_threshold = 300;
+  options.crossfield.solver.petsc_threshold_complex = 300;
   options.cross_fields = true;
   options.until = Stage::Unstructured;
   std::ostringstream sink;

@@ -154,6 +154,11 @@ struct SolverOptions {
   /// thread, analyze + 2 factorizations + 10 solves cost the same in both at about 5e5-6.5e5
   /// unknowns (Eigen's solves are 2x faster; MUMPS factorizes faster from 2e5-3e5 unknowns).
   LO petsc_threshold = 500000;
+  /// Automatic, for a complex_pairs system: its threshold instead of petsc_threshold. Factorized
+  /// as complex, Eigen stays faster than one-rank MUMPS on the real form up to the largest size
+  /// measured, 2e6 unknowns (analyze + 2 factorizations + 10 solves: 18 s against 36 s;
+  /// docs/benchmarks.md, "Complex factorization").
+  LO petsc_threshold_complex = 2000000;
   /// Backend::PetscMultigrid: relative residual (unpreconditioned 2-norm) at which CG stops.
   double multigrid_rtol = 1e-10;
   /// Backend::PetscMultigrid: unknowns per node (the cross field's 2 per edge), so that GAMG
@@ -164,6 +169,15 @@ struct SolverOptions {
   /// large for the split to pay: the ranks exchange the factors' fronts, and every rank still
   /// assembles the whole system (docs/benchmarks.md, "A face's system split over ranks").
   LO distributed_threshold = 2000000;
+  /// The system is the real form of a complex Hermitian positive definite one: its unknowns come
+  /// in pairs (2i, 2i+1), the real and imaginary parts of z_i, and every 2 x 2 block (2i, 2j) is
+  /// [[a, -c], [c, a]] for the complex entry a + ic (all four entries in the pattern, the values
+  /// exactly so; factorize() throws otherwise). The Eigen backend then factorizes the complex
+  /// matrix of n / 2 unknowns (L D L^H): half the fill of the real form, and on the cross field's
+  /// Crouzeix-Raviart systems 1.5x faster factorizations and 2x faster solves (docs/benchmarks.md,
+  /// "Complex factorization"). The solution agrees with the real form's to rounding, not bit for
+  /// bit. The PETSc backends ignore it. n must be even.
+  bool complex_pairs = false;
 };
 
 /// A direct solver for symmetric positive definite systems.
