@@ -131,7 +131,8 @@ int run_info(const Arguments& args) {
     if (!(size > 0))
       throw InputError("size: the model '" + args.model + "' has an empty bounding box");
     costs = parallel::estimate_face_costs(model, size);
-    field_costs = parallel::estimate_field_costs(model, size);
+    // The run's estimates: its field divisions (the shortcuts on, their default).
+    field_costs = parallel::estimate_field_costs(model, size, true, true, field_divisions(args));
     // METIS prints its complaints (more parts than a graph bisects well) on stdout, which holds
     // the JSON: they go to stderr instead.
     std::cout.flush();
@@ -139,7 +140,8 @@ int run_info(const Arguments& args) {
     const int saved = ::dup(STDOUT_FILENO);
     if (saved >= 0) ::dup2(STDERR_FILENO, STDOUT_FILENO);
     for (const int p : args.partition)
-      parts.push_back(parallel::partition_model_faces(model, size, p));
+      parts.push_back(
+          parallel::partition_model_faces(model, size, p, true, true, field_divisions(args)));
     std::fflush(stdout);
     if (saved >= 0) {
       ::dup2(saved, STDOUT_FILENO);
@@ -249,7 +251,8 @@ int run_info(const Arguments& args) {
               << " (weights area / size^2; cross field: 0 on\n"
               << "faces of the exact shortcuts, planar with lines at right angles or cylinders\n"
               << "cut along their circles and lines, a tenth on other faces of revolution that\n"
-              << "take theirs):\n";
+              << "take theirs; the area over the square of the face's background edge,\n"
+              << "its bounding box diagonal / --field-divisions where that is larger):\n";
     for (std::size_t k = 0; k < parts.size(); ++k)
       std::cout << "  " << args.partition[k] << " ranks: " << balance(args.partition[k], parts[k])
                 << "\n";

@@ -56,10 +56,16 @@ std::vector<double> estimate_face_costs(const cad::CadModel& model, double size)
 }
 
 std::vector<double> estimate_field_costs(const cad::CadModel& model, double size,
-                                         bool exact_uniform, bool exact_revolution) {
+                                         bool exact_uniform, bool exact_revolution,
+                                         double field_divisions) {
   std::vector<double> cost = estimate_face_costs(model, size);
   for (LO f = 0; f < model.num_faces(); ++f) {
     double& c = cost[static_cast<std::size_t>(f)];
+    if (field_divisions > 0) {
+      const cad::Face& face = model.faces()[static_cast<std::size_t>(f)];
+      const double edge = std::max(size, face.box.diagonal() / field_divisions);
+      c = std::max(1.0, face.area / (edge * edge));
+    }
     if (exact_uniform && cad::planar_with_right_angle_lines(model, f)) {
       c = 0;
     } else if (const auto axis =
@@ -71,10 +77,11 @@ std::vector<double> estimate_field_costs(const cad::CadModel& model, double size
 }
 
 std::vector<int> partition_model_faces(const cad::CadModel& model, double size, int nranks,
-                                       bool exact_uniform, bool exact_revolution) {
-  return partition_faces(model.face2faces(), estimate_face_costs(model, size),
-                         estimate_field_costs(model, size, exact_uniform, exact_revolution),
-                         nranks);
+                                       bool exact_uniform, bool exact_revolution,
+                                       double field_divisions) {
+  return partition_faces(
+      model.face2faces(), estimate_face_costs(model, size),
+      estimate_field_costs(model, size, exact_uniform, exact_revolution, field_divisions), nranks);
 }
 
 namespace {
@@ -1157,9 +1164,9 @@ PipelineResult run_pipeline(const Comm& comm, const cad::CadModel& model,
   // Faces: METIS partition balancing the estimated cost and the estimated cross-field cost. Each
   // face of this rank is one record (FaceTask) that the stages below fill in turn.
   clock.start();
-  result.face_rank =
-      partition_model_faces(model, options.background.sizes.size, nranks,
-                            options.crossfield.exact_uniform, options.crossfield.exact_revolution);
+  result.face_rank = partition_model_faces(
+      model, options.background.sizes.size, nranks, options.crossfield.exact_uniform,
+      options.crossfield.exact_revolution, options.background.sizes.field_divisions);
   // A smooth group is meshed as one surface: its faces go to the rank of its first face (the
   // partition is the same on every rank, so is this).
   const bool by_groups =

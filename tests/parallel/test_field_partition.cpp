@@ -55,6 +55,37 @@ TEST(FieldPartition, TwoConstraintsShareTheCurvedFacesFieldCost) {
   EXPECT_LE(max_over_mean(two, cost, 2), 1.15) << "the whole cost must stay balanced too";
 }
 
+TEST(FieldPartition, FieldCostFollowsTheBackgroundAtTheGeometrysResolution) {
+  // With field divisions (background::SizeOptions::field_divisions) a face's background edge is
+  // the larger of the size and its bounding box diagonal / divisions: the field cost of a face
+  // stops growing once the size is below that, while the quad cost goes on. The wing-body
+  // example: its fuselage and wings span much of the model.
+  const std::string path = test::tmp_dir() + "/field_partition_divisions.brep";
+  cad::write_example("wing-body", path, cad::ExampleFormat::Brep);
+  const cad::CadModel m = cad::load_cad(path);
+  const double divisions = 96;
+  const double coarse = 0.02 * m.diagonal(), fine = coarse / 16;
+  const std::vector<double> at_coarse = estimate_field_costs(m, coarse, true, true, divisions);
+  const std::vector<double> at_fine = estimate_field_costs(m, fine, true, true, divisions);
+  const std::vector<double> unbounded = estimate_field_costs(m, fine);
+  const std::vector<double> quads = estimate_face_costs(m, fine);
+  LO bounded = 0;
+  for (LO f = 0; f < m.num_faces(); ++f) {
+    const cad::Face& face = m.faces()[f];
+    const double cap = face.box.diagonal() / divisions;
+    EXPECT_LE(at_fine[f], std::max(1.0, face.area / (cap * cap)) * (1 + 1e-12)) << f;
+    EXPECT_LE(at_fine[f], unbounded[f] * (1 + 1e-12)) << f;
+    EXPECT_GE(at_fine[f], at_coarse[f]) << f;
+    if (unbounded[f] > 0 && at_fine[f] < 0.5 * unbounded[f]) ++bounded;
+    // The face costs, the first constraint, do not change.
+    EXPECT_EQ(quads[f], std::max(1.0, face.area / (fine * fine))) << f;
+  }
+  EXPECT_GT(bounded, 0) << "no solved face is large enough for the bound: no test";
+  EXPECT_EQ(partition_model_faces(m, fine, 2, true, true, divisions),
+            partition_faces(m.face2faces(), quads, at_fine, 2))
+      << "the run's partition";
+}
+
 TEST(FieldPartition, DegenerateSecondColumnIsTheOneConstraintPartition) {
   // A 6 x 4 grid of faces with uneven costs.
   std::vector<std::pair<LO, LO>> pairs;

@@ -273,7 +273,9 @@ struct PipelineResult {
 [[nodiscard]] std::vector<double> estimate_face_costs(const cad::CadModel& model, double size);
 
 /// Estimated cost of each face's crossfield stage (cross field, singularities, scaling), the
-/// partition's second balance constraint: area / size^2 as estimate_face_costs, but about nothing
+/// partition's second balance constraint: area / e^2, with e the largest edge of the face's
+/// background (`size`, or with `field_divisions` > 0 the larger of `size` and the diagonal of the
+/// face's bounding box over field_divisions, as background::SizeOptions::field_cap), but nothing
 /// (0) for a face that takes the exact-uniform shortcut (cad::planar_with_right_angle_lines) when
 /// `exact_uniform` (CrossFieldOptions::exact_uniform) is on, or the revolution shortcut on a
 /// cylinder (cad::iso_line_revolution_axis) when `exact_revolution` is; a tenth of it on the
@@ -281,12 +283,14 @@ struct PipelineResult {
 /// the CAD model alone, so it is known before the background stage and the same on every rank.
 [[nodiscard]] std::vector<double> estimate_field_costs(const cad::CadModel& model, double size,
                                                        bool exact_uniform = true,
-                                                       bool exact_revolution = true);
+                                                       bool exact_revolution = true,
+                                                       double field_divisions = 0);
 
 /// The faces over `nranks` ranks as run_pipeline partitions them: partition_faces with both
 /// estimates (also `qsmesh info --partition`, which scripts/simulate_scaling.py replays).
 [[nodiscard]] std::vector<int> partition_model_faces(const cad::CadModel& model, double size,
                                                      int nranks, bool exact_uniform = true,
-                                                     bool exact_revolution = true);
+                                                     bool exact_revolution = true,
+                                                     double field_divisions = 0);
 
 }  // namespace qsmesh::parallel
