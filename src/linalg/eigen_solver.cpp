@@ -158,14 +158,15 @@ class ComplexEigenSolver final : public LinearSolver {
     std::int64_t full = 0;  // complex entries of both triangles
     const auto& off = A.row_offsets();
     const auto& col = A.columns();
-    for (LO I = 0; I < m; ++I)
-      for (auto k = off[static_cast<std::size_t>(2 * I)];
-           k < off[static_cast<std::size_t>(2 * I) + 1]; ++k) {
+    for (LO I = 0; I < m; ++I) {
+      const std::size_t row = 2 * static_cast<std::size_t>(I);
+      for (auto k = off[row]; k < off[row + 1]; ++k) {
         const LO c = col[static_cast<std::size_t>(k)];
         if (c % 2 != 0) continue;
         ++full;
         if (c / 2 <= I) trip.emplace_back(I, c / 2, Complex(0, 0));
       }
+    }
     QSMESH_CHECK(4 * full == A.nonzeros(),
                  "eigen (complex pairs): the pattern of the matrix of size "
                      << n << " is not made of whole 2 x 2 blocks (" << A.nonzeros() << " nonzeros, "
