@@ -61,9 +61,10 @@ Frame face_frame(const mesh::FaceMesh& tri, const cad::FaceGeometry& surface,
     // Sec. 4, Eq. 21: heat flow of a tangent vector put at vertex 0, with the connection
     // Laplacian (tangent vectors as complex numbers in per-vertex bases e1 = du projected, e2 =
     // n x e1; each edge carries the rotation between its two bases), one implicit step
-    // (M + t H) z = M z0 delta_0. H is Hermitian; it is solved as the real symmetric system of
-    // twice the size. A long time t = diagonal^2 gives the smoothest field (parallel where the
-    // surface is developable); normalised, it is the global frame.
+    // (M + t H) z = M z0 delta_0. H is Hermitian; it is assembled as the real symmetric system of
+    // twice the size and factorized as complex (linalg::SolverOptions::complex_pairs). A long time
+    // t = diagonal^2 gives the smoothest field (parallel where the surface is developable);
+    // normalised, it is the global frame.
     Box3 box;
     for (const auto& p : tri.points) box.add(p);
     const double t = box.diagonal() * box.diagonal();
@@ -107,7 +108,9 @@ Frame face_frame(const mesh::FaceMesh& tri, const cad::FaceGeometry& surface,
       block(j, i, -t * w * std::cos(rho), -t * w * std::sin(rho));
     }
     const linalg::SparseMatrix A(2 * n, trip);
-    auto solver = factorized(A, linalg::SolverOptions{}, lane);
+    linalg::SolverOptions hermitian;
+    hermitian.complex_pairs = true;  // factorized as the complex matrix it is
+    auto solver = factorized(A, hermitian, lane);
     std::vector<double> b(2 * n, 0.0), x(2 * n);
     b[0] = mass[0];
     solver->solve(b, x);
