@@ -132,7 +132,8 @@ int run_info(const Arguments& args) {
       throw InputError("size: the model '" + args.model + "' has an empty bounding box");
     costs = parallel::estimate_face_costs(model, size);
     // The run's estimates: its field divisions (the shortcuts on, their default).
-    field_costs = parallel::estimate_field_costs(model, size, true, true, field_divisions(args));
+    const double divisions = field_divisions(args);
+    field_costs = parallel::estimate_field_costs(model, size, true, true, divisions);
     // METIS prints its complaints (more parts than a graph bisects well) on stdout, which holds
     // the JSON: they go to stderr instead.
     std::cout.flush();
@@ -140,8 +141,7 @@ int run_info(const Arguments& args) {
     const int saved = ::dup(STDOUT_FILENO);
     if (saved >= 0) ::dup2(STDERR_FILENO, STDOUT_FILENO);
     for (const int p : args.partition)
-      parts.push_back(
-          parallel::partition_model_faces(model, size, p, true, true, field_divisions(args)));
+      parts.push_back(parallel::partition_model_faces(model, size, p, true, true, divisions));
     std::fflush(stdout);
     if (saved >= 0) {
       ::dup2(saved, STDOUT_FILENO);

@@ -41,6 +41,23 @@ bool symmetric_pattern(const SparseMatrix& A) {
   return true;
 }
 
+// The checks after a numeric factorization, for both Eigen solvers: Eigen's status, then the
+// pivots. LDL^T runs on indefinite matrices too; a non-positive pivot means A is not SPD (the
+// pivots of a Hermitian matrix are real: their real parts are read).
+template <class Ldlt>
+void check_factorization(const Ldlt& ldlt, LO n, const char* backend) {
+  QSMESH_CHECK(ldlt.info() == Eigen::Success,
+               backend << ": numeric factorization failed (zero pivot): the matrix of size " << n
+                       << " is singular or not positive definite");
+  const auto& d = ldlt.vectorD();
+  for (Eigen::Index i = 0; i < d.size(); ++i) {
+    const double pivot = std::real(d[i]);
+    QSMESH_CHECK(pivot > 0 && std::isfinite(pivot),
+                 backend << ": the matrix of size " << n << " is not positive definite (pivot "
+                         << pivot << " at elimination step " << i << ")");
+  }
+}
+
 class EigenSolver final : public LinearSolver {
  public:
   void analyze(const SparseMatrix& A) override {
@@ -95,15 +112,7 @@ class EigenSolver final : public LinearSolver {
     for (std::size_t k = 0; k < source_.size(); ++k)
       dst[k] = v[static_cast<std::size_t>(source_[k])];
     ldlt_.factorize(upper_);
-    QSMESH_CHECK(ldlt_.info() == Eigen::Success,
-                 "eigen: numeric factorization failed (zero pivot): the matrix of size "
-                     << A.size() << " is singular or not positive definite");
-    // LDL^T runs on indefinite matrices too; a non-positive pivot means A is not SPD.
-    const auto& d = ldlt_.vectorD();
-    for (Eigen::Index i = 0; i < d.size(); ++i)
-      QSMESH_CHECK(d[i] > 0 && std::isfinite(d[i]),
-                   "eigen: the matrix of size " << A.size() << " is not positive definite (pivot "
-                                                << d[i] << " at elimination step " << i << ")");
+    check_factorization(ldlt_, A.size(), "eigen");
     factorized_ = true;
   }
 
@@ -207,16 +216,7 @@ class ComplexEigenSolver final : public LinearSolver {
       dst[k] = Complex(a, c);
     }
     ldlt_.factorize(lower_);
-    QSMESH_CHECK(ldlt_.info() == Eigen::Success,
-                 "eigen (complex pairs): numeric factorization failed (zero pivot): the matrix of "
-                 "size "
-                     << A.size() << " is singular or not positive definite");
-    const auto& d = ldlt_.vectorD();
-    for (Eigen::Index i = 0; i < d.size(); ++i)
-      QSMESH_CHECK(std::real(d[i]) > 0 && std::isfinite(std::real(d[i])),
-                   "eigen (complex pairs): the matrix of size "
-                       << A.size() << " is not positive definite (pivot " << std::real(d[i])
-                       << " at elimination step " << i << ")");
+    check_factorization(ldlt_, A.size(), "eigen (complex pairs)");
     factorized_ = true;
   }
 

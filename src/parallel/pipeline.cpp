@@ -16,6 +16,7 @@
 #include "improve.hpp"
 #include "qsmesh/background/curve_mesh.hpp"
 #include "qsmesh/background/face_mesh.hpp"
+#include "qsmesh/background/size.hpp"
 #include "qsmesh/core/error.hpp"
 #include "qsmesh/mesh/assemble.hpp"
 #include "qsmesh/mesh/quality.hpp"
@@ -58,14 +59,16 @@ std::vector<double> estimate_face_costs(const cad::CadModel& model, double size)
 std::vector<double> estimate_field_costs(const cad::CadModel& model, double size,
                                          bool exact_uniform, bool exact_revolution,
                                          double field_divisions) {
-  std::vector<double> cost = estimate_face_costs(model, size);
+  // The background's largest edge on each face, as the background stage caps it.
+  background::SizeOptions sizes;
+  sizes.size = size;
+  sizes.field_divisions = field_divisions;
+  std::vector<double> cost(static_cast<std::size_t>(model.num_faces()));
   for (LO f = 0; f < model.num_faces(); ++f) {
+    const cad::Face& face = model.faces()[static_cast<std::size_t>(f)];
+    const double edge = sizes.field_cap(face.box.diagonal());
     double& c = cost[static_cast<std::size_t>(f)];
-    if (field_divisions > 0) {
-      const cad::Face& face = model.faces()[static_cast<std::size_t>(f)];
-      const double edge = std::max(size, face.box.diagonal() / field_divisions);
-      c = std::max(1.0, face.area / (edge * edge));
-    }
+    c = std::max(1.0, face.area / (edge * edge));
     if (exact_uniform && cad::planar_with_right_angle_lines(model, f)) {
       c = 0;
     } else if (const auto axis =
