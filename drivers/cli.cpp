@@ -273,9 +273,10 @@ Arguments parse(const std::vector<std::string>& args) {
       a.fit_loop_widths = v == "fit";
     } else if (opt == "--repairs" && a.command == Command::Mesh) {
       const std::string& v = value();
-      if (v != "local" && v != "restore")
-        throw InputError("--repairs: '" + v + "' is not local or restore");
-      a.local_repairs = v == "local";
+      if (v != "grow" && v != "local" && v != "restore")
+        throw InputError("--repairs: '" + v + "' is not grow, local or restore");
+      a.local_repairs = v != "restore";
+      a.grow_repairs = v == "grow";
     } else if (opt == "--fine-placement" && a.command == Command::Mesh) {
       const std::string& v = value();
       if (v != "former" && v != "laplacian" && v != "spacing" && v != "both" && v != "patch")
@@ -647,10 +648,12 @@ std::string help(const std::string& topic) {
           "  --loop-widths W       with --layout coarse: mean (default: each quad loop's width\n"
           "                        the rounded mean of its input lengths) or fit (the width\n"
           "                        nearest in ratio to the input extent of every cell it crosses)\n"
-          "  --repairs R           with --layout coarse: local (default: where fine quads fold,\n"
-          "                        their patches and rings around them are kept from collapsing\n"
-          "                        before input lengths are restored) or restore (a patch's\n"
-          "                        second repair restores its input lengths)\n"
+          "  --repairs R           with --layout coarse, where fine quads fold: grow (default:\n"
+          "                        their patches and rings around them are kept from\n"
+          "                        collapsing, then grown one coarse unit at a time, before\n"
+          "                        input lengths are restored), local (kept from collapsing,\n"
+          "                        then input lengths) or restore (a patch's second repair\n"
+          "                        restores its input lengths)\n"
           "  --fine-placement P    with --layout coarse: former, laplacian, spacing, both\n"
           "                        (default) or patch: the uv Laplacian before the kernels, fine\n"
           "                        nodes on CAD curves spaced like the input mesh's (both), and\n"

@@ -492,6 +492,8 @@ std::string stats_json(const Arguments& args, const Session& session,
       j.value("ilp_rounds", static_cast<std::int64_t>(c->ilp_rounds));
       j.value("tmesh_patches", c->tmesh_patches);
       j.value("coarse_layout_repairs", static_cast<std::int64_t>(c->repairs));
+      j.value("coarse_layout_repairs_grown", static_cast<std::int64_t>(c->repairs_grown));
+      j.value("coarse_layout_repairs_restored", static_cast<std::int64_t>(c->repairs_restored));
       j.value("smooth_curves_crossed", c->smooth_curves);
       j.value("traces_across_curves", c->traces_across_curves);
       j.value("blocks_across_curves", kept ? c->blocks_across_curves : std::int64_t{0});
@@ -1028,6 +1030,7 @@ int run_mesh(const Arguments& args) {
         co.loop_balance = args.loop_balance;
         co.fit_loop_widths = args.fit_loop_widths;
         co.local_repairs = args.local_repairs;
+        co.grow_repairs = args.grow_repairs;
         co.laplacian_uv = args.fine_laplacian;
         co.input_spacing_on_curves = args.fine_input_spacing;
         co.patch_placement = args.fine_patch;

@@ -214,8 +214,11 @@ class Builder {
         std::vector<IntegerProgram::Row> rows;
         bool fresh = false;
         if (opt_.local_repairs) {
-          rows = local_repair_rows();
+          RepairKind kind = RepairKind::Keep;
+          rows = local_repair_rows(kind);
           fresh = !rows.empty();
+          if (fresh && kind == RepairKind::Grow) ++out.stats.repairs_grown;
+          if (fresh && kind == RepairKind::Restore) ++out.stats.repairs_restored;
         } else {
           // The former repairs: a patch's first repair keeps its arcs from collapsing, its next
           // ones restore its input lengths; when every such row is already there, solving again
@@ -913,17 +916,38 @@ class Builder {
     return true;
   }
 
+  // Rows q_a >= min(l_a, q_a + 1) for the side arcs of `patches`: each arc one coarse unit longer
+  // than in the last solution, up to its input length (CoarseOptions::grow_repairs).
+  [[nodiscard]] std::vector<IntegerProgram::Row> grow_rows(const std::vector<LO>& patches) const {
+    return arc_rows(patches, [this](LO, LO a) {
+      const auto i = static_cast<std::size_t>(a);
+      return std::min(static_cast<double>(arcs_[i].length()), static_cast<double>(q_[i] + 1));
+    });
+  }
+
+  enum class RepairKind { Keep, Grow, Restore };
+
   // The rows of the next repair (CoarseOptions::local_repairs): no-collapse rows on the bad coarse
   // quads' patches, then on up to kMaxRings rings of patches around them, the first of those the
-  // last solution does not meet; only when all are met, the input lengths on the same patches,
-  // ring by ring. Empty when every such set of rows is met.
-  [[nodiscard]] std::vector<IntegerProgram::Row> local_repair_rows() const {
+  // last solution does not meet; when all are met, the same patches' arcs one unit longer
+  // (CoarseOptions::grow_repairs), ring by ring; only then the input lengths on the same patches,
+  // ring by ring. Empty when every such set of rows is met. `kind` says which set was returned.
+  [[nodiscard]] std::vector<IntegerProgram::Row> local_repair_rows(RepairKind& kind) const {
     std::vector<std::vector<LO>> rings;
     for (int ring = 0; ring <= kMaxRings; ++ring) rings.push_back(repair_patches(ring));
+    kind = RepairKind::Keep;
     for (const auto& patches : rings) {
       auto rows = keep_rows(patches);
       if (!met(rows)) return rows;
     }
+    if (opt_.grow_repairs) {
+      kind = RepairKind::Grow;
+      for (const auto& patches : rings) {
+        auto rows = grow_rows(patches);
+        if (!met(rows)) return rows;
+      }
+    }
+    kind = RepairKind::Restore;
     for (const auto& patches : rings) {
       auto rows = bound_rows(patches);
       if (!met(rows)) return rows;

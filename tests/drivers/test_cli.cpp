@@ -237,6 +237,22 @@ TEST(Cli, FinePlacementChoosesTheCoarseMeshsPlacementChanges) {
             std::string::npos);
 }
 
+TEST(Cli, RepairsChooseHowTheCoarseLayoutRepairsFolds) {
+  const auto grow = p({"mesh", "m.step", "-o", "o.xyz", "--layout", "coarse"});
+  EXPECT_TRUE(grow.local_repairs && grow.grow_repairs);
+  const auto local =
+      p({"mesh", "m.step", "-o", "o.xyz", "--layout", "coarse", "--repairs", "local"});
+  EXPECT_TRUE(local.local_repairs && !local.grow_repairs);
+  const auto restore =
+      p({"mesh", "m.step", "-o", "o.xyz", "--layout", "coarse", "--repairs", "restore"});
+  EXPECT_FALSE(restore.local_repairs || restore.grow_repairs);
+  EXPECT_TRUE(
+      p({"mesh", "m.step", "-o", "o.xyz", "--layout", "coarse", "--repairs", "grow"}).grow_repairs);
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.xyz", "--layout", "coarse", "--repairs", "bound"})
+                .find("is not grow, local or restore"),
+            std::string::npos);
+}
+
 TEST(Cli, BlockStructuredNeedsCgnsAndQuads) {
   EXPECT_TRUE(p({"mesh", "m.step", "-o", "o.cgns", "--block-structured"}).block_structured);
   EXPECT_FALSE(p({"mesh", "m.step", "-o", "o.cgns"}).block_structured);

@@ -258,6 +258,29 @@ TEST(CoarseLayout, RepairsForbidCollapseBeforeRestoringInputLengths) {
       << local.stats.cells << " cells with local repairs, " << restore.stats.cells << " without";
 }
 
+TEST(CoarseLayout, GrowRepairsKeepTheLayoutCoarseWhereRingsAreNotEnough) {
+  // The crossing pipes at another size: after four repairs every ring of patches around the last
+  // folded fine quads is kept from collapsing already. Restoring the input lengths of those
+  // patches then spreads along their chains and splits most of the model into cells of one input
+  // quad; growing their arcs one unit does not (measured: 1,317 cells against 11,216).
+  const std::string path = test::write_pipe_cross(test::tmp("coarse_pipe_grow.brep"));
+  const Meshed in = mesh_model(path, 0.037);
+  const CoarseResult grow = build_coarse_layout(in.mesh, in.model);
+  CoarseOptions bound_options;
+  bound_options.grow_repairs = false;
+  const CoarseResult bound = build_coarse_layout(in.mesh, in.model, bound_options);
+  expect_conforming_blocks(grow, in.model);
+  expect_conforming_blocks(bound, in.model);
+  EXPECT_GE(grow.stats.repairs_grown, 1);
+  EXPECT_EQ(grow.stats.repairs_restored, 0);
+  EXPECT_EQ(bound.stats.repairs_grown, 0);
+  EXPECT_GE(bound.stats.repairs_restored, 1);
+  EXPECT_LT(grow.stats.cells * 4, bound.stats.cells)
+      << grow.stats.cells << " cells with grown arcs, " << bound.stats.cells
+      << " with input lengths restored";
+  EXPECT_GT(grow.stats.sicn_min, 0.0);
+}
+
 TEST(CoarseLayout, BlocksCrossSmoothCurvesNotSharpOnes) {
   // A filleted box: the fillets meet the box's faces and each other along smooth curves, which
   // blocks may cross; fewer blocks than with every curve a wall, still conforming.

@@ -78,6 +78,15 @@ struct CoarseOptions {
   /// of its patch, and so on) and on Block kept most of the model at its input lengths (70,841
   /// blocks against 43,132, docs/benchmarks.md, branch coarse10).
   bool local_repairs = true;
+  /// With local_repairs: when every ring is kept from collapsing and fine quads still fold, the
+  /// same patches' arcs first grow by one coarse unit toward their input lengths (q_a >=
+  /// min(l_a, q_a + 1)), ring by ring, repair after repair, before any input length is restored.
+  /// A restored input length spreads along the chains of patches as the no-collapse rows do, but
+  /// with every arc of the chain at its input length the chains split into cells of one input
+  /// quad: on the crossing pipes at size 0.037 one such repair took the layout from 874 to 11,216
+  /// coarse quads, one grow step to 1,317 (docs/benchmarks.md, issue 30). false: restore the
+  /// input lengths straight after the rings.
+  bool grow_repairs = true;
 };
 
 /// One coarse quad a quad loop crosses: how many input quads its cell spans across the loop (in
@@ -124,6 +133,8 @@ struct CoarseStats {
   /// of patches around them kept from collapsing, then at their input lengths
   /// (CoarseOptions::local_repairs; at most 40).
   int repairs = 0;
+  int repairs_grown = 0;     ///< repairs that grew arcs one unit (CoarseOptions::grow_repairs)
+  int repairs_restored = 0;  ///< repairs that restored input lengths
   std::string ilp_status;
   std::int64_t smooth_curves = 0;  ///< CAD curves crossed (CoarseOptions::cross_smooth_curves)
   std::int64_t traces_across_curves = 0;  ///< traces that ran on across a smooth curve
