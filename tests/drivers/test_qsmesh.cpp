@@ -363,6 +363,28 @@ TEST_F(Qsmesh, BlockSidesAlongBothBanksOfASeamAreJoined) {
   EXPECT_GT(s.interfaces, s.structured_zones);
 }
 
+TEST_F(Qsmesh, CoarseLayoutOfTheFarFieldExampleKeepsItsInputQuads) {
+  // At size factor 0.01 one quad of the input mesh wraps the wing's leading edge at its tip: its
+  // corner normals differ by more than a right angle, so the fold test of the fine mesh flagged
+  // it. Its coarse quad was at its input lengths, so no repair could change it and the coarse
+  // layout failed (the dense one was written). A fine quad equal to an input quad is now taken as
+  // the input has it.
+  const std::string step = tmp("e2e_far_field.step");
+  ASSERT_EQ(run("example far-field -o " + step).code, 0);
+  const std::string out = tmp("e2e_far_field.xyz");
+  const std::string stats = tmp("e2e_far_field_coarse.json");
+  const ExeResult r = run("mesh " + step + " -o " + out +
+                          " --block-structured --layout coarse --size-factor 0.01 --threads 2 -q"
+                          " --stats " +
+                          stats);
+  ASSERT_EQ(r.code, 0) << r.err;
+  EXPECT_EQ(r.err.find("coarse layout failed"), std::string::npos) << r.err;
+  const std::string json = slurp(stats);
+  EXPECT_NE(json.find("\"block_layout\": \"coarse\""), std::string::npos) << json;
+  EXPECT_EQ(json_number(json, "coarse_layout_repairs_restored"), 0);
+  EXPECT_GT(json_number(json, "block_mesh_sicn_min"), 0.0);
+}
+
 TEST_F(Qsmesh, UnstructuredValidOnSmallModels) {
   std::vector<std::string> models;
   const std::string example = tmp("e2e_wing_body.step");
