@@ -131,7 +131,7 @@ struct CoarseStats {
   int ilp_rounds = 0;
   /// Solves again after an invalid fine mesh, the patches that made the bad coarse quads and rings
   /// of patches around them kept from collapsing, then at their input lengths
-  /// (CoarseOptions::local_repairs; at most 40).
+  /// (CoarseOptions::local_repairs; at most 60).
   int repairs = 0;
   int repairs_grown = 0;     ///< repairs that grew arcs one unit (CoarseOptions::grow_repairs)
   int repairs_restored = 0;  ///< repairs that restored input lengths
