@@ -275,8 +275,9 @@ Arguments parse(const std::vector<std::string>& args) {
       const std::string& v = value();
       if (v != "grow" && v != "local" && v != "restore")
         throw InputError("--repairs: '" + v + "' is not grow, local or restore");
-      a.local_repairs = v != "restore";
-      a.grow_repairs = v == "grow";
+      a.repairs = v == "grow"    ? layout::Repairs::Grow
+                  : v == "local" ? layout::Repairs::Local
+                                 : layout::Repairs::Restore;
     } else if (opt == "--fine-placement" && a.command == Command::Mesh) {
       const std::string& v = value();
       if (v != "former" && v != "laplacian" && v != "spacing" && v != "both" && v != "patch")

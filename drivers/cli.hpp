@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "qsmesh/cad/model.hpp"
+#include "qsmesh/layout/coarse_layout.hpp"
 
 namespace qsmesh::cli {
 
@@ -58,10 +59,8 @@ struct Arguments {
   double loop_balance = 0;
   /// --loop-widths mean|fit (with --layout coarse): layout::CoarseOptions::fit_loop_widths.
   bool fit_loop_widths = false;
-  /// --repairs grow|local|restore (with --layout coarse): layout::CoarseOptions::local_repairs
-  /// (grow and local) and grow_repairs (grow).
-  bool local_repairs = true;
-  bool grow_repairs = true;
+  /// --repairs grow|local|restore (with --layout coarse): layout::CoarseOptions::repairs.
+  layout::Repairs repairs = layout::Repairs::Grow;
   /// --fine-placement former|laplacian|spacing|both|patch (with --layout coarse): which of the
   /// fine mesh's placement changes are on (layout::CoarseOptions::laplacian_uv,
   /// input_spacing_on_curves and patch_placement); default both, patch is both with

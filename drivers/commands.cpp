@@ -1029,8 +1029,7 @@ int run_mesh(const Arguments& args) {
         layout::CoarseOptions co;
         co.loop_balance = args.loop_balance;
         co.fit_loop_widths = args.fit_loop_widths;
-        co.local_repairs = args.local_repairs;
-        co.grow_repairs = args.grow_repairs;
+        co.repairs = args.repairs;
         co.laplacian_uv = args.fine_laplacian;
         co.input_spacing_on_curves = args.fine_input_spacing;
         co.patch_placement = args.fine_patch;

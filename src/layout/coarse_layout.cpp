@@ -36,7 +36,7 @@ constexpr LO kNever = std::numeric_limits<LO>::max();
 constexpr int kMaxSpacingRounds = 3;
 constexpr int kMaxRounds = 40;
 // A bound against a loop that keeps finding new folds. Growing arcs one unit a repair
-// (CoarseOptions::grow_repairs) takes more repairs than restoring input lengths: Block at size
+// (Repairs::Grow) takes more repairs than restoring input lengths: Block at size
 // factor 0.0035 completes after 51 (local repairs: 38, with 134,695 blocks against 55,315;
 // docs/benchmarks.md, stop 50).
 constexpr int kMaxRepairs = 60;
@@ -210,7 +210,7 @@ class Builder {
         fine_mesh(out);
         if (bad_cquads_.empty()) break;
         // Where the fine mesh is invalid, the patches that made those coarse quads are kept from
-        // collapsing, and all is solved again (local_repairs): first those patches, then up to
+        // collapsing, and all is solved again (Repairs::Local): first those patches, then up to
         // kMaxRings rings of patches around them (every patch touching a corner group of a coarse
         // quad cut from the last ones), the first set whose rows the last solution does not
         // meet; only when every ring is already kept from collapsing, the same patches are
@@ -220,12 +220,12 @@ class Builder {
         // input lengths (docs/benchmarks.md, branch coarse10).
         std::vector<IntegerProgram::Row> rows;
         bool fresh = false;
-        if (opt_.local_repairs) {
-          RepairKind kind = RepairKind::Keep;
-          rows = local_repair_rows(kind);
+        if (opt_.repairs != Repairs::Restore) {
+          LocalRepair next = local_repair_rows();
+          rows = std::move(next.rows);
           fresh = !rows.empty();
-          if (fresh && kind == RepairKind::Grow) ++out.stats.repairs_grown;
-          if (fresh && kind == RepairKind::Restore) ++out.stats.repairs_restored;
+          if (fresh && next.kind == RowKind::Grow) ++out.stats.repairs_grown;
+          if (fresh && next.kind == RowKind::Bound) ++out.stats.repairs_restored;
         } else {
           // The former repairs: a patch's first repair keeps its arcs from collapsing, its next
           // ones restore its input lengths; when every such row is already there, solving again
@@ -899,7 +899,7 @@ class Builder {
     return rows;
   }
 
-  // No-collapse rows q_a >= 1 for the side arcs of `patches` (CoarseOptions::local_repairs).
+  // No-collapse rows q_a >= 1 for the side arcs of `patches` (Repairs::Grow and Local).
   [[nodiscard]] std::vector<IntegerProgram::Row> keep_rows(const std::vector<LO>& patches) const {
     return arc_rows(patches, [](LO, LO) { return 1.0; });
   }
@@ -924,7 +924,7 @@ class Builder {
   }
 
   // Rows q_a >= min(l_a, q_a + 1) for the side arcs of `patches`: each arc one coarse unit longer
-  // than in the last solution, up to its input length (CoarseOptions::grow_repairs).
+  // than in the last solution, up to its input length (Repairs::Grow).
   [[nodiscard]] std::vector<IntegerProgram::Row> grow_rows(const std::vector<LO>& patches) const {
     return arc_rows(patches, [this](LO, LO a) {
       const auto i = static_cast<std::size_t>(a);
@@ -932,37 +932,33 @@ class Builder {
     });
   }
 
-  enum class RepairKind { Keep, Grow, Restore };
+  // The three kinds of rows a local repair adds, in the order they are tried.
+  enum class RowKind { Keep, Grow, Bound };
+  struct LocalRepair {
+    std::vector<IntegerProgram::Row> rows;
+    RowKind kind = RowKind::Keep;
+  };
 
-  // The rows of the next repair (CoarseOptions::local_repairs): no-collapse rows on the bad coarse
-  // quads' patches, then on up to kMaxRings rings of patches around them, the first of those the
-  // last solution does not meet; when all are met, the same patches' arcs one unit longer
-  // (CoarseOptions::grow_repairs), ring by ring; only then the input lengths on the same patches,
-  // ring by ring. Empty when every such set of rows is met. `kind` says which set was returned.
-  [[nodiscard]] std::vector<IntegerProgram::Row> local_repair_rows(RepairKind& kind) const {
+  // The rows of the next repair (Repairs::Grow and Local): for each kind of rows in turn (no
+  // collapse; one unit longer, with Repairs::Grow only; the input lengths), on the bad coarse
+  // quads' patches, then on up to kMaxRings rings of patches around them, the first set the last
+  // solution does not meet. Empty rows when every such set is met.
+  [[nodiscard]] LocalRepair local_repair_rows() const {
     std::vector<std::vector<LO>> rings;
     for (int ring = 0; ring <= kMaxRings; ++ring) rings.push_back(repair_patches(ring));
-    kind = RepairKind::Keep;
-    for (const auto& patches : rings) {
-      auto rows = keep_rows(patches);
-      if (!met(rows)) return rows;
-    }
-    if (opt_.grow_repairs) {
-      kind = RepairKind::Grow;
+    for (const RowKind kind : {RowKind::Keep, RowKind::Grow, RowKind::Bound}) {
+      if (kind == RowKind::Grow && opt_.repairs != Repairs::Grow) continue;
       for (const auto& patches : rings) {
-        auto rows = grow_rows(patches);
-        if (!met(rows)) return rows;
+        auto rows = kind == RowKind::Keep   ? keep_rows(patches)
+                    : kind == RowKind::Grow ? grow_rows(patches)
+                                            : bound_rows(patches);
+        if (!met(rows)) return {std::move(rows), kind};
       }
-    }
-    kind = RepairKind::Restore;
-    for (const auto& patches : rings) {
-      auto rows = bound_rows(patches);
-      if (!met(rows)) return rows;
     }
     return {};
   }
 
-  // Rows of the former repairs (local_repairs off): q_a >= 1 on a patch's first repair, q_a >= l_a
+  // Rows of the former repairs (Repairs::Restore): q_a >= 1 on a patch's first repair, q_a >= l_a
   // on its next ones, for the patches of repair_patches(rings).
   [[nodiscard]] std::vector<IntegerProgram::Row> restore_rows(int rings) {
     const std::vector<LO> patches = repair_patches(rings);

@@ -239,15 +239,15 @@ TEST(Cli, FinePlacementChoosesTheCoarseMeshsPlacementChanges) {
 
 TEST(Cli, RepairsChooseHowTheCoarseLayoutRepairsFolds) {
   const auto grow = p({"mesh", "m.step", "-o", "o.xyz", "--layout", "coarse"});
-  EXPECT_TRUE(grow.local_repairs && grow.grow_repairs);
+  EXPECT_EQ(grow.repairs, layout::Repairs::Grow);
   const auto local =
       p({"mesh", "m.step", "-o", "o.xyz", "--layout", "coarse", "--repairs", "local"});
-  EXPECT_TRUE(local.local_repairs && !local.grow_repairs);
+  EXPECT_EQ(local.repairs, layout::Repairs::Local);
   const auto restore =
       p({"mesh", "m.step", "-o", "o.xyz", "--layout", "coarse", "--repairs", "restore"});
-  EXPECT_FALSE(restore.local_repairs || restore.grow_repairs);
-  EXPECT_TRUE(
-      p({"mesh", "m.step", "-o", "o.xyz", "--layout", "coarse", "--repairs", "grow"}).grow_repairs);
+  EXPECT_EQ(restore.repairs, layout::Repairs::Restore);
+  EXPECT_EQ(p({"mesh", "m.step", "-o", "o.xyz", "--layout", "coarse", "--repairs", "grow"}).repairs,
+            layout::Repairs::Grow);
   EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.xyz", "--layout", "coarse", "--repairs", "bound"})
                 .find("is not grow, local or restore"),
             std::string::npos);

@@ -247,7 +247,7 @@ TEST(CoarseLayout, RepairsForbidCollapseBeforeRestoringInputLengths) {
   const Meshed in = mesh_model(path, 0.036);
   const CoarseResult local = build_coarse_layout(in.mesh, in.model);
   CoarseOptions restore_options;
-  restore_options.local_repairs = false;
+  restore_options.repairs = Repairs::Restore;
   const CoarseResult restore = build_coarse_layout(in.mesh, in.model, restore_options);
   expect_conforming_blocks(local, in.model);
   expect_conforming_blocks(restore, in.model);
@@ -267,7 +267,7 @@ TEST(CoarseLayout, GrowRepairsKeepTheLayoutCoarseWhereRingsAreNotEnough) {
   const Meshed in = mesh_model(path, 0.037);
   const CoarseResult grow = build_coarse_layout(in.mesh, in.model);
   CoarseOptions bound_options;
-  bound_options.grow_repairs = false;
+  bound_options.repairs = Repairs::Local;
   const CoarseResult bound = build_coarse_layout(in.mesh, in.model, bound_options);
   expect_conforming_blocks(grow, in.model);
   expect_conforming_blocks(bound, in.model);

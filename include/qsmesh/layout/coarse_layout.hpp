@@ -17,6 +17,26 @@
 
 namespace qsmesh::layout {
 
+/// CoarseOptions::repairs.
+enum class Repairs {
+  /// A repair first forbids the arcs of the bad coarse quads' patches to collapse (q_a >= 1), then
+  /// those of up to 3 rings of patches around them, the first set the last solution does not
+  /// meet; when all are met, the same patches' arcs grow by one coarse unit toward their input
+  /// lengths (q_a >= min(l_a, q_a + 1)), ring by ring, repair after repair; only when their arcs
+  /// are all at their input lengths are those restored (q_a >= l_a), ring by ring. A restored
+  /// input length spreads along the chains of patches (an arc at its input length forces the
+  /// opposite side of its patch, and so on) and splits them into cells of one input quad: on the
+  /// crossing pipes at size 0.037 one such repair took the layout from 874 to 11,216 coarse quads,
+  /// one growth step to 1,317 (docs/benchmarks.md, issue 30).
+  Grow,
+  /// As Grow without the growth: input lengths straight after the rings.
+  Local,
+  /// The former repairs: a patch's second repair restores its input lengths. On Block they kept
+  /// most of the model at its input lengths (70,841 blocks against 43,132, docs/benchmarks.md,
+  /// branch coarse10).
+  Restore,
+};
+
 struct CoarseOptions {
   /// Half-angle of the cone of the stopping rule and of the geometric consistency (4), radians
   /// (the paper's default pi/4). Larger: traces stop sooner and irregular vertices further off
@@ -69,24 +89,9 @@ struct CoarseOptions {
   /// nearest, in ratio and weighted by the input quads each cell covers, to the extent of every
   /// cell of the loop in its input patch grid) instead of the rounded mean of the loop's targets.
   bool fit_loop_widths = false;
-  /// Repairs after an invalid fine mesh (folded or invalid fine quads) act locally: a repair
-  /// first forbids the arcs of the bad coarse quads' patches to collapse (q_a >= 1), then those
-  /// of up to 3 rings of patches around them, the first set the last solution does not meet, and
-  /// only when all are met restores the input lengths (q_a >= l_a) on the same patches, ring by
-  /// ring. false: the former repairs, where a patch's second repair restores its input lengths;
-  /// those spread along chains of patches (an arc at its input length forces the opposite side
-  /// of its patch, and so on) and on Block kept most of the model at its input lengths (70,841
-  /// blocks against 43,132, docs/benchmarks.md, branch coarse10).
-  bool local_repairs = true;
-  /// With local_repairs: when every ring is kept from collapsing and fine quads still fold, the
-  /// same patches' arcs first grow by one coarse unit toward their input lengths (q_a >=
-  /// min(l_a, q_a + 1)), ring by ring, repair after repair, before any input length is restored.
-  /// A restored input length spreads along the chains of patches as the no-collapse rows do, but
-  /// with every arc of the chain at its input length the chains split into cells of one input
-  /// quad: on the crossing pipes at size 0.037 one such repair took the layout from 874 to 11,216
-  /// coarse quads, one grow step to 1,317 (docs/benchmarks.md, issue 30). false: restore the
-  /// input lengths straight after the rings.
-  bool grow_repairs = true;
+  /// How the layout is repaired where its fine mesh has folded or invalid quads (each repair
+  /// adds rows to the quantization and solves again; at most 60).
+  Repairs repairs = Repairs::Grow;
 };
 
 /// One coarse quad a quad loop crosses: how many input quads its cell spans across the loop (in
@@ -131,9 +136,9 @@ struct CoarseStats {
   int ilp_rounds = 0;
   /// Solves again after an invalid fine mesh, the patches that made the bad coarse quads and rings
   /// of patches around them kept from collapsing, then at their input lengths
-  /// (CoarseOptions::local_repairs; at most 60).
+  /// (CoarseOptions::repairs; at most 60).
   int repairs = 0;
-  int repairs_grown = 0;     ///< repairs that grew arcs one unit (CoarseOptions::grow_repairs)
+  int repairs_grown = 0;     ///< repairs that grew arcs one unit (Repairs::Grow)
   int repairs_restored = 0;  ///< repairs that restored input lengths
   std::string ilp_status;
   std::int64_t smooth_curves = 0;  ///< CAD curves crossed (CoarseOptions::cross_smooth_curves)
