@@ -380,6 +380,11 @@ Arguments parse(const std::vector<std::string>& args) {
         throw InputError(opt + ": '" + v +
                          "' is not a whole number of irregular vertices (0: never)");
       a.second_pass_task = static_cast<std::int64_t>(*n);
+    } else if (opt == "--fill-comparison" && a.command == Command::Mesh) {
+      const std::string& v = value();
+      if (v != "irregular" && v != "mean")
+        throw InputError(opt + ": '" + v + "' is not irregular or mean");
+      a.fill_comparison = v;
     } else if (opt == "--second-pass-quads" && a.command == Command::Mesh) {
       const std::string& v = value();
       const auto n = parse_double(v);
@@ -739,6 +744,13 @@ std::string help(const std::string& topic) {
           "                        second time with looser cavity bounds, and keep that mesh\n"
           "                        when it has fewer irregular vertices at a small SICN cost\n"
           "                        (docs/architecture.md); 0: no second pass (faster)\n"
+          "  --fill-comparison M   which pattern fills kept by their thresholds are compared\n"
+          "                        with the face's unstructured mesh, which replaces them when\n"
+          "                        better: irregular (the default: fills with interior\n"
+          "                        irregular vertices too, replaced by a mesh with fewer at no\n"
+          "                        worse SICN min and mean; slower) or mean (only fills of a\n"
+          "                        poor mean, replaced by a clearly better mean; the default\n"
+          "                        with --layout coarse, whose blocks follow the fills)\n"
           "  --second-pass-task N  a face with at least N irregular vertices (default "
        << parallel::kDefaultSecondPassTaskIrregular
        << ")\n"

@@ -130,6 +130,10 @@ struct Arguments {
   /// improvement runs its second pass as a task of its own
   /// (parallel::PipelineOptions::second_pass_task_irregular; 0: never); -1: the default.
   std::int64_t second_pass_task = -1;
+  /// --fill-comparison irregular|mean: which kept pattern fills wait for their face's
+  /// unstructured mesh (qstruct::PatternFaceOptions::compare_irregular); empty: the default,
+  /// irregular, or mean with --layout coarse.
+  std::string fill_comparison;
   /// --field-divisions N: the background (where the fields are computed) at the geometry's
   /// resolution, each face's edges at most its bounding-box diagonal / N (and at most the target
   /// size's resolution); 0: the background follows the target size. See kDefaultFieldDivisions.

@@ -647,7 +647,9 @@ void print_summary(std::ostream& os, const cad::CadModel& model, const parallel:
       os << " (" << n
          << " of them as good as their unstructured mesh, below the pattern thresholds)";
     if (const std::int64_t n = t("faces_fill_gave_way_to_unstructured"); n > 0)
-      os << "; " << n << " fill(s) with a poor mean gave way to a clearly better unstructured mesh";
+      os << "; " << n
+         << " fill(s) gave way to the face's unstructured mesh (a clearly better mean, or fewer "
+            "irregular vertices at no worse SICN)";
     os << "\n"
        << "  cavity remeshing (other faces): irregular interior vertices "
        << t("irregular_unstructured_before") << " -> " << t("irregular_unstructured_after_cavities")
@@ -980,6 +982,11 @@ int run_mesh(const Arguments& args) {
   if (args.second_pass_task >= 0) options.second_pass_task_irregular = args.second_pass_task;
   if (args.second_pass_quads == 0) options.second_pass_sicn_per_irregular = 0;  // off
   if (args.second_pass_quads > 0) options.second_pass_max_quads = args.second_pass_quads;
+  // Under a coarse block layout the fills' aligned transitions give fewer blocks than the
+  // unstructured meshes that would replace them (A319 at 0.0048-0.0052: 4.9% fewer blocks,
+  // mambo_s34 2-44%; docs/benchmarks.md, stop 52), so there only poor means are compared.
+  options.patterns.compare_irregular =
+      args.fill_comparison.empty() ? !args.coarse_layout : args.fill_comparison == "irregular";
   // Paper 003: read before any work, so that a bad file is one InputError line up front.
   fieldmesh::GivenFields given_fields;
   if (!args.cross_field.empty()) {

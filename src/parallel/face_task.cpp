@@ -99,7 +99,12 @@ PatternFill mesh_face_fill(const cad::CadModel& model, LO f,
 
 void take_fill(FaceTask& task, PatternFill&& fill, const qstruct::PatternFaceOptions& options) {
   qstruct::PatternFaceReport& pr = fill.report;
-  if (pr.ok && qstruct::fill_to_compare(pr.sicn_avg, pr.quads, options)) {
+  // The fill's irregular vertices only where they can send it to the comparison.
+  const auto irregular = [&] {
+    return options.compare_irregular ? mesh::face_quad_stats(fill.mesh).irregular_interior
+                                     : std::int64_t{0};
+  };
+  if (pr.ok && qstruct::fill_to_compare(pr.sicn_avg, pr.quads, irregular(), options)) {
     task.refused = {std::move(fill.mesh), pr.pattern_name, true};
   } else if (pr.ok) {
     task.quasi.by_pattern = true;

@@ -44,9 +44,11 @@ const char* to_string(Refusal r) {
   return "?";
 }
 
-bool fill_to_compare(double sicn_avg, std::int64_t quads, const PatternFaceOptions& options) {
+bool fill_to_compare(double sicn_avg, std::int64_t quads, std::int64_t irregular_interior,
+                     const PatternFaceOptions& options) {
   return options.compare_avg_margin >= 0 && quads > options.small_fill_quads &&
-         !(sicn_avg > options.compare_below_avg);
+         (!(sicn_avg > options.compare_below_avg) ||
+          (options.compare_irregular && irregular_interior > 0));
 }
 
 bool unstructured_clearly_better(const mesh::FaceQuadStats& fill,
@@ -58,9 +60,22 @@ bool unstructured_clearly_better(const mesh::FaceQuadStats& fill,
          unstructured.sicn_avg > fill.sicn_avg + options.compare_avg_margin;
 }
 
+bool unstructured_fewer_irregular(const mesh::FaceQuadStats& fill,
+                                  const mesh::FaceQuadStats& unstructured, double tolerance,
+                                  const PatternFaceOptions& options) {
+  if (!options.compare_irregular) return false;
+  if (unstructured.quads <= 0 || unstructured.triangles > 0 || !(unstructured.sicn_min > 0))
+    return false;
+  return unstructured.irregular_interior < fill.irregular_interior &&
+         unstructured.sicn_min >= fill.sicn_min - tolerance &&
+         unstructured.sicn_avg >= fill.sicn_avg - tolerance;
+}
+
 bool fill_wins(const mesh::FaceQuadStats& fill, const mesh::FaceQuadStats& unstructured, bool kept,
                double tolerance, const PatternFaceOptions& options) {
-  if (kept) return !unstructured_clearly_better(fill, unstructured, options);
+  if (kept)
+    return !unstructured_clearly_better(fill, unstructured, options) &&
+           !unstructured_fewer_irregular(fill, unstructured, tolerance, options);
   return fill.sicn_min >= unstructured.sicn_min - tolerance &&
          fill.sicn_avg >= unstructured.sicn_avg - tolerance &&
          fill.irregular_interior <= unstructured.irregular_interior;

@@ -253,6 +253,17 @@ TEST(Cli, RepairsChooseHowTheCoarseLayoutRepairsFolds) {
             std::string::npos);
 }
 
+TEST(Cli, FillComparisonChoosesWhichKeptFillsAreCompared) {
+  EXPECT_EQ(p({"mesh", "m.step", "-o", "o.msh"}).fill_comparison, "");  // the default
+  EXPECT_EQ(p({"mesh", "m.step", "-o", "o.msh", "--fill-comparison", "mean"}).fill_comparison,
+            "mean");
+  EXPECT_EQ(p({"mesh", "m.step", "-o", "o.msh", "--fill-comparison", "irregular"}).fill_comparison,
+            "irregular");
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.msh", "--fill-comparison", "all"})
+                .find("is not irregular or mean"),
+            std::string::npos);
+}
+
 TEST(Cli, BlockStructuredNeedsCgnsAndQuads) {
   EXPECT_TRUE(p({"mesh", "m.step", "-o", "o.cgns", "--block-structured"}).block_structured);
   EXPECT_FALSE(p({"mesh", "m.step", "-o", "o.cgns"}).block_structured);

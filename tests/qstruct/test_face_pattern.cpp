@@ -190,10 +190,10 @@ TEST(FacePattern, SmallFillIsKeptOnItsMinimumAlone) {
 TEST(FacePattern, PoorMeanFillGivesWayOnlyToAClearlyBetterUnstructuredMesh) {
   const PatternFaceOptions o;
   ASSERT_GE(o.compare_below_avg, o.min_sicn_avg);  // every fill kept on its minimum alone
-  EXPECT_TRUE(fill_to_compare(0.678, 1725, o));
-  EXPECT_TRUE(fill_to_compare(0.727, 1248, o));  // kept on its mean, just above
-  EXPECT_FALSE(fill_to_compare(o.compare_below_avg + 0.01, 1725, o));  // a good mean
-  EXPECT_FALSE(fill_to_compare(0.678, o.small_fill_quads, o));         // a small fill
+  EXPECT_TRUE(fill_to_compare(0.678, 1725, 0, o));
+  EXPECT_TRUE(fill_to_compare(0.727, 1248, 0, o));  // kept on its mean, just above
+  EXPECT_FALSE(fill_to_compare(o.compare_below_avg + 0.01, 1725, 0, o));  // a good mean
+  EXPECT_FALSE(fill_to_compare(0.678, o.small_fill_quads, 0, o));         // a small fill
   const auto stats = [](std::int64_t quads, std::int64_t triangles, double mn, double avg) {
     mesh::FaceQuadStats s;
     s.quads = quads;
@@ -215,8 +215,46 @@ TEST(FacePattern, PoorMeanFillGivesWayOnlyToAClearlyBetterUnstructuredMesh) {
   EXPECT_FALSE(unstructured_clearly_better(fill, stats(0, 0, 0, 0), o));
   PatternFaceOptions off;
   off.compare_avg_margin = -1;
-  EXPECT_FALSE(fill_to_compare(0.678, 1725, off));
+  EXPECT_FALSE(fill_to_compare(0.678, 1725, 4, off));
   EXPECT_FALSE(unstructured_clearly_better(fill, stats(660, 0, 0.61, 0.958), off));
+}
+
+// A kept fill with interior irregular vertices (a transition) is compared whatever its mean, and
+// gives way to an unstructured mesh of the same face with fewer of them at no worse SICN min and
+// mean (within the tolerance). The numbers are A319.brep's faces at its reference count: face 34,
+// a 4-irregular fill at 0.853 / 0.994 against an unstructured mesh with 2 at 0.863 / 0.993; face
+// 40, 4 at 0.755 / 0.921 against 4 at 0.760 / 0.973 (as many: the fill stays, its mean is not
+// clearly worse); face 23, 4 at 0.315 / 0.878 against 8 at 0.730 / 0.971.
+TEST(FacePattern, TransitionFillGivesWayToFewerIrregularVerticesAtNoQualityCost) {
+  const PatternFaceOptions o;
+  ASSERT_TRUE(o.compare_irregular);
+  EXPECT_TRUE(fill_to_compare(0.994, 1535, 4, o));   // a good mean, but irregular vertices
+  EXPECT_FALSE(fill_to_compare(0.994, 1535, 0, o));  // a grid: nothing to gain
+  EXPECT_FALSE(fill_to_compare(0.994, o.small_fill_quads, 4, o));  // a small fill
+  const auto stats = [](std::int64_t irregular, double mn, double avg) {
+    mesh::FaceQuadStats s;
+    s.quads = 500;
+    s.irregular_interior = irregular;
+    s.sicn_min = mn;
+    s.sicn_avg = avg;
+    return s;
+  };
+  const double tol = 0.01;
+  EXPECT_FALSE(fill_wins(stats(4, 0.853, 0.994), stats(2, 0.863, 0.993), true, tol, o));  // 34
+  EXPECT_TRUE(fill_wins(stats(4, 0.755, 0.921), stats(4, 0.760, 0.973), true, tol, o));   // 40
+  EXPECT_TRUE(fill_wins(stats(4, 0.315, 0.878), stats(8, 0.730, 0.971), true, tol, o));   // 23
+  // Fewer irregular vertices bought with a worse minimum or mean beyond the tolerance, or with
+  // triangles, do not replace the fill.
+  EXPECT_TRUE(fill_wins(stats(4, 0.853, 0.994), stats(2, 0.84, 0.993), true, tol, o));
+  EXPECT_TRUE(fill_wins(stats(4, 0.853, 0.994), stats(2, 0.863, 0.98), true, tol, o));
+  mesh::FaceQuadStats with_triangles = stats(2, 0.863, 0.993);
+  with_triangles.triangles = 1;
+  EXPECT_FALSE(unstructured_fewer_irregular(stats(4, 0.853, 0.994), with_triangles, tol, o));
+  // --fill-comparison mean: the former rule, on the mean alone.
+  PatternFaceOptions mean = o;
+  mean.compare_irregular = false;
+  EXPECT_FALSE(fill_to_compare(0.994, 1535, 4, mean));
+  EXPECT_TRUE(fill_wins(stats(4, 0.853, 0.994), stats(2, 0.863, 0.993), true, tol, mean));
 }
 
 // The choice between a fill waiting for its face's unstructured mesh and that mesh, in one place

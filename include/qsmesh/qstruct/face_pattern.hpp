@@ -67,6 +67,18 @@ struct PatternFaceOptions {
   /// unstructured mesh has 0.95-0.96 (docs/benchmarks.md).
   double compare_below_avg = 0.8;
   double compare_avg_margin = 0.1;
+  /// A kept fill of more than small_fill_quads quads with interior irregular vertices (a
+  /// transition, whatever its mean) is compared too (fill_to_compare), and gives way to the
+  /// unstructured mesh of the same face when that has fewer interior irregular vertices and is
+  /// no worse in SICN min and mean within the pipeline's comparison tolerance
+  /// (unstructured_fewer_irregular). Paper 000 Sec. 6.1.1 keeps a pattern mesh for its quality;
+  /// a transition fill's pairs of irregular vertices are not always the fewest the face allows.
+  /// At the reference counts (docs/benchmarks.md, stop 52): interior irregular Block 1563 ->
+  /// 1548, A319 356 -> 345 (SICN avg 0.9203 -> 0.9304), mambo_s34 256 -> 246 (0.9845 -> 0.9840),
+  /// the other three unchanged; the same direction at every neighbouring factor measured. The
+  /// price is the unstructured path on those faces: CPU time +7% on Block, +45% on A319. False:
+  /// only poor means are compared (--fill-comparison mean).
+  bool compare_irregular = true;
   /// The quad at a corner of angle a < 90 degrees reaches SICN sin(a) at best (equal edges): at a
   /// face with a side-splitting corner where sin(a) <= min_sicn, which min_sicn would refuse
   /// whatever the mesh (a < 17.5 degrees for 0.3), the min threshold is corner_sicn_factor x
@@ -331,12 +343,14 @@ struct FaceSides {
                                                PatternFaceReport* report = nullptr);
 
 /// Whether a fill kept by mesh_face_pattern (valid, its minimum above the face's threshold) with
-/// this mean SICN and quad count is compared with the face's unstructured mesh: more than
-/// options.small_fill_quads quads and its mean at or below options.compare_below_avg. That takes
-/// in every fill kept on options.keep_sicn_min alone (the acceptance rule of Gmsh's
+/// this mean SICN, quad count and number of interior irregular vertices is compared with the
+/// face's unstructured mesh: more than options.small_fill_quads quads, and its mean at or below
+/// options.compare_below_avg or (options.compare_irregular) an interior irregular vertex. The
+/// mean takes in every fill kept on options.keep_sicn_min alone (the acceptance rule of Gmsh's
 /// implementation: every quad above it, whatever the mean) when compare_below_avg is at least
 /// min_sicn_avg. False when options.compare_avg_margin is negative (no comparison).
 [[nodiscard]] bool fill_to_compare(double sicn_avg, std::int64_t quads,
+                                   std::int64_t irregular_interior,
                                    const PatternFaceOptions& options);
 
 /// Whether the unstructured mesh of a face (paper 000 Sec. 5-6.3, after the topological steps)
@@ -344,15 +358,24 @@ struct FaceSides {
 /// the fill: it is all quads, valid, with its minimum SICN above options.min_sicn (it trades no
 /// poor quad for the fill's mean), and its mean SICN is above the fill's by more than
 /// options.compare_avg_margin (never when that is negative). Irregular vertices are not
-/// weighed: the fill has the fewest a pattern allows, and its mean is what was given up to get
-/// them. Serial, pure.
+/// weighed here (unstructured_fewer_irregular weighs them): a better mean bought with more of
+/// them replaces the fill only when it is clearly better. Serial, pure.
 [[nodiscard]] bool unstructured_clearly_better(const mesh::FaceQuadStats& fill,
                                                const mesh::FaceQuadStats& unstructured,
                                                const PatternFaceOptions& options);
 
+/// Whether the unstructured mesh of a face has fewer interior irregular vertices than a kept
+/// fill of the same face at no cost in quality: all quads, valid, its SICN min and mean each at
+/// least the fill's less `tolerance`. False unless options.compare_irregular. Serial, pure.
+[[nodiscard]] bool unstructured_fewer_irregular(const mesh::FaceQuadStats& fill,
+                                                const mesh::FaceQuadStats& unstructured,
+                                                double tolerance,
+                                                const PatternFaceOptions& options);
+
 /// Which mesh a face keeps when a pattern fill waits for its unstructured mesh (the pipeline's
 /// comparison after paper 000 Sec. 6.2-6.3): true for the fill. A fill kept by mesh_face_pattern
-/// but held back by fill_to_compare (`kept`) wins unless unstructured_clearly_better; a fill the
+/// but held back by fill_to_compare (`kept`) wins unless unstructured_clearly_better or
+/// unstructured_fewer_irregular; a fill the
 /// thresholds refused wins when it is no worse than the unstructured mesh in SICN min and mean
 /// (within `tolerance`) and has no more interior irregular vertices. Serial, pure.
 [[nodiscard]] bool fill_wins(const mesh::FaceQuadStats& fill,
