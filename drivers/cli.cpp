@@ -746,11 +746,13 @@ std::string help(const std::string& topic) {
           "                        (docs/architecture.md); 0: no second pass (faster)\n"
           "  --fill-comparison M   which pattern fills kept by their thresholds are compared\n"
           "                        with the face's unstructured mesh, which replaces them when\n"
-          "                        better: irregular (the default: fills with interior\n"
-          "                        irregular vertices too, replaced by a mesh with fewer at no\n"
-          "                        worse SICN min and mean; slower) or mean (only fills of a\n"
-          "                        poor mean, replaced by a clearly better mean; the default\n"
-          "                        with --layout coarse, whose blocks follow the fills)\n"
+          "                        better: irregular (the default: fills of at most "
+       << parallel::PipelineOptions{}.patterns.compare_irregular_max_quads
+       << " quads\n"
+          "                        with interior irregular vertices too, replaced by a mesh with\n"
+          "                        fewer at no worse SICN min and mean; slower) or mean (only\n"
+          "                        fills of a poor mean, replaced by a clearly better mean; the\n"
+          "                        default with --layout coarse, whose blocks follow the fills)\n"
           "  --second-pass-task N  a face with at least N irregular vertices (default "
        << parallel::kDefaultSecondPassTaskIrregular
        << ")\n"

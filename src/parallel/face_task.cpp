@@ -101,8 +101,9 @@ void take_fill(FaceTask& task, PatternFill&& fill, const qstruct::PatternFaceOpt
   qstruct::PatternFaceReport& pr = fill.report;
   // The fill's irregular vertices only where they can send it to the comparison.
   const auto irregular = [&] {
-    return options.compare_irregular ? mesh::face_quad_stats(fill.mesh).irregular_interior
-                                     : std::int64_t{0};
+    return options.compare_irregular && pr.quads <= options.compare_irregular_max_quads
+               ? mesh::face_quad_stats(fill.mesh).irregular_interior
+               : std::int64_t{0};
   };
   if (pr.ok && qstruct::fill_to_compare(pr.sicn_avg, pr.quads, irregular(), options)) {
     task.refused = {std::move(fill.mesh), pr.pattern_name, true};

@@ -48,7 +48,8 @@ bool fill_to_compare(double sicn_avg, std::int64_t quads, std::int64_t irregular
                      const PatternFaceOptions& options) {
   return options.compare_avg_margin >= 0 && quads > options.small_fill_quads &&
          (!(sicn_avg > options.compare_below_avg) ||
-          (options.compare_irregular && irregular_interior > 0));
+          (options.compare_irregular && quads <= options.compare_irregular_max_quads &&
+           irregular_interior > 0));
 }
 
 bool unstructured_clearly_better(const mesh::FaceQuadStats& fill,

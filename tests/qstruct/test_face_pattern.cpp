@@ -231,6 +231,10 @@ TEST(FacePattern, TransitionFillGivesWayToFewerIrregularVerticesAtNoQualityCost)
   EXPECT_TRUE(fill_to_compare(0.994, 1535, 4, o));   // a good mean, but irregular vertices
   EXPECT_FALSE(fill_to_compare(0.994, 1535, 0, o));  // a grid: nothing to gain
   EXPECT_FALSE(fill_to_compare(0.994, o.small_fill_quads, 4, o));  // a small fill
+  // A large one: meshing it both ways would cost too much (a poor mean is still compared).
+  EXPECT_TRUE(fill_to_compare(0.994, o.compare_irregular_max_quads, 4, o));
+  EXPECT_FALSE(fill_to_compare(0.994, o.compare_irregular_max_quads + 1, 4, o));
+  EXPECT_TRUE(fill_to_compare(0.7, o.compare_irregular_max_quads + 1, 4, o));
   const auto stats = [](std::int64_t irregular, double mn, double avg) {
     mesh::FaceQuadStats s;
     s.quads = 500;

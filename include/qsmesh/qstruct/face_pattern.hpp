@@ -79,6 +79,12 @@ struct PatternFaceOptions {
   /// price is the unstructured path on those faces: CPU time +7% on Block, +45% on A319. False:
   /// only poor means are compared (--fill-comparison mean).
   bool compare_irregular = true;
+  /// ... on fills of at most this many quads: meshing a face both ways, and holding both meshes
+  /// until the comparison, is then bounded per face. Without the bound A319 at 16x its reference
+  /// vertex count took 30.5 s instead of 15.4 s on 2 ranks and 1541 bytes a quad (issue 27's
+  /// bound: 1.5 KB), its faces of 6,000-25,000 quads meshed both ways. 4000, as the second
+  /// improvement pass's face bound (PipelineOptions::second_pass_max_quads).
+  std::int64_t compare_irregular_max_quads = 4000;
   /// The quad at a corner of angle a < 90 degrees reaches SICN sin(a) at best (equal edges): at a
   /// face with a side-splitting corner where sin(a) <= min_sicn, which min_sicn would refuse
   /// whatever the mesh (a < 17.5 degrees for 0.3), the min threshold is corner_sicn_factor x
@@ -345,7 +351,8 @@ struct FaceSides {
 /// Whether a fill kept by mesh_face_pattern (valid, its minimum above the face's threshold) with
 /// this mean SICN, quad count and number of interior irregular vertices is compared with the
 /// face's unstructured mesh: more than options.small_fill_quads quads, and its mean at or below
-/// options.compare_below_avg or (options.compare_irregular) an interior irregular vertex. The
+/// options.compare_below_avg or (options.compare_irregular, at most
+/// options.compare_irregular_max_quads quads) an interior irregular vertex. The
 /// mean takes in every fill kept on options.keep_sicn_min alone (the acceptance rule of Gmsh's
 /// implementation: every quad above it, whatever the mean) when compare_below_avg is at least
 /// min_sicn_avg. False when options.compare_avg_margin is negative (no comparison).
