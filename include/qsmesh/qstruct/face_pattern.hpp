@@ -382,9 +382,9 @@ struct FaceSides {
 /// Which mesh a face keeps when a pattern fill waits for its unstructured mesh (the pipeline's
 /// comparison after paper 000 Sec. 6.2-6.3): true for the fill. A fill kept by mesh_face_pattern
 /// but held back by fill_to_compare (`kept`) wins unless unstructured_clearly_better or
-/// unstructured_fewer_irregular; a fill the
-/// thresholds refused wins when it is no worse than the unstructured mesh in SICN min and mean
-/// (within `tolerance`) and has no more interior irregular vertices. Serial, pure.
+/// unstructured_fewer_irregular; a fill the thresholds refused wins when it is no worse than the
+/// unstructured mesh in SICN min and mean (within `tolerance`) and has no more interior irregular
+/// vertices. Serial, pure.
 [[nodiscard]] bool fill_wins(const mesh::FaceQuadStats& fill,
                              const mesh::FaceQuadStats& unstructured, bool kept, double tolerance,
                              const PatternFaceOptions& options);
