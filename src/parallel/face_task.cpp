@@ -99,13 +99,9 @@ PatternFill mesh_face_fill(const cad::CadModel& model, LO f,
 
 void take_fill(FaceTask& task, PatternFill&& fill, const qstruct::PatternFaceOptions& options) {
   qstruct::PatternFaceReport& pr = fill.report;
-  // The fill's irregular vertices only where they can send it to the comparison.
-  const auto irregular = [&] {
-    return options.compare_irregular && pr.quads <= options.compare_irregular_max_quads
-               ? mesh::face_quad_stats(fill.mesh).irregular_interior
-               : std::int64_t{0};
-  };
-  if (pr.ok && qstruct::fill_to_compare(pr.sicn_avg, pr.quads, irregular(), options)) {
+  if (pr.ok &&
+      qstruct::fill_to_compare(pr.sicn_avg, pr.quads,
+                               mesh::face_quad_stats(fill.mesh).irregular_interior, options)) {
     task.refused = {std::move(fill.mesh), pr.pattern_name, true};
   } else if (pr.ok) {
     task.quasi.by_pattern = true;

@@ -71,19 +71,15 @@ struct PatternFaceOptions {
   /// transition, whatever its mean) is compared too (fill_to_compare), and gives way to the
   /// unstructured mesh of the same face when that has fewer interior irregular vertices and is
   /// no worse in SICN min and mean within the pipeline's comparison tolerance
-  /// (unstructured_fewer_irregular). Paper 000 Sec. 6.1.1 keeps a pattern mesh for its quality;
-  /// a transition fill's pairs of irregular vertices are not always the fewest the face allows.
-  /// At the reference counts (docs/benchmarks.md, stop 52): interior irregular Block 1563 ->
-  /// 1548, A319 356 -> 345 (SICN avg 0.9203 -> 0.9304), mambo_s34 256 -> 246 (0.9845 -> 0.9840),
-  /// the other three unchanged; the same direction at every neighbouring factor measured. The
-  /// price is the unstructured path on those faces: CPU time +7% on Block, +45% on A319. False:
-  /// only poor means are compared (--fill-comparison mean).
+  /// (unstructured_fewer_irregular): a transition pattern places its irregular vertices in pairs,
+  /// which is not always the fewest the face allows. It costs meshing those faces both ways
+  /// (docs/benchmarks.md, "Transition fills weighed"). False: only poor means are compared
+  /// (--fill-comparison mean).
   bool compare_irregular = true;
-  /// ... on fills of at most this many quads: meshing a face both ways, and holding both meshes
-  /// until the comparison, is then bounded per face. Without the bound A319 at 16x its reference
-  /// vertex count took 30.5 s instead of 15.4 s on 2 ranks and 1541 bytes a quad (issue 27's
-  /// bound: 1.5 KB), its faces of 6,000-25,000 quads meshed both ways. 4000, as the second
-  /// improvement pass's face bound (PipelineOptions::second_pass_max_quads).
+  /// ... on fills of at most this many quads, so that meshing a face both ways, and holding both
+  /// meshes until the comparison, stays bounded per face (at 16x its reference count A319 took
+  /// twice the time and 1.5 KB a quad without it). The second improvement pass's face bound
+  /// (PipelineOptions::second_pass_max_quads).
   std::int64_t compare_irregular_max_quads = 4000;
   /// The quad at a corner of angle a < 90 degrees reaches SICN sin(a) at best (equal edges): at a
   /// face with a side-splitting corner where sin(a) <= min_sicn, which min_sicn would refuse
