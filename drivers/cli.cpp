@@ -243,6 +243,13 @@ Arguments parse(const std::vector<std::string>& args) {
           throw InputError(opt + ": '" + v + "': the ratio after ':' is not in (0, 1)");
         a.field_stall_ratio = *r;
       }
+    } else if (opt == "--field-stall-revolution" && meshing) {
+      const std::string& v = value();
+      const auto n = parse_double(v);
+      if (!n || !std::isfinite(*n) || *n < 0 || *n > 1000 || *n != std::floor(*n))
+        throw InputError(opt + ": '" + v +
+                         "' is not 0 (off) or a number of iterations in [1, 1000]");
+      a.field_stall_revolution = static_cast<int>(*n);
     } else if (opt == "--block-structured" && a.command == Command::Mesh)
       a.block_structured = true;
     else if (opt == "--block-patches" && a.command == Command::Mesh)
@@ -721,6 +728,13 @@ std::string help(const std::string& topic) {
        << crossfield::CrossFieldOptions{}.stall_window << "; R default "
        << crossfield::CrossFieldOptions{}.stall_ratio
        << ")\n"
+          "  --field-stall-revolution K\n"
+          "                        the same rule, with ratio R, on the faces of revolution\n"
+          "                        that are solved (not taken by --field-shortcuts) while\n"
+          "                        --field-stall is off: their singularities drift about the\n"
+          "                        axis and the levels would run to the cap; 0: off (default "
+       << crossfield::CrossFieldOptions{}.revolution_stall_window
+       << ")\n"
           "  --field-shortcuts S   faces whose cross field is known in closed form take it\n"
           "                        without a solve: planar faces bounded by lines at right\n"
           "                        angles, and faces of revolution (cylinders, cones, tori,\n"
@@ -792,7 +806,8 @@ std::string help(const std::string& topic) {
           "                        with the line 'euler-consistent: K/N'\n"
           "  --size H, --size-factor F, --threads T, --stats FILE.json, --max-quads N,\n"
           "  --field-divisions N, --distributed-threshold N, --field-change M,\n"
-          "  --field-iterations N, --field-stall K[:R], --field-shortcuts S, --sew, -q, -v:\n"
+          "  --field-iterations N, --field-stall K[:R], --field-stall-revolution K,\n"
+          "  --field-shortcuts S, --sew, -q, -v:\n"
           "                        as for mesh\n";
   } else if (topic == "sizemap") {
     os << "usage: [mpirun -np P] qsmesh sizemap MODEL -o OUT.vtu [options]\n\n"
@@ -855,7 +870,8 @@ std::string help(const std::string& topic) {
           "                        size constraints at corners, on curves, on faces (model units)\n"
           "  --size H, --size-factor F, --threads T, --stats FILE.json, --max-quads N,\n"
           "  --field-divisions N, --distributed-threshold N, --field-change M,\n"
-          "  --field-iterations N, --field-stall K[:R], --field-shortcuts S, --sew, -q, -v:\n"
+          "  --field-iterations N, --field-stall K[:R], --field-stall-revolution K,\n"
+          "  --field-shortcuts S, --sew, -q, -v:\n"
           "                        as for mesh\n";
   } else if (topic == "example") {
     os << "usage: qsmesh example NAME -o FILE\n\n"

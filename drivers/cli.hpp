@@ -149,6 +149,9 @@ struct Arguments {
   std::optional<int> field_stall;
   /// the R of --field-stall K:R (crossfield::CrossFieldOptions::stall_ratio); unset: its default.
   std::optional<double> field_stall_ratio;
+  /// --field-stall-revolution K (crossfield::CrossFieldOptions::revolution_stall_window); unset:
+  /// its default.
+  std::optional<int> field_stall_revolution;
   /// --field-shortcuts: "all" (default), "uniform" or "none" (crossfield::CrossFieldOptions::
   /// exact_uniform and exact_revolution); empty: unset.
   std::string field_shortcuts;

@@ -859,6 +859,8 @@ parallel::PipelineOptions field_options(const Arguments& args, const Session& s)
   if (args.field_iterations) options.crossfield.max_iterations_per_level = *args.field_iterations;
   if (args.field_stall) options.crossfield.stall_window = *args.field_stall;
   if (args.field_stall_ratio) options.crossfield.stall_ratio = *args.field_stall_ratio;
+  if (args.field_stall_revolution)
+    options.crossfield.revolution_stall_window = *args.field_stall_revolution;
   if (!args.field_shortcuts.empty()) {
     options.crossfield.exact_uniform = args.field_shortcuts != "none";
     options.crossfield.exact_revolution = args.field_shortcuts == "all";

@@ -16,7 +16,10 @@ FaceCrossField compute_face_cross_field(const mesh::FaceMesh& background,
   const bool uniform = options.exact_uniform && detail::set_exact_uniform_field(cf, g);
   bool revolution = !uniform && options.exact_revolution && axis.has_value() &&
                     detail::set_revolution_field(cf, g, *axis);
-  if (!uniform && !revolution) detail::diffuse(cf, g, options, lane);
+  CrossFieldOptions solve_options = options;
+  if (axis.has_value() && options.stall_window == 0)
+    solve_options.stall_window = options.revolution_stall_window;
+  if (!uniform && !revolution) detail::diffuse(cf, g, solve_options, lane);
   detail::compute_directions(cf, g);
   detail::find_singularities(cf, g, options);
   if (revolution && (!cf.singularities.empty() || !cf.euler.consistent)) {
@@ -24,7 +27,7 @@ FaceCrossField compute_face_cross_field(const mesh::FaceMesh& background,
     // shortcut does not hold, the face is solved as any other.
     revolution = false;
     cf.stats.solver.clear();
-    detail::diffuse(cf, g, options, lane);
+    detail::diffuse(cf, g, solve_options, lane);
     detail::compute_directions(cf, g);
     detail::find_singularities(cf, g, options);
   }

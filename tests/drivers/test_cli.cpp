@@ -96,6 +96,23 @@ TEST(Cli, FieldStall) {
   EXPECT_NE(help("mesh").find("--field-stall"), std::string::npos);
 }
 
+TEST(Cli, FieldStallRevolution) {
+  EXPECT_FALSE(p({"mesh", "m.step", "-o", "o.vtu"}).field_stall_revolution.has_value());
+  EXPECT_EQ(
+      *p({"mesh", "m.step", "-o", "o.vtu", "--field-stall-revolution", "0"}).field_stall_revolution,
+      0);
+  EXPECT_EQ(*p({"crossfield", "m.step", "--check", "--field-stall-revolution", "6"})
+                 .field_stall_revolution,
+            6);
+  for (const char* bad : {"-1", "2.5", "x", "1001", "4:0.5"})
+    EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--field-stall-revolution", bad})
+                  .find("--field-stall-revolution"),
+              std::string::npos)
+        << bad;
+  EXPECT_NE(help("mesh").find("--field-stall-revolution"), std::string::npos);
+  EXPECT_NE(help("crossfield").find("--field-stall-revolution"), std::string::npos);
+}
+
 TEST(Cli, FieldShortcuts) {
   EXPECT_TRUE(p({"mesh", "m.step", "-o", "o.vtu"}).field_shortcuts.empty());
   for (const char* v : {"all", "uniform", "none"})

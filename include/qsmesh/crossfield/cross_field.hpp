@@ -57,6 +57,12 @@ struct CrossFieldOptions {
   /// max_iterations_per_level).
   int stall_window = 0;
   double stall_ratio = 0.5;
+  /// The stall rule's window on a solved face of revolution (compute_face_cross_field's `axis`
+  /// given, its shortcut not taken), where stall_window is 0. Turning the field's singularities
+  /// together about the axis changes its energy only through boundary features far away, so the
+  /// levels drift and run to max_iterations_per_level, with an end point set by the cap, not by
+  /// convergence (docs/benchmarks.md, "field6"). 0: such faces run as any other.
+  int revolution_stall_window = 4;
   bool extend_boundary = true;   ///< Sec. 3.1 boundary-condition extension
   double acute_corner_deg = 45;  ///< artificial +1 singularity at CAD corners sharper than this
   /// Sec. 3.3 scaling, outliers clamped: H is clamped to its area-weighted quantiles q and 1 - q
@@ -158,7 +164,8 @@ struct FaceCrossField {
 /// (Eigen). A face without boundary (closed surface, e.g. a full sphere) has no Dirichlet data and
 /// starts from a fixed direction projected on the surface. Throws qsmesh::Error on an empty mesh
 /// or a solver failure; the caller logs the face and falls back. `axis`: the face's axis when it
-/// lies on a surface of revolution (cad::revolution_axis), for CrossFieldOptions::exact_revolution.
+/// lies on a surface of revolution (cad::revolution_axis), for CrossFieldOptions::exact_revolution
+/// and revolution_stall_window.
 [[nodiscard]] FaceCrossField compute_face_cross_field(
     const mesh::FaceMesh& background, const CrossFieldOptions& options, linalg::SolverLane* lane,
     const std::optional<cad::RevolutionAxis>& axis = std::nullopt);
