@@ -75,7 +75,7 @@ int run_crossfield(const Arguments& args) {
 
   const LO nfaces = s.model.num_faces();
   int consistent = 0, with_field = 0, plus = 0, minus = 0, levels = 0, factorizations = 0,
-      solves = 0;
+      solves = 0, stalled_levels = 0;
   for (const auto& cf : result.cross_fields) {
     if (!cf.ok) continue;
     ++with_field;
@@ -84,6 +84,7 @@ int run_crossfield(const Arguments& args) {
     levels += cf.levels;
     factorizations += cf.factorizations;
     solves += cf.solves;
+    stalled_levels += cf.stalled_levels;
   }
   if (!args.output.empty()) {
     Stopwatch clock;
@@ -139,6 +140,7 @@ int run_crossfield(const Arguments& args) {
     j.value("levels", levels);
     j.value("factorizations", factorizations);
     j.value("solves", solves);
+    j.value("stalled_levels", stalled_levels);  // --field-stall, --field-stall-revolution
     write_times(j, s.times);
     j.begin_array("face_list");
     for (LO f = 0; f < nfaces; ++f) {
@@ -156,6 +158,7 @@ int run_crossfield(const Arguments& args) {
           .value("levels", cf.levels)
           .value("factorizations", cf.factorizations)
           .value("solves", cf.solves)
+          .value("stalled_levels", cf.stalled_levels)
           .value("seconds", cf.seconds)
           .value("solver", cf.solver)
           .value("solver_ranks", cf.solver_ranks)  // split over ranks: --distributed-threshold

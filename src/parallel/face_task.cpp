@@ -32,6 +32,7 @@ CrossFieldOutput summarize(const crossfield::FaceCrossField& cf) {
   out.levels = cf.stats.levels;
   out.factorizations = cf.stats.factorizations;
   out.solves = cf.stats.solves;
+  out.stalled_levels = cf.stats.stalled_levels;
   out.seconds = cf.stats.seconds;
   out.solver = cf.stats.solver;
   return out;

@@ -519,6 +519,7 @@ TEST_F(Qsmesh, CrossFieldCheckAndVtu) {
     EXPECT_NE(vtu.find(name), std::string::npos) << name;
   EXPECT_NE(r.out.find("euler-consistent: 26/26"), std::string::npos) << r.out;
   EXPECT_NE(slurp(stats).find("\"factorizations\""), std::string::npos);
+  EXPECT_NE(slurp(stats).find("\"stalled_levels\""), std::string::npos);
   const ExeResult check = run("crossfield --check " + model_ + " --size 0.8");
   ASSERT_EQ(check.code, 0) << check.err;
   // Every face consistent: the listing is the closing line alone.

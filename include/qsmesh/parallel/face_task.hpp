@@ -178,6 +178,8 @@ struct CrossFieldOutput {
   std::vector<crossfield::Singularity> singularities;
   crossfield::EulerCheck euler;
   int levels = 0, factorizations = 0, solves = 0;
+  /// Levels ended by the stall rule (crossfield::CrossFieldStats::stalled_levels).
+  int stalled_levels = 0;
   double seconds = 0;
   std::string solver;  ///< the heat systems' solver (crossfield::CrossFieldStats::solver)
   /// A face whose systems were split over ranks (PipelineOptions: SolverOptions::
@@ -197,6 +199,7 @@ struct CrossFieldOutput {
     visit("levels", self.levels);
     visit("factorizations", self.factorizations);
     visit("solves", self.solves);
+    visit("stalled_levels", self.stalled_levels);
     visit("seconds", self.seconds);
     visit("solver", self.solver);
     visit("solver_ranks", self.solver_ranks);
