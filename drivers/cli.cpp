@@ -44,6 +44,14 @@ std::optional<double> parse_double(const std::string& text) {
   return v;
 }
 
+/// The whole number `text` spells when it lies in [lo, hi]; nullopt otherwise (the caller says
+/// which numbers the option takes).
+std::optional<double> parse_whole(const std::string& text, double lo, double hi) {
+  const auto n = parse_double(text);
+  if (!n || !std::isfinite(*n) || *n < lo || *n > hi || *n != std::floor(*n)) return std::nullopt;
+  return n;
+}
+
 int parse_threads(const std::string& text) {
   std::size_t used = 0;
   int v = 0;
@@ -209,9 +217,8 @@ Arguments parse(const std::vector<std::string>& args) {
       a.field_divisions = *n;
     } else if (opt == "--distributed-threshold" && meshing) {
       const std::string& v = value();
-      const auto n = parse_double(v);
-      if (!n || !std::isfinite(*n) || *n < 1 || *n > 2e9 || *n != std::floor(*n))
-        throw InputError(opt + ": '" + v + "' is not a number of unknowns in [1, 2e9]");
+      const auto n = parse_whole(v, 1, 2e9);
+      if (!n) throw InputError(opt + ": '" + v + "' is not a number of unknowns in [1, 2e9]");
       a.distributed_threshold = static_cast<LO>(*n);
     } else if (opt == "--field-change" && meshing) {
       const std::string& v = value();
@@ -219,9 +226,8 @@ Arguments parse(const std::vector<std::string>& args) {
       a.field_change = v;
     } else if (opt == "--field-iterations" && meshing) {
       const std::string& v = value();
-      const auto n = parse_double(v);
-      if (!n || !std::isfinite(*n) || *n < 1 || *n > 1000 || *n != std::floor(*n))
-        throw InputError(opt + ": '" + v + "' is not a number of iterations in [1, 1000]");
+      const auto n = parse_whole(v, 1, 1000);
+      if (!n) throw InputError(opt + ": '" + v + "' is not a number of iterations in [1, 1000]");
       a.field_iterations = static_cast<int>(*n);
     } else if (opt == "--field-shortcuts" && meshing) {
       const std::string& v = value();
@@ -232,8 +238,8 @@ Arguments parse(const std::vector<std::string>& args) {
       // K or K:R.
       const std::string& v = value();
       const auto colon = v.find(':');
-      const auto n = parse_double(v.substr(0, colon));
-      if (!n || !std::isfinite(*n) || *n < 0 || *n > 1000 || *n != std::floor(*n))
+      const auto n = parse_whole(v.substr(0, colon), 0, 1000);
+      if (!n)
         throw InputError(opt + ": '" + v +
                          "' does not start with 0 (off) or a number of iterations in [1, 1000]");
       a.field_stall = static_cast<int>(*n);
@@ -245,8 +251,8 @@ Arguments parse(const std::vector<std::string>& args) {
       }
     } else if (opt == "--field-stall-revolution" && meshing) {
       const std::string& v = value();
-      const auto n = parse_double(v);
-      if (!n || !std::isfinite(*n) || *n < 0 || *n > 1000 || *n != std::floor(*n))
+      const auto n = parse_whole(v, 0, 1000);
+      if (!n)
         throw InputError(opt + ": '" + v +
                          "' is not 0 (off) or a number of iterations in [1, 1000]");
       a.field_stall_revolution = static_cast<int>(*n);
@@ -376,14 +382,13 @@ Arguments parse(const std::vector<std::string>& args) {
       append(a.face_sizes, parse_id_values(opt, value()));
     else if (opt == "--task-quads" && a.command == Command::Mesh) {
       const std::string& v = value();
-      const auto n = parse_double(v);
-      if (!n || !std::isfinite(*n) || *n < 0 || *n > 1e15 || *n != std::floor(*n))
-        throw InputError(opt + ": '" + v + "' is not a whole number of quads (0: never cut)");
+      const auto n = parse_whole(v, 0, 1e15);
+      if (!n) throw InputError(opt + ": '" + v + "' is not a whole number of quads (0: never cut)");
       a.task_quads = static_cast<std::int64_t>(*n);
     } else if (opt == "--second-pass-task" && a.command == Command::Mesh) {
       const std::string& v = value();
-      const auto n = parse_double(v);
-      if (!n || !std::isfinite(*n) || *n < 0 || *n > 1e15 || *n != std::floor(*n))
+      const auto n = parse_whole(v, 0, 1e15);
+      if (!n)
         throw InputError(opt + ": '" + v +
                          "' is not a whole number of irregular vertices (0: never)");
       a.second_pass_task = static_cast<std::int64_t>(*n);
@@ -394,8 +399,8 @@ Arguments parse(const std::vector<std::string>& args) {
       a.fill_comparison = v;
     } else if (opt == "--second-pass-quads" && a.command == Command::Mesh) {
       const std::string& v = value();
-      const auto n = parse_double(v);
-      if (!n || !std::isfinite(*n) || *n < 0 || *n > 1e15 || *n != std::floor(*n))
+      const auto n = parse_whole(v, 0, 1e15);
+      if (!n)
         throw InputError(opt + ": '" + v + "' is not a whole number of quads (0: no second pass)");
       a.second_pass_quads = static_cast<std::int64_t>(*n);
     } else if (opt == "--max-quads" && meshing) {

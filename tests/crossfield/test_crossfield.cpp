@@ -99,6 +99,15 @@ double cross_deviation_deg(const std::array<Vec3, 2>& d, const Vec3& a, const Ve
   return std::abs(std::remainder(t, kPi / 2)) * 180 / kPi;
 }
 
+/// How many triangles have their crosses in `a` and `b` (two fields on one background) within a
+/// degree of each other.
+std::size_t triangles_within_1_deg(const FaceCrossField& a, const FaceCrossField& b) {
+  std::size_t close = 0;
+  for (std::size_t t = 0; t < a.directions.size(); ++t)
+    if (cross_deviation_deg(b.directions[t], a.directions[t][0], a.directions[t][1]) < 1) ++close;
+  return close;
+}
+
 TEST(CrossField, UnitSquareIsAlignedWithItsSides) {
   const TopoDS_Face face = BRepBuilderAPI_MakeFace(gp_Pln(gp::XOY()), 0.0, 1.0, 0.0, 1.0).Face();
   const auto model = test::load_shape(face, "cf_square.brep");
@@ -539,10 +548,7 @@ TEST(CrossField, RmsLevelChangeSolvesLessForTheSameSingularities) {
   // The two fields agree away from the singularities: the directions of most triangles within a
   // degree.
   ASSERT_EQ(a.cf.directions.size(), b.cf.directions.size());
-  std::size_t close = 0;
-  for (std::size_t t = 0; t < a.cf.directions.size(); ++t)
-    if (cross_deviation_deg(b.cf.directions[t], a.cf.directions[t][0], a.cf.directions[t][1]) < 1)
-      ++close;
+  const std::size_t close = triangles_within_1_deg(a.cf, b.cf);
   std::printf("[crossfield] holes: %zu of %zu triangles within 1 deg\n", close,
               a.cf.directions.size());
   EXPECT_GT(double(close), 0.9 * double(a.cf.directions.size()));
@@ -585,10 +591,7 @@ TEST(CrossField, StalledLevelsEndEarlyWithTheSameSingularities) {
   EXPECT_EQ(a.cf.singularities.size(), b.cf.singularities.size());
   EXPECT_LT(b.cf.stats.solves, a.cf.stats.solves);
   ASSERT_EQ(a.cf.directions.size(), b.cf.directions.size());
-  std::size_t close = 0;
-  for (std::size_t t = 0; t < a.cf.directions.size(); ++t)
-    if (cross_deviation_deg(b.cf.directions[t], a.cf.directions[t][0], a.cf.directions[t][1]) < 1)
-      ++close;
+  const std::size_t close = triangles_within_1_deg(a.cf, b.cf);
   std::printf("[crossfield] holes: %zu of %zu triangles within 1 deg\n", close,
               a.cf.directions.size());
   // Measured: 200 solves (50 at every level) against 49 (15 9 9 16, every level stalled), the
@@ -622,10 +625,7 @@ TEST(CrossField, SolvedFaceOfRevolutionEndsItsDriftingLevels) {
   // Measured: 90 solves (18 11 14 47) against 55 (18 11 13 13).
   EXPECT_LT(4 * b.cf.stats.solves, 3 * a.cf.stats.solves);
   ASSERT_EQ(a.cf.directions.size(), b.cf.directions.size());
-  std::size_t close = 0;
-  for (std::size_t t = 0; t < a.cf.directions.size(); ++t)
-    if (cross_deviation_deg(b.cf.directions[t], a.cf.directions[t][0], a.cf.directions[t][1]) < 1)
-      ++close;
+  const std::size_t close = triangles_within_1_deg(a.cf, b.cf);
   std::printf("[crossfield] notched: %zu of %zu triangles within 1 deg\n", close,
               a.cf.directions.size());
   EXPECT_GT(double(close), 0.95 * double(a.cf.directions.size()));  // measured: 7310 of 7312
