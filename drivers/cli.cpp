@@ -394,8 +394,8 @@ Arguments parse(const std::vector<std::string>& args) {
       a.second_pass_task = static_cast<std::int64_t>(*n);
     } else if (opt == "--fill-comparison" && a.command == Command::Mesh) {
       const std::string& v = value();
-      if (v != "irregular" && v != "mean")
-        throw InputError(opt + ": '" + v + "' is not irregular or mean");
+      if (v != "irregular" && v != "all" && v != "mean")
+        throw InputError(opt + ": '" + v + "' is not irregular, all or mean");
       a.fill_comparison = v;
     } else if (opt == "--second-pass-quads" && a.command == Command::Mesh) {
       const std::string& v = value();
@@ -768,10 +768,13 @@ std::string help(const std::string& topic) {
           "                        better: irregular (the default: fills of at most "
        << parallel::PipelineOptions{}.patterns.compare_irregular_max_quads
        << " quads\n"
-          "                        with interior irregular vertices too, replaced by a mesh with\n"
-          "                        fewer at no worse SICN min and mean; slower) or mean (only\n"
-          "                        fills of a poor mean, replaced by a clearly better mean; the\n"
-          "                        default with --layout coarse, whose blocks follow the fills)\n"
+          "                        with more interior irregular vertices than the face's\n"
+          "                        cross field has singularities too, replaced by a mesh with\n"
+          "                        fewer at no worse SICN min and mean; slower), all (as\n"
+          "                        irregular, but every fill with an interior irregular vertex;\n"
+          "                        slower still) or mean (only fills of a poor mean, replaced\n"
+          "                        by a clearly better mean; the default with --layout coarse,\n"
+          "                        whose blocks follow the fills)\n"
           "  --second-pass-task N  a face with at least N irregular vertices (default "
        << parallel::kDefaultSecondPassTaskIrregular
        << ")\n"

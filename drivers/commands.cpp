@@ -988,7 +988,8 @@ int run_mesh(const Arguments& args) {
   // unstructured meshes that would replace them (A319 at 0.0048-0.0052: 4.9% fewer blocks,
   // mambo_s34 2-44%; docs/benchmarks.md, stop 52), so there only poor means are compared.
   options.patterns.compare_irregular =
-      args.fill_comparison.empty() ? !args.coarse_layout : args.fill_comparison == "irregular";
+      args.fill_comparison.empty() ? !args.coarse_layout : args.fill_comparison != "mean";
+  options.patterns.compare_above_field = args.fill_comparison != "all";
   // Paper 003: read before any work, so that a bad file is one InputError line up front.
   fieldmesh::GivenFields given_fields;
   if (!args.cross_field.empty()) {

@@ -98,11 +98,19 @@ PatternFill mesh_face_fill(const cad::CadModel& model, LO f,
   return fill;
 }
 
+std::int64_t interior_singularities(const FaceTask& task) {
+  if (task.cross_field == nullptr) return 0;
+  return std::count_if(task.cross_field->singularities.begin(),
+                       task.cross_field->singularities.end(), [](const crossfield::Singularity& s) {
+                         return s.where != crossfield::Singularity::Where::AcuteCorner;
+                       });
+}
+
 void take_fill(FaceTask& task, PatternFill&& fill, const qstruct::PatternFaceOptions& options) {
   qstruct::PatternFaceReport& pr = fill.report;
-  if (pr.ok &&
-      qstruct::fill_to_compare(pr.sicn_avg, pr.quads,
-                               mesh::face_quad_stats(fill.mesh).irregular_interior, options)) {
+  if (pr.ok && qstruct::fill_to_compare(pr.sicn_avg, pr.quads,
+                                        mesh::face_quad_stats(fill.mesh).irregular_interior,
+                                        interior_singularities(task), options)) {
     task.refused = {std::move(fill.mesh), pr.pattern_name, true};
   } else if (pr.ok) {
     task.quasi.by_pattern = true;

@@ -45,11 +45,16 @@ const char* to_string(Refusal r) {
 }
 
 bool fill_to_compare(double sicn_avg, std::int64_t quads, std::int64_t irregular_interior,
-                     const PatternFaceOptions& options) {
-  return options.compare_avg_margin >= 0 && quads > options.small_fill_quads &&
-         (!(sicn_avg > options.compare_below_avg) ||
-          (options.compare_irregular && quads <= options.compare_irregular_max_quads &&
-           irregular_interior > 0));
+                     std::int64_t field_singularities, const PatternFaceOptions& options) {
+  if (options.compare_avg_margin < 0 || quads <= options.small_fill_quads) return false;
+  if (!(sicn_avg > options.compare_below_avg)) return true;
+  if (!options.compare_irregular || quads > options.compare_irregular_max_quads ||
+      irregular_interior <= 0)
+    return false;
+  // At the field's count the unstructured mesh can only win on its mean, by more than the margin:
+  // impossible above 1 - margin (SICN is at most 1).
+  return !options.compare_above_field || irregular_interior > field_singularities ||
+         !(sicn_avg > 1.0 - options.compare_avg_margin);
 }
 
 bool unstructured_clearly_better(const mesh::FaceQuadStats& fill,

@@ -276,8 +276,10 @@ TEST(Cli, FillComparisonChoosesWhichKeptFillsAreCompared) {
             "mean");
   EXPECT_EQ(p({"mesh", "m.step", "-o", "o.msh", "--fill-comparison", "irregular"}).fill_comparison,
             "irregular");
-  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.msh", "--fill-comparison", "all"})
-                .find("is not irregular or mean"),
+  EXPECT_EQ(p({"mesh", "m.step", "-o", "o.msh", "--fill-comparison", "all"}).fill_comparison,
+            "all");
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.msh", "--fill-comparison", "none"})
+                .find("is not irregular, all or mean"),
             std::string::npos);
 }
 

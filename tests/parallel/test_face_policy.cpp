@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 #include <optional>
+#include <vector>
 
 #include "qsmesh/mesh/quality.hpp"
 #include "qsmesh/parallel/face_task.hpp"
@@ -95,6 +97,76 @@ TEST(FacePolicy, AKeptFillWithAPoorMeanWaitsForTheUnstructuredMesh) {
   FaceTask small;
   take_fill(small, kept_fill(0.7, kOptions.small_fill_quads), kOptions);
   EXPECT_TRUE(small.quasi.by_pattern);
+}
+
+// A triangle of three quads around one interior vertex of valence 3 (the triangle pattern's
+// topology): one interior irregular vertex.
+mesh::FaceMesh three_quads() {
+  mesh::FaceMesh m;
+  m.face = 0;
+  const double h = std::sqrt(3.0);
+  // Corners 0-2, side midpoints 3 (0-1), 4 (1-2), 5 (2-0), centre 6.
+  m.points = {{0, 0, 0},       {2, 0, 0},       {1, h, 0},    {1, 0, 0},
+              {1.5, h / 2, 0}, {0.5, h / 2, 0}, {1, h / 3, 0}};
+  for (const Vec3& p : m.points) m.uv.push_back({p.x, p.y});
+  for (LO v = 0; v < 7; ++v) {
+    mesh::VertexClass c;
+    c.dim = v < 3 ? 0 : v < 6 ? 1 : 2;
+    c.entity = v < 3 ? v : v < 6 ? v - 3 : 0;
+    m.vclass.push_back(c);
+  }
+  m.quads = {{0, 3, 6, 5}, {1, 4, 6, 3}, {2, 5, 6, 4}};
+  return m;
+}
+
+// A fill with a good mean but an interior irregular vertex waits for the unstructured mesh only
+// when it has more of them than the face's cross field has interior singularities: the
+// unstructured mesh keeps one irregular vertex per singularity, so it cannot beat such a fill on
+// that count. Acute-corner singularities are no interior vertex and do not count.
+TEST(FacePolicy, AFillAtItsFieldsSingularityCountIsNotMeshedBothWays) {
+  PatternFill fill = kept_fill(0.95, 400);
+  fill.mesh = three_quads();
+  ASSERT_EQ(mesh::face_quad_stats(fill.mesh).irregular_interior, 1);
+  const auto with_field = [](std::vector<crossfield::Singularity::Where> where) {
+    FaceTask t;
+    t.cross_field = std::make_unique<crossfield::FaceCrossField>();
+    for (const auto w : where) {
+      crossfield::Singularity s;
+      s.index = 1;
+      s.where = w;
+      t.cross_field->singularities.push_back(s);
+    }
+    return t;
+  };
+  using Where = crossfield::Singularity::Where;
+  FaceTask at_count = with_field({Where::Vertex});
+  EXPECT_EQ(interior_singularities(at_count), 1);
+  take_fill(at_count, PatternFill(fill), kOptions);
+  EXPECT_TRUE(at_count.quasi.by_pattern);
+  EXPECT_TRUE(at_count.refused.mesh.quads.empty());
+
+  // No field, or only an acute-corner singularity: the fill has one irregular vertex too many.
+  for (const bool acute : {false, true}) {
+    FaceTask t = acute ? with_field({Where::AcuteCorner}) : FaceTask{};
+    EXPECT_EQ(interior_singularities(t), 0);
+    take_fill(t, PatternFill(fill), kOptions);
+    EXPECT_FALSE(t.quasi.by_pattern);
+    EXPECT_TRUE(t.refused.kept);
+  }
+  // --fill-comparison all: every fill with an interior irregular vertex is compared.
+  qstruct::PatternFaceOptions all = kOptions;
+  all.compare_above_field = false;
+  FaceTask compared = with_field({Where::Vertex});
+  take_fill(compared, PatternFill(fill), all);
+  EXPECT_FALSE(compared.quasi.by_pattern);
+  EXPECT_TRUE(compared.refused.kept);
+  // A poor mean is compared whatever the field asks for.
+  FaceTask poor = with_field({Where::Vertex, Where::Triangle});
+  PatternFill poor_fill = fill;
+  poor_fill.report.sicn_avg = 0.7;
+  take_fill(poor, std::move(poor_fill), kOptions);
+  EXPECT_FALSE(poor.quasi.by_pattern);
+  EXPECT_TRUE(poor.refused.kept);
 }
 
 TEST(FacePolicy, ARefusedFillLeavesItsReasonAndWaitsWhenValid) {

@@ -190,10 +190,10 @@ TEST(FacePattern, SmallFillIsKeptOnItsMinimumAlone) {
 TEST(FacePattern, PoorMeanFillGivesWayOnlyToAClearlyBetterUnstructuredMesh) {
   const PatternFaceOptions o;
   ASSERT_GE(o.compare_below_avg, o.min_sicn_avg);  // every fill kept on its minimum alone
-  EXPECT_TRUE(fill_to_compare(0.678, 1725, 0, o));
-  EXPECT_TRUE(fill_to_compare(0.727, 1248, 0, o));  // kept on its mean, just above
-  EXPECT_FALSE(fill_to_compare(o.compare_below_avg + 0.01, 1725, 0, o));  // a good mean
-  EXPECT_FALSE(fill_to_compare(0.678, o.small_fill_quads, 0, o));         // a small fill
+  EXPECT_TRUE(fill_to_compare(0.678, 1725, 0, 0, o));
+  EXPECT_TRUE(fill_to_compare(0.727, 1248, 0, 0, o));  // kept on its mean, just above
+  EXPECT_FALSE(fill_to_compare(o.compare_below_avg + 0.01, 1725, 0, 0, o));  // a good mean
+  EXPECT_FALSE(fill_to_compare(0.678, o.small_fill_quads, 0, 0, o));         // a small fill
   const auto stats = [](std::int64_t quads, std::int64_t triangles, double mn, double avg) {
     mesh::FaceQuadStats s;
     s.quads = quads;
@@ -215,7 +215,7 @@ TEST(FacePattern, PoorMeanFillGivesWayOnlyToAClearlyBetterUnstructuredMesh) {
   EXPECT_FALSE(unstructured_clearly_better(fill, stats(0, 0, 0, 0), o));
   PatternFaceOptions off;
   off.compare_avg_margin = -1;
-  EXPECT_FALSE(fill_to_compare(0.678, 1725, 4, off));
+  EXPECT_FALSE(fill_to_compare(0.678, 1725, 4, 0, off));
   EXPECT_FALSE(unstructured_clearly_better(fill, stats(660, 0, 0.61, 0.958), off));
 }
 
@@ -228,13 +228,27 @@ TEST(FacePattern, PoorMeanFillGivesWayOnlyToAClearlyBetterUnstructuredMesh) {
 TEST(FacePattern, TransitionFillGivesWayToFewerIrregularVerticesAtNoQualityCost) {
   const PatternFaceOptions o;
   ASSERT_TRUE(o.compare_irregular);
-  EXPECT_TRUE(fill_to_compare(0.994, 1535, 4, o));   // a good mean, but irregular vertices
-  EXPECT_FALSE(fill_to_compare(0.994, 1535, 0, o));  // a grid: nothing to gain
-  EXPECT_FALSE(fill_to_compare(0.994, o.small_fill_quads, 4, o));  // a small fill
+  EXPECT_TRUE(fill_to_compare(0.994, 1535, 4, 0, o));   // a good mean, but irregular vertices
+  EXPECT_FALSE(fill_to_compare(0.994, 1535, 0, 0, o));  // a grid: nothing to gain
+  EXPECT_FALSE(fill_to_compare(0.994, o.small_fill_quads, 4, 0, o));  // a small fill
   // A large one: meshing it both ways would cost too much (a poor mean is still compared).
-  EXPECT_TRUE(fill_to_compare(0.994, o.compare_irregular_max_quads, 4, o));
-  EXPECT_FALSE(fill_to_compare(0.994, o.compare_irregular_max_quads + 1, 4, o));
-  EXPECT_TRUE(fill_to_compare(0.7, o.compare_irregular_max_quads + 1, 4, o));
+  EXPECT_TRUE(fill_to_compare(0.994, o.compare_irregular_max_quads, 4, 0, o));
+  EXPECT_FALSE(fill_to_compare(0.994, o.compare_irregular_max_quads + 1, 4, 0, o));
+  EXPECT_TRUE(fill_to_compare(0.7, o.compare_irregular_max_quads + 1, 4, 0, o));
+  // No more irregular vertices than the field's singularities, and a mean no mesh beats by the
+  // margin: nothing to gain.
+  ASSERT_TRUE(o.compare_above_field);
+  EXPECT_TRUE(fill_to_compare(0.994, 1535, 4, 3, o));
+  EXPECT_FALSE(fill_to_compare(0.994, 1535, 4, 4, o));
+  EXPECT_FALSE(fill_to_compare(0.994, 3453, 1, 1, o));  // A319 16x's pentagon faces
+  EXPECT_FALSE(fill_to_compare(1.0 - o.compare_avg_margin + 0.01, 1535, 4, 4, o));
+  // Block's half disks at 0.854 gave way to unstructured means of 0.98: still compared.
+  EXPECT_TRUE(fill_to_compare(1.0 - o.compare_avg_margin, 1535, 4, 4, o));
+  EXPECT_TRUE(fill_to_compare(0.854, 568, 2, 2, o));
+  EXPECT_TRUE(fill_to_compare(0.7, 1535, 4, 4, o));  // a poor mean always is
+  PatternFaceOptions all = o;
+  all.compare_above_field = false;
+  EXPECT_TRUE(fill_to_compare(0.994, 1535, 4, 4, all));
   const auto stats = [](std::int64_t irregular, double mn, double avg) {
     mesh::FaceQuadStats s;
     s.quads = 500;
@@ -257,7 +271,7 @@ TEST(FacePattern, TransitionFillGivesWayToFewerIrregularVerticesAtNoQualityCost)
   // --fill-comparison mean: the former rule, on the mean alone.
   PatternFaceOptions mean = o;
   mean.compare_irregular = false;
-  EXPECT_FALSE(fill_to_compare(0.994, 1535, 4, mean));
+  EXPECT_FALSE(fill_to_compare(0.994, 1535, 4, 0, mean));
   EXPECT_TRUE(fill_wins(stats(4, 0.853, 0.994), stats(2, 0.863, 0.993), true, tol, mean));
 }
 

@@ -404,10 +404,15 @@ struct PatternFill {
                                          const qstruct::PatternFaceOptions& options,
                                          std::int64_t max_quads, bool keep_refused);
 
+/// The interior singularities of the face's cross field (acute-corner ones left out: they are
+/// no interior irregular vertex); 0 when the task holds no field.
+[[nodiscard]] std::int64_t interior_singularities(const FaceTask& task);
+
 /// What a face does with its pattern fill: a fill the thresholds kept becomes the face's mesh
-/// (quasi.by_pattern), unless its mean is poor (qstruct::fill_to_compare), when it waits in
-/// task.refused (kept) for the unstructured mesh; a refused fill leaves quasi.refusal and, when
-/// valid, waits in task.refused as well. Adds the fill's time to task.seconds.
+/// (quasi.by_pattern), unless qstruct::fill_to_compare holds it back (a poor mean, or more
+/// interior irregular vertices than interior_singularities), when it waits in task.refused
+/// (kept) for the unstructured mesh; a refused fill leaves quasi.refusal and, when valid, waits
+/// in task.refused as well. Adds the fill's time to task.seconds.
 void take_fill(FaceTask& task, PatternFill&& fill, const qstruct::PatternFaceOptions& options);
 
 /// The unstructured path left the face without a valid all-quad mesh (failed, triangles left, or

@@ -81,6 +81,16 @@ struct PatternFaceOptions {
   /// twice the time and 1.5 KB a quad without it). The second improvement pass's face bound
   /// (PipelineOptions::second_pass_max_quads).
   std::int64_t compare_irregular_max_quads = 4000;
+  /// ... except a fill with no more interior irregular vertices than the face's cross field has
+  /// interior singularities (fill_to_compare's `field_singularities`) and a mean above 1 -
+  /// compare_avg_margin. The unstructured mesh follows the field, and its cavity step keeps an
+  /// irregular vertex at each singularity, so it can hardly beat such a fill on that count, and
+  /// no mesh beats its mean by the margin. At A319's 16x count its two pentagon faces of
+  /// 3,364-3,453 quads (one irregular vertex, one singularity) were meshed both ways for
+  /// nothing, the run's two dearest improvement tasks (docs/benchmarks.md, "Fills at their
+  /// field's count"). False: every fill with an interior irregular vertex is compared
+  /// (--fill-comparison all).
+  bool compare_above_field = true;
   /// The quad at a corner of angle a < 90 degrees reaches SICN sin(a) at best (equal edges): at a
   /// face with a side-splitting corner where sin(a) <= min_sicn, which min_sicn would refuse
   /// whatever the mesh (a < 17.5 degrees for 0.3), the min threshold is corner_sicn_factor x
@@ -348,12 +358,16 @@ struct FaceSides {
 /// this mean SICN, quad count and number of interior irregular vertices is compared with the
 /// face's unstructured mesh: more than options.small_fill_quads quads, and its mean at or below
 /// options.compare_below_avg or (options.compare_irregular, at most
-/// options.compare_irregular_max_quads quads) an interior irregular vertex. The
+/// options.compare_irregular_max_quads quads) an interior irregular vertex; with
+/// options.compare_above_field, not a fill with at most `field_singularities` of them (the
+/// interior singularities of the face's cross field, 0 where the face has no field) and a mean
+/// above 1 - options.compare_avg_margin. The
 /// mean takes in every fill kept on options.keep_sicn_min alone (the acceptance rule of Gmsh's
 /// implementation: every quad above it, whatever the mean) when compare_below_avg is at least
-/// min_sicn_avg. False when options.compare_avg_margin is negative (no comparison).
+/// min_sicn_avg. False when options.compare_avg_margin is negative (no comparison). Serial, pure.
 [[nodiscard]] bool fill_to_compare(double sicn_avg, std::int64_t quads,
                                    std::int64_t irregular_interior,
+                                   std::int64_t field_singularities,
                                    const PatternFaceOptions& options);
 
 /// Whether the unstructured mesh of a face (paper 000 Sec. 5-6.3, after the topological steps)
