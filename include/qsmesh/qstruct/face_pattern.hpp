@@ -85,11 +85,10 @@ struct PatternFaceOptions {
   /// interior singularities (fill_to_compare's `field_singularities`) and a mean above 1 -
   /// compare_avg_margin. The unstructured mesh follows the field, and its cavity step keeps an
   /// irregular vertex at each singularity, so it can hardly beat such a fill on that count, and
-  /// no mesh beats its mean by the margin. At A319's 16x count its two pentagon faces of
-  /// 3,364-3,453 quads (one irregular vertex, one singularity) were meshed both ways for
-  /// nothing, the run's two dearest improvement tasks (docs/benchmarks.md, "Fills at their
-  /// field's count"). False: every fill with an interior irregular vertex is compared
-  /// (--fill-comparison all).
+  /// no mesh beats its mean by the margin. At A319's 16x count its pentagon face 9 (3,453 quads,
+  /// one irregular vertex, one singularity, SICN avg 0.930) was meshed both ways for nothing,
+  /// the run's dearest improvement task (docs/benchmarks.md, "Fills at their field's count").
+  /// False: every fill with an interior irregular vertex is compared (--fill-comparison all).
   bool compare_above_field = true;
   /// The quad at a corner of angle a < 90 degrees reaches SICN sin(a) at best (equal edges): at a
   /// face with a side-splitting corner where sin(a) <= min_sicn, which min_sicn would refuse
