@@ -127,7 +127,7 @@ TEST(FacePolicy, AFillAtItsFieldsSingularityCountIsNotMeshedBothWays) {
   PatternFill fill = kept_fill(0.95, 400);
   fill.mesh = three_quads();
   ASSERT_EQ(mesh::face_quad_stats(fill.mesh).irregular_interior, 1);
-  const auto with_field = [](std::vector<crossfield::Singularity::Where> where) {
+  const auto with_field = [](const std::vector<crossfield::Singularity::Where>& where) {
     FaceTask t;
     t.cross_field = std::make_unique<crossfield::FaceCrossField>();
     for (const auto w : where) {
