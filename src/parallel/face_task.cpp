@@ -101,9 +101,7 @@ PatternFill mesh_face_fill(const cad::CadModel& model, LO f,
 std::int64_t interior_singularities(const FaceTask& task) {
   if (task.cross_field == nullptr) return 0;
   return std::count_if(task.cross_field->singularities.begin(),
-                       task.cross_field->singularities.end(), [](const crossfield::Singularity& s) {
-                         return s.where != crossfield::Singularity::Where::AcuteCorner;
-                       });
+                       task.cross_field->singularities.end(), crossfield::is_interior);
 }
 
 void take_fill(FaceTask& task, PatternFill&& fill, const qstruct::PatternFaceOptions& options) {

@@ -23,8 +23,7 @@ FieldFace mesh_task_by_field(const FaceTask& task, const cad::CadModel& model,
     }
   if (cf != nullptr)
     for (const auto& sg : cf->singularities)
-      if (sg.where != crossfield::Singularity::Where::AcuteCorner)
-        own.singular.push_back({sg.position, sg.index});
+      if (crossfield::is_interior(sg)) own.singular.push_back({sg.position, sg.index});
   const fieldmesh::GivenFaceField* given =
       options.given_fields != nullptr ? options.given_fields->find(task.face) : nullptr;
   out.mesh = fieldmesh::mesh_face_by_method(model, task.face, curves, out.method, given, &own,

@@ -945,8 +945,7 @@ mesh::FaceMesh remesh_cavities(const mesh::FaceMesh& input, const cad::FaceGeome
   CavityReport& rep = report != nullptr ? *report : local;
   rep = CavityReport{};
   for (const auto& s : singularities)
-    if (s.where != crossfield::Singularity::Where::AcuteCorner && (s.index == 1 || s.index == -1))
-      ++rep.singularities;
+    if (crossfield::is_interior(s) && (s.index == 1 || s.index == -1)) ++rep.singularities;
   const auto q0 = smooth::measure(input);
   rep.sicn_min_before = rep.sicn_min_after = q0.sicn_min;
   rep.sicn_avg_before = rep.sicn_avg_after = q0.sicn_avg;
@@ -973,8 +972,7 @@ mesh::FaceMesh remesh_cavities(const mesh::FaceMesh& input, const cad::FaceGeome
     std::vector<LO> flagged;      // flagged vertex of each accepted singularity
     std::vector<LO> flagged_val;  // its valence
     for (const auto& s : singularities) {
-      if (s.where == crossfield::Singularity::Where::AcuteCorner || (s.index != 1 && s.index != -1))
-        continue;
+      if (!crossfield::is_interior(s) || (s.index != 1 && s.index != -1)) continue;
       const LO want = s.index == 1 ? 3 : 5;
       LO best = kNoIndex;
       double best_d = std::numeric_limits<double>::max();

@@ -105,6 +105,12 @@ struct Singularity {
       kNoIndex;  ///< glued vertex (Vertex, AcuteCorner), edge (Edge) or triangle (Triangle)
 };
 
+/// Whether an interior vertex of the quad mesh is to carry the singularity: every kind but the
+/// artificial +1 at an acute CAD corner, which a corner quad holds.
+[[nodiscard]] inline bool is_interior(const Singularity& s) {
+  return s.where != Singularity::Where::AcuteCorner;
+}
+
 /// Eq. 2 of paper 000 with the corner contributions.
 struct EulerCheck {
   int chi = 0;  ///< V - E + F of the glued triangulation
