@@ -256,6 +256,13 @@ Arguments parse(const std::vector<std::string>& args) {
         throw InputError(opt + ": '" + v +
                          "' is not 0 (off) or a number of iterations in [1, 1000]");
       a.field_stall_revolution = static_cast<int>(*n);
+    } else if (opt == "--field-settled" && meshing) {
+      const std::string& v = value();
+      const auto n = parse_whole(v, 0, 1000);
+      if (!n)
+        throw InputError(opt + ": '" + v +
+                         "' is not 0 (off) or a number of iterations in [1, 1000]");
+      a.field_settled = static_cast<int>(*n);
     } else if (opt == "--block-structured" && a.command == Command::Mesh)
       a.block_structured = true;
     else if (opt == "--block-patches" && a.command == Command::Mesh)
@@ -740,6 +747,11 @@ std::string help(const std::string& topic) {
           "                        axis and the levels would run to the cap; 0: off (default "
        << crossfield::CrossFieldOptions{}.revolution_stall_window
        << ")\n"
+          "  --field-settled K     a diffusion level that converges within K iterations, the\n"
+          "                        field no longer moving as the diffusion shrinks, skips the\n"
+          "                        levels left but the last; 0: every level is solved (default "
+       << crossfield::CrossFieldOptions{}.settled_level_iterations
+       << ")\n"
           "  --field-shortcuts S   faces whose cross field is known in closed form take it\n"
           "                        without a solve: planar faces bounded by lines at right\n"
           "                        angles, and faces of revolution (cylinders, cones, tori,\n"
@@ -815,7 +827,7 @@ std::string help(const std::string& topic) {
           "  --size H, --size-factor F, --threads T, --stats FILE.json, --max-quads N,\n"
           "  --field-divisions N, --distributed-threshold N, --field-change M,\n"
           "  --field-iterations N, --field-stall K[:R], --field-stall-revolution K,\n"
-          "  --field-shortcuts S, --sew, -q, -v:\n"
+          "  --field-settled K, --field-shortcuts S, --sew, -q, -v:\n"
           "                        as for mesh\n";
   } else if (topic == "sizemap") {
     os << "usage: [mpirun -np P] qsmesh sizemap MODEL -o OUT.vtu [options]\n\n"
@@ -879,7 +891,7 @@ std::string help(const std::string& topic) {
           "  --size H, --size-factor F, --threads T, --stats FILE.json, --max-quads N,\n"
           "  --field-divisions N, --distributed-threshold N, --field-change M,\n"
           "  --field-iterations N, --field-stall K[:R], --field-stall-revolution K,\n"
-          "  --field-shortcuts S, --sew, -q, -v:\n"
+          "  --field-settled K, --field-shortcuts S, --sew, -q, -v:\n"
           "                        as for mesh\n";
   } else if (topic == "example") {
     os << "usage: qsmesh example NAME -o FILE\n\n"

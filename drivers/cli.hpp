@@ -152,6 +152,9 @@ struct Arguments {
   /// --field-stall-revolution K (crossfield::CrossFieldOptions::revolution_stall_window); unset:
   /// its default.
   std::optional<int> field_stall_revolution;
+  /// --field-settled K (crossfield::CrossFieldOptions::settled_level_iterations); unset: its
+  /// default.
+  std::optional<int> field_settled;
   /// --field-shortcuts: "all" (default), "uniform" or "none" (crossfield::CrossFieldOptions::
   /// exact_uniform and exact_revolution); empty: unset.
   std::string field_shortcuts;

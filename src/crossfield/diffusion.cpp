@@ -246,6 +246,10 @@ void diffuse(FaceCrossField& cf, const Geometry& g, const CrossFieldOptions& opt
     }
     cf.stats.iterations_per_level.push_back(it);
     ++cf.stats.levels;
+    if (change < options.tolerance && it <= options.settled_level_iterations &&
+        level + 2 < options.levels) {
+      level = options.levels - 2;  // the loop's increment makes it the last level
+    }
   }
   for (std::size_t e = 0; e < ne; ++e)
     if (const LO i = edge2unk[e]; i != kNoIndex) {

@@ -195,7 +195,33 @@ class ComplexEigenSolver final : public LinearSolver {
                                                                 << ") is not whole in the pattern");
         sources_.push_back(src);
       }
-    ldlt_.analyzePattern(lower_);
+    // AMD and the permuted upper triangle, as SimplicialLDLT<Lower, AMDOrdering> computes them
+    // (SimplicialCholeskyBase::ordering), once here instead of at every factorization. Each entry
+    // carries its index into lower_ through the twist, and the sign of its imaginary part says
+    // whether the twist conjugated it (an entry that crosses the diagonal).
+    Permutation pinv;
+    {
+      ComplexMatrix c;
+      c = lower_.selfadjointView<Eigen::Lower>();
+      Eigen::AMDOrdering<int>()(c, pinv);
+    }
+    perm_ = pinv.size() > 0 ? Permutation(pinv.inverse()) : Permutation();
+    perm_inv_ = pinv;
+    for (Eigen::Index k = 0; k < lower_.nonZeros(); ++k)
+      lower_.valuePtr()[k] = Complex(static_cast<double>(k), 1.0);
+    upper_.resize(m, m);
+    if (perm_.size() > 0)
+      upper_.selfadjointView<Eigen::Upper>() =
+          lower_.selfadjointView<Eigen::Lower>().twistedBy(perm_);
+    else
+      upper_.selfadjointView<Eigen::Upper>() = lower_.selfadjointView<Eigen::Lower>();
+    twist_.resize(static_cast<std::size_t>(upper_.nonZeros()));
+    for (Eigen::Index k = 0; k < upper_.nonZeros(); ++k) {
+      const Complex code = upper_.valuePtr()[k];
+      twist_[static_cast<std::size_t>(k)] = {static_cast<std::int64_t>(code.real()),
+                                             code.imag() < 0};
+    }
+    ldlt_.analyzePattern(upper_);
     QSMESH_CHECK(ldlt_.info() == Eigen::Success,
                  "eigen (complex pairs): symbolic analysis failed for a matrix of size " << n);
   }
@@ -215,7 +241,12 @@ class ComplexEigenSolver final : public LinearSolver {
               << A.size() << " is not of the form [[a, -c], [c, a]]");
       dst[k] = Complex(a, c);
     }
-    ldlt_.factorize(lower_);
+    Complex* twisted = upper_.valuePtr();
+    for (std::size_t k = 0; k < twist_.size(); ++k) {
+      const Complex value = dst[static_cast<std::size_t>(twist_[k].source)];
+      twisted[k] = twist_[k].conjugate ? std::conj(value) : value;
+    }
+    ldlt_.factorize(upper_);
     check_factorization(ldlt_, A.size(), "eigen (complex pairs)");
     factorized_ = true;
   }
@@ -226,7 +257,14 @@ class ComplexEigenSolver final : public LinearSolver {
     rhs_.resize(m);
     for (Eigen::Index i = 0; i < m; ++i)
       rhs_[i] = Complex(b[static_cast<std::size_t>(2 * i)], b[static_cast<std::size_t>(2 * i + 1)]);
-    work_ = ldlt_.solve(rhs_);
+    // SimplicialLDLT's solve with its permutation: P b, the triangular and diagonal solves, P^-1.
+    if (perm_.size() > 0) {
+      work_ = perm_ * rhs_;
+      rhs_ = ldlt_.solve(work_);
+      work_ = perm_inv_ * rhs_;
+    } else {
+      work_ = ldlt_.solve(rhs_);
+    }
     for (Eigen::Index i = 0; i < m; ++i) {
       x[static_cast<std::size_t>(2 * i)] = work_[i].real();
       x[static_cast<std::size_t>(2 * i + 1)] = work_[i].imag();
@@ -241,12 +279,21 @@ class ComplexEigenSolver final : public LinearSolver {
   struct Sources {
     std::int64_t re, im, minus_im, re2;
   };
+  // Where an entry of the permuted upper triangle comes from: its index in lower_, conjugated or
+  // not.
+  struct Twist {
+    std::int64_t source;
+    bool conjugate;
+  };
   Pattern pattern_;
   bool factorized_ = false;
-  ComplexMatrix lower_;
+  ComplexMatrix lower_;  // the complex matrix's lower triangle, in A's order
+  ComplexMatrix upper_;  // its permuted upper triangle, factorized in place
   std::vector<Sources> sources_;
+  std::vector<Twist> twist_;
+  Permutation perm_, perm_inv_;
   Eigen::VectorXcd rhs_, work_;
-  Eigen::SimplicialLDLT<ComplexMatrix, Eigen::Lower, Eigen::AMDOrdering<int>> ldlt_;
+  Eigen::SimplicialLDLT<ComplexMatrix, Eigen::Upper, Eigen::NaturalOrdering<int>> ldlt_;
 };
 
 }  // namespace

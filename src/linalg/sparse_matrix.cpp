@@ -18,12 +18,18 @@ SparseMatrix::SparseMatrix(LO n, std::span<const Triplet> triplets) : n_(n) {
     ++row_count[static_cast<std::size_t>(t.row) + 1];
   }
   std::partial_sum(row_count.begin(), row_count.end(), row_count.begin());
-  std::vector<std::int64_t> order(triplets.size());
+  // The entries themselves, not their indices, are bucketed: sorting and summing a row then reads
+  // contiguous memory instead of gathering the triplets again (the per-face systems hold tens of
+  // thousands of rows).
+  struct Entry {
+    LO col;
+    double value;
+  };
+  std::vector<Entry> bucket(triplets.size());
   {
     std::vector<std::int64_t> next(row_count.begin(), row_count.end() - 1);
-    for (std::size_t i = 0; i < triplets.size(); ++i)
-      order[static_cast<std::size_t>(next[static_cast<std::size_t>(triplets[i].row)]++)] =
-          static_cast<std::int64_t>(i);
+    for (const Triplet& t : triplets)
+      bucket[static_cast<std::size_t>(next[static_cast<std::size_t>(t.row)]++)] = {t.col, t.value};
   }
 
   offsets_.assign(static_cast<std::size_t>(n) + 1, 0);
@@ -32,25 +38,23 @@ SparseMatrix::SparseMatrix(LO n, std::span<const Triplet> triplets) : n_(n) {
   cols_.reserve(triplets.size());
   values_.reserve(triplets.size());
   for (LO r = 0; r < n; ++r) {
-    const auto begin = order.begin() + row_count[static_cast<std::size_t>(r)];
-    const auto end = order.begin() + row_count[static_cast<std::size_t>(r) + 1];
+    const auto begin = bucket.begin() + row_count[static_cast<std::size_t>(r)];
+    const auto end = bucket.begin() + row_count[static_cast<std::size_t>(r) + 1];
     // Rows hold a few entries (the Laplacians of the per-face systems: about 5-10): a stable
     // insertion sort, without std::stable_sort's buffer allocation. Same order.
     for (auto it = begin + (begin == end ? 0 : 1); it < end; ++it) {
-      const std::int64_t x = *it;
-      const LO c = triplets[static_cast<std::size_t>(x)].col;
+      const Entry x = *it;
       auto j = it;
-      for (; j != begin && triplets[static_cast<std::size_t>(*(j - 1))].col > c; --j) *j = *(j - 1);
+      for (; j != begin && (j - 1)->col > x.col; --j) *j = *(j - 1);
       *j = x;
     }
     for (auto it = begin; it != end; ++it) {
-      const Triplet& t = triplets[static_cast<std::size_t>(*it)];
       const auto row_start = offsets_[static_cast<std::size_t>(r)];
-      if (static_cast<std::int64_t>(cols_.size()) > row_start && cols_.back() == t.col) {
-        values_.back() += t.value;
+      if (static_cast<std::int64_t>(cols_.size()) > row_start && cols_.back() == it->col) {
+        values_.back() += it->value;
       } else {
-        cols_.push_back(t.col);
-        values_.push_back(t.value);
+        cols_.push_back(it->col);
+        values_.push_back(it->value);
       }
     }
     offsets_[static_cast<std::size_t>(r) + 1] = static_cast<std::int64_t>(cols_.size());

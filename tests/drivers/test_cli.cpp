@@ -113,6 +113,19 @@ TEST(Cli, FieldStallRevolution) {
   EXPECT_NE(help("crossfield").find("--field-stall-revolution"), std::string::npos);
 }
 
+TEST(Cli, FieldSettled) {
+  EXPECT_FALSE(p({"mesh", "m.step", "-o", "o.vtu"}).field_settled.has_value());
+  EXPECT_EQ(*p({"mesh", "m.step", "-o", "o.vtu", "--field-settled", "0"}).field_settled, 0);
+  EXPECT_EQ(*p({"sizemap", "m.step", "-o", "s.vtu", "--field-settled", "3"}).field_settled, 3);
+  for (const char* bad : {"-1", "2.5", "x", "1001"})
+    EXPECT_NE(
+        error_of({"mesh", "m.step", "-o", "o.vtu", "--field-settled", bad}).find("--field-settled"),
+        std::string::npos)
+        << bad;
+  EXPECT_NE(help("mesh").find("--field-settled"), std::string::npos);
+  EXPECT_NE(help("crossfield").find("--field-settled"), std::string::npos);
+}
+
 TEST(Cli, FieldShortcuts) {
   EXPECT_TRUE(p({"mesh", "m.step", "-o", "o.vtu"}).field_shortcuts.empty());
   for (const char* v : {"all", "uniform", "none"})

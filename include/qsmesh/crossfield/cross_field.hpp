@@ -63,6 +63,15 @@ struct CrossFieldOptions {
   /// levels drift and run to max_iterations_per_level, with an end point set by the cap, not by
   /// convergence (docs/benchmarks.md, "field6"). 0: such faces run as any other.
   int revolution_stall_window = 4;
+  /// A level before the second-to-last that converges (change below tolerance) within this many
+  /// iterations skips the intermediate levels: the next level solved is the last one, at α_final.
+  /// Such a level shows a field that no longer moves as α shrinks, so the intermediate α, whose
+  /// role is to let singularities settle progressively (Algorithm 1), would each cost a
+  /// factorization for iterations that change nothing; the last level is kept because its α,
+  /// (3 h_min)^2, is orders of magnitude below the others. A field still moving at a level (the
+  /// wing-body example's leading-edge skin: 11, 5, 6, 22 iterations) runs every level.
+  /// 0: every level is solved.
+  int settled_level_iterations = 2;
   bool extend_boundary = true;   ///< Sec. 3.1 boundary-condition extension
   double acute_corner_deg = 45;  ///< artificial +1 singularity at CAD corners sharper than this
   /// Sec. 3.3 scaling, outliers clamped: H is clamped to its area-weighted quantiles q and 1 - q
