@@ -45,7 +45,12 @@ if [ ${#changed[@]} -eq 0 ]; then
 fi
 echo "check_style: clang-tidy on ${#changed[@]} changed files"
 log=$(mktemp)
-"$tidy" -p build --quiet "${changed[@]}" >"$log" 2>&1 || true
+# GCC-only flags that clang 14 rejects as unknown (and then skips the file) are stripped from the
+# compile commands the tidy step reads: -fcx-fortran-rules (src/linalg/CMakeLists.txt).
+db=$(mktemp -d)
+sed 's/ -fcx-fortran-rules//g' build/compile_commands.json >"$db/compile_commands.json"
+"$tidy" -p "$db" --quiet "${changed[@]}" >"$log" 2>&1 || true
+rm -rf "$db"
 grep -E "(warning|error): .*\[[a-z-]+(,[a-z.-]+)*\]$" "$log" || true
 echo "check_style: clang-tidy findings by check:"
 grep -oE "\[[a-z-]+(,[a-z.-]+)*\]$" "$log" | sort | uniq -c | sort -rn || true
