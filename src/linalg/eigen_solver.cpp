@@ -200,7 +200,23 @@ class ComplexEigenSolver final : public LinearSolver {
     // carries its index into lower_ through the twist, and the sign of its imaginary part says
     // whether the twist conjugated it (an entry that crosses the diagonal).
     Permutation pinv;
-    {
+    if (symmetric_pattern(A)) {
+      // AMDOrdering's input is the full matrix symmetrised again (A^T + A), its columns sorted:
+      // with a symmetric pattern that is column J = the even columns of row 2J of A, halved. AMD
+      // reads the pattern only, so it runs on that, as reals, without the two complex copies.
+      EigenMatrix c(m, m);
+      c.resizeNonZeros(static_cast<Eigen::Index>(full));
+      int at = 0;
+      for (LO J = 0; J < m; ++J) {
+        c.outerIndexPtr()[J] = at;
+        const std::size_t row = 2 * static_cast<std::size_t>(J);
+        for (auto k = off[row]; k < off[row + 1]; ++k)
+          if (const LO cc = col[static_cast<std::size_t>(k)]; cc % 2 == 0)
+            c.innerIndexPtr()[at++] = cc / 2;
+      }
+      c.outerIndexPtr()[m] = at;
+      Eigen::internal::minimum_degree_ordering(c, pinv);
+    } else {
       ComplexMatrix c;
       c = lower_.selfadjointView<Eigen::Lower>();
       Eigen::AMDOrdering<int>()(c, pinv);
