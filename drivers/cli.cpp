@@ -392,6 +392,10 @@ Arguments parse(const std::vector<std::string>& args) {
       const auto n = parse_whole(v, 0, 1e15);
       if (!n) throw InputError(opt + ": '" + v + "' is not a whole number of quads (0: never cut)");
       a.task_quads = static_cast<std::int64_t>(*n);
+    } else if (opt == "--pass-after-cuts" && a.command == Command::Mesh) {
+      const std::string& v = value();
+      if (v != "on" && v != "off") throw InputError(opt + ": '" + v + "' is not on or off");
+      a.pass_after_cuts = v == "on";
     } else if (opt == "--second-pass-task" && a.command == Command::Mesh) {
       const std::string& v = value();
       const auto n = parse_whole(v, 0, 1e15);
@@ -768,6 +772,10 @@ std::string help(const std::string& topic) {
           "                        a task of its own for the ranks and threads, in two passes\n"
           "                        whose cuts alternate; 0: never. The mesh depends on N, not on\n"
           "                        the rank or thread count\n"
+          "  --pass-after-cuts on|off\n"
+          "                        after its pieces, a face cut by --task-quads is improved once\n"
+          "                        more whole, as a task of a third pass: the irregular vertices\n"
+          "                        its cuts held back go (default on)\n"
           "  --second-pass-quads N faces of at most N quads (default "
        << parallel::PipelineOptions{}.second_pass_max_quads
        << ") left with irregular\n"

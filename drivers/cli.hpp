@@ -123,6 +123,8 @@ struct Arguments {
   /// --task-quads N: faces of more quads than N are improved in pieces, each a task
   /// (parallel::PipelineOptions::task_quads; 0: never); -1: parallel::kDefaultTaskQuads.
   std::int64_t task_quads = -1;
+  /// --pass-after-cuts on|off (parallel::PipelineOptions::whole_pass_after_cuts); unset: on.
+  std::optional<bool> pass_after_cuts;
   /// --second-pass-quads N: the largest face given a second improvement pass
   /// (parallel::PipelineOptions::second_pass_max_quads; 0: no second pass); -1: the default.
   std::int64_t second_pass_quads = -1;

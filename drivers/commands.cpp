@@ -982,6 +982,7 @@ int run_mesh(const Arguments& args) {
   if (until >= parallel::Stage::Unstructured) note_sliver_curves(s, options.sizemap);
   options.cavities.time_budget_s = args.face_time_budget;
   if (args.task_quads >= 0) options.task_quads = args.task_quads;
+  if (args.pass_after_cuts) options.whole_pass_after_cuts = *args.pass_after_cuts;
   if (args.second_pass_task >= 0) options.second_pass_task_irregular = args.second_pass_task;
   if (args.second_pass_quads == 0) options.second_pass_sicn_per_irregular = 0;  // off
   if (args.second_pass_quads > 0) options.second_pass_max_quads = args.second_pass_quads;

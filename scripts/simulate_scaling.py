@@ -27,10 +27,11 @@ rank, by replaying its measured per-face, per-stage times through the pipeline's
   pattern_layouts, pattern_batches, pattern_search); with one thread per rank its search's lent
   batches go over the ranks done with their faces instead (helped_schedule; pattern_layout_*,
   pattern_vector_lendable). A face improved in
-  pieces (--task-quads; face_stats' stage_seconds.improvement_tasks: 2k + 1 piece times) is k
-  tasks in the first round, dealt with the whole faces, and k + 1 in a second round after it
-  (each piece keyed by the face's quads / pieces); its cutting and merging (its improvement time
-  less its pieces') runs on its owner between and after the rounds. A face whose two passes ran
+  pieces (--task-quads; face_stats' stage_seconds.improvement_tasks: 2k + 1 piece times, or
+  2k + 2 with the whole face after them) is k tasks in the first round, dealt with the whole
+  faces, k + 1 in a second round after it (each piece keyed by the face's quads / pieces), and
+  the whole face in a third (--pass-after-cuts); its cutting and merging (its improvement time
+  less its tasks') runs on its owner between and after the rounds. A face whose two passes ran
   as two tasks (--second-pass-task; face_stats' stage_seconds.improvement_passes) is two tasks of
   the first round, the second passes dealt after every other task; the choice between them (its
   improvement time less the passes') runs on its owner after it.
@@ -430,11 +431,12 @@ class Simulator:
         return cur
 
     def improvement_rounds(self):
-        """The improvement's tasks, [first round, second round], each task (face, order key,
-        piece, seconds, bytes), and the seconds of each cut face's cutting and merging (or of the
-        choice between a face's two passes dealt as two tasks)."""
+        """The improvement's tasks, [first round, second round, third round], each task (face,
+        order key, piece, seconds, bytes), and the seconds of each cut face's cutting and merging
+        (or of the choice between a face's two passes dealt as two tasks). The third round holds
+        the cut faces improved whole after their pieces (2k + 2 piece times: the last one)."""
         run = self.run
-        first, second, owner_work = [], [], {}
+        first, second, third, owner_work = [], [], [], {}
         for f in range(run.n):
             q = run.improve_quads[f]
             if q <= 0:
@@ -455,12 +457,16 @@ class Simulator:
             if not tasks:
                 first.append((f, q, -1, run.t["improvement"][f], run.bytes[f]))
                 continue
-            k = (len(tasks) - 1) // 2
-            for i, sec in enumerate(tasks):
-                n = k if i < k else len(tasks) - k
+            pieces = tasks
+            if len(tasks) % 2 == 0:  # the whole face after its pieces
+                pieces = tasks[:-1]
+                third.append((f, q, len(pieces), tasks[-1], run.bytes[f]))
+            k = (len(pieces) - 1) // 2
+            for i, sec in enumerate(pieces):
+                n = k if i < k else len(pieces) - k
                 (first if i < k else second).append((f, q / n, i, sec, run.bytes[f] / n))
             owner_work[f] = max(0.0, run.t["improvement"][f] - sum(tasks))
-        return [first, second], owner_work
+        return [first, second, third], owner_work
 
     def predict(self, p, t):
         """{stage: predicted seconds} on p ranks x t threads, in the measured run's stage order."""
@@ -506,7 +512,7 @@ class Simulator:
                 f = max(range(run.n), key=lambda i: run.t[s][i])
                 res[s] = (run.faces[f]["face"], run.t[s][f], run.t[s][f] / tot)
         rounds, _ = self.improvement_rounds()
-        tasks = rounds[0] + rounds[1]
+        tasks = rounds[0] + rounds[1] + rounds[2]
         tot = sum(i[3] for i in tasks)
         if tot > 0:
             big = max(tasks, key=lambda i: i[3])
@@ -528,6 +534,7 @@ class Simulator:
                 # task, and the cutting and merging or the choice between the passes.
                 v += (max((i[3] for i in rounds[0]), default=0.0)
                       + max((i[3] for i in rounds[1]), default=0.0)
+                      + max((i[3] for i in rounds[2]), default=0.0)
                       + max(owner_work.values(), default=0.0) + self.residual[s])
             elif s in PARTITIONED or s in DEALT:
                 v += max(run.t[s]) + self.residual[s]

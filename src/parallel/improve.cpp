@@ -601,9 +601,42 @@ std::array<double, 3> improve_faces(const Comm& comm, const cad::CadModel& model
       const Stopwatch clock;
       *f.mesh = merge_pieces(s, results, f, /*first_cut=*/false, log);
       f.mesh->face = f.face;
+      *f.seconds += clock.seconds();
+    }
+    // Round 3 (settings.whole_pass_after_cuts): each cut face whole, one more run of the steps
+    // from its merged mesh. A piece's cavities stop at its cut vertices, which keep their
+    // valence, and the escalated growths that join sparse pairs far apart (CavityOptions::
+    // max_quads_sparse, 3000 quads) do not fit in pieces of a few thousand quads: cut at 5,000
+    // quads, Block at 4x its reference count kept 92 more interior irregular vertices on its 22
+    // cut faces (561 -> 653); this round takes them back (docs/benchmarks.md, stop 55). Few seeds
+    // are left by then, so the whole face costs a fraction of its first improvement.
+    if (settings.whole_pass_after_cuts) {
+      round.clear();
+      for (const Split& s : splits) {
+        const ImproveFace& f = mine[s.face];
+        Task t;
+        t.face = f.face;
+        t.input.mesh = std::move(*f.mesh);
+        t.input.singularities.assign(f.singularities.begin(), f.singularities.end());
+        round.push_back(std::move(t));
+      }
+      results = deal_round(comm, model, round, settings, tasks, log,
+                           "improvement (cut faces whole)", steps);
+      for (std::size_t j = 0; j < splits.size(); ++j) {
+        ImproveFace& f = mine[splits[j].face];
+        Result& r = results[j];
+        *f.mesh = std::move(r.mesh);
+        f.mesh->face = f.face;
+        f.report->add_piece(r.report, /*first_cut=*/false);
+        f.report->second_pass_kept = f.report->second_pass_kept || r.report.second_pass_kept;
+        *f.seconds += r.seconds;
+        if (f.task_seconds != nullptr) f.task_seconds->push_back(r.seconds);
+      }
+    }
+    for (const Split& s : splits) {
+      ImproveFace& f = mine[s.face];
       f.report->whole_face(s.irregular_before, qstruct::count_irregular(*f.mesh),
                            remesh::count_defects(*f.mesh, settings.disk));
-      *f.seconds += clock.seconds();
     }
   }
   if (comm.size() > 1) comm.allreduce_sum(steps);

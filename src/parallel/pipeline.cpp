@@ -755,6 +755,7 @@ std::array<double, 3> improvement_stage(const Context& cx, std::vector<FaceTask>
   settings.final_smooth = cx.options.final_smooth;
   settings.lift = cx.options.lift;
   settings.task_quads = cx.options.task_quads;
+  settings.whole_pass_after_cuts = cx.options.whole_pass_after_cuts;
   settings.second_pass_cavities = cx.options.second_pass_cavities;
   settings.second_pass_sicn_per_irregular = cx.options.second_pass_sicn_per_irregular;
   settings.second_pass_sicn_sum_per_irregular = cx.options.second_pass_sicn_sum_per_irregular;

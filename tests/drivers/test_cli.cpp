@@ -126,6 +126,16 @@ TEST(Cli, FieldSettled) {
   EXPECT_NE(help("crossfield").find("--field-settled"), std::string::npos);
 }
 
+TEST(Cli, PassAfterCuts) {
+  EXPECT_FALSE(p({"mesh", "m.step", "-o", "o.vtu"}).pass_after_cuts.has_value());
+  EXPECT_FALSE(*p({"mesh", "m.step", "-o", "o.vtu", "--pass-after-cuts", "off"}).pass_after_cuts);
+  EXPECT_TRUE(*p({"mesh", "m.step", "-o", "o.vtu", "--pass-after-cuts", "on"}).pass_after_cuts);
+  EXPECT_NE(error_of({"mesh", "m.step", "-o", "o.vtu", "--pass-after-cuts", "1"})
+                .find("--pass-after-cuts"),
+            std::string::npos);
+  EXPECT_NE(help("mesh").find("--pass-after-cuts"), std::string::npos);
+}
+
 TEST(Cli, FieldShortcuts) {
   EXPECT_TRUE(p({"mesh", "m.step", "-o", "o.vtu"}).field_shortcuts.empty());
   for (const char* v : {"all", "uniform", "none"})

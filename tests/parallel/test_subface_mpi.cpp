@@ -53,13 +53,20 @@ TEST(SubFace, PiecesGiveTheSameMeshAtEveryRankCountAndKeepTheQuality) {
   const PipelineResult whole =
       run_pipeline(Comm::self(), model, plate_options(0), TaskArena(1), log);
 
-  // Improved, in at least 8 pieces at the first cut (and one more at the second).
+  // Improved, in at least 8 pieces at the first cut, one more at the second, then whole.
   ASSERT_EQ(dist.face_times.size(), 1U);
   const std::int64_t quads = dist.face_times[0].improvement_quads;
   ASSERT_GT(quads, 8 * kTaskQuads);
   const std::size_t k = static_cast<std::size_t>((quads + kTaskQuads - 1) / kTaskQuads);
-  EXPECT_EQ(dist.face_times[0].improvement_tasks.size(), 2 * k + 1);
+  EXPECT_EQ(dist.face_times[0].improvement_tasks.size(), 2 * k + 2);
   EXPECT_TRUE(whole.face_times[0].improvement_tasks.empty());
+  PipelineOptions pieces_only = plate_options(kTaskQuads);
+  pieces_only.whole_pass_after_cuts = false;
+  const PipelineResult no_third = run_pipeline(Comm::self(), model, pieces_only, TaskArena(1), log);
+  EXPECT_EQ(no_third.face_times[0].improvement_tasks.size(), 2 * k + 1);
+  std::cout << "plate without the whole pass after the cuts: interior irregular "
+            << no_third.face_stats[0].irregular_interior << ", SICN avg "
+            << no_third.face_stats[0].sicn_avg << "\n";
 
   // The same mesh at every rank count.
   EXPECT_EQ(dist.mesh.points, serial.mesh.points);

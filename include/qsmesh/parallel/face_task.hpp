@@ -235,8 +235,10 @@ struct FaceTimes {
   /// for the face at the gather, and about that of its improvement's input and result.
   std::int64_t bytes = 0;
   /// A face improved in pieces (PipelineOptions::task_quads): the seconds of each piece, the
-  /// first cut's pieces (dealt with the whole faces) then the second cut's (dealt after them).
-  /// Their sum and the cutting and merging make `improvement`. Empty: one task.
+  /// first cut's k pieces (dealt with the whole faces) then the second cut's k + 1 (dealt after
+  /// them), then, where the face was improved whole after them (PipelineOptions::
+  /// whole_pass_after_cuts: 2k + 2 entries), that third round's task. Their sum and the cutting
+  /// and merging make `improvement`. Empty: one task.
   std::vector<double> improvement_tasks;
   /// A whole face whose two improvement passes were dealt as two tasks at once (ImproveSettings::
   /// second_pass_task_irregular): the seconds of its first pass, then of its second (0 where it

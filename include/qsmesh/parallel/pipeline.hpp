@@ -176,6 +176,9 @@ struct PipelineOptions {
   /// in pieces, each a task of its own (ImproveSettings::task_quads; 0: never). A fixed count,
   /// not a share of the ranks' work, so that the mesh does not depend on the rank count.
   std::int64_t task_quads = kDefaultTaskQuads;
+  /// Stage::QuasiStructured: a face improved in pieces is then improved once more whole, as a
+  /// task of a third round (ImproveSettings::whole_pass_after_cuts).
+  bool whole_pass_after_cuts = true;
   /// Stage::QuasiStructured: a whole face of at most second_pass_max_quads quads whose
   /// unstructured mesh has at least this many interior irregular vertices has its second pass
   /// dealt as a task of its own, beside its first (ImproveSettings::second_pass_task_irregular;
