@@ -79,10 +79,11 @@ struct ImproveSettings {
   /// end ones half size) and improved again, so that the first cuts end inside pieces. The
   /// result depends on the face and task_quads only, not on ranks or threads.
   std::int64_t task_quads = 0;
-  /// After the two rounds of pieces, each cut face is improved once more whole, as a task of a
-  /// third round (improve_faces): the pieces' cut vertices keep their valence and their cavities
-  /// stay small, so the irregular vertices the cuts left are taken back there. false: the face
-  /// is what the second round's pieces make it.
+  /// After the two rounds of pieces, each cut face runs its cavity and disk steps once more
+  /// whole, as a task of a third round (improve_faces; no final smoothing: its pieces had it):
+  /// the pieces' cut vertices keep their valence and their cavities stay small, so the irregular
+  /// vertices the cuts left are taken back there. false: the face is what the second round's
+  /// pieces make it.
   bool whole_pass_after_cuts = true;
   /// The second pass of PipelineOptions (second_pass_cavities, ...): whole faces only (a piece's
   /// count depends on its cuts), never after a face reached its time budget. cost <= 0: off.
