@@ -606,10 +606,10 @@ std::array<double, 3> improve_faces(const Comm& comm, const cad::CadModel& model
     // Round 3 (settings.whole_pass_after_cuts): each cut face whole, its cavity and disk steps
     // once more from its merged mesh. A piece's cavities stop at its cut vertices, which keep their
     // valence, and the escalated growths that join sparse pairs far apart (CavityOptions::
-    // max_quads_sparse, 3000 quads) do not fit in pieces of a few thousand quads: cut at 5,000
-    // quads, Block at 4x its reference count kept 92 more interior irregular vertices on its 22
-    // cut faces (561 -> 653); this round takes them back (docs/benchmarks.md, stop 55). Few seeds
-    // are left by then, so the whole face costs a fraction of its first improvement.
+    // max_quads_sparse) do not fit in pieces of a few thousand quads; the irregular vertices they
+    // would have removed are spread over the face, not at its cuts (docs/benchmarks.md, "Cut
+    // faces improved once more whole"). Few seeds are left by then, so the whole face costs a
+    // fraction of its first improvement.
     if (settings.whole_pass_after_cuts) {
       round.clear();
       for (const Split& s : splits) {
@@ -621,9 +621,9 @@ std::array<double, 3> improve_faces(const Comm& comm, const cad::CadModel& model
         round.push_back(std::move(t));
       }
       // The pieces were smoothed and lifted already, and a cavity's replacement is smoothed
-      // where it lands: the whole face's final smoothing is left out (on the 218k-quad plate of
-      // docs/benchmarks.md it made this task 1.69 s instead of 0.65, for the same irregular
-      // count and a SICN average 0.0001 higher).
+      // where it lands: the whole face's final smoothing, most of this task's time where it ran,
+      // is left out. On the measured faces it changed no irregular count, and the SICN average by
+      // at most 0.002.
       ImproveSettings whole_face = settings;
       whole_face.final_smoothing = false;
       results = deal_round(comm, model, round, whole_face, tasks, log,
