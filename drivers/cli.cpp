@@ -52,6 +52,14 @@ std::optional<double> parse_whole(const std::string& text, double lo, double hi)
   return n;
 }
 
+// An option's iteration count: 0 (off) or 1..1000; anything else is refused naming the option.
+int iterations_or_off(const std::string& opt, const std::string& v) {
+  const auto n = parse_whole(v, 0, 1000);
+  if (!n)
+    throw InputError(opt + ": '" + v + "' is not 0 (off) or a number of iterations in [1, 1000]");
+  return static_cast<int>(*n);
+}
+
 int parse_threads(const std::string& text) {
   std::size_t used = 0;
   int v = 0;
@@ -250,19 +258,9 @@ Arguments parse(const std::vector<std::string>& args) {
         a.field_stall_ratio = *r;
       }
     } else if (opt == "--field-stall-revolution" && meshing) {
-      const std::string& v = value();
-      const auto n = parse_whole(v, 0, 1000);
-      if (!n)
-        throw InputError(opt + ": '" + v +
-                         "' is not 0 (off) or a number of iterations in [1, 1000]");
-      a.field_stall_revolution = static_cast<int>(*n);
+      a.field_stall_revolution = iterations_or_off(opt, value());
     } else if (opt == "--field-settled" && meshing) {
-      const std::string& v = value();
-      const auto n = parse_whole(v, 0, 1000);
-      if (!n)
-        throw InputError(opt + ": '" + v +
-                         "' is not 0 (off) or a number of iterations in [1, 1000]");
-      a.field_settled = static_cast<int>(*n);
+      a.field_settled = iterations_or_off(opt, value());
     } else if (opt == "--block-structured" && a.command == Command::Mesh)
       a.block_structured = true;
     else if (opt == "--block-patches" && a.command == Command::Mesh)

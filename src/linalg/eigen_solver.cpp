@@ -58,6 +58,30 @@ void check_factorization(const Ldlt& ldlt, LO n, const char* backend) {
   }
 }
 
+// AMD's inverse permutation as AMDOrdering computes it for SimplicialLDLT<Lower, AMDOrdering>:
+// on the full matrix built from `lower`, symmetrised again. For patterns that are not symmetric;
+// a symmetric one gives the same from its own sorted pattern (minimum_degree_ordering on it).
+template <class Matrix>
+Permutation amd_of_lower(const Matrix& lower) {
+  Matrix full;
+  full = lower.template selfadjointView<Eigen::Lower>();
+  Permutation pinv;
+  Eigen::AMDOrdering<int>()(full, pinv);
+  return pinv;
+}
+
+// The upper triangle of P A P^T from A's lower triangle `lower` (SimplicialCholeskyBase::
+// ordering's twist; no permutation: A's upper triangle), into `upper`.
+template <class Matrix>
+void twist_to_upper(const Matrix& lower, const Permutation& perm, Matrix& upper) {
+  upper.resize(lower.rows(), lower.cols());
+  if (perm.size() > 0)
+    upper.template selfadjointView<Eigen::Upper>() =
+        lower.template selfadjointView<Eigen::Lower>().twistedBy(perm);
+  else
+    upper.template selfadjointView<Eigen::Upper>() = lower.template selfadjointView<Eigen::Lower>();
+}
+
 class EigenSolver final : public LinearSolver {
  public:
   void analyze(const SparseMatrix& A) override {
@@ -82,20 +106,14 @@ class EigenSolver final : public LinearSolver {
       EigenMatrix c = a;
       Eigen::internal::minimum_degree_ordering(c, pinv);
     } else {
-      EigenMatrix c;
-      c = a.selfadjointView<Eigen::Lower>();
-      Eigen::AMDOrdering<int>()(c, pinv);
+      pinv = amd_of_lower(a);
     }
     perm_ = pinv.size() > 0 ? Permutation(pinv.inverse()) : Permutation();
     perm_inv_ = pinv;
     // The permuted upper triangle (SimplicialCholeskyBase::ordering), its values traced back to
     // A's: each entry carries its index into A.values() through the twist.
     for (std::int64_t k = 0; k < A.nonzeros(); ++k) a.valuePtr()[k] = static_cast<double>(k);
-    upper_.resize(n, n);
-    if (perm_.size() > 0)
-      upper_.selfadjointView<Eigen::Upper>() = a.selfadjointView<Eigen::Lower>().twistedBy(perm_);
-    else
-      upper_.selfadjointView<Eigen::Upper>() = a.selfadjointView<Eigen::Lower>();
+    twist_to_upper(a, perm_, upper_);
     source_.resize(static_cast<std::size_t>(upper_.nonZeros()));
     for (Eigen::Index k = 0; k < upper_.nonZeros(); ++k)
       source_[static_cast<std::size_t>(k)] = static_cast<std::int64_t>(upper_.valuePtr()[k]);
@@ -217,20 +235,13 @@ class ComplexEigenSolver final : public LinearSolver {
       c.outerIndexPtr()[m] = at;
       Eigen::internal::minimum_degree_ordering(c, pinv);
     } else {
-      ComplexMatrix c;
-      c = lower_.selfadjointView<Eigen::Lower>();
-      Eigen::AMDOrdering<int>()(c, pinv);
+      pinv = amd_of_lower(lower_);
     }
     perm_ = pinv.size() > 0 ? Permutation(pinv.inverse()) : Permutation();
     perm_inv_ = pinv;
     for (Eigen::Index k = 0; k < lower_.nonZeros(); ++k)
       lower_.valuePtr()[k] = Complex(static_cast<double>(k), 1.0);
-    upper_.resize(m, m);
-    if (perm_.size() > 0)
-      upper_.selfadjointView<Eigen::Upper>() =
-          lower_.selfadjointView<Eigen::Lower>().twistedBy(perm_);
-    else
-      upper_.selfadjointView<Eigen::Upper>() = lower_.selfadjointView<Eigen::Lower>();
+    twist_to_upper(lower_, perm_, upper_);
     twist_.resize(static_cast<std::size_t>(upper_.nonZeros()));
     for (Eigen::Index k = 0; k < upper_.nonZeros(); ++k) {
       const Complex code = upper_.valuePtr()[k];
