@@ -261,6 +261,10 @@ Arguments parse(const std::vector<std::string>& args) {
       a.field_stall_revolution = iterations_or_off(opt, value());
     } else if (opt == "--field-settled" && meshing) {
       a.field_settled = iterations_or_off(opt, value());
+    } else if (opt == "--field-regular" && meshing) {
+      const std::string& v = value();
+      if (v != "on" && v != "off") throw InputError(opt + ": '" + v + "' is not on or off");
+      a.field_regular = v == "on";
     } else if (opt == "--block-structured" && a.command == Command::Mesh)
       a.block_structured = true;
     else if (opt == "--block-patches" && a.command == Command::Mesh)
@@ -754,6 +758,12 @@ std::string help(const std::string& topic) {
           "                        levels left but the last; 0: every level is solved (default "
        << crossfield::CrossFieldOptions{}.settled_level_iterations
        << ")\n"
+          "  --field-regular on|off\n"
+          "                        a level settled in --field-settled iterations on a field\n"
+          "                        without singularity ends the diffusion, the last level\n"
+          "                        included; off: it skips to the last level (default "
+       << (crossfield::CrossFieldOptions{}.settled_regular_ends ? "on" : "off")
+       << ")\n"
           "  --field-shortcuts S   faces whose cross field is known in closed form take it\n"
           "                        without a solve: planar faces bounded by lines at right\n"
           "                        angles, and faces of revolution (cylinders, cones, tori,\n"
@@ -833,7 +843,8 @@ std::string help(const std::string& topic) {
           "  --size H, --size-factor F, --threads T, --stats FILE.json, --max-quads N,\n"
           "  --field-divisions N, --distributed-threshold N, --field-change M,\n"
           "  --field-iterations N, --field-stall K[:R], --field-stall-revolution K,\n"
-          "  --field-settled K, --field-shortcuts S, --sew, -q, -v:\n"
+          "  --field-settled K, --field-regular on|off, --field-shortcuts S, --sew, -q,\n"
+          "  -v:\n"
           "                        as for mesh\n";
   } else if (topic == "sizemap") {
     os << "usage: [mpirun -np P] qsmesh sizemap MODEL -o OUT.vtu [options]\n\n"
@@ -897,7 +908,8 @@ std::string help(const std::string& topic) {
           "  --size H, --size-factor F, --threads T, --stats FILE.json, --max-quads N,\n"
           "  --field-divisions N, --distributed-threshold N, --field-change M,\n"
           "  --field-iterations N, --field-stall K[:R], --field-stall-revolution K,\n"
-          "  --field-settled K, --field-shortcuts S, --sew, -q, -v:\n"
+          "  --field-settled K, --field-regular on|off, --field-shortcuts S, --sew, -q,\n"
+          "  -v:\n"
           "                        as for mesh\n";
   } else if (topic == "example") {
     os << "usage: qsmesh example NAME -o FILE\n\n"

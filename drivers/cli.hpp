@@ -157,6 +157,9 @@ struct Arguments {
   /// --field-settled K (crossfield::CrossFieldOptions::settled_level_iterations); unset: its
   /// default.
   std::optional<int> field_settled;
+  /// --field-regular on|off (crossfield::CrossFieldOptions::settled_regular_ends); unset:
+  /// its default.
+  std::optional<bool> field_regular;
   /// --field-shortcuts: "all" (default), "uniform" or "none" (crossfield::CrossFieldOptions::
   /// exact_uniform and exact_revolution); empty: unset.
   std::string field_shortcuts;

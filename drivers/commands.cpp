@@ -862,6 +862,7 @@ parallel::PipelineOptions field_options(const Arguments& args, const Session& s)
   if (args.field_stall_revolution)
     options.crossfield.revolution_stall_window = *args.field_stall_revolution;
   if (args.field_settled) options.crossfield.settled_level_iterations = *args.field_settled;
+  if (args.field_regular) options.crossfield.settled_regular_ends = *args.field_regular;
   if (!args.field_shortcuts.empty()) {
     options.crossfield.exact_uniform = args.field_shortcuts != "none";
     options.crossfield.exact_revolution = args.field_shortcuts == "all";

@@ -159,6 +159,8 @@ int run_crossfield(const Arguments& args) {
           .value("factorizations", cf.factorizations)
           .value("solves", cf.solves)
           .value("stalled_levels", cf.stalled_levels)
+          .value("iterations_per_level", std::vector<double>(cf.iterations_per_level.begin(),
+                                                             cf.iterations_per_level.end()))
           .value("seconds", cf.seconds)
           .value("solver", cf.solver)
           .value("solver_ranks", cf.solver_ranks)  // split over ranks: --distributed-threshold

@@ -15,8 +15,6 @@
 namespace qsmesh::crossfield::detail {
 namespace {
 
-using Triplet = linalg::SparseMatrix::Triplet;
-
 // The cross field's systems are the real form of complex Hermitian ones (each edge's two
 // unknowns are the real and imaginary parts of its representation vector, and the connection
 // couples them by rotations): factorized as complex, they cost less (linalg::SolverOptions).
@@ -25,16 +23,19 @@ linalg::SolverOptions pair_solver(linalg::SolverOptions options) {
   return options;
 }
 
-/// CR stiffness of the triangles selected by `use`, on the unknowns edge2unk (2 per edge, kNoIndex:
-/// Dirichlet). Returns the free-free triplets and adds -K_fd u_d to `coupling`.
-std::vector<Triplet> assemble_stiffness(const FaceCrossField& cf, const Geometry& g,
+/// CR stiffness of the triangles selected by `use`, on the n unknowns edge2unk (2 per edge,
+/// kNoIndex: Dirichlet). Returns the free-free matrix and adds -K_fd u_d to `coupling`.
+linalg::SparseMatrix assemble_stiffness(const FaceCrossField& cf, const Geometry& g,
                                         const std::vector<std::uint8_t>& use,
-                                        const std::vector<LO>& edge2unk,
+                                        const std::vector<LO>& edge2unk, LO n,
                                         std::vector<double>& coupling) {
-  std::vector<Triplet> trip;
-  // 36 entries a triangle, and room for the diagonal the callers add (two per unknown edge), so
-  // that those additions do not double the capacity.
-  trip.reserve(cf.triangles.size() * 36 + 2 * cf.edges.size());
+  // One element a triangle: its three edges' unknown pairs and their 6 x 6 block.
+  constexpr int kDofs = 6;
+  const auto used = static_cast<std::size_t>(std::count(use.begin(), use.end(), 1));
+  std::vector<LO> dofs;
+  std::vector<double> blocks;
+  dofs.reserve(used * kDofs);
+  blocks.reserve(used * kDofs * kDofs);
   for (std::size_t t = 0; t < cf.triangles.size(); ++t) {
     if (!use[t]) continue;
     // Edge k of the triangle joins vertices k and k+1: it is opposite vertex k+2. The CR basis
@@ -52,18 +53,24 @@ std::vector<Triplet> assemble_stiffness(const FaceCrossField& cf, const Geometry
       }
     }
     for (int i = 0; i < 3; ++i) {
-      const LO ei = cf.tri2edges[t][i];
-      const LO ui = edge2unk[ei];
+      const LO ui = edge2unk[cf.tri2edges[t][i]];
+      dofs.push_back(ui);
+      dofs.push_back(ui == kNoIndex ? kNoIndex : ui + 1);
+    }
+    const std::size_t block = blocks.size();
+    blocks.resize(block + kDofs * kDofs, 0.0);
+    for (int i = 0; i < 3; ++i) {
+      const LO ui = edge2unk[cf.tri2edges[t][i]];
       if (ui == kNoIndex) continue;
       for (int j = 0; j < 3; ++j) {
         const LO ej = cf.tri2edges[t][j];
         const double beta = 4 * (g.phi[t][j] - g.phi[t][i]);
         const double c = std::cos(beta) * K[i][j], s = std::sin(beta) * K[i][j];
         const double B[2][2] = {{c, -s}, {s, c}};
-        const LO uj = edge2unk[ej];
-        if (uj != kNoIndex) {
+        if (edge2unk[ej] != kNoIndex) {
           for (int a = 0; a < 2; ++a)
-            for (int b = 0; b < 2; ++b) trip.push_back({ui + a, uj + b, B[a][b]});
+            for (int b = 0; b < 2; ++b)
+              blocks[block + static_cast<std::size_t>((2 * i + a) * kDofs + 2 * j + b)] = B[a][b];
         } else {
           const Vec2& d = cf.u[ej];
           coupling[ui] -= B[0][0] * d.u + B[0][1] * d.v;
@@ -72,7 +79,7 @@ std::vector<Triplet> assemble_stiffness(const FaceCrossField& cf, const Geometry
       }
     }
   }
-  return trip;
+  return linalg::SparseMatrix::from_elements(n, kDofs, dofs, blocks);
 }
 
 /// Lumped CR mass (|t1| + |t2|) / 3 of each edge.
@@ -111,13 +118,12 @@ void extend_boundary_conditions(FaceCrossField& cf, const Geometry& g,
   }
   if (n == 0) return;
   std::vector<double> rhs(static_cast<std::size_t>(n), 0.0);
-  auto trip = assemble_stiffness(cf, g, layer, edge2unk, rhs);
+  linalg::SparseMatrix A = assemble_stiffness(cf, g, layer, edge2unk, n, rhs);
   // A vanishing mass term keeps the system definite should a layer triangle be degenerate.
   const double eps = 1e-10 / (g.min_edge * g.min_edge);
   for (std::size_t e = 0; e < ne; ++e)
-    if (edge2unk[e] != kNoIndex)
-      for (int a = 0; a < 2; ++a) trip.push_back({edge2unk[e] + a, edge2unk[e] + a, eps * mass[e]});
-  const linalg::SparseMatrix A(n, trip);
+    if (const LO i = edge2unk[e]; i != kNoIndex)
+      for (int a = 0; a < 2; ++a) A.values()[A.find(i + a, i + a)] += eps * mass[e];
   auto solver = linalg::make_solver(n, pair_solver(options.solver), lane);
   solver->analyze(A);
   solver->factorize(A);
@@ -173,22 +179,19 @@ void diffuse(FaceCrossField& cf, const Geometry& g, const CrossFieldOptions& opt
   if (n == 0) return;  // every edge is fixed: nothing to diffuse
 
   std::vector<double> coupling(static_cast<std::size_t>(n), 0.0);
-  // The triplets (36 a triangle) go once K is built: held through the solves they were the
-  // largest allocation of the cross-field stage (t20_data's largest face, docs/benchmarks.md).
-  const linalg::SparseMatrix K = [&] {
-    auto trip = assemble_stiffness(cf, g, std::vector<std::uint8_t>(nt, 1), edge2unk, coupling);
-    for (std::size_t e = 0; e < ne; ++e)
-      if (edge2unk[e] != kNoIndex)
-        for (int a = 0; a < 2; ++a) trip.push_back({edge2unk[e] + a, edge2unk[e] + a, 0.0});
-    return linalg::SparseMatrix(n, trip);
-  }();
+  // Every unknown edge lies in a triangle, so the diagonal is in K's pattern. A level's matrix
+  // K + M / α differs from K on the diagonal only: A is K, and a level rewrites its diagonal.
+  linalg::SparseMatrix A =
+      assemble_stiffness(cf, g, std::vector<std::uint8_t>(nt, 1), edge2unk, n, coupling);
   std::vector<double> mfree(static_cast<std::size_t>(n));
   std::vector<std::int64_t> diag(static_cast<std::size_t>(n));
+  std::vector<double> k_diag(static_cast<std::size_t>(n));
   for (std::size_t e = 0; e < ne; ++e)
     if (const LO i = edge2unk[e]; i != kNoIndex)
       for (int a = 0; a < 2; ++a) {
         mfree[i + a] = mass[e];
-        diag[i + a] = K.find(i + a, i + a);
+        diag[i + a] = A.find(i + a, i + a);
+        k_diag[i + a] = A.values()[static_cast<std::size_t>(diag[i + a])];
       }
 
   // α from (0.1 d)^2 down to (3 h_min)^2, linearly (Algorithm 1).
@@ -196,7 +199,7 @@ void diffuse(FaceCrossField& cf, const Geometry& g, const CrossFieldOptions& opt
   const double a1 = std::min(a0, std::pow(3 * g.min_edge, 2));
   auto solver = linalg::make_solver(n, pair_solver(options.solver), lane);
   cf.stats.solver = solver->name();
-  solver->analyze(K);
+  solver->analyze(A);
 
   std::vector<double> U(static_cast<std::size_t>(n)), X(U.size()), rhs(U.size());
   for (std::size_t e = 0; e < ne; ++e)
@@ -208,14 +211,19 @@ void diffuse(FaceCrossField& cf, const Geometry& g, const CrossFieldOptions& opt
   std::vector<double> previous(U.size()), pair_mass(U.size() / 2), m_alpha(U.size());
   std::vector<double> rms;  // the level's RMS changes, for the stall rule
   for (std::size_t k = 0; k < pair_mass.size(); ++k) pair_mass[k] = mfree[2 * k];
-  linalg::SparseMatrix A = K;
+  // Whether the crosses U have a singularity inside the face: U's pairs written into cf.u, which
+  // the end of the diffusion overwrites anyway.
+  const auto singular_inside = [&](const std::vector<double>& crosses) {
+    for (std::size_t e = 0; e < ne; ++e)
+      if (const LO i = edge2unk[e]; i != kNoIndex) cf.u[e] = {crosses[i], crosses[i + 1]};
+    return has_singular_cell(cf, g);
+  };
   for (int level = 0; level < options.levels; ++level) {
     const double alpha =
         options.levels == 1 ? a1 : a0 + (a1 - a0) * double(level) / double(options.levels - 1);
-    A.values() = K.values();
     // M / α once a level: the same quotients the loops below would divide out every iteration.
     for (LO i = 0; i < n; ++i) m_alpha[i] = mfree[i] / alpha;
-    for (LO i = 0; i < n; ++i) A.values()[diag[i]] += m_alpha[i];
+    for (LO i = 0; i < n; ++i) A.values()[diag[i]] = k_diag[i] + m_alpha[i];
     solver->factorize(A);
     ++cf.stats.factorizations;
     int it = 0;
@@ -248,6 +256,8 @@ void diffuse(FaceCrossField& cf, const Geometry& g, const CrossFieldOptions& opt
     ++cf.stats.levels;
     if (change < options.tolerance && it <= options.settled_level_iterations &&
         level + 2 < options.levels) {
+      // A regular field set by its boundary: the levels left would keep it.
+      if (options.settled_regular_ends && !singular_inside(U)) break;
       level = options.levels - 2;  // the loop's increment makes it the last level
     }
   }

@@ -61,6 +61,10 @@ bool set_revolution_field(FaceCrossField& cf, const Geometry& g, const cad::Revo
 /// Branches of the cross at each triangle barycentre. Fills directions.
 void compute_directions(FaceCrossField& cf, const Geometry& g);
 
+/// Whether some cell of the medial subdivision (a vertex cell inside the face, or a triangle cell)
+/// has a non-zero index under the crosses cf.u: the field has a singularity inside the face.
+[[nodiscard]] bool has_singular_cell(const FaceCrossField& cf, const Geometry& g);
+
 /// Sec. 3.2 and Eq. 2: fills singularities and euler.
 void find_singularities(FaceCrossField& cf, const Geometry& g, const CrossFieldOptions& options);
 

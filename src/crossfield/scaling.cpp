@@ -56,8 +56,11 @@ void compute_scaling(FaceCrossField& cf, const Geometry& g, const CrossFieldOpti
         g.vertex_angle[v] * 180 / kPi < options.cusp_angle_deg)
       return;
   // H is fixed to 0 at vertex 0 (then shifted to zero mean): unknown of vertex v is v - 1.
-  std::vector<linalg::SparseMatrix::Triplet> trip;
-  trip.reserve(static_cast<std::size_t>(nt) * 9);
+  // One element a triangle of positive area: its vertices' unknowns and their 3 x 3 block.
+  std::vector<LO> dofs;
+  std::vector<double> blocks;
+  dofs.reserve(static_cast<std::size_t>(nt) * 3);
+  blocks.reserve(static_cast<std::size_t>(nt) * 9);
   std::vector<double> rhs(static_cast<std::size_t>(nv - 1), 0.0);
   for (LO t = 0; t < nt; ++t) {
     if (g.area[t] <= 0) continue;
@@ -76,14 +79,12 @@ void compute_scaling(FaceCrossField& cf, const Geometry& g, const CrossFieldOpti
     }
     const Vec3 target = cross(grad_theta, n);  // -∇⊥θ
     for (int i = 0; i < 3; ++i) {
-      if (tri[i] == 0) continue;
-      rhs[tri[i] - 1] += g.area[t] * dot(grad_l[i], target);
-      for (int j = 0; j < 3; ++j)
-        if (tri[j] != 0)
-          trip.push_back({tri[i] - 1, tri[j] - 1, g.area[t] * dot(grad_l[i], grad_l[j])});
+      dofs.push_back(tri[i] == 0 ? kNoIndex : tri[i] - 1);
+      if (tri[i] != 0) rhs[tri[i] - 1] += g.area[t] * dot(grad_l[i], target);
+      for (int j = 0; j < 3; ++j) blocks.push_back(g.area[t] * dot(grad_l[i], grad_l[j]));
     }
   }
-  const linalg::SparseMatrix A(nv - 1, trip);
+  const auto A = linalg::SparseMatrix::from_elements(nv - 1, 3, dofs, blocks);
   auto solver = linalg::make_solver(nv - 1, options.solver, lane);
   solver->analyze(A);
   solver->factorize(A);

@@ -17,10 +17,20 @@
 
 namespace qsmesh::crossfield::detail {
 
-void find_singularities(FaceCrossField& cf, const Geometry& g, const CrossFieldOptions& options) {
+namespace {
+
+// The index of every cell of the medial subdivision: vertex cells (0 at boundary vertices), then
+// triangle cells, and the field's boundary term summed over the boundary vertices.
+struct CellIndices {
+  std::vector<int> vertex, triangle;
+  int field_boundary = 0;
+};
+
+CellIndices cell_indices(const FaceCrossField& cf, const Geometry& g) {
   const LO nv = static_cast<LO>(cf.points.size()), nt = static_cast<LO>(cf.triangles.size());
+  CellIndices out;
   std::vector<double> S(static_cast<std::size_t>(nv), 0.0);
-  std::vector<int> tri_index(static_cast<std::size_t>(nt), 0);
+  out.triangle.assign(static_cast<std::size_t>(nt), 0);
   for (LO t = 0; t < nt; ++t) {
     double sum = 0;
     const double angle[3] = {angle_in_triangle(cf, g, t, 0), angle_in_triangle(cf, g, t, 1),
@@ -32,27 +42,44 @@ void find_singularities(FaceCrossField& cf, const Geometry& g, const CrossFieldO
       sum += d;
     }
     // The midpoint triangle is walked clockwise by the vertex cells around it.
-    tri_index[t] = -static_cast<int>(std::lround(sum / (2 * kPi)));
+    out.triangle[t] = -static_cast<int>(std::lround(sum / (2 * kPi)));
   }
-  std::vector<int> vert_index(static_cast<std::size_t>(nv), 0);
-  int field_boundary = 0;
+  out.vertex.assign(static_cast<std::size_t>(nv), 0);
   for (LO v = 0; v < nv; ++v) {
     if (g.boundary_vertex[v]) {
-      field_boundary +=
+      out.field_boundary +=
           static_cast<int>(std::lround(2 + (S[v] - 4 * g.vertex_angle[v]) / (2 * kPi)));
     } else {
-      vert_index[v] =
+      out.vertex[v] =
           static_cast<int>(std::lround((S[v] + 4 * (2 * kPi - g.vertex_angle[v])) / (2 * kPi)));
     }
   }
+  return out;
+}
+
+bool any_nonzero(const std::vector<int>& index) {
+  return std::any_of(index.begin(), index.end(), [](int k) { return k != 0; });
+}
+
+}  // namespace
+
+bool has_singular_cell(const FaceCrossField& cf, const Geometry& g) {
+  const CellIndices cells = cell_indices(cf, g);
+  return any_nonzero(cells.vertex) || any_nonzero(cells.triangle);
+}
+
+void find_singularities(FaceCrossField& cf, const Geometry& g, const CrossFieldOptions& options) {
+  const LO nv = static_cast<LO>(cf.points.size()), nt = static_cast<LO>(cf.triangles.size());
+  const CellIndices cells = cell_indices(cf, g);
+  const std::vector<int>& vert_index = cells.vertex;
+  const std::vector<int>& tri_index = cells.triangle;
+  const int field_boundary = cells.field_boundary;
 
   // Group singular cells touching each other (vertex-vertex by an edge, vertex-triangle by
   // incidence, triangle-triangle by an edge); a group whose indices sum to ±1 is one singularity.
   // The triangles around each vertex, built only when some cell is singular (most faces of a CAD
   // model have no singularity at all).
-  const bool any_singular =
-      std::any_of(vert_index.begin(), vert_index.end(), [](int k) { return k != 0; }) ||
-      std::any_of(tri_index.begin(), tri_index.end(), [](int k) { return k != 0; });
+  const bool any_singular = any_nonzero(vert_index) || any_nonzero(tri_index);
   std::vector<std::vector<LO>> v2t(any_singular ? static_cast<std::size_t>(nv) : 0);
   if (any_singular)
     for (LO t = 0; t < nt; ++t)

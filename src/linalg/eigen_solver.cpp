@@ -15,6 +15,7 @@
 #include <cmath>
 #include <complex>
 #include <limits>
+#include <numeric>
 
 #include "backends.hpp"
 
@@ -180,39 +181,58 @@ class ComplexEigenSolver final : public LinearSolver {
     factorized_ = false;
     const LO m = n / 2;
     // The lower triangle of the complex matrix: the blocks (I, J), J <= I, met at the even
-    // entries (2I, 2J) of the real form.
-    std::vector<Eigen::Triplet<Complex, int>> trip;
-    std::int64_t full = 0;  // complex entries of both triangles
+    // entries (2I, 2J) of the real form. Walking the rows I in order appends each column J's
+    // entries in row order, the compressed columns' own order: counted first, then filled.
     const auto& off = A.row_offsets();
     const auto& col = A.columns();
+    std::int64_t full = 0;  // complex entries of both triangles
+    std::vector<int> column_start(static_cast<std::size_t>(m) + 1, 0);
     for (LO I = 0; I < m; ++I) {
       const std::size_t row = 2 * static_cast<std::size_t>(I);
       for (auto k = off[row]; k < off[row + 1]; ++k) {
         const LO c = col[static_cast<std::size_t>(k)];
         if (c % 2 != 0) continue;
         ++full;
-        if (c / 2 <= I) trip.emplace_back(I, c / 2, Complex(0, 0));
+        if (c / 2 <= I) ++column_start[static_cast<std::size_t>(c / 2) + 1];
       }
     }
     QSMESH_CHECK(4 * full == A.nonzeros(),
                  "eigen (complex pairs): the pattern of the matrix of size "
                      << n << " is not made of whole 2 x 2 blocks (" << A.nonzeros() << " nonzeros, "
                      << full << " blocks)");
+    std::partial_sum(column_start.begin(), column_start.end(), column_start.begin());
     lower_.resize(m, m);
-    lower_.setFromTriplets(trip.begin(), trip.end());
-    lower_.makeCompressed();
-    sources_.clear();
-    sources_.reserve(static_cast<std::size_t>(lower_.nonZeros()));
-    for (int j = 0; j < lower_.outerSize(); ++j)
-      for (ComplexMatrix::InnerIterator it(lower_, j); it; ++it) {
-        const LO I = static_cast<LO>(it.row()), J = static_cast<LO>(it.col());
-        const Sources src{A.find(2 * I, 2 * J), A.find(2 * I + 1, 2 * J), A.find(2 * I, 2 * J + 1),
-                          A.find(2 * I + 1, 2 * J + 1)};
-        QSMESH_CHECK(src.re >= 0 && src.im >= 0 && src.minus_im >= 0 && src.re2 >= 0,
-                     "eigen (complex pairs): the 2 x 2 block (" << I << ", " << J
-                                                                << ") is not whole in the pattern");
-        sources_.push_back(src);
+    lower_.resizeNonZeros(column_start.back());
+    std::copy(column_start.begin(), column_start.end(), lower_.outerIndexPtr());
+    sources_.resize(static_cast<std::size_t>(column_start.back()));
+    {
+      std::vector<int> next(column_start.begin(), column_start.end() - 1);
+      // Where (row, column) sits in A.values(): rows 2I and 2I+1 of a whole-block pattern hold the
+      // same columns, so the same offset from the row's start, checked before it is trusted.
+      const auto at = [&](LO row, std::int64_t offset, LO column) -> std::int64_t {
+        const auto k = off[static_cast<std::size_t>(row)] + offset;
+        if (k < off[static_cast<std::size_t>(row) + 1] &&
+            col[static_cast<std::size_t>(k)] == column)
+          return k;
+        return A.find(row, column);
+      };
+      for (LO I = 0; I < m; ++I) {
+        const std::size_t row = 2 * static_cast<std::size_t>(I);
+        for (auto k = off[row]; k < off[row + 1]; ++k) {
+          const LO c = col[static_cast<std::size_t>(k)];
+          if (c % 2 != 0 || c / 2 > I) continue;
+          const auto slot = static_cast<std::size_t>(next[static_cast<std::size_t>(c / 2)]++);
+          lower_.innerIndexPtr()[slot] = I;
+          const std::int64_t offset = k - off[row];
+          const Sources src{k, at(2 * I + 1, offset, c), at(2 * I, offset + 1, c + 1),
+                            at(2 * I + 1, offset + 1, c + 1)};
+          QSMESH_CHECK(src.im >= 0 && src.minus_im >= 0 && src.re2 >= 0,
+                       "eigen (complex pairs): the 2 x 2 block ("
+                           << I << ", " << c / 2 << ") is not whole in the pattern");
+          sources_[slot] = src;
+        }
       }
+    }
     // AMD and the permuted upper triangle, as SimplicialLDLT<Lower, AMDOrdering> computes them
     // (SimplicialCholeskyBase::ordering), once here instead of at every factorization. Each entry
     // carries its index into lower_ through the twist, and the sign of its imaginary part says

@@ -33,6 +33,8 @@ CrossFieldOutput summarize(const crossfield::FaceCrossField& cf) {
   out.factorizations = cf.stats.factorizations;
   out.solves = cf.stats.solves;
   out.stalled_levels = cf.stats.stalled_levels;
+  out.iterations_per_level.assign(cf.stats.iterations_per_level.begin(),
+                                  cf.stats.iterations_per_level.end());
   out.seconds = cf.stats.seconds;
   out.solver = cf.stats.solver;
   return out;

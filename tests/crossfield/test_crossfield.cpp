@@ -83,9 +83,13 @@ LO face_of_type(const cad::CadModel& model, cad::SurfaceType type) {
 void expect_stats(const FaceCrossField& cf) {
   const CrossFieldOptions defaults;
   // Every level, or the first ones and the last once the field has settled
-  // (settled_level_iterations): the last level always runs.
+  // (settled_level_iterations): the last level runs unless a settled field is regular
+  // (settled_regular_ends), which ends the diffusion there.
   EXPECT_LE(cf.stats.levels, defaults.levels);
-  EXPECT_GE(cf.stats.levels, std::min(2, defaults.levels));
+  const bool regular = std::none_of(cf.singularities.begin(), cf.singularities.end(), [](auto& s) {
+    return s.where != Singularity::Where::AcuteCorner;
+  });
+  EXPECT_GE(cf.stats.levels, regular ? 1 : std::min(2, defaults.levels));
   EXPECT_EQ(cf.stats.factorizations, cf.stats.levels);
   // The heat systems are the real form of complex Hermitian ones, factorized as such
   // (linalg::SolverOptions::complex_pairs).
@@ -649,17 +653,24 @@ TEST(CrossField, SettledLevelsSkipTheIntermediateOnes) {
   const LO f = face_of_type(model, cad::SurfaceType::Sphere);
   CrossFieldOptions every;
   every.settled_level_iterations = 0;
+  CrossFieldOptions skip;  // to the last level (without settled_regular_ends, which ends there)
+  skip.settled_regular_ends = false;
   const auto a = run(model, f, 0.08, "sphere-all", every);
-  const auto b = run(model, f, 0.08, "sphere", {});
+  const auto b = run(model, f, 0.08, "sphere", skip);
+  const auto d = run(model, f, 0.08, "sphere-ends", {});
   EXPECT_EQ(a.cf.stats.factorizations, every.levels);
   EXPECT_LT(b.cf.stats.factorizations, a.cf.stats.factorizations);
+  EXPECT_LT(d.cf.stats.factorizations, b.cf.stats.factorizations);
   EXPECT_TRUE(a.cf.singularities.empty());
   EXPECT_TRUE(b.cf.singularities.empty());
+  EXPECT_TRUE(d.cf.singularities.empty());
   ASSERT_EQ(a.cf.directions.size(), b.cf.directions.size());
+  ASSERT_EQ(a.cf.directions.size(), d.cf.directions.size());
   const std::size_t close = triangles_within_1_deg(a.cf, b.cf);
   std::printf("[crossfield] sphere patch: %zu of %zu triangles within 1 deg\n", close,
               a.cf.directions.size());
   EXPECT_EQ(close, a.cf.directions.size());
+  EXPECT_EQ(triangles_within_1_deg(a.cf, d.cf), a.cf.directions.size());
 
   const TopoDS_Shape notched = BRepAlgoAPI_Cut(
       BRepPrimAPI_MakeCylinder(gp_Ax2(gp_Pnt(0, 0, 0), gp_Dir(0, 0, 1)), 2, 6).Shape(),
@@ -668,6 +679,29 @@ TEST(CrossField, SettledLevelsSkipTheIntermediateOnes) {
   const auto c = run(moving, face_of_type(moving, cad::SurfaceType::Cylinder), 0.15,
                      "notched-all-levels", {}, std::nullopt);
   EXPECT_EQ(c.cf.stats.factorizations, CrossFieldOptions{}.levels);
+}
+
+// A level that settles on a field without singularity ends the diffusion (settled_regular_ends):
+// a square solved by diffusion settles at its first level, and the level at α_final that the
+// settled rule alone would add moves no triangle's cross by a degree. A field with singularities
+// to place keeps its levels (SettledLevelsSkipTheIntermediateOnes' notched cylinder runs all four).
+TEST(CrossField, SettledRegularFieldEndsTheDiffusion) {
+  const TopoDS_Face face = BRepBuilderAPI_MakeFace(gp_Pln(gp::XOY()), 0.0, 2.0, 0.0, 1.0).Face();
+  const auto model = test::load_shape(face, "cf_settled_regular.brep");
+  CrossFieldOptions ends;
+  ends.exact_uniform = false;
+  CrossFieldOptions last = ends;
+  last.settled_regular_ends = false;
+  const auto a = run(model, 0, 0.03, "regular-ends", ends);
+  const auto b = run(model, 0, 0.03, "regular-last-level", last);
+  EXPECT_TRUE(a.cf.singularities.empty());
+  EXPECT_TRUE(b.cf.singularities.empty());
+  EXPECT_EQ(a.cf.stats.levels, 1);
+  EXPECT_EQ(a.cf.stats.factorizations, 1);
+  ASSERT_EQ(b.cf.stats.iterations_per_level.size(), 2U);
+  EXPECT_EQ(b.cf.stats.iterations_per_level[0], a.cf.stats.iterations_per_level[0]);
+  ASSERT_EQ(a.cf.directions.size(), b.cf.directions.size());
+  EXPECT_EQ(triangles_within_1_deg(a.cf, b.cf), a.cf.directions.size());
 }
 
 // A face on a surface of revolution cut along its parallels and meridians takes the cross of the

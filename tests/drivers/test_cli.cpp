@@ -126,6 +126,18 @@ TEST(Cli, FieldSettled) {
   EXPECT_NE(help("crossfield").find("--field-settled"), std::string::npos);
 }
 
+TEST(Cli, FieldRegular) {
+  EXPECT_FALSE(p({"mesh", "m.step", "-o", "o.vtu"}).field_regular.has_value());
+  EXPECT_FALSE(*p({"mesh", "m.step", "-o", "o.vtu", "--field-regular", "off"}).field_regular);
+  EXPECT_TRUE(*p({"crossfield", "m.step", "-o", "c.vtu", "--field-regular", "on"}).field_regular);
+  EXPECT_NE(
+      error_of({"mesh", "m.step", "-o", "o.vtu", "--field-regular", "1"}).find("--field-regular"),
+      std::string::npos);
+  EXPECT_NE(help("mesh").find("--field-regular"), std::string::npos);
+  EXPECT_NE(help("crossfield").find("--field-regular"), std::string::npos);
+  EXPECT_NE(help("sizemap").find("--field-regular"), std::string::npos);
+}
+
 TEST(Cli, PassAfterCuts) {
   EXPECT_FALSE(p({"mesh", "m.step", "-o", "o.vtu"}).pass_after_cuts.has_value());
   EXPECT_FALSE(*p({"mesh", "m.step", "-o", "o.vtu", "--pass-after-cuts", "off"}).pass_after_cuts);

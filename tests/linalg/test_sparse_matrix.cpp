@@ -1,5 +1,8 @@
 #include <gtest/gtest.h>
 
+#include <array>
+#include <cmath>
+#include <random>
 #include <vector>
 
 #include "qsmesh/core/error.hpp"
@@ -66,6 +69,59 @@ TEST(SparseMatrix, RejectsEntriesOutsideTheMatrix) {
   EXPECT_THROW(SparseMatrix(3, t), Error);
   const std::vector<T> neg{{-1, 0, 1.0}};
   EXPECT_THROW(SparseMatrix(3, neg), Error);
+}
+
+// Elements of a triangle mesh of a strip, 2 unknowns a node (a block pattern, as the cross field's
+// pairs), values of every magnitude and some unknowns fixed: the element assembly gives the
+// triplets' matrix entry for entry, bit for bit, since each entry sums in element order.
+TEST(SparseMatrix, ElementsGiveTheTripletsMatrixBitForBit) {
+  constexpr int kAcross = 7, kAlong = 40, kM = 6;
+  const auto node = [](int i, int j) { return j * kAcross + i; };
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> mantissa(-1, 1);
+  std::uniform_int_distribution<int> exponent(-30, 30);
+  std::vector<LO> unknown(kAcross * kAlong);
+  LO n = 0;
+  for (std::size_t v = 0; v < unknown.size(); ++v) {
+    unknown[v] = v % 11 == 3 ? kNoIndex : n;  // a fixed node now and then
+    if (unknown[v] != kNoIndex) n += 2;
+  }
+  std::vector<LO> dofs;
+  std::vector<double> blocks;
+  std::vector<T> triplets;
+  for (int j = 0; j + 1 < kAlong; ++j)
+    for (int i = 0; i + 1 < kAcross; ++i)
+      for (const auto& tri : {std::array<int, 3>{node(i, j), node(i + 1, j), node(i + 1, j + 1)},
+                              std::array<int, 3>{node(i, j), node(i + 1, j + 1), node(i, j + 1)}}) {
+        const std::size_t first = dofs.size();
+        for (const int v : tri) {
+          const LO u = unknown[static_cast<std::size_t>(v)];
+          dofs.push_back(u);
+          dofs.push_back(u == kNoIndex ? kNoIndex : u + 1);
+        }
+        for (int a = 0; a < kM; ++a)
+          for (int b = 0; b < kM; ++b) {
+            const double value = std::ldexp(mantissa(random), exponent(random));
+            blocks.push_back(value);
+            const LO r = dofs[first + a], c = dofs[first + b];
+            if (r != kNoIndex && c != kNoIndex) triplets.push_back({r, c, value});
+          }
+      }
+  const SparseMatrix expected(n, triplets);
+  const SparseMatrix A = SparseMatrix::from_elements(n, kM, dofs, blocks);
+  EXPECT_EQ(A.size(), n);
+  EXPECT_EQ(A.row_offsets(), expected.row_offsets());
+  EXPECT_EQ(A.columns(), expected.columns());
+  ASSERT_EQ(A.values().size(), expected.values().size());
+  for (std::size_t k = 0; k < A.values().size(); ++k)
+    EXPECT_EQ(A.values()[k], expected.values()[k]) << k;  // exact: the same sums, same order
+
+  EXPECT_THROW(static_cast<void>(SparseMatrix::from_elements(2, 2, std::vector<LO>{0, 2},
+                                                             std::vector<double>(4, 1.0))),
+               Error);
+  EXPECT_THROW(static_cast<void>(SparseMatrix::from_elements(2, 2, std::vector<LO>{0, 1},
+                                                             std::vector<double>(3, 1.0))),
+               Error);
 }
 
 }  // namespace

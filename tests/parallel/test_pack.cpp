@@ -62,6 +62,7 @@ FaceOutput full_output() {
   o.cross_field.factorizations = 2;
   o.cross_field.solves = 9;
   o.cross_field.stalled_levels = 2;
+  o.cross_field.iterations_per_level = {5, 2, 2};
   o.cross_field.seconds = 0.125;
   o.cross_field.solver = "petsc/mumps-cholesky-mpi2";
   o.cross_field.solver_ranks = 2;
@@ -114,9 +115,9 @@ FaceOutput full_output() {
 TEST(Pack, EveryFieldOfAFaceOutputRoundTrips) {
   const FaceOutput a = full_output();
   // 12 parts; the counts of their fields: mesh 1 (packed whole), background report 5, cross field
-  // 15, sizes 3, unstructured 7, quasi 11 + improvement 8, stats 7, seconds 1, times 22, field
+  // 16, sizes 3, unstructured 7, quasi 11 + improvement 8, stats 7, seconds 1, times 22, field
   // grids 1 (a vector of records), a smooth group's quad faces 1 and first face 1.
-  ASSERT_EQ(count_fields(a), 1 + 5 + 15 + 3 + 7 + 19 + 7 + 1 + 22 + 1 + 2)
+  ASSERT_EQ(count_fields(a), 1 + 5 + 16 + 3 + 7 + 19 + 7 + 1 + 22 + 1 + 2)
       << "a field was added to a report: set it in full_output() and check it here";
   std::vector<char> buf;
   write_record(buf, a);
@@ -157,6 +158,7 @@ TEST(Pack, EveryFieldOfAFaceOutputRoundTrips) {
   EXPECT_EQ(b.cross_field.factorizations, 2);
   EXPECT_EQ(b.cross_field.solves, 9);
   EXPECT_EQ(b.cross_field.stalled_levels, 2);
+  EXPECT_EQ(b.cross_field.iterations_per_level, a.cross_field.iterations_per_level);
   EXPECT_EQ(b.cross_field.seconds, 0.125);
   EXPECT_EQ(b.sizes.s, a.sizes.s);
   EXPECT_EQ(b.sizes.s_min, a.sizes.s_min);

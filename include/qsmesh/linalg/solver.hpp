@@ -31,6 +31,16 @@ class SparseMatrix {
   SparseMatrix() = default;
   /// Builds an n x n matrix from (row, col, value) triplets.
   SparseMatrix(LO n, std::span<const Triplet> triplets);
+  /// Builds the n x n sum of element matrices: element k couples the m unknowns
+  /// dofs[k m .. k m + m) (kNoIndex: a fixed unknown, whose row and column are left out) by the
+  /// dense m x m block blocks[k m^2 ..), row-major. The result equals the triplet constructor's on
+  /// the triplets of the elements in order (row a, column b within each element), entry for entry
+  /// and bit for bit: each entry sums its contributions in element order. Finite element systems
+  /// come this way; assembling them without the triplets' bucket sort costs a fraction of it.
+  /// Preconditions: m > 0, dofs.size() a multiple of m, blocks.size() == dofs.size() * m, every dof
+  /// in [0, n) or kNoIndex.
+  [[nodiscard]] static SparseMatrix from_elements(LO n, int m, std::span<const LO> dofs,
+                                                  std::span<const double> blocks);
 
   [[nodiscard]] LO size() const { return n_; }
   [[nodiscard]] std::int64_t nonzeros() const { return static_cast<std::int64_t>(values_.size()); }

@@ -180,6 +180,8 @@ struct CrossFieldOutput {
   int levels = 0, factorizations = 0, solves = 0;
   /// Levels ended by the stall rule (crossfield::CrossFieldStats::stalled_levels).
   int stalled_levels = 0;
+  /// Solves of each level run, in order (crossfield::CrossFieldStats::iterations_per_level).
+  std::vector<LO> iterations_per_level;
   double seconds = 0;
   std::string solver;  ///< the heat systems' solver (crossfield::CrossFieldStats::solver)
   /// A face whose systems were split over ranks (PipelineOptions: SolverOptions::
@@ -200,6 +202,7 @@ struct CrossFieldOutput {
     visit("factorizations", self.factorizations);
     visit("solves", self.solves);
     visit("stalled_levels", self.stalled_levels);
+    visit("iterations_per_level", self.iterations_per_level);
     visit("seconds", self.seconds);
     visit("solver", self.solver);
     visit("solver_ranks", self.solver_ranks);
