@@ -95,6 +95,20 @@ Vec2 project(const Vec2& x, const Vec2& fallback) {
   return n > 1e-14 ? x / n : fallback;
 }
 
+// The two measures of level_change, accumulated pair by pair in the pairs' order.
+struct ChangeSum {
+  double max = 0, sum = 0, total = 0;
+  void add(double du, double dv, double mass) {
+    max = std::max(max, std::max(std::abs(du), std::abs(dv)));
+    sum += mass * (du * du + dv * dv);
+    total += mass;
+  }
+  [[nodiscard]] double value(LevelChange how) const {
+    if (how == LevelChange::Max) return max;
+    return total > 0 ? std::sqrt(sum / total) : 0.0;
+  }
+};
+
 /// Boundary-condition extension: the crosses of the triangles touching the boundary are fixed to
 /// the solution of the CR Laplace equation on that one-triangle layer with the boundary crosses as
 /// data.
@@ -208,7 +222,7 @@ void diffuse(FaceCrossField& cf, const Geometry& g, const CrossFieldOptions& opt
       U[i] = has_boundary ? 0.0 : cf.u[e].u;
       U[i + 1] = has_boundary ? 0.0 : cf.u[e].v;
     }
-  std::vector<double> previous(U.size()), pair_mass(U.size() / 2), m_alpha(U.size());
+  std::vector<double> pair_mass(U.size() / 2), m_alpha(U.size());
   std::vector<double> rms;  // the level's RMS changes, for the stall rule
   for (std::size_t k = 0; k < pair_mass.size(); ++k) pair_mass[k] = mfree[2 * k];
   // Whether the crosses U have a singularity inside the face: U's pairs written into cf.u, which
@@ -234,17 +248,17 @@ void diffuse(FaceCrossField& cf, const Geometry& g, const CrossFieldOptions& opt
       solver->solve(rhs, X);
       ++cf.stats.solves;
       ++it;
-      previous = U;
+      // The projection and level_change's two measures in one pass.
+      ChangeSum moved;
       for (LO i = 0; i < n; i += 2) {
         const Vec2 p = project({X[i], X[i + 1]}, Vec2{U[i], U[i + 1]});
+        moved.add(p.u - U[i], p.v - U[i + 1], pair_mass[static_cast<std::size_t>(i / 2)]);
         U[i] = p.u;
         U[i + 1] = p.v;
       }
-      change = level_change(previous, U, pair_mass, options.level_change);
+      change = moved.value(options.level_change);
       if (options.stall_window > 0) {
-        rms.push_back(options.level_change == LevelChange::Rms
-                          ? change
-                          : level_change(previous, U, pair_mass, LevelChange::Rms));
+        rms.push_back(moved.value(LevelChange::Rms));
         if (change >= options.tolerance &&
             level_stalled(rms, options.stall_window, options.stall_ratio)) {
           ++cf.stats.stalled_levels;
@@ -283,19 +297,10 @@ double level_change(std::span<const double> before, std::span<const double> afte
                     std::span<const double> mass, LevelChange how) {
   QSMESH_CHECK(before.size() == after.size() && before.size() == 2 * mass.size(),
                "crossfield: level_change needs two pairs of values per mass");
-  if (how == LevelChange::Max) {
-    double change = 0;
-    for (std::size_t i = 0; i < before.size(); ++i)
-      change = std::max(change, std::abs(after[i] - before[i]));
-    return change;
-  }
-  double sum = 0, total = 0;
-  for (std::size_t k = 0; k < mass.size(); ++k) {
-    const double du = after[2 * k] - before[2 * k], dv = after[2 * k + 1] - before[2 * k + 1];
-    sum += mass[k] * (du * du + dv * dv);
-    total += mass[k];
-  }
-  return total > 0 ? std::sqrt(sum / total) : 0.0;
+  detail::ChangeSum moved;
+  for (std::size_t k = 0; k < mass.size(); ++k)
+    moved.add(after[2 * k] - before[2 * k], after[2 * k + 1] - before[2 * k + 1], mass[k]);
+  return moved.value(how);
 }
 
 }  // namespace qsmesh::crossfield
