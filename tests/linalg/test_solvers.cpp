@@ -382,6 +382,39 @@ TEST(Solvers, ComplexPairsAreBitForBitEigensOwnFactorization) {
   }
 }
 
+// The real solver runs Eigen's SimplicialLDLT with the ordering, the permuted triangle and the
+// symbolic analysis done by analyze (the last without Eigen's ordering step, which copies the
+// matrix twice): its solutions are bit for bit those of Eigen's own SimplicialLDLT<Lower,
+// AMDOrdering>, at every factorization.
+TEST(Solvers, RealIsBitForBitEigensOwnFactorization) {
+  using EigenMatrix = Eigen::SparseMatrix<double, Eigen::ColMajor, int>;
+  SparseMatrix A = poisson(17, 0.01);
+  const auto b = rhs(A.size(), 2);
+  SolverOptions options;
+  options.backend = Backend::Eigen;
+  auto solver = make_solver(A.size(), options, nullptr);
+  solver->analyze(A);
+  for (int round = 0; round < 2; ++round) {
+    std::vector<Eigen::Triplet<double, int>> trip;
+    for (LO r = 0; r < A.size(); ++r)
+      for (auto k = A.row_offsets()[static_cast<std::size_t>(r)];
+           k < A.row_offsets()[static_cast<std::size_t>(r) + 1]; ++k)
+        if (const LO c = A.columns()[static_cast<std::size_t>(k)]; c <= r)
+          trip.emplace_back(r, c, A.values()[static_cast<std::size_t>(k)]);
+    EigenMatrix lower(A.size(), A.size());
+    lower.setFromTriplets(trip.begin(), trip.end());
+    Eigen::SimplicialLDLT<EigenMatrix, Eigen::Lower, Eigen::AMDOrdering<int>> reference(lower);
+    ASSERT_EQ(reference.info(), Eigen::Success);
+    const Eigen::VectorXd expected =
+        reference.solve(Eigen::Map<const Eigen::VectorXd>(b.data(), A.size()));
+    solver->factorize(A);
+    std::vector<double> x(b.size());
+    solver->solve(b, x);
+    for (LO i = 0; i < A.size(); ++i) EXPECT_EQ(x[static_cast<std::size_t>(i)], expected[i]) << i;
+    for (LO r = 0; r < A.size(); ++r) A.values()[static_cast<std::size_t>(A.find(r, r))] += 0.7;
+  }
+}
+
 TEST(Solvers, ComplexPairsRejectWhatIsNotAHermitianRealForm) {
   SolverOptions options;
   options.backend = Backend::Eigen;
