@@ -60,6 +60,12 @@ int iterations_or_off(const std::string& opt, const std::string& v) {
   return static_cast<int>(*n);
 }
 
+// An option that takes on or off.
+bool on_or_off(const std::string& opt, const std::string& v) {
+  if (v != "on" && v != "off") throw InputError(opt + ": '" + v + "' is not on or off");
+  return v == "on";
+}
+
 int parse_threads(const std::string& text) {
   std::size_t used = 0;
   int v = 0;
@@ -262,9 +268,7 @@ Arguments parse(const std::vector<std::string>& args) {
     } else if (opt == "--field-settled" && meshing) {
       a.field_settled = iterations_or_off(opt, value());
     } else if (opt == "--field-regular" && meshing) {
-      const std::string& v = value();
-      if (v != "on" && v != "off") throw InputError(opt + ": '" + v + "' is not on or off");
-      a.field_regular = v == "on";
+      a.field_regular = on_or_off(opt, value());
     } else if (opt == "--block-structured" && a.command == Command::Mesh)
       a.block_structured = true;
     else if (opt == "--block-patches" && a.command == Command::Mesh)
@@ -395,9 +399,7 @@ Arguments parse(const std::vector<std::string>& args) {
       if (!n) throw InputError(opt + ": '" + v + "' is not a whole number of quads (0: never cut)");
       a.task_quads = static_cast<std::int64_t>(*n);
     } else if (opt == "--pass-after-cuts" && a.command == Command::Mesh) {
-      const std::string& v = value();
-      if (v != "on" && v != "off") throw InputError(opt + ": '" + v + "' is not on or off");
-      a.pass_after_cuts = v == "on";
+      a.pass_after_cuts = on_or_off(opt, value());
     } else if (opt == "--second-pass-task" && a.command == Command::Mesh) {
       const std::string& v = value();
       const auto n = parse_whole(v, 0, 1e15);

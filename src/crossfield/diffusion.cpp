@@ -58,7 +58,7 @@ linalg::SparseMatrix assemble_stiffness(const FaceCrossField& cf, const Geometry
       dofs.push_back(ui == kNoIndex ? kNoIndex : ui + 1);
     }
     const std::size_t block = blocks.size();
-    blocks.resize(block + kDofs * kDofs, 0.0);
+    blocks.resize(block + static_cast<std::size_t>(kDofs) * kDofs, 0.0);
     for (int i = 0; i < 3; ++i) {
       const LO ui = edge2unk[cf.tri2edges[t][i]];
       if (ui == kNoIndex) continue;

@@ -80,7 +80,7 @@ TEST(SparseMatrix, ElementsGiveTheTripletsMatrixBitForBit) {
   std::mt19937 random(7);
   std::uniform_real_distribution<double> mantissa(-1, 1);
   std::uniform_int_distribution<int> exponent(-30, 30);
-  std::vector<LO> unknown(kAcross * kAlong);
+  std::vector<LO> unknown(static_cast<std::size_t>(kAcross) * kAlong);
   LO n = 0;
   for (std::size_t v = 0; v < unknown.size(); ++v) {
     unknown[v] = v % 11 == 3 ? kNoIndex : n;  // a fixed node now and then
