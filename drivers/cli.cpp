@@ -845,8 +845,8 @@ std::string help(const std::string& topic) {
           "  --size H, --size-factor F, --threads T, --stats FILE.json, --max-quads N,\n"
           "  --field-divisions N, --distributed-threshold N, --field-change M,\n"
           "  --field-iterations N, --field-stall K[:R], --field-stall-revolution K,\n"
-          "  --field-settled K, --field-regular on|off, --field-shortcuts S, --sew, -q,\n"
-          "  -v:\n"
+          "  --field-settled K, --field-regular on|off, --field-shortcuts S,\n"
+          "  --sew, -q, -v:\n"
           "                        as for mesh\n";
   } else if (topic == "sizemap") {
     os << "usage: [mpirun -np P] qsmesh sizemap MODEL -o OUT.vtu [options]\n\n"
@@ -910,8 +910,8 @@ std::string help(const std::string& topic) {
           "  --size H, --size-factor F, --threads T, --stats FILE.json, --max-quads N,\n"
           "  --field-divisions N, --distributed-threshold N, --field-change M,\n"
           "  --field-iterations N, --field-stall K[:R], --field-stall-revolution K,\n"
-          "  --field-settled K, --field-regular on|off, --field-shortcuts S, --sew, -q,\n"
-          "  -v:\n"
+          "  --field-settled K, --field-regular on|off, --field-shortcuts S,\n"
+          "  --sew, -q, -v:\n"
           "                        as for mesh\n";
   } else if (topic == "example") {
     os << "usage: qsmesh example NAME -o FILE\n\n"

@@ -86,7 +86,7 @@ void twist_to_upper(const Matrix& lower, const Permutation& perm, Matrix& upper)
 // SimplicialLDLT on a matrix already ordered (its upper triangle permuted by the solver itself),
 // analysed without Eigen's ordering step. With a natural ordering that step still copies the
 // matrix twice (Eigen tests for NaturalOrdering<Index>, not the NaturalOrdering<int> its storage
-// index needs), which was a third of the analysis of the small cavity systems. The symbolic
+// index needs), which costs the many small systems of the cavity candidates. The symbolic
 // analysis reads the pattern only: the same factor as analyzePattern's.
 template <class Matrix>
 class PreorderedLdlt

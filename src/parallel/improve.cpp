@@ -622,8 +622,7 @@ std::array<double, 3> improve_faces(const Comm& comm, const cad::CadModel& model
       }
       // The pieces were smoothed and lifted already, and a cavity's replacement is smoothed
       // where it lands: the whole face's final smoothing, most of this task's time where it ran,
-      // is left out. On the measured faces it changed no irregular count, and the SICN average by
-      // at most 0.002.
+      // is left out (docs/benchmarks.md, "Cut faces improved once more whole").
       ImproveSettings whole_face = settings;
       whole_face.final_smoothing = false;
       results = deal_round(comm, model, round, whole_face, tasks, log,

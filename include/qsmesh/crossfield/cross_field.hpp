@@ -74,11 +74,10 @@ struct CrossFieldOptions {
   int settled_level_iterations = 2;
   /// A level that settles (settled_level_iterations) on a field with no singularity inside the
   /// face ends the diffusion: the last level is not solved either. Such a field is set by its
-  /// boundary, and the later levels move it by far less than the tolerance (t20_data's two
-  /// largest faces: 1.6e-6, 4.3e-7 and 3.7e-8 at levels 1-3) for a factorization each. A level
-  /// that needs more iterations, even to a regular field, still goes through every level: the
-  /// continuation shapes the field (the wing-body example's leading-edge skins end without
-  /// singularity, but skipping their middle levels gives quads of SICN 0.008 there).
+  /// boundary, and the later levels would move it by far less than the tolerance, for a
+  /// factorization each. A level that needs more iterations, even to a regular field, still goes
+  /// through every level: the continuation through the intermediate α shapes the field
+  /// (docs/benchmarks.md, "Settled regular fields end the diffusion").
   /// false: a settled level skips to the last one, which is always solved.
   bool settled_regular_ends = true;
   bool extend_boundary = true;   ///< Sec. 3.1 boundary-condition extension
